@@ -1,0 +1,86 @@
+//! The one error type of the core crate.
+//!
+//! Every fallible public function returns [`Result<T>`]. The binding maps
+//! [`Error::InvalidParameter`] to a `ValueError` subclass and
+//! [`Error::NotConverged`] to a `RuntimeError` subclass, in one place.
+
+use thiserror::Error;
+
+/// Errors raised by the softrod core.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum Error {
+    /// A parameter is outside its valid range (or not finite).
+    #[error("invalid parameter `{name}` = {value}: must be {expected}")]
+    InvalidParameter {
+        /// Name of the parameter, as the user spells it (e.g. `"tip_radius"`).
+        name: String,
+        /// The offending value, formatted for the message.
+        value: String,
+        /// The valid range, in words (e.g. `"finite and > 0 m"`).
+        expected: String,
+    },
+    /// An iterative solver or an adaptive integrator did not reach its tolerance.
+    #[error("{what} did not converge after {iterations} iterations (residual {residual:.3e})")]
+    NotConverged {
+        /// What did not converge (e.g. `"shooting Newton"`, `"ode23 step size"`).
+        what: String,
+        /// Iterations (or steps) taken before giving up.
+        iterations: usize,
+        /// Residual norm (or error estimate) at the last iterate.
+        residual: f64,
+    },
+}
+
+/// Result alias used throughout the crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Builds an [`Error::InvalidParameter`] from any displayable value.
+    pub fn invalid(
+        name: impl Into<String>,
+        value: impl std::fmt::Display,
+        expected: impl Into<String>,
+    ) -> Self {
+        Error::InvalidParameter {
+            name: name.into(),
+            value: value.to_string(),
+            expected: expected.into(),
+        }
+    }
+}
+
+/// Checks that `value` is finite and strictly positive.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn check_positive(name: &str, value: f64, unit: &str) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::invalid(name, value, format!("finite and > 0 {unit}")))
+    }
+}
+
+/// Checks that `value` is finite and non-negative.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn check_non_negative(name: &str, value: f64, unit: &str) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::invalid(name, value, format!("finite and >= 0 {unit}")))
+    }
+}
+
+/// Checks that `value` is finite.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn check_finite(name: &str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::invalid(name, value, "finite"))
+    }
+}

@@ -1,0 +1,338 @@
+//! Ordinary-differential-equation integrators shared by every model.
+//!
+//! * [`bs23`]: the adaptive Bogacki–Shampine 3(2) pair (the method of MATLAB's `ode23`),
+//!   FSAL, with cubic Hermite dense output; integrates forward or backward in `t`.
+//!
+//! States are fixed-size arrays `[f64; N]` so the compiler can keep them in registers.
+//!
+//! # References
+//! P. Bogacki, L. F. Shampine, "A 3(2) pair of Runge–Kutta formulas",
+//! Appl. Math. Lett. 2(4), 1989. L. F. Shampine, M. W. Reichelt, "The MATLAB ODE suite",
+//! SIAM J. Sci. Comput. 18(1), 1997.
+
+use crate::error::{Error, Result};
+
+/// Default relative tolerance of the adaptive integrators.
+pub const DEFAULT_RTOL: f64 = 1e-8;
+/// Default absolute tolerance of the adaptive integrators (in the state's own units).
+pub const DEFAULT_ATOL: f64 = 1e-10;
+/// Default cap on the number of attempted steps of one adaptive integration.
+pub const DEFAULT_MAX_STEPS: usize = 100_000;
+
+/// Options of an adaptive integration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptiveOptions {
+    /// Relative tolerance (> 0): per component, the local error estimate is kept below
+    /// `atol + rtol * |y|`.
+    pub rtol: f64,
+    /// Absolute tolerance (> 0), in the units of the state.
+    pub atol: f64,
+    /// Maximum number of attempted steps before [`Error::NotConverged`].
+    pub max_steps: usize,
+}
+
+impl Default for AdaptiveOptions {
+    fn default() -> Self {
+        Self {
+            rtol: DEFAULT_RTOL,
+            atol: DEFAULT_ATOL,
+            max_steps: DEFAULT_MAX_STEPS,
+        }
+    }
+}
+
+impl AdaptiveOptions {
+    /// Validates the tolerances.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a non-finite or non-positive `rtol`/`atol`, an `rtol`
+    /// below 100 machine epsilons, or `max_steps == 0`.
+    pub fn validated(self) -> Result<Self> {
+        if !(self.rtol.is_finite() && self.rtol >= 100.0 * f64::EPSILON && self.rtol < 1.0) {
+            return Err(Error::invalid("rtol", self.rtol, "in [2.2e-14, 1)"));
+        }
+        if !(self.atol.is_finite() && self.atol > 0.0) {
+            return Err(Error::invalid("atol", self.atol, "finite and > 0"));
+        }
+        if self.max_steps == 0 {
+            return Err(Error::invalid("max_steps", self.max_steps, ">= 1"));
+        }
+        Ok(self)
+    }
+}
+
+/// Statistics of one adaptive integration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct IntegrationStats {
+    /// Accepted steps.
+    pub accepted: usize,
+    /// Rejected steps.
+    pub rejected: usize,
+    /// Right-hand-side evaluations.
+    pub evaluations: usize,
+}
+
+/// The accepted steps of an adaptive integration, with cubic Hermite dense output.
+#[derive(Debug, Clone)]
+pub struct DenseSolution<const N: usize> {
+    /// Mesh points in the order of integration (decreasing if integrated backward).
+    pub t: Vec<f64>,
+    /// States at the mesh points.
+    pub y: Vec<[f64; N]>,
+    /// Derivatives at the mesh points.
+    pub dy: Vec<[f64; N]>,
+    /// Step statistics.
+    pub stats: IntegrationStats,
+}
+
+impl<const N: usize> DenseSolution<N> {
+    /// Interpolated state at `t` (cubic Hermite on the step that contains `t`, third order
+    /// like the method). `t` outside the integrated interval is clamped to it.
+    pub fn eval(&self, t: f64) -> [f64; N] {
+        let n = self.t.len();
+        if n == 1 {
+            return self.y[0];
+        }
+        let forward = self.t[n - 1] > self.t[0];
+        // Index i of the step [t_i, t_{i+1}] that contains t (in integration order).
+        let pos = if forward {
+            self.t.partition_point(|&ti| ti <= t)
+        } else {
+            self.t.partition_point(|&ti| ti >= t)
+        };
+        let i = pos.clamp(1, n - 1) - 1;
+        let (t0, t1) = (self.t[i], self.t[i + 1]);
+        let h = t1 - t0;
+        let x = ((t - t0) / h).clamp(0.0, 1.0);
+        let x2 = x * x;
+        let x3 = x2 * x;
+        let h00 = 2.0 * x3 - 3.0 * x2 + 1.0;
+        let h10 = x3 - 2.0 * x2 + x;
+        let h01 = -2.0 * x3 + 3.0 * x2;
+        let h11 = x3 - x2;
+        let mut out = [0.0; N];
+        for j in 0..N {
+            out[j] = h00 * self.y[i][j]
+                + h * h10 * self.dy[i][j]
+                + h01 * self.y[i + 1][j]
+                + h * h11 * self.dy[i + 1][j];
+        }
+        out
+    }
+}
+
+#[inline]
+fn axpy<const N: usize>(y: &[f64; N], h: f64, terms: &[(f64, &[f64; N])]) -> [f64; N] {
+    let mut out = *y;
+    for &(c, k) in terms {
+        for j in 0..N {
+            out[j] += h * c * k[j];
+        }
+    }
+    out
+}
+
+/// Integrates `dy/dt = f(t, y)` from `(t0, y0)` to `t1` with the Bogacki–Shampine 3(2) pair.
+///
+/// `t1 < t0` integrates backward (a final-value problem). Local extrapolation: the third-order
+/// solution is propagated, the embedded second-order one only estimates the error, which is kept
+/// below `atol + rtol * max(|y_n|, |y_{n+1}|)` per component (max norm), as in `ode23`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for bad options or non-finite end points;
+/// [`Error::NotConverged`] if `max_steps` is exceeded, the step size underflows, or the
+/// right-hand side returns a non-finite value.
+pub fn bs23<const N: usize, F>(
+    mut f: F,
+    t0: f64,
+    y0: [f64; N],
+    t1: f64,
+    options: AdaptiveOptions,
+) -> Result<DenseSolution<N>>
+where
+    F: FnMut(f64, &[f64; N]) -> [f64; N],
+{
+    let opts = options.validated()?;
+    if !t0.is_finite() || !t1.is_finite() {
+        return Err(Error::invalid("t_span", format!("[{t0}, {t1}]"), "finite"));
+    }
+    let mut stats = IntegrationStats::default();
+    let mut sol = DenseSolution {
+        t: vec![t0],
+        y: vec![y0],
+        dy: Vec::new(),
+        stats,
+    };
+    let mut k1 = f(t0, &y0);
+    stats.evaluations += 1;
+    sol.dy.push(k1);
+    let span = t1 - t0;
+    if span == 0.0 {
+        sol.stats = stats;
+        return Ok(sol);
+    }
+    let dir = span.signum();
+    let tiny = 16.0 * f64::EPSILON * t0.abs().max(t1.abs()).max(f64::MIN_POSITIVE);
+
+    // Initial step (Hairer–Nørsett–Wanner's heuristic, order 3).
+    let scale = |y: &[f64; N], j: usize| opts.atol + opts.rtol * y[j].abs();
+    let d0 = (0..N).map(|j| (y0[j] / scale(&y0, j)).abs()).fold(0.0, f64::max);
+    let d1 = (0..N).map(|j| (k1[j] / scale(&y0, j)).abs()).fold(0.0, f64::max);
+    let mut h = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    h = h.min(span.abs()).max(tiny);
+
+    let (mut t, mut y) = (t0, y0);
+    let mut attempts = 0usize;
+    let mut last_err = f64::NAN;
+    while (t1 - t) * dir > tiny {
+        attempts += 1;
+        if attempts > opts.max_steps {
+            return Err(Error::NotConverged {
+                what: "ode23 (Bogacki-Shampine) integration".into(),
+                iterations: attempts - 1,
+                residual: last_err,
+            });
+        }
+        let mut hs = h.min((t1 - t).abs()) * dir;
+        if (t1 - (t + hs)) * dir <= tiny {
+            hs = t1 - t;
+        }
+        let k2 = f(t + 0.5 * hs, &axpy(&y, hs, &[(0.5, &k1)]));
+        let k3 = f(t + 0.75 * hs, &axpy(&y, hs, &[(0.75, &k2)]));
+        let y_new = axpy(&y, hs, &[(2.0 / 9.0, &k1), (1.0 / 3.0, &k2), (4.0 / 9.0, &k3)]);
+        let t_new = if hs == t1 - t { t1 } else { t + hs };
+        let k4 = f(t_new, &y_new);
+        stats.evaluations += 3;
+        let mut err = 0.0f64;
+        for j in 0..N {
+            let e = hs * (-5.0 / 72.0 * k1[j] + 1.0 / 12.0 * k2[j] + 1.0 / 9.0 * k3[j]
+                - 1.0 / 8.0 * k4[j]);
+            let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
+            err = err.max((e / sc).abs());
+        }
+        if !err.is_finite() || y_new.iter().any(|v| !v.is_finite()) {
+            return Err(Error::NotConverged {
+                what: "ode23 (Bogacki-Shampine) integration: non-finite state".into(),
+                iterations: attempts,
+                residual: f64::INFINITY,
+            });
+        }
+        last_err = err;
+        if err <= 1.0 {
+            t = t_new;
+            y = y_new;
+            k1 = k4;
+            stats.accepted += 1;
+            sol.t.push(t);
+            sol.y.push(y);
+            sol.dy.push(k1);
+            let fac = if err == 0.0 {
+                5.0
+            } else {
+                (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
+            };
+            h = hs.abs() * fac;
+        } else {
+            stats.rejected += 1;
+            h = hs.abs() * (0.9 * err.powf(-1.0 / 3.0)).clamp(0.1, 0.9);
+            if h <= tiny {
+                return Err(Error::NotConverged {
+                    what: "ode23 (Bogacki-Shampine) integration: step size underflow".into(),
+                    iterations: attempts,
+                    residual: err,
+                });
+            }
+        }
+    }
+    sol.stats = stats;
+    Ok(sol)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exponential_decay_forward_meets_tolerance() {
+        let opts = AdaptiveOptions {
+            rtol: 1e-9,
+            atol: 1e-12,
+            ..Default::default()
+        };
+        let sol = bs23(|_, y: &[f64; 1]| [-2.0 * y[0]], 0.0, [1.0], 3.0, opts).unwrap();
+        let y_end = sol.y.last().unwrap()[0];
+        let exact = (-6.0f64).exp();
+        assert!((y_end - exact).abs() / exact < 1e-6, "{y_end} vs {exact}");
+        // Dense output at an interior point.
+        let mid = sol.eval(1.3)[0];
+        assert!((mid - (-2.6f64).exp()).abs() < 1e-8);
+    }
+
+    #[test]
+    fn backward_integration_of_final_value_problem() {
+        // y' = cos t, y(2) = sin 2, integrate to 0: y(0) = 0.
+        let sol = bs23(
+            |t, _y: &[f64; 1]| [t.cos()],
+            2.0,
+            [2.0f64.sin()],
+            0.0,
+            AdaptiveOptions {
+                rtol: 1e-10,
+                atol: 1e-12,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(*sol.t.last().unwrap(), 0.0);
+        assert!(sol.y.last().unwrap()[0].abs() < 1e-9);
+        assert!((sol.eval(1.0)[0] - 1.0f64.sin()).abs() < 1e-8);
+    }
+
+    #[test]
+    fn third_order_error_scaling() {
+        // Global error ~ tol: tightening rtol by 1000 must reduce the error by >= 100.
+        let run = |rtol: f64| {
+            let sol = bs23(
+                |t, y: &[f64; 2]| [y[1], -y[0] + 0.0 * t],
+                0.0,
+                [0.0, 1.0],
+                10.0,
+                AdaptiveOptions {
+                    rtol,
+                    atol: rtol * 1e-2,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            (sol.y.last().unwrap()[0] - 10.0f64.sin()).abs()
+        };
+        let (e1, e2) = (run(1e-6), run(1e-9));
+        assert!(e2 < e1 / 100.0, "{e1} {e2}");
+    }
+
+    #[test]
+    fn rejects_bad_tolerances() {
+        let bad = AdaptiveOptions {
+            rtol: -1.0,
+            ..Default::default()
+        };
+        assert!(matches!(
+            bs23(|_, y: &[f64; 1]| *y, 0.0, [1.0], 1.0, bad),
+            Err(Error::InvalidParameter { .. })
+        ));
+    }
+
+    #[test]
+    fn max_steps_reports_non_convergence() {
+        let opts = AdaptiveOptions {
+            max_steps: 3,
+            ..Default::default()
+        };
+        let r = bs23(|t, _y: &[f64; 1]| [(50.0 * t).sin()], 0.0, [0.0], 10.0, opts);
+        assert!(matches!(r, Err(Error::NotConverged { iterations: 3, .. })));
+    }
+}

@@ -1,0 +1,646 @@
+//! Seed 000: the planar steady-state model of a tapered cable-driven arm.
+//!
+//! A silicone cone of length `L` with radius `R(s) = R0 + (RL - R0) s / L`, one cable at
+//! distance `a R(s)` from the backbone, anchored at `s = anchor` (default the tip) and pulled at
+//! the base with tension `T`. Planar, no gravity, linear material `E`. Along the undeformed arc
+//! length `s`:
+//!
+//! * curvature (per deformed length) `k(s) = T a R / (E pi R^4 / 4 + T a^2 R^2)`,
+//! * axial strain `q(s) = T (a R k - 1) / (E pi R^2)`,
+//! * tangent angle `theta(s) = int_0^s (1 + q) k ds`,
+//! * backbone `x' = (1 + q) cos theta`, `y' = (1 + q) sin theta` (x along the unloaded arm,
+//!   y toward the cable).
+//!
+//! Beyond the anchor the arm is unloaded and straight. `k` is either evaluated in closed form or
+//! obtained from the published final-value ODE (with the final value's typo corrected,
+//! `R(L)^4`), integrated from the anchor to the base with [`crate::integrate::bs23`].
+//!
+//! The backbone (`theta`, `x`, `y`) is integrated by a 4-stage Lobatto IIIA collocation
+//! (order 6) on panels no longer than the output spacing and short enough that the tangent turns
+//! by at most [`MAX_PANEL_TURN`] rad per panel; the panels break at the anchor, where `k` jumps.
+//!
+//! # References
+//! Seed 000 and its erratum (`shared/notes/seed-notes.md`).
+
+use std::f64::consts::PI;
+
+use rayon::prelude::*;
+
+use crate::error::{check_positive, Error, Result};
+use crate::integrate::{bs23, AdaptiveOptions, IntegrationStats};
+
+/// Largest tangent-angle change (rad) allowed across one backbone-integration panel.
+///
+/// With the order-6 panel rule this keeps the backbone error below 1e-10 of the arm length.
+pub const MAX_PANEL_TURN: f64 = 0.1;
+
+/// The seed-000 tapered cable-driven arm (immutable, validated).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarCableArm {
+    length: f64,
+    base_radius: f64,
+    tip_radius: f64,
+    offset_ratio: f64,
+    youngs_modulus: f64,
+    anchor: f64,
+}
+
+/// How the curvature profile `k(s)` is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlanarMethod {
+    /// The closed form `k = T a R / (E pi R^4 / 4 + T a^2 R^2)`.
+    ClosedForm,
+    /// The published final-value ODE, integrated from the anchor to the base with the adaptive
+    /// Bogacki–Shampine 3(2) pair (MATLAB `ode23`'s method) at the given tolerances.
+    Ode(AdaptiveOptions),
+}
+
+/// Samples of one solved arm. All arrays have the length of the requested samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanarSolution {
+    /// Cable tension `T` (N).
+    pub tension: f64,
+    /// Undeformed arc length of each sample (m).
+    pub s: Vec<f64>,
+    /// Curvature `k` per deformed length (1/m); zero beyond the anchor.
+    pub curvature: Vec<f64>,
+    /// Axial strain `q` (dimensionless, negative in compression); zero beyond the anchor.
+    pub strain: Vec<f64>,
+    /// Tangent angle `theta` from the x axis toward the cable (rad).
+    pub angle: Vec<f64>,
+    /// Backbone x, along the unloaded arm (m).
+    pub x: Vec<f64>,
+    /// Backbone y, toward the cable (m).
+    pub y: Vec<f64>,
+    /// Tip position `(x, y)` at `s = L` (m).
+    pub tip: [f64; 2],
+    /// Tangent angle at the tip (rad).
+    pub tip_angle: f64,
+    /// Integrator statistics of the ODE path (`None` for the closed form).
+    pub ode_stats: Option<IntegrationStats>,
+}
+
+impl PlanarSolution {
+    /// Largest compressive axial strain, `max(-q)` (dimensionless, >= 0).
+    pub fn max_compressive_strain(&self) -> f64 {
+        self.strain.iter().fold(0.0f64, |m, &q| m.max(-q))
+    }
+}
+
+/// Many tensions solved on one set of samples; 2-D arrays are row-major `(tensions, samples)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanarBatch {
+    /// Tensions (N), one per row.
+    pub tensions: Vec<f64>,
+    /// Undeformed arc length of each sample (m), shared by all rows.
+    pub s: Vec<f64>,
+    /// Curvature (1/m), `tensions.len() * s.len()`.
+    pub curvature: Vec<f64>,
+    /// Axial strain, `tensions.len() * s.len()`.
+    pub strain: Vec<f64>,
+    /// Tangent angle (rad), `tensions.len() * s.len()`.
+    pub angle: Vec<f64>,
+    /// Backbone x (m), `tensions.len() * s.len()`.
+    pub x: Vec<f64>,
+    /// Backbone y (m), `tensions.len() * s.len()`.
+    pub y: Vec<f64>,
+    /// Tip positions `(x, y)` (m), one per tension.
+    pub tip: Vec<[f64; 2]>,
+    /// Tip tangent angles (rad), one per tension.
+    pub tip_angle: Vec<f64>,
+}
+
+impl PlanarCableArm {
+    /// Builds and validates an arm.
+    ///
+    /// * `length` `L` (m), `base_radius` `R0` and `tip_radius` `RL` (m): all finite and > 0;
+    /// * `offset_ratio` `a` in `[0, 1)`: the cable runs at `a R(s)` from the backbone;
+    /// * `youngs_modulus` `E` (Pa) > 0;
+    /// * `anchor` (m) in `(0, L]`, `None` for the tip.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first parameter out of range.
+    pub fn new(
+        length: f64,
+        base_radius: f64,
+        tip_radius: f64,
+        offset_ratio: f64,
+        youngs_modulus: f64,
+        anchor: Option<f64>,
+    ) -> Result<Self> {
+        check_positive("length", length, "m")?;
+        check_positive("base_radius", base_radius, "m")?;
+        check_positive("tip_radius", tip_radius, "m")?;
+        if !(offset_ratio.is_finite() && (0.0..1.0).contains(&offset_ratio)) {
+            return Err(Error::invalid("offset_ratio", offset_ratio, "in [0, 1)"));
+        }
+        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        let anchor = anchor.unwrap_or(length);
+        if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
+            return Err(Error::invalid(
+                "anchor",
+                anchor,
+                format!("in (0, length] = (0, {length}] m"),
+            ));
+        }
+        Ok(Self {
+            length,
+            base_radius,
+            tip_radius,
+            offset_ratio,
+            youngs_modulus,
+            anchor,
+        })
+    }
+
+    /// The seed's experimental arm: `L = 270 mm`, `R0 = 15 mm`, `RL = 7.4 mm`, `a = 1/3`,
+    /// `E = 110 kPa`, cable anchored at the tip.
+    pub fn seed_arm() -> Self {
+        Self {
+            length: 0.270,
+            base_radius: 0.015,
+            tip_radius: 0.0074,
+            offset_ratio: 1.0 / 3.0,
+            youngs_modulus: 110e3,
+            anchor: 0.270,
+        }
+    }
+
+    /// Arm length `L` (m).
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+    /// Base radius `R0` (m).
+    pub fn base_radius(&self) -> f64 {
+        self.base_radius
+    }
+    /// Tip radius `RL` (m).
+    pub fn tip_radius(&self) -> f64 {
+        self.tip_radius
+    }
+    /// Cable offset ratio `a` (dimensionless).
+    pub fn offset_ratio(&self) -> f64 {
+        self.offset_ratio
+    }
+    /// Young's modulus `E` (Pa).
+    pub fn youngs_modulus(&self) -> f64 {
+        self.youngs_modulus
+    }
+    /// Cable anchor arc length (m).
+    pub fn anchor(&self) -> f64 {
+        self.anchor
+    }
+
+    /// Section radius `R(s)` (m), linear taper.
+    #[inline]
+    pub fn radius(&self, s: f64) -> f64 {
+        self.base_radius + (self.tip_radius - self.base_radius) * s / self.length
+    }
+
+    /// Taper rate `dR/ds` (dimensionless).
+    #[inline]
+    pub fn radius_rate(&self) -> f64 {
+        (self.tip_radius - self.base_radius) / self.length
+    }
+
+    /// Closed-form curvature `k(s)` (1/m) and axial strain `q(s)` at `s <= anchor`.
+    ///
+    /// Uses `q = T (a R k - 1) / (E pi R^2) = -T / (4 D)` with `D = E pi R^2 / 4 + T a^2`
+    /// and `k = T a / (R D)`, one division per call.
+    #[inline]
+    pub fn closed_form(&self, s: f64, tension: f64) -> (f64, f64) {
+        let r = self.radius(s);
+        let a = self.offset_ratio;
+        let d = 0.25 * self.youngs_modulus * PI * r * r + tension * a * a;
+        let inv_rd = 1.0 / (r * d);
+        (tension * a * inv_rd, -0.25 * tension * r * inv_rd)
+    }
+
+    /// Axial strain `q = T (a R k - 1) / (E pi R^2)` for a given curvature `k` (seed eq. 1).
+    #[inline]
+    pub fn strain(&self, s: f64, curvature: f64, tension: f64) -> f64 {
+        let r = self.radius(s);
+        tension * (self.offset_ratio * r * curvature - 1.0) / (self.youngs_modulus * PI * r * r)
+    }
+
+    /// Final value of the ODE, `k(anchor) = T a R / (T a^2 R^2 + E (pi/4) R^4)` (1/m), with
+    /// the seed's `R(L)^2` corrected to `R(L)^4`.
+    pub fn final_value(&self, tension: f64) -> f64 {
+        let r = self.radius(self.anchor);
+        let a = self.offset_ratio;
+        tension * a * r / (tension * a * a * r * r + self.youngs_modulus * PI / 4.0 * r.powi(4))
+    }
+
+    /// Right-hand side of the published ODE, `dk/ds` (1/m^2), term by term as printed:
+    /// `k Rdot R (-E pi R^2 - 2 T a^2) / (R^2 (E pi/4 R^2 + T a^2))
+    ///  + T a Rdot / (R^2 (E pi/4 R^2 + T a^2))`.
+    #[inline]
+    pub fn curvature_rate(&self, s: f64, curvature: f64, tension: f64) -> f64 {
+        let r = self.radius(s);
+        let rd = self.radius_rate();
+        let (e, a) = (self.youngs_modulus, self.offset_ratio);
+        let den = r * r * (e * PI / 4.0 * r * r + tension * a * a);
+        curvature * rd * r * (-e * PI * r * r - 2.0 * tension * a * a) / den
+            + tension * a * rd / den
+    }
+
+    /// Validates a tension: finite, >= 0, and small enough that `1 + q > 0` along the arm
+    /// (the linear model stops making sense when the arm is compressed to zero length).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `tension`.
+    pub fn check_tension(&self, tension: f64) -> Result<f64> {
+        if !(tension.is_finite() && tension >= 0.0) {
+            return Err(Error::invalid("tension", tension, "finite and >= 0 N"));
+        }
+        let limit = self.max_tension();
+        if tension >= limit {
+            return Err(Error::invalid(
+                "tension",
+                tension,
+                format!("< {limit:.6e} N (axial strain would reach -1)"),
+            ));
+        }
+        Ok(tension)
+    }
+
+    /// Supremum of the tension for which `1 + q > 0` along the loaded part (N);
+    /// infinite when `a >= 1/2`.
+    pub fn max_tension(&self) -> f64 {
+        let r_min = self.radius(0.0).min(self.radius(self.anchor));
+        let a2 = self.offset_ratio * self.offset_ratio;
+        let c = 1.0 - 4.0 * a2;
+        if c <= 0.0 {
+            f64::INFINITY
+        } else {
+            self.youngs_modulus * PI * r_min * r_min / c
+        }
+    }
+}
+
+/// `n_points` uniformly spaced arc lengths over `[0, length]` (m).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] if `n_points < 2`.
+pub fn uniform_samples(length: f64, n_points: usize) -> Result<Vec<f64>> {
+    if n_points < 2 {
+        return Err(Error::invalid("n_points", n_points, ">= 2"));
+    }
+    let last = (n_points - 1) as f64;
+    Ok((0..n_points)
+        .map(|i| if i + 1 == n_points { length } else { length * i as f64 / last })
+        .collect())
+}
+
+fn check_samples(samples: &[f64], length: f64) -> Result<()> {
+    if samples.is_empty() {
+        return Err(Error::invalid("s", "[]", "at least one arc length"));
+    }
+    let mut prev = 0.0;
+    for (i, &s) in samples.iter().enumerate() {
+        if !(s.is_finite() && (0.0..=length).contains(&s) && s >= prev) {
+            return Err(Error::invalid(
+                format!("s[{i}]"),
+                s,
+                format!("non-decreasing and in [0, length] = [0, {length}] m"),
+            ));
+        }
+        prev = s;
+    }
+    Ok(())
+}
+
+/// `(cos x, sin x)` for `|x| <= 0.2` by truncated Taylor series (error < 1e-18), else libm.
+#[inline]
+fn small_angle_cis(x: f64) -> (f64, f64) {
+    if x.abs() > 0.2 {
+        let (s, c) = x.sin_cos();
+        return (c, s);
+    }
+    let x2 = x * x;
+    let c = 1.0
+        - x2 * (1.0 / 2.0)
+            * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0) * (1.0 - x2 * (1.0 / 90.0) * (1.0 - x2 * (1.0 / 132.0))))));
+    let s = x
+        * (1.0
+            - x2 * (1.0 / 6.0)
+                * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0) * (1.0 - x2 * (1.0 / 110.0) * (1.0 - x2 * (1.0 / 156.0)))))));
+    (c, s)
+}
+
+/// Lobatto IIIA, 4 stages: nodes, stage matrix rows 2–4 and weights.
+mod lobatto {
+    pub const SQ5: f64 = 2.236_067_977_499_79;
+    pub const C: [f64; 4] = [0.0, (5.0 - SQ5) / 10.0, (5.0 + SQ5) / 10.0, 1.0];
+    pub const A: [[f64; 4]; 3] = [
+        [
+            (11.0 + SQ5) / 120.0,
+            (25.0 - SQ5) / 120.0,
+            (25.0 - 13.0 * SQ5) / 120.0,
+            (-1.0 + SQ5) / 120.0,
+        ],
+        [
+            (11.0 - SQ5) / 120.0,
+            (25.0 + 13.0 * SQ5) / 120.0,
+            (25.0 + SQ5) / 120.0,
+            (-1.0 - SQ5) / 120.0,
+        ],
+        [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0],
+    ];
+    pub const B: [f64; 4] = [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0];
+}
+
+/// State of the backbone integration: arc length, angle, unit tangent, position, and the
+/// profile `(k, q)` at the current arc length.
+#[derive(Clone, Copy)]
+struct BackboneState {
+    s: f64,
+    theta: f64,
+    cos: f64,
+    sin: f64,
+    x: f64,
+    y: f64,
+    k: f64,
+    q: f64,
+}
+
+impl BackboneState {
+    /// Advances over `[self.s, b]` (all of it loaded) in `m` equal Lobatto IIIA panels.
+    #[inline]
+    fn advance_loaded<P: Fn(f64) -> (f64, f64)>(&mut self, profile: &P, b: f64, kappa_max: f64) {
+        let span = b - self.s;
+        if span <= 0.0 {
+            return;
+        }
+        let m = ((span * kappa_max / MAX_PANEL_TURN).ceil() as usize).max(1);
+        let h = span / m as f64;
+        let a0 = self.s;
+        for p in 0..m {
+            let s0 = a0 + p as f64 * h;
+            let s_end = if p + 1 == m { b } else { s0 + h };
+            let mut f = [(1.0 + self.q) * self.k, 0.0, 0.0, 0.0];
+            let mut g = [1.0 + self.q, 0.0, 0.0, 0.0];
+            let mut kq = (self.k, self.q);
+            for j in 1..4 {
+                let sj = if j == 3 { s_end } else { s0 + lobatto::C[j] * h };
+                kq = profile(sj);
+                f[j] = (1.0 + kq.1) * kq.0;
+                g[j] = 1.0 + kq.1;
+            }
+            let mut dx = lobatto::B[0] * g[0] * self.cos;
+            let mut dy = lobatto::B[0] * g[0] * self.sin;
+            let mut end = (self.cos, self.sin, 0.0);
+            for j in 1..4 {
+                let row = &lobatto::A[j - 1];
+                let dth = h * (row[0] * f[0] + row[1] * f[1] + row[2] * f[2] + row[3] * f[3]);
+                let (c, s) = small_angle_cis(dth);
+                let (cj, sj) = (self.cos * c - self.sin * s, self.sin * c + self.cos * s);
+                dx += lobatto::B[j] * g[j] * cj;
+                dy += lobatto::B[j] * g[j] * sj;
+                end = (cj, sj, dth);
+            }
+            self.x += h * dx;
+            self.y += h * dy;
+            // Renormalise the unit tangent (first-order correction of |t|^2 - 1).
+            let n2 = end.0 * end.0 + end.1 * end.1;
+            let fix = 1.5 - 0.5 * n2;
+            self.cos = end.0 * fix;
+            self.sin = end.1 * fix;
+            self.theta += end.2;
+            self.s = s_end;
+            self.k = kq.0;
+            self.q = kq.1;
+        }
+    }
+
+    /// Advances straight (unloaded: `k = q = 0`) to `b`.
+    #[inline]
+    fn advance_straight(&mut self, b: f64) {
+        let d = b - self.s;
+        self.x += d * self.cos;
+        self.y += d * self.sin;
+        self.s = b;
+        self.k = 0.0;
+        self.q = 0.0;
+    }
+
+    /// Advances to `b`, loaded up to `anchor` and straight beyond it.
+    #[inline]
+    fn advance<P: Fn(f64) -> (f64, f64)>(
+        &mut self,
+        profile: &P,
+        b: f64,
+        anchor: f64,
+        kappa_max: f64,
+    ) {
+        if self.s < anchor {
+            self.advance_loaded(profile, b.min(anchor), kappa_max);
+        }
+        if b > anchor {
+            self.advance_straight(b);
+        }
+    }
+}
+
+/// Output slices of one solve (each of the samples' length).
+struct Out<'a> {
+    k: &'a mut [f64],
+    q: &'a mut [f64],
+    theta: &'a mut [f64],
+    x: &'a mut [f64],
+    y: &'a mut [f64],
+}
+
+/// Integrates the backbone for a curvature/strain profile, writing the samples.
+/// Returns the tip `(x, y, theta)`.
+fn integrate_backbone<P: Fn(f64) -> (f64, f64)>(
+    profile: P,
+    samples: &[f64],
+    length: f64,
+    anchor: f64,
+    kappa_max: f64,
+    out: Out<'_>,
+) -> (f64, f64, f64) {
+    let (k0, q0) = profile(0.0);
+    let mut st = BackboneState {
+        s: 0.0,
+        theta: 0.0,
+        cos: 1.0,
+        sin: 0.0,
+        x: 0.0,
+        y: 0.0,
+        k: k0,
+        q: q0,
+    };
+    for (i, &si) in samples.iter().enumerate() {
+        st.advance(&profile, si, anchor, kappa_max);
+        out.k[i] = st.k;
+        out.q[i] = st.q;
+        out.theta[i] = st.theta;
+        out.x[i] = st.x;
+        out.y[i] = st.y;
+    }
+    st.advance(&profile, length, anchor, kappa_max);
+    (st.x, st.y, st.theta)
+}
+
+/// Solves one tension into the output slices; returns tip and ODE statistics.
+fn solve_into(
+    arm: &PlanarCableArm,
+    tension: f64,
+    samples: &[f64],
+    method: PlanarMethod,
+    out: Out<'_>,
+) -> Result<((f64, f64, f64), Option<IntegrationStats>)> {
+    arm.check_tension(tension)?;
+    let (l, anchor) = (arm.length, arm.anchor);
+    match method {
+        PlanarMethod::ClosedForm => {
+            let turn = |(k, q): (f64, f64)| ((1.0 + q) * k).abs();
+            let kappa_max = turn(arm.closed_form(0.0, tension))
+                .max(turn(arm.closed_form(anchor, tension)));
+            let tip = integrate_backbone(
+                |s| arm.closed_form(s, tension),
+                samples,
+                l,
+                anchor,
+                kappa_max,
+                out,
+            );
+            Ok((tip, None))
+        }
+        PlanarMethod::Ode(options) => {
+            let sol = bs23(
+                |s, k: &[f64; 1]| [arm.curvature_rate(s, k[0], tension)],
+                anchor,
+                [arm.final_value(tension)],
+                0.0,
+                options,
+            )?;
+            let kappa_max = sol.y.iter().fold(0.0f64, |m, k| m.max(k[0].abs()));
+            let profile = |s: f64| {
+                let k = sol.eval(s)[0];
+                (k, arm.strain(s, k, tension))
+            };
+            let tip = integrate_backbone(profile, samples, l, anchor, kappa_max, out);
+            Ok((tip, Some(sol.stats)))
+        }
+    }
+}
+
+/// Solves the arm for one tension at the given arc-length samples.
+///
+/// `samples` are undeformed arc lengths (m), non-decreasing, in `[0, L]` (see
+/// [`uniform_samples`]). The tip is always reported at `s = L`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad tension or samples; [`Error::NotConverged`] if the
+/// ODE integration fails.
+pub fn solve_planar(
+    arm: &PlanarCableArm,
+    tension: f64,
+    samples: &[f64],
+    method: PlanarMethod,
+) -> Result<PlanarSolution> {
+    check_samples(samples, arm.length)?;
+    let n = samples.len();
+    let (mut k, mut q, mut th, mut x, mut y) =
+        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let ((tx, ty, tth), ode_stats) = solve_into(
+        arm,
+        tension,
+        samples,
+        method,
+        Out {
+            k: &mut k,
+            q: &mut q,
+            theta: &mut th,
+            x: &mut x,
+            y: &mut y,
+        },
+    )?;
+    Ok(PlanarSolution {
+        tension,
+        s: samples.to_vec(),
+        curvature: k,
+        strain: q,
+        angle: th,
+        x,
+        y,
+        tip: [tx, ty],
+        tip_angle: tth,
+        ode_stats,
+    })
+}
+
+/// Solves many tensions on one set of samples, in parallel over tensions.
+///
+/// # Errors
+/// The first error of any tension (see [`solve_planar`]); tensions are validated before any
+/// work is done.
+pub fn solve_planar_many(
+    arm: &PlanarCableArm,
+    tensions: &[f64],
+    samples: &[f64],
+    method: PlanarMethod,
+) -> Result<PlanarBatch> {
+    check_samples(samples, arm.length)?;
+    for (i, &t) in tensions.iter().enumerate() {
+        arm.check_tension(t).map_err(|e| match e {
+            Error::InvalidParameter {
+                value, expected, ..
+            } => Error::InvalidParameter {
+                name: format!("tensions[{i}]"),
+                value,
+                expected,
+            },
+            other => other,
+        })?;
+    }
+    let (nt, ns) = (tensions.len(), samples.len());
+    let mut batch = PlanarBatch {
+        tensions: tensions.to_vec(),
+        s: samples.to_vec(),
+        curvature: vec![0.0; nt * ns],
+        strain: vec![0.0; nt * ns],
+        angle: vec![0.0; nt * ns],
+        x: vec![0.0; nt * ns],
+        y: vec![0.0; nt * ns],
+        tip: vec![[0.0; 2]; nt],
+        tip_angle: vec![0.0; nt],
+    };
+    if nt == 0 {
+        return Ok(batch);
+    }
+    let rows = batch
+        .curvature
+        .par_chunks_mut(ns)
+        .zip(batch.strain.par_chunks_mut(ns))
+        .zip(batch.angle.par_chunks_mut(ns))
+        .zip(batch.x.par_chunks_mut(ns))
+        .zip(batch.y.par_chunks_mut(ns))
+        .zip(batch.tip.par_iter_mut())
+        .zip(batch.tip_angle.par_iter_mut())
+        .zip(tensions.par_iter());
+    rows.with_min_len(64).try_for_each(
+        |(((((((k, q), th), x), y), tip), tip_angle), &t)| -> Result<()> {
+            let ((tx, ty, tth), _) = solve_into(
+                arm,
+                t,
+                samples,
+                method,
+                Out {
+                    k,
+                    q,
+                    theta: th,
+                    x,
+                    y,
+                },
+            )?;
+            *tip = [tx, ty];
+            *tip_angle = tth;
+            Ok(())
+        },
+    )?;
+    Ok(batch)
+}
