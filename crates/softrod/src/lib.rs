@@ -10,17 +10,49 @@
 //! * [`planar`]: seed 000, the planar tapered cable-driven arm (closed form and final-value ODE);
 //! * [`compare`]: distances between backbones at equal arm index;
 //! * [`integrate`]: ODE integrators shared by every model;
+//! * [`hyperelastic`]: uniaxial material laws (linear, Neo-Hookean, Mooney–Rivlin, Yeoh, Ogden)
+//!   and a library of named silicones;
+//! * [`fit`]: least-squares fitting of those laws to uniaxial test data;
 //! * [`error`]: the crate's one error type.
 
 pub mod compare;
 pub mod error;
+pub mod fit;
+pub mod hyperelastic;
 pub mod integrate;
 pub mod planar;
 
 pub use compare::{backbone_distance, BackboneDistance};
 pub use error::{Error, Result};
+pub use fit::{
+    fit_stats, fit_uniaxial, FitOptions, FitStats, ModelKind, StrainMeasure, StressMeasure,
+    UniaxialData, UniaxialFit,
+};
+pub use hyperelastic::{
+    Hookean, Linearised, MooneyRivlin, NeoHookean, Ogden, Silicone, UniaxialLaw, UniaxialModel,
+    Yeoh,
+};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
 pub use planar::{
     solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,
     PlanarSolution,
 };
+
+pub mod cosserat;
+pub mod loads;
+pub mod material;
+pub mod rod;
+pub mod section;
+pub mod so3;
+pub mod statics;
+pub mod tendon;
+
+pub use loads::{Frame, Loads, PointLoad};
+pub use material::{LinearElastic, Material};
+pub use nalgebra;
+pub use rod::{Pose, Profile, Rod};
+pub use section::{Section, SectionProperties};
+pub use statics::{
+    solve_statics, Integrator, SolveOptions, SolverStats, StaticsSolution, WarmStart,
+};
+pub use tendon::{Routing, Tendon};

@@ -1,0 +1,468 @@
+//! The Cosserat-rod equations with tendons, as a right-hand side for shooting.
+//!
+//! Along the undeformed arc length `s` (world frame unless noted; `(·)_b` body components):
+//!
+//! ```text
+//! p' = R v,        R' = R û,
+//! N' = -f(s),      M' = -p' × N - l(s),
+//! ```
+//!
+//! where `N`, `M` are the **total** internal force and moment carried across the section at
+//! `s` by the rod *and the tendons that pass through it*:
+//! `N = n + Σ τ_i t_i`, `M = m + Σ (R r_i) × τ_i t_i`, with `n`, `m` the rod's own (elastic)
+//! internal wrench, `t_i` the unit tangent of tendon `i`'s path `p_i = p + R r_i`, and
+//! `f`, `l` the external distributed force and moment. Cutting the rod *and* its tendons at `s`,
+//! the only loads on the distal part are external, hence these two equations. In body
+//! components the constitutive law closes the system:
+//!
+//! ```text
+//! n_b = N_b - Σ τ_i t_i,b,   m_b = M_b - Σ τ_i r_i × t_i,b,
+//! v = v* + C_v n_b,          u = u* + C_u m_b,
+//! t_i,b = w_i / |w_i|,       w_i = v + u × r_i + r_i',
+//! ```
+//!
+//! an implicit equation for `(v, u)` solved by a local Newton iteration at every evaluation
+//! (its Jacobian `I + C D`, `D = d(Σ τ t, Σ τ r × t)/d(v, u)`, is exact).
+//!
+//! This is Rucker & Webster's (2011) tendon model exactly, written for the total wrench:
+//! differentiating `n = N - Σ τ t_i` gives their distributed tendon load
+//! `-τ_i t_i'` (from the curvature of the tendon path); at a termination `σ` the tendon's term
+//! drops out of the sum while `N`, `M` are continuous, so the rod's own wrench jumps by exactly
+//! their point force `-τ_i t_i(σ)` and moment `-(R r_i) × τ_i t_i(σ)`. The integration
+//! intervals break at every termination and point load, so these jumps are applied exactly.
+//!
+//! The shooting Jacobian is propagated with the state: for each of the six unknowns of the
+//! base wrench, a variation `(δp, w, δN, δM)` with `δR = R ŵ` (body-frame rotation variation)
+//! obeys the variational equations
+//!
+//! ```text
+//! δp' = R (w × v + δv),   w' = w × u + δu,   δN' = 0,   δM' = -(δp' × N + p' × δN),
+//! (δv, δu) = (I + C D)⁻¹ C (N_b × w + Rᵀ δN, M_b × w + Rᵀ δM).
+//! ```
+//!
+//! # References
+//! D. C. Rucker, R. J. Webster III, IEEE Trans. Robotics 27(6), 2011, eqs. (1)–(18).
+//! J. Till, V. Aloi, D. C. Rucker, Int. J. Robotics Research 38(6), 2019 (shooting).
+
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+use crate::loads::{Frame, Loads};
+use crate::rod::Rod;
+use crate::section::SectionProperties;
+use crate::so3::hat;
+use crate::tendon::Tendon;
+
+/// Length of the state `(p, R, N, M)`: 3 + 9 + 3 + 3.
+pub(crate) const STATE: usize = 18;
+/// Length of the state with the six sensitivity columns `(δp, w, δN, δM)` appended.
+pub(crate) const FULL: usize = STATE + 6 * 12;
+
+/// Relative step tolerance of the local (constitutive) Newton iteration.
+pub const LOCAL_TOLERANCE: f64 = 1e-14;
+/// Iteration cap of the local (constitutive) Newton iteration.
+pub const LOCAL_MAX_ITERATIONS: usize = 50;
+
+#[inline]
+pub(crate) fn v3(y: &[f64], i: usize) -> Vector3<f64> {
+    Vector3::new(y[i], y[i + 1], y[i + 2])
+}
+
+#[inline]
+pub(crate) fn put3(y: &mut [f64], i: usize, v: &Vector3<f64>) {
+    y[i] = v.x;
+    y[i + 1] = v.y;
+    y[i + 2] = v.z;
+}
+
+#[inline]
+pub(crate) fn rot(y: &[f64]) -> Matrix3<f64> {
+    Matrix3::from_column_slice(&y[3..12])
+}
+
+/// Tangent of the local strains with respect to the body wrench.
+#[derive(Clone, Copy)]
+pub(crate) enum Tangent {
+    Diagonal([f64; 6]),
+    Full(Matrix6<f64>),
+}
+
+/// The local solution at one `s`: strains and tendon load sums (body frame).
+#[derive(Clone, Copy)]
+pub(crate) struct Local {
+    pub v: Vector3<f64>,
+    pub u: Vector3<f64>,
+    /// `Σ τ t_i` (N, body frame).
+    pub tendon_force: Vector3<f64>,
+    /// `Σ τ r_i × t_i` (N m, body frame).
+    pub tendon_moment: Vector3<f64>,
+    pub tangent: Tangent,
+}
+
+/// A prepared tendon: termination and scaled tension.
+pub(crate) struct ActiveTendon<'a> {
+    pub tendon: &'a Tendon,
+    pub end: f64,
+}
+
+/// The validated problem at one load factor.
+pub(crate) struct Model<'a> {
+    pub rod: &'a Rod,
+    pub tendons: Vec<ActiveTendon<'a>>,
+    pub loads: &'a Loads,
+    pub shear_coefficient: f64,
+    /// `rho g` (N/m³), if gravity is on.
+    pub rho_g: Option<Vector3<f64>>,
+    /// Load factor `λ` multiplying every load and tension.
+    pub factor: f64,
+    /// Force scale (N) of the shooting unknowns and residual; moments use `f_ref L`.
+    pub f_ref: f64,
+    pub length: f64,
+    /// Interval end points `0 = b_0 < b_1 < ... = L`.
+    pub breaks: Vec<f64>,
+}
+
+impl<'a> Model<'a> {
+    /// Distributed force `λ (f(s) + rho A(s) g)` (N/m, world).
+    #[inline]
+    fn distributed_force(&self, s: f64, props: &SectionProperties) -> Vector3<f64> {
+        let mut f = match &self.loads.distributed_force {
+            Some(p) => p.at(s),
+            None => Vector3::zeros(),
+        };
+        if let Some(g) = &self.rho_g {
+            f += g * props.area;
+        }
+        f * self.factor
+    }
+
+    #[inline]
+    fn distributed_moment(&self, s: f64) -> Vector3<f64> {
+        match &self.loads.distributed_moment {
+            Some(p) => p.at(s) * self.factor,
+            None => Vector3::zeros(),
+        }
+    }
+
+    /// Initial state for the scaled base wrench `x` (`N(0) = f_ref x[0..3]`,
+    /// `M(0) = f_ref L x[3..6]`), with identity sensitivity seeds when `N == FULL`.
+    pub fn initial<const N: usize>(&self, x: &Vector6<f64>) -> [f64; N] {
+        let mut y = [0.0; N];
+        let pose = self.rod.base_pose();
+        put3(&mut y, 0, &pose.position());
+        y[3..12].copy_from_slice(pose.rotation().as_slice());
+        let fm = self.f_ref * self.length;
+        for k in 0..3 {
+            y[12 + k] = self.f_ref * x[k];
+            y[15 + k] = fm * x[3 + k];
+        }
+        if N == FULL {
+            for k in 0..3 {
+                y[STATE + 12 * k + 6 + k] = self.f_ref;
+                y[STATE + 12 * (k + 3) + 9 + k] = fm;
+            }
+        }
+        y
+    }
+
+    /// World-frame force and moment (and their sensitivity columns) of a load given in
+    /// `frame`, applied where the state is `y`.
+    #[inline]
+    fn applied<const N: usize>(
+        &self,
+        y: &[f64; N],
+        force: &Vector3<f64>,
+        moment: &Vector3<f64>,
+        frame: Frame,
+    ) -> (Vector3<f64>, Vector3<f64>, [[Vector3<f64>; 2]; 6]) {
+        let (f, m) = (force * self.factor, moment * self.factor);
+        let mut d = [[Vector3::zeros(); 2]; 6];
+        match frame {
+            Frame::World => (f, m, d),
+            Frame::Body => {
+                let r = rot(y);
+                if N == FULL {
+                    for (k, dk) in d.iter_mut().enumerate() {
+                        let w = v3(y, STATE + 12 * k + 3);
+                        dk[0] = r * w.cross(&f);
+                        dk[1] = r * w.cross(&m);
+                    }
+                }
+                (r * f, r * m, d)
+            }
+        }
+    }
+
+    /// Applies the point loads at the interior break `sigma` (crossing it toward the tip).
+    pub fn jump<const N: usize>(&self, sigma: f64, y: &mut [f64; N]) {
+        for pl in self.loads.point_loads.iter().filter(|p| p.s == sigma) {
+            let (f, m, d) = self.applied(y, &pl.force, &pl.moment, pl.frame);
+            let (n1, m1) = (v3(y, 12) - f, v3(y, 15) - m);
+            put3(y, 12, &n1);
+            put3(y, 15, &m1);
+            if N == FULL {
+                for (k, dk) in d.iter().enumerate() {
+                    let b = STATE + 12 * k;
+                    let (dn1, dm1) = (v3(y, b + 6) - dk[0], v3(y, b + 9) - dk[1]);
+                    put3(y, b + 6, &dn1);
+                    put3(y, b + 9, &dm1);
+                }
+            }
+        }
+    }
+
+    /// Scaled tip residual `[(N(L) - F)/f_ref; (M(L) - M)/(f_ref L)]` and, when `N == FULL`,
+    /// its Jacobian with respect to the scaled base wrench.
+    pub fn residual<const N: usize>(&self, y: &[f64; N]) -> (Vector6<f64>, Option<Matrix6<f64>>) {
+        let lw = &self.loads;
+        let (mut f, mut m, mut d) = self.applied(y, &lw.tip_force, &lw.tip_moment, lw.tip_frame);
+        for pl in lw.point_loads.iter().filter(|p| p.s == self.length) {
+            let (f2, m2, d2) = self.applied(y, &pl.force, &pl.moment, pl.frame);
+            f += f2;
+            m += m2;
+            for k in 0..6 {
+                d[k][0] += d2[k][0];
+                d[k][1] += d2[k][1];
+            }
+        }
+        let fm = self.f_ref * self.length;
+        let rf = (v3(y, 12) - f) / self.f_ref;
+        let rm = (v3(y, 15) - m) / fm;
+        let r = Vector6::new(rf.x, rf.y, rf.z, rm.x, rm.y, rm.z);
+        if N != FULL {
+            return (r, None);
+        }
+        let mut j = Matrix6::zeros();
+        for k in 0..6 {
+            let b = STATE + 12 * k;
+            let jf = (v3(y, b + 6) - d[k][0]) / self.f_ref;
+            let jm = (v3(y, b + 9) - d[k][1]) / fm;
+            for i in 0..3 {
+                j[(i, k)] = jf[i];
+                j[(i + 3, k)] = jm[i];
+            }
+        }
+        (r, Some(j))
+    }
+}
+
+/// Evaluates the right-hand side; holds the per-interval set of active tendons and scratch.
+pub(crate) struct Evaluator<'m, 'a> {
+    pub model: &'m Model<'a>,
+    /// Indices of the tendons that pass through the current interval.
+    active: Vec<usize>,
+    /// Scratch: offsets `(r, r', τ)` of the active tendons at the current `s`.
+    offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
+    /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
+    guess: Option<Vector6<f64>>,
+    /// `|w_i| = |p_i'|` of every tendon at the last evaluation (0 for inactive ones).
+    pub tendon_speed: Vec<f64>,
+    /// Right-hand-side evaluations so far.
+    pub evaluations: usize,
+}
+
+impl<'m, 'a> Evaluator<'m, 'a> {
+    pub fn new(model: &'m Model<'a>) -> Self {
+        let n = model.tendons.len();
+        Self {
+            model,
+            active: Vec::with_capacity(n),
+            offsets: Vec::with_capacity(n),
+            guess: None,
+            tendon_speed: vec![0.0; n],
+            evaluations: 0,
+        }
+    }
+
+    /// Selects the tendons active on interval `k` (those ending at or beyond its end).
+    pub fn set_interval(&mut self, k: usize) {
+        let b = self.model.breaks[k + 1];
+        self.active.clear();
+        for (i, t) in self.model.tendons.iter().enumerate() {
+            if t.end >= b && t.tendon.tension() > 0.0 {
+                self.active.push(i);
+            }
+        }
+        self.guess = None;
+    }
+
+    /// Solves the constitutive equations at `s` for the body wrench `(nb, mb)`.
+    /// Returns NaN strains if the local Newton iteration fails.
+    pub fn local(
+        &mut self,
+        s: f64,
+        props: &SectionProperties,
+        nb: &Vector3<f64>,
+        mb: &Vector3<f64>,
+        tangent: bool,
+    ) -> Local {
+        let model = self.model;
+        let rod = model.rod;
+        let wb = [nb.x, nb.y, nb.z, mb.x, mb.y, mb.z];
+        let vs = rod.rest_strain().at(s);
+        let us = rod.rest_curvature().at(s);
+        let (e, c) = rod.material().elastic_strain(
+            props,
+            model.shear_coefficient,
+            rod.inextensible(),
+            &wb,
+        );
+        if self.active.is_empty() {
+            return Local {
+                v: vs + Vector3::new(e[0], e[1], e[2]),
+                u: us + Vector3::new(e[3], e[4], e[5]),
+                tendon_force: Vector3::zeros(),
+                tendon_moment: Vector3::zeros(),
+                tangent: Tangent::Diagonal(c),
+            };
+        }
+        self.offsets.clear();
+        for &i in &self.active {
+            let t = &model.tendons[i];
+            let (r, rp) = t.tendon.routing().offset(s, props);
+            self.offsets.push((
+                Vector3::new(r[0], r[1], 0.0),
+                Vector3::new(rp[0], rp[1], 0.0),
+                t.tendon.tension() * model.factor,
+            ));
+        }
+        let cd = Vector6::from_column_slice(&c);
+        let xs = Vector6::new(vs.x, vs.y, vs.z, us.x, us.y, us.z);
+        let wv = Vector6::from_column_slice(&wb);
+        let mut x = match self.guess {
+            Some(g) => g,
+            None => {
+                // Straight tendons: t_i = e_z.
+                let mut tf = Vector3::zeros();
+                let mut tm = Vector3::zeros();
+                for (r, _, tau) in &self.offsets {
+                    tf.z += tau;
+                    tm += r.cross(&Vector3::z()) * *tau;
+                }
+                xs + cd.component_mul(&(wv - Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)))
+            }
+        };
+        let mut out = Local {
+            v: Vector3::repeat(f64::NAN),
+            u: Vector3::repeat(f64::NAN),
+            tendon_force: Vector3::zeros(),
+            tendon_moment: Vector3::zeros(),
+            tangent: Tangent::Diagonal([f64::NAN; 6]),
+        };
+        for _ in 0..LOCAL_MAX_ITERATIONS {
+            let v = Vector3::new(x[0], x[1], x[2]);
+            let u = Vector3::new(x[3], x[4], x[5]);
+            let mut tf = Vector3::zeros();
+            let mut tm = Vector3::zeros();
+            let mut dfv = Matrix3::zeros();
+            let mut dfu = Matrix3::zeros();
+            let mut dmv = Matrix3::zeros();
+            let mut dmu = Matrix3::zeros();
+            for (r, rp, tau) in &self.offsets {
+                let w = v + u.cross(r) + rp;
+                let len = w.norm();
+                let t = w / len;
+                tf += t * *tau;
+                tm += r.cross(&t) * *tau;
+                let a = (Matrix3::identity() - t * t.transpose()) * (*tau / len);
+                let rh = hat(r);
+                let ar = a * rh;
+                dfv += a;
+                dfu -= ar;
+                dmv += rh * a;
+                dmu -= rh * ar;
+            }
+            let tw = Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z);
+            let g = x - xs - cd.component_mul(&(wv - tw));
+            let mut h = Matrix6::identity();
+            for i in 0..3 {
+                for j in 0..3 {
+                    h[(i, j)] += c[i] * dfv[(i, j)];
+                    h[(i, j + 3)] += c[i] * dfu[(i, j)];
+                    h[(i + 3, j)] += c[i + 3] * dmv[(i, j)];
+                    h[(i + 3, j + 3)] += c[i + 3] * dmu[(i, j)];
+                }
+            }
+            let lu = h.lu();
+            let Some(dx) = lu.solve(&g) else {
+                return out;
+            };
+            x -= dx;
+            if !x.iter().all(|v| v.is_finite()) {
+                return out;
+            }
+            if dx.amax() <= LOCAL_TOLERANCE * (1.0 + x.amax()) {
+                out.v = Vector3::new(x[0], x[1], x[2]);
+                out.u = Vector3::new(x[3], x[4], x[5]);
+                out.tendon_force = tf;
+                out.tendon_moment = tm;
+                if tangent {
+                    if let Some(s) = lu.solve(&Matrix6::from_diagonal(&cd)) {
+                        out.tangent = Tangent::Full(s);
+                    } else {
+                        return out;
+                    }
+                }
+                // Tendon speeds |p_i'| at the solution.
+                for (k, &i) in self.active.iter().enumerate() {
+                    let (r, rp, _) = &self.offsets[k];
+                    self.tendon_speed[i] = (out.v + out.u.cross(r) + rp).norm();
+                }
+                self.guess = Some(x);
+                return out;
+            }
+        }
+        out
+    }
+
+    /// Right-hand side of the state (`N == STATE`) or of the state with sensitivities
+    /// (`N == FULL`).
+    #[inline]
+    pub fn rhs<const N: usize>(&mut self, s: f64, y: &[f64; N]) -> [f64; N] {
+        self.evaluations += 1;
+        let model = self.model;
+        let props = model.rod.section_at(s);
+        let r = rot(y);
+        let nw = v3(y, 12);
+        let mw = v3(y, 15);
+        let nb = r.tr_mul(&nw);
+        let mb = r.tr_mul(&mw);
+        let loc = self.local(s, &props, &nb, &mb, N == FULL);
+        let (v, u) = (loc.v, loc.u);
+        let pd = r * v;
+        let rd = r * hat(&u);
+        let nd = -model.distributed_force(s, &props);
+        let md = -pd.cross(&nw) - model.distributed_moment(s);
+        let mut out = [0.0; N];
+        put3(&mut out, 0, &pd);
+        out[3..12].copy_from_slice(rd.as_slice());
+        put3(&mut out, 12, &nd);
+        put3(&mut out, 15, &md);
+        if N == FULL {
+            for k in 0..6 {
+                let b = STATE + 12 * k;
+                let w = v3(y, b + 3);
+                let dn = v3(y, b + 6);
+                let dm = v3(y, b + 9);
+                let dnb = nb.cross(&w) + r.tr_mul(&dn);
+                let dmb = mb.cross(&w) + r.tr_mul(&dm);
+                let (dv, du) = match &loc.tangent {
+                    Tangent::Diagonal(c) => (
+                        Vector3::new(c[0] * dnb.x, c[1] * dnb.y, c[2] * dnb.z),
+                        Vector3::new(c[3] * dmb.x, c[4] * dmb.y, c[5] * dmb.z),
+                    ),
+                    Tangent::Full(sm) => {
+                        let d = sm * Vector6::new(dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z);
+                        (Vector3::new(d[0], d[1], d[2]), Vector3::new(d[3], d[4], d[5]))
+                    }
+                };
+                let dpd = r * (w.cross(&v) + dv);
+                let wd = w.cross(&u) + du;
+                let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
+                put3(&mut out, b, &dpd);
+                put3(&mut out, b + 3, &wd);
+                put3(&mut out, b + 9, &dmd);
+            }
+        }
+        out
+    }
+}

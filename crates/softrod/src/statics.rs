@@ -1,0 +1,724 @@
+//! Steady-state shape of a Cosserat rod with tendons and external loads, by shooting.
+//!
+//! [`solve_statics`] finds the unknown total base wrench `(N(0), M(0))` (world frame) such that
+//! the integrated internal wrench matches the tip loads, with damped Newton iterations on an
+//! exact Jacobian (variational equations integrated with the state, see `cosserat.rs`). If the
+//! direct solve fails it restarts from the unloaded rod and steps the load factor from 0 to 1
+//! (continuation). The ODE is integrated piecewise between the breaks at tendon terminations
+//! and point loads, either with fixed-step RK4 (the seed's method) or with the adaptive
+//! Dormand–Prince 5(4) pair; rotation matrices are re-orthonormalised after every step.
+//!
+//! The Newton residual and unknowns are scaled by `F = E I(0) / L²` (forces) and `F L`
+//! (moments), so [`SolveOptions::tolerance`] is dimensionless: a residual `ε` leaves a tip
+//! error of about `ε L / 3`.
+
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+use crate::cosserat::{rot, v3, Evaluator, Model, ActiveTendon, FULL, STATE};
+use crate::error::{Error, Result};
+use crate::integrate::{dp54, rk4_step, AdaptiveOptions};
+use crate::loads::Loads;
+use crate::rod::Rod;
+use crate::so3::{quaternion_xyzw, reorthonormalise};
+use crate::tendon::Tendon;
+
+/// Default number of RK4 steps over the whole rod (split among the intervals in proportion
+/// to their length, at least one each).
+pub const DEFAULT_RK4_STEPS: usize = 50;
+/// Default tolerance on the scaled shooting residual (max norm).
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+/// Default cap on Newton iterations per solve (per load step under continuation).
+pub const DEFAULT_MAX_ITERATIONS: usize = 30;
+/// Default cap on load steps under continuation.
+pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
+/// Most step halvings of the Newton line search.
+pub const MAX_LINE_SEARCH_HALVINGS: usize = 12;
+/// Sufficient-decrease constant of the line search (Armijo, on the residual norm).
+pub const ARMIJO: f64 = 1e-4;
+/// Smallest load-factor increment of the continuation before giving up.
+pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
+
+/// The ODE integrator used by the shooting method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Integrator {
+    /// Classical RK4 with `steps` equal-length steps over `[0, L]` in total (each interval
+    /// between breaks gets `max(1, round(steps * length / L))`).
+    Rk4 {
+        /// Total number of steps (>= 1).
+        steps: usize,
+    },
+    /// Adaptive Dormand–Prince 5(4) with error control on `(p, R, N, M)`.
+    Adaptive(AdaptiveOptions),
+}
+
+impl Default for Integrator {
+    fn default() -> Self {
+        Integrator::Rk4 {
+            steps: DEFAULT_RK4_STEPS,
+        }
+    }
+}
+
+/// A starting point for the shooting unknowns, taken from a previous solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WarmStart {
+    /// Total base wrench `[N(0); M(0)]` (N, N m; world frame) including the tendons' share.
+    pub base_wrench: [f64; 6],
+}
+
+/// Options of [`solve_statics`] (keyword arguments in Python).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveOptions {
+    /// ODE integrator.
+    pub integrator: Integrator,
+    /// Tolerance on the scaled residual (max norm), > 0. With the adaptive integrator the
+    /// residual is only resolved down to the integration error, `10 rtol (1 + |x|)`.
+    pub tolerance: f64,
+    /// Newton iterations per solve (per load step), >= 1.
+    pub max_iterations: usize,
+    /// Whether to fall back on load stepping when the direct solve fails.
+    pub continuation: bool,
+    /// Load steps (attempted) under continuation, >= 1.
+    pub max_load_steps: usize,
+    /// Initial guess of the base wrench; `None` starts from zero (the unloaded rod).
+    pub warm_start: Option<WarmStart>,
+    /// `true`: non-convergence is [`Error::NotConverged`]; `false`: the last iterate is
+    /// returned with `stats.converged == false`.
+    pub throw: bool,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        Self {
+            integrator: Integrator::default(),
+            tolerance: DEFAULT_TOLERANCE,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            continuation: true,
+            max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+            warm_start: None,
+            throw: true,
+        }
+    }
+}
+
+/// Solver statistics.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SolverStats {
+    /// Newton iterations (accepted steps), over all load steps.
+    pub iterations: usize,
+    /// Final scaled residual (max norm, dimensionless).
+    pub residual: f64,
+    /// Right-hand-side evaluations.
+    pub function_evaluations: usize,
+    /// Whether the residual met the tolerance.
+    pub converged: bool,
+    /// Load steps taken by the continuation (0: solved directly).
+    pub load_steps: usize,
+}
+
+/// A solved rod, sampled at the integration mesh.
+///
+/// Every array has one entry per sample. At an interval break (tendon termination, point
+/// load) the sample appears twice with the same `s`: the values just before and just after
+/// the jump. Vectors are `[x, y, z]`; rotations are body → world matrices; quaternions are
+/// scalar-last `[x, y, z, w]` with `w >= 0`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticsSolution {
+    /// Undeformed arc length (m).
+    pub s: Vec<f64>,
+    /// Backbone position (m, world), shape (N, 3).
+    pub position: Vec<[f64; 3]>,
+    /// Rotation body → world, row-major, shape (N, 3, 3).
+    pub rotation: Vec<[[f64; 3]; 3]>,
+    /// Orientation quaternion `[x, y, z, w]`, shape (N, 4).
+    pub quaternion: Vec<[f64; 4]>,
+    /// Rod's internal force `n` (N, world), excluding the tendons' tension.
+    pub n_world: Vec<[f64; 3]>,
+    /// Rod's internal moment `m` (N m, world).
+    pub m_world: Vec<[f64; 3]>,
+    /// Rod's internal force `n` in body components (N).
+    pub n_body: Vec<[f64; 3]>,
+    /// Rod's internal moment `m` in body components (N m).
+    pub m_body: Vec<[f64; 3]>,
+    /// Shear/stretch strain `v` (body, dimensionless; `(0, 0, 1)` undeformed).
+    pub v: Vec<[f64; 3]>,
+    /// Bending/twist strain `u` (body, 1/m per undeformed length).
+    pub u: Vec<[f64; 3]>,
+    /// Path length of each tendon from the base to its termination (m), `∫ |p_i'| ds`.
+    pub tendon_lengths: Vec<f64>,
+    /// Total base wrench (rod + tendons), for [`SolveOptions::warm_start`].
+    pub base_wrench: [f64; 6],
+    /// Solver statistics.
+    pub stats: SolverStats,
+}
+
+impl StaticsSolution {
+    /// Tip position (m, world).
+    pub fn tip_position(&self) -> [f64; 3] {
+        self.position.last().copied().unwrap_or([f64::NAN; 3])
+    }
+
+    /// Warm start for a nearby problem.
+    pub fn warm_start(&self) -> WarmStart {
+        WarmStart {
+            base_wrench: self.base_wrench,
+        }
+    }
+}
+
+/// A recorded mesh node.
+#[derive(Clone, Copy)]
+struct Node {
+    s: f64,
+    interval: usize,
+    y: [f64; STATE],
+}
+
+/// Per-interval step counts of the RK4 plan.
+fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
+    let l = breaks[breaks.len() - 1];
+    breaks
+        .windows(2)
+        .map(|w| ((steps as f64 * (w[1] - w[0]) / l).round() as usize).max(1))
+        .collect()
+}
+
+fn head(y: &[f64]) -> [f64; STATE] {
+    let mut h = [0.0; STATE];
+    h.copy_from_slice(&y[..STATE]);
+    h
+}
+
+fn project<const N: usize>(y: &mut [f64; N]) {
+    let r = reorthonormalise(&rot(y));
+    y[3..12].copy_from_slice(r.as_slice());
+}
+
+/// The outcome of one shooting pass.
+struct Pass {
+    residual: Vector6<f64>,
+    jacobian: Option<Matrix6<f64>>,
+}
+
+/// Scratch shared by the passes of one solve.
+struct Workspace {
+    nodes: Vec<Node>,
+    tendon_lengths: Vec<f64>,
+}
+
+/// Integrates from the base with unknowns `x` over all intervals, recording nodes.
+fn shoot<const N: usize>(
+    ev: &mut Evaluator<'_, '_>,
+    x: &Vector6<f64>,
+    integrator: &Integrator,
+    plan: &[usize],
+    ws: &mut Workspace,
+) -> Result<Pass> {
+    let model = ev.model;
+    let breaks = &model.breaks;
+    ws.nodes.clear();
+    ws.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
+    let mut y: [f64; N] = model.initial(x);
+    for k in 0..breaks.len() - 1 {
+        let (a, b) = (breaks[k], breaks[k + 1]);
+        ev.set_interval(k);
+        ws.nodes.push(Node {
+            s: a,
+            interval: k,
+            y: head(&y),
+        });
+        match integrator {
+            Integrator::Rk4 { .. } => {
+                let n = plan[k];
+                let h = (b - a) / n as f64;
+                const W: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+                for i in 0..n {
+                    let t = a + h * i as f64;
+                    let mut stage = 0usize;
+                    let lengths = &mut ws.tendon_lengths;
+                    let mut f = |s: f64, yy: &[f64; N]| {
+                        let d = ev.rhs(s, yy);
+                        let wgt = W[stage] * h;
+                        for (l, sp) in lengths.iter_mut().zip(ev.tendon_speed.iter()) {
+                            *l += wgt * sp;
+                        }
+                        stage += 1;
+                        d
+                    };
+                    y = rk4_step(&mut f, t, &y, h);
+                    project(&mut y);
+                    if !y[..STATE].iter().all(|v| v.is_finite()) {
+                        return Err(Error::NotConverged {
+                            what: "rod integration: non-finite state".into(),
+                            iterations: i,
+                            residual: f64::INFINITY,
+                        });
+                    }
+                    ws.nodes.push(Node {
+                        s: if i + 1 == n { b } else { t + h },
+                        interval: k,
+                        y: head(&y),
+                    });
+                }
+            }
+            Integrator::Adaptive(opts) => {
+                let sol = dp54(|s, yy: &[f64; N]| ev.rhs(s, yy), a, y, b, *opts, STATE, project)?;
+                // Tendon lengths: 3-point Gauss–Legendre on each step with the dense output.
+                const G: [(f64, f64); 3] = [
+                    (0.112_701_665_379_258_31, 5.0 / 18.0),
+                    (0.5, 8.0 / 18.0),
+                    (0.887_298_334_620_741_7, 5.0 / 18.0),
+                ];
+                for i in 1..sol.t.len() {
+                    let (t0, t1) = (sol.t[i - 1], sol.t[i]);
+                    if !ws.tendon_lengths.is_empty() {
+                        for (c, wg) in G {
+                            let s = t0 + c * (t1 - t0);
+                            let yy = sol.eval(s);
+                            let r = rot(&yy);
+                            let props = model.rod.section_at(s);
+                            let nb = r.tr_mul(&v3(&yy, 12));
+                            let mb = r.tr_mul(&v3(&yy, 15));
+                            ev.local(s, &props, &nb, &mb, false);
+                            for (l, sp) in ws.tendon_lengths.iter_mut().zip(ev.tendon_speed.iter())
+                            {
+                                *l += wg * (t1 - t0) * sp;
+                            }
+                        }
+                    }
+                    ws.nodes.push(Node {
+                        s: t1,
+                        interval: k,
+                        y: head(&sol.y[i]),
+                    });
+                }
+                ev.evaluations += 0;
+                y = sol.y[sol.y.len() - 1];
+            }
+        }
+        if k + 2 < breaks.len() {
+            model.jump(b, &mut y);
+        }
+        // Inactive tendons keep their speed from the last interval; zero them for the next.
+        for (i, t) in model.tendons.iter().enumerate() {
+            if t.end <= b {
+                ev.tendon_speed[i] = 0.0;
+            }
+        }
+    }
+    let (residual, jacobian) = model.residual(&y);
+    Ok(Pass { residual, jacobian })
+}
+
+fn shoot_any(
+    ev: &mut Evaluator<'_, '_>,
+    x: &Vector6<f64>,
+    sens: bool,
+    integrator: &Integrator,
+    plan: &[usize],
+    ws: &mut Workspace,
+) -> Result<Pass> {
+    if sens {
+        shoot::<FULL>(ev, x, integrator, plan, ws)
+    } else {
+        shoot::<STATE>(ev, x, integrator, plan, ws)
+    }
+}
+
+/// Outcome of the Newton iteration at one load factor.
+struct NewtonOut {
+    x: Vector6<f64>,
+    residual: f64,
+    converged: bool,
+    iterations: usize,
+    /// Whether the workspace holds the pass at `x`.
+    recorded: bool,
+}
+
+fn norm(r: &Vector6<f64>) -> f64 {
+    if r.iter().all(|v| v.is_finite()) {
+        r.amax()
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Damped Newton on the scaled base wrench, from `x0`.
+fn newton(
+    ev: &mut Evaluator<'_, '_>,
+    x0: Vector6<f64>,
+    opts: &SolveOptions,
+    plan: &[usize],
+    ws: &mut Workspace,
+) -> NewtonOut {
+    let tol_of = |x: &Vector6<f64>| match opts.integrator {
+        Integrator::Rk4 { .. } => opts.tolerance,
+        Integrator::Adaptive(a) => opts.tolerance.max(10.0 * a.rtol * (1.0 + x.amax())),
+    };
+    let mut x = x0;
+    let mut out = NewtonOut {
+        x,
+        residual: f64::INFINITY,
+        converged: false,
+        iterations: 0,
+        recorded: false,
+    };
+    // A cheap first pass without sensitivities: often already converged (warm starts,
+    // tendon-only loading, for which the total base wrench is exactly zero).
+    let (mut r, mut rn) = match shoot_any(ev, &x, false, &opts.integrator, plan, ws) {
+        Ok(p) => (p.residual, norm(&p.residual)),
+        Err(_) => (Vector6::repeat(f64::NAN), f64::INFINITY),
+    };
+    out.residual = rn;
+    out.recorded = rn.is_finite();
+    if rn <= tol_of(&x) {
+        out.converged = true;
+        return out;
+    }
+    let mut jac = match shoot_any(ev, &x, true, &opts.integrator, plan, ws) {
+        Ok(p) if norm(&p.residual).is_finite() => {
+            r = p.residual;
+            rn = norm(&r);
+            p.jacobian
+        }
+        _ => None,
+    };
+    out.recorded = jac.is_some();
+    for _ in 0..opts.max_iterations {
+        let Some(j) = jac else {
+            break;
+        };
+        let Some(dx) = j.lu().solve(&(-r)) else {
+            break;
+        };
+        if !dx.iter().all(|v| v.is_finite()) {
+            break;
+        }
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
+            let xt = x + dx * lambda;
+            if let Ok(p) = shoot_any(ev, &xt, true, &opts.integrator, plan, ws) {
+                let rt = norm(&p.residual);
+                if rt <= (1.0 - ARMIJO * lambda) * rn || rt <= tol_of(&xt) {
+                    x = xt;
+                    r = p.residual;
+                    rn = rt;
+                    jac = p.jacobian;
+                    accepted = true;
+                    break;
+                }
+            }
+            lambda *= 0.5;
+        }
+        out.recorded = accepted;
+        if !accepted {
+            break;
+        }
+        out.iterations += 1;
+        out.x = x;
+        out.residual = rn;
+        if rn <= tol_of(&x) {
+            out.converged = true;
+            return out;
+        }
+    }
+    out.x = x;
+    out.residual = rn;
+    out
+}
+
+/// Validates the inputs and builds the model at load factor 1.
+fn build_model<'a>(
+    rod: &'a Rod,
+    tendons: &'a [Tendon],
+    loads: &'a Loads,
+) -> Result<Model<'a>> {
+    let l = rod.length();
+    loads.validate(l, rod.density())?;
+    let mut prepared = Vec::with_capacity(tendons.len());
+    let mut breaks = vec![0.0, l];
+    for (i, t) in tendons.iter().enumerate() {
+        let end = t.end().unwrap_or(l);
+        if !(end.is_finite() && end > 0.0 && end <= l) {
+            return Err(Error::invalid(
+                format!("tendons[{i}].end"),
+                end,
+                format!("in (0, length] = (0, {l}] m"),
+            ));
+        }
+        if t.tension() < 0.0 || !t.tension().is_finite() {
+            return Err(Error::invalid(
+                format!("tendons[{i}].tension"),
+                t.tension(),
+                "finite and >= 0 N",
+            ));
+        }
+        breaks.push(end);
+        prepared.push(ActiveTendon { tendon: t, end });
+    }
+    for p in &loads.point_loads {
+        breaks.push(p.s);
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    let props0 = rod.section_at(0.0);
+    let f_ref = rod.material().bending_stiffness(&props0) / (l * l);
+    if !(f_ref.is_finite() && f_ref > 0.0) {
+        return Err(Error::invalid("section(0)", format!("{props0:?}"), "positive and finite"));
+    }
+    // Tendon offsets must be finite (user functions) and inside... finite at the checks.
+    for (i, t) in tendons.iter().enumerate() {
+        let end = prepared[i].end;
+        for k in 0..=crate::rod::FUNCTION_CHECKS {
+            let s = end * k as f64 / crate::rod::FUNCTION_CHECKS as f64;
+            let (r, rp) = t.routing().offset(s, &rod.section_at(s));
+            if !(r.iter().chain(rp.iter()).all(|v| v.is_finite())) {
+                return Err(Error::invalid(
+                    format!("tendons[{i}].offset({s})"),
+                    format!("{r:?}, {rp:?}"),
+                    "finite",
+                ));
+            }
+        }
+    }
+    Ok(Model {
+        rod,
+        tendons: prepared,
+        loads,
+        shear_coefficient: rod.shear_coefficient(),
+        rho_g: rod
+            .density()
+            .filter(|_| loads.gravity != Vector3::zeros())
+            .map(|rho| loads.gravity * rho),
+        factor: 1.0,
+        f_ref,
+        length: l,
+        breaks,
+    })
+}
+
+fn check_options(opts: &SolveOptions) -> Result<()> {
+    match opts.integrator {
+        Integrator::Rk4 { steps } => {
+            if steps == 0 {
+                return Err(Error::invalid("integrator.steps", steps, ">= 1"));
+            }
+        }
+        Integrator::Adaptive(a) => {
+            a.validated()?;
+        }
+    }
+    if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
+        return Err(Error::invalid("tolerance", opts.tolerance, "finite and > 0"));
+    }
+    if opts.max_iterations == 0 {
+        return Err(Error::invalid("max_iterations", opts.max_iterations, ">= 1"));
+    }
+    if opts.max_load_steps == 0 {
+        return Err(Error::invalid("max_load_steps", opts.max_load_steps, ">= 1"));
+    }
+    if let Some(w) = &opts.warm_start {
+        for (k, v) in w.base_wrench.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    format!("warm_start.base_wrench[{k}]"),
+                    v,
+                    "finite",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves the statics of `rod` actuated by `tendons` under `loads`
+/// (`solve_statics(rod, tendons=(), loads=None, ...)` in Python).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the offending field (loads, tendon terminations outside
+/// `(0, L]`, options); [`Error::NotConverged`] with the Newton iterations and final scaled
+/// residual if the shooting does not converge and `options.throw` is true.
+pub fn solve_statics(
+    rod: &Rod,
+    tendons: &[Tendon],
+    loads: &Loads,
+    options: &SolveOptions,
+) -> Result<StaticsSolution> {
+    check_options(options)?;
+    let mut model = build_model(rod, tendons, loads)?;
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(&model.breaks, steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let fm = model.f_ref * model.length;
+    let x0 = match &options.warm_start {
+        Some(w) => {
+            let b = &w.base_wrench;
+            Vector6::new(
+                b[0] / model.f_ref,
+                b[1] / model.f_ref,
+                b[2] / model.f_ref,
+                b[3] / fm,
+                b[4] / fm,
+                b[5] / fm,
+            )
+        }
+        None => Vector6::zeros(),
+    };
+    let mut ws = Workspace {
+        nodes: Vec::new(),
+        tendon_lengths: vec![0.0; tendons.len()],
+    };
+    let mut evaluations = 0usize;
+    let mut stats = SolverStats::default();
+
+    let direct = {
+        let mut ev = Evaluator::new(&model);
+        let out = newton(&mut ev, x0, options, &plan, &mut ws);
+        evaluations += ev.evaluations;
+        out
+    };
+    stats.iterations = direct.iterations;
+    let mut result = direct;
+
+    if !result.converged && options.continuation {
+        // Load stepping from the unloaded rod (x = 0 is exact at load factor 0).
+        let mut lambda = 0.0f64;
+        let mut dl = 0.25f64;
+        let mut x = Vector6::zeros();
+        let mut steps = 0usize;
+        let mut last = None;
+        while steps < options.max_load_steps {
+            let target = (lambda + dl).min(1.0);
+            model.factor = target;
+            let mut ev = Evaluator::new(&model);
+            let out = newton(&mut ev, x, options, &plan, &mut ws);
+            evaluations += ev.evaluations;
+            stats.iterations += out.iterations;
+            steps += 1;
+            if out.converged {
+                lambda = target;
+                x = out.x;
+                let done = lambda >= 1.0;
+                last = Some(out);
+                if done {
+                    break;
+                }
+                dl = (dl * 2.0).min(0.5);
+            } else {
+                dl *= 0.5;
+                last = Some(out);
+                if dl < MIN_LOAD_INCREMENT {
+                    break;
+                }
+            }
+        }
+        stats.load_steps = steps;
+        if let Some(out) = last {
+            if out.converged && lambda >= 1.0 {
+                result = out;
+            } else if model.factor < 1.0 || !out.converged {
+                result = NewtonOut {
+                    converged: false,
+                    ..out
+                };
+            }
+        }
+    }
+    // Make sure the workspace holds the pass at the final unknowns, at full load.
+    if (model.factor - 1.0).abs() > 0.0 || !result.recorded {
+        model.factor = if result.converged { 1.0 } else { model.factor };
+        let mut ev = Evaluator::new(&model);
+        if let Ok(p) = shoot::<STATE>(&mut ev, &result.x, &options.integrator, &plan, &mut ws) {
+            if !result.converged {
+                result.residual = norm(&p.residual);
+            }
+        }
+        evaluations += ev.evaluations;
+    }
+    stats.residual = result.residual;
+    stats.converged = result.converged;
+    stats.function_evaluations = evaluations;
+    if !result.converged && options.throw {
+        return Err(Error::NotConverged {
+            what: "shooting Newton (Cosserat rod statics)".into(),
+            iterations: stats.iterations,
+            residual: result.residual,
+        });
+    }
+    let x = result.x;
+    let base_wrench = [
+        x[0] * model.f_ref,
+        x[1] * model.f_ref,
+        x[2] * model.f_ref,
+        x[3] * fm,
+        x[4] * fm,
+        x[5] * fm,
+    ];
+    Ok(assemble(&model, &ws, base_wrench, stats))
+}
+
+fn arr(v: &Vector3<f64>) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+fn rows(r: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    [
+        [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
+        [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
+        [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
+    ]
+}
+
+/// Derived quantities at the recorded nodes.
+fn assemble(
+    model: &Model<'_>,
+    ws: &Workspace,
+    base_wrench: [f64; 6],
+    stats: SolverStats,
+) -> StaticsSolution {
+    let n = ws.nodes.len();
+    let mut sol = StaticsSolution {
+        s: Vec::with_capacity(n),
+        position: Vec::with_capacity(n),
+        rotation: Vec::with_capacity(n),
+        quaternion: Vec::with_capacity(n),
+        n_world: Vec::with_capacity(n),
+        m_world: Vec::with_capacity(n),
+        n_body: Vec::with_capacity(n),
+        m_body: Vec::with_capacity(n),
+        v: Vec::with_capacity(n),
+        u: Vec::with_capacity(n),
+        tendon_lengths: ws.tendon_lengths.clone(),
+        base_wrench,
+        stats,
+    };
+    let mut ev = Evaluator::new(model);
+    let mut current = usize::MAX;
+    for node in &ws.nodes {
+        if node.interval != current {
+            ev.set_interval(node.interval);
+            current = node.interval;
+        }
+        let y = &node.y;
+        let r = rot(y);
+        let nb_tot = r.tr_mul(&v3(y, 12));
+        let mb_tot = r.tr_mul(&v3(y, 15));
+        let props = model.rod.section_at(node.s);
+        let loc = ev.local(node.s, &props, &nb_tot, &mb_tot, false);
+        let nb = nb_tot - loc.tendon_force;
+        let mb = mb_tot - loc.tendon_moment;
+        sol.s.push(node.s);
+        sol.position.push(arr(&v3(y, 0)));
+        sol.rotation.push(rows(&r));
+        sol.quaternion.push(quaternion_xyzw(&r));
+        sol.n_world.push(arr(&(r * nb)));
+        sol.m_world.push(arr(&(r * mb)));
+        sol.n_body.push(arr(&nb));
+        sol.m_body.push(arr(&mb));
+        sol.v.push(arr(&loc.v));
+        sol.u.push(arr(&loc.u));
+    }
+    sol
+}

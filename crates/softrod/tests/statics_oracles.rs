@@ -1,0 +1,342 @@
+//! Cosserat-rod statics against independent oracles: closed-form arcs, the Bisshopp–Drucker
+//! elastica (elliptic integrals computed here with Carlson's forms), and the tendon
+//! closed form.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::f64::consts::PI;
+
+use softrod::integrate::AdaptiveOptions;
+use softrod::nalgebra::{Matrix3, Vector3};
+use softrod::{
+    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon,
+};
+
+fn rk4(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        tolerance: 1e-13,
+        ..Default::default()
+    }
+}
+
+fn adaptive(rtol: f64) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
+            rtol,
+            atol: rtol * 1e-3,
+            max_steps: 1_000_000,
+        }),
+        tolerance: 1e-13,
+        ..Default::default()
+    }
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+#[test]
+fn pure_tip_moment_gives_circular_arc() {
+    let (l, r, e): (f64, f64, f64) = (0.5, 0.005, 2e9);
+    let ei = e * PI * r.powi(4) / 4.0;
+    let kappa = 1.5 / l; // 1.5 rad of bending
+    let mtip = kappa * ei;
+    for inextensible in [true, false] {
+        let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.3).unwrap())
+            .unwrap()
+            .with_inextensible(inextensible);
+        let sol = solve_statics(
+            &rod,
+            &[],
+            &Loads::tip_moment(Vector3::new(mtip, 0.0, 0.0)),
+            &rk4(400),
+        )
+        .unwrap();
+        // u = (kappa, 0, 0): the tangent turns from +z toward -y.
+        let exact = [0.0, -(1.0 - (kappa * l).cos()) / kappa, (kappa * l).sin() / kappa];
+        let err = dist(sol.tip_position(), exact);
+        println!("arc inextensible={inextensible}: tip error {err:.3e} m, iterations {}", sol.stats.iterations);
+        assert!(err < 1e-10, "tip error {err}");
+        for u in &sol.u {
+            assert!((u[0] - kappa).abs() < 1e-9 * kappa && u[1].abs() < 1e-9 && u[2].abs() < 1e-9);
+        }
+        assert!(sol.stats.converged);
+    }
+}
+
+// ---- Elliptic integrals (Carlson's symmetric forms, duplication + series). ----
+
+fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
+    loop {
+        let a = (x + y + z) / 3.0;
+        let (dx, dy, dz) = (1.0 - x / a, 1.0 - y / a, 1.0 - z / a);
+        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
+            let e2 = dx * dy - dz * dz;
+            let e3 = dx * dy * dz;
+            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / a.sqrt();
+        }
+        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        let lam = sx * sy + sy * sz + sz * sx;
+        x = (x + lam) / 4.0;
+        y = (y + lam) / 4.0;
+        z = (z + lam) / 4.0;
+    }
+}
+
+fn carlson_rd(mut x: f64, mut y: f64, mut z: f64) -> f64 {
+    let mut sum = 0.0;
+    let mut fac = 1.0;
+    loop {
+        let a = (x + y + 3.0 * z) / 5.0;
+        let (dx, dy, dz) = ((a - x) / a, (a - y) / a, (a - z) / a);
+        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
+            let ea = dx * dy;
+            let eb = dz * dz;
+            let ec = ea - eb;
+            let ed = ea - 6.0 * eb;
+            let ee = ed + ec + ec;
+            return 3.0 * sum
+                + fac
+                    * (1.0
+                        + ed * (-3.0 / 14.0 + 9.0 / 88.0 * ed - 9.0 / 52.0 * dz * ee)
+                        + dz * (ee / 6.0 + dz * (-9.0 / 22.0 * ec + 3.0 / 26.0 * dz * ea)))
+                    / (a * a.sqrt());
+        }
+        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        let lam = sx * (sy + sz) + sy * sz;
+        sum += fac / (sz * (z + lam));
+        fac *= 0.25;
+        x = (x + lam) / 4.0;
+        y = (y + lam) / 4.0;
+        z = (z + lam) / 4.0;
+    }
+}
+
+/// Incomplete elliptic integral of the first kind `F(phi, k)`.
+fn ell_f(phi: f64, k: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    s * carlson_rf(c * c, 1.0 - k * k * s * s, 1.0)
+}
+
+/// Incomplete elliptic integral of the second kind `E(phi, k)`.
+fn ell_e(phi: f64, k: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    let q = 1.0 - k * k * s * s;
+    s * carlson_rf(c * c, q, 1.0) - k * k * s.powi(3) / 3.0 * carlson_rd(c * c, q, 1.0)
+}
+
+/// Composite Gauss–Legendre (5 points, `n` panels) of `f` over `[a, b]`: a check of the
+/// elliptic integrals that shares nothing with Carlson's forms.
+fn quad(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+    let x = [0.0, 0.538_469_310_105_683, -0.538_469_310_105_683, 0.906_179_845_938_664, -0.906_179_845_938_664];
+    let w = [0.568_888_888_888_889, 0.478_628_670_499_366, 0.478_628_670_499_366, 0.236_926_885_056_189, 0.236_926_885_056_189];
+    let h = (b - a) / n as f64;
+    let mut sum = 0.0;
+    for i in 0..n {
+        let c = a + h * (i as f64 + 0.5);
+        for j in 0..5 {
+            sum += w[j] * f(c + 0.5 * h * x[j]);
+        }
+    }
+    sum * 0.5 * h
+}
+
+#[test]
+fn elliptic_integrals_match_quadrature_and_tables() {
+    // K(m = 1/2) and E(m = 1/2) (Abramowitz & Stegun table 17.1).
+    let k = 0.5f64.sqrt();
+    assert!((ell_f(PI / 2.0, k) - 1.854_074_677_301_372).abs() < 1e-14);
+    assert!((ell_e(PI / 2.0, k) - 1.350_643_881_047_675).abs() < 1e-14);
+    for (phi, k) in [(0.3, 0.9), (1.2, 0.99), (0.8, 0.75)] {
+        let f = quad(|t| 1.0 / (1.0 - k * k * t.sin().powi(2)).sqrt(), 0.0, phi, 200);
+        let e = quad(|t| (1.0 - k * k * t.sin().powi(2)).sqrt(), 0.0, phi, 200);
+        assert!((ell_f(phi, k) - f).abs() < 1e-13, "F({phi},{k})");
+        assert!((ell_e(phi, k) - e).abs() < 1e-13, "E({phi},{k})");
+    }
+}
+
+/// Bisshopp–Drucker: tip of an inextensible cantilever of length 1 under a transverse dead
+/// load with `alpha = P L² / (E I)`: (transverse deflection, axial projection) / L.
+fn bisshopp_drucker(alpha: f64) -> (f64, f64) {
+    let phi1 = |k: f64| (1.0 / (k * 2.0f64.sqrt())).min(1.0).asin();
+    let g = |k: f64| ell_f(PI / 2.0, k) - ell_f(phi1(k), k) - alpha.sqrt();
+    let (mut lo, mut hi) = (0.5f64.sqrt(), 1.0 - 1e-15);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if g(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let k = 0.5 * (lo + hi);
+    let p1 = phi1(k);
+    let delta = 1.0 - 2.0 * (ell_e(PI / 2.0, k) - ell_e(p1, k)) / alpha.sqrt();
+    let x = (2.0 * (2.0 * k * k - 1.0) / alpha).sqrt();
+    (delta, x)
+}
+
+#[test]
+fn bisshopp_drucker_reference_matches_published_values() {
+    // Bisshopp & Drucker (1945), table: alpha = 1 -> vertical deflection 0.3017 L, and
+    // the small-load limit alpha / 3.
+    let (d1, _) = bisshopp_drucker(1.0);
+    assert!((d1 - 0.3017).abs() < 1e-4, "{d1}");
+    let (ds, xs) = bisshopp_drucker(1e-4);
+    assert!((ds - 1e-4 / 3.0).abs() < 1e-9 && (xs - 1.0).abs() < 1e-8);
+}
+
+#[test]
+fn tip_loaded_cantilever_matches_elastica() {
+    let (l, r, e): (f64, f64, f64) = (0.3, 0.002, 5e6);
+    let ei = e * PI * r.powi(4) / 4.0;
+    let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.3).unwrap())
+        .unwrap()
+        .with_inextensible(true);
+    println!("alpha   delta/L (ref)        x/L (ref)         tip error / L   iters  load steps");
+    for alpha in [0.1, 0.3, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0] {
+        let p = alpha * ei / (l * l);
+        let sol = solve_statics(
+            &rod,
+            &[],
+            &Loads::tip_force(Vector3::new(p, 0.0, 0.0)),
+            &adaptive(1e-12),
+        )
+        .unwrap();
+        let (d, x) = bisshopp_drucker(alpha);
+        let tip = sol.tip_position();
+        let err = dist(tip, [d * l, 0.0, x * l]) / l;
+        println!(
+            "{alpha:5.1}  {d:.12}  {x:.12}  {err:.3e}      {:3}   {}",
+            sol.stats.iterations, sol.stats.load_steps
+        );
+        assert!(err < 1e-7, "alpha {alpha}: tip error {err} L");
+    }
+}
+
+#[test]
+fn constant_offset_tendon_gives_constant_curvature_and_strain() {
+    let (l, r, e, nu): (f64, f64, f64, f64) = (0.25, 0.004, 3e6, 0.45);
+    let (tau, d) = (2.0, 0.003);
+    let mat = LinearElastic::new(e, nu).unwrap();
+    let rod = Rod::new(l, Section::circular(r).unwrap(), mat).unwrap();
+    let ei = e * PI * r.powi(4) / 4.0;
+    let ea = e * PI * r * r;
+    let kappa = tau * d / ei;
+    let eps = -tau / ea;
+    let tendon = Tendon::constant([d, 0.0], tau, None).unwrap();
+    let sol = solve_statics(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
+    for (u, v) in sol.u.iter().zip(&sol.v) {
+        assert!((u[1] - kappa).abs() <= 1e-10 * kappa, "u {u:?} vs {kappa}");
+        assert!(u[0].abs() < 1e-10 * kappa && u[2].abs() < 1e-10 * kappa);
+        assert!((v[2] - 1.0 - eps).abs() < 1e-10 * eps.abs(), "v {v:?} vs {eps}");
+        assert!(v[0].abs() < 1e-12 && v[1].abs() < 1e-12);
+    }
+    // Arc of curvature kappa per undeformed length, stretched by 1 + eps, toward the tendon.
+    let exact = [
+        (1.0 + eps) * (1.0 - (kappa * l).cos()) / kappa,
+        0.0,
+        (1.0 + eps) * (kappa * l).sin() / kappa,
+    ];
+    let err = dist(sol.tip_position(), exact);
+    println!("tendon arc: kappa {kappa:.6} 1/m, eps {eps:.3e}, tip error {err:.3e} m");
+    assert!(err < 1e-10);
+    // The tendon runs parallel to the backbone at distance d: length (1 + eps - kappa d) L.
+    let lt = (1.0 + eps - kappa * d) * l;
+    assert!((sol.tendon_lengths[0] - lt).abs() < 1e-12, "{} vs {lt}", sol.tendon_lengths[0]);
+    // Tendon-only loading: the total base wrench is zero and no Newton step is needed.
+    assert_eq!(sol.stats.iterations, 0);
+    // The rod's own internal force is the tendon's compression.
+    assert!((sol.n_body[0][2] + tau).abs() < 1e-12);
+}
+
+#[test]
+fn base_pose_rotation_rotates_the_solution() {
+    use softrod::{Pose, Routing};
+    let (l, r, e) = (0.3, 0.003, 1e7);
+    let mat = LinearElastic::new(e, 0.4).unwrap();
+    let tendon = Tendon::new(
+        Routing::Helical {
+            radius: 0.002,
+            pitch: 0.2,
+            phase: 0.3,
+        },
+        1.5,
+        Some(0.25),
+    )
+    .unwrap();
+    let q = softrod::so3::exp_so3(&Vector3::new(0.7, -1.9, 0.4));
+    let t0 = Vector3::new(0.1, -0.2, 0.05);
+    let f = Vector3::new(0.02, -0.05, 0.01);
+    let base = Rod::new(l, Section::tapered_circular(r, 0.6 * r).unwrap(), mat).unwrap();
+    let rotated = base.clone().with_base_pose(Pose::new(t0, q).unwrap());
+    let mut loads = Loads::tip_force(f);
+    let mut loads_q = Loads::tip_force(q * f);
+    loads.point_loads.push(softrod::PointLoad::force(0.1, Vector3::new(0.0, 0.03, 0.0)));
+    loads_q.point_loads.push(softrod::PointLoad::force(0.1, q * Vector3::new(0.0, 0.03, 0.0)));
+    let a = solve_statics(&base, &[tendon.clone()], &loads, &rk4(60)).unwrap();
+    let b = solve_statics(&rotated, &[tendon], &loads_q, &rk4(60)).unwrap();
+    assert_eq!(a.s.len(), b.s.len());
+    let mut worst: f64 = 0.0;
+    for i in 0..a.s.len() {
+        let pa = Vector3::from(a.position[i]);
+        let pb = Vector3::from(b.position[i]);
+        worst = worst.max((q * pa + t0 - pb).amax());
+        let ra = Matrix3::from_fn(|r, c| a.rotation[i][r][c]);
+        let rb = Matrix3::from_fn(|r, c| b.rotation[i][r][c]);
+        worst = worst.max((q * ra - rb).amax());
+        for k in 0..3 {
+            worst = worst.max((a.u[i][k] - b.u[i][k]).abs() * l);
+        }
+    }
+    println!("rotation invariance: worst difference {worst:.3e}");
+    assert!(worst < 1e-12, "{worst}");
+    assert!((a.tendon_lengths[0] - b.tendon_lengths[0]).abs() < 1e-14);
+}
+
+#[test]
+fn helical_tendon_bends_out_of_plane_with_its_handedness() {
+    use softrod::Routing;
+    let (l, r, e): (f64, f64, f64) = (0.2, 0.002, 2e8);
+    let ei = e * PI * r.powi(4) / 4.0;
+    let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.3).unwrap())
+        .unwrap();
+    let (rho, pitch) = (0.0015, 0.4);
+    let omega = 2.0 * PI / pitch;
+    let tau = 1e-3 * ei / (rho * l); // small: tip rotation ~ 1e-3 rad
+    let helix = |p: f64| {
+        let t = Tendon::new(
+            Routing::Helical {
+                radius: rho,
+                pitch: p,
+                phase: 0.0,
+            },
+            tau,
+            None,
+        )
+        .unwrap();
+        solve_statics(&rod, &[t], &Loads::default(), &rk4(200)).unwrap()
+    };
+    let right = helix(pitch);
+    let left = helix(-pitch);
+    // Linear theory: (x, y)'' = kappa (cos ws, sin ws), kappa = tau rho / EI.
+    let kappa = tau * rho / ei;
+    let lin = [
+        kappa * (1.0 - (omega * l).cos()) / (omega * omega),
+        kappa * (l / omega - (omega * l).sin() / (omega * omega)),
+    ];
+    let tr = right.tip_position();
+    let tl = left.tip_position();
+    println!("helical: right-handed tip {tr:?}, left-handed tip {tl:?}, linear {lin:?}");
+    // Out of plane, toward +y for the right-handed helix, mirror image for the left-handed.
+    assert!(tr[1] > 0.0 && tl[1] < 0.0);
+    assert!((tr[0] - tl[0]).abs() < 1e-15 && (tr[1] + tl[1]).abs() < 1e-15 && (tr[2] - tl[2]).abs() < 1e-15);
+    // Agreement with the linear theory to the order of the neglected terms (kappa L ~ 1e-3).
+    for k in 0..2 {
+        assert!((tr[k] - lin[k]).abs() < 5e-3 * lin[0].hypot(lin[1]), "{k}: {} vs {}", tr[k], lin[k]);
+    }
+    // And a visible twist appears (nonzero u_z), of opposite sign for the mirror image.
+    let uz_r = right.u[right.u.len() / 2][2];
+    let uz_l = left.u[left.u.len() / 2][2];
+    assert!(uz_r != 0.0 && (uz_r + uz_l).abs() < 1e-12 * uz_r.abs().max(1e-300));
+}
