@@ -26,11 +26,7 @@ pub struct BackboneDistance {
 fn arm_index(points: &[f64], dim: usize, name: &str) -> Result<Vec<f64>> {
     let n = points.len() / dim;
     if n < 2 {
-        return Err(Error::invalid(
-            format!("{name}.shape[0]"),
-            n,
-            ">= 2 points",
-        ));
+        return Err(Error::invalid(format!("{name}.shape[0]"), n, ">= 2 points"));
     }
     if let Some(i) = points.iter().position(|v| !v.is_finite()) {
         return Err(Error::invalid(
@@ -71,7 +67,11 @@ fn resample(points: &[f64], dim: usize, u: &[f64], targets: &[f64]) -> Vec<f64> 
             seg += 1;
         }
         let (u0, u1) = (u[seg], u[seg + 1]);
-        let w = if u1 > u0 { ((t - u0) / (u1 - u0)).clamp(0.0, 1.0) } else { 0.0 };
+        let w = if u1 > u0 {
+            ((t - u0) / (u1 - u0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         for j in 0..dim {
             let a = points[seg * dim + j];
             let b = points[(seg + 1) * dim + j];
@@ -140,6 +140,7 @@ pub fn backbone_distance(
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
@@ -170,8 +171,8 @@ mod tests {
     fn bad_inputs_are_named() {
         let e = backbone_distance(&[0.0, 0.0], &[0.0, 0.0, 1.0, 1.0], 2, None).unwrap_err();
         assert!(matches!(e, Error::InvalidParameter { ref name, .. } if name == "a.shape[0]"));
-        let e = backbone_distance(&[0.0, 0.0, 0.0, 0.0], &[0.0, 0.0, 1.0, 1.0], 2, None)
-            .unwrap_err();
+        let e =
+            backbone_distance(&[0.0, 0.0, 0.0, 0.0], &[0.0, 0.0, 1.0, 1.0], 2, None).unwrap_err();
         assert!(matches!(e, Error::InvalidParameter { ref name, .. } if name == "a length"));
         let e = backbone_distance(&[0.0, f64::NAN, 1.0, 0.0], &[0.0, 0.0, 1.0, 1.0], 2, None)
             .unwrap_err();

@@ -57,7 +57,11 @@ pub fn check_positive(name: &str, value: f64, unit: &str) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(name, value, format!("finite and > 0 {unit}")))
+        Err(Error::invalid(
+            name,
+            value,
+            format!("finite and > 0 {unit}"),
+        ))
     }
 }
 
@@ -69,7 +73,11 @@ pub fn check_non_negative(name: &str, value: f64, unit: &str) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(name, value, format!("finite and >= 0 {unit}")))
+        Err(Error::invalid(
+            name,
+            value,
+            format!("finite and >= 0 {unit}"),
+        ))
     }
 }
 

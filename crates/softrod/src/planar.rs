@@ -15,9 +15,11 @@
 //! obtained from the published final-value ODE (with the final value's typo corrected,
 //! `R(L)^4`), integrated from the anchor to the base with [`crate::integrate::bs23`].
 //!
-//! The backbone (`theta`, `x`, `y`) is integrated by a 4-stage Lobatto IIIA collocation
-//! (order 6) on panels no longer than the output spacing and short enough that the tangent turns
-//! by at most [`MAX_PANEL_TURN`] rad per panel; the panels break at the anchor, where `k` jumps.
+//! The backbone (`theta`, `x`, `y`) is integrated by Lobatto IIIA collocation on panels no
+//! longer than the output spacing: 3 stages (order 4) where the tangent turns by less than
+//! 0.023 rad per panel, else 4 stages (order 6) on panels turning by at most
+//! [`MAX_PANEL_TURN`] rad, whichever needs fewer evaluations. Both keep the backbone error
+//! below about `1e-10 L`. Panels break at the anchor, where `k` jumps.
 //!
 //! # References
 //! Seed 000 and its erratum (`shared/notes/seed-notes.md`).
@@ -43,6 +45,8 @@ pub struct PlanarCableArm {
     offset_ratio: f64,
     youngs_modulus: f64,
     anchor: f64,
+    /// `dR/ds = (RL - R0) / L`, cached so that `R(s)` costs no division.
+    taper: f64,
 }
 
 /// How the curvature profile `k(s)` is evaluated.
@@ -150,6 +154,7 @@ impl PlanarCableArm {
             offset_ratio,
             youngs_modulus,
             anchor,
+            taper: (tip_radius - base_radius) / length,
         })
     }
 
@@ -163,6 +168,7 @@ impl PlanarCableArm {
             offset_ratio: 1.0 / 3.0,
             youngs_modulus: 110e3,
             anchor: 0.270,
+            taper: (0.0074 - 0.015) / 0.270,
         }
     }
 
@@ -194,13 +200,13 @@ impl PlanarCableArm {
     /// Section radius `R(s)` (m), linear taper.
     #[inline]
     pub fn radius(&self, s: f64) -> f64 {
-        self.base_radius + (self.tip_radius - self.base_radius) * s / self.length
+        self.base_radius + self.taper * s
     }
 
     /// Taper rate `dR/ds` (dimensionless).
     #[inline]
     pub fn radius_rate(&self) -> f64 {
-        (self.tip_radius - self.base_radius) / self.length
+        self.taper
     }
 
     /// Closed-form curvature `k(s)` (1/m) and axial strain `q(s)` at `s <= anchor`.
@@ -288,7 +294,13 @@ pub fn uniform_samples(length: f64, n_points: usize) -> Result<Vec<f64>> {
     }
     let last = (n_points - 1) as f64;
     Ok((0..n_points)
-        .map(|i| if i + 1 == n_points { length } else { length * i as f64 / last })
+        .map(|i| {
+            if i + 1 == n_points {
+                length
+            } else {
+                length * i as f64 / last
+            }
+        })
         .collect())
 }
 
@@ -310,29 +322,73 @@ fn check_samples(samples: &[f64], length: f64) -> Result<()> {
     Ok(())
 }
 
-/// `(cos x, sin x)` for `|x| <= 0.2` by truncated Taylor series (error < 1e-18), else libm.
+/// `max(1, ceil(x))` for `x >= 0` without libm (baseline x86-64 has no rounding instruction).
 #[inline]
-fn small_angle_cis(x: f64) -> (f64, f64) {
-    if x.abs() > 0.2 {
+fn panel_count(x: f64) -> usize {
+    // Through i32 (one instruction each way); panel counts beyond 2^30 are not meaningful.
+    let x = x.min(1073741824.0);
+    let i = x as i32; // NaN -> 0
+    (if (i as f64) < x { i + 1 } else { i.max(1) }) as usize
+}
+
+/// `(cos x, sin x)` for `|x| <= 0.2` by truncated Taylor series, else libm.
+///
+/// The truncation error (`x^8 / 8!` < 7e-11 at 0.2, < 3e-13 at [`MAX_PANEL_TURN`]) moves the
+/// backbone by at most `L` times that, below the panel rule's own error.
+#[inline]
+fn small_angle_cis<const SHORT: bool>(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    if SHORT && x2 <= SHORT_CIS_MAX * SHORT_CIS_MAX {
+        // |x| <= 0.03: error x^6 / 720 < 1.1e-12.
+        let c = 1.0 - x2 * (1.0 / 2.0) * (1.0 - x2 * (1.0 / 12.0));
+        let s = x * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0)));
+        return (c, s);
+    }
+    if x2 > 0.04 {
         let (s, c) = x.sin_cos();
         return (c, s);
     }
-    let x2 = x * x;
-    let c = 1.0
-        - x2 * (1.0 / 2.0)
-            * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0) * (1.0 - x2 * (1.0 / 90.0) * (1.0 - x2 * (1.0 / 132.0))))));
-    let s = x
-        * (1.0
-            - x2 * (1.0 / 6.0)
-                * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0) * (1.0 - x2 * (1.0 / 110.0) * (1.0 - x2 * (1.0 / 156.0)))))));
+    let c = 1.0 - x2 * (1.0 / 2.0) * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0)));
+    let s = x * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0))));
     (c, s)
 }
 
-/// Lobatto IIIA, 4 stages: nodes, stage matrix rows 2–4 and weights.
-mod lobatto {
-    pub const SQ5: f64 = 2.236_067_977_499_79;
-    pub const C: [f64; 4] = [0.0, (5.0 - SQ5) / 10.0, (5.0 + SQ5) / 10.0, 1.0];
-    pub const A: [[f64; 4]; 3] = [
+/// Largest angle (rad) for the short series of [`small_angle_cis`].
+const SHORT_CIS_MAX: f64 = 0.03;
+
+/// A Lobatto IIIA collocation rule with `S` stages (nodes include both panel ends, so the
+/// first stage reuses the previous panel's last evaluation).
+struct Rule<const S: usize, const SHORT: bool> {
+    /// Nodes in `[0, 1]`.
+    c: [f64; S],
+    /// Stage matrix rows 2..=S (row 1 is zero).
+    a: [[f64; S]; S],
+    /// Weights (equal to the last row of the stage matrix).
+    b: [f64; S],
+    /// Largest tangent turn (rad) per panel that keeps this rule's backbone error below
+    /// `1e-10 L`: its global error is about `L (h kappa)^p / C_p` (`p` the order).
+    max_turn: f64,
+}
+
+const SQ5: f64 = 2.236_067_977_499_79;
+
+/// Lobatto IIIA, 3 stages (Simpson), order 4: error `L (h kappa)^4 / 2880`.
+const LOBATTO3: Rule<3, true> = Rule {
+    c: [0.0, 0.5, 1.0],
+    a: [
+        [0.0, 0.0, 0.0],
+        [5.0 / 24.0, 1.0 / 3.0, -1.0 / 24.0],
+        [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    ],
+    b: [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    max_turn: 0.023,
+};
+
+/// Lobatto IIIA, 4 stages, order 6.
+const LOBATTO4: Rule<4, false> = Rule {
+    c: [0.0, (5.0 - SQ5) / 10.0, (5.0 + SQ5) / 10.0, 1.0],
+    a: [
+        [0.0, 0.0, 0.0, 0.0],
         [
             (11.0 + SQ5) / 120.0,
             (25.0 - SQ5) / 120.0,
@@ -346,9 +402,10 @@ mod lobatto {
             (-1.0 - SQ5) / 120.0,
         ],
         [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0],
-    ];
-    pub const B: [f64; 4] = [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0];
-}
+    ],
+    b: [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0],
+    max_turn: MAX_PANEL_TURN,
+};
 
 /// State of the backbone integration: arc length, angle, unit tangent, position, and the
 /// profile `(k, q)` at the current arc length.
@@ -365,51 +422,115 @@ struct BackboneState {
 }
 
 impl BackboneState {
-    /// Advances over `[self.s, b]` (all of it loaded) in `m` equal Lobatto IIIA panels.
+    /// Advances over `[self.s, b]` (all of it loaded), choosing the cheaper of the order-4
+    /// and order-6 rules that meets its turn bound (fine output spacing favours order 4,
+    /// coarse spacing or high curvature order 6).
     #[inline]
     fn advance_loaded<P: Fn(f64) -> (f64, f64)>(&mut self, profile: &P, b: f64, kappa_max: f64) {
         let span = b - self.s;
         if span <= 0.0 {
             return;
         }
-        let m = ((span * kappa_max / MAX_PANEL_TURN).ceil() as usize).max(1);
-        let h = span / m as f64;
+        let turn = span * kappa_max;
+        if turn <= LOBATTO3.max_turn {
+            // One Simpson panel: the common case at fine output spacing.
+            self.simpson_panels(profile, b, 1);
+            return;
+        }
+        let m4 = panel_count(turn * (1.0 / LOBATTO3.max_turn));
+        let m6 = panel_count(turn * (1.0 / LOBATTO4.max_turn));
+        // Cost in profile evaluations: 2 per order-4 panel, 3 per order-6 panel.
+        if 2 * m4 <= 3 * m6 {
+            self.simpson_panels(profile, b, m4);
+        } else {
+            self.panels(profile, b, m6, &LOBATTO4);
+        }
+    }
+
+    /// `m` equal panels of [`LOBATTO3`] over `[self.s, b]`, written out by hand: this is the
+    /// hot path at fine output spacing (about 110 flops per panel).
+    #[inline(always)]
+    fn simpson_panels<P: Fn(f64) -> (f64, f64)>(&mut self, profile: &P, b: f64, m: usize) {
+        const A1: [f64; 3] = LOBATTO3.a[1];
+        let h = (b - self.s) / m as f64;
+        let a0 = self.s;
+        let (mut f0, mut g0) = ((1.0 + self.q) * self.k, 1.0 + self.q);
+        for p in 0..m {
+            let s0 = a0 + p as f64 * h;
+            let s_end = if p + 1 == m { b } else { s0 + h };
+            let (k1, q1) = profile(s0 + 0.5 * h);
+            let (k2, q2) = profile(s_end);
+            let (g1, g2) = (1.0 + q1, 1.0 + q2);
+            let (f1, f2) = (g1 * k1, g2 * k2);
+            let d1 = h * (A1[0] * f0 + A1[1] * f1 + A1[2] * f2);
+            let d2 = h * (1.0 / 6.0) * (f0 + 4.0 * f1 + f2);
+            let (c1, s1) = small_angle_cis::<true>(d1);
+            let (c2, s2) = small_angle_cis::<true>(d2);
+            let (c0, s0_) = (self.cos, self.sin);
+            let (x1, y1) = (c0 * c1 - s0_ * s1, s0_ * c1 + c0 * s1);
+            let (x2, y2) = (c0 * c2 - s0_ * s2, s0_ * c2 + c0 * s2);
+            let (w0, w1, w2) = (g0 * (h / 6.0), g1 * (h * 2.0 / 3.0), g2 * (h / 6.0));
+            self.x += w0 * c0 + w1 * x1 + w2 * x2;
+            self.y += w0 * s0_ + w1 * y1 + w2 * y2;
+            // |t| drifts by the series error (< 1e-12) per panel; `advance` renormalises.
+            self.cos = x2;
+            self.sin = y2;
+            self.theta += d2;
+            self.s = s_end;
+            (self.k, self.q) = (k2, q2);
+            (f0, g0) = (f2, g2);
+        }
+    }
+
+    /// `m` equal panels of `rule` over `[self.s, b]`.
+    #[inline(always)]
+    fn panels<P: Fn(f64) -> (f64, f64), const S: usize, const SHORT: bool>(
+        &mut self,
+        profile: &P,
+        b: f64,
+        m: usize,
+        rule: &Rule<S, SHORT>,
+    ) {
+        let h = (b - self.s) / m as f64;
         let a0 = self.s;
         for p in 0..m {
             let s0 = a0 + p as f64 * h;
             let s_end = if p + 1 == m { b } else { s0 + h };
-            let mut f = [(1.0 + self.q) * self.k, 0.0, 0.0, 0.0];
-            let mut g = [1.0 + self.q, 0.0, 0.0, 0.0];
-            let mut kq = (self.k, self.q);
-            for j in 1..4 {
-                let sj = if j == 3 { s_end } else { s0 + lobatto::C[j] * h };
-                kq = profile(sj);
-                f[j] = (1.0 + kq.1) * kq.0;
-                g[j] = 1.0 + kq.1;
-            }
-            let mut dx = lobatto::B[0] * g[0] * self.cos;
-            let mut dy = lobatto::B[0] * g[0] * self.sin;
-            let mut end = (self.cos, self.sin, 0.0);
-            for j in 1..4 {
-                let row = &lobatto::A[j - 1];
-                let dth = h * (row[0] * f[0] + row[1] * f[1] + row[2] * f[2] + row[3] * f[3]);
-                let (c, s) = small_angle_cis(dth);
-                let (cj, sj) = (self.cos * c - self.sin * s, self.sin * c + self.cos * s);
-                dx += lobatto::B[j] * g[j] * cj;
-                dy += lobatto::B[j] * g[j] * sj;
-                end = (cj, sj, dth);
+            let (k0, q0) = (self.k, self.q);
+            let kq: [(f64, f64); S] = std::array::from_fn(|j| {
+                if j == 0 {
+                    (k0, q0)
+                } else if j == S - 1 {
+                    profile(s_end)
+                } else {
+                    profile(s0 + rule.c[j] * h)
+                }
+            });
+            let f: [f64; S] = std::array::from_fn(|j| (1.0 + kq[j].1) * kq[j].0);
+            let (c0, s0_) = (self.cos, self.sin);
+            // Stage angles relative to the panel start, and the rotated tangents.
+            let cis: [(f64, f64, f64); S] = std::array::from_fn(|j| {
+                if j == 0 {
+                    return (c0, s0_, 0.0);
+                }
+                let dth = h * rule.a[j].iter().zip(&f).map(|(a, f)| a * f).sum::<f64>();
+                let (c, s) = small_angle_cis::<SHORT>(dth);
+                (c0 * c - s0_ * s, s0_ * c + c0 * s, dth)
+            });
+            let (mut dx, mut dy) = (0.0, 0.0);
+            for j in 0..S {
+                let w = rule.b[j] * (1.0 + kq[j].1);
+                dx += w * cis[j].0;
+                dy += w * cis[j].1;
             }
             self.x += h * dx;
             self.y += h * dy;
-            // Renormalise the unit tangent (first-order correction of |t|^2 - 1).
-            let n2 = end.0 * end.0 + end.1 * end.1;
-            let fix = 1.5 - 0.5 * n2;
-            self.cos = end.0 * fix;
-            self.sin = end.1 * fix;
-            self.theta += end.2;
+            let (ce, se, dth) = cis[S - 1];
+            self.cos = ce;
+            self.sin = se;
+            self.theta += dth;
             self.s = s_end;
-            self.k = kq.0;
-            self.q = kq.1;
+            (self.k, self.q) = kq[S - 1];
         }
     }
 
@@ -435,6 +556,10 @@ impl BackboneState {
     ) {
         if self.s < anchor {
             self.advance_loaded(profile, b.min(anchor), kappa_max);
+            // Renormalise the unit tangent (first-order correction of |t|^2 - 1).
+            let fix = 1.5 - 0.5 * (self.cos * self.cos + self.sin * self.sin);
+            self.cos *= fix;
+            self.sin *= fix;
         }
         if b > anchor {
             self.advance_straight(b);
@@ -497,8 +622,8 @@ fn solve_into(
     match method {
         PlanarMethod::ClosedForm => {
             let turn = |(k, q): (f64, f64)| ((1.0 + q) * k).abs();
-            let kappa_max = turn(arm.closed_form(0.0, tension))
-                .max(turn(arm.closed_form(anchor, tension)));
+            let kappa_max =
+                turn(arm.closed_form(0.0, tension)).max(turn(arm.closed_form(anchor, tension)));
             let tip = integrate_backbone(
                 |s| arm.closed_form(s, tension),
                 samples,
@@ -544,8 +669,13 @@ pub fn solve_planar(
 ) -> Result<PlanarSolution> {
     check_samples(samples, arm.length)?;
     let n = samples.len();
-    let (mut k, mut q, mut th, mut x, mut y) =
-        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let (mut k, mut q, mut th, mut x, mut y) = (
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+    );
     let ((tx, ty, tth), ode_stats) = solve_into(
         arm,
         tension,

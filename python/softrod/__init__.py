@@ -1,0 +1,32 @@
+"""softrod: steady-state shape and compliance of soft and continuum robots.
+
+SI units everywhere (m, N, Pa, rad). See https://softrod docs in ``docs/`` for the models.
+
+The numerics live in the compiled core ``softrod._core``; this package re-exports it and adds
+file I/O (:mod:`softrod.io`), plots (:mod:`softrod.plot`) and the ``softrod`` command line
+(:mod:`softrod.cli`).
+"""
+
+from ._core import (
+    ConvergenceError,
+    ParameterError,
+    PlanarBatch,
+    PlanarCableArm,
+    PlanarSolution,
+    __version__,
+)
+from .compare import BackboneDistance, backbone_distance
+from .io import read_backbone_csv, write_samples_csv
+
+__all__ = [
+    "BackboneDistance",
+    "ConvergenceError",
+    "ParameterError",
+    "PlanarBatch",
+    "PlanarCableArm",
+    "PlanarSolution",
+    "__version__",
+    "backbone_distance",
+    "read_backbone_csv",
+    "write_samples_csv",
+]

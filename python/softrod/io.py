@@ -1,0 +1,116 @@
+"""File I/O: backbones from CSV, solution samples to CSV or JSON-ready dicts."""
+
+from __future__ import annotations
+
+import csv
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ._core import ParameterError, PlanarSolution
+
+__all__ = ["read_backbone_csv", "solution_to_dict", "write_samples_csv"]
+
+SAMPLE_FIELDS = ("s", "curvature", "strain", "angle", "x", "y")
+
+
+def read_backbone_csv(
+    path: str | os.PathLike[str],
+    *,
+    scale: float = 1.0,
+    columns: Sequence[int] | None = None,
+) -> np.ndarray:
+    """Reads a backbone (a list of points) from a CSV file.
+
+    The file has one point per row, two or three numeric columns (x, y[, z]); an optional
+    header row is skipped, as are blank lines and lines starting with ``#``. Delimiters
+    ``,``, ``;``, tab or spaces are detected.
+
+    Args:
+        path: CSV file.
+        scale: Factor applied to every coordinate, e.g. ``1e-3`` for a file in millimetres.
+        columns: Indices of the coordinate columns (default: the first two, or three if every
+            row has three numeric columns).
+
+    Returns:
+        Points, shape (n, 2) or (n, 3), multiplied by ``scale``.
+
+    Raises:
+        ParameterError: Unreadable numbers, fewer than two points, or a bad ``scale``.
+    """
+    if not (np.isfinite(scale) and scale > 0):
+        raise ParameterError(f"invalid parameter `scale` = {scale}: must be finite and > 0")
+    with open(path, newline="", encoding="utf-8") as fh:
+        text = fh.read()
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise ParameterError(f"invalid parameter `path` = {os.fspath(path)!r}: no data rows")
+    try:
+        dialect = csv.Sniffer().sniff(lines[0], delimiters=",;\t ")
+        delim = dialect.delimiter
+    except csv.Error:
+        delim = ","
+    rows: list[list[str]] = [
+        [c for c in (r if delim != " " else ln.split()) if c.strip() != ""]
+        for ln, r in zip(lines, csv.reader(lines, delimiter=delim), strict=True)
+    ]
+
+    def numeric(row: list[str]) -> list[float] | None:
+        try:
+            return [float(c) for c in row]
+        except ValueError:
+            return None
+
+    parsed = [numeric(r) for r in rows]
+    if parsed and parsed[0] is None:  # header
+        parsed = parsed[1:]
+        rows = rows[1:]
+    bad = [i for i, p in enumerate(parsed) if p is None]
+    if bad:
+        raise ParameterError(
+            f"invalid parameter `path` = {os.fspath(path)!r}: row {bad[0] + 1} of data is not "
+            f"numeric: {rows[bad[0]]!r}"
+        )
+    width = min(len(p) for p in parsed if p is not None)
+    if columns is None:
+        columns = (0, 1, 2) if width >= 3 else (0, 1)
+    cols = list(columns)
+    if len(cols) not in (2, 3) or max(cols) >= width or min(cols) < 0:
+        raise ParameterError(
+            f"invalid parameter `columns` = {cols}: must be 2 or 3 indices < {width}"
+        )
+    pts = np.array([[p[c] for c in cols] for p in parsed if p is not None], dtype=np.float64)
+    if pts.shape[0] < 2:
+        raise ParameterError(
+            f"invalid parameter `path` = {os.fspath(path)!r}: {pts.shape[0]} points, need >= 2"
+        )
+    if not np.all(np.isfinite(pts)):
+        raise ParameterError(f"invalid parameter `path` = {os.fspath(path)!r}: non-finite value")
+    return pts * scale
+
+
+def solution_to_dict(sol: PlanarSolution) -> dict[str, Any]:
+    """A JSON-ready dict of one planar solution (lists of floats, SI units)."""
+    out: dict[str, Any] = {"tension": sol.tension, "method": sol.method}
+    out["tip"] = [float(v) for v in sol.tip]
+    out["tip_angle"] = sol.tip_angle
+    out["max_compressive_strain"] = sol.max_compressive_strain
+    for name in SAMPLE_FIELDS:
+        out[name] = getattr(sol, name).tolist()
+    return out
+
+
+def write_samples_csv(path: str | os.PathLike[str], solutions: Sequence[PlanarSolution]) -> None:
+    """Writes the samples of one or more planar solutions to one CSV file.
+
+    Columns: ``tension, s, curvature, strain, angle, x, y`` (SI units), one row per sample.
+    """
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(("tension", *SAMPLE_FIELDS))
+        for sol in solutions:
+            cols = [getattr(sol, name) for name in SAMPLE_FIELDS]
+            for i in range(len(sol.s)):
+                w.writerow([repr(sol.tension), *(repr(float(c[i])) for c in cols)])

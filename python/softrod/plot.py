@@ -1,0 +1,84 @@
+"""Plots of softrod results (matplotlib). Every function returns the figure it drew on."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ._core import PlanarCableArm, PlanarSolution
+
+__all__ = ["plot_planar"]
+
+
+def _section_outline(arm: PlanarCableArm, sol: PlanarSolution) -> tuple[np.ndarray, np.ndarray]:
+    """Outline of the deformed cone: backbone offset by +-R(s) along the normal (m)."""
+    r = arm.radius(sol.s)
+    nx, ny = -np.sin(sol.angle), np.cos(sol.angle)
+    upper = np.column_stack((sol.x + r * nx, sol.y + r * ny))
+    lower = np.column_stack((sol.x - r * nx, sol.y - r * ny))
+    return upper, lower
+
+
+def plot_planar(
+    arm: PlanarCableArm,
+    solutions: Sequence[PlanarSolution],
+    *,
+    title: str | None = None,
+    profiles: bool = True,
+):
+    """Backbones of the planar cable arm for several tensions, with the arm's outline.
+
+    Args:
+        arm: The arm that was solved.
+        solutions: Solutions to draw, e.g. one per tension.
+        title: Figure title (default: describes the arm).
+        profiles: Also draw curvature k(s) and axial strain q(s) panels.
+
+    Returns:
+        The matplotlib figure (axes in millimetres; x along the unloaded arm, y toward the
+        cable).
+    """
+    import matplotlib.pyplot as plt
+
+    if profiles:
+        fig = plt.figure(figsize=(11, 5.2), layout="constrained")
+        grid = fig.add_gridspec(2, 2, width_ratios=(1.35, 1))
+        ax = fig.add_subplot(grid[:, 0])
+        ax_k = fig.add_subplot(grid[0, 1])
+        ax_q = fig.add_subplot(grid[1, 1], sharex=ax_k)
+    else:
+        fig, ax = plt.subplots(figsize=(6.5, 5.2), layout="constrained")
+    cmap = plt.get_cmap("viridis")
+    n = max(len(solutions), 1)
+    for i, sol in enumerate(solutions):
+        color = cmap(0.05 + 0.85 * i / max(n - 1, 1))
+        upper, lower = _section_outline(arm, sol)
+        poly = np.vstack((upper, lower[::-1]))
+        ax.fill(poly[:, 0] * 1e3, poly[:, 1] * 1e3, color=color, alpha=0.12, lw=0)
+        ax.plot(sol.x * 1e3, sol.y * 1e3, color=color, lw=2, label=f"T = {sol.tension:g} N")
+        ax.plot(sol.tip[0] * 1e3, sol.tip[1] * 1e3, "o", color=color, ms=4)
+        if profiles:
+            ax_k.plot(sol.s * 1e3, sol.curvature, color=color)
+            ax_q.plot(sol.s * 1e3, sol.strain * 100, color=color)
+    ax.plot([0, 0], [-arm.base_radius * 1e3, arm.base_radius * 1e3], "k-", lw=4)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (mm), along the unloaded arm")
+    ax.set_ylabel("y (mm), toward the cable")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    if profiles:
+        ax_k.set_ylabel("curvature k (1/m)")
+        ax_k.grid(alpha=0.3)
+        ax_q.set_ylabel("axial strain q (%)")
+        ax_q.set_xlabel("arc length s (mm)")
+        ax_q.grid(alpha=0.3)
+    fig.suptitle(
+        title
+        or (
+            f"Tapered cable-driven arm: L = {arm.length * 1e3:g} mm, "
+            f"R = {arm.base_radius * 1e3:g} -> {arm.tip_radius * 1e3:g} mm, "
+            f"a = {arm.offset_ratio:.3g}, E = {arm.youngs_modulus / 1e3:g} kPa"
+        )
+    )
+    return fig

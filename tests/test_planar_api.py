@@ -1,0 +1,123 @@
+"""Binding surface of the planar cable arm: names, shapes, errors. Physics is tested in Rust."""
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod import ConvergenceError, ParameterError, PlanarCableArm
+
+SEED = dict(
+    length=0.27, base_radius=0.015, tip_radius=0.0074, offset_ratio=1 / 3, youngs_modulus=110e3
+)
+
+
+def test_constructor_keywords_and_seed_arm_agree():
+    a = PlanarCableArm(**SEED)
+    b = PlanarCableArm.seed_arm()
+    assert a.anchor == pytest.approx(a.length)
+    for name in ("length", "base_radius", "tip_radius", "offset_ratio", "youngs_modulus"):
+        assert getattr(a, name) == pytest.approx(getattr(b, name))
+    assert "PlanarCableArm(" in repr(a)
+
+
+def test_solve_returns_arrays_of_the_requested_length():
+    arm = PlanarCableArm(**SEED)
+    sol = arm.solve(1.0)
+    for name in ("s", "curvature", "strain", "angle", "x", "y"):
+        arr = getattr(sol, name)
+        assert isinstance(arr, np.ndarray) and arr.shape == (201,) and arr.dtype == np.float64
+    assert sol.tip.shape == (2,)
+    assert sol.s[0] == 0.0 and sol.s[-1] == pytest.approx(0.27)
+    assert sol.tip[0] == sol.x[-1] and sol.tip[1] == sol.y[-1]
+    assert sol.max_compressive_strain == pytest.approx(-sol.strain.min())
+    assert sol.method == "closed-form" and sol.stats is None
+    assert arm.solve(1.0, 11).x.shape == (11,)
+
+
+def test_ode_method_and_tolerances():
+    arm = PlanarCableArm(**SEED)
+    cf = arm.solve(2.0)
+    ode = arm.solve(2.0, method="ode", rtol=1e-10, atol=1e-12)
+    assert ode.method == "ode" and ode.stats["accepted_steps"] > 0
+    assert np.max(np.abs(ode.curvature - cf.curvature)) / cf.curvature.max() < 1e-8
+
+
+def test_custom_samples():
+    arm = PlanarCableArm(**SEED)
+    s = np.array([0.0, 0.1, 0.2])
+    sol = arm.solve(1.0, s=s)
+    np.testing.assert_array_equal(sol.s, s)
+    full = arm.solve(1.0)
+    assert np.allclose(sol.tip, full.tip, rtol=0, atol=1e-10)  # different panel grids
+
+
+def test_solve_many_is_vectorised_and_matches_solve():
+    arm = PlanarCableArm(**SEED)
+    tensions = np.linspace(0, 3, 7)
+    batch = arm.solve_many(tensions, n_points=51)
+    assert len(batch) == 7
+    for name in ("curvature", "strain", "angle", "x", "y"):
+        assert getattr(batch, name).shape == (7, 51)
+    assert batch.tip.shape == (7, 2) and batch.tip_angle.shape == (7,)
+    one = arm.solve(tensions[4], 51)
+    np.testing.assert_array_equal(batch.x[4], one.x)
+    # Lists and scalars are accepted too.
+    assert arm.solve_many([0.5, 1.0]).x.shape == (2, 201)
+    assert arm.solve_many(0.5).x.shape == (1, 201)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        (dict(SEED, length=0.0), "length"),
+        (dict(SEED, length=float("nan")), "length"),
+        (dict(SEED, base_radius=-0.01), "base_radius"),
+        (dict(SEED, tip_radius=0.0), "tip_radius"),
+        (dict(SEED, offset_ratio=1.0), "offset_ratio"),
+        (dict(SEED, offset_ratio=-0.2), "offset_ratio"),
+        (dict(SEED, youngs_modulus=0.0), "youngs_modulus"),
+        (dict(SEED, anchor=0.0), "anchor"),
+        (dict(SEED, anchor=0.5), "anchor"),
+    ],
+)
+def test_bad_parameters_raise_value_error_naming_them(kwargs, name):
+    with pytest.raises(ValueError) as info:
+        PlanarCableArm(**kwargs)
+    assert isinstance(info.value, ParameterError)
+    assert info.value.parameter == name
+    assert name in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda arm: arm.solve(-1.0), "tension"),
+        (lambda arm: arm.solve(float("nan")), "tension"),
+        (lambda arm: arm.solve(float("inf")), "tension"),
+        (lambda arm: arm.solve(1.0, 1), "n_points"),
+        (lambda arm: arm.solve(1.0, -3), "n_points"),
+        (lambda arm: arm.solve(1.0, method="rk45"), "method"),
+        (lambda arm: arm.solve(1.0, method="ode", rtol=0.0), "rtol"),
+        (lambda arm: arm.solve(1.0, method="ode", atol=-1.0), "atol"),
+        (lambda arm: arm.solve(1.0, s=[0.0, 1.0]), "s[1]"),
+        (lambda arm: arm.solve_many([1.0, -1.0]), "tensions[1]"),
+    ],
+)
+def test_bad_solve_arguments_raise_value_error_naming_them(call, name):
+    with pytest.raises(ParameterError) as info:
+        call(PlanarCableArm(**SEED))
+    assert info.value.parameter == name
+
+
+def test_non_convergence_raises_with_iterations_and_residual():
+    arm = PlanarCableArm(**SEED)
+    with pytest.raises(ConvergenceError) as info:
+        arm.solve(1.0, method="ode", rtol=1e-10, atol=1e-12, max_steps=5)
+    assert info.value.iterations == 5
+    assert np.isfinite(info.value.residual)
+    assert isinstance(info.value, RuntimeError)
+
+
+def test_exceptions_are_exported():
+    assert issubclass(softrod.ParameterError, ValueError)
+    assert issubclass(softrod.ConvergenceError, RuntimeError)
