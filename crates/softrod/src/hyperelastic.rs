@@ -1,0 +1,1193 @@
+//! Uniaxial material laws: linear, linearised (secant) and incompressible hyperelastic.
+//!
+//! Every law maps the axial stretch `λ = l / l0 = 1 + ε` of an incompressible bar in simple
+//! tension or compression (`λ2 = λ3 = λ^(-1/2)`) to its axial stress. Two stress measures are
+//! used:
+//!
+//! * nominal (engineering, first Piola–Kirchhoff) stress `P`: force per *undeformed* area, so
+//!   the axial force of a rod section of rest area `A0` is `N = A0 P(λ)`;
+//! * true (Cauchy) stress `σ = λ P`: force per *deformed* area `A0 / λ`.
+//!
+//! For a strain-energy density `W(I1, I2)` with `I1 = λ² + 2/λ` and `I2 = 2λ + 1/λ²`,
+//!
+//! ```text
+//! σ = 2 (λ² − 1/λ) (∂W/∂I1 + (1/λ) ∂W/∂I2),      P = σ / λ,
+//! ```
+//!
+//! and the tangent modulus is `E(ε) = dσ/dε` (with `ε = λ − 1`, so `dσ/dε = dσ/dλ`). Every
+//! law here gives `σ`, `P`, `dσ/dλ` and `dP/dλ` in closed form, valid in tension (`λ > 1`) and
+//! compression (`0 < λ < 1`). Stresses and moduli are in Pa, stretch and strain are
+//! dimensionless, forces in N and areas in m².
+//!
+//! The laws share the [`UniaxialLaw`] trait; [`UniaxialModel`] is the closed set of them as one
+//! value type (what a rod model stores and what a fit returns). [`Silicone`] is a small library
+//! of named silicones with sourced parameters.
+//!
+//! # References
+//! * R. W. Ogden, *Non-linear Elastic Deformations*, Dover 1997, ch. 7 (incompressible
+//!   uniaxial tension, stress measures).
+//! * R. S. Rivlin, D. W. Saunders, Phil. Trans. R. Soc. A 243, 1951 (Mooney–Rivlin).
+//! * O. H. Yeoh, Rubber Chem. Technol. 66(5), 1993 (the Yeoh form).
+//! * R. W. Ogden, Proc. R. Soc. A 326, 1972 (the Ogden form).
+//! * Seed 001, section II.B, and its corrections in `shared/notes/seed-notes.md`.
+
+use std::fmt;
+
+use crate::error::{check_finite, check_positive, Error, Result};
+
+/// Number of stretches (geometrically spaced, end points included) at which
+/// [`UniaxialLaw::check_stable`] evaluates `dP/dλ`.
+pub const STABILITY_SAMPLES: usize = 2001;
+
+/// Relative stretch tolerance of the force → stretch inversion
+/// ([`UniaxialLaw::stretch_from_nominal_stress`]).
+pub const INVERSE_STRETCH_TOLERANCE: f64 = 1e-13;
+
+/// Iteration cap of the force → stretch inversion (Newton with bisection safeguard).
+pub const INVERSE_MAX_ITERATIONS: usize = 200;
+
+/// Smallest stretch the force → stretch inversion searches (a compression to 1e-9 of the length).
+pub const INVERSE_STRETCH_MIN: f64 = 1e-9;
+
+/// Largest stretch the force → stretch inversion searches.
+pub const INVERSE_STRETCH_MAX: f64 = 1e6;
+
+/// Checks a stretch `λ`: finite and strictly positive.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn check_stretch(name: &str, stretch: f64) -> Result<f64> {
+    if stretch.is_finite() && stretch > 0.0 {
+        Ok(stretch)
+    } else {
+        Err(Error::invalid(
+            name,
+            stretch,
+            "finite and > 0 (stretch = current length / rest length)",
+        ))
+    }
+}
+
+/// Checks an engineering strain `ε = λ − 1`: finite and `> −1`; returns the stretch `1 + ε`.
+fn check_strain(name: &str, strain: f64) -> Result<f64> {
+    if strain.is_finite() && strain > -1.0 {
+        Ok(1.0 + strain)
+    } else {
+        Err(Error::invalid(
+            name,
+            strain,
+            "finite and > -1 (engineering strain = stretch - 1)",
+        ))
+    }
+}
+
+/// An incompressible uniaxial constitutive law: axial stress as a function of axial stretch.
+///
+/// Implementors give the nominal stress and its slope (the `*_unchecked` methods, which take a
+/// stretch already known to be finite and positive and never panic); every other method is
+/// provided, validates its input and returns [`Error::InvalidParameter`] naming the argument.
+/// The trait is object safe (`&dyn UniaxialLaw`).
+pub trait UniaxialLaw: fmt::Debug + fmt::Display + Send + Sync {
+    /// Short model name, e.g. `"Yeoh"` (used in error messages).
+    fn model_name(&self) -> &'static str;
+
+    /// Small-strain Young's modulus `E0 = dσ/dε` at `ε = 0` (Pa): `3 μ0` for an incompressible
+    /// hyperelastic law with initial shear modulus `μ0`.
+    fn small_strain_modulus(&self) -> f64;
+
+    /// Nominal stress `P(λ)` (Pa) for a stretch already validated as finite and `> 0`.
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64;
+
+    /// Slope `dP/dλ` of the nominal stress (Pa) for a validated stretch.
+    fn nominal_slope_unchecked(&self, stretch: f64) -> f64;
+
+    /// True stress `σ(λ) = λ P(λ)` (Pa) for a validated stretch.
+    fn true_stress_unchecked(&self, stretch: f64) -> f64 {
+        stretch * self.nominal_stress_unchecked(stretch)
+    }
+
+    /// Tangent modulus `dσ/dλ = P + λ dP/dλ` (Pa) for a validated stretch.
+    fn true_slope_unchecked(&self, stretch: f64) -> f64 {
+        self.nominal_stress_unchecked(stretch) + stretch * self.nominal_slope_unchecked(stretch)
+    }
+
+    /// Nominal (engineering) stress `P(λ)`: axial force per undeformed area (Pa).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0`.
+    fn nominal_stress(&self, stretch: f64) -> Result<f64> {
+        let stretch = check_stretch("stretch", stretch)?;
+        Ok(self.nominal_stress_unchecked(stretch))
+    }
+
+    /// True (Cauchy) stress `σ(λ) = λ P(λ)`: axial force per deformed area (Pa).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0`.
+    fn true_stress(&self, stretch: f64) -> Result<f64> {
+        let stretch = check_stretch("stretch", stretch)?;
+        Ok(self.true_stress_unchecked(stretch))
+    }
+
+    /// Tangent modulus `E(ε) = dσ/dε` of the true stress at engineering strain `ε = λ − 1` (Pa).
+    ///
+    /// Equals [`small_strain_modulus`](Self::small_strain_modulus) at `ε = 0`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`strain`) unless `strain` is finite and `> −1`.
+    fn tangent_modulus(&self, strain: f64) -> Result<f64> {
+        let stretch = check_strain("strain", strain)?;
+        Ok(self.true_slope_unchecked(stretch))
+    }
+
+    /// Slope `dP/dλ` of the nominal stress (Pa): the axial stiffness per rest area.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0`.
+    fn nominal_tangent(&self, stretch: f64) -> Result<f64> {
+        let stretch = check_stretch("stretch", stretch)?;
+        Ok(self.nominal_slope_unchecked(stretch))
+    }
+
+    /// Secant modulus `P(1 + ε) / ε` at engineering strain `ε` (Pa), e.g. the "100 % modulus"
+    /// of a datasheet at `ε = 1`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`strain`) unless `strain` is finite, `> −1` and `≠ 0`.
+    fn secant_modulus(&self, strain: f64) -> Result<f64> {
+        let stretch = check_strain("strain", strain)?;
+        if strain == 0.0 {
+            return Err(Error::invalid(
+                "strain",
+                strain,
+                "non-zero (secant modulus)",
+            ));
+        }
+        Ok(self.nominal_stress_unchecked(stretch) / strain)
+    }
+
+    /// Axial force `N = A0 P(λ)` (N) of a section of rest area `area0` (m²).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `area0` or `stretch` if either is not finite and `> 0`.
+    fn axial_force(&self, area0: f64, stretch: f64) -> Result<f64> {
+        let area0 = check_positive("area0", area0, "m^2")?;
+        Ok(area0 * self.nominal_stress(stretch)?)
+    }
+
+    /// Axial stiffness `dN/dλ = A0 dP/dλ` (N) of a section of rest area `area0` (m²).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `area0` or `stretch` if either is not finite and `> 0`.
+    fn axial_stiffness(&self, area0: f64, stretch: f64) -> Result<f64> {
+        let area0 = check_positive("area0", area0, "m^2")?;
+        Ok(area0 * self.nominal_tangent(stretch)?)
+    }
+
+    /// Stretch `λ` at which the nominal stress equals `nominal_stress` (Pa): the inverse of
+    /// [`nominal_stress`](Self::nominal_stress), by Newton's method safeguarded by bisection
+    /// on a bracket grown geometrically from `λ = 1` within
+    /// `[INVERSE_STRETCH_MIN, INVERSE_STRETCH_MAX]`, to a relative stretch tolerance of
+    /// [`INVERSE_STRETCH_TOLERANCE`].
+    ///
+    /// For a stable law (see [`check_stable`](Self::check_stable)) the solution is unique; for
+    /// an unstable one this returns one of the solutions.
+    ///
+    /// # Errors
+    /// * [`Error::InvalidParameter`] (`nominal_stress`) if it is not finite or not reached by
+    ///   the law in the searched stretch range (e.g. a compressive stress `≤ −E` for the linear
+    ///   law, which would need `λ ≤ 0`).
+    /// * [`Error::NotConverged`] if the iteration cap [`INVERSE_MAX_ITERATIONS`] is reached.
+    fn stretch_from_nominal_stress(&self, nominal_stress: f64) -> Result<f64> {
+        let target = check_finite("nominal_stress", nominal_stress)?;
+        invert_nominal_stress(self, target)
+    }
+
+    /// Stretch at which a section of rest area `area0` (m²) carries the axial force `force`
+    /// (N, positive in tension); see
+    /// [`stretch_from_nominal_stress`](Self::stretch_from_nominal_stress).
+    ///
+    /// # Errors
+    /// As [`stretch_from_nominal_stress`](Self::stretch_from_nominal_stress), and
+    /// [`Error::InvalidParameter`] naming `area0` or `force` if not finite (`area0 > 0`).
+    fn stretch_from_axial_force(&self, area0: f64, force: f64) -> Result<f64> {
+        let area0 = check_positive("area0", area0, "m^2")?;
+        let force = check_finite("force", force)?;
+        invert_nominal_stress(self, force / area0).map_err(|e| match e {
+            Error::InvalidParameter { expected, .. } => Error::InvalidParameter {
+                name: "force".into(),
+                value: force.to_string(),
+                expected: format!("{expected} (times area0 = {area0} m^2)"),
+            },
+            other => other,
+        })
+    }
+
+    /// Checks that the law is stable on `[stretch_min, stretch_max]`: the nominal stress (hence
+    /// the axial force) strictly increases with stretch, `dP/dλ > 0`. In tension this implies a
+    /// positive tangent modulus `dσ/dε`. `dP/dλ` is evaluated at [`STABILITY_SAMPLES`]
+    /// geometrically spaced stretches, end points included.
+    ///
+    /// # Errors
+    /// * [`Error::InvalidParameter`] naming `stretch_min` / `stretch_max` unless
+    ///   `0 < stretch_min <= stretch_max` (both finite).
+    /// * [`Error::InvalidParameter`] naming the model's parameters, with the first stretch at
+    ///   which `dP/dλ <= 0` (or is not finite), if the law is unstable there.
+    fn check_stable(&self, stretch_min: f64, stretch_max: f64) -> Result<()> {
+        let lo = check_stretch("stretch_min", stretch_min)?;
+        let hi = check_stretch("stretch_max", stretch_max)?;
+        if hi < lo {
+            return Err(Error::invalid(
+                "stretch_max",
+                hi,
+                format!("finite and >= stretch_min = {lo}"),
+            ));
+        }
+        let ratio = (hi / lo).ln();
+        for i in 0..STABILITY_SAMPLES {
+            let t = i as f64 / (STABILITY_SAMPLES - 1) as f64;
+            let stretch = if i + 1 == STABILITY_SAMPLES {
+                hi
+            } else {
+                lo * (ratio * t).exp()
+            };
+            let slope = self.nominal_slope_unchecked(stretch);
+            if !(slope.is_finite() && slope > 0.0) {
+                return Err(Error::invalid(
+                    format!("{} parameters", self.model_name()),
+                    self,
+                    format!(
+                        "a stable law on stretch [{lo}, {hi}] (dP/dstretch > 0); \
+                         dP/dstretch = {slope:.4e} Pa at stretch {stretch:.6}"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Newton–bisection inversion of `P(λ) = target` (see
+/// [`UniaxialLaw::stretch_from_nominal_stress`]).
+fn invert_nominal_stress<L: UniaxialLaw + ?Sized>(law: &L, target: f64) -> Result<f64> {
+    let p = |x: f64| law.nominal_stress_unchecked(x) - target;
+    // Bracket [lo, hi] with p(lo) <= 0 <= p(hi), grown geometrically from λ = 1.
+    let (mut lo, mut hi) = (1.0_f64, 1.0_f64);
+    let f1 = p(1.0);
+    if f1 == 0.0 {
+        return Ok(1.0);
+    }
+    let unreachable = || {
+        let p_min = law.nominal_stress_unchecked(INVERSE_STRETCH_MIN);
+        let p_max = law.nominal_stress_unchecked(INVERSE_STRETCH_MAX);
+        Error::invalid(
+            "nominal_stress",
+            target,
+            format!(
+                "within the range of the {} law for stretch in [{INVERSE_STRETCH_MIN:e}, \
+                 {INVERSE_STRETCH_MAX:e}]: [{p_min:.4e}, {p_max:.4e}] Pa",
+                law.model_name()
+            ),
+        )
+    };
+    if f1 < 0.0 {
+        loop {
+            lo = hi;
+            hi *= 2.0;
+            if hi > INVERSE_STRETCH_MAX {
+                return Err(unreachable());
+            }
+            let f = p(hi);
+            if f >= 0.0 {
+                break;
+            }
+            if !f.is_finite() {
+                return Err(unreachable());
+            }
+        }
+    } else {
+        loop {
+            hi = lo;
+            lo *= 0.5;
+            if lo < INVERSE_STRETCH_MIN {
+                return Err(unreachable());
+            }
+            let f = p(lo);
+            if f <= 0.0 {
+                break;
+            }
+            if !f.is_finite() {
+                return Err(unreachable());
+            }
+        }
+    }
+    // Safeguarded Newton inside the bracket.
+    let mut x = 0.5 * (lo + hi);
+    let mut residual = f64::INFINITY;
+    for _ in 0..INVERSE_MAX_ITERATIONS {
+        let f = p(x);
+        residual = f.abs();
+        if f == 0.0 {
+            return Ok(x);
+        }
+        if f < 0.0 {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let slope = law.nominal_slope_unchecked(x);
+        let newton = x - f / slope;
+        let next = if slope > 0.0 && newton.is_finite() && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if (next - x).abs() <= INVERSE_STRETCH_TOLERANCE * x
+            || (hi - lo) <= INVERSE_STRETCH_TOLERANCE * x
+        {
+            return Ok(next);
+        }
+        x = next;
+    }
+    Err(Error::NotConverged {
+        what: format!("{} stretch-from-stress inversion", law.model_name()),
+        iterations: INVERSE_MAX_ITERATIONS,
+        residual,
+    })
+}
+
+/// `λ² − 1/λ = (λ − 1)(λ² + λ + 1)/λ`, written to keep its relative accuracy near `λ = 1`.
+#[inline]
+fn sigma_factor(stretch: f64) -> f64 {
+    (stretch - 1.0) * (stretch * stretch + stretch + 1.0) / stretch
+}
+
+/// `I1 − 3 = λ² + 2/λ − 3 = (λ − 1)² (λ + 2) / λ`, accurate near `λ = 1`.
+#[inline]
+fn i1_minus_3(stretch: f64) -> f64 {
+    let d = stretch - 1.0;
+    d * d * (stretch + 2.0) / stretch
+}
+
+/// Linear elastic uniaxial law (Hooke's law) in engineering measures: `P = E (λ − 1)`, the law
+/// of a rod with axial stiffness `E A0`; true stress `σ = λ P` by incompressibility. (Named
+/// `Hookean`, not `LinearElastic`, which is the rod-section material of `crate::material`.)
+///
+/// Note that `dσ/dε = E (2λ − 1)` is not constant (only `dP/dλ = E` is) and turns negative
+/// below `λ = 1/2`, while the force stays monotonic.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hookean {
+    youngs_modulus: f64,
+}
+
+impl Hookean {
+    /// A linear law with Young's modulus `youngs_modulus` (Pa).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`youngs_modulus`) unless finite and `> 0`.
+    pub fn new(youngs_modulus: f64) -> Result<Self> {
+        Ok(Self {
+            youngs_modulus: check_positive("youngs_modulus", youngs_modulus, "Pa")?,
+        })
+    }
+
+    /// Young's modulus `E` (Pa).
+    pub fn youngs_modulus(&self) -> f64 {
+        self.youngs_modulus
+    }
+}
+
+impl fmt::Display for Hookean {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Hookean(youngs_modulus={:e} Pa)", self.youngs_modulus)
+    }
+}
+
+impl UniaxialLaw for Hookean {
+    fn model_name(&self) -> &'static str {
+        "Hookean"
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        self.youngs_modulus
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.youngs_modulus * (stretch - 1.0)
+    }
+    fn nominal_slope_unchecked(&self, _stretch: f64) -> f64 {
+        self.youngs_modulus
+    }
+}
+
+/// A linearised law: the linear law `P = E_l (λ − 1)` whose modulus `E_l` is the secant
+/// modulus of a nonlinear curve at a reference strain (seed 001, II.B.1: "100 % modulus"), or a
+/// straight line through the origin fitted to data (`crate::fit::fit_uniaxial` with
+/// `ModelKind::Linearised`). The reference strain records where the line is exact (or the
+/// largest strain of the fitted data).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Linearised {
+    secant_modulus: f64,
+    reference_strain: f64,
+}
+
+impl Linearised {
+    /// A linearised law with secant modulus `secant_modulus` (Pa), taken at the engineering
+    /// strain `reference_strain`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `secant_modulus` (finite, `> 0`) or
+    /// `reference_strain` (finite, `> −1`, `≠ 0`).
+    pub fn new(secant_modulus: f64, reference_strain: f64) -> Result<Self> {
+        let secant_modulus = check_positive("secant_modulus", secant_modulus, "Pa")?;
+        check_strain("reference_strain", reference_strain)?;
+        if reference_strain == 0.0 {
+            return Err(Error::invalid(
+                "reference_strain",
+                reference_strain,
+                "non-zero (the strain of the secant)",
+            ));
+        }
+        Ok(Self {
+            secant_modulus,
+            reference_strain,
+        })
+    }
+
+    /// From one datasheet point: nominal stress `nominal_stress` (Pa) at engineering strain
+    /// `strain` (e.g. the 100 % modulus: `strain = 1`). `E_l = nominal_stress / strain`.
+    ///
+    /// # Errors
+    /// As [`Linearised::new`]; also [`Error::InvalidParameter`] (`nominal_stress`) if the
+    /// resulting modulus is not finite and `> 0`.
+    pub fn from_secant_point(nominal_stress: f64, strain: f64) -> Result<Self> {
+        check_finite("nominal_stress", nominal_stress)?;
+        check_strain("strain", strain)?;
+        if strain == 0.0 {
+            return Err(Error::invalid("strain", strain, "non-zero"));
+        }
+        let modulus = nominal_stress / strain;
+        if !(modulus.is_finite() && modulus > 0.0) {
+            return Err(Error::invalid(
+                "nominal_stress",
+                nominal_stress,
+                "of the same sign as strain (a positive secant modulus)",
+            ));
+        }
+        Self::new(modulus, strain)
+    }
+
+    /// The secant of another law at engineering strain `strain`.
+    ///
+    /// # Errors
+    /// As [`UniaxialLaw::secant_modulus`], and [`Error::InvalidParameter`] if the secant is not
+    /// positive (an unstable law).
+    pub fn secant_of(law: &dyn UniaxialLaw, strain: f64) -> Result<Self> {
+        let modulus = law.secant_modulus(strain)?;
+        if !(modulus.is_finite() && modulus > 0.0) {
+            return Err(Error::invalid(
+                format!("{} secant modulus", law.model_name()),
+                modulus,
+                format!("finite and > 0 Pa at strain {strain}"),
+            ));
+        }
+        Self::new(modulus, strain)
+    }
+
+    /// Secant modulus `E_l` (Pa).
+    pub fn secant_modulus(&self) -> f64 {
+        self.secant_modulus
+    }
+
+    /// Engineering strain at which the secant was taken.
+    pub fn reference_strain(&self) -> f64 {
+        self.reference_strain
+    }
+
+    /// The same law as a [`Hookean`] with `E = E_l`.
+    pub fn as_hookean(&self) -> Hookean {
+        Hookean {
+            youngs_modulus: self.secant_modulus,
+        }
+    }
+}
+
+impl fmt::Display for Linearised {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "Linearised(secant_modulus={:e} Pa, reference_strain={})",
+            self.secant_modulus, self.reference_strain
+        )
+    }
+}
+
+impl UniaxialLaw for Linearised {
+    fn model_name(&self) -> &'static str {
+        "Linearised"
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        self.secant_modulus
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.secant_modulus * (stretch - 1.0)
+    }
+    fn nominal_slope_unchecked(&self, _stretch: f64) -> f64 {
+        self.secant_modulus
+    }
+}
+
+/// Incompressible Neo-Hookean law `W = μ0/2 (I1 − 3)`: `σ = μ0 (λ² − 1/λ)`,
+/// `P = μ0 (λ − 1/λ²)`, `E0 = 3 μ0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NeoHookean {
+    mu: f64,
+}
+
+impl NeoHookean {
+    /// A Neo-Hookean law with initial shear modulus `mu` (Pa); `C10 = mu / 2`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`mu`) unless finite and `> 0`.
+    pub fn new(mu: f64) -> Result<Self> {
+        Ok(Self {
+            mu: check_positive("mu", mu, "Pa")?,
+        })
+    }
+
+    /// Initial shear modulus `μ0` (Pa).
+    pub fn mu(&self) -> f64 {
+        self.mu
+    }
+}
+
+impl fmt::Display for NeoHookean {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "NeoHookean(mu={:e} Pa)", self.mu)
+    }
+}
+
+impl UniaxialLaw for NeoHookean {
+    fn model_name(&self) -> &'static str {
+        "NeoHookean"
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        3.0 * self.mu
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.mu * sigma_factor(stretch) / stretch
+    }
+    fn nominal_slope_unchecked(&self, stretch: f64) -> f64 {
+        self.mu * (1.0 + 2.0 / (stretch * stretch * stretch))
+    }
+    fn true_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.mu * sigma_factor(stretch)
+    }
+    fn true_slope_unchecked(&self, stretch: f64) -> f64 {
+        self.mu * (2.0 * stretch + 1.0 / (stretch * stretch))
+    }
+}
+
+/// Incompressible two-parameter Mooney–Rivlin law `W = C10 (I1 − 3) + C01 (I2 − 3)`:
+/// `σ = 2 (λ² − 1/λ)(C10 + C01/λ)`, `E0 = 6 (C10 + C01)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MooneyRivlin {
+    c10: f64,
+    c01: f64,
+}
+
+impl MooneyRivlin {
+    /// A Mooney–Rivlin law with coefficients `c10`, `c01` (Pa). Either may be negative, but the
+    /// initial shear modulus `2 (c10 + c01)` must be positive; use
+    /// [`UniaxialLaw::check_stable`] for the stretch range of interest.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `c10` or `c01` if not finite, or `c10 + c01` if `<= 0`.
+    pub fn new(c10: f64, c01: f64) -> Result<Self> {
+        let c10 = check_finite("c10", c10)?;
+        let c01 = check_finite("c01", c01)?;
+        if c10 + c01 <= 0.0 {
+            return Err(Error::invalid(
+                "c10 + c01",
+                c10 + c01,
+                "> 0 Pa (initial shear modulus 2 (c10 + c01) > 0)",
+            ));
+        }
+        Ok(Self { c10, c01 })
+    }
+
+    /// `C10` (Pa).
+    pub fn c10(&self) -> f64 {
+        self.c10
+    }
+
+    /// `C01` (Pa).
+    pub fn c01(&self) -> f64 {
+        self.c01
+    }
+}
+
+impl fmt::Display for MooneyRivlin {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "MooneyRivlin(c10={:e} Pa, c01={:e} Pa)",
+            self.c10, self.c01
+        )
+    }
+}
+
+impl UniaxialLaw for MooneyRivlin {
+    fn model_name(&self) -> &'static str {
+        "MooneyRivlin"
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        6.0 * (self.c10 + self.c01)
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.true_stress_unchecked(stretch) / stretch
+    }
+    fn nominal_slope_unchecked(&self, stretch: f64) -> f64 {
+        // P = 2 (λ − 1/λ²)(C10 + C01/λ).
+        let l3 = stretch * stretch * stretch;
+        let g = sigma_factor(stretch) / stretch;
+        2.0 * (1.0 + 2.0 / l3) * (self.c10 + self.c01 / stretch)
+            - 2.0 * g * self.c01 / (stretch * stretch)
+    }
+    fn true_stress_unchecked(&self, stretch: f64) -> f64 {
+        2.0 * sigma_factor(stretch) * (self.c10 + self.c01 / stretch)
+    }
+    fn true_slope_unchecked(&self, stretch: f64) -> f64 {
+        let l2 = stretch * stretch;
+        2.0 * (2.0 * stretch + 1.0 / l2) * (self.c10 + self.c01 / stretch)
+            - 2.0 * sigma_factor(stretch) * self.c01 / l2
+    }
+}
+
+/// Incompressible Yeoh law `W = C10 (I1 − 3) + C20 (I1 − 3)² + C30 (I1 − 3)³`:
+/// `σ = 2 (λ² − 1/λ) ∂W/∂I1`, `E0 = 6 C10`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Yeoh {
+    c10: f64,
+    c20: f64,
+    c30: f64,
+}
+
+impl Yeoh {
+    /// A Yeoh law with `c10 > 0` and any finite `c20`, `c30` (Pa); pass `0.0` for unused terms
+    /// (one term is Neo-Hookean with `mu = 2 c10`). A negative `c20` is common in fits and may
+    /// lose stability at large stretch; use [`UniaxialLaw::check_stable`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `c10` (finite, `> 0`), `c20` or `c30` (finite).
+    pub fn new(c10: f64, c20: f64, c30: f64) -> Result<Self> {
+        Ok(Self {
+            c10: check_positive("c10", c10, "Pa")?,
+            c20: check_finite("c20", c20)?,
+            c30: check_finite("c30", c30)?,
+        })
+    }
+
+    /// `C10` (Pa).
+    pub fn c10(&self) -> f64 {
+        self.c10
+    }
+
+    /// `C20` (Pa).
+    pub fn c20(&self) -> f64 {
+        self.c20
+    }
+
+    /// `C30` (Pa).
+    pub fn c30(&self) -> f64 {
+        self.c30
+    }
+
+    /// `∂W/∂I1` and its derivative with respect to `λ`.
+    fn w1(&self, stretch: f64) -> (f64, f64) {
+        let x = i1_minus_3(stretch);
+        let w1 = self.c10 + 2.0 * self.c20 * x + 3.0 * self.c30 * x * x;
+        let dx = 2.0 * sigma_factor(stretch) / stretch; // dI1/dλ = 2λ − 2/λ²
+        let dw1 = (2.0 * self.c20 + 6.0 * self.c30 * x) * dx;
+        (w1, dw1)
+    }
+}
+
+impl fmt::Display for Yeoh {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "Yeoh(c10={:e} Pa, c20={:e} Pa, c30={:e} Pa)",
+            self.c10, self.c20, self.c30
+        )
+    }
+}
+
+impl UniaxialLaw for Yeoh {
+    fn model_name(&self) -> &'static str {
+        "Yeoh"
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        6.0 * self.c10
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.true_stress_unchecked(stretch) / stretch
+    }
+    fn nominal_slope_unchecked(&self, stretch: f64) -> f64 {
+        let (w1, dw1) = self.w1(stretch);
+        let g = sigma_factor(stretch) / stretch; // λ − 1/λ²
+        2.0 * (1.0 + 2.0 / (stretch * stretch * stretch)) * w1 + 2.0 * g * dw1
+    }
+    fn true_stress_unchecked(&self, stretch: f64) -> f64 {
+        2.0 * sigma_factor(stretch) * self.w1(stretch).0
+    }
+    fn true_slope_unchecked(&self, stretch: f64) -> f64 {
+        let (w1, dw1) = self.w1(stretch);
+        2.0 * (2.0 * stretch + 1.0 / (stretch * stretch)) * w1 + 2.0 * sigma_factor(stretch) * dw1
+    }
+}
+
+/// Largest `|α ln λ|` below which the Ogden term is evaluated by its Taylor series.
+const OGDEN_SERIES_LIMIT: f64 = 0.1;
+
+/// Number of Taylor terms used below [`OGDEN_SERIES_LIMIT`] (truncation error < 1e-17).
+const OGDEN_SERIES_TERMS: i32 = 14;
+
+/// `f(α, L) = (e^(αL) − e^(−αL/2)) / α` with `L = ln λ` and its derivative `∂f/∂α`, accurate
+/// for every finite `α` (including `α → 0`, where `f → 3L/2`).
+pub(crate) fn ogden_term(alpha: f64, log_stretch: f64) -> (f64, f64) {
+    let z = alpha * log_stretch;
+    if z.abs() < OGDEN_SERIES_LIMIT {
+        // e^z − e^(−z/2) = Σ_k z^k (1 − (−1/2)^k) / k!
+        let (mut f, mut df) = (0.0, 0.0);
+        let mut zpow = 1.0; // z^(k−1)
+        let mut zpow_prev = 0.0; // z^(k−2)
+        let mut fact = 1.0; // k!
+        let mut half = -0.5_f64; // (−1/2)^k
+        for k in 1..=OGDEN_SERIES_TERMS {
+            let kf = f64::from(k);
+            fact *= kf;
+            let c = (1.0 - half) / fact;
+            f += c * zpow;
+            if k >= 2 {
+                df += (kf - 1.0) * c * zpow_prev;
+            }
+            zpow_prev = zpow;
+            zpow *= z;
+            half *= -0.5;
+        }
+        (log_stretch * f, log_stretch * log_stretch * df)
+    } else {
+        let f = (z.exp_m1() - (-0.5 * z).exp_m1()) / alpha;
+        let df = (log_stretch * (z.exp() + 0.5 * (-0.5 * z).exp()) - f) / alpha;
+        (f, df)
+    }
+}
+
+/// Incompressible N-term Ogden law, in the convention
+/// `W = Σ_p 2 μ_p / α_p² (λ1^α_p + λ2^α_p + λ3^α_p − 3)`, so that the initial shear modulus is
+/// `μ0 = Σ μ_p` and `E0 = 3 Σ μ_p`:
+/// `σ = Σ_p (2 μ_p / α_p)(λ^α_p − λ^(−α_p/2))`.
+///
+/// One term with `α = 2` is Neo-Hookean; terms `(2 C10, 2)` and `(2 C01, −2)` make
+/// Mooney–Rivlin. A term with `μ_p > 0` has positive energy and raises `dσ/dλ` (Ogden's
+/// condition `μ_p α_p > 0` in his original convention `W = Σ μ_p/α_p (…)`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ogden {
+    mu: Vec<f64>,
+    alpha: Vec<f64>,
+}
+
+impl Ogden {
+    /// An Ogden law from moduli `mu` (Pa) and exponents `alpha` (dimensionless), one entry per
+    /// term (shape `[N]` each, `N >= 1`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `mu` / `alpha` if the lengths differ or are zero, an
+    /// entry is not finite, an `alpha` is zero, or `Σ mu <= 0` (initial shear modulus).
+    pub fn new(mu: &[f64], alpha: &[f64]) -> Result<Self> {
+        if mu.is_empty() || mu.len() != alpha.len() {
+            return Err(Error::invalid(
+                "mu",
+                format!("{} terms (alpha has {})", mu.len(), alpha.len()),
+                "at least one term, as many as alpha",
+            ));
+        }
+        for (i, (&m, &a)) in mu.iter().zip(alpha).enumerate() {
+            check_finite(&format!("mu[{i}]"), m)?;
+            if !(a.is_finite() && a != 0.0) {
+                return Err(Error::invalid(
+                    format!("alpha[{i}]"),
+                    a,
+                    "finite and non-zero",
+                ));
+            }
+        }
+        let mu0: f64 = mu.iter().sum();
+        if mu0 <= 0.0 {
+            return Err(Error::invalid(
+                "mu",
+                format!("{mu:?}"),
+                "sum(mu) > 0 Pa (initial shear modulus)",
+            ));
+        }
+        Ok(Self {
+            mu: mu.to_vec(),
+            alpha: alpha.to_vec(),
+        })
+    }
+
+    /// Term moduli `μ_p` (Pa).
+    pub fn mu(&self) -> &[f64] {
+        &self.mu
+    }
+
+    /// Term exponents `α_p`.
+    pub fn alpha(&self) -> &[f64] {
+        &self.alpha
+    }
+
+    /// Number of terms `N`.
+    pub fn terms(&self) -> usize {
+        self.mu.len()
+    }
+}
+
+impl fmt::Display for Ogden {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Ogden(mu=[")?;
+        for (i, m) in self.mu.iter().enumerate() {
+            write!(f, "{}{m:e}", if i > 0 { ", " } else { "" })?;
+        }
+        write!(f, "] Pa, alpha=[")?;
+        for (i, a) in self.alpha.iter().enumerate() {
+            write!(f, "{}{a}", if i > 0 { ", " } else { "" })?;
+        }
+        write!(f, "])")
+    }
+}
+
+impl UniaxialLaw for Ogden {
+    fn model_name(&self) -> &'static str {
+        "Ogden"
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        3.0 * self.mu.iter().sum::<f64>()
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        self.true_stress_unchecked(stretch) / stretch
+    }
+    fn nominal_slope_unchecked(&self, stretch: f64) -> f64 {
+        (self.true_slope_unchecked(stretch) - self.nominal_stress_unchecked(stretch)) / stretch
+    }
+    fn true_stress_unchecked(&self, stretch: f64) -> f64 {
+        let log_stretch = stretch.ln();
+        self.mu
+            .iter()
+            .zip(&self.alpha)
+            .map(|(&m, &a)| 2.0 * m * ogden_term(a, log_stretch).0)
+            .sum()
+    }
+    fn true_slope_unchecked(&self, stretch: f64) -> f64 {
+        self.mu
+            .iter()
+            .zip(&self.alpha)
+            .map(|(&m, &a)| 2.0 * m * (stretch.powf(a - 1.0) + 0.5 * stretch.powf(-0.5 * a - 1.0)))
+            .sum()
+    }
+}
+
+/// Any of the uniaxial laws, as one value type (what a rod model stores and a fit returns).
+#[derive(Debug, Clone, PartialEq)]
+pub enum UniaxialModel {
+    /// [`Hookean`].
+    Hookean(Hookean),
+    /// [`Linearised`].
+    Linearised(Linearised),
+    /// [`NeoHookean`].
+    NeoHookean(NeoHookean),
+    /// [`MooneyRivlin`].
+    MooneyRivlin(MooneyRivlin),
+    /// [`Yeoh`].
+    Yeoh(Yeoh),
+    /// [`Ogden`].
+    Ogden(Ogden),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $law:ident => $body:expr) => {
+        match $self {
+            UniaxialModel::Hookean($law) => $body,
+            UniaxialModel::Linearised($law) => $body,
+            UniaxialModel::NeoHookean($law) => $body,
+            UniaxialModel::MooneyRivlin($law) => $body,
+            UniaxialModel::Yeoh($law) => $body,
+            UniaxialModel::Ogden($law) => $body,
+        }
+    };
+}
+
+impl UniaxialModel {
+    /// The law as a trait object.
+    pub fn as_law(&self) -> &dyn UniaxialLaw {
+        dispatch!(self, law => law)
+    }
+}
+
+impl fmt::Display for UniaxialModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        dispatch!(self, law => fmt::Display::fmt(law, f))
+    }
+}
+
+impl UniaxialLaw for UniaxialModel {
+    fn model_name(&self) -> &'static str {
+        dispatch!(self, law => law.model_name())
+    }
+    fn small_strain_modulus(&self) -> f64 {
+        dispatch!(self, law => law.small_strain_modulus())
+    }
+    fn nominal_stress_unchecked(&self, stretch: f64) -> f64 {
+        dispatch!(self, law => law.nominal_stress_unchecked(stretch))
+    }
+    fn nominal_slope_unchecked(&self, stretch: f64) -> f64 {
+        dispatch!(self, law => law.nominal_slope_unchecked(stretch))
+    }
+    fn true_stress_unchecked(&self, stretch: f64) -> f64 {
+        dispatch!(self, law => law.true_stress_unchecked(stretch))
+    }
+    fn true_slope_unchecked(&self, stretch: f64) -> f64 {
+        dispatch!(self, law => law.true_slope_unchecked(stretch))
+    }
+}
+
+macro_rules! into_model {
+    ($($ty:ident),*) => {$(
+        impl From<$ty> for UniaxialModel {
+            fn from(law: $ty) -> Self {
+                UniaxialModel::$ty(law)
+            }
+        }
+    )*};
+}
+into_model!(Hookean, Linearised, NeoHookean, MooneyRivlin, Yeoh, Ogden);
+
+/// Named silicones with sourced hyperelastic parameters.
+///
+/// Except for Elastosil M4601, every parameter set is a least-squares fit by
+/// [`crate::fit::fit_uniaxial`] (nominal stress, unweighted, exact linear solve) to the measured
+/// tensile curve of the Soft Robotics Materials Database, restricted to stretch `λ <= 3`
+/// (engineering strain <= 200 %, see [`Silicone::fit_stretch_range`]):
+///
+/// > L. Marechal, P. Balland, L. Lindenroth, F. Petrou, C. Kontovounisios, F. Bello, "Toward a
+/// > Common Framework and Database of Materials for Soft Robotics", Soft Robotics 8(3), 2021,
+/// > doi:10.1089/soro.2019.0115; data github.com/LucMarechal/Soft-Robotics-Materials-Database,
+/// > folder `Tensile-Tests-Data/`, commit 8ff66c3bdc17bd226eabe83b778e13ea1e2ef8ce, licensed
+/// > ODbL 1.0 (database) / DbCL 1.0 (contents).
+///
+/// Those curves are ASTM D412 tests (3 × 6 mm section, 33 mm gauge, 450 mm/min) with strain
+/// taken from the crosshead, which overstates strain: the moduli are therefore on the low side,
+/// and batch, cure and test method change them by more than the choice of model (datasheets
+/// differ by 2–4× for the Ecoflex grades). The fits are reproduced, with their errors, by
+/// `cargo run --release -p softrod --example fit_silicones -- <data dir>`; the constants are
+/// stored to six significant digits.
+///
+/// These curves stiffen with strain, so unconstrained Mooney–Rivlin fits come out with
+/// `C01 < 0` and are stable only in tension or mild compression (stretch bounds in each
+/// entry); three-term Yeoh fits have `C30 < 0` and lose stability a little above `λ = 3.7`
+/// (Dragon Skin) or 4.4 (Ecoflex). Check [`UniaxialLaw::check_stable`] on the stretch range of
+/// the application; prefer Yeoh where a section is compressed (bending).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Silicone {
+    /// Smooth-On Ecoflex 00-30.
+    ///
+    /// Fit errors on the 86 points with λ ≤ 3 (RMS / max |residual| of the nominal stress):
+    /// Neo-Hookean 1.343 / 2.712 kPa (R² 0.9908); Mooney–Rivlin 0.419 / 1.096 kPa (R²
+    /// 0.9991), stable for λ ≥ 0.503 only; Yeoh 0.412 / 1.468 kPa (R² 0.9991), stable for λ
+    /// ≤ 4.71.
+    Ecoflex0030,
+    /// Smooth-On Ecoflex 00-50.
+    ///
+    /// Fit errors on the 87 points with λ ≤ 3: Neo-Hookean 3.157 / 6.458 kPa (R² 0.9788);
+    /// Mooney–Rivlin 0.846 / 2.983 kPa (R² 0.9985), stable for λ ≥ 0.687 only; Yeoh 0.524 /
+    /// 3.610 kPa (R² 0.9994), stable for λ ≤ 4.38.
+    Ecoflex0050,
+    /// Smooth-On Dragon Skin 10 (MEDIUM).
+    ///
+    /// Fit (file `Dragon Skin 10 MEDIUM.csv`) errors on the 87 points with λ ≤ 3:
+    /// Neo-Hookean 24.59 / 45.63 kPa (R² 0.904); Mooney–Rivlin 6.031 / 9.770 kPa (R² 0.9942),
+    /// stable for λ ≥ 0.997 only (tension only; its initial modulus 6 (c10 + c01) is near
+    /// zero); Yeoh 0.842 / 3.553 kPa (R² 0.99989), stable for 0.110 ≤ λ ≤ 3.77.
+    DragonSkin10,
+    /// Smooth-On Dragon Skin 20.
+    ///
+    /// Fit errors on the 87 points with λ ≤ 3: Neo-Hookean 57.28 / 111.1 kPa (R² 0.923);
+    /// Mooney–Rivlin 10.93 / 23.80 kPa (R² 0.9972), stable for λ ≥ 0.958 only; Yeoh 4.297 /
+    /// 8.583 kPa (R² 0.99957), stable for 0.113 ≤ λ ≤ 3.71.
+    DragonSkin20,
+    /// Smooth-On Dragon Skin 30.
+    ///
+    /// Fit errors on the 87 points with λ ≤ 3: Neo-Hookean 69.30 / 131.6 kPa (R² 0.936);
+    /// Mooney–Rivlin 14.17 / 26.26 kPa (R² 0.9973), stable for λ ≥ 0.922 only; Yeoh 3.107 /
+    /// 6.360 kPa (R² 0.99987), stable for 0.112 ≤ λ ≤ 3.71.
+    DragonSkin30,
+    /// Wacker Elastosil M4601 (literature values; no curve in the database).
+    ///
+    /// Yeoh `C10 = 0.11 MPa`, `C20 = 0.02 MPa` as reported by P. Polygerinos, Z. Wang,
+    /// J. T. B. Overvelde, K. C. Galloway, R. J. Wood, K. Bertoldi, C. J. Walsh, "Modeling of
+    /// Soft Fiber-Reinforced Bending Actuators", IEEE T-RO 31(3), 778–789, 2015 (fitted there to
+    /// their uniaxial test of the material; the fitted stretch range is not restated here). The
+    /// Neo-Hookean `mu = 2 C10 = 0.22 MPa` is the initial shear modulus of that Yeoh law, not a
+    /// separate fit. No Mooney–Rivlin set is provided.
+    ElastosilM4601,
+}
+
+/// Sourced parameters of one silicone (Pa).
+struct SiliconeParams {
+    name: &'static str,
+    mu: f64,
+    mooney_rivlin: Option<(f64, f64)>,
+    yeoh: (f64, f64, f64),
+    stretch_max: f64,
+    source: &'static str,
+}
+
+impl Silicone {
+    /// Every silicone of the library.
+    pub const ALL: [Silicone; 6] = [
+        Silicone::Ecoflex0030,
+        Silicone::Ecoflex0050,
+        Silicone::DragonSkin10,
+        Silicone::DragonSkin20,
+        Silicone::DragonSkin30,
+        Silicone::ElastosilM4601,
+    ];
+
+    fn params(self) -> SiliconeParams {
+        match self {
+            Silicone::Ecoflex0030 => SiliconeParams {
+                name: "Ecoflex 00-30",
+                mu: 17204.9,
+                mooney_rivlin: Some((10148.3, -3614.42)),
+                yeoh: (7733.53, 139.149, -4.06163),
+                stretch_max: 3.0,
+                source: MARECHAL_2021,
+            },
+            Silicone::Ecoflex0050 => SiliconeParams {
+                name: "Ecoflex 00-50",
+                mu: 25112.6,
+                mooney_rivlin: Some((16260.3, -8659.60)),
+                yeoh: (10411.7, 346.974, -10.5176),
+                stretch_max: 3.0,
+                source: MARECHAL_2021,
+            },
+            Silicone::DragonSkin10 => SiliconeParams {
+                name: "Dragon Skin 10",
+                mu: 78634.9,
+                mooney_rivlin: Some((68341.6, -67855.7)),
+                yeoh: (21589.8, 3044.25, -111.600),
+                stretch_max: 3.0,
+                source: MARECHAL_2021,
+            },
+            Silicone::DragonSkin20 => SiliconeParams {
+                name: "Dragon Skin 20",
+                mu: 211548.0,
+                mooney_rivlin: Some((174249.0, -160087.0)),
+                yeoh: (63798.8, 7372.43, -287.254),
+                stretch_max: 3.0,
+                source: MARECHAL_2021,
+            },
+            Silicone::DragonSkin30 => SiliconeParams {
+                name: "Dragon Skin 30",
+                mu: 286574.0,
+                mooney_rivlin: Some((225892.0, -193122.0)),
+                yeoh: (92174.8, 9028.40, -356.941),
+                stretch_max: 3.0,
+                source: MARECHAL_2021,
+            },
+            Silicone::ElastosilM4601 => SiliconeParams {
+                name: "Elastosil M4601",
+                mu: 2.0 * 0.11e6,
+                mooney_rivlin: None,
+                yeoh: (0.11e6, 0.02e6, 0.0),
+                stretch_max: f64::NAN,
+                source: POLYGERINOS_2015,
+            },
+        }
+    }
+
+    /// Display name, e.g. `"Dragon Skin 10"`.
+    pub fn name(self) -> &'static str {
+        self.params().name
+    }
+
+    /// Looks a silicone up by name, ignoring case, spaces, `-` and `_` (`"ecoflex 00-30"`,
+    /// `"DragonSkin10"`, `"elastosil_m4601"`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`name`) listing the known names otherwise.
+    pub fn from_name(name: &str) -> Result<Self> {
+        let key = |s: &str| {
+            s.chars()
+                .filter(|c| c.is_ascii_alphanumeric())
+                .map(|c| c.to_ascii_lowercase())
+                .collect::<String>()
+        };
+        let wanted = key(name);
+        Self::ALL
+            .into_iter()
+            .find(|s| key(s.name()) == wanted)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|s| s.name()).collect();
+                Error::invalid("name", name, format!("one of {}", names.join(", ")))
+            })
+    }
+
+    /// Neo-Hookean law (see [`Silicone::source`]).
+    pub fn neo_hookean(self) -> NeoHookean {
+        NeoHookean {
+            mu: self.params().mu,
+        }
+    }
+
+    /// Two-parameter Mooney–Rivlin law, where a sourced one exists (`None` for Elastosil M4601).
+    pub fn mooney_rivlin(self) -> Option<MooneyRivlin> {
+        self.params()
+            .mooney_rivlin
+            .map(|(c10, c01)| MooneyRivlin { c10, c01 })
+    }
+
+    /// Yeoh law (three terms for the fitted silicones).
+    pub fn yeoh(self) -> Yeoh {
+        let (c10, c20, c30) = self.params().yeoh;
+        Yeoh { c10, c20, c30 }
+    }
+
+    /// Stretch range `(min, max)` of the data the parameters were fitted to; the laws are only
+    /// validated there. `None` where the source does not state it (Elastosil M4601).
+    pub fn fit_stretch_range(self) -> Option<(f64, f64)> {
+        let p = self.params();
+        p.stretch_max.is_finite().then_some((1.0, p.stretch_max))
+    }
+
+    /// Where the parameters come from (for citations).
+    pub fn source(self) -> &'static str {
+        self.params().source
+    }
+}
+
+impl fmt::Display for Silicone {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Source note of the fitted entries.
+const MARECHAL_2021: &str =
+    "least-squares fit (softrod fit_uniaxial, nominal stress, stretch 1 to 3) \
+to the tensile curve of the Soft Robotics Materials Database: L. Marechal et al., Soft Robotics \
+8(3), 2021, doi:10.1089/soro.2019.0115, github.com/LucMarechal/Soft-Robotics-Materials-Database \
+commit 8ff66c3b, Tensile-Tests-Data (ODbL 1.0 / DbCL 1.0)";
+
+/// Source note of Elastosil M4601.
+const POLYGERINOS_2015: &str = "Yeoh C10 = 0.11 MPa, C20 = 0.02 MPa: P. Polygerinos et al., \
+Modeling of Soft Fiber-Reinforced Bending Actuators, IEEE T-RO 31(3), 2015; Neo-Hookean \
+mu = 2 C10 is the initial shear modulus of that Yeoh law";
