@@ -1,0 +1,46 @@
+//! Python exceptions and the one place where core errors become them.
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+use softrod::Error;
+
+create_exception!(
+    _core,
+    ParameterError,
+    PyValueError,
+    "A parameter is outside its valid range; the message names it, its value and the range."
+);
+create_exception!(
+    _core,
+    ConvergenceError,
+    PyRuntimeError,
+    "A solver or integrator did not converge; carries `iterations` and `residual`."
+);
+
+/// The one place where core errors become Python exceptions.
+pub(crate) fn to_py_err(e: Error) -> PyErr {
+    let msg = e.to_string();
+    match e {
+        Error::InvalidParameter { name, .. } => Python::attach(|py| {
+            let err = ParameterError::new_err(msg);
+            let _ = err.value(py).setattr("parameter", name);
+            err
+        }),
+        Error::NotConverged {
+            iterations,
+            residual,
+            ..
+        } => Python::attach(|py| {
+            let err = ConvergenceError::new_err(msg);
+            let _ = err.value(py).setattr("iterations", iterations);
+            let _ = err.value(py).setattr("residual", residual);
+            err
+        }),
+    }
+}
+
+pub(crate) fn param_err(name: &str, value: impl std::fmt::Display, expected: &str) -> PyErr {
+    to_py_err(Error::invalid(name, value, expected))
+}

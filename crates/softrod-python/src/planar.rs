@@ -1,0 +1,339 @@
+//! Binding of the seed-000 planar cable arm and the backbone distance.
+
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use softrod::AdaptiveOptions;
+
+use crate::convert::Floats;
+use crate::errors::{param_err, to_py_err};
+
+// The Python signatures spell the core's default tolerances as literals (so that
+// `inspect.signature` shows them); these checks keep the two in step.
+const _: () = assert!(softrod::integrate::DEFAULT_RTOL == 1e-8);
+const _: () = assert!(softrod::integrate::DEFAULT_ATOL == 1e-10);
+const _: () = assert!(softrod::integrate::DEFAULT_MAX_STEPS == 100_000);
+
+fn method_from(
+    method: &str,
+    rtol: f64,
+    atol: f64,
+    max_steps: i64,
+) -> PyResult<softrod::PlanarMethod> {
+    if max_steps < 1 {
+        return Err(param_err("max_steps", max_steps, ">= 1"));
+    }
+    match method {
+        "closed-form" | "closed_form" => Ok(softrod::PlanarMethod::ClosedForm),
+        "ode" => {
+            let opts = AdaptiveOptions {
+                rtol,
+                atol,
+                max_steps: max_steps as usize,
+            }
+            .validated()
+            .map_err(to_py_err)?;
+            Ok(softrod::PlanarMethod::Ode(opts))
+        }
+        other => Err(param_err("method", other, "\"closed-form\" or \"ode\"")),
+    }
+}
+
+fn samples_from(length: f64, n_points: i64, s: Option<Floats<'_>>) -> PyResult<Vec<f64>> {
+    match s {
+        Some(s) => s.to_vec(),
+        None => {
+            if n_points < 2 {
+                return Err(param_err("n_points", n_points, ">= 2"));
+            }
+            softrod::uniform_samples(length, n_points as usize).map_err(to_py_err)
+        }
+    }
+}
+
+/// The seed-000 tapered cable-driven arm (immutable).
+#[pyclass(frozen, module = "softrod._core")]
+pub(crate) struct PlanarCableArm {
+    inner: softrod::PlanarCableArm,
+}
+
+/// Samples of one solved planar arm.
+#[pyclass(frozen, module = "softrod._core")]
+pub(crate) struct PlanarSolution {
+    #[pyo3(get)]
+    tension: f64,
+    #[pyo3(get)]
+    s: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    curvature: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    strain: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    angle: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    x: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    y: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    tip: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    tip_angle: f64,
+    #[pyo3(get)]
+    max_compressive_strain: f64,
+    #[pyo3(get)]
+    method: String,
+    #[pyo3(get)]
+    stats: Option<Py<PyDict>>,
+}
+
+#[pymethods]
+impl PlanarSolution {
+    fn __repr__(&self) -> String {
+        format!(
+            "PlanarSolution(tension={} N, method={:?}, tip_angle={:.6} rad)",
+            self.tension, self.method, self.tip_angle
+        )
+    }
+}
+
+/// Many tensions solved on one set of samples; 2-D arrays are `(n_tensions, n_samples)`.
+#[pyclass(frozen, module = "softrod._core")]
+pub(crate) struct PlanarBatch {
+    #[pyo3(get)]
+    tension: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    s: Py<PyArray1<f64>>,
+    #[pyo3(get)]
+    curvature: Py<PyArray2<f64>>,
+    #[pyo3(get)]
+    strain: Py<PyArray2<f64>>,
+    #[pyo3(get)]
+    angle: Py<PyArray2<f64>>,
+    #[pyo3(get)]
+    x: Py<PyArray2<f64>>,
+    #[pyo3(get)]
+    y: Py<PyArray2<f64>>,
+    #[pyo3(get)]
+    tip: Py<PyArray2<f64>>,
+    #[pyo3(get)]
+    tip_angle: Py<PyArray1<f64>>,
+}
+
+#[pymethods]
+impl PlanarBatch {
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let shape = self.x.bind(py).dims();
+        format!("PlanarBatch(tensions={}, samples={})", shape[0], shape[1])
+    }
+    fn __len__(&self, py: Python<'_>) -> usize {
+        self.x.bind(py).dims()[0]
+    }
+}
+
+fn to_2d(py: Python<'_>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<Py<PyArray2<f64>>> {
+    Ok(v.into_pyarray(py).reshape([rows, cols])?.unbind())
+}
+
+#[pymethods]
+impl PlanarCableArm {
+    #[new]
+    #[pyo3(signature = (length, base_radius, tip_radius, offset_ratio, youngs_modulus, anchor=None))]
+    fn new(
+        length: f64,
+        base_radius: f64,
+        tip_radius: f64,
+        offset_ratio: f64,
+        youngs_modulus: f64,
+        anchor: Option<f64>,
+    ) -> PyResult<Self> {
+        softrod::PlanarCableArm::new(
+            length,
+            base_radius,
+            tip_radius,
+            offset_ratio,
+            youngs_modulus,
+            anchor,
+        )
+        .map(|inner| Self { inner })
+        .map_err(to_py_err)
+    }
+
+    /// The seed's experimental arm (L 270 mm, R0 15 mm, RL 7.4 mm, a 1/3, E 110 kPa).
+    #[staticmethod]
+    fn seed_arm() -> Self {
+        Self {
+            inner: softrod::PlanarCableArm::seed_arm(),
+        }
+    }
+
+    #[getter]
+    fn length(&self) -> f64 {
+        self.inner.length()
+    }
+    #[getter]
+    fn base_radius(&self) -> f64 {
+        self.inner.base_radius()
+    }
+    #[getter]
+    fn tip_radius(&self) -> f64 {
+        self.inner.tip_radius()
+    }
+    #[getter]
+    fn offset_ratio(&self) -> f64 {
+        self.inner.offset_ratio()
+    }
+    #[getter]
+    fn youngs_modulus(&self) -> f64 {
+        self.inner.youngs_modulus()
+    }
+    #[getter]
+    fn anchor(&self) -> f64 {
+        self.inner.anchor()
+    }
+    #[getter]
+    fn max_tension(&self) -> f64 {
+        self.inner.max_tension()
+    }
+
+    /// Section radius R(s) (m) at arc lengths `s` (m).
+    fn radius<'py>(&self, py: Python<'py>, s: Floats<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let s = s.to_vec()?;
+        Ok(s.iter()
+            .map(|&si| self.inner.radius(si))
+            .collect::<Vec<_>>()
+            .into_pyarray(py))
+    }
+
+    fn __repr__(&self) -> String {
+        let a = &self.inner;
+        format!(
+            "PlanarCableArm(length={}, base_radius={}, tip_radius={}, offset_ratio={}, \
+             youngs_modulus={}, anchor={})",
+            a.length(),
+            a.base_radius(),
+            a.tip_radius(),
+            a.offset_ratio(),
+            a.youngs_modulus(),
+            a.anchor()
+        )
+    }
+
+    #[pyo3(signature = (tension, n_points=201, *, s=None, method="closed-form", rtol=1e-8, atol=1e-10, max_steps=100_000))]
+    fn solve(
+        &self,
+        py: Python<'_>,
+        tension: f64,
+        n_points: i64,
+        s: Option<Floats<'_>>,
+        method: &str,
+        rtol: f64,
+        atol: f64,
+        max_steps: i64,
+    ) -> PyResult<PlanarSolution> {
+        let samples = samples_from(self.inner.length(), n_points, s)?;
+        let m = method_from(method, rtol, atol, max_steps)?;
+        let arm = self.inner;
+        let sol = py
+            .detach(move || softrod::solve_planar(&arm, tension, &samples, m))
+            .map_err(to_py_err)?;
+        let stats = match sol.ode_stats {
+            Some(st) => {
+                let d = PyDict::new(py);
+                d.set_item("accepted_steps", st.accepted)?;
+                d.set_item("rejected_steps", st.rejected)?;
+                d.set_item("evaluations", st.evaluations)?;
+                Some(d.unbind())
+            }
+            None => None,
+        };
+        let mcs = sol.max_compressive_strain();
+        Ok(PlanarSolution {
+            tension: sol.tension,
+            s: sol.s.into_pyarray(py).unbind(),
+            curvature: sol.curvature.into_pyarray(py).unbind(),
+            strain: sol.strain.into_pyarray(py).unbind(),
+            angle: sol.angle.into_pyarray(py).unbind(),
+            x: sol.x.into_pyarray(py).unbind(),
+            y: sol.y.into_pyarray(py).unbind(),
+            tip: sol.tip.to_vec().into_pyarray(py).unbind(),
+            tip_angle: sol.tip_angle,
+            max_compressive_strain: mcs,
+            method: if sol.ode_stats.is_some() {
+                "ode"
+            } else {
+                "closed-form"
+            }
+            .to_string(),
+            stats,
+        })
+    }
+
+    #[pyo3(signature = (tensions, n_points=201, *, s=None, method="closed-form", rtol=1e-8, atol=1e-10, max_steps=100_000))]
+    fn solve_many(
+        &self,
+        py: Python<'_>,
+        tensions: Floats<'_>,
+        n_points: i64,
+        s: Option<Floats<'_>>,
+        method: &str,
+        rtol: f64,
+        atol: f64,
+        max_steps: i64,
+    ) -> PyResult<PlanarBatch> {
+        let samples = samples_from(self.inner.length(), n_points, s)?;
+        let m = method_from(method, rtol, atol, max_steps)?;
+        let arm = self.inner;
+        let t = tensions.to_vec()?;
+        let b = py
+            .detach(move || softrod::solve_planar_many(&arm, &t, &samples, m))
+            .map_err(to_py_err)?;
+        let (nt, ns) = (b.tensions.len(), b.s.len());
+        let tip: Vec<f64> = b.tip.iter().flatten().copied().collect();
+        Ok(PlanarBatch {
+            tension: b.tensions.into_pyarray(py).unbind(),
+            s: b.s.into_pyarray(py).unbind(),
+            curvature: to_2d(py, b.curvature, nt, ns)?,
+            strain: to_2d(py, b.strain, nt, ns)?,
+            angle: to_2d(py, b.angle, nt, ns)?,
+            x: to_2d(py, b.x, nt, ns)?,
+            y: to_2d(py, b.y, nt, ns)?,
+            tip: to_2d(py, tip, nt, 2)?,
+            tip_angle: b.tip_angle.into_pyarray(py).unbind(),
+        })
+    }
+}
+
+/// Distance of two backbones `(n, dim)` at equal arm index; returns a dict.
+#[pyfunction]
+#[pyo3(signature = (a, b, n_index=None))]
+pub(crate) fn backbone_distance<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray2<'py, f64>,
+    b: PyReadonlyArray2<'py, f64>,
+    n_index: Option<i64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (da, db) = (a.as_array().ncols(), b.as_array().ncols());
+    if da != db {
+        return Err(param_err(
+            "b.shape[1]",
+            db,
+            &format!("equal to a.shape[1] = {da}"),
+        ));
+    }
+    let n_index = match n_index {
+        Some(n) if n < 2 => return Err(param_err("n_index", n, ">= 2")),
+        Some(n) => Some(n as usize),
+        None => None,
+    };
+    let av = a.as_array().iter().copied().collect::<Vec<_>>();
+    let bv = b.as_array().iter().copied().collect::<Vec<_>>();
+    let d = softrod::backbone_distance(&av, &bv, da, n_index).map_err(to_py_err)?;
+    let out = PyDict::new(py);
+    out.set_item("max", d.max)?;
+    out.set_item("mean", d.mean)?;
+    out.set_item("argmax_index", d.argmax_index)?;
+    out.set_item("index", d.index.into_pyarray(py))?;
+    out.set_item("distance", d.distance.into_pyarray(py))?;
+    Ok(out)
+}
