@@ -125,7 +125,7 @@ fn main() -> ExitCode {
         ("Yeoh 3", ModelKind::Yeoh { terms: 3 }, false),
         ("Yeoh 3 (c >= 0)", ModelKind::Yeoh { terms: 3 }, true),
         ("Ogden 2", ModelKind::Ogden { terms: 2 }, false),
-        ("Ogden 3 (mu >= 0)", ModelKind::Ogden { terms: 3 }, true),
+        ("Ogden 2 (mu >= 0)", ModelKind::Ogden { terms: 2 }, true),
     ];
     // Library range first (what the `Silicone` constants come from), then the whole curve.
     for (label, stretch_max) in [

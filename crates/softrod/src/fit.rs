@@ -183,7 +183,10 @@ pub enum ModelKind {
         /// Number of coefficients, 1 to 3.
         terms: usize,
     },
-    /// [`Ogden`] with `terms` = 1 to [`MAX_OGDEN_TERMS`] pairs `(μ_p, α_p)`.
+    /// [`Ogden`] with `terms` = 1 to [`MAX_OGDEN_TERMS`] pairs `(μ_p, α_p)`. The fit is a local
+    /// minimum from several starts and is not unique: without `nonnegative`, two terms may
+    /// merge into nearly equal exponents with huge opposite moduli (a good fit that
+    /// extrapolates badly); check the result with [`UniaxialLaw::check_stable`].
     Ogden {
         /// Number of terms.
         terms: usize,
@@ -217,7 +220,8 @@ const SVD_RCOND: f64 = 1e-13;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
     /// Constrain the coefficients: every coefficient `>= 0` (for Ogden the moduli `μ_p >= 0`,
-    /// Ogden's condition `μ_p α_p > 0` in his original convention). Default `false`.
+    /// Ogden's condition `μ_p α_p > 0` in his original convention). Default `false`. An Ogden
+    /// term whose modulus ends at zero is inactive (its exponent is then meaningless).
     pub nonnegative: bool,
     /// Levenberg–Marquardt iteration cap per start (Ogden only). Default 200.
     pub max_iterations: usize,
