@@ -8,25 +8,51 @@ file I/O (:mod:`softrod.io`), plots (:mod:`softrod.plot`) and the ``softrod`` co
 """
 
 from ._core import (
+    CircularSection,
     ConvergenceError,
+    FunctionSection,
+    LinearElastic,
+    Loads,
     ParameterError,
     PlanarBatch,
     PlanarCableArm,
     PlanarSolution,
+    PointLoad,
+    Rod,
+    Section,
+    StaticsSolution,
+    TableSection,
+    TaperedCircularSection,
+    Tendon,
+    TubeSection,
     __version__,
+    solve_statics,
 )
 from .compare import BackboneDistance, backbone_distance
 from .io import read_backbone_csv, write_samples_csv
 
 __all__ = [
     "BackboneDistance",
+    "CircularSection",
     "ConvergenceError",
+    "FunctionSection",
+    "LinearElastic",
+    "Loads",
     "ParameterError",
     "PlanarBatch",
     "PlanarCableArm",
     "PlanarSolution",
+    "PointLoad",
+    "Rod",
+    "Section",
+    "StaticsSolution",
+    "TableSection",
+    "TaperedCircularSection",
+    "Tendon",
+    "TubeSection",
     "__version__",
     "backbone_distance",
     "read_backbone_csv",
+    "solve_statics",
     "write_samples_csv",
 ]

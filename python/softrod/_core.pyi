@@ -1,6 +1,6 @@
 """Type stubs of the compiled core ``softrod._core`` (checked against the module by the tests)."""
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Literal, final
 
 import numpy as np
@@ -131,3 +131,208 @@ class PlanarCableArm:
 def backbone_distance(
     a: NDArray[np.float64], b: NDArray[np.float64], n_index: int | None = None
 ) -> dict[str, object]: ...
+
+# ----------------------------------------------------------------------------- statics
+
+_Vec3 = Sequence[float] | NDArray[np.float64]
+_VecFn = Callable[[float], _Vec3]
+
+class Section:
+    """A rod's cross-section along its length."""
+
+    def properties(self, s: float, length: float) -> dict[str, float]: ...
+
+@final
+class CircularSection(Section):
+    """Solid circle of constant radius (m)."""
+
+    def __init__(self, radius: float) -> None: ...
+
+@final
+class TaperedCircularSection(Section):
+    """Solid circle tapering linearly from base_radius to tip_radius (m)."""
+
+    def __init__(self, base_radius: float, tip_radius: float) -> None: ...
+
+@final
+class TubeSection(Section):
+    """Circular tube (m)."""
+
+    def __init__(self, outer_radius: float, inner_radius: float = 0.0) -> None: ...
+
+@final
+class TableSection(Section):
+    """Section tables over s (m): area (m^2), ix, iy, j (m^4)."""
+
+    def __init__(
+        self,
+        s: Sequence[float],
+        area: Sequence[float],
+        ix: Sequence[float],
+        iy: Sequence[float],
+        j: Sequence[float],
+    ) -> None: ...
+
+@final
+class FunctionSection(Section):
+    """Section from a function s -> (area, ix, iy, j)."""
+
+    def __init__(self, function: Callable[[float], Sequence[float]]) -> None: ...
+
+@final
+class LinearElastic:
+    """Linear elastic material: E (Pa) and Poisson's ratio, or the shear modulus (Pa)."""
+
+    def __init__(
+        self,
+        youngs_modulus: float,
+        poisson_ratio: float | None = None,
+        *,
+        shear_modulus: float | None = None,
+    ) -> None: ...
+    @property
+    def youngs_modulus(self) -> float: ...
+    @property
+    def shear_modulus(self) -> float: ...
+    @property
+    def poisson_ratio(self) -> float: ...
+
+@final
+class Rod:
+    """A Cosserat rod (immutable)."""
+
+    def __init__(
+        self,
+        length: float,
+        section: Section,
+        material: LinearElastic,
+        rest_strain: _Vec3 | _VecFn | None = None,
+        rest_curvature: _Vec3 | _VecFn | None = None,
+        inextensible: bool = False,
+        density: float | None = None,
+        base_pose: NDArray[np.float64]
+        | Sequence[Sequence[float]]
+        | tuple[_Vec3, object]
+        | None = None,
+        *,
+        shear_coefficient: float | None = None,
+    ) -> None: ...
+    @property
+    def length(self) -> float: ...
+    @property
+    def inextensible(self) -> bool: ...
+    @property
+    def density(self) -> float | None: ...
+    @property
+    def shear_coefficient(self) -> float: ...
+    @property
+    def base_pose(self) -> NDArray[np.float64]: ...
+
+@final
+class Tendon:
+    """A tendon: body-frame offset (m), tension (N), end arc length (m)."""
+
+    def __init__(
+        self,
+        offset: Sequence[float] | Callable[[float], Sequence[float]],
+        tension: float,
+        end: float | None = None,
+        *,
+        derivative: Callable[[float], Sequence[float]] | None = None,
+    ) -> None: ...
+    @staticmethod
+    def radius_proportional(
+        ratio: float, angle: float, tension: float, end: float | None = None
+    ) -> Tendon: ...
+    @staticmethod
+    def helical(
+        radius: float, pitch: float, tension: float, phase: float = 0.0, end: float | None = None
+    ) -> Tendon: ...
+    def with_tension(self, tension: float) -> Tendon: ...
+    @property
+    def tension(self) -> float: ...
+    @property
+    def end(self) -> float | None: ...
+
+@final
+class PointLoad:
+    """A force (N) and moment (N m) at arc length s (m)."""
+
+    def __init__(
+        self,
+        s: float,
+        force: _Vec3 = ...,
+        moment: _Vec3 = ...,
+        frame: Literal["world", "body"] = "world",
+    ) -> None: ...
+
+@final
+class Loads:
+    """External loads (world frame unless told otherwise)."""
+
+    def __init__(
+        self,
+        tip_force: _Vec3 | None = None,
+        tip_moment: _Vec3 | None = None,
+        gravity: _Vec3 | None = None,
+        *,
+        tip_frame: Literal["world", "body"] = "world",
+        point_loads: Sequence[PointLoad] = ...,
+        distributed_force: _Vec3 | _VecFn | None = None,
+        distributed_moment: _Vec3 | _VecFn | None = None,
+    ) -> None: ...
+
+@final
+class StaticsSolution:
+    """A solved rod sampled at the integration mesh (SI, world frame unless _body)."""
+
+    @property
+    def s(self) -> NDArray[np.float64]: ...
+    @property
+    def position(self) -> NDArray[np.float64]: ...
+    @property
+    def rotation(self) -> NDArray[np.float64]: ...
+    @property
+    def quaternion(self) -> NDArray[np.float64]: ...
+    @property
+    def force(self) -> NDArray[np.float64]: ...
+    @property
+    def moment(self) -> NDArray[np.float64]: ...
+    @property
+    def force_body(self) -> NDArray[np.float64]: ...
+    @property
+    def moment_body(self) -> NDArray[np.float64]: ...
+    @property
+    def v(self) -> NDArray[np.float64]: ...
+    @property
+    def u(self) -> NDArray[np.float64]: ...
+    @property
+    def tendon_lengths(self) -> NDArray[np.float64]: ...
+    @property
+    def base_wrench(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_position(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_rotation(self) -> NDArray[np.float64]: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def stats(self) -> dict[str, float | int | bool]: ...
+    def __len__(self) -> int: ...
+
+def solve_statics(
+    rod: Rod,
+    tendons: Sequence[Tendon] = ...,
+    loads: Loads | None = None,
+    *,
+    integrator: Literal["rk4", "adaptive"] = "rk4",
+    steps: int = 50,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    tolerance: float = 1e-10,
+    max_iterations: int = 30,
+    continuation: bool = True,
+    max_load_steps: int = 64,
+    warm_start: StaticsSolution | Sequence[float] | None = None,
+    throw: bool = True,
+) -> StaticsSolution: ...

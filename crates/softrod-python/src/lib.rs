@@ -2,13 +2,14 @@
 //!
 //! This crate only converts arrays, maps the core's one error type to Python exceptions (in
 //! `errors::to_py_err`) and releases the GIL around solves. All numerics live in the `softrod`
-//! crate. One module per area of the API: `planar`; conversions in `convert`.
+//! crate. One module per area of the API: `planar`, `statics`; conversions in `convert`.
 
 use pyo3::prelude::*;
 
 mod convert;
 mod errors;
 mod planar;
+mod statics;
 
 /// The compiled core of softrod.
 #[pymodule]
@@ -26,5 +27,18 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;
     m.add_function(wrap_pyfunction!(planar::backbone_distance, m)?)?;
+    m.add_class::<statics::PySection>()?;
+    m.add_class::<statics::CircularSection>()?;
+    m.add_class::<statics::TaperedCircularSection>()?;
+    m.add_class::<statics::TubeSection>()?;
+    m.add_class::<statics::TableSection>()?;
+    m.add_class::<statics::FunctionSection>()?;
+    m.add_class::<statics::LinearElastic>()?;
+    m.add_class::<statics::Rod>()?;
+    m.add_class::<statics::Tendon>()?;
+    m.add_class::<statics::PointLoad>()?;
+    m.add_class::<statics::Loads>()?;
+    m.add_class::<statics::StaticsSolution>()?;
+    m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
     Ok(())
 }
