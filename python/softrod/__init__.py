@@ -30,6 +30,7 @@ from ._core import (
 )
 from .compare import BackboneDistance, backbone_distance
 from .io import read_backbone_csv, write_samples_csv
+from .robot import Robot, load_robot
 
 __all__ = [
     "BackboneDistance",
@@ -43,6 +44,7 @@ __all__ = [
     "PlanarCableArm",
     "PlanarSolution",
     "PointLoad",
+    "Robot",
     "Rod",
     "Section",
     "StaticsSolution",
@@ -52,6 +54,7 @@ __all__ = [
     "TubeSection",
     "__version__",
     "backbone_distance",
+    "load_robot",
     "read_backbone_csv",
     "solve_statics",
     "write_samples_csv",

@@ -2,7 +2,8 @@
 
 Subcommands:
     demo    the seed-000 arm at several tensions: a table and a PNG of the backbones;
-    planar  the planar tapered cable arm with any parameters.
+    planar  the planar tapered cable arm with any parameters;
+    solve   the Cosserat statics of a robot description file (TOML).
 
 Bad input exits with status 2 and a one-line message naming the parameter.
 """
@@ -13,6 +14,8 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+
+import numpy as np
 
 from ._core import ConvergenceError, ParameterError, PlanarCableArm, PlanarSolution
 
@@ -116,6 +119,55 @@ def _cmd_demo(args) -> int:
     return 0
 
 
+def _cmd_solve(args) -> int:
+    from .robot import load_robot
+
+    robot = load_robot(args.robot)
+    if args.tensions is not None:
+        robot = robot.with_tensions(args.tensions)
+    sol = robot.solve()
+    p, r = sol.tip_position, sol.tip_rotation
+    q = sol.quaternion[-1]
+    st = sol.stats
+    print(f"robot: {robot.name} ({args.robot})")
+    if robot.description:
+        print(f"  {robot.description}")
+    print(f"tip position (m):   [{p[0]: .9f}, {p[1]: .9f}, {p[2]: .9f}]")
+    print("tip rotation (body -> world):")
+    for row in r:
+        print(f"  [{row[0]: .9f}, {row[1]: .9f}, {row[2]: .9f}]")
+    print(f"tip quaternion [x, y, z, w]: [{q[0]: .9f}, {q[1]: .9f}, {q[2]: .9f}, {q[3]: .9f}]")
+    if len(robot.tendons):
+        lengths = ", ".join(f"{x:.9f}" for x in sol.tendon_lengths)
+        print(f"tendon path lengths (m): [{lengths}]")
+    print(
+        f"solver: converged={st['converged']}, iterations={st['iterations']}, "
+        f"residual={st['residual']:.2e}, evaluations={st['function_evaluations']}, "
+        f"load steps={st['load_steps']}"
+    )
+    if args.csv:
+        from .io import write_statics_csv
+
+        write_statics_csv(args.csv, sol)
+        print(f"wrote {args.csv}", file=sys.stderr)
+    if args.json:
+        from .io import statics_to_dict
+
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump({"robot": robot.name, "solution": statics_to_dict(sol)}, fh)
+        print(f"wrote {args.json}", file=sys.stderr)
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .plot import plot_rod
+
+        fig = plot_rod(sol, title=f"{robot.name}: tip at {np.round(p * 1e3, 2)} mm")
+        fig.savefig(args.plot, dpi=130)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return 0
+
+
 def _positive_int(text: str) -> int:
     try:
         return int(text)
@@ -177,6 +229,20 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--csv", metavar="FILE", help="write all samples to CSV")
     pl.add_argument("--json", action="store_true", help="print arm and samples as JSON")
     pl.set_defaults(func=_cmd_planar)
+
+    so = sub.add_parser("solve", help="Cosserat statics of a robot description file (TOML)")
+    so.add_argument("robot", metavar="ROBOT.toml", help="robot description file")
+    so.add_argument(
+        "--tensions",
+        type=float,
+        nargs="+",
+        metavar="T",
+        help="override the tendon tensions (N), one per tendon",
+    )
+    so.add_argument("--plot", metavar="FILE", help="PNG of the 3-D backbone")
+    so.add_argument("--csv", metavar="FILE", help="write the solution samples to CSV")
+    so.add_argument("--json", metavar="FILE", help="write the solution to JSON")
+    so.set_defaults(func=_cmd_solve)
     return p
 
 

@@ -9,9 +9,15 @@ from typing import Any
 
 import numpy as np
 
-from ._core import ParameterError, PlanarSolution
+from ._core import ParameterError, PlanarSolution, StaticsSolution
 
-__all__ = ["read_backbone_csv", "solution_to_dict", "write_samples_csv"]
+__all__ = [
+    "read_backbone_csv",
+    "solution_to_dict",
+    "statics_to_dict",
+    "write_samples_csv",
+    "write_statics_csv",
+]
 
 SAMPLE_FIELDS = ("s", "curvature", "strain", "angle", "x", "y")
 
@@ -114,3 +120,52 @@ def write_samples_csv(path: str | os.PathLike[str], solutions: Sequence[PlanarSo
             cols = [getattr(sol, name) for name in SAMPLE_FIELDS]
             for i in range(len(sol.s)):
                 w.writerow([repr(sol.tension), *(repr(float(c[i])) for c in cols)])
+
+
+STATICS_COLUMNS = (
+    ("s", ("s",)),
+    ("position", ("x", "y", "z")),
+    ("quaternion", ("qx", "qy", "qz", "qw")),
+    ("force", ("nx", "ny", "nz")),
+    ("moment", ("mx", "my", "mz")),
+    ("v", ("vx", "vy", "vz")),
+    ("u", ("ux", "uy", "uz")),
+)
+
+
+def write_statics_csv(path: str | os.PathLike[str], sol: StaticsSolution) -> None:
+    """Writes a statics solution's samples to CSV, one row per sample (SI units).
+
+    Columns: ``s``; position ``x, y, z`` (world); quaternion ``qx, qy, qz, qw``; internal force
+    ``nx, ny, nz`` and moment ``mx, my, mz`` (world); strains ``vx..vz``, ``ux..uz`` (body).
+    """
+    blocks = [
+        np.asarray(getattr(sol, name), dtype=float).reshape(len(sol), -1)
+        for name, _ in STATICS_COLUMNS
+    ]
+    table = np.hstack(blocks)
+    header = ",".join(c for _, cols in STATICS_COLUMNS for c in cols)
+    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.17g")
+
+
+def statics_to_dict(sol: StaticsSolution) -> dict[str, Any]:
+    """A JSON-ready dict of a statics solution (lists of floats, SI units, world frame)."""
+    out: dict[str, Any] = {
+        name: np.asarray(getattr(sol, name)).tolist()
+        for name in (
+            "s",
+            "position",
+            "rotation",
+            "quaternion",
+            "force",
+            "moment",
+            "v",
+            "u",
+            "tendon_lengths",
+            "base_wrench",
+            "tip_position",
+            "tip_rotation",
+        )
+    }
+    out["stats"] = dict(sol.stats)
+    return out

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._core import PlanarCableArm, PlanarSolution
 
-__all__ = ["plot_planar"]
+__all__ = ["plot_planar", "plot_rod"]
 
 
 def _section_outline(arm: PlanarCableArm, sol: PlanarSolution) -> tuple[np.ndarray, np.ndarray]:
@@ -81,4 +81,69 @@ def plot_planar(
             f"a = {arm.offset_ratio:.3g}, E = {arm.youngs_modulus / 1e3:g} kPa"
         )
     )
+    return fig
+
+
+def _set_equal_3d(ax, pts: np.ndarray) -> None:
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    centre, half = (lo + hi) / 2, max((hi - lo).max() / 2, 1e-9)
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
+        setter(c - half, c + half)
+    ax.set_box_aspect((1, 1, 1))
+
+
+def plot_rod(
+    solutions,
+    *,
+    labels=None,
+    frames: int = 5,
+    title: str | None = None,
+    ax=None,
+):
+    """3-D backbones of one or more statics solutions, with body frames along them.
+
+    Args:
+        solutions: A :class:`softrod.StaticsSolution` or a sequence of them.
+        labels: One legend label per solution.
+        frames: Number of body-frame triads drawn along each backbone (x red, y green,
+            z = tangent blue), 0 for none.
+        title: Figure title.
+        ax: A 3-D matplotlib axes to draw into (default: a new figure).
+
+    Returns:
+        The matplotlib figure (axes in millimetres, world frame).
+    """
+    import matplotlib.pyplot as plt
+
+    sols = [solutions] if hasattr(solutions, "position") else list(solutions)
+    if ax is None:
+        fig = plt.figure(figsize=(6.5, 6.5), layout="constrained")
+        ax = fig.add_subplot(projection="3d")
+    else:
+        fig = ax.figure
+    allpts = []
+    cmap = plt.get_cmap("viridis")
+    for i, sol in enumerate(sols):
+        p = sol.position * 1e3
+        allpts.append(p)
+        label = labels[i] if labels else None
+        color = cmap(0.1 + 0.8 * i / max(len(sols) - 1, 1))
+        ax.plot(p[:, 0], p[:, 1], p[:, 2], color=color, lw=2.2, label=label)
+        ax.scatter(*p[-1], color=color, s=18)
+        if frames:
+            size = 0.08 * max(np.ptp(p, axis=0).max(), 1e-6)
+            for k in np.linspace(0, len(p) - 1, frames).round().astype(int):
+                r = sol.rotation[k]
+                for axis, c in zip(range(3), ("tab:red", "tab:green", "tab:blue"), strict=True):
+                    d = r[:, axis] * size
+                    ax.plot(*np.column_stack((p[k], p[k] + d)), color=c, lw=1)
+    pts = np.vstack(allpts)
+    _set_equal_3d(ax, pts)
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_zlabel("z (mm)")
+    if labels:
+        ax.legend(loc="upper left", fontsize="small")
+    if title:
+        ax.set_title(title)
     return fig
