@@ -18,6 +18,10 @@ def _blocks():
 
 @pytest.mark.parametrize("code", list(_blocks()))
 def test_documentation_example_runs(code, tmp_path, monkeypatch, capsys):
+    # Examples use repository-relative paths; files they write land in a temporary folder.
+    for name in ("examples", "data"):
+        if (ROOT / name).exists():
+            (tmp_path / name).symlink_to(ROOT / name)
     monkeypatch.chdir(tmp_path)
     exec(compile(code, "<doc>", "exec"), {"__name__": "__doc_example__"})
     assert capsys.readouterr().out  # every example prints what the page says it shows
