@@ -40,5 +40,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statics::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::_time_solve_statics, m)?)?;
     Ok(())
 }

@@ -790,6 +790,93 @@ pub(crate) enum WarmArg<'py> {
     Wrench([f64; 6]),
 }
 
+/// A statics problem ready for the core: rod, tendons, loads, options and the error slots of
+/// their Python callables.
+struct Problem {
+    rod: softrod::Rod,
+    tendons: Vec<softrod::Tendon>,
+    loads: softrod::Loads,
+    options: softrod::SolveOptions,
+    slots: Vec<ErrorSlot>,
+}
+
+impl Problem {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        rod: &Rod,
+        tendons: &[PyRef<'_, Tendon>],
+        loads: Option<&Loads>,
+        integrator: &str,
+        steps: i64,
+        rtol: f64,
+        atol: f64,
+        tolerance: f64,
+        max_iterations: i64,
+        continuation: bool,
+        max_load_steps: i64,
+        warm_start: Option<WarmArg<'_>>,
+        throw: bool,
+    ) -> PyResult<Self> {
+        let integ = match integrator {
+            "rk4" => {
+                if steps < 1 {
+                    return Err(param_err("steps", steps, ">= 1"));
+                }
+                softrod::Integrator::Rk4 {
+                    steps: steps as usize,
+                }
+            }
+            "adaptive" => softrod::Integrator::Adaptive(AdaptiveOptions {
+                rtol,
+                atol,
+                ..Default::default()
+            }),
+            other => return Err(param_err("integrator", other, "\"rk4\" or \"adaptive\"")),
+        };
+        if max_iterations < 1 {
+            return Err(param_err("max_iterations", max_iterations, ">= 1"));
+        }
+        if max_load_steps < 1 {
+            return Err(param_err("max_load_steps", max_load_steps, ">= 1"));
+        }
+        let warm = match warm_start {
+            None => None,
+            Some(WarmArg::Solution(s)) => Some(s.inner.warm_start()),
+            Some(WarmArg::Wrench(w)) => Some(softrod::WarmStart { base_wrench: w }),
+        };
+        let options = softrod::SolveOptions {
+            integrator: integ,
+            tolerance,
+            max_iterations: max_iterations as usize,
+            continuation,
+            max_load_steps: max_load_steps as usize,
+            warm_start: warm,
+            throw,
+        };
+        let mut slots: Vec<ErrorSlot> = rod.slots.clone();
+        slots.extend(tendons.iter().map(|t| t.slot.clone()));
+        if let Some(l) = loads {
+            slots.push(l.slot.clone());
+        }
+        Ok(Self {
+            rod: rod.inner.clone(),
+            tendons: tendons.iter().map(|t| t.inner.clone()).collect(),
+            loads: loads.map(|l| l.inner.clone()).unwrap_or_default(),
+            options,
+            slots,
+        })
+    }
+
+    fn solve(&self) -> softrod::Result<softrod::StaticsSolution> {
+        softrod::solve_statics(&self.rod, &self.tendons, &self.loads, &self.options)
+    }
+
+    /// The first exception raised by a Python callable during the solve, if any.
+    fn callback_error(&self) -> Option<PyErr> {
+        self.slots.iter().find_map(ErrorSlot::take)
+    }
+}
+
 /// Solves the statics of `rod` with `tendons` and `loads` by shooting (see the docs).
 #[pyfunction]
 #[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator="rk4", steps=50,
@@ -811,60 +898,83 @@ pub(crate) fn solve_statics(
     warm_start: Option<WarmArg<'_>>,
     throw: bool,
 ) -> PyResult<StaticsSolution> {
-    let integ = match integrator {
-        "rk4" => {
-            if steps < 1 {
-                return Err(param_err("steps", steps, ">= 1"));
-            }
-            softrod::Integrator::Rk4 {
-                steps: steps as usize,
-            }
-        }
-        "adaptive" => softrod::Integrator::Adaptive(AdaptiveOptions {
-            rtol,
-            atol,
-            ..Default::default()
-        }),
-        other => return Err(param_err("integrator", other, "\"rk4\" or \"adaptive\"")),
-    };
-    if max_iterations < 1 {
-        return Err(param_err("max_iterations", max_iterations, ">= 1"));
-    }
-    if max_load_steps < 1 {
-        return Err(param_err("max_load_steps", max_load_steps, ">= 1"));
-    }
-    let warm = match warm_start {
-        None => None,
-        Some(WarmArg::Solution(s)) => Some(s.inner.warm_start()),
-        Some(WarmArg::Wrench(w)) => Some(softrod::WarmStart { base_wrench: w }),
-    };
-    let options = softrod::SolveOptions {
-        integrator: integ,
+    let problem = Problem::new(
+        &rod,
+        &tendons,
+        loads.as_deref(),
+        integrator,
+        steps,
+        rtol,
+        atol,
         tolerance,
-        max_iterations: max_iterations as usize,
+        max_iterations,
         continuation,
-        max_load_steps: max_load_steps as usize,
-        warm_start: warm,
+        max_load_steps,
+        warm_start,
         throw,
-    };
-    let mut slots: Vec<ErrorSlot> = rod.slots.clone();
-    slots.extend(tendons.iter().map(|t| t.slot.clone()));
-    let core_tendons: Vec<softrod::Tendon> = tendons.iter().map(|t| t.inner.clone()).collect();
-    let core_loads = loads.as_ref().map(|l| l.inner.clone()).unwrap_or_default();
-    if let Some(l) = &loads {
-        slots.push(l.slot.clone());
+    )?;
+    let result = py.detach(|| problem.solve());
+    if let Some(err) = problem.callback_error() {
+        return Err(err);
     }
-    let core_rod = rod.inner.clone();
-    let result =
-        py.detach(move || softrod::solve_statics(&core_rod, &core_tendons, &core_loads, &options));
-    for slot in &slots {
-        if let Some(err) = slot.take() {
-            return Err(err);
-        }
-    }
-    let inner = result.map_err(to_py_err)?;
     Ok(StaticsSolution {
-        inner,
+        inner: result.map_err(to_py_err)?,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
     })
+}
+
+/// Benchmark hook: runs the same solve `repeats` times inside Rust and returns each call's
+/// wall time (s), so that the Python overhead of `solve_statics` can be measured.
+#[pyfunction]
+#[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, repeats=1000, integrator="rk4",
+                    steps=50, rtol=1e-8, atol=1e-10, tolerance=1e-10, warm_start=None))]
+pub(crate) fn _time_solve_statics(
+    py: Python<'_>,
+    rod: PyRef<'_, Rod>,
+    tendons: Vec<PyRef<'_, Tendon>>,
+    loads: Option<PyRef<'_, Loads>>,
+    repeats: i64,
+    integrator: &str,
+    steps: i64,
+    rtol: f64,
+    atol: f64,
+    tolerance: f64,
+    warm_start: Option<WarmArg<'_>>,
+) -> PyResult<Vec<f64>> {
+    if repeats < 1 {
+        return Err(param_err("repeats", repeats, ">= 1"));
+    }
+    let problem = Problem::new(
+        &rod,
+        &tendons,
+        loads.as_deref(),
+        integrator,
+        steps,
+        rtol,
+        atol,
+        tolerance,
+        30,
+        true,
+        64,
+        warm_start,
+        true,
+    )?;
+    let times = py.detach(|| {
+        (0..repeats)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                let r = problem.solve();
+                (t0.elapsed().as_secs_f64(), r.is_ok())
+            })
+            .collect::<Vec<_>>()
+    });
+    if let Some(err) = problem.callback_error() {
+        return Err(err);
+    }
+    if times.iter().any(|(_, ok)| !ok) {
+        if let Err(e) = problem.solve() {
+            return Err(to_py_err(e));
+        }
+    }
+    Ok(times.into_iter().map(|(t, _)| t).collect())
 }
