@@ -20,6 +20,7 @@ pub mod error;
 pub mod fit;
 pub mod hyperelastic;
 pub mod integrate;
+pub mod pcc;
 pub mod planar;
 
 pub use compare::{backbone_distance, BackboneDistance};

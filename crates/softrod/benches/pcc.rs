@@ -1,0 +1,80 @@
+//! PCC solves: actuation → arc parameters → tip pose, for one segment and a two-segment
+//! chain (the issue asks for <= 5 µs per configuration), and the closed-form Jacobians.
+//!
+//! Run: `cargo bench -p softrod --bench pcc`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use softrod::nalgebra::Vector3;
+use softrod::pcc::{
+    arc_from_pressures, arc_from_tendon_displacements, arc_from_tendon_tensions, arc_from_tip,
+    chain_jacobian, chain_pose, ArcCoordinates, ElasticSegment, JacobianFrame, PccChambers,
+    PccSegment, PccTendons,
+};
+use std::hint::black_box;
+
+fn pcc(c: &mut Criterion) {
+    let body = ElasticSegment::solid_circle(0.15, 0.01, 1e6, true).unwrap();
+    let tendons = PccTendons::equally_spaced(3, 0.007, 0.0).unwrap();
+    let chambers = PccChambers::equally_spaced(3, 5e-5, 0.005, 0.0).unwrap();
+    let tensions = [0.8, 0.1, 0.3];
+    let mut g = c.benchmark_group("pcc_solve");
+    g.bench_function("tensions_to_pose_1_segment", |b| {
+        b.iter(|| {
+            let s = arc_from_tendon_tensions(black_box(&tensions), &tendons, &body).unwrap();
+            s.pose()
+        })
+    });
+    g.bench_function("pressures_to_pose_1_segment", |b| {
+        b.iter(|| {
+            let s = arc_from_pressures(black_box(&[2e4, 0.0, 5e3]), &chambers, &body).unwrap();
+            s.pose()
+        })
+    });
+    g.bench_function("displacements_to_pose_1_segment", |b| {
+        b.iter(|| {
+            let s = arc_from_tendon_displacements(
+                black_box(&[-0.004, 0.002, 0.001]),
+                &tendons,
+                0.15,
+                true,
+            )
+            .unwrap();
+            s.pose()
+        })
+    });
+    g.bench_function("tensions_to_pose_2_segment_chain", |b| {
+        b.iter(|| {
+            let s1 = arc_from_tendon_tensions(black_box(&tensions), &tendons, &body).unwrap();
+            let s2 =
+                arc_from_tendon_tensions(black_box(&[0.0, 0.6, 0.2]), &tendons, &body).unwrap();
+            chain_pose(&[s1, s2])
+        })
+    });
+    g.finish();
+
+    let s = PccSegment::new(12.0, 0.7, 0.15).unwrap();
+    let chain = [s, PccSegment::new(-4.0, 2.0, 0.1).unwrap()];
+    let mut g = c.benchmark_group("pcc_kinematics");
+    g.bench_function("arc_pose", |b| b.iter(|| black_box(&s).pose()));
+    g.bench_function("arc_jacobian_spatial_arc", |b| {
+        b.iter(|| black_box(&s).jacobian(JacobianFrame::Spatial, ArcCoordinates::Arc))
+    });
+    g.bench_function("chain_jacobian_2_segments_body", |b| {
+        b.iter(|| {
+            chain_jacobian(
+                black_box(&chain),
+                JacobianFrame::Body,
+                ArcCoordinates::CurvatureVector,
+            )
+        })
+    });
+    let tip = s.tip_position();
+    g.bench_function("arc_from_tip", |b| {
+        b.iter(|| arc_from_tip(black_box(&Vector3::new(tip.x, tip.y, tip.z))).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, pcc);
+criterion_main!(benches);

@@ -1,0 +1,1419 @@
+//! Piecewise-constant-curvature (PCC) kinematics of continuum robots.
+//!
+//! Each segment is a circular arc described by its *arc parameters*: curvature `κ` (1/m, per
+//! deformed length, signed), bending-plane angle `φ` (rad) and arc length `ℓ` (m, deformed,
+//! `>= 0`). The kinematics splits, as in Webster & Jones (2010), into
+//!
+//! * a robot-independent map, arc parameters ↔ pose ([`PccSegment::pose`], [`arc_pose`],
+//!   [`arc_frames`], [`arc_jacobian`], [`arc_from_tip`], [`arc_from_tip_with_length`]) and its
+//!   product over a chain ([`PccChain`], [`chain_pose`]);
+//! * robot-specific maps, actuation → arc parameters, for tendons ([`PccTendons`]: from
+//!   displacements or tensions) and pneumatic chambers ([`PccChambers`]: from pressures), with
+//!   their Jacobians.
+//!
+//! # Convention
+//! The segment's base is at the origin of its base frame with the tangent along `+z` (the body
+//! z axis is the tangent everywhere). The segment bends in the plane containing `z` and the
+//! direction `(cos φ, sin φ, 0)`: a positive `κ` moves the tip toward that direction. At arc
+//! length `s` in `[0, ℓ]` the frame is
+//!
+//! ```text
+//! R(s) = Rz(φ) Ry(κ s) Rz(-φ),
+//! p(s) = ((1 - cos κs)/κ cos φ, (1 - cos κs)/κ sin φ, sin(κs)/κ),
+//! ```
+//!
+//! so that a planar arc with `φ = 0` ends at `((1 - cos κℓ)/κ, 0, sin(κℓ)/κ)`. This is the
+//! Webster & Jones transform **with the trailing `Rz(-φ)`** (the twist-free convention): the
+//! frame is not twisted about the tangent, `R(s)` is the rotation by `κ s` about the fixed axis
+//! `(-sin φ, cos φ, 0)`, and the segment is exactly a Cosserat rod with constant body curvature
+//! `u = κ (-sin φ, cos φ, 0)` and `v = (0, 0, 1)`, i.e. `T(s) = exp(s [v; u]^)`. (Their eq. 2
+//! without `Rz(-φ)` twists the tip frame by `φ` about the tangent and makes the body frame
+//! jump when `φ` changes at `κ = 0`.) Consequences: a straight segment's frame is the identity
+//! whatever `φ`, and the pose is a smooth function of the *curvature vector* `(u_x, u_y)`
+//! ([`ArcCoordinates::CurvatureVector`]), through `κ = 0`.
+//!
+//! Chains: segment `i`'s arc parameters are expressed in the tip frame of segment `i - 1`
+//! (the base frame for the first), and the chain's pose is the product of the segment
+//! transforms.
+//!
+//! Tendon `i` runs at distance `d_i` from the backbone at angle `β_i` from the body x axis
+//! toward body y (body offset `d_i (cos β_i, sin β_i, 0)`), is fixed at the segment's tip and
+//! pulled at its base: pulling one tendon bends the segment toward it (`φ = β_i`). Chamber `i`
+//! has its centroid at `r_i (cos β_i, sin β_i, 0)`; pressurising one chamber lengthens that
+//! side and bends the segment away from it (`φ = β_i + π`).
+//!
+//! The elastic maps (tensions, pressures) balance the actuators' tip moment with `E I κ`, `κ`
+//! per *deformed* length as in seed 000, and stretch the segment by the axial force over
+//! `E A`. The Cosserat engine's `u` is per undeformed length, so for the same moment its
+//! bending angle is larger by the stretch `1 + ε`; keep this in mind when comparing models.
+//!
+//! Twists are `[translation; rotation]`; see [`JacobianFrame`] for the three Jacobians.
+//! Poses are 4×4 homogeneous transforms mapping segment-tip (body) coordinates to base
+//! coordinates.
+//!
+//! # Straight segments
+//! Every function of `θ = κ ℓ` that is `0/0` at `θ = 0` is evaluated in a form without
+//! cancellation (`(1 - cos θ)/θ² = sinc²(θ/2)/2`, `sin θ / θ = sinc(θ/2) cos(θ/2)`) or by its
+//! Taylor series below [`SERIES_THRESHOLD`], so poses and Jacobians are finite and smooth
+//! through `κ = 0`. The plane angle itself is undefined at `κ = 0`: inverse maps return `φ = 0`
+//! there, and Jacobians *into* `(κ, φ, ℓ)` are only defined for `κ ≠ 0` (use the curvature
+//! vector coordinates, which are smooth).
+//!
+//! # References
+//! R. J. Webster III, B. A. Jones, "Design and kinematic modeling of constant curvature
+//! continuum robots: a review", IJRR 29(13), 2010 (arc ↔ pose, Jacobians, tendon lengths).
+
+use nalgebra::{Matrix2xX, Matrix3, Matrix3xX, Matrix4, Matrix6x3, Matrix6xX, MatrixXx3, Vector3};
+
+use crate::error::{check_finite, check_positive, Error, Result};
+
+/// `|θ|` (rad) below which `(θ cos θ - sin θ)/θ²` is evaluated by its Taylor series.
+///
+/// The direct form loses `eps/θ²` relative accuracy; the four-term series is accurate to
+/// `1e-15` relative below this bound.
+pub const SERIES_THRESHOLD: f64 = 0.1;
+
+/// `|x|` below which `sin(x)/x` is evaluated as `1 - x²/6` (error `x⁴/120 < 1e-18`).
+const SINC_SERIES: f64 = 1e-4;
+
+/// Relative tolerance on the smallest eigenvalue of the normal equations of the tendon
+/// displacement map: layouts below it cannot resolve the arc parameters.
+pub const RANK_TOLERANCE: f64 = 1e-12;
+
+/// Samples of the bending angle over `[0, 2π]` that bracket the closest arc in
+/// [`arc_from_tip_with_length`] before it is refined.
+pub const FIT_SAMPLES: usize = 64;
+
+/// The frame of a Jacobian: which 6-vector a column is, for a unit rate of one parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JacobianFrame {
+    /// Spatial twist `[v_s; ω_s]` with `Ṫ T⁻¹ = [ω_s^, v_s; 0, 0]` (base-frame components;
+    /// `v_s` is the velocity of the base-frame point currently at the origin).
+    #[default]
+    Spatial,
+    /// Body twist `[v_b; ω_b]` with `T⁻¹ Ṫ = [ω_b^, v_b; 0, 0]` (tip-frame components).
+    Body,
+    /// Tip-point velocity and angular velocity, both in base-frame components, `[ṗ; ω_s]`
+    /// (Webster & Jones' `J`; `ṗ = v_s + ω_s × p`).
+    Hybrid,
+}
+
+/// The coordinates of a segment's configuration that a Jacobian differentiates with respect
+/// to (or into).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ArcCoordinates {
+    /// Arc parameters `(κ, φ, ℓ)` (1/m, rad, m). The `φ` column of a pose Jacobian vanishes at
+    /// `κ = 0`; Jacobians into these coordinates are undefined at `κ = 0`.
+    #[default]
+    Arc,
+    /// Body curvature vector and length `(u_x, u_y, ℓ)` with `u = κ (-sin φ, cos φ, 0)`
+    /// (1/m, 1/m, m): smooth everywhere, including straight segments.
+    CurvatureVector,
+}
+
+/// One constant-curvature segment (immutable, validated arc parameters).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PccSegment {
+    curvature: f64,
+    plane_angle: f64,
+    length: f64,
+    cos_phi: f64,
+    sin_phi: f64,
+}
+
+/// A rigid transform `(R, p)`, composed without 4×4 products.
+#[derive(Debug, Clone, Copy)]
+struct Rigid {
+    r: Matrix3<f64>,
+    p: Vector3<f64>,
+}
+
+impl Rigid {
+    fn identity() -> Self {
+        Self {
+            r: Matrix3::identity(),
+            p: Vector3::zeros(),
+        }
+    }
+
+    #[inline]
+    fn then(&self, next: &Rigid) -> Rigid {
+        Rigid {
+            r: self.r * next.r,
+            p: self.p + self.r * next.p,
+        }
+    }
+
+    #[inline]
+    fn to_matrix(self) -> Matrix4<f64> {
+        let mut t = Matrix4::identity();
+        t.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.r);
+        t.fixed_view_mut::<3, 1>(0, 3).copy_from(&self.p);
+        t
+    }
+}
+
+/// Trigonometric functions of a bending angle `θ`, all well conditioned at `θ = 0`.
+#[derive(Debug, Clone, Copy)]
+struct ArcTrig {
+    sin: f64,
+    cos: f64,
+    /// `1 - cos θ`.
+    omc: f64,
+    /// `sin θ / θ`.
+    s1: f64,
+    /// `(1 - cos θ) / θ²`.
+    c2: f64,
+}
+
+#[inline]
+fn arc_trig(theta: f64) -> ArcTrig {
+    let h = 0.5 * theta;
+    let (sh, ch) = h.sin_cos();
+    let sinc_h = if h.abs() < SINC_SERIES {
+        1.0 - h * h * (1.0 / 6.0)
+    } else {
+        sh / h
+    };
+    let omc = 2.0 * sh * sh;
+    ArcTrig {
+        sin: 2.0 * sh * ch,
+        cos: 1.0 - omc,
+        omc,
+        s1: sinc_h * ch,
+        c2: 0.5 * sinc_h * sinc_h,
+    }
+}
+
+/// `(θ cos θ - sin θ)/θ² = d(sin θ/θ)/dθ`, by series below [`SERIES_THRESHOLD`].
+#[inline]
+fn dsinc(theta: f64, t: &ArcTrig) -> f64 {
+    if theta.abs() < SERIES_THRESHOLD {
+        let x2 = theta * theta;
+        // -θ/3 + θ³/30 - θ⁵/840 + θ⁷/45360 (next term θ⁹/3991680).
+        -theta * (1.0 / 3.0 - x2 * (1.0 / 30.0 - x2 * (1.0 / 840.0 - x2 * (1.0 / 45360.0))))
+    } else {
+        (t.cos - t.s1) / theta
+    }
+}
+
+fn check_length(name: &str, length: f64) -> Result<f64> {
+    if length.is_finite() && length >= 0.0 {
+        Ok(length)
+    } else {
+        Err(Error::invalid(name, length, "finite and >= 0 m"))
+    }
+}
+
+impl PccSegment {
+    /// A segment from its arc parameters: `curvature` `κ` (1/m, any sign; negative bends
+    /// toward `φ + π`), `plane_angle` `φ` (rad), `length` `ℓ` (m).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `curvature` or `plane_angle` if not finite, or
+    /// `length` unless finite and `>= 0`.
+    pub fn new(curvature: f64, plane_angle: f64, length: f64) -> Result<Self> {
+        check_finite("curvature", curvature)?;
+        check_finite("plane_angle", plane_angle)?;
+        check_length("length", length)?;
+        let (sin_phi, cos_phi) = plane_angle.sin_cos();
+        Ok(Self {
+            curvature,
+            plane_angle,
+            length,
+            cos_phi,
+            sin_phi,
+        })
+    }
+
+    /// A straight segment of `length` (m) (`κ = 0`, `φ = 0`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `length` unless finite and `>= 0`.
+    pub fn straight(length: f64) -> Result<Self> {
+        Self::new(0.0, 0.0, length)
+    }
+
+    /// A segment from its body curvature vector `(u_x, u_y)` (1/m) and `length` (m):
+    /// `κ = |u| >= 0`, `φ = atan2(-u_x, u_y)` (`φ = 0` for `u = 0`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `u_x`, `u_y` if not finite, or `length`.
+    pub fn from_curvature_vector(u_x: f64, u_y: f64, length: f64) -> Result<Self> {
+        check_finite("u_x", u_x)?;
+        check_finite("u_y", u_y)?;
+        let kappa = u_x.hypot(u_y);
+        let phi = if kappa > 0.0 { (-u_x).atan2(u_y) } else { 0.0 };
+        Self::new(kappa, phi, length)
+    }
+
+    /// Curvature `κ` (1/m).
+    pub fn curvature(&self) -> f64 {
+        self.curvature
+    }
+    /// Bending-plane angle `φ` (rad), as given.
+    pub fn plane_angle(&self) -> f64 {
+        self.plane_angle
+    }
+    /// Arc length `ℓ` (m).
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+    /// Total bending angle `θ = κ ℓ` (rad).
+    pub fn bending_angle(&self) -> f64 {
+        self.curvature * self.length
+    }
+    /// Body curvature vector `u = κ (-sin φ, cos φ, 0)` (1/m), the same in every frame of the
+    /// arc.
+    pub fn curvature_vector(&self) -> Vector3<f64> {
+        Vector3::new(
+            -self.curvature * self.sin_phi,
+            self.curvature * self.cos_phi,
+            0.0,
+        )
+    }
+
+    /// Frame at arc length `s` (not checked).
+    #[inline]
+    fn rigid_at(&self, s: f64) -> Rigid {
+        let (c, sn) = (self.cos_phi, self.sin_phi);
+        let th = self.curvature * s;
+        let t = arc_trig(th);
+        // (1 - cos κs)/κ = s θ (1 - cos θ)/θ².
+        let a = s * th * t.c2;
+        let r = Matrix3::new(
+            1.0 - c * c * t.omc,
+            -sn * c * t.omc,
+            c * t.sin,
+            -sn * c * t.omc,
+            1.0 - sn * sn * t.omc,
+            sn * t.sin,
+            -c * t.sin,
+            -sn * t.sin,
+            t.cos,
+        );
+        Rigid {
+            r,
+            p: Vector3::new(c * a, sn * a, s * t.s1),
+        }
+    }
+
+    /// Tip pose: the 4×4 transform from the tip frame to the segment's base frame.
+    #[inline]
+    pub fn pose(&self) -> Matrix4<f64> {
+        self.rigid_at(self.length).to_matrix()
+    }
+
+    /// Tip position (m, base frame).
+    #[inline]
+    pub fn tip_position(&self) -> Vector3<f64> {
+        self.rigid_at(self.length).p
+    }
+
+    /// Backbone frame at arc length `s` (m) in `[0, ℓ]`, as a 4×4 transform to the base frame.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `s` unless finite and in `[0, ℓ]`.
+    pub fn pose_at(&self, s: f64) -> Result<Matrix4<f64>> {
+        if !(s.is_finite() && (0.0..=self.length).contains(&s)) {
+            return Err(Error::invalid(
+                "s",
+                s,
+                format!("in [0, length] = [0, {}] m", self.length),
+            ));
+        }
+        Ok(self.rigid_at(s).to_matrix())
+    }
+
+    /// Backbone frames at each arc length of `s` (m, each in `[0, ℓ]`, any order).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `s[i]` for the first arc length out of range.
+    pub fn backbone(&self, s: &[f64]) -> Result<Vec<Matrix4<f64>>> {
+        s.iter()
+            .enumerate()
+            .map(|(i, &si)| {
+                self.pose_at(si).map_err(|_| {
+                    Error::invalid(
+                        format!("s[{i}]"),
+                        si,
+                        format!("in [0, length] = [0, {}] m", self.length),
+                    )
+                })
+            })
+            .collect()
+    }
+
+    /// Columns `(∂p, ω_s)` of the tip pose per unit rate of each coordinate, with the tip.
+    fn raw_jacobian(
+        &self,
+        coordinates: ArcCoordinates,
+    ) -> (Rigid, [Vector3<f64>; 3], [Vector3<f64>; 3]) {
+        let (c, sn, k, l) = (self.cos_phi, self.sin_phi, self.curvature, self.length);
+        let th = k * l;
+        let t = arc_trig(th);
+        let g = t.s1 - t.c2; // d/dθ (1 - cos θ)/θ
+        let h = dsinc(th, &t); // d/dθ sin θ/θ
+        let l2 = l * l;
+        let tip = self.rigid_at(l);
+        // ∂/∂κ.
+        let dp_k = Vector3::new(c * g * l2, sn * g * l2, h * l2);
+        let w_k = Vector3::new(-sn * l, c * l, 0.0);
+        // (1/κ) ∂/∂φ, smooth at κ = 0.
+        let dp_f = Vector3::new(-sn * l2 * t.c2, c * l2 * t.c2, 0.0);
+        let w_f = Vector3::new(-c * l * t.s1, -sn * l * t.s1, l * th * t.c2);
+        // ∂/∂ℓ: the unit tangent and the curvature vector.
+        let dp_l = tip.r.column(2).into_owned();
+        let w_l = Vector3::new(-sn * k, c * k, 0.0);
+        match coordinates {
+            ArcCoordinates::Arc => (tip, [dp_k, dp_f * k, dp_l], [w_k, w_f * k, w_l]),
+            ArcCoordinates::CurvatureVector => (
+                tip,
+                // ∂/∂u_x = -sin φ ∂/∂κ - (cos φ/κ) ∂/∂φ; ∂/∂u_y = cos φ ∂/∂κ - (sin φ/κ) ∂/∂φ.
+                [-sn * dp_k - c * dp_f, c * dp_k - sn * dp_f, dp_l],
+                [-sn * w_k - c * w_f, c * w_k - sn * w_f, w_l],
+            ),
+        }
+    }
+
+    /// The 6×3 Jacobian of the tip pose with respect to `coordinates`, as twists in `frame`
+    /// (see [`JacobianFrame`]), in closed form and smooth through `κ = 0`.
+    pub fn jacobian(&self, frame: JacobianFrame, coordinates: ArcCoordinates) -> Matrix6x3<f64> {
+        let (tip, dp, w) = self.raw_jacobian(coordinates);
+        let mut j = Matrix6x3::zeros();
+        for col in 0..3 {
+            let (v, om) = match frame {
+                JacobianFrame::Spatial => (dp[col] - w[col].cross(&tip.p), w[col]),
+                JacobianFrame::Body => (tip.r.tr_mul(&dp[col]), tip.r.tr_mul(&w[col])),
+                JacobianFrame::Hybrid => (dp[col], w[col]),
+            };
+            j.fixed_view_mut::<3, 1>(0, col).copy_from(&v);
+            j.fixed_view_mut::<3, 1>(3, col).copy_from(&om);
+        }
+        j
+    }
+}
+
+/// Tip pose of one arc (4×4, tip frame → base frame); see [`PccSegment::pose`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the invalid arc parameter.
+pub fn arc_pose(curvature: f64, plane_angle: f64, length: f64) -> Result<Matrix4<f64>> {
+    Ok(PccSegment::new(curvature, plane_angle, length)?.pose())
+}
+
+/// Backbone frames of one arc at the arc lengths `s` (m); see [`PccSegment::backbone`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the invalid arc parameter or `s[i]`.
+pub fn arc_frames(
+    curvature: f64,
+    plane_angle: f64,
+    length: f64,
+    s: &[f64],
+) -> Result<Vec<Matrix4<f64>>> {
+    PccSegment::new(curvature, plane_angle, length)?.backbone(s)
+}
+
+/// 6×3 Jacobian of one arc's tip pose; see [`PccSegment::jacobian`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the invalid arc parameter.
+pub fn arc_jacobian(
+    curvature: f64,
+    plane_angle: f64,
+    length: f64,
+    frame: JacobianFrame,
+    coordinates: ArcCoordinates,
+) -> Result<Matrix6x3<f64>> {
+    Ok(PccSegment::new(curvature, plane_angle, length)?.jacobian(frame, coordinates))
+}
+
+fn check_position(position: &Vector3<f64>) -> Result<()> {
+    for k in 0..3 {
+        if !position[k].is_finite() {
+            return Err(Error::invalid(
+                format!("position[{k}]"),
+                position[k],
+                "finite (m)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The unique arc from the base (origin, tangent `+z`) through a tip `position` (m, base
+/// frame), with `κ >= 0`, `φ = atan2(y, x)` and bending angle in `[0, 2π)`: the inverse map of
+/// an extensible segment (its length is an output). With `r = |(x, y)|`:
+/// `κ = 2 r / (r² + z²)`, `θ = 2 atan2(r, z)`, `ℓ = θ / κ`.
+///
+/// On the `+z` axis the arc is straight (`κ = 0`, `φ = 0`, `ℓ = z`).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `position[k]` if not finite, or `position` if it lies on
+/// the axis below the base (`x = y = 0`, `z < 0`: no arc reaches it).
+pub fn arc_from_tip(position: &Vector3<f64>) -> Result<PccSegment> {
+    check_position(position)?;
+    let (x, y, z) = (position.x, position.y, position.z);
+    let r = x.hypot(y);
+    if r == 0.0 {
+        if z >= 0.0 {
+            return PccSegment::new(0.0, 0.0, z);
+        }
+        return Err(Error::invalid(
+            "position",
+            format!("[{x}, {y}, {z}]"),
+            "reachable by an arc tangent to +z at the origin (not on the -z axis)",
+        ));
+    }
+    let d2 = r * r + z * z;
+    let half = r.atan2(z); // θ/2 in (0, π]
+    PccSegment::new(2.0 * r / d2, y.atan2(x), d2 * (half / r))
+}
+
+/// Result of [`arc_from_tip_with_length`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipFit {
+    /// The arc of the given length whose tip is closest to the target.
+    pub segment: PccSegment,
+    /// Distance from its tip to the target (m); zero (to rounding) when the target is
+    /// reachable.
+    pub residual: f64,
+}
+
+/// Inverse map of an inextensible segment of known `length` (m): the arc with `κ >= 0`,
+/// bending angle in `[0, 2π]` and `φ = atan2(y, x)` whose tip is closest to `position`
+/// (m, base frame).
+///
+/// The reachable tips form a surface, so the target over-determines `(κ, φ)`; when it is
+/// reachable the arc is exact (residual at rounding level), otherwise it is the least-squares
+/// arc and [`TipFit::residual`] says by how much it misses. The bending angle is bracketed on
+/// [`FIT_SAMPLES`] samples and refined by a root search on the distance's derivative. On the
+/// axis `φ = 0`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `position[k]` if not finite or `length` unless finite
+/// and > 0.
+pub fn arc_from_tip_with_length(position: &Vector3<f64>, length: f64) -> Result<TipFit> {
+    check_position(position)?;
+    check_positive("length", length, "m")?;
+    let (x, y, z) = (position.x, position.y, position.z);
+    let r = x.hypot(y);
+    let phi = if r > 0.0 { y.atan2(x) } else { 0.0 };
+    let l = length;
+    // Tip in the bending plane and its θ-derivative, per unit length.
+    let plane = |th: f64| {
+        let t = arc_trig(th);
+        (
+            l * th * t.c2,
+            l * t.s1,
+            l * (t.s1 - t.c2),
+            l * dsinc(th, &t),
+        )
+    };
+    let dist2 = |th: f64| {
+        let (px, pz, _, _) = plane(th);
+        (px - r).powi(2) + (pz - z).powi(2)
+    };
+    // Half the derivative of the squared distance.
+    let slope = |th: f64| {
+        let (px, pz, dx, dz) = plane(th);
+        (px - r) * dx + (pz - z) * dz
+    };
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let node = |i: usize| two_pi * i as f64 / FIT_SAMPLES as f64;
+    let mut best = 0;
+    let mut best_d = dist2(0.0);
+    for i in 1..=FIT_SAMPLES {
+        let d = dist2(node(i));
+        if d < best_d {
+            best = i;
+            best_d = d;
+        }
+    }
+    let mut theta = node(best);
+    // Refine on each side of the best sample where the slope changes sign.
+    let mut candidates = [theta; 2];
+    for (side, (lo, hi)) in [
+        (node(best.saturating_sub(1)), theta),
+        (theta, node((best + 1).min(FIT_SAMPLES))),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let (fa, fb) = (slope(lo), slope(hi));
+        if hi > lo && fa < 0.0 && fb > 0.0 {
+            candidates[side] = illinois(&slope, lo, hi, fa, fb);
+        }
+    }
+    for c in candidates {
+        let d = dist2(c);
+        if d < best_d {
+            best_d = d;
+            theta = c;
+        }
+    }
+    Ok(TipFit {
+        segment: PccSegment::new(theta / l, phi, l)?,
+        residual: best_d.sqrt(),
+    })
+}
+
+/// Root of `f` in `[a, b]` with `f(a) < 0 < f(b)` by the Illinois variant of regula falsi.
+fn illinois<F: Fn(f64) -> f64>(f: &F, mut a: f64, mut b: f64, mut fa: f64, mut fb: f64) -> f64 {
+    let mut side = 0i8;
+    let mut x = a;
+    for _ in 0..200 {
+        let prev = x;
+        x = (a * fb - b * fa) / (fb - fa);
+        if !(x > a && x < b) {
+            x = 0.5 * (a + b);
+        }
+        let fx = f(x);
+        if fx == 0.0 || (x - prev).abs() <= 4.0 * f64::EPSILON * x.abs().max(1.0) {
+            break;
+        }
+        if fx < 0.0 {
+            a = x;
+            fa = fx;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = x;
+            fb = fx;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    x
+}
+
+/// A chain of constant-curvature segments (immutable): segment `i`'s arc parameters are
+/// relative to the tip frame of segment `i - 1`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccChain {
+    segments: Vec<PccSegment>,
+    /// Cumulative arc length at each segment's tip (m).
+    ends: Vec<f64>,
+}
+
+impl PccChain {
+    /// A chain of at least one segment.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `segments` if empty.
+    pub fn new(segments: Vec<PccSegment>) -> Result<Self> {
+        if segments.is_empty() {
+            return Err(Error::invalid("segments", "[]", "at least one segment"));
+        }
+        let mut total = 0.0;
+        let ends = segments
+            .iter()
+            .map(|seg| {
+                total += seg.length;
+                total
+            })
+            .collect();
+        Ok(Self { segments, ends })
+    }
+
+    /// A chain from rows `[κ, φ, ℓ]` (1/m, rad, m).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `segments[i].curvature` (etc.) or `segments`.
+    pub fn from_parameters(parameters: &[[f64; 3]]) -> Result<Self> {
+        let segments = parameters
+            .iter()
+            .enumerate()
+            .map(|(i, q)| {
+                PccSegment::new(q[0], q[1], q[2]).map_err(|e| match e {
+                    Error::InvalidParameter {
+                        name,
+                        value,
+                        expected,
+                    } => Error::InvalidParameter {
+                        name: format!("segments[{i}].{name}"),
+                        value,
+                        expected,
+                    },
+                    other => other,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Self::new(segments)
+    }
+
+    /// The segments, base to tip.
+    pub fn segments(&self) -> &[PccSegment] {
+        &self.segments
+    }
+    /// Number of segments.
+    pub fn len(&self) -> usize {
+        self.segments.len()
+    }
+    /// Always false: a chain has at least one segment.
+    pub fn is_empty(&self) -> bool {
+        self.segments.is_empty()
+    }
+    /// Total arc length (m).
+    pub fn length(&self) -> f64 {
+        self.ends[self.ends.len() - 1]
+    }
+
+    /// Tip pose of the chain (4×4, tip frame → base frame).
+    pub fn tip_pose(&self) -> Matrix4<f64> {
+        chain_pose(&self.segments)
+    }
+
+    /// Pose of every segment's tip in the chain's base frame, base to tip.
+    pub fn segment_poses(&self) -> Vec<Matrix4<f64>> {
+        let mut acc = Rigid::identity();
+        self.segments
+            .iter()
+            .map(|seg| {
+                acc = acc.then(&seg.rigid_at(seg.length));
+                acc.to_matrix()
+            })
+            .collect()
+    }
+
+    /// Backbone frame at the chain's arc length `s` (m) in `[0, total length]`; at a segment
+    /// junction both segments give the same frame.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `s` if out of range.
+    pub fn pose_at(&self, s: f64) -> Result<Matrix4<f64>> {
+        self.backbone(&[s]).map(|v| v[0]).map_err(|_| {
+            Error::invalid("s", s, format!("in [0, length] = [0, {}] m", self.length()))
+        })
+    }
+
+    /// Backbone frames at the chain's arc lengths `s` (m, each in `[0, total length]`, any
+    /// order).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `s[i]` for the first arc length out of range.
+    pub fn backbone(&self, s: &[f64]) -> Result<Vec<Matrix4<f64>>> {
+        let total = self.length();
+        let mut bases = Vec::with_capacity(self.segments.len());
+        let mut acc = Rigid::identity();
+        for seg in &self.segments {
+            bases.push(acc);
+            acc = acc.then(&seg.rigid_at(seg.length));
+        }
+        s.iter()
+            .enumerate()
+            .map(|(i, &si)| {
+                if !(si.is_finite() && (0.0..=total).contains(&si)) {
+                    return Err(Error::invalid(
+                        format!("s[{i}]"),
+                        si,
+                        format!("in [0, length] = [0, {total}] m"),
+                    ));
+                }
+                let k = self
+                    .ends
+                    .partition_point(|&e| e < si)
+                    .min(self.segments.len() - 1);
+                let start = if k == 0 { 0.0 } else { self.ends[k - 1] };
+                let seg = &self.segments[k];
+                let local = (si - start).clamp(0.0, seg.length);
+                Ok(bases[k].then(&seg.rigid_at(local)).to_matrix())
+            })
+            .collect()
+    }
+
+    /// The 6×3n Jacobian of the chain's tip pose with respect to every segment's coordinates
+    /// (columns `3i..3i+3` for segment `i`), as twists in `frame`.
+    pub fn jacobian(&self, frame: JacobianFrame, coordinates: ArcCoordinates) -> Matrix6xX<f64> {
+        chain_jacobian(&self.segments, frame, coordinates)
+    }
+}
+
+/// Tip pose of a chain of segments (4×4; segment `i` relative to the tip of `i - 1`); the
+/// identity for an empty slice.
+pub fn chain_pose(segments: &[PccSegment]) -> Matrix4<f64> {
+    segments
+        .iter()
+        .fold(Rigid::identity(), |acc, seg| {
+            acc.then(&seg.rigid_at(seg.length))
+        })
+        .to_matrix()
+}
+
+/// The 6×3n Jacobian of a chain's tip pose (see [`PccChain::jacobian`]).
+///
+/// Segment `i`'s spatial columns are mapped by the adjoint of the pose of its base,
+/// `Ad_T = [R, p^ R; 0, R]`, then the whole matrix is expressed in `frame`.
+pub fn chain_jacobian(
+    segments: &[PccSegment],
+    frame: JacobianFrame,
+    coordinates: ArcCoordinates,
+) -> Matrix6xX<f64> {
+    let mut j = Matrix6xX::zeros(3 * segments.len());
+    let mut base = Rigid::identity();
+    for (i, seg) in segments.iter().enumerate() {
+        let local = seg.jacobian(JacobianFrame::Spatial, coordinates);
+        for col in 0..3 {
+            let v = local.fixed_view::<3, 1>(0, col).into_owned();
+            let w = base.r * local.fixed_view::<3, 1>(3, col);
+            let v = base.r * v + base.p.cross(&w);
+            j.fixed_view_mut::<3, 1>(0, 3 * i + col).copy_from(&v);
+            j.fixed_view_mut::<3, 1>(3, 3 * i + col).copy_from(&w);
+        }
+        base = base.then(&seg.rigid_at(seg.length));
+    }
+    if frame != JacobianFrame::Spatial {
+        for col in 0..j.ncols() {
+            let v = j.fixed_view::<3, 1>(0, col).into_owned();
+            let w = j.fixed_view::<3, 1>(3, col).into_owned();
+            let (v, w) = match frame {
+                JacobianFrame::Body => (base.r.tr_mul(&(v - base.p.cross(&w))), base.r.tr_mul(&w)),
+                _ => (v + w.cross(&base.p), w),
+            };
+            j.fixed_view_mut::<3, 1>(0, col).copy_from(&v);
+            j.fixed_view_mut::<3, 1>(3, col).copy_from(&w);
+        }
+    }
+    j
+}
+
+// ---------------------------------------------------------------------------------------------
+// Robot-specific maps: actuation → arc parameters.
+// ---------------------------------------------------------------------------------------------
+
+/// Elastic properties of a uniform segment for the tension and pressure maps (immutable).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElasticSegment {
+    rest_length: f64,
+    bending_stiffness: f64,
+    axial_stiffness: Option<f64>,
+}
+
+impl ElasticSegment {
+    /// `rest_length` `ℓ0` (m), `bending_stiffness` `E I` (N m²), `axial_stiffness` `E A` (N),
+    /// `None` for an inextensible segment.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the parameter that is not finite and > 0.
+    pub fn new(
+        rest_length: f64,
+        bending_stiffness: f64,
+        axial_stiffness: Option<f64>,
+    ) -> Result<Self> {
+        check_positive("rest_length", rest_length, "m")?;
+        check_positive("bending_stiffness", bending_stiffness, "N m^2")?;
+        if let Some(ea) = axial_stiffness {
+            check_positive("axial_stiffness", ea, "N")?;
+        }
+        Ok(Self {
+            rest_length,
+            bending_stiffness,
+            axial_stiffness,
+        })
+    }
+
+    /// A solid circular section of `radius` (m) and Young's modulus `youngs_modulus` (Pa):
+    /// `E I = E π r⁴/4`, `E A = E π r²` (or inextensible).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the parameter that is not finite and > 0.
+    pub fn solid_circle(
+        rest_length: f64,
+        radius: f64,
+        youngs_modulus: f64,
+        extensible: bool,
+    ) -> Result<Self> {
+        check_positive("radius", radius, "m")?;
+        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        let area = std::f64::consts::PI * radius * radius;
+        Self::new(
+            rest_length,
+            youngs_modulus * area * radius * radius / 4.0,
+            extensible.then_some(youngs_modulus * area),
+        )
+    }
+
+    /// Rest length `ℓ0` (m).
+    pub fn rest_length(&self) -> f64 {
+        self.rest_length
+    }
+    /// Bending stiffness `E I` (N m²).
+    pub fn bending_stiffness(&self) -> f64 {
+        self.bending_stiffness
+    }
+    /// Axial stiffness `E A` (N), `None` if inextensible.
+    pub fn axial_stiffness(&self) -> Option<f64> {
+        self.axial_stiffness
+    }
+}
+
+/// Tendons of one segment (immutable): distances `d_i` (m) from the backbone and angles `β_i`
+/// (rad) from body x toward body y. Terminated at the segment's tip.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccTendons {
+    distances: Vec<f64>,
+    angles: Vec<f64>,
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+    /// Least-squares inverse of the displacement map, rows `(e, a, b)` (extensible).
+    pinv_extensible: Option<Matrix3xX<f64>>,
+    /// Rows `(a, b)` (inextensible).
+    pinv_inextensible: Option<Matrix2xX<f64>>,
+}
+
+fn check_actuators(distances: &[f64], angles: &[f64]) -> Result<()> {
+    if distances.is_empty() {
+        return Err(Error::invalid("distances", "[]", "at least one actuator"));
+    }
+    if angles.len() != distances.len() {
+        return Err(Error::invalid(
+            "angles.len()",
+            angles.len(),
+            format!("equal to distances.len() = {}", distances.len()),
+        ));
+    }
+    for (i, (&d, &b)) in distances.iter().zip(angles).enumerate() {
+        check_positive(&format!("distances[{i}]"), d, "m")?;
+        check_finite(&format!("angles[{i}]"), b)?;
+    }
+    Ok(())
+}
+
+/// Pseudo-inverse `(MᵀM)⁻¹Mᵀ` (3×n) of the extensible displacement map, rows
+/// `[1, -d_i cos β_i, -d_i sin β_i]`; `None` if `MᵀM` is singular to [`RANK_TOLERANCE`].
+fn pseudo_inverse3(rows: &[[f64; 3]]) -> Option<Matrix3xX<f64>> {
+    let mt = Matrix3xX::from_fn(rows.len(), |r, c| rows[c][r]);
+    let normal = &mt * mt.transpose();
+    let eig = normal.symmetric_eigenvalues();
+    let (lo, hi) = (eig.min(), eig.max());
+    if !(hi > 0.0 && lo > RANK_TOLERANCE * hi) {
+        return None;
+    }
+    Some(normal.try_inverse()? * mt)
+}
+
+/// Pseudo-inverse (2×n) of the inextensible displacement map, rows
+/// `[-d_i cos β_i, -d_i sin β_i]`.
+fn pseudo_inverse2(rows: &[[f64; 2]]) -> Option<Matrix2xX<f64>> {
+    let mt = Matrix2xX::from_fn(rows.len(), |r, c| rows[c][r]);
+    let normal = &mt * mt.transpose();
+    let eig = normal.symmetric_eigenvalues();
+    let (lo, hi) = (eig.min(), eig.max());
+    if !(hi > 0.0 && lo > RANK_TOLERANCE * hi) {
+        return None;
+    }
+    Some(normal.try_inverse()? * mt)
+}
+
+impl PccTendons {
+    /// Tendons at `distances` `d_i` (m, > 0) and `angles` `β_i` (rad).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `distances` if empty, `angles.len()` if the lengths
+    /// differ, or the first invalid `distances[i]` / `angles[i]`.
+    pub fn new(distances: &[f64], angles: &[f64]) -> Result<Self> {
+        check_actuators(distances, angles)?;
+        let (sin, cos): (Vec<f64>, Vec<f64>) = angles.iter().map(|b| b.sin_cos()).unzip();
+        let ext: Vec<[f64; 3]> = distances
+            .iter()
+            .zip(cos.iter().zip(&sin))
+            .map(|(d, (c, s))| [1.0, -d * c, -d * s])
+            .collect();
+        let inext: Vec<[f64; 2]> = ext.iter().map(|r| [r[1], r[2]]).collect();
+        Ok(Self {
+            distances: distances.to_vec(),
+            angles: angles.to_vec(),
+            cos,
+            sin,
+            pinv_extensible: pseudo_inverse3(&ext),
+            pinv_inextensible: pseudo_inverse2(&inext),
+        })
+    }
+
+    /// `count` tendons at the same `distance` (m), equally spaced from `first_angle` (rad).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `count` if zero, or as [`PccTendons::new`].
+    pub fn equally_spaced(count: usize, distance: f64, first_angle: f64) -> Result<Self> {
+        if count == 0 {
+            return Err(Error::invalid("count", count, ">= 1"));
+        }
+        let step = 2.0 * std::f64::consts::PI / count as f64;
+        let angles: Vec<f64> = (0..count).map(|i| first_angle + step * i as f64).collect();
+        Self::new(&vec![distance; count], &angles)
+    }
+
+    /// Number of tendons.
+    pub fn len(&self) -> usize {
+        self.distances.len()
+    }
+    /// Always false (at least one tendon).
+    pub fn is_empty(&self) -> bool {
+        self.distances.is_empty()
+    }
+    /// Distances `d_i` (m).
+    pub fn distances(&self) -> &[f64] {
+        &self.distances
+    }
+    /// Angles `β_i` (rad).
+    pub fn angles(&self) -> &[f64] {
+        &self.angles
+    }
+}
+
+/// Pneumatic chambers of one segment (immutable): cross-section areas `A_i` (m²), centroid
+/// distances `r_i` (m) and angles `β_i` (rad, from body x toward body y).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccChambers {
+    areas: Vec<f64>,
+    distances: Vec<f64>,
+    angles: Vec<f64>,
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+}
+
+impl PccChambers {
+    /// Chambers with `areas` (m², > 0), `distances` (m, > 0) and `angles` (rad).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first invalid entry or mismatched length.
+    pub fn new(areas: &[f64], distances: &[f64], angles: &[f64]) -> Result<Self> {
+        check_actuators(distances, angles)?;
+        if areas.len() != distances.len() {
+            return Err(Error::invalid(
+                "areas.len()",
+                areas.len(),
+                format!("equal to distances.len() = {}", distances.len()),
+            ));
+        }
+        for (i, &a) in areas.iter().enumerate() {
+            check_positive(&format!("areas[{i}]"), a, "m^2")?;
+        }
+        let (sin, cos) = angles.iter().map(|b| b.sin_cos()).unzip();
+        Ok(Self {
+            areas: areas.to_vec(),
+            distances: distances.to_vec(),
+            angles: angles.to_vec(),
+            cos,
+            sin,
+        })
+    }
+
+    /// `count` chambers of equal `area` (m²) at the same `distance` (m), equally spaced from
+    /// `first_angle` (rad).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `count` if zero, or as [`PccChambers::new`].
+    pub fn equally_spaced(
+        count: usize,
+        area: f64,
+        distance: f64,
+        first_angle: f64,
+    ) -> Result<Self> {
+        if count == 0 {
+            return Err(Error::invalid("count", count, ">= 1"));
+        }
+        let step = 2.0 * std::f64::consts::PI / count as f64;
+        let angles: Vec<f64> = (0..count).map(|i| first_angle + step * i as f64).collect();
+        Self::new(&vec![area; count], &vec![distance; count], &angles)
+    }
+
+    /// Number of chambers.
+    pub fn len(&self) -> usize {
+        self.areas.len()
+    }
+    /// Always false (at least one chamber).
+    pub fn is_empty(&self) -> bool {
+        self.areas.is_empty()
+    }
+    /// Areas `A_i` (m²).
+    pub fn areas(&self) -> &[f64] {
+        &self.areas
+    }
+    /// Centroid distances `r_i` (m).
+    pub fn distances(&self) -> &[f64] {
+        &self.distances
+    }
+    /// Angles `β_i` (rad).
+    pub fn angles(&self) -> &[f64] {
+        &self.angles
+    }
+}
+
+fn check_count(name: &str, got: usize, expected: usize) -> Result<()> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            format!("{name}.len()"),
+            got,
+            format!("equal to the number of actuators, {expected}"),
+        ))
+    }
+}
+
+/// Tendon length changes `Δl_i` (m, positive when the tendon pays out) for a segment of
+/// arc parameters `segment` whose rest length is `rest_length` (m; `None`: the segment's
+/// length, i.e. inextensible):
+/// `Δl_i = (ℓ - ℓ0) - d_i κ ℓ cos(φ - β_i)`.
+///
+/// This is exact for tendons parallel to the backbone in a twist-free arc: the tendon at body
+/// offset `r_i` has length `∫ |1 + (u × r_i)·z| ds = ℓ (1 - d_i κ cos(φ - β_i))` while
+/// `d_i |κ| < 1`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `rest_length` unless finite and > 0.
+pub fn tendon_displacements(
+    segment: &PccSegment,
+    tendons: &PccTendons,
+    rest_length: Option<f64>,
+) -> Result<Vec<f64>> {
+    let l0 = match rest_length {
+        Some(l0) => check_positive("rest_length", l0, "m")?,
+        None => segment.length,
+    };
+    let (k, l) = (segment.curvature, segment.length);
+    Ok((0..tendons.len())
+        .map(|i| {
+            let cos_rel = segment.cos_phi * tendons.cos[i] + segment.sin_phi * tendons.sin[i];
+            (l - l0) - tendons.distances[i] * k * l * cos_rel
+        })
+        .collect())
+}
+
+/// The n×3 Jacobian `∂Δl/∂q` of [`tendon_displacements`] with respect to the segment's
+/// `coordinates` `q`, at fixed rest length (so `∂Δl_i/∂ℓ = 1 - d_i κ cos(φ - β_i)`).
+/// Smooth everywhere in both coordinate systems.
+pub fn tendon_displacement_jacobian(
+    segment: &PccSegment,
+    tendons: &PccTendons,
+    coordinates: ArcCoordinates,
+) -> MatrixXx3<f64> {
+    let (k, l, cf, sf) = (
+        segment.curvature,
+        segment.length,
+        segment.cos_phi,
+        segment.sin_phi,
+    );
+    let mut j = MatrixXx3::zeros(tendons.len());
+    for i in 0..tendons.len() {
+        let (d, cb, sb) = (tendons.distances[i], tendons.cos[i], tendons.sin[i]);
+        let cos_rel = cf * cb + sf * sb;
+        let sin_rel = sf * cb - cf * sb;
+        j[(i, 2)] = 1.0 - d * k * cos_rel;
+        match coordinates {
+            ArcCoordinates::Arc => {
+                j[(i, 0)] = -d * l * cos_rel;
+                j[(i, 1)] = d * k * l * sin_rel;
+            }
+            ArcCoordinates::CurvatureVector => {
+                // Δl = (ℓ - ℓ0) - d ℓ (u_y cos β - u_x sin β).
+                j[(i, 0)] = d * l * sb;
+                j[(i, 1)] = -d * l * cb;
+            }
+        }
+    }
+    j
+}
+
+fn check_values(name: &str, values: &[f64], non_negative: bool) -> Result<()> {
+    for (i, &v) in values.iter().enumerate() {
+        if !(v.is_finite() && (!non_negative || v >= 0.0)) {
+            let expected = if non_negative {
+                "finite and >= 0"
+            } else {
+                "finite"
+            };
+            return Err(Error::invalid(format!("{name}[{i}]"), v, expected));
+        }
+    }
+    Ok(())
+}
+
+/// `(e, a, b)`: elongation `ℓ - ℓ0` and bending vector `θ (cos φ, sin φ)` from displacements.
+fn displacement_unknowns(
+    displacements: &[f64],
+    tendons: &PccTendons,
+    rest_length: f64,
+    extensible: bool,
+) -> Result<(f64, f64, f64)> {
+    check_count("displacements", displacements.len(), tendons.len())?;
+    check_values("displacements", displacements, false)?;
+    check_positive("rest_length", rest_length, "m")?;
+    let degenerate = |need: &str| {
+        Error::invalid(
+            "tendons",
+            format!("{} tendons at angles {:?}", tendons.len(), tendons.angles),
+            format!("a layout that resolves {need} (full-rank displacement map)"),
+        )
+    };
+    let (e, a, b) = if extensible {
+        let p = tendons
+            .pinv_extensible
+            .as_ref()
+            .ok_or_else(|| degenerate("elongation and bending (>= 3 tendons)"))?;
+        let mut x = [0.0; 3];
+        for (i, &dl) in displacements.iter().enumerate() {
+            for r in 0..3 {
+                x[r] += p[(r, i)] * dl;
+            }
+        }
+        (x[0], x[1], x[2])
+    } else {
+        let p = tendons
+            .pinv_inextensible
+            .as_ref()
+            .ok_or_else(|| degenerate("bending (>= 2 non-opposite tendons)"))?;
+        let mut x = [0.0; 2];
+        for (i, &dl) in displacements.iter().enumerate() {
+            for r in 0..2 {
+                x[r] += p[(r, i)] * dl;
+            }
+        }
+        (0.0, x[0], x[1])
+    };
+    if !(rest_length + e > 0.0 && e.is_finite()) {
+        return Err(Error::invalid(
+            "displacements",
+            format!("{displacements:?}"),
+            format!("a common elongation > -rest_length = {} m", -rest_length),
+        ));
+    }
+    Ok((e, a, b))
+}
+
+/// Inverse of [`tendon_displacements`]: the arc (with `κ >= 0`) from tendon length changes
+/// `displacements` (m) of a segment of `rest_length` (m). Extensible: unknowns elongation and
+/// bending (needs 3 tendons not all on one line through the backbone); inextensible (`ℓ =
+/// ℓ0`): bending only (needs 2 non-opposite tendons). With more tendons than unknowns the
+/// displacements are fitted in the least-squares sense (consistent ones exactly).
+///
+/// The map is linear in the elongation `e` and the bending vector `θ (cos φ, sin φ)`:
+/// `Δl_i = e - d_i θ cos(φ - β_i)`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `displacements.len()`, `displacements[i]`,
+/// `rest_length`, `tendons` (degenerate layout), or `displacements` (length would be <= 0).
+pub fn arc_from_tendon_displacements(
+    displacements: &[f64],
+    tendons: &PccTendons,
+    rest_length: f64,
+    extensible: bool,
+) -> Result<PccSegment> {
+    let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
+    let l = rest_length + e;
+    PccSegment::from_curvature_vector(-b / l, a / l, l)
+}
+
+/// Converts a 3×n Jacobian into `(u_x, u_y, ℓ)` at curvature vector `(u_x, u_y)` into
+/// `coordinates`.
+fn to_coordinates(
+    mut j: Matrix3xX<f64>,
+    u_x: f64,
+    u_y: f64,
+    coordinates: ArcCoordinates,
+) -> Result<Matrix3xX<f64>> {
+    if coordinates == ArcCoordinates::CurvatureVector {
+        return Ok(j);
+    }
+    let k2 = u_x * u_x + u_y * u_y;
+    if !(k2 > 0.0 && k2.is_finite()) {
+        return Err(Error::invalid(
+            "curvature",
+            0.0,
+            "nonzero: (curvature, plane_angle) are not differentiable at a straight segment; \
+             use ArcCoordinates::CurvatureVector",
+        ));
+    }
+    let k = k2.sqrt();
+    for col in 0..j.ncols() {
+        let (dx, dy) = (j[(0, col)], j[(1, col)]);
+        j[(0, col)] = (u_x * dx + u_y * dy) / k;
+        j[(1, col)] = (u_x * dy - u_y * dx) / k2;
+    }
+    Ok(j)
+}
+
+/// The 3×n Jacobian of [`arc_from_tendon_displacements`] with respect to the displacements,
+/// in closed form. In [`ArcCoordinates::Arc`] it is undefined at a straight segment
+/// (`∂φ/∂Δl` grows as `1/κ`).
+///
+/// # Errors
+/// As [`arc_from_tendon_displacements`], and [`Error::InvalidParameter`] naming `curvature`
+/// for arc coordinates at `κ = 0`.
+pub fn arc_from_tendon_displacements_jacobian(
+    displacements: &[f64],
+    tendons: &PccTendons,
+    rest_length: f64,
+    extensible: bool,
+    coordinates: ArcCoordinates,
+) -> Result<Matrix3xX<f64>> {
+    let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
+    let l = rest_length + e;
+    let n = tendons.len();
+    let mut j = Matrix3xX::zeros(n);
+    for i in 0..n {
+        let (de, da, db) = match (
+            extensible,
+            &tendons.pinv_extensible,
+            &tendons.pinv_inextensible,
+        ) {
+            (true, Some(p), _) => (p[(0, i)], p[(1, i)], p[(2, i)]),
+            (false, _, Some(p)) => (0.0, p[(0, i)], p[(1, i)]),
+            _ => (0.0, 0.0, 0.0), // unreachable: checked by displacement_unknowns
+        };
+        // u_x = -b/ℓ, u_y = a/ℓ, ℓ = ℓ0 + e.
+        j[(0, i)] = b / (l * l) * de - db / l;
+        j[(1, i)] = -a / (l * l) * de + da / l;
+        j[(2, i)] = de;
+    }
+    to_coordinates(j, -b / l, a / l, coordinates)
+}
+
+/// Per unit of actuation `q_i`: axial force (N) and body moment `(m_x, m_y)` (N m).
+type Loading = (f64, f64, f64);
+
+/// The elastic arc under actuation loads: `E I u = Σ q_i m_i`, `ℓ = ℓ0 (1 + Σ q_i f_i / E A)`.
+/// Returns `(u_x, u_y, ℓ)`.
+fn elastic_arc<F: Fn(usize) -> Loading>(
+    name: &str,
+    values: &[f64],
+    loading: F,
+    body: &ElasticSegment,
+) -> Result<(f64, f64, f64)> {
+    let (mut f, mut mx, mut my) = (0.0, 0.0, 0.0);
+    for (i, &q) in values.iter().enumerate() {
+        let (fi, mxi, myi) = loading(i);
+        f += q * fi;
+        mx += q * mxi;
+        my += q * myi;
+    }
+    let ei = body.bending_stiffness;
+    let l = match body.axial_stiffness {
+        Some(ea) => body.rest_length * (1.0 + f / ea),
+        None => body.rest_length,
+    };
+    if !(l > 0.0 && l.is_finite()) {
+        return Err(Error::invalid(
+            name,
+            format!("{values:?}"),
+            format!("an axial strain > -1 (net axial force {f:e} N)"),
+        ));
+    }
+    Ok((mx / ei, my / ei, l))
+}
+
+fn elastic_jacobian<F: Fn(usize) -> Loading>(
+    n: usize,
+    loading: F,
+    body: &ElasticSegment,
+) -> Matrix3xX<f64> {
+    let ei = body.bending_stiffness;
+    Matrix3xX::from_fn(n, |r, i| {
+        let (fi, mxi, myi) = loading(i);
+        match r {
+            0 => mxi / ei,
+            1 => myi / ei,
+            _ => body
+                .axial_stiffness
+                .map_or(0.0, |ea| body.rest_length * fi / ea),
+        }
+    })
+}
+
+/// Tendon `i` at unit tension: axial force `-1` (compression) and tip moment
+/// `r_i × (-z) = d_i (-sin β_i, cos β_i)`.
+fn tendon_loading(tendons: &PccTendons) -> impl Fn(usize) -> Loading + '_ {
+    move |i| {
+        let d = tendons.distances[i];
+        (-1.0, -d * tendons.sin[i], d * tendons.cos[i])
+    }
+}
+
+/// Chamber `i` at unit pressure: axial force `A_i` and moment `r_i × (A_i z)`.
+fn chamber_loading(chambers: &PccChambers) -> impl Fn(usize) -> Loading + '_ {
+    move |i| {
+        let (a, r) = (chambers.areas[i], chambers.distances[i]);
+        (a, a * r * chambers.sin[i], -a * r * chambers.cos[i])
+    }
+}
+
+/// The arc of a linear elastic uniform segment `body` pulled by `tensions` (N, >= 0) in
+/// `tendons` (moment balance at the tip, tendon forces taken along the tangent):
+/// `E I κ (cos φ, sin φ) = Σ τ_i d_i (cos β_i, sin β_i)`, axial strain `-Σ τ_i / E A`
+/// (`ℓ = ℓ0 (1 - Σ τ_i / E A)`; `ℓ = ℓ0` if inextensible). `κ` is per deformed length, as in
+/// seed 000. Returns `κ >= 0`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]` (negative or not
+/// finite), or `tensions` (compressed to zero length).
+pub fn arc_from_tendon_tensions(
+    tensions: &[f64],
+    tendons: &PccTendons,
+    body: &ElasticSegment,
+) -> Result<PccSegment> {
+    check_count("tensions", tensions.len(), tendons.len())?;
+    check_values("tensions", tensions, true)?;
+    let (ux, uy, l) = elastic_arc("tensions", tensions, tendon_loading(tendons), body)?;
+    PccSegment::from_curvature_vector(ux, uy, l)
+}
+
+/// The 3×n Jacobian of [`arc_from_tendon_tensions`] with respect to the tensions (constant in
+/// curvature-vector coordinates).
+///
+/// # Errors
+/// As [`arc_from_tendon_tensions`], and naming `curvature` for arc coordinates at `κ = 0`.
+pub fn arc_from_tendon_tensions_jacobian(
+    tensions: &[f64],
+    tendons: &PccTendons,
+    body: &ElasticSegment,
+    coordinates: ArcCoordinates,
+) -> Result<Matrix3xX<f64>> {
+    check_count("tensions", tensions.len(), tendons.len())?;
+    check_values("tensions", tensions, true)?;
+    let (ux, uy, _) = elastic_arc("tensions", tensions, tendon_loading(tendons), body)?;
+    let j = elastic_jacobian(tendons.len(), tendon_loading(tendons), body);
+    to_coordinates(j, ux, uy, coordinates)
+}
+
+/// The arc of a linear elastic uniform segment `body` with chamber `pressures` (Pa, gauge;
+/// negative for vacuum): axial force `F = Σ p_i A_i`, moment `Σ p_i A_i r_i × z` (bending
+/// away from a pressurised chamber), `E I u = moment`, `ℓ = ℓ0 (1 + F / E A)` (`ℓ0` if
+/// inextensible). Returns `κ >= 0`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `pressures.len()`, `pressures[i]` (not finite), or
+/// `pressures` (compressed to zero length).
+pub fn arc_from_pressures(
+    pressures: &[f64],
+    chambers: &PccChambers,
+    body: &ElasticSegment,
+) -> Result<PccSegment> {
+    check_count("pressures", pressures.len(), chambers.len())?;
+    check_values("pressures", pressures, false)?;
+    let (ux, uy, l) = elastic_arc("pressures", pressures, chamber_loading(chambers), body)?;
+    PccSegment::from_curvature_vector(ux, uy, l)
+}
+
+/// The 3×n Jacobian of [`arc_from_pressures`] with respect to the pressures (constant in
+/// curvature-vector coordinates).
+///
+/// # Errors
+/// As [`arc_from_pressures`], and naming `curvature` for arc coordinates at `κ = 0`.
+pub fn arc_from_pressures_jacobian(
+    pressures: &[f64],
+    chambers: &PccChambers,
+    body: &ElasticSegment,
+    coordinates: ArcCoordinates,
+) -> Result<Matrix3xX<f64>> {
+    check_count("pressures", pressures.len(), chambers.len())?;
+    check_values("pressures", pressures, false)?;
+    let (ux, uy, _) = elastic_arc("pressures", pressures, chamber_loading(chambers), body)?;
+    let j = elastic_jacobian(chambers.len(), chamber_loading(chambers), body);
+    to_coordinates(j, ux, uy, coordinates)
+}
