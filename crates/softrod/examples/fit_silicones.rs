@@ -2,8 +2,8 @@
 //! Database (Marechal et al., Soft Robotics 8(3), 2021, doi:10.1089/soro.2019.0115; ODbL 1.0 /
 //! DbCL 1.0) and prints the parameters and errors as Markdown tables.
 //!
-//! Usage: `cargo run -p softrod --example fit_silicones -- <dir with the CSV files>`
-//! (or set `SOFTROD_SILICONE_DATA`).
+//! Usage: `cargo run --release -p softrod --example fit_silicones [-- <dir with the CSV files>]`;
+//! the default directory is the copy vendored with the repository, `data/silicone-tensile/`.
 //!
 //! Each file has 17 `;`-separated header lines, then the column names
 //! `Time (s);True Strain;True Stress (MPa);Engineering Strain;Engineering Stress (MPa)`.
@@ -109,14 +109,18 @@ fn stable_range(law: &dyn UniaxialLaw) -> String {
 }
 
 fn main() -> ExitCode {
-    let dir = std::env::args()
-        .nth(1)
-        .or_else(|| std::env::var("SOFTROD_SILICONE_DATA").ok())
-        .map(PathBuf::from);
-    let Some(dir) = dir else {
-        eprintln!("usage: fit_silicones <dir with the Soft Robotics Materials Database CSV files>");
+    let dir = std::env::args().nth(1).map_or_else(
+        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/silicone-tensile"),
+        PathBuf::from,
+    );
+    if !dir.is_dir() {
+        eprintln!(
+            "fit_silicones: no directory {} (usage: fit_silicones [<dir with the Soft Robotics \
+             Materials Database CSV files>])",
+            dir.display()
+        );
         return ExitCode::from(2);
-    };
+    }
     let kinds = [
         ("Linearised", ModelKind::Linearised, false),
         ("Neo-Hookean", ModelKind::NeoHookean, false),

@@ -972,7 +972,7 @@ into_model!(Hookean, Linearised, NeoHookean, MooneyRivlin, Yeoh, Ogden);
 
 /// Named silicones with sourced hyperelastic parameters.
 ///
-/// Except for Elastosil M4601, every parameter set is a least-squares fit by
+/// Every parameter set is a least-squares fit by
 /// [`crate::fit::fit_uniaxial`] (nominal stress, unweighted, exact linear solve) to the measured
 /// tensile curve of the Soft Robotics Materials Database, restricted to stretch `λ <= 3`
 /// (engineering strain <= 200 %, see [`Silicone::fit_stretch_range`]):
@@ -995,6 +995,9 @@ into_model!(Hookean, Linearised, NeoHookean, MooneyRivlin, Yeoh, Ogden);
 /// entry); three-term Yeoh fits have `C30 < 0` and lose stability a little above `λ = 3.7`
 /// (Dragon Skin) or 4.4 (Ecoflex). Check [`UniaxialLaw::check_stable`] on the stretch range of
 /// the application; prefer Yeoh where a section is compressed (bending).
+///
+/// The measured curves are vendored in `data/silicone-tensile/` (with their licence). Literature
+/// parameter sets whose primary source could not be checked are deliberately not included.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Silicone {
     /// Smooth-On Ecoflex 00-30.
@@ -1029,15 +1032,6 @@ pub enum Silicone {
     /// Mooney–Rivlin 14.17 / 26.26 kPa (R² 0.9973), stable for λ ≥ 0.922 only; Yeoh 3.107 /
     /// 6.360 kPa (R² 0.99987), stable for 0.112 ≤ λ ≤ 3.71.
     DragonSkin30,
-    /// Wacker Elastosil M4601 (literature values; no curve in the database).
-    ///
-    /// Yeoh `C10 = 0.11 MPa`, `C20 = 0.02 MPa` as reported by P. Polygerinos, Z. Wang,
-    /// J. T. B. Overvelde, K. C. Galloway, R. J. Wood, K. Bertoldi, C. J. Walsh, "Modeling of
-    /// Soft Fiber-Reinforced Bending Actuators", IEEE T-RO 31(3), 778–789, 2015 (fitted there to
-    /// their uniaxial test of the material; the fitted stretch range is not restated here). The
-    /// Neo-Hookean `mu = 2 C10 = 0.22 MPa` is the initial shear modulus of that Yeoh law, not a
-    /// separate fit. No Mooney–Rivlin set is provided.
-    ElastosilM4601,
 }
 
 /// Sourced parameters of one silicone (Pa).
@@ -1052,13 +1046,12 @@ struct SiliconeParams {
 
 impl Silicone {
     /// Every silicone of the library.
-    pub const ALL: [Silicone; 6] = [
+    pub const ALL: [Silicone; 5] = [
         Silicone::Ecoflex0030,
         Silicone::Ecoflex0050,
         Silicone::DragonSkin10,
         Silicone::DragonSkin20,
         Silicone::DragonSkin30,
-        Silicone::ElastosilM4601,
     ];
 
     fn params(self) -> SiliconeParams {
@@ -1103,14 +1096,6 @@ impl Silicone {
                 stretch_max: 3.0,
                 source: MARECHAL_2021,
             },
-            Silicone::ElastosilM4601 => SiliconeParams {
-                name: "Elastosil M4601",
-                mu: 2.0 * 0.11e6,
-                mooney_rivlin: None,
-                yeoh: (0.11e6, 0.02e6, 0.0),
-                stretch_max: f64::NAN,
-                source: POLYGERINOS_2015,
-            },
         }
     }
 
@@ -1120,7 +1105,7 @@ impl Silicone {
     }
 
     /// Looks a silicone up by name, ignoring case, spaces, `-` and `_` (`"ecoflex 00-30"`,
-    /// `"DragonSkin10"`, `"elastosil_m4601"`).
+    /// `"DragonSkin10"`, `"dragon_skin_20"`).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] (`name`) listing the known names otherwise.
@@ -1148,7 +1133,8 @@ impl Silicone {
         }
     }
 
-    /// Two-parameter Mooney–Rivlin law, where a sourced one exists (`None` for Elastosil M4601).
+    /// Two-parameter Mooney–Rivlin law, where a sourced one exists (every current entry has
+    /// one; `None` is kept for literature entries without a measured curve).
     pub fn mooney_rivlin(self) -> Option<MooneyRivlin> {
         self.params()
             .mooney_rivlin
@@ -1162,7 +1148,7 @@ impl Silicone {
     }
 
     /// Stretch range `(min, max)` of the data the parameters were fitted to; the laws are only
-    /// validated there. `None` where the source does not state it (Elastosil M4601).
+    /// validated there. `None` where a source does not state it (no current entry).
     pub fn fit_stretch_range(self) -> Option<(f64, f64)> {
         let p = self.params();
         p.stretch_max.is_finite().then_some((1.0, p.stretch_max))
@@ -1186,8 +1172,3 @@ const MARECHAL_2021: &str =
 to the tensile curve of the Soft Robotics Materials Database: L. Marechal et al., Soft Robotics \
 8(3), 2021, doi:10.1089/soro.2019.0115, github.com/LucMarechal/Soft-Robotics-Materials-Database \
 commit 8ff66c3b, Tensile-Tests-Data (ODbL 1.0 / DbCL 1.0)";
-
-/// Source note of Elastosil M4601.
-const POLYGERINOS_2015: &str = "Yeoh C10 = 0.11 MPa, C20 = 0.02 MPa: P. Polygerinos et al., \
-Modeling of Soft Fiber-Reinforced Bending Actuators, IEEE T-RO 31(3), 2015; Neo-Hookean \
-mu = 2 C10 is the initial shear modulus of that Yeoh law";
