@@ -79,11 +79,76 @@ pub(crate) fn rot(y: &[f64]) -> Matrix3<f64> {
     Matrix3::from_column_slice(&y[3..12])
 }
 
-/// Tangent of the local strains with respect to the body wrench.
+/// LU factorisation with partial pivoting of a 6×6 matrix (row-major arrays, no allocation;
+/// several times faster than the generic routine for this size).
 #[derive(Clone, Copy)]
-pub(crate) enum Tangent {
-    Diagonal([f64; 6]),
-    Full(Matrix6<f64>),
+pub(crate) struct Lu6 {
+    a: [[f64; 6]; 6],
+    inv_diag: [f64; 6],
+    perm: [usize; 6],
+}
+
+impl Lu6 {
+    /// Factorises `m`; `None` if it is singular to working precision or not finite.
+    #[inline]
+    pub fn new(m: &Matrix6<f64>) -> Option<Self> {
+        let mut a = [[0.0; 6]; 6];
+        for i in 0..6 {
+            for j in 0..6 {
+                a[i][j] = m[(i, j)];
+            }
+        }
+        let mut perm = [0, 1, 2, 3, 4, 5];
+        let mut inv_diag = [0.0; 6];
+        for k in 0..6 {
+            let mut p = k;
+            let mut best = a[k][k].abs();
+            for i in k + 1..6 {
+                if a[i][k].abs() > best {
+                    best = a[i][k].abs();
+                    p = i;
+                }
+            }
+            if !(best > 0.0 && best.is_finite()) {
+                return None;
+            }
+            if p != k {
+                a.swap(p, k);
+                perm.swap(p, k);
+            }
+            let inv = 1.0 / a[k][k];
+            inv_diag[k] = inv;
+            for i in k + 1..6 {
+                let f = a[i][k] * inv;
+                a[i][k] = f;
+                for j in k + 1..6 {
+                    a[i][j] -= f * a[k][j];
+                }
+            }
+        }
+        Some(Self { a, inv_diag, perm })
+    }
+
+    /// Solves `M x = b`.
+    #[inline]
+    pub fn solve(&self, b: &[f64; 6]) -> [f64; 6] {
+        let mut x = [0.0; 6];
+        for i in 0..6 {
+            let mut v = b[self.perm[i]];
+            for j in 0..i {
+                v -= self.a[i][j] * x[j];
+            }
+            x[i] = v;
+        }
+        for i in (0..6).rev() {
+            let mut v = x[i];
+            for j in i + 1..6 {
+                v -= self.a[i][j] * x[j];
+            }
+            x[i] = v * self.inv_diag[i];
+        }
+        x
+    }
 }
 
 /// The local solution at one `s`: strains and tendon load sums (body frame).
@@ -95,7 +160,17 @@ pub(crate) struct Local {
     pub tendon_force: Vector3<f64>,
     /// `Σ τ r_i × t_i` (N m, body frame).
     pub tendon_moment: Vector3<f64>,
-    pub tangent: Tangent,
+}
+
+impl Local {
+    fn nan() -> Self {
+        Self {
+            v: Vector3::repeat(f64::NAN),
+            u: Vector3::repeat(f64::NAN),
+            tendon_force: Vector3::zeros(),
+            tendon_moment: Vector3::zeros(),
+        }
+    }
 }
 
 /// A prepared tendon: termination and scaled tension.
@@ -119,6 +194,12 @@ pub(crate) struct Model<'a> {
     pub length: f64,
     /// Interval end points `0 = b_0 < b_1 < ... = L`.
     pub breaks: Vec<f64>,
+    /// Whether no force is applied along the rod (only world-frame tip loads and moments):
+    /// then `N ≡ 0` for a zero base force.
+    pub force_free: bool,
+    /// The section compliance when it does not depend on `s` (linear material, uniform
+    /// section), precomputed.
+    pub uniform_compliance: Option<[f64; 6]>,
 }
 
 impl<'a> Model<'a> {
@@ -248,14 +329,26 @@ impl<'a> Model<'a> {
 /// Evaluates the right-hand side; holds the per-interval set of active tendons and scratch.
 pub(crate) struct Evaluator<'m, 'a> {
     pub model: &'m Model<'a>,
-    /// Indices of the tendons that pass through the current interval.
+    /// Indices of the tendons that pass through the current interval with nonzero tension.
     active: Vec<usize>,
+    /// Indices of the tendons that pass through the current interval without tension (their
+    /// paths are still followed for their lengths).
+    passive: Vec<usize>,
     /// Scratch: offsets `(r, r', τ)` of the active tendons at the current `s`.
     offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
     /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
     guess: Option<Vector6<f64>>,
-    /// `|w_i| = |p_i'|` of every tendon at the last evaluation (0 for inactive ones).
+    /// Factorised local Jacobian `I + C D` of the last local Newton iteration (chord steps).
+    last_lu: Option<Lu6>,
+    /// Tangent `d(v, u)/d(n_b, m_b)` of the last [`Evaluator::local`] call made with
+    /// `tangent = true`: diagonal in `tangent_diag` unless `tangent_full` is set.
+    tangent_diag: [f64; 6],
+    tangent_full: Option<Matrix6<f64>>,
+    /// `|w_i| = |p_i'|` of every tendon at the last evaluation (only updated while
+    /// `track_speeds` is set; stale for tendons that end before the current interval).
     pub tendon_speed: Vec<f64>,
+    /// Whether [`Evaluator::local`] records the tendon speeds.
+    pub track_speeds: bool,
     /// Right-hand-side evaluations so far.
     pub evaluations: usize,
 }
@@ -266,9 +359,14 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         Self {
             model,
             active: Vec::with_capacity(n),
+            passive: Vec::with_capacity(n),
             offsets: Vec::with_capacity(n),
             guess: None,
+            last_lu: None,
+            tangent_diag: [0.0; 6],
+            tangent_full: None,
             tendon_speed: vec![0.0; n],
+            track_speeds: false,
             evaluations: 0,
         }
     }
@@ -277,16 +375,109 @@ impl<'m, 'a> Evaluator<'m, 'a> {
     pub fn set_interval(&mut self, k: usize) {
         let b = self.model.breaks[k + 1];
         self.active.clear();
+        self.passive.clear();
         for (i, t) in self.model.tendons.iter().enumerate() {
-            if t.end >= b && t.tendon.tension() > 0.0 {
-                self.active.push(i);
+            if t.end >= b {
+                if t.tendon.tension() * self.model.factor > 0.0 {
+                    self.active.push(i);
+                } else {
+                    self.passive.push(i);
+                }
             }
         }
         self.guess = None;
+        self.last_lu = None;
     }
 
-    /// Solves the constitutive equations at `s` for the body wrench `(nb, mb)`.
-    /// Returns NaN strains if the local Newton iteration fails.
+    /// Records `|p_i'|` of the tension-free tendons for the strains `(v, u)`.
+    #[inline]
+    fn passive_speeds(
+        &mut self,
+        s: f64,
+        props: &SectionProperties,
+        v: &Vector3<f64>,
+        u: &Vector3<f64>,
+    ) {
+        for &i in &self.passive {
+            let (r, rp) = self.model.tendons[i].tendon.routing().offset(s, props);
+            let r = Vector3::new(r[0], r[1], 0.0);
+            let rp = Vector3::new(rp[0], rp[1], 0.0);
+            self.tendon_speed[i] = (v + u.cross(&r) + rp).norm();
+        }
+    }
+
+    /// Tendon load sums `(Σ τ t, Σ τ r × t)` at the strains `x = (v, u)`, and, if `jac`, the
+    /// local Jacobian `I + C D` (see the module documentation).
+    ///
+    /// Per tendon, with `t = w/|w|`, `q = r × t`, `a = τ/|w|` and `A = a (I - t tᵀ)`:
+    /// `dT_F/dv = A`, `dT_F/du = -A r̂ = -a (r̂ + t qᵀ)`, `dT_M/dv = r̂ A = a (r̂ - q tᵀ)`,
+    /// `dT_M/du = -r̂ A r̂ = -a (r rᵀ - |r|² I + q qᵀ)`.
+    #[inline]
+    fn tendon_sums(
+        &self,
+        x: &Vector6<f64>,
+        c: &[f64; 6],
+        jac: bool,
+    ) -> (Vector6<f64>, Option<Matrix6<f64>>) {
+        let v = Vector3::new(x[0], x[1], x[2]);
+        let u = Vector3::new(x[3], x[4], x[5]);
+        let mut tf = Vector3::zeros();
+        let mut tm = Vector3::zeros();
+        let mut sa = 0.0;
+        let mut sar = Vector3::zeros();
+        let mut ar2 = 0.0;
+        let mut tt = Matrix3::zeros();
+        let mut tq = Matrix3::zeros();
+        let mut qq = Matrix3::zeros();
+        let mut rr = Matrix3::zeros();
+        for (r, rp, tau) in &self.offsets {
+            let w = v + u.cross(r) + rp;
+            let inv_len = 1.0 / w.norm();
+            let t = w * inv_len;
+            let q = r.cross(&t);
+            tf += t * *tau;
+            tm += q * *tau;
+            if jac {
+                let a = *tau * inv_len;
+                let at = t * a;
+                sa += a;
+                sar += r * a;
+                ar2 += a * r.norm_squared();
+                tt += at * t.transpose();
+                tq += at * q.transpose();
+                qq += q * (q * a).transpose();
+                rr += r * (r * a).transpose();
+            }
+        }
+        let sums = Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z);
+        if !jac {
+            return (sums, None);
+        }
+        let rh = hat(&sar);
+        let dfv = Matrix3::identity() * sa - tt;
+        let dfu = -(rh + tq);
+        let dmv = rh - tq.transpose();
+        let dmu = Matrix3::identity() * ar2 - rr - qq;
+        let mut h = Matrix6::identity();
+        for i in 0..3 {
+            for j in 0..3 {
+                h[(i, j)] += c[i] * dfv[(i, j)];
+                h[(i, j + 3)] += c[i] * dfu[(i, j)];
+                h[(i + 3, j)] += c[i + 3] * dmv[(i, j)];
+                h[(i + 3, j + 3)] += c[i + 3] * dmu[(i, j)];
+            }
+        }
+        (sums, Some(h))
+    }
+
+    /// Solves the constitutive equations at `s` for the body wrench `(nb, mb)`; with
+    /// `tangent`, also stores `d(v, u)/d(nb, mb)` for [`Evaluator::rhs`].
+    /// Returns NaN strains if the local iteration fails.
+    ///
+    /// The iteration on `G(x) = x - x* - C (W - T(x)) = 0` starts from the previous solution
+    /// and takes chord steps with the previous factorised Jacobian while they contract fast
+    /// (consecutive evaluations are close), and exact Newton steps otherwise; the tangent is
+    /// always factorised afresh at the solution.
     pub fn local(
         &mut self,
         s: f64,
@@ -300,20 +491,36 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         let wb = [nb.x, nb.y, nb.z, mb.x, mb.y, mb.z];
         let vs = rod.rest_strain().at(s);
         let us = rod.rest_curvature().at(s);
-        let (e, c) = rod.material().elastic_strain(
-            props,
-            model.shear_coefficient,
-            rod.inextensible(),
-            &wb,
-        );
+        let (e, c) = match &model.uniform_compliance {
+            Some(c) => {
+                let mut e = [0.0; 6];
+                for k in 0..6 {
+                    e[k] = c[k] * wb[k];
+                }
+                (e, *c)
+            }
+            None => rod.material().elastic_strain(
+                props,
+                model.shear_coefficient,
+                rod.inextensible(),
+                &wb,
+            ),
+        };
         if self.active.is_empty() {
-            return Local {
+            let out = Local {
                 v: vs + Vector3::new(e[0], e[1], e[2]),
                 u: us + Vector3::new(e[3], e[4], e[5]),
                 tendon_force: Vector3::zeros(),
                 tendon_moment: Vector3::zeros(),
-                tangent: Tangent::Diagonal(c),
             };
+            if tangent {
+                self.tangent_diag = c;
+                self.tangent_full = None;
+            }
+            if self.track_speeds {
+                self.passive_speeds(s, props, &out.v, &out.u);
+            }
+            return out;
         }
         self.offsets.clear();
         for &i in &self.active {
@@ -341,76 +548,98 @@ impl<'m, 'a> Evaluator<'m, 'a> {
                 xs + cd.component_mul(&(wv - Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)))
             }
         };
-        let mut out = Local {
-            v: Vector3::repeat(f64::NAN),
-            u: Vector3::repeat(f64::NAN),
-            tendon_force: Vector3::zeros(),
-            tendon_moment: Vector3::zeros(),
-            tangent: Tangent::Diagonal([f64::NAN; 6]),
-        };
+        let mut last_step = f64::INFINITY;
+        let mut converged = false;
+        let mut chord = self.last_lu.is_some();
         for _ in 0..LOCAL_MAX_ITERATIONS {
-            let v = Vector3::new(x[0], x[1], x[2]);
-            let u = Vector3::new(x[3], x[4], x[5]);
-            let mut tf = Vector3::zeros();
-            let mut tm = Vector3::zeros();
-            let mut dfv = Matrix3::zeros();
-            let mut dfu = Matrix3::zeros();
-            let mut dmv = Matrix3::zeros();
-            let mut dmu = Matrix3::zeros();
-            for (r, rp, tau) in &self.offsets {
-                let w = v + u.cross(r) + rp;
-                let len = w.norm();
-                let t = w / len;
-                tf += t * *tau;
-                tm += r.cross(&t) * *tau;
-                let a = (Matrix3::identity() - t * t.transpose()) * (*tau / len);
-                let rh = hat(r);
-                let ar = a * rh;
-                dfv += a;
-                dfu -= ar;
-                dmv += rh * a;
-                dmu -= rh * ar;
-            }
-            let tw = Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z);
+            let (tw, h) = self.tendon_sums(&x, &c, !chord);
             let g = x - xs - cd.component_mul(&(wv - tw));
-            let mut h = Matrix6::identity();
-            for i in 0..3 {
-                for j in 0..3 {
-                    h[(i, j)] += c[i] * dfv[(i, j)];
-                    h[(i, j + 3)] += c[i] * dfu[(i, j)];
-                    h[(i + 3, j)] += c[i + 3] * dmv[(i, j)];
-                    h[(i + 3, j + 3)] += c[i + 3] * dmu[(i, j)];
+            if let Some(h) = h {
+                match Lu6::new(&h) {
+                    Some(lu) => self.last_lu = Some(lu),
+                    None => return Local::nan(),
                 }
             }
-            let lu = h.lu();
-            let Some(dx) = lu.solve(&g) else {
-                return out;
+            let Some(lu) = &self.last_lu else {
+                return Local::nan();
             };
+            let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
             x -= dx;
             if !x.iter().all(|v| v.is_finite()) {
-                return out;
+                return Local::nan();
             }
-            if dx.amax() <= LOCAL_TOLERANCE * (1.0 + x.amax()) {
-                out.v = Vector3::new(x[0], x[1], x[2]);
-                out.u = Vector3::new(x[3], x[4], x[5]);
-                out.tendon_force = tf;
-                out.tendon_moment = tm;
-                if tangent {
-                    if let Some(s) = lu.solve(&Matrix6::from_diagonal(&cd)) {
-                        out.tangent = Tangent::Full(s);
-                    } else {
-                        return out;
+            let step = dx.amax();
+            let tol = LOCAL_TOLERANCE * (1.0 + x.amax());
+            if step <= tol {
+                converged = true;
+                break;
+            }
+            if chord {
+                // Chord steps converge linearly with ratio rho: the error left after this step
+                // is about step rho / (1 - rho). Switch to Newton unless they contract fast.
+                if last_step.is_finite() {
+                    let rho = step / last_step;
+                    if rho > 0.1 {
+                        chord = false;
+                    } else if step * rho / (1.0 - rho) <= tol {
+                        converged = true;
+                        break;
                     }
                 }
-                // Tendon speeds |p_i'| at the solution.
-                for (k, &i) in self.active.iter().enumerate() {
-                    let (r, rp, _) = &self.offsets[k];
-                    self.tendon_speed[i] = (out.v + out.u.cross(r) + rp).norm();
+            } else {
+                // Quadratic convergence: the error after this step is about |dx|³ / |dx_prev|².
+                let predicted = step * (step / last_step).powi(2);
+                if last_step.is_finite() && step < 1e-3 * last_step && predicted <= tol {
+                    converged = true;
+                    break;
                 }
-                self.guess = Some(x);
-                return out;
             }
+            last_step = step;
         }
+        if !converged {
+            return Local::nan();
+        }
+        let mut out = Local {
+            v: Vector3::new(x[0], x[1], x[2]),
+            u: Vector3::new(x[3], x[4], x[5]),
+            tendon_force: Vector3::zeros(),
+            tendon_moment: Vector3::zeros(),
+        };
+        if tangent {
+            // (I + C D)⁻¹ C at the solution, column by column.
+            let (_, h) = self.tendon_sums(&x, &c, true);
+            let Some(lu) = h.as_ref().and_then(Lu6::new) else {
+                return Local::nan();
+            };
+            let mut sm = Matrix6::zeros();
+            for j in 0..6 {
+                let mut e = [0.0; 6];
+                e[j] = c[j];
+                let col = lu.solve(&e);
+                for i in 0..6 {
+                    sm[(i, j)] = col[i];
+                }
+            }
+            self.tangent_full = Some(sm);
+            self.last_lu = Some(lu);
+        }
+        // Tendon loads and speeds |p_i'| at the solution.
+        let (mut tf, mut tm) = (Vector3::zeros(), Vector3::zeros());
+        for (k, &i) in self.active.iter().enumerate() {
+            let (r, rp, tau) = &self.offsets[k];
+            let w = out.v + out.u.cross(r) + rp;
+            let len = w.norm();
+            let a = *tau / len;
+            tf += w * a;
+            tm += r.cross(&w) * a;
+            self.tendon_speed[i] = len;
+        }
+        out.tendon_force = tf;
+        out.tendon_moment = tm;
+        if self.track_speeds {
+            self.passive_speeds(s, props, &out.v, &out.u);
+        }
+        self.guess = Some(x);
         out
     }
 
@@ -445,14 +674,20 @@ impl<'m, 'a> Evaluator<'m, 'a> {
                 let dm = v3(y, b + 9);
                 let dnb = nb.cross(&w) + r.tr_mul(&dn);
                 let dmb = mb.cross(&w) + r.tr_mul(&dm);
-                let (dv, du) = match &loc.tangent {
-                    Tangent::Diagonal(c) => (
-                        Vector3::new(c[0] * dnb.x, c[1] * dnb.y, c[2] * dnb.z),
-                        Vector3::new(c[3] * dmb.x, c[4] * dmb.y, c[5] * dmb.z),
-                    ),
-                    Tangent::Full(sm) => {
+                let (dv, du) = match &self.tangent_full {
+                    None => {
+                        let c = &self.tangent_diag;
+                        (
+                            Vector3::new(c[0] * dnb.x, c[1] * dnb.y, c[2] * dnb.z),
+                            Vector3::new(c[3] * dmb.x, c[4] * dmb.y, c[5] * dmb.z),
+                        )
+                    }
+                    Some(sm) => {
                         let d = sm * Vector6::new(dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z);
-                        (Vector3::new(d[0], d[1], d[2]), Vector3::new(d[3], d[4], d[5]))
+                        (
+                            Vector3::new(d[0], d[1], d[2]),
+                            Vector3::new(d[3], d[4], d[5]),
+                        )
                     }
                 };
                 let dpd = r * (w.cross(&v) + dv);

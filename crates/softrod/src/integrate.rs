@@ -180,8 +180,12 @@ where
 
     // Initial step (Hairer–Nørsett–Wanner's heuristic, order 3).
     let scale = |y: &[f64; N], j: usize| opts.atol + opts.rtol * y[j].abs();
-    let d0 = (0..N).map(|j| (y0[j] / scale(&y0, j)).abs()).fold(0.0, f64::max);
-    let d1 = (0..N).map(|j| (k1[j] / scale(&y0, j)).abs()).fold(0.0, f64::max);
+    let d0 = (0..N)
+        .map(|j| (y0[j] / scale(&y0, j)).abs())
+        .fold(0.0, f64::max);
+    let d1 = (0..N)
+        .map(|j| (k1[j] / scale(&y0, j)).abs())
+        .fold(0.0, f64::max);
     let mut h = if d0 < 1e-5 || d1 < 1e-5 {
         1e-6
     } else {
@@ -207,14 +211,19 @@ where
         }
         let k2 = f(t + 0.5 * hs, &axpy(&y, hs, &[(0.5, &k1)]));
         let k3 = f(t + 0.75 * hs, &axpy(&y, hs, &[(0.75, &k2)]));
-        let y_new = axpy(&y, hs, &[(2.0 / 9.0, &k1), (1.0 / 3.0, &k2), (4.0 / 9.0, &k3)]);
+        let y_new = axpy(
+            &y,
+            hs,
+            &[(2.0 / 9.0, &k1), (1.0 / 3.0, &k2), (4.0 / 9.0, &k3)],
+        );
         let t_new = if hs == t1 - t { t1 } else { t + hs };
         let k4 = f(t_new, &y_new);
         stats.evaluations += 3;
         let mut err = 0.0f64;
         for j in 0..N {
-            let e = hs * (-5.0 / 72.0 * k1[j] + 1.0 / 12.0 * k2[j] + 1.0 / 9.0 * k3[j]
-                - 1.0 / 8.0 * k4[j]);
+            let e = hs
+                * (-5.0 / 72.0 * k1[j] + 1.0 / 12.0 * k2[j] + 1.0 / 9.0 * k3[j]
+                    - 1.0 / 8.0 * k4[j]);
             let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
             err = err.max((e / sc).abs());
         }
@@ -449,7 +458,11 @@ where
         return Err(Error::invalid("t_span", format!("[{t0}, {t1}]"), "finite"));
     }
     if controlled == 0 || controlled > N {
-        return Err(Error::invalid("controlled", controlled, format!("in 1..={N}")));
+        return Err(Error::invalid(
+            "controlled",
+            controlled,
+            format!("in 1..={N}"),
+        ));
     }
     let mut stats = IntegrationStats::default();
     let mut sol = Dp54Solution {
@@ -502,14 +515,23 @@ where
         );
         let k4 = f(
             t + dp::C[3] * hs,
-            &axpy(&y, hs, &[(dp::A4[0], &k1), (dp::A4[1], &k2), (dp::A4[2], &k3)]),
+            &axpy(
+                &y,
+                hs,
+                &[(dp::A4[0], &k1), (dp::A4[1], &k2), (dp::A4[2], &k3)],
+            ),
         );
         let k5 = f(
             t + dp::C[4] * hs,
             &axpy(
                 &y,
                 hs,
-                &[(dp::A5[0], &k1), (dp::A5[1], &k2), (dp::A5[2], &k3), (dp::A5[3], &k4)],
+                &[
+                    (dp::A5[0], &k1),
+                    (dp::A5[1], &k2),
+                    (dp::A5[2], &k3),
+                    (dp::A5[3], &k4),
+                ],
             ),
         );
         let t_new = if hs == t1 - t { t1 } else { t + hs };
@@ -609,6 +631,7 @@ where
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::*;
 
     #[test]
@@ -687,14 +710,21 @@ mod tests {
             max_steps: 3,
             ..Default::default()
         };
-        let r = bs23(|t, _y: &[f64; 1]| [(50.0 * t).sin()], 0.0, [0.0], 10.0, opts);
+        let r = bs23(
+            |t, _y: &[f64; 1]| [(50.0 * t).sin()],
+            0.0,
+            [0.0],
+            10.0,
+            opts,
+        );
         assert!(matches!(r, Err(Error::NotConverged { iterations: 3, .. })));
     }
 
     #[test]
     fn rk4_is_fourth_order() {
         let err = |steps| {
-            let (_, ys) = rk4(|_, y: &[f64; 2]| [y[1], -y[0]], 0.0, [0.0, 1.0], 3.0, steps).unwrap();
+            let (_, ys) =
+                rk4(|_, y: &[f64; 2]| [y[1], -y[0]], 0.0, [0.0, 1.0], 3.0, steps).unwrap();
             (ys.last().unwrap()[0] - 3.0f64.sin()).abs()
         };
         let ratio = err(20) / err(40);
@@ -709,8 +739,16 @@ mod tests {
                 atol: rtol * 1e-3,
                 ..Default::default()
             };
-            let sol = dp54(|_, y: &[f64; 2]| [y[1], -y[0]], 0.0, [0.0, 1.0], 6.0, opts, 2, |_| {})
-                .unwrap();
+            let sol = dp54(
+                |_, y: &[f64; 2]| [y[1], -y[0]],
+                0.0,
+                [0.0, 1.0],
+                6.0,
+                opts,
+                2,
+                |_| {},
+            )
+            .unwrap();
             let e = (sol.y.last().unwrap()[0] - 6.0f64.sin()).abs();
             assert!(e < 10.0 * rtol, "rtol {rtol}: {e}");
             let ed = (sol.eval(2.345)[0] - 2.345f64.sin()).abs();

@@ -36,7 +36,11 @@ impl LinearElastic {
     pub fn new(youngs_modulus: f64, poisson_ratio: f64) -> Result<Self> {
         check_positive("youngs_modulus", youngs_modulus, "Pa")?;
         if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio <= 0.5) {
-            return Err(Error::invalid("poisson_ratio", poisson_ratio, "in (-1, 0.5]"));
+            return Err(Error::invalid(
+                "poisson_ratio",
+                poisson_ratio,
+                "in (-1, 0.5]",
+            ));
         }
         Ok(Self {
             youngs_modulus,
@@ -57,7 +61,10 @@ impl LinearElastic {
             return Err(Error::invalid(
                 "shear_modulus",
                 shear_modulus,
-                format!("in [E/3, inf) = [{}, inf) Pa (Poisson's ratio in (-1, 0.5])", youngs_modulus / 3.0),
+                format!(
+                    "in [E/3, inf) = [{}, inf) Pa (Poisson's ratio in (-1, 0.5])",
+                    youngs_modulus / 3.0
+                ),
             ));
         }
         Ok(Self {
@@ -134,9 +141,19 @@ impl Material {
                 let (cs, ca) = if inextensible {
                     (0.0, 0.0)
                 } else {
-                    (1.0 / (shear_coefficient * g * props.area), 1.0 / (e * props.area))
+                    (
+                        1.0 / (shear_coefficient * g * props.area),
+                        1.0 / (e * props.area),
+                    )
                 };
-                [cs, cs, ca, 1.0 / (e * props.ix), 1.0 / (e * props.iy), 1.0 / (g * props.j)]
+                [
+                    cs,
+                    cs,
+                    ca,
+                    1.0 / (e * props.ix),
+                    1.0 / (e * props.iy),
+                    1.0 / (g * props.j),
+                ]
             }
         }
     }

@@ -119,7 +119,7 @@ impl Pose {
             }
         }
         let err = orthonormality_error(&rotation);
-        if !(err <= ROTATION_TOLERANCE) {
+        if err.is_nan() || err > ROTATION_TOLERANCE {
             return Err(Error::invalid(
                 "base_pose.rotation",
                 format!("{rotation:?}"),

@@ -82,10 +82,21 @@ pub type SectionFn = Arc<dyn Fn(f64) -> SectionProperties + Send + Sync>;
 
 #[derive(Clone)]
 enum Kind {
-    Circular { radius: f64 },
-    Tapered { base_radius: f64, tip_radius: f64 },
-    Tube { outer_radius: f64, inner_radius: f64 },
-    Table { s: Vec<f64>, props: Vec<SectionProperties> },
+    Circular {
+        radius: f64,
+    },
+    Tapered {
+        base_radius: f64,
+        tip_radius: f64,
+    },
+    Tube {
+        outer_radius: f64,
+        inner_radius: f64,
+    },
+    Table {
+        s: Vec<f64>,
+        props: Vec<SectionProperties>,
+    },
     Function(SectionFn),
 }
 
@@ -249,6 +260,11 @@ impl Section {
             Kind::Table { s: ts, props } => table_lookup(ts, props, s),
             Kind::Function(f) => f(s),
         }
+    }
+
+    /// Whether the properties are the same at every `s` (circles and tubes).
+    pub fn is_uniform(&self) -> bool {
+        matches!(self.kind, Kind::Circular { .. } | Kind::Tube { .. })
     }
 
     /// Inner-to-outer radius ratio `m` (0 for solid sections), used by the default shear

@@ -70,7 +70,10 @@ pub fn quaternion_xyzw(r: &Matrix3<f64>) -> [f64; 4] {
 pub fn exp_so3(theta: &Vector3<f64>) -> Matrix3<f64> {
     let a2 = theta.norm_squared();
     let (sa, ca) = if a2 < 1e-8 {
-        (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0), 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0))
+        (
+            1.0 - a2 / 6.0 * (1.0 - a2 / 20.0),
+            0.5 - a2 / 24.0 * (1.0 - a2 / 30.0),
+        )
     } else {
         let a = a2.sqrt();
         (a.sin() / a, (1.0 - a.cos()) / a2)

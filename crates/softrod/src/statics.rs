@@ -14,17 +14,19 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::cosserat::{rot, v3, Evaluator, Model, ActiveTendon, FULL, STATE};
+use crate::cosserat::{rot, v3, ActiveTendon, Evaluator, Model, FULL, STATE};
 use crate::error::{Error, Result};
 use crate::integrate::{dp54, rk4_step, AdaptiveOptions};
-use crate::loads::Loads;
+use crate::loads::{Frame, Loads};
 use crate::rod::Rod;
-use crate::so3::{quaternion_xyzw, reorthonormalise};
+use crate::so3::{hat, quaternion_xyzw, reorthonormalise};
 use crate::tendon::Tendon;
 
 /// Default number of RK4 steps over the whole rod (split among the intervals in proportion
 /// to their length, at least one each).
-pub const DEFAULT_RK4_STEPS: usize = 50;
+pub const DEFAULT_RK4_STEPS: usize = 40;
+/// Largest accepted number of RK4 steps (the mesh is stored).
+pub const MAX_RK4_STEPS: usize = 10_000_000;
 /// Default tolerance on the scaled shooting residual (max norm).
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
 /// Default cap on Newton iterations per solve (per load step under continuation).
@@ -198,6 +200,8 @@ fn project<const N: usize>(y: &mut [f64; N]) {
 struct Pass {
     residual: Vector6<f64>,
     jacobian: Option<Matrix6<f64>>,
+    /// Chord `p(L) - p(0)` (m, world).
+    chord: Vector3<f64>,
 }
 
 /// Scratch shared by the passes of one solve.
@@ -231,20 +235,9 @@ fn shoot<const N: usize>(
             Integrator::Rk4 { .. } => {
                 let n = plan[k];
                 let h = (b - a) / n as f64;
-                const W: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
                 for i in 0..n {
                     let t = a + h * i as f64;
-                    let mut stage = 0usize;
-                    let lengths = &mut ws.tendon_lengths;
-                    let mut f = |s: f64, yy: &[f64; N]| {
-                        let d = ev.rhs(s, yy);
-                        let wgt = W[stage] * h;
-                        for (l, sp) in lengths.iter_mut().zip(ev.tendon_speed.iter()) {
-                            *l += wgt * sp;
-                        }
-                        stage += 1;
-                        d
-                    };
+                    let mut f = |s: f64, yy: &[f64; N]| ev.rhs(s, yy);
                     y = rk4_step(&mut f, t, &y, h);
                     project(&mut y);
                     if !y[..STATE].iter().all(|v| v.is_finite()) {
@@ -262,13 +255,22 @@ fn shoot<const N: usize>(
                 }
             }
             Integrator::Adaptive(opts) => {
-                let sol = dp54(|s, yy: &[f64; N]| ev.rhs(s, yy), a, y, b, *opts, STATE, project)?;
+                let sol = dp54(
+                    |s, yy: &[f64; N]| ev.rhs(s, yy),
+                    a,
+                    y,
+                    b,
+                    *opts,
+                    STATE,
+                    project,
+                )?;
                 // Tendon lengths: 3-point Gauss–Legendre on each step with the dense output.
                 const G: [(f64, f64); 3] = [
                     (0.112_701_665_379_258_31, 5.0 / 18.0),
                     (0.5, 8.0 / 18.0),
                     (0.887_298_334_620_741_7, 5.0 / 18.0),
                 ];
+                ev.track_speeds = true;
                 for i in 1..sol.t.len() {
                     let (t0, t1) = (sol.t[i - 1], sol.t[i]);
                     if !ws.tendon_lengths.is_empty() {
@@ -280,9 +282,10 @@ fn shoot<const N: usize>(
                             let nb = r.tr_mul(&v3(&yy, 12));
                             let mb = r.tr_mul(&v3(&yy, 15));
                             ev.local(s, &props, &nb, &mb, false);
-                            for (l, sp) in ws.tendon_lengths.iter_mut().zip(ev.tendon_speed.iter())
-                            {
-                                *l += wg * (t1 - t0) * sp;
+                            for (i, t) in model.tendons.iter().enumerate() {
+                                if t.end >= b {
+                                    ws.tendon_lengths[i] += wg * (t1 - t0) * ev.tendon_speed[i];
+                                }
                             }
                         }
                     }
@@ -292,22 +295,21 @@ fn shoot<const N: usize>(
                         y: head(&sol.y[i]),
                     });
                 }
-                ev.evaluations += 0;
+                ev.track_speeds = false;
                 y = sol.y[sol.y.len() - 1];
             }
         }
         if k + 2 < breaks.len() {
             model.jump(b, &mut y);
         }
-        // Inactive tendons keep their speed from the last interval; zero them for the next.
-        for (i, t) in model.tendons.iter().enumerate() {
-            if t.end <= b {
-                ev.tendon_speed[i] = 0.0;
-            }
-        }
     }
     let (residual, jacobian) = model.residual(&y);
-    Ok(Pass { residual, jacobian })
+    let chord = v3(&y, 0) - model.rod.base_pose().position();
+    Ok(Pass {
+        residual,
+        jacobian,
+        chord,
+    })
 }
 
 fn shoot_any(
@@ -347,6 +349,7 @@ fn norm(r: &Vector6<f64>) -> f64 {
 fn newton(
     ev: &mut Evaluator<'_, '_>,
     x0: Vector6<f64>,
+    try_cheap: bool,
     opts: &SolveOptions,
     plan: &[usize],
     ws: &mut Workspace,
@@ -363,27 +366,48 @@ fn newton(
         iterations: 0,
         recorded: false,
     };
-    // A cheap first pass without sensitivities: often already converged (warm starts,
-    // tendon-only loading, for which the total base wrench is exactly zero).
-    let (mut r, mut rn) = match shoot_any(ev, &x, false, &opts.integrator, plan, ws) {
-        Ok(p) => (p.residual, norm(&p.residual)),
-        Err(_) => (Vector6::repeat(f64::NAN), f64::INFINITY),
-    };
-    out.residual = rn;
-    out.recorded = rn.is_finite();
-    if rn <= tol_of(&x) {
-        out.converged = true;
-        return out;
+    // A cheap first pass without sensitivities when the guess may already solve the problem
+    // (warm starts; tendon-only loading, for which the total base wrench is exactly zero).
+    let (mut r, mut rn) = (Vector6::repeat(f64::NAN), f64::INFINITY);
+    if try_cheap {
+        if let Ok(p) = shoot_any(ev, &x, false, &opts.integrator, plan, ws) {
+            r = p.residual;
+            rn = norm(&r);
+        }
+        out.residual = rn;
+        out.recorded = rn.is_finite();
+        if rn <= tol_of(&x) {
+            out.converged = true;
+            return out;
+        }
     }
-    let mut jac = match shoot_any(ev, &x, true, &opts.integrator, plan, ws) {
+    // With a zero base force and no force applied along the rod, N(s) = 0 everywhere, and
+    // the variational equations integrate in closed form: δN(L) = δN(0) and
+    // δM(L) = δM(0) - (p(L) - p(0)) × δN(0). The exact Jacobian then comes from a pass
+    // without sensitivities.
+    let analytic = ev.model.force_free && x.fixed_rows::<3>(0).iter().all(|v| *v == 0.0);
+    let mut jac = match shoot_any(ev, &x, !analytic, &opts.integrator, plan, ws) {
         Ok(p) if norm(&p.residual).is_finite() => {
             r = p.residual;
             rn = norm(&r);
-            p.jacobian
+            if analytic {
+                let mut j = Matrix6::identity();
+                let h = hat(&p.chord) / ev.model.length;
+                for a in 0..3 {
+                    for b in 0..3 {
+                        j[(3 + a, b)] = -h[(a, b)];
+                    }
+                }
+                Some(j)
+            } else {
+                p.jacobian
+            }
         }
         _ => None,
     };
     out.recorded = jac.is_some();
+    out.residual = rn;
+    let mut r_prev = f64::INFINITY;
     for _ in 0..opts.max_iterations {
         let Some(j) = jac else {
             break;
@@ -394,6 +418,25 @@ fn newton(
         if !dx.iter().all(|v| v.is_finite()) {
             break;
         }
+        // Under quadratic convergence the next residual is about rn³ / r_prev²; when that is
+        // far below the tolerance, try the full step without sensitivities first (it is then
+        // the last pass).
+        if r_prev.is_finite() && rn < 0.1 * r_prev && rn * (rn / r_prev).powi(2) < 0.5 * tol_of(&x)
+        {
+            let xt = x + dx;
+            if let Ok(p) = shoot_any(ev, &xt, false, &opts.integrator, plan, ws) {
+                let rt = norm(&p.residual);
+                if rt <= tol_of(&xt) {
+                    out.iterations += 1;
+                    out.x = xt;
+                    out.residual = rt;
+                    out.recorded = true;
+                    out.converged = true;
+                    return out;
+                }
+            }
+        }
+        r_prev = rn;
         let mut lambda = 1.0;
         let mut accepted = false;
         for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
@@ -429,11 +472,7 @@ fn newton(
 }
 
 /// Validates the inputs and builds the model at load factor 1.
-fn build_model<'a>(
-    rod: &'a Rod,
-    tendons: &'a [Tendon],
-    loads: &'a Loads,
-) -> Result<Model<'a>> {
+fn build_model<'a>(rod: &'a Rod, tendons: &'a [Tendon], loads: &'a Loads) -> Result<Model<'a>> {
     let l = rod.length();
     loads.validate(l, rod.density())?;
     let mut prepared = Vec::with_capacity(tendons.len());
@@ -465,7 +504,11 @@ fn build_model<'a>(
     let props0 = rod.section_at(0.0);
     let f_ref = rod.material().bending_stiffness(&props0) / (l * l);
     if !(f_ref.is_finite() && f_ref > 0.0) {
-        return Err(Error::invalid("section(0)", format!("{props0:?}"), "positive and finite"));
+        return Err(Error::invalid(
+            "section(0)",
+            format!("{props0:?}"),
+            "positive and finite",
+        ));
     }
     // Tendon offsets must be finite (user functions) and inside... finite at the checks.
     for (i, t) in tendons.iter().enumerate() {
@@ -495,14 +538,30 @@ fn build_model<'a>(
         f_ref,
         length: l,
         breaks,
+        force_free: loads.distributed_force.is_none()
+            && loads.gravity == Vector3::zeros()
+            && loads.point_loads.iter().all(|p| {
+                p.force == Vector3::zeros()
+                    && (p.frame == Frame::World || p.moment == Vector3::zeros())
+            })
+            && (loads.tip_frame == Frame::World
+                || (loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros())),
+        uniform_compliance: rod.section().is_uniform().then(|| {
+            rod.material()
+                .compliance(&props0, rod.shear_coefficient(), rod.inextensible())
+        }),
     })
 }
 
 fn check_options(opts: &SolveOptions) -> Result<()> {
     match opts.integrator {
         Integrator::Rk4 { steps } => {
-            if steps == 0 {
-                return Err(Error::invalid("integrator.steps", steps, ">= 1"));
+            if steps == 0 || steps > MAX_RK4_STEPS {
+                return Err(Error::invalid(
+                    "integrator.steps",
+                    steps,
+                    format!("in [1, {MAX_RK4_STEPS}]"),
+                ));
             }
         }
         Integrator::Adaptive(a) => {
@@ -510,13 +569,25 @@ fn check_options(opts: &SolveOptions) -> Result<()> {
         }
     }
     if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
-        return Err(Error::invalid("tolerance", opts.tolerance, "finite and > 0"));
+        return Err(Error::invalid(
+            "tolerance",
+            opts.tolerance,
+            "finite and > 0",
+        ));
     }
     if opts.max_iterations == 0 {
-        return Err(Error::invalid("max_iterations", opts.max_iterations, ">= 1"));
+        return Err(Error::invalid(
+            "max_iterations",
+            opts.max_iterations,
+            ">= 1",
+        ));
     }
     if opts.max_load_steps == 0 {
-        return Err(Error::invalid("max_load_steps", opts.max_load_steps, ">= 1"));
+        return Err(Error::invalid(
+            "max_load_steps",
+            opts.max_load_steps,
+            ">= 1",
+        ));
     }
     if let Some(w) = &opts.warm_start {
         for (k, v) in w.base_wrench.iter().enumerate() {
@@ -575,7 +646,14 @@ pub fn solve_statics(
 
     let direct = {
         let mut ev = Evaluator::new(&model);
-        let out = newton(&mut ev, x0, options, &plan, &mut ws);
+        let unloaded = loads.tip_force == Vector3::zeros()
+            && loads.tip_moment == Vector3::zeros()
+            && loads.point_loads.is_empty()
+            && loads.distributed_force.is_none()
+            && loads.distributed_moment.is_none()
+            && model.rho_g.is_none();
+        let try_cheap = options.warm_start.is_some() || unloaded;
+        let out = newton(&mut ev, x0, try_cheap, options, &plan, &mut ws);
         evaluations += ev.evaluations;
         out
     };
@@ -593,7 +671,7 @@ pub fn solve_statics(
             let target = (lambda + dl).min(1.0);
             model.factor = target;
             let mut ev = Evaluator::new(&model);
-            let out = newton(&mut ev, x, options, &plan, &mut ws);
+            let out = newton(&mut ev, x, false, options, &plan, &mut ws);
             evaluations += ev.evaluations;
             stats.iterations += out.iterations;
             steps += 1;
@@ -656,7 +734,8 @@ pub fn solve_statics(
         x[4] * fm,
         x[5] * fm,
     ];
-    Ok(assemble(&model, &ws, base_wrench, stats))
+    let rk4 = matches!(options.integrator, Integrator::Rk4 { .. });
+    Ok(assemble(&model, &ws, base_wrench, stats, rk4))
 }
 
 fn arr(v: &Vector3<f64>) -> [f64; 3] {
@@ -677,6 +756,7 @@ fn assemble(
     ws: &Workspace,
     base_wrench: [f64; 6],
     stats: SolverStats,
+    rk4: bool,
 ) -> StaticsSolution {
     let n = ws.nodes.len();
     let mut sol = StaticsSolution {
@@ -695,11 +775,19 @@ fn assemble(
         stats,
     };
     let mut ev = Evaluator::new(model);
+    ev.track_speeds = true;
+    let nt = model.tendons.len();
+    // Tendon speeds |p_i'| at the nodes of the current interval, per tendon (RK4 quadrature).
+    let mut speeds: Vec<Vec<f64>> = vec![Vec::new(); nt];
+    if rk4 {
+        sol.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
+    }
     let mut current = usize::MAX;
-    for node in &ws.nodes {
+    for (j, node) in ws.nodes.iter().enumerate() {
         if node.interval != current {
             ev.set_interval(node.interval);
             current = node.interval;
+            speeds.iter_mut().for_each(Vec::clear);
         }
         let y = &node.y;
         let r = rot(y);
@@ -719,6 +807,50 @@ fn assemble(
         sol.m_body.push(arr(&mb));
         sol.v.push(arr(&loc.v));
         sol.u.push(arr(&loc.u));
+        if rk4 && nt > 0 {
+            let k = node.interval;
+            let b = model.breaks[k + 1];
+            for (i, t) in model.tendons.iter().enumerate() {
+                if t.end >= b {
+                    speeds[i].push(ev.tendon_speed[i]);
+                }
+            }
+            let last_of_interval = ws.nodes.get(j + 1).is_none_or(|n| n.interval != k);
+            if last_of_interval {
+                let h = (b - model.breaks[k])
+                    / (ws.nodes.iter().filter(|n| n.interval == k).count() - 1).max(1) as f64;
+                for (i, sp) in speeds.iter().enumerate() {
+                    if !sp.is_empty() {
+                        sol.tendon_lengths[i] += uniform_quadrature(sp, h);
+                    }
+                }
+            }
+        }
     }
     sol
+}
+
+/// Fourth-order quadrature of samples `f` on a uniform grid of spacing `h`: composite Simpson,
+/// with Simpson's 3/8 rule on the last three panels when the number of panels is odd
+/// (trapezoid for a single panel).
+fn uniform_quadrature(f: &[f64], h: f64) -> f64 {
+    let panels = f.len().saturating_sub(1);
+    match panels {
+        0 => 0.0,
+        1 => 0.5 * h * (f[0] + f[1]),
+        _ => {
+            let simpson_end = if panels % 2 == 0 { panels } else { panels - 3 };
+            let mut sum = 0.0;
+            let mut i = 0;
+            while i < simpson_end {
+                sum += h / 3.0 * (f[i] + 4.0 * f[i + 1] + f[i + 2]);
+                i += 2;
+            }
+            if simpson_end < panels {
+                let k = simpson_end;
+                sum += 3.0 * h / 8.0 * (f[k] + 3.0 * f[k + 1] + 3.0 * f[k + 2] + f[k + 3]);
+            }
+            sum
+        }
+    }
 }

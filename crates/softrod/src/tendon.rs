@@ -91,7 +91,10 @@ impl Routing {
             } => {
                 let w = 2.0 * PI / pitch;
                 let (sn, cs) = (phase + w * s).sin_cos();
-                ([radius * cs, radius * sn], [-radius * w * sn, radius * w * cs])
+                (
+                    [radius * cs, radius * sn],
+                    [-radius * w * sn, radius * w * cs],
+                )
             }
             Routing::Function { offset, derivative } => (offset(s), derivative(s)),
         }
@@ -140,7 +143,11 @@ impl Tendon {
             } => {
                 check_non_negative("radius", *radius, "m")?;
                 if !(pitch.is_finite() && *pitch != 0.0) {
-                    return Err(Error::invalid("pitch", pitch, "finite and nonzero (m/turn)"));
+                    return Err(Error::invalid(
+                        "pitch",
+                        pitch,
+                        "finite and nonzero (m/turn)",
+                    ));
                 }
                 if !phase.is_finite() {
                     return Err(Error::invalid("phase", phase, "finite (rad)"));

@@ -42,9 +42,13 @@ fn pure_tip_moment_gives_circular_arc() {
     let kappa = 1.5 / l; // 1.5 rad of bending
     let mtip = kappa * ei;
     for inextensible in [true, false] {
-        let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.3).unwrap())
-            .unwrap()
-            .with_inextensible(inextensible);
+        let rod = Rod::new(
+            l,
+            Section::circular(r).unwrap(),
+            LinearElastic::new(e, 0.3).unwrap(),
+        )
+        .unwrap()
+        .with_inextensible(inextensible);
         let sol = solve_statics(
             &rod,
             &[],
@@ -53,9 +57,16 @@ fn pure_tip_moment_gives_circular_arc() {
         )
         .unwrap();
         // u = (kappa, 0, 0): the tangent turns from +z toward -y.
-        let exact = [0.0, -(1.0 - (kappa * l).cos()) / kappa, (kappa * l).sin() / kappa];
+        let exact = [
+            0.0,
+            -(1.0 - (kappa * l).cos()) / kappa,
+            (kappa * l).sin() / kappa,
+        ];
         let err = dist(sol.tip_position(), exact);
-        println!("arc inextensible={inextensible}: tip error {err:.3e} m, iterations {}", sol.stats.iterations);
+        println!(
+            "arc inextensible={inextensible}: tip error {err:.3e} m, iterations {}",
+            sol.stats.iterations
+        );
         assert!(err < 1e-10, "tip error {err}");
         for u in &sol.u {
             assert!((u[0] - kappa).abs() < 1e-9 * kappa && u[1].abs() < 1e-9 && u[2].abs() < 1e-9);
@@ -73,7 +84,8 @@ fn carlson_rf(mut x: f64, mut y: f64, mut z: f64) -> f64 {
         if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
             let e2 = dx * dy - dz * dz;
             let e3 = dx * dy * dz;
-            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / a.sqrt();
+            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0)
+                / a.sqrt();
         }
         let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
         let lam = sx * sy + sy * sz + sz * sx;
@@ -128,8 +140,20 @@ fn ell_e(phi: f64, k: f64) -> f64 {
 /// Composite Gauss–Legendre (5 points, `n` panels) of `f` over `[a, b]`: a check of the
 /// elliptic integrals that shares nothing with Carlson's forms.
 fn quad(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
-    let x = [0.0, 0.538_469_310_105_683, -0.538_469_310_105_683, 0.906_179_845_938_664, -0.906_179_845_938_664];
-    let w = [0.568_888_888_888_889, 0.478_628_670_499_366, 0.478_628_670_499_366, 0.236_926_885_056_189, 0.236_926_885_056_189];
+    let x = [
+        0.0,
+        0.538_469_310_105_683,
+        -0.538_469_310_105_683,
+        0.906_179_845_938_664,
+        -0.906_179_845_938_664,
+    ];
+    let w = [
+        0.568_888_888_888_889,
+        0.478_628_670_499_366,
+        0.478_628_670_499_366,
+        0.236_926_885_056_189,
+        0.236_926_885_056_189,
+    ];
     let h = (b - a) / n as f64;
     let mut sum = 0.0;
     for i in 0..n {
@@ -148,7 +172,12 @@ fn elliptic_integrals_match_quadrature_and_tables() {
     assert!((ell_f(PI / 2.0, k) - 1.854_074_677_301_372).abs() < 1e-14);
     assert!((ell_e(PI / 2.0, k) - 1.350_643_881_047_675).abs() < 1e-14);
     for (phi, k) in [(0.3, 0.9), (1.2, 0.99), (0.8, 0.75)] {
-        let f = quad(|t| 1.0 / (1.0 - k * k * t.sin().powi(2)).sqrt(), 0.0, phi, 200);
+        let f = quad(
+            |t| 1.0 / (1.0 - k * k * t.sin().powi(2)).sqrt(),
+            0.0,
+            phi,
+            200,
+        );
         let e = quad(|t| (1.0 - k * k * t.sin().powi(2)).sqrt(), 0.0, phi, 200);
         assert!((ell_f(phi, k) - f).abs() < 1e-13, "F({phi},{k})");
         assert!((ell_e(phi, k) - e).abs() < 1e-13, "E({phi},{k})");
@@ -190,9 +219,13 @@ fn bisshopp_drucker_reference_matches_published_values() {
 fn tip_loaded_cantilever_matches_elastica() {
     let (l, r, e): (f64, f64, f64) = (0.3, 0.002, 5e6);
     let ei = e * PI * r.powi(4) / 4.0;
-    let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.3).unwrap())
-        .unwrap()
-        .with_inextensible(true);
+    let rod = Rod::new(
+        l,
+        Section::circular(r).unwrap(),
+        LinearElastic::new(e, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true);
     println!("alpha   delta/L (ref)        x/L (ref)         tip error / L   iters  load steps");
     for alpha in [0.1, 0.3, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0] {
         let p = alpha * ei / (l * l);
@@ -229,7 +262,10 @@ fn constant_offset_tendon_gives_constant_curvature_and_strain() {
     for (u, v) in sol.u.iter().zip(&sol.v) {
         assert!((u[1] - kappa).abs() <= 1e-10 * kappa, "u {u:?} vs {kappa}");
         assert!(u[0].abs() < 1e-10 * kappa && u[2].abs() < 1e-10 * kappa);
-        assert!((v[2] - 1.0 - eps).abs() < 1e-10 * eps.abs(), "v {v:?} vs {eps}");
+        assert!(
+            (v[2] - 1.0 - eps).abs() < 1e-10 * eps.abs(),
+            "v {v:?} vs {eps}"
+        );
         assert!(v[0].abs() < 1e-12 && v[1].abs() < 1e-12);
     }
     // Arc of curvature kappa per undeformed length, stretched by 1 + eps, toward the tendon.
@@ -243,7 +279,11 @@ fn constant_offset_tendon_gives_constant_curvature_and_strain() {
     assert!(err < 1e-10);
     // The tendon runs parallel to the backbone at distance d: length (1 + eps - kappa d) L.
     let lt = (1.0 + eps - kappa * d) * l;
-    assert!((sol.tendon_lengths[0] - lt).abs() < 1e-12, "{} vs {lt}", sol.tendon_lengths[0]);
+    assert!(
+        (sol.tendon_lengths[0] - lt).abs() < 1e-12,
+        "{} vs {lt}",
+        sol.tendon_lengths[0]
+    );
     // Tendon-only loading: the total base wrench is zero and no Newton step is needed.
     assert_eq!(sol.stats.iterations, 0);
     // The rod's own internal force is the tendon's compression.
@@ -272,9 +312,14 @@ fn base_pose_rotation_rotates_the_solution() {
     let rotated = base.clone().with_base_pose(Pose::new(t0, q).unwrap());
     let mut loads = Loads::tip_force(f);
     let mut loads_q = Loads::tip_force(q * f);
-    loads.point_loads.push(softrod::PointLoad::force(0.1, Vector3::new(0.0, 0.03, 0.0)));
-    loads_q.point_loads.push(softrod::PointLoad::force(0.1, q * Vector3::new(0.0, 0.03, 0.0)));
-    let a = solve_statics(&base, &[tendon.clone()], &loads, &rk4(60)).unwrap();
+    loads
+        .point_loads
+        .push(softrod::PointLoad::force(0.1, Vector3::new(0.0, 0.03, 0.0)));
+    loads_q.point_loads.push(softrod::PointLoad::force(
+        0.1,
+        q * Vector3::new(0.0, 0.03, 0.0),
+    ));
+    let a = solve_statics(&base, std::slice::from_ref(&tendon), &loads, &rk4(60)).unwrap();
     let b = solve_statics(&rotated, &[tendon], &loads_q, &rk4(60)).unwrap();
     assert_eq!(a.s.len(), b.s.len());
     let mut worst: f64 = 0.0;
@@ -299,8 +344,12 @@ fn helical_tendon_bends_out_of_plane_with_its_handedness() {
     use softrod::Routing;
     let (l, r, e): (f64, f64, f64) = (0.2, 0.002, 2e8);
     let ei = e * PI * r.powi(4) / 4.0;
-    let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.3).unwrap())
-        .unwrap();
+    let rod = Rod::new(
+        l,
+        Section::circular(r).unwrap(),
+        LinearElastic::new(e, 0.3).unwrap(),
+    )
+    .unwrap();
     let (rho, pitch) = (0.0015, 0.4);
     let omega = 2.0 * PI / pitch;
     let tau = 1e-3 * ei / (rho * l); // small: tip rotation ~ 1e-3 rad
@@ -330,13 +379,152 @@ fn helical_tendon_bends_out_of_plane_with_its_handedness() {
     println!("helical: right-handed tip {tr:?}, left-handed tip {tl:?}, linear {lin:?}");
     // Out of plane, toward +y for the right-handed helix, mirror image for the left-handed.
     assert!(tr[1] > 0.0 && tl[1] < 0.0);
-    assert!((tr[0] - tl[0]).abs() < 1e-15 && (tr[1] + tl[1]).abs() < 1e-15 && (tr[2] - tl[2]).abs() < 1e-15);
+    assert!(
+        (tr[0] - tl[0]).abs() < 1e-15
+            && (tr[1] + tl[1]).abs() < 1e-15
+            && (tr[2] - tl[2]).abs() < 1e-15
+    );
     // Agreement with the linear theory to the order of the neglected terms (kappa L ~ 1e-3).
     for k in 0..2 {
-        assert!((tr[k] - lin[k]).abs() < 5e-3 * lin[0].hypot(lin[1]), "{k}: {} vs {}", tr[k], lin[k]);
+        assert!(
+            (tr[k] - lin[k]).abs() < 5e-3 * lin[0].hypot(lin[1]),
+            "{k}: {} vs {}",
+            tr[k],
+            lin[k]
+        );
     }
     // And a visible twist appears (nonzero u_z), of opposite sign for the mirror image.
     let uz_r = right.u[right.u.len() / 2][2];
     let uz_l = left.u[left.u.len() / 2][2];
     assert!(uz_r != 0.0 && (uz_r + uz_l).abs() < 1e-12 * uz_r.abs().max(1e-300));
+}
+
+#[test]
+fn seed_000_arm_agrees_to_the_order_of_its_linearisation() {
+    use softrod::{solve_planar, PlanarCableArm, PlanarMethod, Routing};
+    // The seed's planar model takes the cable moment as T d (1 - d k) per *deformed* length and
+    // neglects shear; the 3-D rod uses the exact tendon direction per *undeformed* length.
+    // Their relative difference is of the order of the terms the seed linearises, |q| + d k
+    // (both O(T)); with the rod made shear-rigid like the seed, it must stay below their
+    // maximum along the arm, and shrink linearly with T.
+    let arm = PlanarCableArm::seed_arm();
+    let rod = Rod::new(
+        arm.length(),
+        Section::tapered_circular(arm.base_radius(), arm.tip_radius()).unwrap(),
+        LinearElastic::new(arm.youngs_modulus(), 0.5).unwrap(),
+    )
+    .unwrap()
+    .with_shear_coefficient(1e9)
+    .unwrap();
+    let samples = softrod::uniform_samples(arm.length(), 201).unwrap();
+    let mut rel = Vec::new();
+    println!(" T [N]  |tip diff| [m]  relative   bound max(|q| + d k)");
+    for t in [0.05, 0.1, 0.5, 1.0, 2.0, 5.0] {
+        let planar = solve_planar(&arm, t, &samples, PlanarMethod::ClosedForm).unwrap();
+        let tendon = Tendon::new(
+            Routing::RadiusProportional {
+                ratio: arm.offset_ratio(),
+                angle: 0.0,
+            },
+            t,
+            None,
+        )
+        .unwrap();
+        let sol = solve_statics(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
+        let tip = sol.tip_position();
+        let (px, py) = (planar.tip[0], planar.tip[1]);
+        let diff = ((px - tip[2]).powi(2) + (py - tip[0]).powi(2) + tip[1].powi(2)).sqrt();
+        let defl = (py.powi(2) + (arm.length() - px).powi(2)).sqrt();
+        let bound = samples
+            .iter()
+            .zip(planar.curvature.iter().zip(&planar.strain))
+            .map(|(&s, (&k, &q))| q.abs() + arm.offset_ratio() * arm.radius(s) * k.abs())
+            .fold(0.0f64, f64::max);
+        println!("{t:5.2}  {diff:.3e}      {:.3e}  {bound:.3e}", diff / defl);
+        assert!(
+            diff / defl < bound,
+            "T = {t}: relative difference {} >= {bound}",
+            diff / defl
+        );
+        assert!(tip[1].abs() < 1e-12, "planar problem must stay planar");
+        rel.push(diff / defl);
+    }
+    // First order in T: halving T from 0.1 to 0.05 N halves the relative difference.
+    let ratio = rel[0] / rel[1];
+    assert!((0.45..0.55).contains(&ratio), "ratio {ratio}");
+}
+
+#[test]
+fn precurved_rod_rests_in_its_rest_shape() {
+    use softrod::Profile;
+    let (l, kappa): (f64, f64) = (0.4, 5.0);
+    let rod = Rod::new(
+        l,
+        Section::tube(0.003, 0.002).unwrap(),
+        LinearElastic::new(1e8, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_rest_curvature(Profile::Constant(Vector3::new(0.0, kappa, 0.0)))
+    .unwrap();
+    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(400)).unwrap();
+    let exact = [
+        (1.0 - (kappa * l).cos()) / kappa,
+        0.0,
+        (kappa * l).sin() / kappa,
+    ];
+    assert!(dist(sol.tip_position(), exact) < 1e-10);
+    assert!(sol
+        .m_world
+        .iter()
+        .all(|m| m.iter().all(|c| c.abs() < 1e-15)));
+}
+
+#[test]
+fn small_loads_match_euler_bernoulli_cantilever() {
+    use softrod::PointLoad;
+    // Inextensible cantilever, deflection/L ~ 1e-5, so geometric nonlinearity is ~1e-10
+    // relative: uniform load q -> q L^4 / (8 E I); gravity rho A g is the same load; a point
+    // force P at a -> P a^2 (3 L - a) / (6 E I).
+    let (l, r, e, rho): (f64, f64, f64, f64) = (0.5, 0.002, 2e9, 1000.0);
+    let ei = e * PI * r.powi(4) / 4.0;
+    let area = PI * r * r;
+    let rod = Rod::new(
+        l,
+        Section::circular(r).unwrap(),
+        LinearElastic::new(e, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true)
+    .with_density(rho)
+    .unwrap();
+    let q = 8.0 * ei * 1e-5 / l.powi(3);
+    let w_q = q * l.powi(4) / (8.0 * ei);
+    let dist_load = Loads {
+        distributed_force: Some(softrod::Profile::Constant(Vector3::new(q, 0.0, 0.0))),
+        ..Default::default()
+    };
+    let grav = Loads {
+        gravity: Vector3::new(q / (rho * area), 0.0, 0.0),
+        ..Default::default()
+    };
+    for loads in [dist_load, grav] {
+        let sol = solve_statics(&rod, &[], &loads, &rk4(200)).unwrap();
+        let w = sol.tip_position()[0];
+        assert!((w - w_q).abs() < 1e-6 * w_q, "{w} vs {w_q}");
+        // Base reaction: the whole load.
+        assert!((sol.n_world[0][0] - q * l).abs() < 1e-12 * q * l);
+    }
+    let a = 0.3;
+    let p = 6.0 * ei * 1e-5 * l / (a * a * (3.0 * l - a));
+    let mut loads = Loads::default();
+    loads
+        .point_loads
+        .push(PointLoad::force(a, Vector3::new(p, 0.0, 0.0)));
+    let sol = solve_statics(&rod, &[], &loads, &rk4(200)).unwrap();
+    let w_p = p * a * a * (3.0 * l - a) / (6.0 * ei);
+    assert!((sol.tip_position()[0] - w_p).abs() < 1e-6 * w_p);
+    // The internal force jumps by the point force at s = a (the sample appears twice).
+    let i = sol.s.iter().position(|&s| s == a).unwrap();
+    assert_eq!(sol.s[i + 1], a);
+    assert!((sol.n_world[i][0] - sol.n_world[i + 1][0] - p).abs() < 1e-12 * p);
 }

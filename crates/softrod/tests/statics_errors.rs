@@ -1,0 +1,286 @@
+//! Bad input to the statics API returns `Error::InvalidParameter` naming the field; nothing
+//! panics on user input.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::sync::Arc;
+
+use softrod::nalgebra::{Matrix3, Vector3};
+use softrod::{
+    solve_statics, Error, Integrator, LinearElastic, Loads, PointLoad, Pose, Profile, Rod, Routing,
+    Section, SectionProperties, SolveOptions, Tendon, WarmStart,
+};
+
+fn name_of<T: std::fmt::Debug>(r: softrod::Result<T>) -> String {
+    match r {
+        Err(Error::InvalidParameter { name, .. }) => name,
+        other => panic!("expected InvalidParameter, got {other:?}"),
+    }
+}
+
+fn rod() -> Rod {
+    Rod::new(
+        0.3,
+        Section::circular(0.002).unwrap(),
+        LinearElastic::new(1e7, 0.3).unwrap(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn bad_geometry_and_moduli_are_named() {
+    for r in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert_eq!(name_of(Section::circular(r)), "radius");
+        assert_eq!(name_of(Section::tapered_circular(r, 0.01)), "base_radius");
+        assert_eq!(name_of(Section::tapered_circular(0.01, r)), "tip_radius");
+        assert_eq!(name_of(Section::tube(r, 0.0)), "outer_radius");
+        assert_eq!(name_of(LinearElastic::new(r, 0.3)), "youngs_modulus");
+        assert_eq!(
+            name_of(Rod::new(
+                r,
+                Section::circular(0.01).unwrap(),
+                LinearElastic::new(1.0, 0.3).unwrap()
+            )),
+            "length"
+        );
+        assert_eq!(name_of(rod().with_density(r)), "density");
+        assert_eq!(
+            name_of(rod().with_shear_coefficient(r)),
+            "shear_coefficient"
+        );
+    }
+    // A tube whose inner radius reaches (or passes) the outer one.
+    for ri in [0.01, 0.02, -0.001, f64::NAN] {
+        assert_eq!(name_of(Section::tube(0.01, ri)), "inner_radius");
+    }
+    for nu in [0.6, -1.0, f64::NAN] {
+        assert_eq!(name_of(LinearElastic::new(1e6, nu)), "poisson_ratio");
+    }
+    assert_eq!(
+        name_of(LinearElastic::with_shear_modulus(1e6, 1e5)),
+        "shear_modulus"
+    );
+    assert_eq!(
+        name_of(Section::table(
+            &[0.0, 0.1],
+            &[1e-6, -1e-6],
+            &[1e-12; 2],
+            &[1e-12; 2],
+            &[2e-12; 2]
+        )),
+        "area[1]"
+    );
+    assert_eq!(
+        name_of(Section::table(
+            &[0.0, 0.0],
+            &[1e-6; 2],
+            &[1e-12; 2],
+            &[1e-12; 2],
+            &[2e-12; 2]
+        )),
+        "s[1]"
+    );
+    // A table that does not cover the rod.
+    let short = Section::table(
+        &[0.0, 0.1],
+        &[1e-6; 2],
+        &[1e-12; 2],
+        &[1e-12; 2],
+        &[2e-12; 2],
+    )
+    .unwrap();
+    assert_eq!(
+        name_of(Rod::new(0.3, short, LinearElastic::new(1e6, 0.3).unwrap())),
+        "section.s"
+    );
+    // A user section that becomes negative.
+    let f = Section::function(Arc::new(|s: f64| {
+        let mut p = SectionProperties::circle(0.001, 0.0);
+        p.area = 1e-6 - s * 1e-5;
+        p
+    }));
+    assert!(name_of(Rod::new(0.3, f, LinearElastic::new(1e6, 0.3).unwrap())).ends_with(".area"));
+    // NaN in a rest strain, a non-rotation base pose.
+    assert_eq!(
+        name_of(rod().with_rest_curvature(Profile::Constant(Vector3::new(0.0, f64::NAN, 0.0)))),
+        "rest_curvature[1]"
+    );
+    assert_eq!(
+        name_of(Pose::new(Vector3::zeros(), Matrix3::identity() * 2.0)),
+        "base_pose.rotation"
+    );
+    assert_eq!(
+        name_of(Pose::new(
+            Vector3::new(f64::NAN, 0.0, 0.0),
+            Matrix3::identity()
+        )),
+        "base_pose.position[0]"
+    );
+}
+
+#[test]
+fn bad_tendons_are_named() {
+    assert_eq!(
+        name_of(Tendon::constant([0.001, 0.0], -1.0, None)),
+        "tension"
+    );
+    assert_eq!(
+        name_of(Tendon::constant([0.001, 0.0], f64::NAN, None)),
+        "tension"
+    );
+    assert_eq!(
+        name_of(Tendon::constant([0.001, f64::NAN], 1.0, None)),
+        "offset[1]"
+    );
+    for end in [0.0, -0.1, f64::NAN] {
+        assert_eq!(
+            name_of(Tendon::constant([0.001, 0.0], 1.0, Some(end))),
+            "end"
+        );
+    }
+    let helix = |pitch| {
+        Tendon::new(
+            Routing::Helical {
+                radius: 0.001,
+                pitch,
+                phase: 0.0,
+            },
+            1.0,
+            None,
+        )
+    };
+    assert_eq!(name_of(helix(0.0)), "pitch");
+    assert_eq!(name_of(helix(f64::INFINITY)), "pitch");
+    // A termination beyond the tip is caught when solving, with the tendon's index.
+    let t = Tendon::constant([0.001, 0.0], 1.0, Some(0.31)).unwrap();
+    let ok = Tendon::constant([0.001, 0.0], 1.0, None).unwrap();
+    assert_eq!(
+        name_of(solve_statics(
+            &rod(),
+            &[ok, t],
+            &Loads::default(),
+            &SolveOptions::default()
+        )),
+        "tendons[1].end"
+    );
+    // A user routing that returns NaN.
+    let bad = Tendon::new(
+        Routing::Function {
+            offset: Arc::new(|s| [0.001, if s > 0.2 { f64::NAN } else { 0.0 }]),
+            derivative: Arc::new(|_| [0.0, 0.0]),
+        },
+        1.0,
+        None,
+    )
+    .unwrap();
+    assert!(name_of(solve_statics(
+        &rod(),
+        &[bad],
+        &Loads::default(),
+        &SolveOptions::default()
+    ))
+    .starts_with("tendons[0].offset"));
+}
+
+#[test]
+fn bad_loads_and_options_are_named() {
+    let solve = |loads: &Loads, opts: &SolveOptions| solve_statics(&rod(), &[], loads, opts);
+    let d = SolveOptions::default();
+    let mut l = Loads::tip_force(Vector3::new(0.0, f64::NAN, 0.0));
+    assert_eq!(name_of(solve(&l, &d)), "loads.tip_force[1]");
+    l = Loads::tip_moment(Vector3::new(f64::INFINITY, 0.0, 0.0));
+    assert_eq!(name_of(solve(&l, &d)), "loads.tip_moment[0]");
+    l = Loads::default();
+    l.point_loads.push(PointLoad::force(0.5, Vector3::x()));
+    assert_eq!(name_of(solve(&l, &d)), "loads.point_loads[0].s");
+    l = Loads::default();
+    l.point_loads.push(PointLoad::force(0.0, Vector3::x()));
+    assert_eq!(name_of(solve(&l, &d)), "loads.point_loads[0].s");
+    l = Loads {
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+        ..Default::default()
+    };
+    assert_eq!(name_of(solve(&l, &d)), "density");
+    l = Loads {
+        distributed_force: Some(Profile::Function(Arc::new(|s| {
+            Vector3::new(0.0, if s > 0.1 { f64::NAN } else { 0.0 }, 0.0)
+        }))),
+        ..Default::default()
+    };
+    assert!(name_of(solve(&l, &d)).starts_with("loads.distributed_force("));
+    let l = Loads::default();
+    let o = SolveOptions {
+        integrator: Integrator::Rk4 { steps: 0 },
+        ..d
+    };
+    assert_eq!(name_of(solve(&l, &o)), "integrator.steps");
+    let o = SolveOptions {
+        integrator: Integrator::Rk4 { steps: usize::MAX },
+        ..d
+    };
+    assert_eq!(name_of(solve(&l, &o)), "integrator.steps");
+    let o = SolveOptions {
+        tolerance: f64::NAN,
+        ..d
+    };
+    assert_eq!(name_of(solve(&l, &o)), "tolerance");
+    let o = SolveOptions {
+        max_iterations: 0,
+        ..d
+    };
+    assert_eq!(name_of(solve(&l, &o)), "max_iterations");
+    let o = SolveOptions {
+        warm_start: Some(WarmStart {
+            base_wrench: [0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0],
+        }),
+        ..d
+    };
+    assert_eq!(name_of(solve(&l, &o)), "warm_start.base_wrench[2]");
+    let o = SolveOptions {
+        integrator: Integrator::Adaptive(softrod::integrate::AdaptiveOptions {
+            rtol: -1.0,
+            ..Default::default()
+        }),
+        ..d
+    };
+    assert_eq!(name_of(solve(&l, &o)), "rtol");
+}
+
+#[test]
+fn extreme_inputs_never_panic() {
+    // Enormous tensions (the tendon path folds back), loads, stiffnesses and tiny step counts:
+    // each returns a result or an error.
+    for e in [1e-6, 1.0, 1e12, 1e300] {
+        for tau in [0.0, 1e-9, 1.0, 1e6, 1e15] {
+            for f in [0.0, 1e-3, 1e3, 1e12] {
+                let rod = Rod::new(
+                    0.3,
+                    Section::circular(0.002).unwrap(),
+                    LinearElastic::new(e, 0.3).unwrap(),
+                )
+                .unwrap();
+                let t = Tendon::constant([0.0015, 0.0], tau, Some(0.2)).unwrap();
+                let loads = Loads::tip_force(Vector3::new(f, 0.0, -f));
+                let opts = SolveOptions {
+                    integrator: Integrator::Rk4 { steps: 3 },
+                    max_load_steps: 4,
+                    max_iterations: 5,
+                    ..Default::default()
+                };
+                let r = solve_statics(&rod, &[t], &loads, &opts);
+                if let Ok(sol) = &r {
+                    assert!(sol.stats.converged);
+                }
+                let r2 = solve_statics(
+                    &rod,
+                    &[],
+                    &loads,
+                    &SolveOptions {
+                        throw: false,
+                        ..opts
+                    },
+                );
+                assert!(r2.is_ok() || matches!(r2, Err(Error::NotConverged { .. })));
+            }
+        }
+    }
+}

@@ -1,0 +1,303 @@
+//! Numerical properties of the statics solver: RK4 convergence order, the adaptive
+//! integrator's tolerance, warm starts, the two-segment robot's accuracy at the default step
+//! count, frames of tip loads, and inspection of non-converged results.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::f64::consts::PI;
+
+use softrod::integrate::AdaptiveOptions;
+use softrod::nalgebra::{Matrix3, Vector3};
+use softrod::{
+    solve_statics, Error, Frame, Integrator, LinearElastic, Loads, Rod, Routing, Section,
+    SolveOptions, StaticsSolution, Tendon,
+};
+
+fn rk4(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        tolerance: 1e-13,
+        ..Default::default()
+    }
+}
+
+fn adaptive(rtol: f64) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
+            rtol,
+            atol: rtol * 1e-3,
+            max_steps: 1_000_000,
+        }),
+        tolerance: 1e-13,
+        ..Default::default()
+    }
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// The two-segment NiTi robot of the benchmark.
+fn niti() -> Rod {
+    Rod::new(
+        0.4,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap()
+}
+
+fn niti_tendons(tensions: &[f64; 6]) -> Vec<Tendon> {
+    (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            Tendon::constant(
+                [0.01 * ang.cos(), 0.01 * ang.sin()],
+                tensions[i],
+                Some(if i < 3 { 0.2 } else { 0.4 }),
+            )
+            .unwrap()
+        })
+        .collect()
+}
+
+/// A 3-D test problem: tapered soft rod, helical tendon ending mid-way, tip force.
+fn helix_problem() -> (Rod, Vec<Tendon>, Loads) {
+    let rod = Rod::new(
+        0.3,
+        Section::tapered_circular(0.004, 0.0025).unwrap(),
+        LinearElastic::new(2e6, 0.45).unwrap(),
+    )
+    .unwrap();
+    let t = Tendon::new(
+        Routing::Helical {
+            radius: 0.002,
+            pitch: 0.25,
+            phase: 0.0,
+        },
+        0.3,
+        Some(0.2),
+    )
+    .unwrap();
+    (
+        rod,
+        vec![t],
+        Loads::tip_force(Vector3::new(0.0, 0.01, -0.005)),
+    )
+}
+
+#[test]
+fn rk4_converges_with_order_four() {
+    let (rod, tendons, loads) = helix_problem();
+    let reference = solve_statics(&rod, &tendons, &loads, &adaptive(1e-13)).unwrap();
+    let r = reference.tip_position();
+    // Asymptotic range (at 10 steps the tendon's helix is resolved by 8 points per turn).
+    let errors: Vec<f64> = [20, 40, 80, 160]
+        .iter()
+        .map(|&n| {
+            dist(
+                solve_statics(&rod, &tendons, &loads, &rk4(n))
+                    .unwrap()
+                    .tip_position(),
+                r,
+            )
+        })
+        .collect();
+    println!("RK4 tip errors for 20, 40, 80, 160 steps: {errors:?}");
+    for w in errors.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!((3.7..4.3).contains(&order), "observed order {order}");
+    }
+    // The tendon path length converges too.
+    let lt = solve_statics(&rod, &tendons, &loads, &rk4(80))
+        .unwrap()
+        .tendon_lengths[0];
+    assert!(
+        (lt - reference.tendon_lengths[0]).abs() < 1e-9,
+        "{lt} {}",
+        reference.tendon_lengths[0]
+    );
+}
+
+#[test]
+fn adaptive_integrator_meets_its_tolerance() {
+    let (rod, tendons, loads) = helix_problem();
+    let reference = solve_statics(&rod, &tendons, &loads, &rk4(4000)).unwrap();
+    let r = reference.tip_position();
+    for rtol in [1e-6, 1e-8, 1e-10] {
+        let sol = solve_statics(&rod, &tendons, &loads, &adaptive(rtol)).unwrap();
+        let e = dist(sol.tip_position(), r) / rod.length();
+        println!(
+            "rtol {rtol:e}: tip error {e:.2e} L, {} samples, {} evaluations",
+            sol.s.len(),
+            sol.stats.function_evaluations
+        );
+        assert!(e < rtol, "rtol {rtol}: error {e} L");
+        assert!(sol.stats.converged);
+    }
+}
+
+#[test]
+fn two_segment_robot_default_options_are_accurate() {
+    let rod = niti();
+    let tendons = niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let tight = solve_statics(&rod, &tendons, &Loads::default(), &adaptive(1e-12)).unwrap();
+    let sol = solve_statics(&rod, &tendons, &Loads::default(), &SolveOptions::default()).unwrap();
+    let e = dist(sol.tip_position(), tight.tip_position());
+    println!(
+        "two-segment robot: tip {:?}, error {e:.2e} m",
+        sol.tip_position()
+    );
+    assert!(e < 1e-7, "{e}");
+    // Both segments bend; the tendon ending at 0.2 m leaves the second segment with the
+    // curvature of the 2 N tendon alone: |u| = 2 N * 10 mm / EI.
+    let ei = 54e9 * PI * 0.7e-3f64.powi(4) / 4.0;
+    let last = sol.u.last().unwrap();
+    let k2 = (last[0].powi(2) + last[1].powi(2)).sqrt();
+    assert!((k2 - 2.0 * 0.01 / ei).abs() < 1e-9 * k2, "{k2}");
+    let first = sol.u[1];
+    let k1 = (first[0].powi(2) + first[1].powi(2)).sqrt();
+    // 4 N at 90 deg and 2 N at -30 deg: |4 e(90) + 2 e(-30)| = sqrt(12) N.
+    assert!((k1 - 12f64.sqrt() * 0.01 / ei).abs() < 1e-9 * k1, "{k1}");
+}
+
+#[test]
+fn warm_start_reaches_the_cold_solution_in_fewer_iterations() {
+    let rod = niti();
+    let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
+    let a = solve_statics(
+        &rod,
+        &niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]),
+        &loads,
+        &rk4(40),
+    )
+    .unwrap();
+    let changed = niti_tendons(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
+    let cold = solve_statics(&rod, &changed, &loads, &rk4(40)).unwrap();
+    let warm_opts = SolveOptions {
+        warm_start: Some(a.warm_start()),
+        ..rk4(40)
+    };
+    let warm = solve_statics(&rod, &changed, &loads, &warm_opts).unwrap();
+    println!(
+        "iterations: cold {}, warm {}; evaluations: cold {}, warm {}",
+        cold.stats.iterations,
+        warm.stats.iterations,
+        cold.stats.function_evaluations,
+        warm.stats.function_evaluations
+    );
+    assert!(dist(cold.tip_position(), warm.tip_position()) < 1e-12);
+    assert!(warm.stats.iterations < cold.stats.iterations);
+    assert!(warm.stats.function_evaluations < cold.stats.function_evaluations);
+}
+
+fn rot(sol: &StaticsSolution, i: usize) -> Matrix3<f64> {
+    Matrix3::from_fn(|r, c| sol.rotation[i][r][c])
+}
+
+#[test]
+fn body_frame_tip_load_is_the_world_load_rotated() {
+    let (rod, tendons, _) = helix_problem();
+    let f = Vector3::new(0.01, 0.02, -0.01);
+    let m = Vector3::new(0.0, 1e-3, 5e-4);
+    let world = Loads {
+        tip_force: f,
+        tip_moment: m,
+        ..Default::default()
+    };
+    let a = solve_statics(&rod, &tendons, &world, &rk4(100)).unwrap();
+    let rl = rot(&a, a.s.len() - 1);
+    let body = Loads {
+        tip_force: rl.transpose() * f,
+        tip_moment: rl.transpose() * m,
+        tip_frame: Frame::Body,
+        ..Default::default()
+    };
+    let b = solve_statics(&rod, &tendons, &body, &rk4(100)).unwrap();
+    assert!(dist(a.tip_position(), b.tip_position()) < 1e-12);
+    // Quaternions are unit, scalar last, and agree with the rotation matrices.
+    for i in 0..a.s.len() {
+        let q = a.quaternion[i];
+        let uq = softrod::nalgebra::UnitQuaternion::from_quaternion(
+            softrod::nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]),
+        );
+        assert!((uq.to_rotation_matrix().matrix() - rot(&a, i)).amax() < 1e-12);
+        assert!(q[3] >= 0.0);
+        let r = rot(&a, i);
+        assert!((r.transpose() * r - Matrix3::identity()).amax() < 1e-13);
+    }
+}
+
+#[test]
+fn internal_wrench_is_consistent_with_strains_and_frames() {
+    let (rod, tendons, loads) = helix_problem();
+    let sol = solve_statics(&rod, &tendons, &loads, &rk4(60)).unwrap();
+    let e: f64 = 2e6;
+    let g = e / (2.0 * 1.45);
+    let k = rod.shear_coefficient();
+    for i in 0..sol.s.len() {
+        let props = rod.section_at(sol.s[i]);
+        let (v, u) = (sol.v[i], sol.u[i]);
+        let nb = sol.n_body[i];
+        let mb = sol.m_body[i];
+        // n = K_se (v - v*), m = K_bt (u - u*), in body components.
+        let tol = 1e-9;
+        assert!(
+            (nb[2] - e * props.area * (v[2] - 1.0)).abs() < tol * (1.0 + nb[2].abs()),
+            "s = {}: n_z {} vs EA (v_z - 1) {}",
+            sol.s[i],
+            nb[2],
+            e * props.area * (v[2] - 1.0)
+        );
+        assert!((nb[0] - k * g * props.area * v[0]).abs() < tol * (1.0 + nb[0].abs()));
+        assert!((mb[0] - e * props.ix * u[0]).abs() < tol * (1.0 + mb[0].abs()));
+        assert!((mb[2] - g * props.j * u[2]).abs() < tol * (1.0 + mb[2].abs()));
+        let r = rot(&sol, i);
+        let nw = r * Vector3::from(nb);
+        assert!((nw - Vector3::from(sol.n_world[i])).amax() < 1e-14);
+    }
+    // Beyond the termination at 0.2 m only the tip force acts: n = F.
+    let last = sol.n_world.last().unwrap();
+    assert!((Vector3::from(*last) - loads.tip_force).amax() < 1e-12);
+}
+
+#[test]
+fn non_convergence_is_an_error_or_an_inspectable_result() {
+    let rod = Rod::new(
+        0.3,
+        Section::circular(0.002).unwrap(),
+        LinearElastic::new(5e6, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true);
+    let loads = Loads::tip_force(Vector3::new(0.5, 0.0, 0.0)); // alpha ~ 1.4e2: hard
+    let opts = SolveOptions {
+        max_iterations: 2,
+        continuation: false,
+        ..Default::default()
+    };
+    match solve_statics(&rod, &[], &loads, &opts) {
+        Err(Error::NotConverged {
+            iterations,
+            residual,
+            ..
+        }) => {
+            assert!(iterations <= 2);
+            assert!(residual > opts.tolerance && residual.is_finite());
+        }
+        other => panic!("expected NotConverged, got {other:?}"),
+    }
+    let sol = solve_statics(
+        &rod,
+        &[],
+        &loads,
+        &SolveOptions {
+            throw: false,
+            ..opts
+        },
+    )
+    .unwrap();
+    assert!(!sol.stats.converged);
+    assert!(sol.stats.residual > opts.tolerance);
+    assert_eq!(sol.s.len(), sol.position.len());
+    assert!(!sol.s.is_empty());
+}
