@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 
 mod convert;
 mod errors;
+mod materials;
 mod planar;
 mod statics;
 
@@ -40,6 +41,18 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statics::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_class::<materials::PyUniaxialLaw>()?;
+    m.add_class::<materials::Hookean>()?;
+    m.add_class::<materials::Linearised>()?;
+    m.add_class::<materials::NeoHookean>()?;
+    m.add_class::<materials::MooneyRivlin>()?;
+    m.add_class::<materials::Yeoh>()?;
+    m.add_class::<materials::Ogden>()?;
+    m.add_class::<materials::UniaxialFit>()?;
+    m.add_class::<materials::Silicone>()?;
+    m.add_function(wrap_pyfunction!(materials::fit_uniaxial, m)?)?;
+    m.add_function(wrap_pyfunction!(materials::silicone, m)?)?;
+    m.add("SILICONES", materials::silicone_names(m.py())?)?;
     m.add_function(wrap_pyfunction!(statics::_time_solve_statics, m)?)?;
     Ok(())
 }
