@@ -28,8 +28,12 @@
 //! differentiating `n = N - Σ τ t_i` gives their distributed tendon load
 //! `-τ_i t_i'` (from the curvature of the tendon path); at a termination `σ` the tendon's term
 //! drops out of the sum while `N`, `M` are continuous, so the rod's own wrench jumps by exactly
-//! their point force `-τ_i t_i(σ)` and moment `-(R r_i) × τ_i t_i(σ)`. The integration
-//! intervals break at every termination and point load, so these jumps are applied exactly.
+//! their point force `-τ_i t_i(σ)` and moment `-(R r_i) × τ_i t_i(σ)`. Where the curvature
+//! jumps (at a termination or a point load), the tendons that continue have a kink in their
+//! path and add the point force `τ_j (t_j⁺ - t_j⁻)` of a tensioned string over a kink (their
+//! distributed load integrated across the jump); the total-wrench form includes it exactly.
+//! The integration intervals break at every termination and point load, so all jumps are
+//! applied exactly.
 //!
 //! The shooting Jacobian is propagated with the state: for each of the six unknowns of the
 //! base wrench, a variation `(δp, w, δN, δM)` with `δR = R ŵ` (body-frame rotation variation)

@@ -9,7 +9,8 @@
 //! unshearable Kirchhoff limit).
 //!
 //! # Adding a hyperelastic law
-//! Add a variant (e.g. holding a uniaxial law `P(λ)`) and implement its branch of
+//! Add a variant (e.g. holding a [`crate::hyperelastic::UniaxialModel`], nominal stress
+//! `P(λ)`) and implement its branch of
 //! [`Material::elastic_strain`]: the axial strain solves `A P(1 + ε) = n_z` (one scalar Newton
 //! solve per call), and the bending and shear compliances come from the tangent modulus
 //! `dσ/dλ` at that stretch. The tangent must then also carry the coupling `du/dn_z` (bending

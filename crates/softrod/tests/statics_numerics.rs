@@ -301,3 +301,38 @@ fn non_convergence_is_an_error_or_an_inspectable_result() {
     assert_eq!(sol.s.len(), sol.position.len());
     assert!(!sol.s.is_empty());
 }
+
+#[test]
+fn tendon_termination_applies_point_force_and_moment() {
+    // At s = 0.2 m the 4 N tendon ends. Across it the rod's internal wrench jumps by that
+    // tendon's point force -tau t and moment -(R r) x tau t (Rucker & Webster 2011), with t its
+    // unit tangent R (v + u x r) / |v + u x r| just before the end; and, since the curvature
+    // jumps there, the 2 N tendon that continues has a kink in its path and adds the point
+    // force tau (t+ - t-) of a tensioned string over a kink (its distributed load -tau t'
+    // integrated across the jump).
+    let rod = niti();
+    let tendons = niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads::tip_force(Vector3::new(0.02, 0.01, 0.0));
+    let sol = solve_statics(&rod, &tendons, &loads, &rk4(40)).unwrap();
+    let i = sol.s.iter().position(|&s| s == 0.2).unwrap();
+    assert_eq!(sol.s[i + 1], 0.2);
+    let r = rot(&sol, i);
+    assert_eq!(r, rot(&sol, i + 1));
+    let tangent = |j: usize, off: &Vector3<f64>| {
+        let w = Vector3::from(sol.v[j]) + Vector3::from(sol.u[j]).cross(off);
+        r * w.normalize()
+    };
+    let r0 = Vector3::new(0.0, 0.01, 0.0); // 4 N tendon at 90 degrees, ends here
+    let a4 = (-30.0f64).to_radians();
+    let r4 = Vector3::new(0.01 * a4.cos(), 0.01 * a4.sin(), 0.0); // 2 N tendon, continues
+    let f0 = -tangent(i, &r0) * 4.0;
+    let kink = (tangent(i + 1, &r4) - tangent(i, &r4)) * 2.0;
+    let f = f0 + kink;
+    let m = (r * r0).cross(&f0) + (r * r4).cross(&kink);
+    let dn = Vector3::from(sol.n_world[i]) - Vector3::from(sol.n_world[i + 1]);
+    let dm = Vector3::from(sol.m_world[i]) - Vector3::from(sol.m_world[i + 1]);
+    println!("jump: point force {f0:?}, kink force {kink:?}");
+    assert!((dn - f).amax() < 1e-12, "{dn:?} vs {f:?}");
+    assert!((dm - m).amax() < 1e-14, "{dm:?} vs {m:?}");
+    assert_eq!(sol.position[i], sol.position[i + 1]);
+}

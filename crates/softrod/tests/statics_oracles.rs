@@ -528,3 +528,58 @@ fn small_loads_match_euler_bernoulli_cantilever() {
     assert_eq!(sol.s[i + 1], a);
     assert!((sol.n_world[i][0] - sol.n_world[i + 1][0] - p).abs() < 1e-12 * p);
 }
+
+#[test]
+fn uniform_distributed_moment_bends_with_the_exact_angle() {
+    // A world-frame distributed moment l about x on an inextensible rod along z: the internal
+    // moment is l (L - s) about x, the rod bends in the y-z plane with the exact angle
+    // theta(s) = l (L s - s²/2) / (E I), and p(s) = ∫ (0, -sin theta, cos theta) ds.
+    use softrod::Profile;
+    let (l, r, e): (f64, f64, f64) = (0.4, 0.002, 1e8);
+    let ei = e * PI * r.powi(4) / 4.0;
+    let l0 = 2.0 * ei / (l * l); // tip angle 1 rad
+    let rod = Rod::new(
+        l,
+        Section::circular(r).unwrap(),
+        LinearElastic::new(e, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true);
+    let loads = Loads {
+        distributed_moment: Some(Profile::Constant(Vector3::new(l0, 0.0, 0.0))),
+        ..Default::default()
+    };
+    let sol = solve_statics(&rod, &[], &loads, &rk4(400)).unwrap();
+    let theta = |s: f64| l0 * (l * s - 0.5 * s * s) / ei;
+    let y = quad(|s| -theta(s).sin(), 0.0, l, 100);
+    let z = quad(|s| theta(s).cos(), 0.0, l, 100);
+    let err = dist(sol.tip_position(), [0.0, y, z]);
+    println!("distributed moment: tip error {err:.2e} m");
+    assert!(err < 1e-10);
+}
+
+#[test]
+fn tabulated_and_function_sections_match_the_circle() {
+    use softrod::SectionProperties;
+    use std::sync::Arc;
+    let (l, r, e): (f64, f64, f64) = (0.3, 0.003, 3e6);
+    let mat = LinearElastic::new(e, 0.4).unwrap();
+    let c = SectionProperties::circle(r, 0.0);
+    let table = Section::table(&[0.0, l], &[c.area; 2], &[c.ix; 2], &[c.iy; 2], &[c.j; 2]).unwrap();
+    let func = Section::function(Arc::new(move |_| SectionProperties::circle(r, 0.0)));
+    let t = Tendon::constant([0.002, 0.001], 0.5, Some(0.2)).unwrap();
+    let loads = Loads::tip_force(Vector3::new(0.01, 0.0, 0.0));
+    let tips: Vec<[f64; 3]> = [Section::circular(r).unwrap(), table, func]
+        .into_iter()
+        .map(|sec| {
+            let rod = Rod::new(l, sec, mat)
+                .unwrap()
+                .with_shear_coefficient(0.9)
+                .unwrap();
+            solve_statics(&rod, std::slice::from_ref(&t), &loads, &rk4(80))
+                .unwrap()
+                .tip_position()
+        })
+        .collect();
+    assert!(dist(tips[0], tips[1]) < 1e-14 && dist(tips[0], tips[2]) < 1e-14);
+}
