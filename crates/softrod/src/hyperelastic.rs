@@ -987,8 +987,8 @@ into_model!(Hookean, Linearised, NeoHookean, MooneyRivlin, Yeoh, Ogden);
 /// taken from the crosshead, which overstates strain: the moduli are therefore on the low side,
 /// and batch, cure and test method change them by more than the choice of model (datasheets
 /// differ by 2–4× for the Ecoflex grades). The fits are reproduced, with their errors, by
-/// `cargo run --release -p softrod --example fit_silicones -- <data dir>`; the constants are
-/// stored to six significant digits.
+/// `cargo run --release -p softrod --example fit_silicones` (reading the vendored
+/// `data/silicone-tensile/`); the constants are stored to six significant digits.
 ///
 /// These curves stiffen with strain, so unconstrained Mooney–Rivlin fits come out with
 /// `C01 < 0` and are stable only in tension or mild compression (stretch bounds in each
