@@ -3,8 +3,12 @@
 //! [`solve_statics`] finds the unknown total base wrench `(N(0), M(0))` (world frame) such that
 //! the integrated internal wrench matches the tip loads, with damped Newton iterations on an
 //! exact Jacobian (variational equations integrated with the state, see `cosserat.rs`). If the
-//! direct solve fails it restarts from the unloaded rod and steps the load factor from 0 to 1
-//! (continuation). The ODE is integrated piecewise between the breaks at tendon terminations
+//! direct solve fails, or its first Newton step is larger than [`DIRECT_STEP_LIMIT`] (a strongly
+//! nonlinear problem, where Newton may land on an unstable equilibrium branch such as a looped
+//! elastica), it restarts from the unloaded rod and steps the load factor from 0 to 1
+//! (continuation with a secant predictor), refusing load steps that change the shape by more
+//! than [`MAX_LOAD_STEP_TURN`], so that the solution found is the one connected to the
+//! unloaded rod. The ODE is integrated piecewise between the breaks at tendon terminations
 //! and point loads, either with fixed-step RK4 (the seed's method) or with the adaptive
 //! Dormand–Prince 5(4) pair; rotation matrices are re-orthonormalised after every step.
 //!
@@ -37,6 +41,14 @@ pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
 pub const MAX_LINE_SEARCH_HALVINGS: usize = 12;
 /// Sufficient-decrease constant of the line search (Armijo, on the residual norm).
 pub const ARMIJO: f64 = 1e-4;
+/// Largest first Newton step (max norm of the scaled base wrench, about the bending in rad it
+/// predicts) taken directly when continuation is enabled; beyond it the load is stepped, so
+/// that the solution stays on the equilibrium branch connected to the unloaded rod.
+pub const DIRECT_STEP_LIMIT: f64 = 4.0;
+/// Largest change of the shape per continuation step: rotation in rad at any mesh node (and
+/// half of it, in units of the rod length, in position). Larger jumps may switch equilibrium
+/// branch, so the step is halved.
+pub const MAX_LOAD_STEP_TURN: f64 = 1.0;
 /// Smallest load-factor increment of the continuation before giving up.
 pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
 
@@ -104,7 +116,7 @@ impl Default for SolveOptions {
 }
 
 /// Solver statistics.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverStats {
     /// Newton iterations (accepted steps), over all load steps.
     pub iterations: usize,
@@ -116,6 +128,9 @@ pub struct SolverStats {
     pub converged: bool,
     /// Load steps taken by the continuation (0: solved directly).
     pub load_steps: usize,
+    /// Fraction of the loads (and tensions) the returned shape carries: 1 when converged; for
+    /// a non-converged result under continuation, the last load factor reached.
+    pub load_factor: f64,
 }
 
 /// A solved rod, sampled at the integration mesh.
@@ -335,6 +350,8 @@ struct NewtonOut {
     iterations: usize,
     /// Whether the workspace holds the pass at `x`.
     recorded: bool,
+    /// Size of a first Newton step refused for exceeding the step limit (0 otherwise).
+    first_step: f64,
 }
 
 fn norm(r: &Vector6<f64>) -> f64 {
@@ -350,6 +367,7 @@ fn newton(
     ev: &mut Evaluator<'_, '_>,
     x0: Vector6<f64>,
     try_cheap: bool,
+    step_limit: Option<f64>,
     opts: &SolveOptions,
     plan: &[usize],
     ws: &mut Workspace,
@@ -365,6 +383,7 @@ fn newton(
         converged: false,
         iterations: 0,
         recorded: false,
+        first_step: 0.0,
     };
     // A cheap first pass without sensitivities when the guess may already solve the problem
     // (warm starts; tendon-only loading, for which the total base wrench is exactly zero).
@@ -418,6 +437,14 @@ fn newton(
         if !dx.iter().all(|v| v.is_finite()) {
             break;
         }
+        if let Some(limit) = step_limit {
+            if out.iterations == 0 && dx.amax() > limit {
+                // Too far from the guess for Newton to stay on the equilibrium branch that is
+                // connected to it: leave it to the continuation.
+                out.first_step = dx.amax();
+                break;
+            }
+        }
         // Under quadratic convergence the next residual is about rn³ / r_prev²; when that is
         // far below the tolerance, try the full step without sensitivities first (it is then
         // the last pass).
@@ -469,6 +496,34 @@ fn newton(
     out.x = x;
     out.residual = rn;
     out
+}
+
+/// Positions and rotations at the nodes of the pass held by the workspace.
+fn shape_of(ws: &Workspace) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
+    ws.nodes.iter().map(|n| (v3(&n.y, 0), rot(&n.y))).collect()
+}
+
+/// Whether two shapes differ by at most [`MAX_LOAD_STEP_TURN`] in rotation (rad) and
+/// `MAX_LOAD_STEP_TURN L / 2` in position, node by node on a common mesh (RK4), at the tip
+/// otherwise (adaptive meshes differ between passes).
+fn shape_change_is_small(
+    a: &[(Vector3<f64>, Matrix3<f64>)],
+    b: &[(Vector3<f64>, Matrix3<f64>)],
+    length: f64,
+) -> bool {
+    let close = |(p0, r0): &(Vector3<f64>, Matrix3<f64>),
+                 (p1, r1): &(Vector3<f64>, Matrix3<f64>)| {
+        let c = ((r0.tr_mul(r1).trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
+        c.acos() <= MAX_LOAD_STEP_TURN && (p1 - p0).norm() <= 0.5 * MAX_LOAD_STEP_TURN * length
+    };
+    if a.len() == b.len() {
+        a.iter().zip(b).all(|(x, y)| close(x, y))
+    } else {
+        match (a.last(), b.last()) {
+            (Some(x), Some(y)) => close(x, y),
+            _ => false,
+        }
+    }
 }
 
 /// Validates the inputs and builds the model at load factor 1.
@@ -642,7 +697,14 @@ pub fn solve_statics(
         tendon_lengths: vec![0.0; tendons.len()],
     };
     let mut evaluations = 0usize;
-    let mut stats = SolverStats::default();
+    let mut stats = SolverStats {
+        iterations: 0,
+        residual: f64::INFINITY,
+        function_evaluations: 0,
+        converged: false,
+        load_steps: 0,
+        load_factor: 1.0,
+    };
 
     let direct = {
         let mut ev = Evaluator::new(&model);
@@ -653,7 +715,8 @@ pub fn solve_statics(
             && loads.distributed_moment.is_none()
             && model.rho_g.is_none();
         let try_cheap = options.warm_start.is_some() || unloaded;
-        let out = newton(&mut ev, x0, try_cheap, options, &plan, &mut ws);
+        let limit = options.continuation.then_some(DIRECT_STEP_LIMIT);
+        let out = newton(&mut ev, x0, try_cheap, limit, options, &plan, &mut ws);
         evaluations += ev.evaluations;
         out
     };
@@ -661,21 +724,61 @@ pub fn solve_statics(
     let mut result = direct;
 
     if !result.converged && options.continuation {
-        // Load stepping from the unloaded rod (x = 0 is exact at load factor 0).
+        // Load stepping from the unloaded rod (x = 0 is exact at load factor 0), with a secant
+        // predictor; a step fails (and is halved) if Newton does not converge or its first
+        // step exceeds the step limit.
         let mut lambda = 0.0f64;
-        let mut dl = 0.25f64;
+        let mut dl = if result.first_step > 0.0 {
+            (0.8 * DIRECT_STEP_LIMIT / result.first_step).clamp(MIN_LOAD_INCREMENT, 0.5)
+        } else {
+            0.25
+        };
         let mut x = Vector6::zeros();
+        let mut prev: Option<(Vector6<f64>, f64)> = None;
+        // Tip pose of the last accepted load step (the unloaded rod to begin with).
+        model.factor = 0.0;
+        let mut tip = {
+            let mut ev = Evaluator::new(&model);
+            let pass = shoot::<STATE>(&mut ev, &x, &options.integrator, &plan, &mut ws);
+            evaluations += ev.evaluations;
+            pass.ok().map(|_| shape_of(&ws))
+        };
         let mut steps = 0usize;
         let mut last = None;
         while steps < options.max_load_steps {
             let target = (lambda + dl).min(1.0);
             model.factor = target;
+            let guess = match prev {
+                Some((xp, dlp)) => x + (x - xp) * ((target - lambda) / dlp),
+                None => x,
+            };
             let mut ev = Evaluator::new(&model);
-            let out = newton(&mut ev, x, false, options, &plan, &mut ws);
+            let out = newton(
+                &mut ev,
+                guess,
+                false,
+                Some(DIRECT_STEP_LIMIT),
+                options,
+                &plan,
+                &mut ws,
+            );
             evaluations += ev.evaluations;
             stats.iterations += out.iterations;
             steps += 1;
-            if out.converged {
+            // A load step must not move the tip by more than MAX_LOAD_STEP_TURN (rotation, rad)
+            // or MAX_LOAD_STEP_TURN L (position): larger jumps may switch equilibrium branch.
+            let new_tip = if out.converged {
+                Some(shape_of(&ws))
+            } else {
+                None
+            };
+            let small = match (&tip, &new_tip) {
+                (Some(a), Some(b)) => shape_change_is_small(a, b, model.length),
+                _ => false,
+            };
+            if out.converged && small {
+                tip = new_tip;
+                prev = Some((x, target - lambda));
                 lambda = target;
                 x = out.x;
                 let done = lambda >= 1.0;
@@ -686,30 +789,38 @@ pub fn solve_statics(
                 dl = (dl * 2.0).min(0.5);
             } else {
                 dl *= 0.5;
-                last = Some(out);
+                last = Some(NewtonOut {
+                    converged: false,
+                    ..out
+                });
                 if dl < MIN_LOAD_INCREMENT {
                     break;
                 }
             }
         }
         stats.load_steps = steps;
+        stats.load_factor = lambda;
         if let Some(out) = last {
             if out.converged && lambda >= 1.0 {
                 result = out;
-            } else if model.factor < 1.0 || !out.converged {
+            } else {
+                // Report the last converged load step.
+                model.factor = lambda;
                 result = NewtonOut {
+                    x,
                     converged: false,
+                    recorded: false,
                     ..out
                 };
             }
         }
     }
-    // Make sure the workspace holds the pass at the final unknowns, at full load.
-    if (model.factor - 1.0).abs() > 0.0 || !result.recorded {
-        model.factor = if result.converged { 1.0 } else { model.factor };
+    // Make sure the workspace holds the pass at the final unknowns (at the load factor they
+    // belong to).
+    if !result.recorded {
         let mut ev = Evaluator::new(&model);
         if let Ok(p) = shoot::<STATE>(&mut ev, &result.x, &options.integrator, &plan, &mut ws) {
-            if !result.converged {
+            if !result.converged && stats.load_factor >= 1.0 {
                 result.residual = norm(&p.residual);
             }
         }
