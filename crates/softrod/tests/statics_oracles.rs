@@ -583,3 +583,24 @@ fn tabulated_and_function_sections_match_the_circle() {
         .collect();
     assert!(dist(tips[0], tips[1]) < 1e-14 && dist(tips[0], tips[2]) < 1e-14);
 }
+
+#[test]
+fn inextensible_rod_with_tendon_bends_without_stretch() {
+    // Kirchhoff limit: v = v* exactly, the tendon's compression is a reaction, and the
+    // curvature is still tau d / (E I); here with the offset along body y (bending about -x).
+    let (l, r, e): (f64, f64, f64) = (0.25, 0.004, 3e6);
+    let (tau, d) = (2.0, 0.003);
+    let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.45).unwrap())
+        .unwrap()
+        .with_inextensible(true);
+    let kappa = tau * d / (e * PI * r.powi(4) / 4.0);
+    let t = Tendon::constant([0.0, d], tau, None).unwrap();
+    let sol = solve_statics(&rod, &[t], &Loads::default(), &rk4(400)).unwrap();
+    for (u, v) in sol.u.iter().zip(&sol.v) {
+        assert!((u[0] + kappa).abs() <= 1e-10 * kappa && u[1].abs() < 1e-12 && u[2].abs() < 1e-12);
+        assert_eq!(*v, [0.0, 0.0, 1.0]);
+    }
+    let exact = [0.0, (1.0 - (kappa * l).cos()) / kappa, (kappa * l).sin() / kappa];
+    assert!(dist(sol.tip_position(), exact) < 1e-10);
+    assert!((sol.n_body[3][2] + tau).abs() < 1e-12);
+}
