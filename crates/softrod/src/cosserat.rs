@@ -345,9 +345,10 @@ pub(crate) struct Evaluator<'m, 'a> {
     /// Factorised local Jacobian `I + C D` of the last local Newton iteration (chord steps).
     last_lu: Option<Lu6>,
     /// Tangent `d(v, u)/d(n_b, m_b)` of the last [`Evaluator::local`] call made with
-    /// `tangent = true`: diagonal in `tangent_diag` unless `tangent_full` is set.
+    /// `tangent = true`: the compliance `C` (`tangent_diag`), premultiplied by `(I + C D)⁻¹`
+    /// when tendons are active (`tangent_lu` holds the factorised `I + C D`).
     tangent_diag: [f64; 6],
-    tangent_full: Option<Matrix6<f64>>,
+    tangent_lu: Option<Lu6>,
     /// `|w_i| = |p_i'|` of every tendon at the last evaluation (only updated while
     /// `track_speeds` is set; stale for tendons that end before the current interval).
     pub tendon_speed: Vec<f64>,
@@ -368,7 +369,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             guess: None,
             last_lu: None,
             tangent_diag: [0.0; 6],
-            tangent_full: None,
+            tangent_lu: None,
             tendon_speed: vec![0.0; n],
             track_speeds: false,
             evaluations: 0,
@@ -519,7 +520,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             };
             if tangent {
                 self.tangent_diag = c;
-                self.tangent_full = None;
+                self.tangent_lu = None;
             }
             if self.track_speeds {
                 self.passive_speeds(s, props, &out.v, &out.u);
@@ -610,21 +611,13 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             tendon_moment: Vector3::zeros(),
         };
         if tangent {
-            // (I + C D)⁻¹ C at the solution, column by column.
+            // (I + C D)⁻¹ C at the solution: keep the factorisation for the sensitivities.
             let (_, h) = self.tendon_sums(&x, &c, true);
             let Some(lu) = h.as_ref().and_then(Lu6::new) else {
                 return Local::nan();
             };
-            let mut sm = Matrix6::zeros();
-            for j in 0..6 {
-                let mut e = [0.0; 6];
-                e[j] = c[j];
-                let col = lu.solve(&e);
-                for i in 0..6 {
-                    sm[(i, j)] = col[i];
-                }
-            }
-            self.tangent_full = Some(sm);
+            self.tangent_diag = c;
+            self.tangent_lu = Some(lu);
             self.last_lu = Some(lu);
         }
         // Tendon loads and speeds |p_i'| at the solution.
@@ -678,22 +671,23 @@ impl<'m, 'a> Evaluator<'m, 'a> {
                 let dm = v3(y, b + 9);
                 let dnb = nb.cross(&w) + r.tr_mul(&dn);
                 let dmb = mb.cross(&w) + r.tr_mul(&dm);
-                let (dv, du) = match &self.tangent_full {
-                    None => {
-                        let c = &self.tangent_diag;
-                        (
-                            Vector3::new(c[0] * dnb.x, c[1] * dnb.y, c[2] * dnb.z),
-                            Vector3::new(c[3] * dmb.x, c[4] * dmb.y, c[5] * dmb.z),
-                        )
-                    }
-                    Some(sm) => {
-                        let d = sm * Vector6::new(dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z);
-                        (
-                            Vector3::new(d[0], d[1], d[2]),
-                            Vector3::new(d[3], d[4], d[5]),
-                        )
-                    }
+                let c = &self.tangent_diag;
+                let cw = [
+                    c[0] * dnb.x,
+                    c[1] * dnb.y,
+                    c[2] * dnb.z,
+                    c[3] * dmb.x,
+                    c[4] * dmb.y,
+                    c[5] * dmb.z,
+                ];
+                let d = match &self.tangent_lu {
+                    None => cw,
+                    Some(lu) => lu.solve(&cw),
                 };
+                let (dv, du) = (
+                    Vector3::new(d[0], d[1], d[2]),
+                    Vector3::new(d[3], d[4], d[5]),
+                );
                 let dpd = r * (w.cross(&v) + dv);
                 let wd = w.cross(&u) + du;
                 let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
