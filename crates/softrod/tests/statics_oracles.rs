@@ -590,9 +590,13 @@ fn inextensible_rod_with_tendon_bends_without_stretch() {
     // curvature is still tau d / (E I); here with the offset along body y (bending about -x).
     let (l, r, e): (f64, f64, f64) = (0.25, 0.004, 3e6);
     let (tau, d) = (2.0, 0.003);
-    let rod = Rod::new(l, Section::circular(r).unwrap(), LinearElastic::new(e, 0.45).unwrap())
-        .unwrap()
-        .with_inextensible(true);
+    let rod = Rod::new(
+        l,
+        Section::circular(r).unwrap(),
+        LinearElastic::new(e, 0.45).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true);
     let kappa = tau * d / (e * PI * r.powi(4) / 4.0);
     let t = Tendon::constant([0.0, d], tau, None).unwrap();
     let sol = solve_statics(&rod, &[t], &Loads::default(), &rk4(400)).unwrap();
@@ -600,7 +604,54 @@ fn inextensible_rod_with_tendon_bends_without_stretch() {
         assert!((u[0] + kappa).abs() <= 1e-10 * kappa && u[1].abs() < 1e-12 && u[2].abs() < 1e-12);
         assert_eq!(*v, [0.0, 0.0, 1.0]);
     }
-    let exact = [0.0, (1.0 - (kappa * l).cos()) / kappa, (kappa * l).sin() / kappa];
+    let exact = [
+        0.0,
+        (1.0 - (kappa * l).cos()) / kappa,
+        (kappa * l).sin() / kappa,
+    ];
     assert!(dist(sol.tip_position(), exact) < 1e-10);
     assert!((sol.n_body[3][2] + tau).abs() < 1e-12);
+}
+
+#[test]
+fn user_routing_function_matches_the_builtin_helix() {
+    use softrod::Routing;
+    use std::sync::Arc;
+    let (rho, pitch, phase): (f64, f64, f64) = (0.002, 0.15, 0.4);
+    let w = 2.0 * PI / pitch;
+    let rod = Rod::new(
+        0.3,
+        Section::circular(0.003).unwrap(),
+        LinearElastic::new(5e6, 0.4).unwrap(),
+    )
+    .unwrap();
+    let builtin = Tendon::new(
+        Routing::Helical {
+            radius: rho,
+            pitch,
+            phase,
+        },
+        0.8,
+        Some(0.25),
+    )
+    .unwrap();
+    let user = Tendon::new(
+        Routing::Function {
+            offset: Arc::new(move |s| [rho * (phase + w * s).cos(), rho * (phase + w * s).sin()]),
+            derivative: Arc::new(move |s| {
+                [
+                    -rho * w * (phase + w * s).sin(),
+                    rho * w * (phase + w * s).cos(),
+                ]
+            }),
+        },
+        0.8,
+        Some(0.25),
+    )
+    .unwrap();
+    let loads = Loads::tip_force(Vector3::new(0.0, 0.01, 0.0));
+    let a = solve_statics(&rod, &[builtin], &loads, &rk4(80)).unwrap();
+    let b = solve_statics(&rod, &[user], &loads, &rk4(80)).unwrap();
+    assert!(dist(a.tip_position(), b.tip_position()) < 1e-14);
+    assert!((a.tendon_lengths[0] - b.tendon_lengths[0]).abs() < 1e-15);
 }
