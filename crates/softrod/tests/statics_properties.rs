@@ -59,12 +59,12 @@ fn random_problems_satisfy_global_equilibrium() {
                 0 => Routing::Constant([g.range(-0.5, 0.5) * r0, g.range(-0.5, 0.5) * r0]),
                 1 => Routing::RadiusProportional {
                     ratio: g.range(0.1, 0.6),
-                    angle: g.range(0.0, 6.28),
+                    angle: g.range(0.0, std::f64::consts::TAU),
                 },
                 _ => Routing::Helical {
                     radius: 0.5 * r0,
                     pitch: g.range(-2.0, 2.0) * l + 0.05,
-                    phase: g.range(0.0, 6.28),
+                    phase: g.range(0.0, std::f64::consts::TAU),
                 },
             };
             let end = if g.next() < 0.5 {
