@@ -76,5 +76,56 @@ fn pcc(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, pcc);
+/// PCC statics (issue 6): the two-segment NiTi robot of the docs, by Newton on the
+/// equilibrium equations (`softrod::pcc_statics`).
+fn pcc_statics(c: &mut Criterion) {
+    use softrod::pcc_statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
+    let body = ElasticSegment::solid_circle(0.2, 0.0007, 54e9, true).unwrap();
+    let angles: Vec<f64> = [90.0f64, -30.0, 210.0]
+        .iter()
+        .map(|a| a.to_radians())
+        .collect();
+    let tendons = PccTendons::new(&[0.01; 3], &angles).unwrap();
+    let robot = PccRobot::new(vec![body, body])
+        .unwrap()
+        .with_segment_tendons(0, &tendons)
+        .unwrap()
+        .with_segment_tendons(1, &tendons)
+        .unwrap();
+    let tensions = vec![4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
+    let opts = PccSolveOptions::default();
+    let mut g = c.benchmark_group("pcc_statics");
+    for (name, force, moment) in [
+        ("niti_2_segment_tendons_only", [0.0; 3], [0.0; 3]),
+        (
+            "niti_2_segment_tip_force_0.02N",
+            [0.0, -0.02, 0.0],
+            [0.0; 3],
+        ),
+        ("niti_2_segment_tip_force_0.1N", [0.0, -0.1, 0.0], [0.0; 3]),
+        (
+            "niti_2_segment_tip_wrench",
+            [0.01, -0.02, 0.005],
+            [1e-3, 0.0, -5e-4],
+        ),
+    ] {
+        let loads = PccLoads {
+            tensions: tensions.clone(),
+            tip_force: Vector3::from(force),
+            tip_moment: Vector3::from(moment),
+            ..Default::default()
+        };
+        let sol = solve_pcc_statics(&robot, &loads, &opts).unwrap();
+        println!(
+            "{name}: {} Newton iterations, {} load steps",
+            sol.stats.iterations, sol.stats.load_steps
+        );
+        g.bench_function(name, |b| {
+            b.iter(|| solve_pcc_statics(&robot, black_box(&loads), &opts).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, pcc, pcc_statics);
 criterion_main!(benches);

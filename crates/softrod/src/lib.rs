@@ -21,6 +21,7 @@ pub mod fit;
 pub mod hyperelastic;
 pub mod integrate;
 pub mod pcc;
+pub mod pcc_statics;
 pub mod planar;
 
 pub use compare::{backbone_distance, BackboneDistance};

@@ -1,0 +1,1137 @@
+//! Statics of piecewise-constant-curvature (PCC) robots: arc parameters of every segment from
+//! tendon tensions, chamber pressures and an external tip wrench.
+//!
+//! # Formulation: stationary potential energy over the PCC ansatz
+//! Each segment `i` is a Cosserat rod of rest length `ℓ0`, bending stiffness `E I` and axial
+//! stiffness `E A` (or inextensible), *restricted* to constant-curvature, twist-free,
+//! shear-free shapes. Its configuration is the bending vector `θ = ℓ u = (θ_x, θ_y)` (rad, body
+//! frame; `u` the curvature vector per deformed length, [`ArcCoordinates::CurvatureVector`]) and
+//! the length `ℓ`. The Cosserat energy of such a shape is, with the curvature per *undeformed*
+//! length `θ/ℓ0` (as in the Cosserat engine) and the axial strain `ℓ/ℓ0 - 1`,
+//!
+//! ```text
+//! U_i = E I |θ|² / (2 ℓ0) + E A (ℓ - ℓ0)² / (2 ℓ0).
+//! ```
+//!
+//! A tendon pulled with tension `τ` at the base has potential `τ L` with `L` its path length; a
+//! chamber at gauge pressure `p` does work `p A L_c`. For a straight tendon at the constant
+//! body offset `d (cos β, sin β)` through segments `0..=k` (and a chamber in one segment),
+//! the length on segment `j` is exact for an arc:
+//! `L_j = ℓ_j - d (θ_y cos β - θ_x sin β)`. An external tip force `F` and moment `M` (world
+//! frame, dead loads) do the virtual work `F·δp_tip + M·δω`. Equilibrium is stationarity,
+//!
+//! ```text
+//! g(q) = ∂U/∂q + Σ τ ∂L/∂q - Σ p A ∂L_c/∂q - J_h(q)ᵀ [F; M] = 0,
+//! ```
+//!
+//! with `J_h` the tip's hybrid Jacobian ([`JacobianFrame::Hybrid`]). In `θ` coordinates the
+//! energy is quadratic and the actuator terms are constant: only the tip load is nonlinear.
+//!
+//! **Why energy and not a moment balance per segment.** Without external loads every section
+//! of a segment carries the same actuator moment, and the two agree. Under a tip load the
+//! moment varies along the segment and no arc balances it everywhere; a per-segment moment
+//! balance must pick a section (base, middle, tip) arbitrarily. The stationarity condition
+//! picks the *mean*: for a constant-curvature variation, the virtual work of the tip wrench is
+//! `∫ m_b(s)·δũ ds0`, so `E I θ / ℓ0 = m_act + mean over the segment of the tip load's body
+//! moment` (and the same for the axial force), the Galerkin (Ritz) projection of the Cosserat
+//! rod onto the PCC shapes. Consequences that the tests check: without external loads, a
+//! tendon-driven segment (or chain, distal tendons passing through proximal segments) is the
+//! Cosserat solution exactly, extensible or not; a tip moment about the bending axis is exact
+//! too; a small tip force on a straight segment gives the exact tip *rotation* `F L²/(2 E I)`
+//! and 3/4 of the beam's tip deflection.
+//!
+//! The equilibrium equations are solved by damped Newton in the curvature-vector coordinates
+//! `(u_x, u_y, ℓ)` of every segment with the exact Jacobian (second derivatives of the chain
+//! kinematics in closed form; the dead moment makes it unsymmetric), starting from the
+//! actuator-only solution, which is closed form. If the direct solve fails, the tip load is
+//! applied in steps (continuation). For an inextensible segment the equation for `ℓ` is
+//! replaced by the constraint `ℓ = ℓ0`.
+//!
+//! The tension map [`arc_from_tendon_tensions`](crate::pcc::arc_from_tendon_tensions) takes
+//! `κ` per deformed length (seed 000's convention); this module takes the Cosserat engine's.
+//! They agree for inextensible segments and differ by the factor `1 + ε` on `κ` otherwise.
+//!
+//! # References
+//! R. J. Webster III, B. A. Jones, IJRR 29(13), 2010 (PCC kinematics, tendon lengths).
+//! D. C. Rucker, R. J. Webster III, IEEE T-RO 27(6), 2011 (the Cosserat model it is compared
+//! with). P. Rao, Q. Peyron, S. Lilge, J. Burgner-Kahrs, "How to model tendon-driven
+//! continuum robots and benchmark modelling performance", Front. Robot. AI 7, 2021
+//! (constant-curvature vs. Cosserat statics of tendon-driven robots).
+
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
+
+use crate::error::{check_finite, check_positive, Error, Result};
+use crate::pcc::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
+
+/// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
+/// (rad) and axial residual `|g_ℓ| / E A` (strain).
+pub const DEFAULT_TOLERANCE: f64 = 1e-12;
+/// Default cap on Newton iterations (per load step under continuation).
+pub const DEFAULT_MAX_ITERATIONS: usize = 50;
+/// Default cap on load steps under continuation.
+pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
+/// Most step halvings of the Newton line search.
+pub const MAX_LINE_SEARCH_HALVINGS: usize = 20;
+/// Sufficient-decrease constant of the line search (Armijo, on the residual norm).
+pub const ARMIJO: f64 = 1e-4;
+/// Smallest load-factor increment of the continuation before giving up.
+pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
+/// `θ²` (rad²) below which the arc functions are summed as series (12 terms: error below
+/// `1e-20` for `θ² < 1`); above it the closed forms lose at most `~1e-14` relative.
+const SERIES_BOUND: f64 = 1.0;
+/// Number of series terms.
+const SERIES_TERMS: usize = 13;
+
+/// A tendon of a multi-segment robot: straight, at the constant body offset
+/// `distance (cos angle, sin angle)` (m, rad from body x toward body y) in every segment it
+/// passes through, pulled at the base and fixed at the tip of segment `last_segment`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoutedTendon {
+    distance: f64,
+    angle: f64,
+    last_segment: usize,
+    cos: f64,
+    sin: f64,
+}
+
+impl RoutedTendon {
+    /// A tendon at `distance` (m, > 0) and `angle` (rad), terminated at the tip of segment
+    /// `last_segment` (0-based; checked against the robot when added).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `distance` or `angle`.
+    pub fn new(distance: f64, angle: f64, last_segment: usize) -> Result<Self> {
+        check_positive("distance", distance, "m")?;
+        check_finite("angle", angle)?;
+        let (sin, cos) = angle.sin_cos();
+        Ok(Self {
+            distance,
+            angle,
+            last_segment,
+            cos,
+            sin,
+        })
+    }
+    /// Distance from the backbone (m).
+    pub fn distance(&self) -> f64 {
+        self.distance
+    }
+    /// Angle from body x toward body y (rad).
+    pub fn angle(&self) -> f64 {
+        self.angle
+    }
+    /// Index of the segment at whose tip the tendon is fixed.
+    pub fn last_segment(&self) -> usize {
+        self.last_segment
+    }
+}
+
+/// A PCC robot (immutable, validated): elastic segments base to tip, tendons routed through
+/// them, and pneumatic chambers per segment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccRobot {
+    bodies: Vec<ElasticSegment>,
+    tendons: Vec<RoutedTendon>,
+    /// `(segment, chambers)` in the order the pressures are given.
+    chambers: Vec<(usize, PccChambers)>,
+}
+
+impl PccRobot {
+    /// A robot of at least one segment, base to tip, without actuators.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `segments` if empty.
+    pub fn new(segments: Vec<ElasticSegment>) -> Result<Self> {
+        if segments.is_empty() {
+            return Err(Error::invalid("segments", "[]", "at least one segment"));
+        }
+        Ok(Self {
+            bodies: segments,
+            tendons: Vec::new(),
+            chambers: Vec::new(),
+        })
+    }
+
+    /// Adds a tendon (its index is the number of tendons added before it).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `last_segment` if it is not a segment of the robot.
+    pub fn with_tendon(mut self, tendon: RoutedTendon) -> Result<Self> {
+        self.check_segment("last_segment", tendon.last_segment)?;
+        self.tendons.push(tendon);
+        Ok(self)
+    }
+
+    /// Adds every tendon of `tendons`, terminated at the tip of `segment` (and passing through
+    /// the segments before it at the same body offsets).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `segment` if it is not a segment of the robot.
+    pub fn with_segment_tendons(mut self, segment: usize, tendons: &PccTendons) -> Result<Self> {
+        self.check_segment("segment", segment)?;
+        for (&d, &b) in tendons.distances().iter().zip(tendons.angles()) {
+            self.tendons.push(RoutedTendon::new(d, b, segment)?);
+        }
+        Ok(self)
+    }
+
+    /// Adds pneumatic `chambers` to `segment` (their pressures follow those of the chambers
+    /// added before).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `segment` if it is not a segment of the robot.
+    pub fn with_chambers(mut self, segment: usize, chambers: PccChambers) -> Result<Self> {
+        self.check_segment("segment", segment)?;
+        self.chambers.push((segment, chambers));
+        Ok(self)
+    }
+
+    fn check_segment(&self, name: &str, segment: usize) -> Result<()> {
+        if segment < self.bodies.len() {
+            Ok(())
+        } else {
+            Err(Error::invalid(
+                name,
+                segment,
+                format!("a segment index < {}", self.bodies.len()),
+            ))
+        }
+    }
+
+    /// The segments' elastic properties, base to tip.
+    pub fn segments(&self) -> &[ElasticSegment] {
+        &self.bodies
+    }
+    /// The tendons, in the order of their tensions.
+    pub fn tendons(&self) -> &[RoutedTendon] {
+        &self.tendons
+    }
+    /// The chamber groups `(segment, chambers)`, in the order of their pressures.
+    pub fn chambers(&self) -> &[(usize, PccChambers)] {
+        &self.chambers
+    }
+    /// Number of tensions expected.
+    pub fn n_tendons(&self) -> usize {
+        self.tendons.len()
+    }
+    /// Number of pressures expected.
+    pub fn n_chambers(&self) -> usize {
+        self.chambers.iter().map(|(_, c)| c.len()).sum()
+    }
+}
+
+/// Actuation and external loads of one configuration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PccLoads {
+    /// One tension per tendon (N, >= 0); empty: all zero.
+    pub tensions: Vec<f64>,
+    /// One gauge pressure per chamber (Pa); empty: all zero.
+    pub pressures: Vec<f64>,
+    /// Force at the tip (N, world frame, dead load).
+    pub tip_force: Vector3<f64>,
+    /// Moment at the tip (N m, world frame, dead load).
+    pub tip_moment: Vector3<f64>,
+}
+
+/// Options of [`solve_pcc_statics`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccSolveOptions {
+    /// Tolerance on the scaled residual (max norm), > 0.
+    pub tolerance: f64,
+    /// Newton iterations per solve (per load step), >= 1.
+    pub max_iterations: usize,
+    /// Whether to fall back on stepping the tip load when the direct solve fails.
+    pub continuation: bool,
+    /// Load steps (attempted) under continuation, >= 1.
+    pub max_load_steps: usize,
+    /// Initial guess, one segment per robot segment; `None` starts from the actuator-only
+    /// solution (exact without a tip load).
+    pub warm_start: Option<Vec<PccSegment>>,
+    /// `true`: non-convergence is [`Error::NotConverged`]; `false`: the last iterate is
+    /// returned with `stats.converged == false`.
+    pub throw: bool,
+}
+
+impl Default for PccSolveOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: DEFAULT_TOLERANCE,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
+            continuation: true,
+            max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+            warm_start: None,
+            throw: true,
+        }
+    }
+}
+
+/// Solver statistics of [`solve_pcc_statics`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PccSolverStats {
+    /// Newton iterations (accepted steps), over all load steps.
+    pub iterations: usize,
+    /// Final scaled residual (max norm: rad for bending, strain for stretch).
+    pub residual: f64,
+    /// Whether the residual met the tolerance.
+    pub converged: bool,
+    /// Load steps taken by the continuation (0: solved directly).
+    pub load_steps: usize,
+}
+
+/// A solved PCC robot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccStaticsSolution {
+    /// Arc parameters of every segment, base to tip (segment `i` in the tip frame of `i - 1`).
+    pub segments: Vec<PccSegment>,
+    /// Tip pose (4×4, tip frame → world).
+    pub tip_pose: Matrix4<f64>,
+    /// Path length of every tendon from the base to its termination (m).
+    pub tendon_lengths: Vec<f64>,
+    /// Solver statistics.
+    pub stats: PccSolverStats,
+}
+
+impl PccStaticsSolution {
+    /// The solved shape as a chain (backbone frames, Jacobians).
+    pub fn chain(&self) -> PccChain {
+        // Never empty: a robot has at least one segment.
+        PccChain::new(self.segments.clone()).unwrap_or_else(|_| unreachable!())
+    }
+
+    /// Curvature-vector coordinates `(u_x, u_y, ℓ)` (1/m, 1/m, m) of every segment.
+    pub fn coordinates(&self) -> Vec<[f64; 3]> {
+        self.segments
+            .iter()
+            .map(|s| {
+                let u = s.curvature_vector();
+                [u.x, u.y, s.length()]
+            })
+            .collect()
+    }
+
+    /// Warm start for a nearby problem.
+    pub fn warm_start(&self) -> Vec<PccSegment> {
+        self.segments.clone()
+    }
+}
+
+/// The equilibrium equations at one configuration, in curvature-vector coordinates
+/// `(u_x, u_y, ℓ)` per segment (3n rows, segment-major).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PccEquilibrium {
+    /// `g = ∂U/∂q + Σ τ ∂L/∂q - Σ p A ∂L_c/∂q - J_hᵀ [F; M]`: N m² for `u_x, u_y`, N for
+    /// `ℓ`. For an inextensible segment the `ℓ` row is `(E I/ℓ0²) (ℓ - ℓ0)` instead.
+    pub residual: DVector<f64>,
+    /// Exact Jacobian `∂g/∂q` (3n × 3n, unsymmetric under a tip moment).
+    pub jacobian: DMatrix<f64>,
+    /// Scaled residual (max norm), as compared with [`PccSolveOptions::tolerance`].
+    pub scaled_residual: f64,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Arc functions of x = θ².
+// ---------------------------------------------------------------------------------------------
+
+/// `S = sin θ/θ`, `B = (1 - cos θ)/θ²`, `C = (θ - sin θ)/θ³` and their derivatives in `x = θ²`.
+#[derive(Debug, Clone, Copy)]
+struct ArcFns {
+    s: f64,
+    s1: f64,
+    s2: f64,
+    b: f64,
+    b1: f64,
+    b2: f64,
+    c: f64,
+    c1: f64,
+}
+
+/// Coefficients `(-1)^k / (2k + n)!` of the series of `S` (`n = 1`), `B` (2) and `C` (3).
+const fn series_coefficients(n: u32) -> [f64; SERIES_TERMS] {
+    let mut c = [0.0; SERIES_TERMS];
+    let mut fact = 1.0;
+    let mut i = 2;
+    while i <= n {
+        fact *= i as f64;
+        i += 1;
+    }
+    c[0] = 1.0 / fact;
+    let mut k = 1;
+    while k < SERIES_TERMS {
+        let m = (2 * k as u32 + n) as f64;
+        c[k] = -c[k - 1] / ((m - 1.0) * m);
+        k += 1;
+    }
+    c
+}
+
+const SERIES_S: [f64; SERIES_TERMS] = series_coefficients(1);
+const SERIES_B: [f64; SERIES_TERMS] = series_coefficients(2);
+const SERIES_C: [f64; SERIES_TERMS] = series_coefficients(3);
+
+/// `Σ_k c_k x^k` and its first two derivatives, by Horner's rule.
+#[inline]
+fn series(c: &[f64; SERIES_TERMS], x: f64) -> (f64, f64, f64) {
+    let (mut f, mut f1, mut f2) = (0.0, 0.0, 0.0);
+    for k in (0..SERIES_TERMS).rev() {
+        let kf = k as f64;
+        f = f * x + c[k];
+        if k >= 1 {
+            f1 = f1 * x + kf * c[k];
+        }
+        if k >= 2 {
+            f2 = f2 * x + kf * (kf - 1.0) * c[k];
+        }
+    }
+    (f, f1, f2)
+}
+
+fn arc_fns(x: f64) -> ArcFns {
+    if x < SERIES_BOUND {
+        let (s, s1, s2) = series(&SERIES_S, x);
+        let (b, b1, b2) = series(&SERIES_B, x);
+        let (c, c1, _) = series(&SERIES_C, x);
+        return ArcFns {
+            s,
+            s1,
+            s2,
+            b,
+            b1,
+            b2,
+            c,
+            c1,
+        };
+    }
+    let th = x.sqrt();
+    let (sn, cs) = th.sin_cos();
+    let s = sn / th;
+    let s1 = (cs - s) / (2.0 * x);
+    let s2 = (-0.5 * s - 3.0 * s1) / (2.0 * x);
+    let b = (1.0 - cs) / x;
+    let b1 = (0.5 * s - b) / x;
+    let b2 = (0.5 * s1 - 2.0 * b1) / x;
+    let c = (1.0 - s) / x;
+    let c1 = (-s1 - c) / x;
+    ArcFns {
+        s,
+        s1,
+        s2,
+        b,
+        b1,
+        b2,
+        c,
+        c1,
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Segment kinematics in θ coordinates (θ_x, θ_y, ℓ) with first and second derivatives.
+// ---------------------------------------------------------------------------------------------
+
+/// One segment's tip pose (segment base frame) and its derivatives in `(θ_x, θ_y, ℓ)`.
+#[derive(Debug, Clone, Copy)]
+struct SegKin {
+    r: Matrix3<f64>,
+    p: Vector3<f64>,
+    /// `∂p/∂(θ_x, θ_y, ℓ)`.
+    dp: [Vector3<f64>; 3],
+    /// Spatial angular velocity per unit `θ_x`, `θ_y` (zero for `ℓ`).
+    w: [Vector3<f64>; 2],
+    /// `∂²p/∂q_k∂q_m`.
+    ddp: [[Vector3<f64>; 3]; 3],
+    /// `∂w_k/∂θ_m`.
+    dw: [[Vector3<f64>; 2]; 2],
+}
+
+fn seg_kin(a: f64, b: f64, l: f64) -> SegKin {
+    let x = a * a + b * b;
+    let f = arc_fns(x);
+    let (ab, a2, b2) = (a * b, a * a, b * b);
+    let r = Matrix3::new(
+        1.0 - f.b * b2,
+        f.b * ab,
+        f.s * b,
+        f.b * ab,
+        1.0 - f.b * a2,
+        -f.s * a,
+        -f.s * b,
+        f.s * a,
+        1.0 - f.b * x,
+    );
+    // P = p/ℓ = (B b, -B a, S).
+    let pp = Vector3::new(f.b * b, -f.b * a, f.s);
+    let dpa = Vector3::new(2.0 * ab * f.b1, -2.0 * a2 * f.b1 - f.b, 2.0 * a * f.s1);
+    let dpb = Vector3::new(2.0 * b2 * f.b1 + f.b, -2.0 * ab * f.b1, 2.0 * b * f.s1);
+    let daa = Vector3::new(
+        2.0 * b * f.b1 + 4.0 * a2 * b * f.b2,
+        -6.0 * a * f.b1 - 4.0 * a2 * a * f.b2,
+        2.0 * f.s1 + 4.0 * a2 * f.s2,
+    );
+    let dab = Vector3::new(
+        2.0 * a * f.b1 + 4.0 * a * b2 * f.b2,
+        -2.0 * b * f.b1 - 4.0 * a2 * b * f.b2,
+        4.0 * ab * f.s2,
+    );
+    let dbb = Vector3::new(
+        6.0 * b * f.b1 + 4.0 * b2 * b * f.b2,
+        -2.0 * a * f.b1 - 4.0 * a * b2 * f.b2,
+        2.0 * f.s1 + 4.0 * b2 * f.s2,
+    );
+    let wa = Vector3::new(1.0 - f.c * b2, f.c * ab, -f.b * b);
+    let wb = Vector3::new(f.c * ab, 1.0 - f.c * a2, f.b * a);
+    let waa = Vector3::new(
+        -2.0 * a * b2 * f.c1,
+        2.0 * a2 * b * f.c1 + b * f.c,
+        -2.0 * ab * f.b1,
+    );
+    let wab = Vector3::new(
+        -2.0 * b2 * b * f.c1 - 2.0 * b * f.c,
+        2.0 * a * b2 * f.c1 + a * f.c,
+        -2.0 * b2 * f.b1 - f.b,
+    );
+    let wba = Vector3::new(
+        2.0 * a2 * b * f.c1 + b * f.c,
+        -2.0 * a2 * a * f.c1 - 2.0 * a * f.c,
+        2.0 * a2 * f.b1 + f.b,
+    );
+    let wbb = Vector3::new(
+        2.0 * a * b2 * f.c1 + a * f.c,
+        -2.0 * a2 * b * f.c1,
+        2.0 * ab * f.b1,
+    );
+    let z = Vector3::zeros();
+    SegKin {
+        r,
+        p: pp * l,
+        dp: [dpa * l, dpb * l, pp],
+        w: [wa, wb],
+        ddp: [
+            [daa * l, dab * l, dpa],
+            [dab * l, dbb * l, dpb],
+            [dpa, dpb, z],
+        ],
+        dw: [[waa, wab], [wba, wbb]],
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The equilibrium equations.
+// ---------------------------------------------------------------------------------------------
+
+/// Validated loads with per-segment actuator terms (constant in θ coordinates).
+struct Prepared {
+    /// Per segment: generalized actuator force on `(θ_x, θ_y, ℓ)` (N m, N m, N).
+    actuation: Vec<[f64; 3]>,
+    force: Vector3<f64>,
+    moment: Vector3<f64>,
+}
+
+fn check_vector(name: &str, v: &Vector3<f64>) -> Result<()> {
+    for k in 0..3 {
+        if !v[k].is_finite() {
+            return Err(Error::invalid(format!("{name}[{k}]"), v[k], "finite"));
+        }
+    }
+    Ok(())
+}
+
+fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
+    let nt = robot.n_tendons();
+    let nc = robot.n_chambers();
+    if !(loads.tensions.is_empty() || loads.tensions.len() == nt) {
+        return Err(Error::invalid(
+            "tensions.len()",
+            loads.tensions.len(),
+            format!("the number of tendons, {nt} (or 0 for none)"),
+        ));
+    }
+    if !(loads.pressures.is_empty() || loads.pressures.len() == nc) {
+        return Err(Error::invalid(
+            "pressures.len()",
+            loads.pressures.len(),
+            format!("the number of chambers, {nc} (or 0 for none)"),
+        ));
+    }
+    for (i, &t) in loads.tensions.iter().enumerate() {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(Error::invalid(
+                format!("tensions[{i}]"),
+                t,
+                "finite and >= 0 N",
+            ));
+        }
+    }
+    for (i, &p) in loads.pressures.iter().enumerate() {
+        check_finite(&format!("pressures[{i}]"), p)?;
+    }
+    check_vector("tip_force", &loads.tip_force)?;
+    check_vector("tip_moment", &loads.tip_moment)?;
+    let mut actuation = vec![[0.0; 3]; robot.bodies.len()];
+    for (t, &tau) in robot.tendons.iter().zip(&loads.tensions) {
+        // -τ ∂L/∂(θ_x, θ_y, ℓ) = τ (-d sin β, d cos β, -1) on every segment passed.
+        for act in actuation.iter_mut().take(t.last_segment + 1) {
+            act[0] -= tau * t.distance * t.sin;
+            act[1] += tau * t.distance * t.cos;
+            act[2] -= tau;
+        }
+    }
+    let mut k = 0;
+    for (seg, ch) in &robot.chambers {
+        for i in 0..ch.len() {
+            let p = loads.pressures.get(k).copied().unwrap_or(0.0);
+            k += 1;
+            let (a, r, b) = (ch.areas()[i], ch.distances()[i], ch.angles()[i]);
+            let (sb, cb) = b.sin_cos();
+            // p A ∂L_c/∂(θ_x, θ_y, ℓ) = p A (r sin β, -r cos β, 1).
+            actuation[*seg][0] += p * a * r * sb;
+            actuation[*seg][1] -= p * a * r * cb;
+            actuation[*seg][2] += p * a;
+        }
+    }
+    Ok(Prepared {
+        actuation,
+        force: loads.tip_force,
+        moment: loads.tip_moment,
+    })
+}
+
+/// Scratch of one solve: per-segment kinematics in the world frame.
+struct Work {
+    kin: Vec<SegKin>,
+    /// Rotation of each segment's base frame (world).
+    base_r: Vec<Matrix3<f64>>,
+    /// World position of each segment's tip.
+    tips: Vec<Vector3<f64>>,
+    g_theta: DVector<f64>,
+    h_theta: DMatrix<f64>,
+    g: DVector<f64>,
+    h: DMatrix<f64>,
+    /// Load-stiffness scratch: world columns `P`, `Ω`, `V`, tip offsets `d`, moments `μ`.
+    pc: Vec<[Vector3<f64>; 3]>,
+    oc: Vec<[Vector3<f64>; 3]>,
+    vc: Vec<[Vector3<f64>; 3]>,
+    dd: Vec<Vector3<f64>>,
+    mu: Vec<Vector3<f64>>,
+}
+
+impl Work {
+    fn new(n: usize) -> Self {
+        Self {
+            kin: Vec::with_capacity(n),
+            base_r: Vec::with_capacity(n),
+            tips: Vec::with_capacity(n),
+            g_theta: DVector::zeros(3 * n),
+            h_theta: DMatrix::zeros(0, 0),
+            g: DVector::zeros(3 * n),
+            h: DMatrix::zeros(0, 0),
+            pc: Vec::new(),
+            oc: Vec::new(),
+            vc: Vec::new(),
+            dd: Vec::new(),
+            mu: Vec::new(),
+        }
+    }
+}
+
+/// Evaluates the residual (and, if `jacobian`, its Jacobian) at `q` (`(u_x, u_y, ℓ)` per
+/// segment) with the tip load scaled by `factor`. Returns the scaled max-norm residual.
+fn evaluate(
+    robot: &PccRobot,
+    prep: &Prepared,
+    q: &[[f64; 3]],
+    factor: f64,
+    jacobian: bool,
+    w: &mut Work,
+) -> f64 {
+    let n = q.len();
+    w.kin.clear();
+    w.base_r.clear();
+    w.tips.clear();
+    let (mut gr, mut gp) = (Matrix3::identity(), Vector3::zeros());
+    for qi in q {
+        let l = qi[2];
+        let k = seg_kin(l * qi[0], l * qi[1], l);
+        w.base_r.push(gr);
+        gp += gr * k.p;
+        gr *= k.r;
+        w.tips.push(gp);
+        w.kin.push(k);
+    }
+    let p_tip = gp;
+    let f = prep.force * factor;
+    let m = prep.moment * factor;
+    let loaded = f != Vector3::zeros() || m != Vector3::zeros();
+
+    // World columns P (position), Ω (rotation), V (tip velocity) and per-segment μ, d.
+    let mut scaled = 0.0f64;
+    for i in 0..n {
+        let body = &robot.bodies[i];
+        let (l0, ei) = (body.rest_length(), body.bending_stiffness());
+        let k = &w.kin[i];
+        let a = q[i][2] * q[i][0];
+        let b = q[i][2] * q[i][1];
+        let act = prep.actuation[i];
+        let mut gq = [
+            ei / l0 * a - act[0],
+            ei / l0 * b - act[1],
+            match body.axial_stiffness() {
+                Some(ea) => ea / l0 * (q[i][2] - l0) - act[2],
+                None => 0.0,
+            },
+        ];
+        if loaded {
+            let d = p_tip - w.tips[i];
+            let mu = m + d.cross(&f);
+            let rt = w.base_r[i].transpose();
+            let (fl, ml) = (rt * f, rt * mu);
+            for c in 0..3 {
+                let mut qc = fl.dot(&k.dp[c]);
+                if c < 2 {
+                    qc += ml.dot(&k.w[c]);
+                }
+                gq[c] -= qc;
+            }
+        }
+        for c in 0..3 {
+            w.g_theta[3 * i + c] = gq[c];
+        }
+        scaled = scaled.max(gq[0].abs().max(gq[1].abs()) * l0 / ei);
+        if let Some(ea) = body.axial_stiffness() {
+            scaled = scaled.max(gq[2].abs() / ea);
+        }
+    }
+    if !scaled.is_finite() {
+        scaled = f64::INFINITY;
+    }
+
+    if jacobian {
+        if w.h.nrows() != 3 * n {
+            w.h_theta = DMatrix::zeros(3 * n, 3 * n);
+            w.h = DMatrix::zeros(3 * n, 3 * n);
+        }
+        w.h_theta.fill(0.0);
+        for i in 0..n {
+            let body = &robot.bodies[i];
+            let l0 = body.rest_length();
+            let kb = body.bending_stiffness() / l0;
+            w.h_theta[(3 * i, 3 * i)] = kb;
+            w.h_theta[(3 * i + 1, 3 * i + 1)] = kb;
+            if let Some(ea) = body.axial_stiffness() {
+                w.h_theta[(3 * i + 2, 3 * i + 2)] = ea / l0;
+            }
+        }
+        if loaded {
+            load_stiffness(w, p_tip, &f, &m);
+        }
+    }
+
+    // To curvature-vector coordinates: g_u = Jᵀ g_θ, H_u = Jᵀ H_θ J + Σ g_θ ∂²θ/∂q².
+    for i in 0..n {
+        let (ux, uy, l) = (q[i][0], q[i][1], q[i][2]);
+        let (ga, gb, gl) = (w.g_theta[3 * i], w.g_theta[3 * i + 1], w.g_theta[3 * i + 2]);
+        w.g[3 * i] = l * ga;
+        w.g[3 * i + 1] = l * gb;
+        w.g[3 * i + 2] = ux * ga + uy * gb + gl;
+    }
+    if jacobian {
+        let dim = 3 * n;
+        // Right multiplication by J (columns), then left by Jᵀ (rows).
+        for j in 0..n {
+            let (ux, uy, l) = (q[j][0], q[j][1], q[j][2]);
+            for r in 0..dim {
+                let (ca, cb, cl) = (
+                    w.h_theta[(r, 3 * j)],
+                    w.h_theta[(r, 3 * j + 1)],
+                    w.h_theta[(r, 3 * j + 2)],
+                );
+                w.h[(r, 3 * j)] = l * ca;
+                w.h[(r, 3 * j + 1)] = l * cb;
+                w.h[(r, 3 * j + 2)] = ux * ca + uy * cb + cl;
+            }
+        }
+        for i in 0..n {
+            let (ux, uy, l) = (q[i][0], q[i][1], q[i][2]);
+            for c in 0..dim {
+                let (ra, rb, rl) = (w.h[(3 * i, c)], w.h[(3 * i + 1, c)], w.h[(3 * i + 2, c)]);
+                w.h[(3 * i, c)] = l * ra;
+                w.h[(3 * i + 1, c)] = l * rb;
+                w.h[(3 * i + 2, c)] = ux * ra + uy * rb + rl;
+            }
+            let (ga, gb) = (w.g_theta[3 * i], w.g_theta[3 * i + 1]);
+            w.h[(3 * i, 3 * i + 2)] += ga;
+            w.h[(3 * i + 2, 3 * i)] += ga;
+            w.h[(3 * i + 1, 3 * i + 2)] += gb;
+            w.h[(3 * i + 2, 3 * i + 1)] += gb;
+        }
+    }
+    // Inextensible segments: the ℓ row is the constraint ℓ = ℓ0.
+    for (i, body) in robot.bodies.iter().enumerate() {
+        if body.axial_stiffness().is_none() {
+            let l0 = body.rest_length();
+            let kc = body.bending_stiffness() / (l0 * l0);
+            w.g[3 * i + 2] = kc * (q[i][2] - l0);
+            if jacobian {
+                for c in 0..3 * n {
+                    w.h[(3 * i + 2, c)] = 0.0;
+                }
+                w.h[(3 * i + 2, 3 * i + 2)] = kc;
+            }
+        }
+    }
+    scaled
+}
+
+/// Adds `-∂(J_hᵀ W)/∂θ` (the load stiffness of the dead tip wrench) to `w.h_theta`.
+fn load_stiffness(w: &mut Work, p_tip: Vector3<f64>, f: &Vector3<f64>, m: &Vector3<f64>) {
+    let n = w.kin.len();
+    if w.pc.len() != n {
+        w.pc = vec![[Vector3::zeros(); 3]; n];
+        w.oc = vec![[Vector3::zeros(); 3]; n];
+        w.vc = vec![[Vector3::zeros(); 3]; n];
+        w.dd = vec![Vector3::zeros(); n];
+        w.mu = vec![Vector3::zeros(); n];
+    }
+    // Here pc = P (world position columns), oc = Ω, vc = V = P + Ω × d (tip velocity).
+    let (pc, oc, vc, dd, mu) = (&mut w.pc, &mut w.oc, &mut w.vc, &mut w.dd, &mut w.mu);
+    for i in 0..n {
+        let gr = &w.base_r[i];
+        let k = &w.kin[i];
+        dd[i] = p_tip - w.tips[i];
+        mu[i] = m + dd[i].cross(f);
+        for c in 0..3 {
+            pc[i][c] = gr * k.dp[c];
+            oc[i][c] = if c < 2 { gr * k.w[c] } else { Vector3::zeros() };
+            vc[i][c] = pc[i][c] + oc[i][c].cross(&dd[i]);
+        }
+    }
+    // Each entry is one dot product with the other segment's column:
+    // j < i: Ω_j·a_ik, a = P_ik × F + d_i × (F × Ω_ik) + Ω_ik × μ_i (proximal rotation);
+    // j > i: V_j·b_ik, b = F × Ω_ik (distal motion of the tip);
+    // j = i: second derivatives of the segment plus Ω_i·(d_i × b_ik).
+    for i in 0..n {
+        let k = &w.kin[i];
+        let rt = w.base_r[i].transpose();
+        let (fl, ml) = (rt * f, rt * mu[i]);
+        for kk in 0..3 {
+            let b = f.cross(&oc[i][kk]);
+            let db = dd[i].cross(&b);
+            let a = pc[i][kk].cross(f) + db + oc[i][kk].cross(&mu[i]);
+            for j in 0..n {
+                for mm in 0..3 {
+                    let dq = if j < i {
+                        oc[j][mm].dot(&a)
+                    } else if j > i {
+                        vc[j][mm].dot(&b)
+                    } else {
+                        let mut v = fl.dot(&k.ddp[kk][mm]) + oc[i][mm].dot(&db);
+                        if kk < 2 && mm < 2 {
+                            v += ml.dot(&k.dw[kk][mm]);
+                        }
+                        v
+                    };
+                    w.h_theta[(3 * i + kk, 3 * j + mm)] -= dq;
+                }
+            }
+        }
+    }
+}
+
+fn check_coordinates(robot: &PccRobot, q: &[[f64; 3]]) -> Result<()> {
+    if q.len() != robot.bodies.len() {
+        return Err(Error::invalid(
+            "coordinates.len()",
+            q.len(),
+            format!("the number of segments, {}", robot.bodies.len()),
+        ));
+    }
+    for (i, qi) in q.iter().enumerate() {
+        for (k, name) in ["u_x", "u_y", "length"].iter().enumerate() {
+            let ok = qi[k].is_finite() && (k < 2 || qi[k] > 0.0);
+            if !ok {
+                return Err(Error::invalid(
+                    format!("coordinates[{i}].{name}"),
+                    qi[k],
+                    if k < 2 {
+                        "finite (1/m)"
+                    } else {
+                        "finite and > 0 m"
+                    },
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The equilibrium residual and its exact Jacobian at the configuration `coordinates`
+/// (`(u_x, u_y, ℓ)` per segment: 1/m, 1/m, m) of `robot` under `loads`; see the module
+/// documentation. Zero residual is equilibrium.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the invalid load (`tensions[i]`, `tip_force[k]`, ...)
+/// or coordinate (`coordinates[i].length`, ...).
+pub fn pcc_equilibrium(
+    robot: &PccRobot,
+    loads: &PccLoads,
+    coordinates: &[[f64; 3]],
+) -> Result<PccEquilibrium> {
+    let prep = prepare(robot, loads)?;
+    check_coordinates(robot, coordinates)?;
+    let mut w = Work::new(coordinates.len());
+    let scaled = evaluate(robot, &prep, coordinates, 1.0, true, &mut w);
+    Ok(PccEquilibrium {
+        residual: w.g,
+        jacobian: w.h,
+        scaled_residual: scaled,
+    })
+}
+
+/// Outcome of the Newton iteration at one load factor.
+struct NewtonOut {
+    q: Vec<[f64; 3]>,
+    residual: f64,
+    converged: bool,
+    iterations: usize,
+}
+
+fn newton(
+    robot: &PccRobot,
+    prep: &Prepared,
+    q0: &[[f64; 3]],
+    factor: f64,
+    likely_exact: bool,
+    opts: &PccSolveOptions,
+    w: &mut Work,
+) -> NewtonOut {
+    let n = q0.len();
+    let mut q = q0.to_vec();
+    let mut trial = q.clone();
+    // Without a tip load the actuator-only start is exact: check it without the Jacobian.
+    let mut rn = evaluate(robot, prep, &q, factor, !likely_exact, w);
+    let mut out = NewtonOut {
+        q: q.clone(),
+        residual: rn,
+        converged: rn <= opts.tolerance,
+        iterations: 0,
+    };
+    if out.converged || !rn.is_finite() {
+        return out;
+    }
+    if likely_exact {
+        evaluate(robot, prep, &q, factor, true, w);
+    }
+    for _ in 0..opts.max_iterations {
+        let rhs = -&w.g;
+        let Some(dx) = w.h.clone().lu().solve(&rhs) else {
+            break;
+        };
+        if !dx.iter().all(|v| v.is_finite()) {
+            break;
+        }
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
+            let mut ok = true;
+            for i in 0..n {
+                for c in 0..3 {
+                    trial[i][c] = q[i][c] + lambda * dx[3 * i + c];
+                }
+                ok &= trial[i][2] > 0.0;
+            }
+            if ok {
+                let rt = evaluate(robot, prep, &trial, factor, true, w);
+                if rt <= (1.0 - ARMIJO * lambda) * rn || rt <= opts.tolerance {
+                    q.copy_from_slice(&trial);
+                    rn = rt;
+                    accepted = true;
+                    break;
+                }
+            }
+            lambda *= 0.5;
+        }
+        if !accepted {
+            // Restore the workspace to the last accepted iterate.
+            evaluate(robot, prep, &q, factor, true, w);
+            break;
+        }
+        out.iterations += 1;
+        if rn <= opts.tolerance {
+            out.converged = true;
+            break;
+        }
+    }
+    out.q = q;
+    out.residual = rn;
+    out
+}
+
+fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
+    if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
+        return Err(Error::invalid(
+            "tolerance",
+            opts.tolerance,
+            "finite and > 0",
+        ));
+    }
+    if opts.max_iterations == 0 {
+        return Err(Error::invalid(
+            "max_iterations",
+            opts.max_iterations,
+            ">= 1",
+        ));
+    }
+    if opts.max_load_steps == 0 {
+        return Err(Error::invalid(
+            "max_load_steps",
+            opts.max_load_steps,
+            ">= 1",
+        ));
+    }
+    if let Some(ws) = &opts.warm_start {
+        if ws.len() != robot.bodies.len() {
+            return Err(Error::invalid(
+                "warm_start.len()",
+                ws.len(),
+                format!("the number of segments, {}", robot.bodies.len()),
+            ));
+        }
+        for (i, s) in ws.iter().enumerate() {
+            if s.length() <= 0.0 {
+                return Err(Error::invalid(
+                    format!("warm_start[{i}].length"),
+                    s.length(),
+                    "> 0 m",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The actuator-only equilibrium (exact, closed form) in `(u_x, u_y, ℓ)`.
+fn actuated(robot: &PccRobot, prep: &Prepared, loads: &PccLoads) -> Result<Vec<[f64; 3]>> {
+    robot
+        .bodies
+        .iter()
+        .zip(&prep.actuation)
+        .map(|(body, act)| {
+            let l0 = body.rest_length();
+            let l = match body.axial_stiffness() {
+                Some(ea) => l0 * (1.0 + act[2] / ea),
+                None => l0,
+            };
+            if !(l > 0.0 && l.is_finite()) {
+                let (name, values) = if loads.pressures.is_empty() {
+                    ("tensions", format!("{:?}", loads.tensions))
+                } else {
+                    ("pressures", format!("{:?}", loads.pressures))
+                };
+                return Err(Error::invalid(
+                    name,
+                    values,
+                    format!("an axial strain > -1 (net axial force {:e} N)", act[2]),
+                ));
+            }
+            let th = l0 / body.bending_stiffness();
+            Ok([th * act[0] / l, th * act[1] / l, l])
+        })
+        .collect()
+}
+
+/// Solves the statics of `robot` under `loads` (tensions, pressures, world-frame tip wrench)
+/// by damped Newton with the exact Jacobian; see the module documentation for the model.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the invalid load (`tensions.len()`, `tensions[i]`,
+/// `pressures[i]`, `tip_force[k]`, `tip_moment[k]`), option or warm start, or the actuation
+/// (`tensions`/`pressures`) if it would compress a segment to zero length;
+/// [`Error::NotConverged`] if Newton (with continuation) fails and `options.throw` is true.
+pub fn solve_pcc_statics(
+    robot: &PccRobot,
+    loads: &PccLoads,
+    options: &PccSolveOptions,
+) -> Result<PccStaticsSolution> {
+    check_options(robot, options)?;
+    let prep = prepare(robot, loads)?;
+    let n = robot.bodies.len();
+    let q_act = actuated(robot, &prep, loads)?;
+    let q0 = match &options.warm_start {
+        Some(ws) => ws
+            .iter()
+            .map(|s| {
+                let u = s.curvature_vector();
+                [u.x, u.y, s.length()]
+            })
+            .collect(),
+        None => q_act.clone(),
+    };
+    let mut w = Work::new(n);
+    let mut stats = PccSolverStats::default();
+    let unloaded = prep.force == Vector3::zeros() && prep.moment == Vector3::zeros();
+    let likely_exact = unloaded && options.warm_start.is_none();
+    let mut result = newton(robot, &prep, &q0, 1.0, likely_exact, options, &mut w);
+    stats.iterations = result.iterations;
+    if !result.converged && options.continuation {
+        let (mut lambda, mut dl) = (0.0f64, 0.25f64);
+        let mut q = q_act;
+        let mut steps = 0usize;
+        let mut last = None;
+        while steps < options.max_load_steps {
+            let target = (lambda + dl).min(1.0);
+            let out = newton(robot, &prep, &q, target, false, options, &mut w);
+            stats.iterations += out.iterations;
+            steps += 1;
+            if out.converged {
+                lambda = target;
+                q.clone_from(&out.q);
+                let done = lambda >= 1.0;
+                last = Some(out);
+                if done {
+                    break;
+                }
+                dl = (dl * 2.0).min(0.5);
+            } else {
+                dl *= 0.5;
+                if dl < MIN_LOAD_INCREMENT {
+                    break;
+                }
+            }
+        }
+        stats.load_steps = steps;
+        if let Some(out) = last.filter(|_| lambda >= 1.0) {
+            result = out;
+        }
+    }
+    stats.residual = result.residual;
+    stats.converged = result.converged;
+    if !result.converged && options.throw {
+        return Err(Error::NotConverged {
+            what: "PCC statics Newton".into(),
+            iterations: stats.iterations,
+            residual: result.residual,
+        });
+    }
+    let segments = result
+        .q
+        .iter()
+        .map(|qi| PccSegment::from_curvature_vector(qi[0], qi[1], qi[2]))
+        .collect::<Result<Vec<_>>>()?;
+    let tendon_lengths = robot
+        .tendons
+        .iter()
+        .map(|t| {
+            result.q[..=t.last_segment]
+                .iter()
+                .map(|qi| {
+                    let (a, b) = (qi[2] * qi[0], qi[2] * qi[1]);
+                    qi[2] - t.distance * (b * t.cos - a * t.sin)
+                })
+                .sum()
+        })
+        .collect();
+    Ok(PccStaticsSolution {
+        tip_pose: chain_pose(&segments),
+        segments,
+        tendon_lengths,
+        stats,
+    })
+}
