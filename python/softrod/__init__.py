@@ -7,6 +7,7 @@ file I/O (:mod:`softrod.io`), plots (:mod:`softrod.plot`) and the ``softrod`` co
 (:mod:`softrod.cli`).
 """
 
+from . import pcc
 from ._core import (
     SILICONES,
     CircularSection,
@@ -80,6 +81,7 @@ __all__ = [
     "backbone_distance",
     "fit_uniaxial",
     "load_robot",
+    "pcc",
     "read_backbone_csv",
     "read_tensile_csv",
     "silicone",

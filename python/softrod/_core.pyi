@@ -478,3 +478,171 @@ def fit_uniaxial(
     tolerance: float | None = None,
 ) -> UniaxialFit: ...
 def silicone(name: str) -> Silicone: ...
+
+# ----------------------------------------------------------------------------- PCC (softrod.pcc)
+
+_Frame = Literal["spatial", "body", "hybrid"]
+_Coordinates = Literal["arc", "curvature_vector"]
+_Rows = Sequence[Sequence[float]] | NDArray[np.float64]
+
+@final
+class PccRobot:
+    """A PCC robot (immutable): elastic segments base to tip, routed tendons, chambers."""
+
+    def __new__(
+        cls,
+        rest_lengths: _Floats,
+        bending_stiffness: _Floats,
+        axial_stiffness: _Floats | None = None,
+    ) -> PccRobot: ...
+    @staticmethod
+    def solid_circle(
+        rest_lengths: _Floats, radius: float, youngs_modulus: float, *, extensible: bool = True
+    ) -> PccRobot: ...
+    def with_tendons(self, segment: int, distances: _Floats, angles: _Floats) -> PccRobot: ...
+    def with_chambers(
+        self, segment: int, areas: _Floats, distances: _Floats, angles: _Floats
+    ) -> PccRobot: ...
+    @property
+    def n_segments(self) -> int: ...
+    @property
+    def n_tendons(self) -> int: ...
+    @property
+    def n_chambers(self) -> int: ...
+    @property
+    def rest_lengths(self) -> NDArray[np.float64]: ...
+    @property
+    def bending_stiffness(self) -> NDArray[np.float64]: ...
+    @property
+    def axial_stiffness(self) -> list[float | None]: ...
+    @property
+    def tendons(self) -> NDArray[np.float64]: ...
+
+@final
+class PccSolution:
+    """A solved PCC robot: arcs, tip pose, backbone frames (SI units)."""
+
+    @property
+    def arcs(self) -> NDArray[np.float64]: ...
+    @property
+    def coordinates(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_pose(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_position(self) -> NDArray[np.float64]: ...
+    @property
+    def s(self) -> NDArray[np.float64]: ...
+    @property
+    def frames(self) -> NDArray[np.float64]: ...
+    @property
+    def positions(self) -> NDArray[np.float64]: ...
+    @property
+    def tendon_lengths(self) -> NDArray[np.float64]: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def residual(self) -> float: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def load_steps(self) -> int: ...
+    def frames_at(self, s: _Floats) -> NDArray[np.float64]: ...
+
+def pcc_solve(
+    robot: PccRobot,
+    tensions: _Floats | None = None,
+    pressures: _Floats | None = None,
+    *,
+    tip_force: _Floats | None = None,
+    tip_moment: _Floats | None = None,
+    s: _Floats | None = None,
+    n_points: int = 50,
+    tolerance: float = 1e-12,
+    max_iterations: int = 50,
+    continuation: bool = True,
+    max_load_steps: int = 64,
+    warm_start: PccSolution | _Rows | None = None,
+    throw: bool = True,
+) -> PccSolution: ...
+def pcc_arc_pose(curvature: float, plane_angle: float, length: float) -> NDArray[np.float64]: ...
+def pcc_arc_frames(
+    curvature: float, plane_angle: float, length: float, s: _Floats
+) -> NDArray[np.float64]: ...
+def pcc_arc_jacobian(
+    curvature: float,
+    plane_angle: float,
+    length: float,
+    *,
+    frame: _Frame = "spatial",
+    coordinates: _Coordinates = "arc",
+) -> NDArray[np.float64]: ...
+def pcc_chain_pose(segments: _Rows) -> NDArray[np.float64]: ...
+def pcc_chain_frames(segments: _Rows, s: _Floats) -> NDArray[np.float64]: ...
+def pcc_chain_jacobian(
+    segments: _Rows, *, frame: _Frame = "spatial", coordinates: _Coordinates = "arc"
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_tip(position: _Floats) -> NDArray[np.float64]: ...
+def pcc_arc_from_tip_with_length(
+    position: _Floats, length: float
+) -> tuple[NDArray[np.float64], float]: ...
+def pcc_tendon_displacements(
+    arc: _Floats, distances: _Floats, angles: _Floats, rest_length: float | None = None
+) -> NDArray[np.float64]: ...
+def pcc_tendon_displacement_jacobian(
+    arc: _Floats, distances: _Floats, angles: _Floats, *, coordinates: _Coordinates = "arc"
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_tendon_displacements(
+    displacements: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    *,
+    extensible: bool = True,
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_tendon_displacements_jacobian(
+    displacements: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    *,
+    extensible: bool = True,
+    coordinates: _Coordinates = "arc",
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_tendon_tensions(
+    tensions: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    bending_stiffness: float,
+    axial_stiffness: float | None = None,
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_tendon_tensions_jacobian(
+    tensions: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    bending_stiffness: float,
+    axial_stiffness: float | None = None,
+    *,
+    coordinates: _Coordinates = "arc",
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_pressures(
+    pressures: _Floats,
+    areas: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    bending_stiffness: float,
+    axial_stiffness: float | None = None,
+) -> NDArray[np.float64]: ...
+def pcc_arc_from_pressures_jacobian(
+    pressures: _Floats,
+    areas: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    bending_stiffness: float,
+    axial_stiffness: float | None = None,
+    *,
+    coordinates: _Coordinates = "arc",
+) -> NDArray[np.float64]: ...

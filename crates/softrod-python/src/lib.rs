@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 mod convert;
 mod errors;
 mod materials;
+mod pcc;
 mod planar;
 mod statics;
 
@@ -54,5 +55,27 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(materials::silicone, m)?)?;
     m.add("SILICONES", materials::silicone_names(m.py())?)?;
     m.add_function(wrap_pyfunction!(statics::_time_solve_statics, m)?)?;
+    m.add_class::<pcc::PccRobot>()?;
+    m.add_class::<pcc::PccSolution>()?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_chain_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_chain_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_chain_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tip, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tip_with_length, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_tendon_displacements, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_tendon_displacement_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tendon_displacements, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        pcc::pcc_arc_from_tendon_displacements_jacobian,
+        m
+    )?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tendon_tensions, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tendon_tensions_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_pressures, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_pressures_jacobian, m)?)?;
     Ok(())
 }

@@ -1,0 +1,788 @@
+//! Binding of PCC kinematics, actuation maps and statics (`softrod.pcc` in Python).
+//!
+//! Every function here is `pcc_<name>` in `softrod._core` and `softrod.pcc.<name>` in the
+//! package. Arc parameters are rows `(curvature, plane_angle, length)` (1/m, rad, m); poses
+//! are 4×4 homogeneous transforms; Jacobians are 6×3 per segment with twists
+//! `[translation; rotation]`.
+
+use numpy::ndarray::Array;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use softrod::nalgebra::{Matrix4, Vector3};
+use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegment};
+use softrod::pcc_statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
+
+use crate::errors::{param_err, to_py_err};
+
+/// Floats given as a NumPy array (any strides), any sequence, or one number.
+#[derive(FromPyObject)]
+pub(crate) enum Floats<'py> {
+    Array(numpy::PyReadonlyArray1<'py, f64>),
+    Scalar(f64),
+    Seq(Vec<f64>),
+}
+
+impl Floats<'_> {
+    fn to_vec(&self) -> PyResult<Vec<f64>> {
+        Ok(match self {
+            Floats::Array(a) => a.as_array().to_vec(),
+            Floats::Scalar(x) => vec![*x],
+            Floats::Seq(v) => v.clone(),
+        })
+    }
+}
+
+// The Python signature spells the core's defaults as literals; keep them in step.
+const _: () = assert!(statics::DEFAULT_TOLERANCE == 1e-12);
+const _: () = assert!(statics::DEFAULT_MAX_ITERATIONS == 50);
+const _: () = assert!(statics::DEFAULT_MAX_LOAD_STEPS == 64);
+
+fn frame_from(frame: &str) -> PyResult<JacobianFrame> {
+    match frame {
+        "spatial" => Ok(JacobianFrame::Spatial),
+        "body" => Ok(JacobianFrame::Body),
+        "hybrid" => Ok(JacobianFrame::Hybrid),
+        other => Err(param_err(
+            "frame",
+            other,
+            "\"spatial\", \"body\" or \"hybrid\"",
+        )),
+    }
+}
+
+fn coordinates_from(coordinates: &str) -> PyResult<ArcCoordinates> {
+    match coordinates {
+        "arc" => Ok(ArcCoordinates::Arc),
+        "curvature_vector" | "curvature-vector" => Ok(ArcCoordinates::CurvatureVector),
+        other => Err(param_err(
+            "coordinates",
+            other,
+            "\"arc\" or \"curvature_vector\"",
+        )),
+    }
+}
+
+/// Rows of three floats: an (n, 3) array or nested sequence (one row of 3 is accepted too).
+fn rows3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
+    let rows: Vec<Vec<f64>> = if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, f64>>() {
+        a.as_array()
+            .rows()
+            .into_iter()
+            .map(|r| r.to_vec())
+            .collect()
+    } else if let Ok(v) = obj.extract::<Vec<Vec<f64>>>() {
+        v
+    } else if let Ok(v) = obj.extract::<Vec<f64>>() {
+        vec![v]
+    } else {
+        return Err(param_err(name, "<object>", "an (n, 3) array of floats"));
+    };
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            <[f64; 3]>::try_from(r.as_slice()).map_err(|_| {
+                param_err(
+                    &format!("{name}[{i}]"),
+                    format!("{r:?}"),
+                    "a row of 3 floats (curvature, plane_angle, length)",
+                )
+            })
+        })
+        .collect()
+}
+
+fn vector3(v: Floats<'_>, name: &str) -> PyResult<Vector3<f64>> {
+    let v = v.to_vec()?;
+    if v.len() != 3 {
+        return Err(param_err(&format!("{name}.len()"), v.len(), "3 (x, y, z)"));
+    }
+    Ok(Vector3::new(v[0], v[1], v[2]))
+}
+
+fn arc3(arc: Floats<'_>, name: &str) -> PyResult<PccSegment> {
+    let a = vector3(arc, name)?;
+    PccSegment::new(a[0], a[1], a[2]).map_err(to_py_err)
+}
+
+fn segments_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<PccSegment>> {
+    let rows = rows3(obj, "segments")?;
+    pcc::PccChain::from_parameters(&rows)
+        .map(|c| c.segments().to_vec())
+        .map_err(to_py_err)
+}
+
+fn pose_array<'py>(py: Python<'py>, t: &Matrix4<f64>) -> Bound<'py, PyArray2<f64>> {
+    Array::from_shape_fn((4, 4), |(i, j)| t[(i, j)]).into_pyarray(py)
+}
+
+fn poses_array<'py>(py: Python<'py>, ts: &[Matrix4<f64>]) -> Bound<'py, PyArray3<f64>> {
+    Array::from_shape_fn((ts.len(), 4, 4), |(k, i, j)| ts[k][(i, j)]).into_pyarray(py)
+}
+
+fn matrix_array<'py, R: softrod::nalgebra::Dim, C: softrod::nalgebra::Dim, S>(
+    py: Python<'py>,
+    m: &softrod::nalgebra::Matrix<f64, R, C, S>,
+) -> Bound<'py, PyArray2<f64>>
+where
+    S: softrod::nalgebra::RawStorage<f64, R, C>,
+{
+    Array::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
+}
+
+fn arc_array<'py>(py: Python<'py>, s: &PccSegment) -> Bound<'py, PyArray1<f64>> {
+    vec![s.curvature(), s.plane_angle(), s.length()].into_pyarray(py)
+}
+
+// ------------------------------------------------------------------------------ kinematics
+
+/// Tip pose (4×4) of one arc.
+#[pyfunction]
+pub(crate) fn pcc_arc_pose(
+    py: Python<'_>,
+    curvature: f64,
+    plane_angle: f64,
+    length: f64,
+) -> PyResult<Bound<'_, PyArray2<f64>>> {
+    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(to_py_err)?;
+    Ok(pose_array(py, &t))
+}
+
+/// Backbone frames (N, 4, 4) of one arc at arc lengths `s`.
+#[pyfunction]
+pub(crate) fn pcc_arc_frames<'py>(
+    py: Python<'py>,
+    curvature: f64,
+    plane_angle: f64,
+    length: f64,
+    s: Floats<'py>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let s = s.to_vec()?;
+    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(to_py_err)?;
+    Ok(poses_array(py, &ts))
+}
+
+/// 6×3 Jacobian of one arc's tip pose.
+#[pyfunction]
+#[pyo3(signature = (curvature, plane_angle, length, *, frame="spatial", coordinates="arc"))]
+pub(crate) fn pcc_arc_jacobian<'py>(
+    py: Python<'py>,
+    curvature: f64,
+    plane_angle: f64,
+    length: f64,
+    frame: &str,
+    coordinates: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (f, c) = (frame_from(frame)?, coordinates_from(coordinates)?);
+    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(to_py_err)?;
+    Ok(matrix_array(py, &j))
+}
+
+/// Tip pose (4×4) of a chain of arcs given as rows (curvature, plane_angle, length).
+#[pyfunction]
+pub(crate) fn pcc_chain_pose<'py>(
+    py: Python<'py>,
+    segments: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let segs = segments_from(segments)?;
+    Ok(pose_array(py, &pcc::chain_pose(&segs)))
+}
+
+/// Backbone frames (N, 4, 4) of a chain at its arc lengths `s`.
+#[pyfunction]
+pub(crate) fn pcc_chain_frames<'py>(
+    py: Python<'py>,
+    segments: &Bound<'py, PyAny>,
+    s: Floats<'py>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(to_py_err)?;
+    let ts = chain.backbone(&s.to_vec()?).map_err(to_py_err)?;
+    Ok(poses_array(py, &ts))
+}
+
+/// 6×3n Jacobian of a chain's tip pose.
+#[pyfunction]
+#[pyo3(signature = (segments, *, frame="spatial", coordinates="arc"))]
+pub(crate) fn pcc_chain_jacobian<'py>(
+    py: Python<'py>,
+    segments: &Bound<'py, PyAny>,
+    frame: &str,
+    coordinates: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (f, c) = (frame_from(frame)?, coordinates_from(coordinates)?);
+    let segs = segments_from(segments)?;
+    Ok(matrix_array(py, &pcc::chain_jacobian(&segs, f, c)))
+}
+
+/// The arc (curvature, plane_angle, length) through a tip position (extensible segment).
+#[pyfunction]
+pub(crate) fn pcc_arc_from_tip<'py>(
+    py: Python<'py>,
+    position: Floats<'py>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let p = vector3(position, "position")?;
+    let s = pcc::arc_from_tip(&p).map_err(to_py_err)?;
+    Ok(arc_array(py, &s))
+}
+
+/// The arc of a given length whose tip is closest to a position, and the distance (m).
+#[pyfunction]
+pub(crate) fn pcc_arc_from_tip_with_length<'py>(
+    py: Python<'py>,
+    position: Floats<'py>,
+    length: f64,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
+    let p = vector3(position, "position")?;
+    let fit = pcc::arc_from_tip_with_length(&p, length).map_err(to_py_err)?;
+    Ok((arc_array(py, &fit.segment), fit.residual))
+}
+
+// ---------------------------------------------------------------------------- actuation maps
+
+fn tendons_from(distances: Floats<'_>, angles: Floats<'_>) -> PyResult<pcc::PccTendons> {
+    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?).map_err(to_py_err)
+}
+
+fn chambers_from(
+    areas: Floats<'_>,
+    distances: Floats<'_>,
+    angles: Floats<'_>,
+) -> PyResult<pcc::PccChambers> {
+    pcc::PccChambers::new(&areas.to_vec()?, &distances.to_vec()?, &angles.to_vec()?)
+        .map_err(to_py_err)
+}
+
+/// Tendon length changes (m) of a segment with arc parameters `arc`.
+#[pyfunction]
+#[pyo3(signature = (arc, distances, angles, rest_length=None))]
+pub(crate) fn pcc_tendon_displacements<'py>(
+    py: Python<'py>,
+    arc: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let seg = arc3(arc, "arc")?;
+    let t = tendons_from(distances, angles)?;
+    let d = pcc::tendon_displacements(&seg, &t, rest_length).map_err(to_py_err)?;
+    Ok(d.into_pyarray(py))
+}
+
+/// n×3 Jacobian of the tendon length changes with respect to the segment's coordinates.
+#[pyfunction]
+#[pyo3(signature = (arc, distances, angles, *, coordinates="arc"))]
+pub(crate) fn pcc_tendon_displacement_jacobian<'py>(
+    py: Python<'py>,
+    arc: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    coordinates: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = coordinates_from(coordinates)?;
+    let seg = arc3(arc, "arc")?;
+    let t = tendons_from(distances, angles)?;
+    Ok(matrix_array(
+        py,
+        &pcc::tendon_displacement_jacobian(&seg, &t, c),
+    ))
+}
+
+/// The arc from tendon length changes (m).
+#[pyfunction]
+#[pyo3(signature = (displacements, distances, angles, rest_length, *, extensible=true))]
+pub(crate) fn pcc_arc_from_tendon_displacements<'py>(
+    py: Python<'py>,
+    displacements: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: f64,
+    extensible: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let t = tendons_from(distances, angles)?;
+    let s =
+        pcc::arc_from_tendon_displacements(&displacements.to_vec()?, &t, rest_length, extensible)
+            .map_err(to_py_err)?;
+    Ok(arc_array(py, &s))
+}
+
+/// 3×n Jacobian of the arc from tendon length changes.
+#[pyfunction]
+#[pyo3(signature = (displacements, distances, angles, rest_length, *, extensible=true, coordinates="arc"))]
+pub(crate) fn pcc_arc_from_tendon_displacements_jacobian<'py>(
+    py: Python<'py>,
+    displacements: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: f64,
+    extensible: bool,
+    coordinates: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = coordinates_from(coordinates)?;
+    let t = tendons_from(distances, angles)?;
+    let j = pcc::arc_from_tendon_displacements_jacobian(
+        &displacements.to_vec()?,
+        &t,
+        rest_length,
+        extensible,
+        c,
+    )
+    .map_err(to_py_err)?;
+    Ok(matrix_array(py, &j))
+}
+
+fn body_from(
+    rest_length: f64,
+    bending_stiffness: f64,
+    axial_stiffness: Option<f64>,
+) -> PyResult<ElasticSegment> {
+    ElasticSegment::new(rest_length, bending_stiffness, axial_stiffness).map_err(to_py_err)
+}
+
+/// The arc of a uniform elastic segment pulled by tendon tensions (N).
+#[pyfunction]
+#[pyo3(signature = (tensions, distances, angles, rest_length, bending_stiffness, axial_stiffness=None))]
+pub(crate) fn pcc_arc_from_tendon_tensions<'py>(
+    py: Python<'py>,
+    tensions: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: f64,
+    bending_stiffness: f64,
+    axial_stiffness: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let t = tendons_from(distances, angles)?;
+    let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
+    let s = pcc::arc_from_tendon_tensions(&tensions.to_vec()?, &t, &body).map_err(to_py_err)?;
+    Ok(arc_array(py, &s))
+}
+
+/// 3×n Jacobian of the arc with respect to the tendon tensions.
+#[pyfunction]
+#[pyo3(signature = (tensions, distances, angles, rest_length, bending_stiffness, axial_stiffness=None, *, coordinates="arc"))]
+pub(crate) fn pcc_arc_from_tendon_tensions_jacobian<'py>(
+    py: Python<'py>,
+    tensions: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: f64,
+    bending_stiffness: f64,
+    axial_stiffness: Option<f64>,
+    coordinates: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = coordinates_from(coordinates)?;
+    let t = tendons_from(distances, angles)?;
+    let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
+    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c)
+        .map_err(to_py_err)?;
+    Ok(matrix_array(py, &j))
+}
+
+/// The arc of a uniform elastic segment with chamber pressures (Pa).
+#[pyfunction]
+#[pyo3(signature = (pressures, areas, distances, angles, rest_length, bending_stiffness, axial_stiffness=None))]
+pub(crate) fn pcc_arc_from_pressures<'py>(
+    py: Python<'py>,
+    pressures: Floats<'py>,
+    areas: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: f64,
+    bending_stiffness: f64,
+    axial_stiffness: Option<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let ch = chambers_from(areas, distances, angles)?;
+    let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
+    let s = pcc::arc_from_pressures(&pressures.to_vec()?, &ch, &body).map_err(to_py_err)?;
+    Ok(arc_array(py, &s))
+}
+
+/// 3×n Jacobian of the arc with respect to the chamber pressures.
+#[pyfunction]
+#[pyo3(signature = (pressures, areas, distances, angles, rest_length, bending_stiffness, axial_stiffness=None, *, coordinates="arc"))]
+pub(crate) fn pcc_arc_from_pressures_jacobian<'py>(
+    py: Python<'py>,
+    pressures: Floats<'py>,
+    areas: Floats<'py>,
+    distances: Floats<'py>,
+    angles: Floats<'py>,
+    rest_length: f64,
+    bending_stiffness: f64,
+    axial_stiffness: Option<f64>,
+    coordinates: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let c = coordinates_from(coordinates)?;
+    let ch = chambers_from(areas, distances, angles)?;
+    let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
+    let j =
+        pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c).map_err(to_py_err)?;
+    Ok(matrix_array(py, &j))
+}
+
+// ---------------------------------------------------------------------------------- statics
+
+/// One value per segment from a scalar or a sequence of `n`.
+fn per_segment(v: Floats<'_>, n: usize, name: &str) -> PyResult<Vec<f64>> {
+    let v = v.to_vec()?;
+    match v.len() {
+        1 => Ok(vec![v[0]; n]),
+        k if k == n => Ok(v),
+        k => Err(param_err(
+            &format!("{name}.len()"),
+            k,
+            &format!("1 or the number of segments, {n}"),
+        )),
+    }
+}
+
+/// A PCC robot (immutable): elastic segments, routed tendons, chambers.
+#[pyclass(frozen, module = "softrod._core", name = "PccRobot")]
+pub(crate) struct PccRobot {
+    inner: CoreRobot,
+}
+
+#[pymethods]
+impl PccRobot {
+    #[new]
+    #[pyo3(signature = (rest_lengths, bending_stiffness, axial_stiffness=None))]
+    fn new(
+        rest_lengths: Floats<'_>,
+        bending_stiffness: Floats<'_>,
+        axial_stiffness: Option<Floats<'_>>,
+    ) -> PyResult<Self> {
+        let l0 = rest_lengths.to_vec()?;
+        let n = l0.len();
+        let ei = per_segment(bending_stiffness, n, "bending_stiffness")?;
+        let ea = match axial_stiffness {
+            Some(a) => Some(per_segment(a, n, "axial_stiffness")?),
+            None => None,
+        };
+        let bodies = (0..n)
+            .map(|i| {
+                ElasticSegment::new(l0[i], ei[i], ea.as_ref().map(|a| a[i])).map_err(|e| match e {
+                    softrod::Error::InvalidParameter {
+                        name,
+                        value,
+                        expected,
+                    } => softrod::Error::InvalidParameter {
+                        name: format!("{name}[{i}]"),
+                        value,
+                        expected,
+                    },
+                    other => other,
+                })
+            })
+            .collect::<softrod::Result<Vec<_>>>()
+            .map_err(to_py_err)?;
+        let inner = CoreRobot::new(bodies)
+            .map_err(|_| param_err("rest_lengths", "[]", "at least one segment"))?;
+        Ok(Self { inner })
+    }
+
+    /// Solid circular segments of `radius` (m) and Young's modulus (Pa).
+    #[staticmethod]
+    #[pyo3(signature = (rest_lengths, radius, youngs_modulus, *, extensible=true))]
+    fn solid_circle(
+        rest_lengths: Floats<'_>,
+        radius: f64,
+        youngs_modulus: f64,
+        extensible: bool,
+    ) -> PyResult<Self> {
+        let l0 = rest_lengths.to_vec()?;
+        let bodies = l0
+            .iter()
+            .map(|&l| ElasticSegment::solid_circle(l, radius, youngs_modulus, extensible))
+            .collect::<softrod::Result<Vec<_>>>()
+            .map_err(to_py_err)?;
+        let inner = CoreRobot::new(bodies)
+            .map_err(|_| param_err("rest_lengths", "[]", "at least one segment"))?;
+        Ok(Self { inner })
+    }
+
+    /// A new robot with tendons ending at the tip of `segment` (and passing through the
+    /// segments before it at the same body offsets).
+    fn with_tendons(
+        &self,
+        segment: usize,
+        distances: Floats<'_>,
+        angles: Floats<'_>,
+    ) -> PyResult<Self> {
+        let t = tendons_from(distances, angles)?;
+        let inner = self
+            .inner
+            .clone()
+            .with_segment_tendons(segment, &t)
+            .map_err(to_py_err)?;
+        Ok(Self { inner })
+    }
+
+    /// A new robot with pneumatic chambers in `segment`.
+    fn with_chambers(
+        &self,
+        segment: usize,
+        areas: Floats<'_>,
+        distances: Floats<'_>,
+        angles: Floats<'_>,
+    ) -> PyResult<Self> {
+        let ch = chambers_from(areas, distances, angles)?;
+        let inner = self
+            .inner
+            .clone()
+            .with_chambers(segment, ch)
+            .map_err(to_py_err)?;
+        Ok(Self { inner })
+    }
+
+    #[getter]
+    fn n_segments(&self) -> usize {
+        self.inner.segments().len()
+    }
+    #[getter]
+    fn n_tendons(&self) -> usize {
+        self.inner.n_tendons()
+    }
+    #[getter]
+    fn n_chambers(&self) -> usize {
+        self.inner.n_chambers()
+    }
+    #[getter]
+    fn rest_lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self
+            .inner
+            .segments()
+            .iter()
+            .map(|s| s.rest_length())
+            .collect();
+        v.into_pyarray(py)
+    }
+    #[getter]
+    fn bending_stiffness<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self
+            .inner
+            .segments()
+            .iter()
+            .map(|s| s.bending_stiffness())
+            .collect();
+        v.into_pyarray(py)
+    }
+    /// Axial stiffness per segment (N), `None` for an inextensible one.
+    #[getter]
+    fn axial_stiffness(&self) -> Vec<Option<f64>> {
+        self.inner
+            .segments()
+            .iter()
+            .map(|s| s.axial_stiffness())
+            .collect()
+    }
+    /// Tendons as rows (distance, angle, last_segment).
+    #[getter]
+    fn tendons<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let t = self.inner.tendons();
+        Array::from_shape_fn((t.len(), 3), |(i, j)| match j {
+            0 => t[i].distance(),
+            1 => t[i].angle(),
+            _ => t[i].last_segment() as f64,
+        })
+        .into_pyarray(py)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "PccRobot(segments={}, tendons={}, chambers={})",
+            self.inner.segments().len(),
+            self.inner.n_tendons(),
+            self.inner.n_chambers()
+        )
+    }
+}
+
+/// A solved PCC robot.
+#[pyclass(frozen, module = "softrod._core", name = "PccSolution")]
+pub(crate) struct PccSolution {
+    inner: statics::PccStaticsSolution,
+    s: Vec<f64>,
+    frames: Vec<Matrix4<f64>>,
+}
+
+#[pymethods]
+impl PccSolution {
+    /// Arc parameters per segment, rows (curvature, plane_angle, length).
+    #[getter]
+    fn arcs<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let s = &self.inner.segments;
+        Array::from_shape_fn((s.len(), 3), |(i, j)| match j {
+            0 => s[i].curvature(),
+            1 => s[i].plane_angle(),
+            _ => s[i].length(),
+        })
+        .into_pyarray(py)
+    }
+    /// Curvature-vector coordinates per segment, rows (u_x, u_y, length).
+    #[getter]
+    fn coordinates<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let c = self.inner.coordinates();
+        Array::from_shape_fn((c.len(), 3), |(i, j)| c[i][j]).into_pyarray(py)
+    }
+    #[getter]
+    fn tip_pose<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        pose_array(py, &self.inner.tip_pose)
+    }
+    #[getter]
+    fn tip_position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let t = &self.inner.tip_pose;
+        vec![t[(0, 3)], t[(1, 3)], t[(2, 3)]].into_pyarray(py)
+    }
+    /// Deformed arc length of the frame samples (m).
+    #[getter]
+    fn s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.s.clone().into_pyarray(py)
+    }
+    /// Backbone frames (N, 4, 4) at `s`.
+    #[getter]
+    fn frames<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        poses_array(py, &self.frames)
+    }
+    /// Backbone positions (N, 3) at `s`.
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let f = &self.frames;
+        Array::from_shape_fn((f.len(), 3), |(k, i)| f[k][(i, 3)]).into_pyarray(py)
+    }
+    #[getter]
+    fn tendon_lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.tendon_lengths.clone().into_pyarray(py)
+    }
+    #[getter]
+    fn iterations(&self) -> usize {
+        self.inner.stats.iterations
+    }
+    #[getter]
+    fn residual(&self) -> f64 {
+        self.inner.stats.residual
+    }
+    #[getter]
+    fn converged(&self) -> bool {
+        self.inner.stats.converged
+    }
+    #[getter]
+    fn load_steps(&self) -> usize {
+        self.inner.stats.load_steps
+    }
+    /// Backbone frames (N, 4, 4) at other arc lengths `s` (m, deformed, along the chain).
+    fn frames_at<'py>(
+        &self,
+        py: Python<'py>,
+        s: Floats<'py>,
+    ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        let ts = self
+            .inner
+            .chain()
+            .backbone(&s.to_vec()?)
+            .map_err(to_py_err)?;
+        Ok(poses_array(py, &ts))
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "PccSolution(segments={}, converged={}, iterations={})",
+            self.inner.segments.len(),
+            self.inner.stats.converged,
+            self.inner.stats.iterations
+        )
+    }
+}
+
+/// A warm start: a previous solution or arc rows (curvature, plane_angle, length).
+#[derive(FromPyObject)]
+pub(crate) enum PccWarm<'py> {
+    Solution(PyRef<'py, PccSolution>),
+    Arcs(Bound<'py, PyAny>),
+}
+
+/// Statics of a PCC robot under tensions, pressures and a world-frame tip wrench.
+#[pyfunction]
+#[pyo3(signature = (robot, tensions=None, pressures=None, *, tip_force=None, tip_moment=None,
+                    s=None, n_points=50, tolerance=1e-12, max_iterations=50, continuation=true,
+                    max_load_steps=64, warm_start=None, throw=true))]
+pub(crate) fn pcc_solve<'py>(
+    py: Python<'py>,
+    robot: PyRef<'py, PccRobot>,
+    tensions: Option<Floats<'py>>,
+    pressures: Option<Floats<'py>>,
+    tip_force: Option<Floats<'py>>,
+    tip_moment: Option<Floats<'py>>,
+    s: Option<Floats<'py>>,
+    n_points: i64,
+    tolerance: f64,
+    max_iterations: i64,
+    continuation: bool,
+    max_load_steps: i64,
+    warm_start: Option<PccWarm<'py>>,
+    throw: bool,
+) -> PyResult<PccSolution> {
+    if max_iterations < 1 {
+        return Err(param_err("max_iterations", max_iterations, ">= 1"));
+    }
+    if max_load_steps < 1 {
+        return Err(param_err("max_load_steps", max_load_steps, ">= 1"));
+    }
+    if s.is_none() && n_points < 2 {
+        return Err(param_err("n_points", n_points, ">= 2"));
+    }
+    let loads = PccLoads {
+        tensions: tensions
+            .map(|t| t.to_vec())
+            .transpose()?
+            .unwrap_or_default(),
+        pressures: pressures
+            .map(|p| p.to_vec())
+            .transpose()?
+            .unwrap_or_default(),
+        tip_force: tip_force
+            .map(|f| vector3(f, "tip_force"))
+            .transpose()?
+            .unwrap_or_else(Vector3::zeros),
+        tip_moment: tip_moment
+            .map(|m| vector3(m, "tip_moment"))
+            .transpose()?
+            .unwrap_or_else(Vector3::zeros),
+    };
+    let warm = match warm_start {
+        None => None,
+        Some(PccWarm::Solution(sol)) => Some(sol.inner.warm_start()),
+        Some(PccWarm::Arcs(a)) => {
+            let rows = rows3(&a, "warm_start")?;
+            Some(
+                pcc::PccChain::from_parameters(&rows)
+                    .map_err(to_py_err)?
+                    .segments()
+                    .to_vec(),
+            )
+        }
+    };
+    let options = PccSolveOptions {
+        tolerance,
+        max_iterations: max_iterations as usize,
+        continuation,
+        max_load_steps: max_load_steps as usize,
+        warm_start: warm,
+        throw,
+    };
+    let samples = match s {
+        Some(s) => Some(s.to_vec()?),
+        None => None,
+    };
+    let model = &robot.inner;
+    let (inner, s, frames) = py
+        .detach(move || -> softrod::Result<_> {
+            let sol = statics::solve_pcc_statics(model, &loads, &options)?;
+            let chain = sol.chain();
+            let s = samples.unwrap_or_else(|| {
+                let l = chain.length();
+                let n = n_points as usize;
+                (0..n).map(|i| l * i as f64 / (n - 1) as f64).collect()
+            });
+            let frames = chain.backbone(&s)?;
+            Ok((sol, s, frames))
+        })
+        .map_err(to_py_err)?;
+    Ok(PccSolution { inner, s, frames })
+}

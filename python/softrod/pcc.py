@@ -1,0 +1,68 @@
+"""Piecewise-constant-curvature (PCC) kinematics, actuation maps and statics.
+
+Conventions (see ``docs/pcc.md``): a segment is an arc with parameters ``(curvature,
+plane_angle, length)`` (1/m, rad, m). Its base is at the origin with the tangent along +z; a
+positive curvature bends the tip toward ``(cos plane_angle, sin plane_angle, 0)``. The frame at
+arc length ``s`` is ``Rz(phi) Ry(kappa s) Rz(-phi)`` (no twist about the tangent). Poses are 4x4
+homogeneous transforms (tip frame -> base frame); chains are ``(n, 3)`` arrays of arc rows, each
+segment relative to the tip frame of the previous one. Jacobians map parameter rates to twists
+``[translation; rotation]`` in the ``"spatial"``, ``"body"`` or ``"hybrid"`` frame, with respect
+to ``"arc"`` coordinates ``(curvature, plane_angle, length)`` or ``"curvature_vector"``
+coordinates ``(u_x, u_y, length)`` with ``u = curvature * (-sin phi, cos phi)`` (smooth when
+straight).
+
+Statics (:func:`solve`): stationary potential energy of the Cosserat rod restricted to arcs,
+tendons passing through proximal segments, pneumatic chambers, and a world-frame tip force and
+moment; Newton with the exact Jacobian. Errors are :class:`softrod.ParameterError` naming the
+parameter, and :class:`softrod.ConvergenceError`.
+
+Example:
+    >>> import numpy as np
+    >>> from softrod import pcc
+    >>> pcc.arc_pose(np.pi / 2 / 0.1, 0.0, 0.1)[:3, 3].round(4)  # quarter circle toward +x
+    array([0.0637, 0.    , 0.0637])
+"""
+
+from ._core import PccRobot as Robot
+from ._core import PccSolution as Solution
+from ._core import pcc_arc_frames as arc_frames
+from ._core import pcc_arc_from_pressures as arc_from_pressures
+from ._core import pcc_arc_from_pressures_jacobian as arc_from_pressures_jacobian
+from ._core import pcc_arc_from_tendon_displacements as arc_from_tendon_displacements
+from ._core import (
+    pcc_arc_from_tendon_displacements_jacobian as arc_from_tendon_displacements_jacobian,
+)
+from ._core import pcc_arc_from_tendon_tensions as arc_from_tendon_tensions
+from ._core import pcc_arc_from_tendon_tensions_jacobian as arc_from_tendon_tensions_jacobian
+from ._core import pcc_arc_from_tip as arc_from_tip
+from ._core import pcc_arc_from_tip_with_length as arc_from_tip_with_length
+from ._core import pcc_arc_jacobian as arc_jacobian
+from ._core import pcc_arc_pose as arc_pose
+from ._core import pcc_chain_frames as chain_frames
+from ._core import pcc_chain_jacobian as chain_jacobian
+from ._core import pcc_chain_pose as chain_pose
+from ._core import pcc_solve as solve
+from ._core import pcc_tendon_displacement_jacobian as tendon_displacement_jacobian
+from ._core import pcc_tendon_displacements as tendon_displacements
+
+__all__ = [
+    "Robot",
+    "Solution",
+    "arc_frames",
+    "arc_from_pressures",
+    "arc_from_pressures_jacobian",
+    "arc_from_tendon_displacements",
+    "arc_from_tendon_displacements_jacobian",
+    "arc_from_tendon_tensions",
+    "arc_from_tendon_tensions_jacobian",
+    "arc_from_tip",
+    "arc_from_tip_with_length",
+    "arc_jacobian",
+    "arc_pose",
+    "chain_frames",
+    "chain_jacobian",
+    "chain_pose",
+    "solve",
+    "tendon_displacement_jacobian",
+    "tendon_displacements",
+]
