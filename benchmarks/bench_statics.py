@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
+from _timing import median_time
 
 import softrod
 from softrod import _core
@@ -30,17 +30,6 @@ def two_segment_robot(tensions=(4, 0, 0, 0, 2, 0)):
     return rod, tendons
 
 
-def python_median(fn, calls: int, repeats: int) -> float:
-    fn()
-    out = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            fn()
-        out.append((time.perf_counter() - t0) / calls)
-    return statistics.median(out)
-
-
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("--repeats", type=int, default=15)
@@ -52,7 +41,9 @@ def main() -> None:
     rows = []
 
     def case(name, rod, tendons=(), loads=None, **kw):
-        py = python_median(lambda: softrod.solve_statics(rod, tendons, loads, **kw), calls, reps)
+        py = median_time(
+            lambda: softrod.solve_statics(rod, tendons, loads, **kw), calls=calls, repeats=reps
+        )
         rust = statistics.median(
             _core._time_solve_statics(rod, tendons, loads, repeats=calls * reps, **kw)
         )

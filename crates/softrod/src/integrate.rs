@@ -93,18 +93,9 @@ impl<const N: usize> DenseSolution<N> {
     /// Interpolated state at `t` (cubic Hermite on the step that contains `t`, third order
     /// like the method). `t` outside the integrated interval is clamped to it.
     pub fn eval(&self, t: f64) -> [f64; N] {
-        let n = self.t.len();
-        if n == 1 {
+        let Some(i) = step_containing(&self.t, t) else {
             return self.y[0];
-        }
-        let forward = self.t[n - 1] > self.t[0];
-        // Index i of the step [t_i, t_{i+1}] that contains t (in integration order).
-        let pos = if forward {
-            self.t.partition_point(|&ti| ti <= t)
-        } else {
-            self.t.partition_point(|&ti| ti >= t)
         };
-        let i = pos.clamp(1, n - 1) - 1;
         let (t0, t1) = (self.t[i], self.t[i + 1]);
         let h = t1 - t0;
         let x = ((t - t0) / h).clamp(0.0, 1.0);
@@ -123,6 +114,21 @@ impl<const N: usize> DenseSolution<N> {
         }
         out
     }
+}
+
+/// Index `i` of the step `[t_i, t_{i+1}]` of a mesh (increasing or decreasing, in integration
+/// order) that contains `t`, clamped to the first or last step; `None` for a one-point mesh.
+fn step_containing(mesh: &[f64], t: f64) -> Option<usize> {
+    let n = mesh.len();
+    if n < 2 {
+        return None;
+    }
+    let pos = if mesh[n - 1] > mesh[0] {
+        mesh.partition_point(|&ti| ti <= t)
+    } else {
+        mesh.partition_point(|&ti| ti >= t)
+    };
+    Some(pos.clamp(1, n - 1) - 1)
 }
 
 #[inline]
@@ -401,17 +407,9 @@ impl<const N: usize> Dp54Solution<N> {
     /// Interpolated state at `t` (fourth-order continuous extension of the step containing
     /// `t`); `t` outside the integrated interval is clamped to it.
     pub fn eval(&self, t: f64) -> [f64; N] {
-        let n = self.t.len();
-        if n == 1 {
+        let Some(i) = step_containing(&self.t, t) else {
             return self.y[0];
-        }
-        let forward = self.t[n - 1] > self.t[0];
-        let pos = if forward {
-            self.t.partition_point(|&ti| ti <= t)
-        } else {
-            self.t.partition_point(|&ti| ti >= t)
         };
-        let i = pos.clamp(1, n - 1) - 1;
         let (t0, t1) = (self.t[i], self.t[i + 1]);
         let th = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
         let th1 = 1.0 - th;
