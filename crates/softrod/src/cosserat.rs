@@ -640,6 +640,28 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         out
     }
 
+    /// Tangent `d(v, u)/d(n_b, m_b)` of the constitutive solve (`(I + C D)⁻¹ C` with active
+    /// tendons) left by the last [`Evaluator::rhs`] call with sensitivities (`N == FULL`);
+    /// used by `compliance.rs`.
+    pub(crate) fn tangent(&self) -> Matrix6<f64> {
+        let c = &self.tangent_diag;
+        match &self.tangent_lu {
+            Some(lu) => {
+                let mut m = Matrix6::zeros();
+                for j in 0..6 {
+                    let mut e = [0.0; 6];
+                    e[j] = c[j];
+                    let col = lu.solve(&e);
+                    for i in 0..6 {
+                        m[(i, j)] = col[i];
+                    }
+                }
+                m
+            }
+            None => Matrix6::from_diagonal(&Vector6::from_column_slice(c)),
+        }
+    }
+
     /// Right-hand side of the state (`N == STATE`) or of the state with sensitivities
     /// (`N == FULL`).
     #[inline]

@@ -13,9 +13,14 @@
 //! * [`hyperelastic`]: uniaxial material laws (linear, Neo-Hookean, Mooney–Rivlin, Yeoh, Ogden)
 //!   and a library of named silicones;
 //! * [`fit`]: least-squares fitting of those laws to uniaxial test data;
+//! * [`se3`]: the adjoint and the twist/wrench ordering (owned here, used everywhere);
+//! * [`compliance`], [`eigenscrew`], [`workspace`]: seed 001, configuration-dependent
+//!   compliance and stiffness, eigenscrews, workspace maps;
 //! * [`error`]: the crate's one error type.
 
 pub mod compare;
+pub mod compliance;
+pub mod eigenscrew;
 pub mod error;
 pub mod fit;
 pub mod hyperelastic;
@@ -25,6 +30,10 @@ pub mod pcc_statics;
 pub mod planar;
 
 pub use compare::{backbone_distance, BackboneDistance};
+pub use compliance::{
+    compliance, tangent_compliance, Compliance, TangentCompliance, TendonControl,
+};
+pub use eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
 pub use error::{Error, Result};
 pub use fit::{
     fit_stats, fit_uniaxial, FitOptions, FitStats, ModelKind, StrainMeasure, StressMeasure,
@@ -44,10 +53,12 @@ pub mod cosserat;
 pub mod loads;
 pub mod material;
 pub mod rod;
+pub mod se3;
 pub mod section;
 pub mod so3;
 pub mod statics;
 pub mod tendon;
+pub mod workspace;
 
 pub use loads::{Frame, Loads, PointLoad};
 pub use material::{LinearElastic, Material};
@@ -58,3 +69,4 @@ pub use statics::{
     solve_statics, Integrator, SolveOptions, SolverStats, StaticsSolution, WarmStart,
 };
 pub use tendon::{Routing, Tendon};
+pub use workspace::{workspace_map, WorkspaceSample};

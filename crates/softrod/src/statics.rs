@@ -192,7 +192,7 @@ struct Node {
 }
 
 /// Per-interval step counts of the RK4 plan.
-fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
+pub(crate) fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
     let l = breaks[breaks.len() - 1];
     breaks
         .windows(2)
@@ -206,7 +206,7 @@ fn head(y: &[f64]) -> [f64; STATE] {
     h
 }
 
-fn project<const N: usize>(y: &mut [f64; N]) {
+pub(crate) fn project<const N: usize>(y: &mut [f64; N]) {
     let r = reorthonormalise(&rot(y));
     y[3..12].copy_from_slice(r.as_slice());
 }
@@ -527,7 +527,11 @@ fn shape_change_is_small(
 }
 
 /// Validates the inputs and builds the model at load factor 1.
-fn build_model<'a>(rod: &'a Rod, tendons: &'a [Tendon], loads: &'a Loads) -> Result<Model<'a>> {
+pub(crate) fn build_model<'a>(
+    rod: &'a Rod,
+    tendons: &'a [Tendon],
+    loads: &'a Loads,
+) -> Result<Model<'a>> {
     let l = rod.length();
     loads.validate(l, rod.density())?;
     let mut prepared = Vec::with_capacity(tendons.len());

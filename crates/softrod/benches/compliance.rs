@@ -1,0 +1,103 @@
+//! Compliance along the arm vs the statics solve alone, the tangent compliance, and a
+//! 10 000-configuration workspace map of the two-segment NiTi tendon robot.
+//!
+//! Run: `CARGO_TARGET_DIR=... cargo bench -p softrod --bench compliance`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use softrod::compliance::{compliance, tangent_compliance, TendonControl};
+use softrod::nalgebra::Vector3;
+use softrod::workspace::{workspace_map, DEFAULT_CHUNK};
+use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
+use std::hint::black_box;
+
+fn two_segment(tensions: &[f64; 6]) -> Vec<Tendon> {
+    (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            Tendon::constant(
+                [0.01 * ang.cos(), 0.01 * ang.sin()],
+                tensions[i],
+                Some(if i < 3 { 0.2 } else { 0.4 }),
+            )
+            .unwrap()
+        })
+        .collect()
+}
+
+fn niti() -> Rod {
+    Rod::new(
+        0.4,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    let rod = niti();
+    let opts = SolveOptions::default();
+    let tendons = two_segment(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    for (name, loads) in [
+        ("tendons_only", Loads::default()),
+        ("tip_force", Loads::tip_force(Vector3::new(0.05, 0.0, 0.0))),
+    ] {
+        let mut g = c.benchmark_group(format!("compliance_niti_{name}"));
+        let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+        g.bench_function("solve", |b| {
+            b.iter(|| solve_statics(&rod, black_box(&tendons), &loads, &opts).unwrap())
+        });
+        g.bench_function("compliance_along_arm", |b| {
+            b.iter(|| compliance(&rod, black_box(&sol)).unwrap())
+        });
+        g.bench_function("solve_plus_compliance", |b| {
+            b.iter(|| {
+                let s = solve_statics(&rod, black_box(&tendons), &loads, &opts).unwrap();
+                compliance(&rod, &s).unwrap()
+            })
+        });
+        for (mode, ctl) in [
+            ("tension", TendonControl::Tension),
+            ("length", TendonControl::Length),
+        ] {
+            g.bench_function(format!("tangent_tip_{mode}"), |b| {
+                b.iter(|| {
+                    tangent_compliance(&rod, &tendons, &loads, black_box(&sol), &opts, ctl, None)
+                        .unwrap()
+                })
+            });
+        }
+        g.finish();
+    }
+    let base = two_segment(&[0.0; 6]);
+    let mut tensions = Vec::with_capacity(60_000);
+    for i in 0..100 {
+        for j in 0..100 {
+            // Boustrophedon rows so that neighbours in a chunk are close.
+            let jj = if i % 2 == 0 { j } else { 99 - j };
+            let mut t = [0.0; 6];
+            t[0] = 4.0 * i as f64 / 99.0;
+            t[4] = 2.0 * jj as f64 / 99.0;
+            tensions.extend_from_slice(&t);
+        }
+    }
+    let mut g = c.benchmark_group("workspace_map_niti");
+    g.sample_size(10);
+    g.bench_function("10000_configurations", |b| {
+        b.iter(|| {
+            workspace_map(
+                &rod,
+                &base,
+                &Loads::default(),
+                black_box(&tensions),
+                &opts,
+                DEFAULT_CHUNK,
+            )
+            .unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,157 @@
+//! Workspace maps: sweep the tendon tensions, solve every configuration (warm-started from its
+//! neighbour, in parallel across cores) and report the tip position with scalar stiffness
+//! measures of the integrated tip compliance (seed 001, Fig. 1d).
+//!
+//! The samples are cut into contiguous chunks; each chunk is solved in order on one thread,
+//! every solve warm-started from the previous converged one (so order the samples along a
+//! path, e.g. grid rows in boustrophedon order); chunks run in parallel (rayon).
+
+use rayon::prelude::*;
+
+use crate::compliance::tip_compliance_world;
+use crate::eigenscrew::{eigenscrews, MatrixKind};
+use crate::error::{Error, Result};
+use crate::loads::Loads;
+use crate::rod::Rod;
+use crate::statics::{solve_statics, SolveOptions};
+use crate::tendon::Tendon;
+
+/// Default number of samples per warm-started chunk.
+pub const DEFAULT_CHUNK: usize = 64;
+
+/// One configuration of a workspace map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorkspaceSample {
+    /// Whether the statics converged (the other fields are NaN otherwise).
+    pub converged: bool,
+    /// Tip position (m, world).
+    pub tip_position: [f64; 3],
+    /// Largest translational compliance at the tip (m/N): largest eigenvalue of the
+    /// force-to-translation block of the integrated tip compliance.
+    pub max_translational_compliance: f64,
+    /// Smallest translational compliance at the tip (m/N).
+    pub min_translational_compliance: f64,
+    /// Eigenstiffnesses of the tip stiffness (world frame at the tip), decreasing.
+    pub eigen_stiffness: [f64; 6],
+    /// 1-norm condition number of the tip compliance (SI units).
+    pub condition: f64,
+}
+
+impl WorkspaceSample {
+    fn failed() -> Self {
+        Self {
+            converged: false,
+            tip_position: [f64::NAN; 3],
+            max_translational_compliance: f64::NAN,
+            min_translational_compliance: f64::NAN,
+            eigen_stiffness: [f64::NAN; 6],
+            condition: f64::NAN,
+        }
+    }
+}
+
+/// Solves `rod` with `tendons` and `loads` for every row of `tensions` (row-major,
+/// `n_samples × tendons.len()`, N), replacing the tendons' tensions, and measures the tip
+/// compliance. `chunk` samples (>= 1) are solved in order per thread with warm starts.
+/// Non-converged samples are reported with `converged == false`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] if `tensions.len()` is not a multiple of the number of tendons,
+/// a tension is negative or not finite, `chunk == 0`, or the problem data are invalid.
+pub fn workspace_map(
+    rod: &Rod,
+    tendons: &[Tendon],
+    loads: &Loads,
+    tensions: &[f64],
+    options: &SolveOptions,
+    chunk: usize,
+) -> Result<Vec<WorkspaceSample>> {
+    let nt = tendons.len();
+    if nt == 0 || tensions.len() % nt != 0 {
+        return Err(Error::invalid(
+            "tensions",
+            format!("{} values for {nt} tendons", tensions.len()),
+            "n_samples x n_tendons values (at least one tendon)",
+        ));
+    }
+    if chunk == 0 {
+        return Err(Error::invalid("chunk", chunk, ">= 1"));
+    }
+    for (i, t) in tensions.iter().enumerate() {
+        if !(t.is_finite() && *t >= 0.0) {
+            return Err(Error::invalid(
+                format!("tensions[{}, {}]", i / nt, i % nt),
+                t,
+                "finite and >= 0 N",
+            ));
+        }
+    }
+    // Validate the problem once (errors here are the user's, not a sample's).
+    let probe: Vec<Tendon> = tendons
+        .iter()
+        .zip(&tensions[..nt])
+        .map(|(t, &tau)| t.with_tension(tau))
+        .collect::<Result<_>>()?;
+    solve_statics(
+        rod,
+        &probe,
+        loads,
+        &SolveOptions {
+            throw: false,
+            ..*options
+        },
+    )?;
+    let rows: Vec<&[f64]> = tensions.chunks(nt).collect();
+    let out: Vec<Vec<WorkspaceSample>> = rows
+        .par_chunks(chunk)
+        .map(|block| {
+            let mut warm = None;
+            let mut local = Vec::with_capacity(block.len());
+            let mut ts: Vec<Tendon> = tendons.to_vec();
+            for row in block {
+                for (t, &tau) in ts.iter_mut().zip(row.iter()) {
+                    if let Ok(n) = t.with_tension(tau) {
+                        *t = n;
+                    }
+                }
+                let opts = SolveOptions {
+                    warm_start: warm,
+                    throw: false,
+                    ..*options
+                };
+                let sample = match solve_statics(rod, &ts, loads, &opts) {
+                    Ok(sol) if sol.stats.converged => {
+                        warm = Some(sol.warm_start());
+                        measure(rod, &sol)
+                    }
+                    _ => WorkspaceSample::failed(),
+                };
+                local.push(sample);
+            }
+            local
+        })
+        .collect();
+    Ok(out.into_iter().flatten().collect())
+}
+
+fn measure(rod: &Rod, sol: &crate::statics::StaticsSolution) -> WorkspaceSample {
+    let Ok(c) = tip_compliance_world(rod, sol) else {
+        return WorkspaceSample::failed();
+    };
+    let ctt = c.fixed_view::<3, 3>(0, 0).into_owned().symmetric_eigen();
+    let (kmat, condition) = crate::compliance::invert_spd(&c);
+    let mut eig = [f64::NAN; 6];
+    if let Ok(d) = eigenscrews(&kmat, MatrixKind::Stiffness) {
+        for (k, s) in d.screws.iter().enumerate() {
+            eig[k] = s.value;
+        }
+    }
+    WorkspaceSample {
+        converged: true,
+        tip_position: sol.tip_position(),
+        max_translational_compliance: ctt.eigenvalues.max(),
+        min_translational_compliance: ctt.eigenvalues.min(),
+        eigen_stiffness: eig,
+        condition,
+    }
+}

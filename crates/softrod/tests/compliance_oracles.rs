@@ -1,0 +1,439 @@
+//! Oracles of the configuration-dependent compliance: closed-form Timoshenko cantilever,
+//! Castigliano on a stress-free circular arc (independent quadrature), frame consistency,
+//! tangent compliance vs finite differences of the nonlinear solve, fixed-length tendons.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::f64::consts::PI;
+
+use softrod::compliance::{compliance, tangent_compliance, TendonControl};
+use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
+use softrod::se3::rotation_adjoint;
+use softrod::so3::exp_so3;
+use softrod::{
+    solve_statics, Integrator, LinearElastic, Loads, Pose, Profile, Rod, Section, SolveOptions,
+    StaticsSolution, Tendon,
+};
+
+const E: f64 = 2.0e9;
+const NU: f64 = 0.3;
+const RADIUS: f64 = 0.01;
+const LENGTH: f64 = 0.5;
+
+fn rk4(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        tolerance: 1e-13,
+        ..Default::default()
+    }
+}
+
+fn rot_of(sol: &StaticsSolution, i: usize) -> Matrix3<f64> {
+    let r = &sol.rotation[i];
+    Matrix3::new(
+        r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
+    )
+}
+
+/// Entry-wise comparison, each 3×3 block relative to that block's largest entry of `exact`
+/// (zero entries of `exact` must be below `tol` times the block scale).
+fn assert_blocks_close(got: &Matrix6<f64>, exact: &Matrix6<f64>, tol: f64, what: &str) {
+    for bi in 0..2 {
+        for bj in 0..2 {
+            let e = exact.fixed_view::<3, 3>(3 * bi, 3 * bj);
+            let g = got.fixed_view::<3, 3>(3 * bi, 3 * bj);
+            let scale = e.amax().max(g.amax());
+            if scale == 0.0 {
+                continue;
+            }
+            for i in 0..3 {
+                for j in 0..3 {
+                    let (x, y) = (g[(i, j)], e[(i, j)]);
+                    let err = if y.abs() > 1e-3 * scale {
+                        ((x - y) / y).abs()
+                    } else {
+                        (x - y).abs() / scale
+                    };
+                    assert!(
+                        err <= tol,
+                        "{what}: block ({bi},{bj}) entry ({i},{j}): {x:e} vs {y:e} (err {err:e})"
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn timoshenko(l: f64, ei: f64, gj: f64, ea: f64, gas: Option<f64>) -> Matrix6<f64> {
+    let lat = l.powi(3) / (3.0 * ei) + gas.map_or(0.0, |g| l / g);
+    let mut c = Matrix6::zeros();
+    c[(0, 0)] = lat;
+    c[(1, 1)] = lat;
+    c[(2, 2)] = if gas.is_some() { l / ea } else { 0.0 };
+    c[(3, 3)] = l / ei;
+    c[(4, 4)] = l / ei;
+    c[(5, 5)] = l / gj;
+    // Convention of se3.rs: a tip moment m_y moves the tip along +x, m_x along -y.
+    c[(0, 4)] = l * l / (2.0 * ei);
+    c[(4, 0)] = c[(0, 4)];
+    c[(1, 3)] = -l * l / (2.0 * ei);
+    c[(3, 1)] = c[(1, 3)];
+    c
+}
+
+fn section_constants(k: f64) -> (f64, f64, f64, f64) {
+    let g = E / (2.0 * (1.0 + NU));
+    let a = PI * RADIUS * RADIUS;
+    let i = PI * RADIUS.powi(4) / 4.0;
+    (E * i, g * 2.0 * i, E * a, k * g * a)
+}
+
+#[test]
+fn straight_cantilever_matches_timoshenko_closed_form() {
+    let base = Pose::new(
+        Vector3::new(0.3, -0.2, 1.0),
+        exp_so3(&Vector3::new(0.4, -0.9, 0.3)),
+    )
+    .unwrap();
+    let rod = Rod::new(
+        LENGTH,
+        Section::circular(RADIUS).unwrap(),
+        LinearElastic::new(E, NU).unwrap(),
+    )
+    .unwrap()
+    .with_base_pose(base);
+    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
+    let c = compliance(&rod, &sol).unwrap();
+    let (ei, gj, ea, gas) = section_constants(rod.shear_coefficient());
+    let exact = timoshenko(LENGTH, ei, gj, ea, Some(gas));
+    assert_blocks_close(&c.tip_body(), &exact, 1e-10, "tip body");
+    // World = body rotated by the tip rotation (the base rotation here).
+    let ad = rotation_adjoint(&base.rotation());
+    assert_blocks_close(
+        &c.tip_world(),
+        &(ad * exact * ad.transpose()),
+        1e-10,
+        "tip world",
+    );
+    // Every node: the cantilever of length s.
+    for (i, &s) in c.s.iter().enumerate().skip(1) {
+        let ex = timoshenko(s, ei, gj, ea, Some(gas));
+        assert_blocks_close(&c.body[i], &ex, 1e-10, &format!("s = {s}"));
+    }
+}
+
+#[test]
+fn gamma_c_is_one_at_the_tip_without_shear() {
+    let rod = Rod::new(
+        LENGTH,
+        Section::circular(RADIUS).unwrap(),
+        LinearElastic::new(E, NU).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true);
+    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
+    let c = compliance(&rod, &sol).unwrap();
+    let g = c.gamma_c.last().unwrap();
+    assert!((g[0] - 1.0).abs() < 1e-12, "{g:?}");
+    assert!((g[1] - 1.0).abs() < 1e-12, "{g:?}");
+    assert!(g[2].abs() < 1e-15);
+    // Along the arm gamma_c = (s/L)^3.
+    for (i, &s) in c.s.iter().enumerate() {
+        let e = (s / LENGTH).powi(3);
+        assert!((c.gamma_c[i][0] - e).abs() < 1e-12);
+    }
+    // Without shear and stretch the compliance is singular: reported, not hidden.
+    assert!(c.condition.last().unwrap().is_infinite() || *c.condition.last().unwrap() > 1e12);
+    assert!(c.stiffness_world.last().unwrap()[(0, 0)].is_nan());
+}
+
+/// Gauss–Legendre nodes and weights on [-1, 1] (Newton on P_n), independent of the library.
+fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (1..=n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// Castigliano: C_ij = ∫ Σ_k B_ki B_kj / S_k ds with B the map from the tip wrench to the
+/// section's internal wrench (local components) of the stress-free arc of curvature `kappa`
+/// about body y; written from the arc's closed-form geometry.
+fn castigliano_arc(kappa: f64, l: f64, stiff: [f64; 6]) -> Matrix6<f64> {
+    let p = |s: f64| {
+        let t = kappa * s;
+        Vector3::new((1.0 - t.cos()) / kappa, 0.0, t.sin() / kappa)
+    };
+    let r = |s: f64| {
+        let t = kappa * s;
+        Matrix3::new(t.cos(), 0.0, t.sin(), 0.0, 1.0, 0.0, -t.sin(), 0.0, t.cos())
+    };
+    let gl = gauss_legendre(30);
+    let panels = 16;
+    let mut c = Matrix6::zeros();
+    for k in 0..panels {
+        let (a, b) = (
+            l * k as f64 / panels as f64,
+            l * (k + 1) as f64 / panels as f64,
+        );
+        for &(x, w) in &gl {
+            let s = 0.5 * (a + b) + 0.5 * (b - a) * x;
+            let rt = r(s).transpose();
+            let d = p(l) - p(s);
+            // Section force = R^T F; section moment = R^T (M + d × F).
+            let mut bm = Matrix6::zeros();
+            let dx = Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
+            bm.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
+            bm.fixed_view_mut::<3, 3>(3, 0).copy_from(&(rt * dx));
+            bm.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
+            let sinv =
+                Matrix6::from_diagonal(&Vector6::from_iterator(stiff.iter().map(|v| 1.0 / v)));
+            c += bm.transpose() * sinv * bm * (0.5 * (b - a) * w);
+        }
+    }
+    c
+}
+
+fn arc_rod(angle: f64) -> Rod {
+    let kappa = angle / LENGTH;
+    Rod::new(
+        LENGTH,
+        Section::circular(RADIUS).unwrap(),
+        LinearElastic::new(E, NU).unwrap(),
+    )
+    .unwrap()
+    .with_rest_curvature(Profile::Constant(Vector3::new(0.0, kappa, 0.0)))
+    .unwrap()
+}
+
+#[test]
+fn stress_free_arc_matches_castigliano() {
+    for angle in [PI / 2.0, PI, 1.5 * PI] {
+        let rod = arc_rod(angle);
+        let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(2000)).unwrap();
+        let c = compliance(&rod, &sol).unwrap();
+        let (ei, gj, ea, gas) = section_constants(rod.shear_coefficient());
+        let exact = castigliano_arc(angle / LENGTH, LENGTH, [gas, gas, ea, ei, ei, gj]);
+        assert_blocks_close(&c.tip_world(), &exact, 1e-8, &format!("arc {angle}"));
+    }
+}
+
+fn two_segment(tensions: [f64; 6]) -> Vec<Tendon> {
+    (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            Tendon::constant(
+                [0.01 * ang.cos(), 0.01 * ang.sin()],
+                tensions[i],
+                Some(if i < 3 { 0.2 } else { 0.4 }),
+            )
+            .unwrap()
+        })
+        .collect()
+}
+
+fn niti() -> Rod {
+    Rod::new(
+        0.4,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn frames_are_related_by_the_adjoint_and_k_inverts_c() {
+    let rod = niti();
+    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
+    let sol = solve_statics(&rod, &tendons, &loads, &rk4(50)).unwrap();
+    let c = compliance(&rod, &sol).unwrap();
+    for i in 1..c.s.len() {
+        let ad = rotation_adjoint(&rot_of(&sol, i));
+        let w = ad * c.body[i] * ad.transpose();
+        assert!((w - c.world[i]).amax() <= 1e-12 * c.world[i].amax());
+        for (cm, km) in [
+            (&c.world[i], &c.stiffness_world[i]),
+            (&c.body[i], &c.stiffness_body[i]),
+        ] {
+            assert!((cm - cm.transpose()).amax() == 0.0);
+            assert!(cm.symmetric_eigen().eigenvalues.min() > 0.0);
+            // K C = I, columns scaled by units: compare K C with I entry-wise.
+            let kc = km * cm;
+            assert!(
+                (kc - Matrix6::identity()).amax() < 1e-6,
+                "{}",
+                (kc - Matrix6::identity()).amax()
+            );
+        }
+    }
+}
+
+/// Tip twist difference `[δp; δθ_world]` between two solutions.
+fn tip_twist(a: &StaticsSolution, b: &StaticsSolution) -> Vector6<f64> {
+    let n = a.s.len() - 1;
+    let dp = Vector3::from(b.position[n]) - Vector3::from(a.position[n]);
+    let dr = rot_of(b, n) * rot_of(a, n).transpose();
+    let th = Rotation3::from_matrix_unchecked(dr).scaled_axis();
+    Vector6::new(dp.x, dp.y, dp.z, th.x, th.y, th.z)
+}
+
+/// Central finite difference of the nonlinear solve (perturbing the world tip wrench),
+/// Richardson-extrapolated over steps `h` and `h/2` (fourth order in the step).
+fn fd_tip_compliance(
+    rod: &Rod,
+    tendons: &[Tendon],
+    loads: &Loads,
+    opts: &SolveOptions,
+    sol: &StaticsSolution,
+    scale: &Matrix6<f64>,
+) -> Matrix6<f64> {
+    let central = |j: usize, eps: f64| {
+        let mut plus = loads.clone();
+        let mut minus = loads.clone();
+        if j < 3 {
+            plus.tip_force[j] += eps;
+            minus.tip_force[j] -= eps;
+        } else {
+            plus.tip_moment[j - 3] += eps;
+            minus.tip_moment[j - 3] -= eps;
+        }
+        let o = SolveOptions {
+            warm_start: Some(sol.warm_start()),
+            ..*opts
+        };
+        let sp = solve_statics(rod, tendons, &plus, &o).unwrap();
+        let sm = solve_statics(rod, tendons, &minus, &o).unwrap();
+        tip_twist(&sm, &sp) / (2.0 * eps)
+    };
+    let mut c = Matrix6::zeros();
+    for j in 0..6 {
+        // Step: a twist of about 1e-3 of the rod length / 1e-3 rad.
+        let eps = 1e-3
+            * if j < 3 {
+                LENGTH / scale[(j, j)]
+            } else {
+                1.0 / scale[(j, j)]
+            };
+        let (d1, d2) = (central(j, eps), central(j, 0.5 * eps));
+        c.set_column(j, &((d2 * 4.0 - d1) / 3.0));
+    }
+    c
+}
+
+#[test]
+fn unloaded_integrated_tangent_and_finite_difference_agree() {
+    for angle in [0.0, PI / 2.0, PI] {
+        let rod = arc_rod(angle);
+        let opts = rk4(400);
+        let loads = Loads::default();
+        let sol = solve_statics(&rod, &[], &loads, &opts).unwrap();
+        let c = compliance(&rod, &sol).unwrap().tip_world();
+        let t = tangent_compliance(&rod, &[], &loads, &sol, &opts, TendonControl::Tension, None)
+            .unwrap();
+        let fd = fd_tip_compliance(&rod, &[], &loads, &opts, &sol, &c);
+        assert_blocks_close(
+            &t.world,
+            &c,
+            1e-6,
+            &format!("tangent vs integrated, arc {angle}"),
+        );
+        assert_blocks_close(&fd, &c, 1e-6, &format!("fd vs integrated, arc {angle}"));
+    }
+}
+
+#[test]
+fn loaded_tangent_matches_finite_difference() {
+    let rod = niti();
+    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads {
+        tip_force: Vector3::new(0.3, -0.2, -0.1),
+        tip_moment: Vector3::new(0.0, 0.002, 0.001),
+        ..Default::default()
+    };
+    let opts = rk4(400);
+    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(
+        &rod,
+        &tendons,
+        &loads,
+        &sol,
+        &opts,
+        TendonControl::Tension,
+        None,
+    )
+    .unwrap();
+    let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
+    assert_blocks_close(&t.world, &fd, 1e-6, "loaded tangent vs fd");
+    // The seed's integrated compliance differs under load and actuation.
+    let c = compliance(&rod, &sol).unwrap().tip_world();
+    let rel = (c - t.world).amax() / t.world.amax();
+    assert!(rel > 1e-3, "{rel}");
+}
+
+#[test]
+fn fixed_length_tendons_stiffen_the_niti_robot() {
+    let rod = niti();
+    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads::default();
+    let opts = rk4(50);
+    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+    let ten = tangent_compliance(
+        &rod,
+        &tendons,
+        &loads,
+        &sol,
+        &opts,
+        TendonControl::Tension,
+        None,
+    )
+    .unwrap();
+    let len = tangent_compliance(
+        &rod,
+        &tendons,
+        &loads,
+        &sol,
+        &opts,
+        TendonControl::Length,
+        None,
+    )
+    .unwrap();
+    let tt = |c: &Matrix6<f64>| {
+        c.fixed_view::<3, 3>(0, 0)
+            .into_owned()
+            .symmetric_eigen()
+            .eigenvalues
+    };
+    let (et, el) = (tt(&ten.world), tt(&len.world));
+    println!("translational compliances (m/N): tension {et:?}, length {el:?}");
+    // Holding the lengths removes compliance: C_tension - C_length is positive semi-definite
+    // (translational block) and the largest translational compliance drops.
+    let diff = (ten.world - len.world)
+        .fixed_view::<3, 3>(0, 0)
+        .into_owned();
+    let d = ((diff + diff.transpose()) * 0.5)
+        .symmetric_eigen()
+        .eigenvalues;
+    assert!(d.min() > -1e-9 * et.max(), "{d:?}");
+    assert!(el.max() < 0.5 * et.max(), "{} vs {}", el.max(), et.max());
+    // The tension rates are reported for every tendon.
+    assert!(len
+        .tension_rate
+        .iter()
+        .any(|r| r.iter().any(|v| v.abs() > 0.0)));
+}
