@@ -539,15 +539,44 @@ pub fn tangent_compliance(
     control: TendonControl,
     node: Option<usize>,
 ) -> Result<TangentCompliance> {
+    let held: Vec<usize> = match control {
+        TendonControl::Tension => Vec::new(),
+        TendonControl::Length => (0..tendons.len()).collect(),
+    };
+    tangent_compliance_held(rod, tendons, loads, solution, options, &held, node)
+}
+
+/// [`tangent_compliance`] with only the tendons `held` (indices into `tendons`) at fixed
+/// length, the others at fixed tension (e.g. hold only the tensioned tendons: a slack tendon
+/// cannot push).
+///
+/// # Errors
+/// As [`tangent_compliance`]; [`Error::InvalidParameter`] naming `held` for an index out of
+/// range or repeated.
+pub fn tangent_compliance_held(
+    rod: &Rod,
+    tendons: &[Tendon],
+    loads: &Loads,
+    solution: &StaticsSolution,
+    options: &SolveOptions,
+    held: &[usize],
+    node: Option<usize>,
+) -> Result<TangentCompliance> {
     let n = solution.s.len();
     let node = node.unwrap_or(n.saturating_sub(1));
     if node >= n {
         return Err(Error::invalid("node", node, format!("in [0, {n})")));
     }
-    let held: Vec<usize> = match control {
-        TendonControl::Tension => Vec::new(),
-        TendonControl::Length => (0..tendons.len()).collect(),
-    };
+    for (k, &i) in held.iter().enumerate() {
+        if i >= tendons.len() || held[..k].contains(&i) {
+            return Err(Error::invalid(
+                format!("held[{k}]"),
+                i,
+                format!("distinct tendon indices in [0, {})", tendons.len()),
+            ));
+        }
+    }
+    let held = held.to_vec();
     if held.len() > MAX_HELD_TENDONS {
         return Err(Error::invalid(
             "tendons",
