@@ -666,6 +666,14 @@ impl<'m, 'a> Evaluator<'m, 'a> {
     /// (`N == FULL`).
     #[inline]
     pub fn rhs<const N: usize>(&mut self, s: f64, y: &[f64; N]) -> [f64; N] {
+        let mut out = [0.0; N];
+        self.rhs_into(s, y, &mut out);
+        out
+    }
+
+    /// [`Evaluator::rhs`] written into `out` (every component), for in-place integrators.
+    #[inline]
+    pub fn rhs_into<const N: usize>(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) {
         self.evaluations += 1;
         let model = self.model;
         let props = model.rod.section_at(s);
@@ -680,11 +688,10 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         let rd = r * hat(&u);
         let nd = -model.distributed_force(s, &props);
         let md = -pd.cross(&nw) - model.distributed_moment(s);
-        let mut out = [0.0; N];
-        put3(&mut out, 0, &pd);
+        put3(out, 0, &pd);
         out[3..12].copy_from_slice(rd.as_slice());
-        put3(&mut out, 12, &nd);
-        put3(&mut out, 15, &md);
+        put3(out, 12, &nd);
+        put3(out, 15, &md);
         if N == FULL {
             for k in 0..6 {
                 let b = STATE + 12 * k;
@@ -713,11 +720,11 @@ impl<'m, 'a> Evaluator<'m, 'a> {
                 let dpd = r * (w.cross(&v) + dv);
                 let wd = w.cross(&u) + du;
                 let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
-                put3(&mut out, b, &dpd);
-                put3(&mut out, b + 3, &wd);
-                put3(&mut out, b + 9, &dmd);
+                put3(out, b, &dpd);
+                put3(out, b + 3, &wd);
+                put3(out, b + 6, &Vector3::zeros());
+                put3(out, b + 9, &dmd);
             }
         }
-        out
     }
 }

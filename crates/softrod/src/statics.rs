@@ -20,7 +20,7 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use crate::cosserat::{rot, v3, ActiveTendon, Evaluator, Model, FULL, STATE};
 use crate::error::{Error, Result};
-use crate::integrate::{dp54, rk4_step, AdaptiveOptions};
+use crate::integrate::{dp54, rk4_step_in_place, AdaptiveOptions, Rk4Workspace};
 use crate::loads::{Frame, Loads};
 use crate::rod::Rod;
 use crate::so3::{hat, quaternion_xyzw, reorthonormalise};
@@ -238,6 +238,7 @@ fn shoot<const N: usize>(
     ws.nodes.clear();
     ws.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
     let mut y: [f64; N] = model.initial(x);
+    let mut rk = Rk4Workspace::<N>::default();
     for k in 0..breaks.len() - 1 {
         let (a, b) = (breaks[k], breaks[k + 1]);
         ev.set_interval(k);
@@ -252,8 +253,8 @@ fn shoot<const N: usize>(
                 let h = (b - a) / n as f64;
                 for i in 0..n {
                     let t = a + h * i as f64;
-                    let mut f = |s: f64, yy: &[f64; N]| ev.rhs(s, yy);
-                    y = rk4_step(&mut f, t, &y, h);
+                    let mut f = |s: f64, yy: &[f64; N], dy: &mut [f64; N]| ev.rhs_into(s, yy, dy);
+                    rk4_step_in_place(&mut f, t, &mut y, h, &mut rk);
                     project(&mut y);
                     if !y[..STATE].iter().all(|v| v.is_finite()) {
                         return Err(Error::NotConverged {
