@@ -403,14 +403,15 @@ fn arc_fns(x: f64) -> ArcFns {
     }
     let th = x.sqrt();
     let (sn, cs) = th.sin_cos();
+    let ix = 1.0 / x;
     let s = sn / th;
-    let s1 = (cs - s) / (2.0 * x);
-    let s2 = (-0.5 * s - 3.0 * s1) / (2.0 * x);
-    let b = (1.0 - cs) / x;
-    let b1 = (0.5 * s - b) / x;
-    let b2 = (0.5 * s1 - 2.0 * b1) / x;
-    let c = (1.0 - s) / x;
-    let c1 = (-s1 - c) / x;
+    let s1 = 0.5 * (cs - s) * ix;
+    let s2 = 0.5 * (-0.5 * s - 3.0 * s1) * ix;
+    let b = (1.0 - cs) * ix;
+    let b1 = (0.5 * s - b) * ix;
+    let b2 = (0.5 * s1 - 2.0 * b1) * ix;
+    let c = (1.0 - s) * ix;
+    let c1 = (-s1 - c) * ix;
     ArcFns {
         s,
         s1,
@@ -594,40 +595,45 @@ fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
     })
 }
 
-/// Scratch of one solve: per-segment kinematics in the world frame.
+/// Per-segment scratch of one evaluation (world frame unless noted).
+#[derive(Debug, Clone, Copy)]
+struct SegWork {
+    kin: SegKin,
+    /// Rotation of the segment's base frame.
+    base_r: Matrix3<f64>,
+    /// Position of the segment's tip.
+    tip: Vector3<f64>,
+    /// Residual in `(θ_x, θ_y, ℓ)`.
+    g_theta: [f64; 3],
+    /// Columns `P` (tip of this segment), `Ω` (rotation) and `V = P + Ω × d` (chain tip)
+    /// per unit rate of `(θ_x, θ_y, ℓ)`; `d` from this segment's tip to the chain tip, `μ`
+    /// the tip load's moment about this segment's tip.
+    pc: [Vector3<f64>; 3],
+    oc: [Vector3<f64>; 3],
+    vc: [Vector3<f64>; 3],
+    dd: Vector3<f64>,
+    mu: Vector3<f64>,
+}
+
+/// Scratch of one solve, allocated once.
 struct Work {
-    kin: Vec<SegKin>,
-    /// Rotation of each segment's base frame (world).
-    base_r: Vec<Matrix3<f64>>,
-    /// World position of each segment's tip.
-    tips: Vec<Vector3<f64>>,
-    g_theta: DVector<f64>,
-    h_theta: DMatrix<f64>,
+    segs: Vec<SegWork>,
+    /// `∂g_θ/∂θ` as n×n blocks of 3×3 (block `(i, j)` at `i n + j`).
+    blocks: Vec<Matrix3<f64>>,
     g: DVector<f64>,
     h: DMatrix<f64>,
-    /// Load-stiffness scratch: world columns `P`, `Ω`, `V`, tip offsets `d`, moments `μ`.
-    pc: Vec<[Vector3<f64>; 3]>,
-    oc: Vec<[Vector3<f64>; 3]>,
-    vc: Vec<[Vector3<f64>; 3]>,
-    dd: Vec<Vector3<f64>>,
-    mu: Vec<Vector3<f64>>,
+    /// Elimination scratch of the Newton step.
+    lu: Vec<f64>,
 }
 
 impl Work {
     fn new(n: usize) -> Self {
         Self {
-            kin: Vec::with_capacity(n),
-            base_r: Vec::with_capacity(n),
-            tips: Vec::with_capacity(n),
-            g_theta: DVector::zeros(3 * n),
-            h_theta: DMatrix::zeros(0, 0),
+            segs: Vec::with_capacity(n),
+            blocks: Vec::new(),
             g: DVector::zeros(3 * n),
             h: DMatrix::zeros(0, 0),
-            pc: Vec::new(),
-            oc: Vec::new(),
-            vc: Vec::new(),
-            dd: Vec::new(),
-            mu: Vec::new(),
+            lu: Vec::new(),
         }
     }
 }
@@ -643,32 +649,37 @@ fn evaluate(
     w: &mut Work,
 ) -> f64 {
     let n = q.len();
-    w.kin.clear();
-    w.base_r.clear();
-    w.tips.clear();
+    w.segs.clear();
     let (mut gr, mut gp) = (Matrix3::identity(), Vector3::zeros());
     for qi in q {
         let l = qi[2];
-        let k = seg_kin(l * qi[0], l * qi[1], l);
-        w.base_r.push(gr);
-        gp += gr * k.p;
-        gr *= k.r;
-        w.tips.push(gp);
-        w.kin.push(k);
+        let kin = seg_kin(l * qi[0], l * qi[1], l);
+        let base_r = gr;
+        gp += gr * kin.p;
+        gr *= kin.r;
+        let z = Vector3::zeros();
+        w.segs.push(SegWork {
+            kin,
+            base_r,
+            tip: gp,
+            g_theta: [0.0; 3],
+            pc: [z; 3],
+            oc: [z; 3],
+            vc: [z; 3],
+            dd: z,
+            mu: z,
+        });
     }
     let p_tip = gp;
     let f = prep.force * factor;
     let m = prep.moment * factor;
     let loaded = f != Vector3::zeros() || m != Vector3::zeros();
 
-    // World columns P (position), Ω (rotation), V (tip velocity) and per-segment μ, d.
     let mut scaled = 0.0f64;
-    for i in 0..n {
+    for (i, sw) in w.segs.iter_mut().enumerate() {
         let body = &robot.bodies[i];
         let (l0, ei) = (body.rest_length(), body.bending_stiffness());
-        let k = &w.kin[i];
-        let a = q[i][2] * q[i][0];
-        let b = q[i][2] * q[i][1];
+        let (a, b) = (q[i][2] * q[i][0], q[i][2] * q[i][1]);
         let act = prep.actuation[i];
         let mut gq = [
             ei / l0 * a - act[0],
@@ -679,21 +690,19 @@ fn evaluate(
             },
         ];
         if loaded {
-            let d = p_tip - w.tips[i];
-            let mu = m + d.cross(&f);
-            let rt = w.base_r[i].transpose();
-            let (fl, ml) = (rt * f, rt * mu);
+            // Generalized force of the tip wrench: F·P + μ·Ω per coordinate.
+            sw.dd = p_tip - sw.tip;
+            sw.mu = m + sw.dd.cross(&f);
             for c in 0..3 {
-                let mut qc = fl.dot(&k.dp[c]);
+                sw.pc[c] = sw.base_r * sw.kin.dp[c];
                 if c < 2 {
-                    qc += ml.dot(&k.w[c]);
+                    sw.oc[c] = sw.base_r * sw.kin.w[c];
                 }
-                gq[c] -= qc;
+                sw.vc[c] = sw.pc[c] + sw.oc[c].cross(&sw.dd);
+                gq[c] -= f.dot(&sw.pc[c]) + sw.mu.dot(&sw.oc[c]);
             }
         }
-        for c in 0..3 {
-            w.g_theta[3 * i + c] = gq[c];
-        }
+        sw.g_theta = gq;
         scaled = scaled.max(gq[0].abs().max(gq[1].abs()) * l0 / ei);
         if let Some(ea) = body.axial_stiffness() {
             scaled = scaled.max(gq[2].abs() / ea);
@@ -703,64 +712,63 @@ fn evaluate(
         scaled = f64::INFINITY;
     }
 
-    if jacobian {
-        if w.h.nrows() != 3 * n {
-            w.h_theta = DMatrix::zeros(3 * n, 3 * n);
-            w.h = DMatrix::zeros(3 * n, 3 * n);
-        }
-        w.h_theta.fill(0.0);
-        for i in 0..n {
-            let body = &robot.bodies[i];
-            let l0 = body.rest_length();
-            let kb = body.bending_stiffness() / l0;
-            w.h_theta[(3 * i, 3 * i)] = kb;
-            w.h_theta[(3 * i + 1, 3 * i + 1)] = kb;
-            if let Some(ea) = body.axial_stiffness() {
-                w.h_theta[(3 * i + 2, 3 * i + 2)] = ea / l0;
-            }
-        }
-        if loaded {
-            load_stiffness(w, p_tip, &f, &m);
-        }
-    }
-
-    // To curvature-vector coordinates: g_u = Jᵀ g_θ, H_u = Jᵀ H_θ J + Σ g_θ ∂²θ/∂q².
-    for i in 0..n {
+    // To curvature-vector coordinates: g_u = Jᵀ g_θ, H_u = Jᵀ H_θ J + Σ g_θ ∂²θ/∂q², with
+    // J = ∂(θ_x, θ_y, ℓ)/∂(u_x, u_y, ℓ) = [ℓ 0 u_x; 0 ℓ u_y; 0 0 1] per segment.
+    for (i, sw) in w.segs.iter().enumerate() {
         let (ux, uy, l) = (q[i][0], q[i][1], q[i][2]);
-        let (ga, gb, gl) = (w.g_theta[3 * i], w.g_theta[3 * i + 1], w.g_theta[3 * i + 2]);
+        let [ga, gb, gl] = sw.g_theta;
         w.g[3 * i] = l * ga;
         w.g[3 * i + 1] = l * gb;
         w.g[3 * i + 2] = ux * ga + uy * gb + gl;
     }
     if jacobian {
-        let dim = 3 * n;
-        // Right multiplication by J (columns), then left by Jᵀ (rows).
-        for j in 0..n {
-            let (ux, uy, l) = (q[j][0], q[j][1], q[j][2]);
-            for r in 0..dim {
-                let (ca, cb, cl) = (
-                    w.h_theta[(r, 3 * j)],
-                    w.h_theta[(r, 3 * j + 1)],
-                    w.h_theta[(r, 3 * j + 2)],
-                );
-                w.h[(r, 3 * j)] = l * ca;
-                w.h[(r, 3 * j + 1)] = l * cb;
-                w.h[(r, 3 * j + 2)] = ux * ca + uy * cb + cl;
+        if w.h.nrows() != 3 * n {
+            w.blocks = vec![Matrix3::zeros(); n * n];
+            w.h = DMatrix::zeros(3 * n, 3 * n);
+        }
+        for (i, body) in robot.bodies.iter().enumerate() {
+            let l0 = body.rest_length();
+            let kb = body.bending_stiffness() / l0;
+            let ka = body.axial_stiffness().map_or(0.0, |ea| ea / l0);
+            for j in 0..n {
+                w.blocks[i * n + j] = if i == j {
+                    Matrix3::from_diagonal(&Vector3::new(kb, kb, ka))
+                } else {
+                    Matrix3::zeros()
+                };
             }
         }
+        if loaded {
+            load_stiffness(w, &f);
+        }
         for i in 0..n {
-            let (ux, uy, l) = (q[i][0], q[i][1], q[i][2]);
-            for c in 0..dim {
-                let (ra, rb, rl) = (w.h[(3 * i, c)], w.h[(3 * i + 1, c)], w.h[(3 * i + 2, c)]);
-                w.h[(3 * i, c)] = l * ra;
-                w.h[(3 * i + 1, c)] = l * rb;
-                w.h[(3 * i + 2, c)] = ux * ra + uy * rb + rl;
+            let (uxi, uyi, li) = (q[i][0], q[i][1], q[i][2]);
+            for j in 0..n {
+                let (uxj, uyj, lj) = (q[j][0], q[j][1], q[j][2]);
+                let b = &w.blocks[i * n + j];
+                // B J: columns ℓ_j b0, ℓ_j b1, u_x b0 + u_y b1 + b2.
+                let mut bj = Matrix3::zeros();
+                for r in 0..3 {
+                    bj[(r, 0)] = lj * b[(r, 0)];
+                    bj[(r, 1)] = lj * b[(r, 1)];
+                    bj[(r, 2)] = uxj * b[(r, 0)] + uyj * b[(r, 1)] + b[(r, 2)];
+                }
+                // Jᵀ (B J): rows ℓ_i r0, ℓ_i r1, u_x r0 + u_y r1 + r2.
+                let mut blk = Matrix3::zeros();
+                for c in 0..3 {
+                    blk[(0, c)] = li * bj[(0, c)];
+                    blk[(1, c)] = li * bj[(1, c)];
+                    blk[(2, c)] = uxi * bj[(0, c)] + uyi * bj[(1, c)] + bj[(2, c)];
+                }
+                if i == j {
+                    let [ga, gb, _] = w.segs[i].g_theta;
+                    blk[(0, 2)] += ga;
+                    blk[(2, 0)] += ga;
+                    blk[(1, 2)] += gb;
+                    blk[(2, 1)] += gb;
+                }
+                w.h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&blk);
             }
-            let (ga, gb) = (w.g_theta[3 * i], w.g_theta[3 * i + 1]);
-            w.h[(3 * i, 3 * i + 2)] += ga;
-            w.h[(3 * i + 2, 3 * i)] += ga;
-            w.h[(3 * i + 1, 3 * i + 2)] += gb;
-            w.h[(3 * i + 2, 3 * i + 1)] += gb;
         }
     }
     // Inextensible segments: the ℓ row is the constraint ℓ = ℓ0.
@@ -780,57 +788,49 @@ fn evaluate(
     scaled
 }
 
-/// Adds `-∂(J_hᵀ W)/∂θ` (the load stiffness of the dead tip wrench) to `w.h_theta`.
-fn load_stiffness(w: &mut Work, p_tip: Vector3<f64>, f: &Vector3<f64>, m: &Vector3<f64>) {
-    let n = w.kin.len();
-    if w.pc.len() != n {
-        w.pc = vec![[Vector3::zeros(); 3]; n];
-        w.oc = vec![[Vector3::zeros(); 3]; n];
-        w.vc = vec![[Vector3::zeros(); 3]; n];
-        w.dd = vec![Vector3::zeros(); n];
-        w.mu = vec![Vector3::zeros(); n];
-    }
-    // Here pc = P (world position columns), oc = Ω, vc = V = P + Ω × d (tip velocity).
-    let (pc, oc, vc, dd, mu) = (&mut w.pc, &mut w.oc, &mut w.vc, &mut w.dd, &mut w.mu);
-    for i in 0..n {
-        let gr = &w.base_r[i];
-        let k = &w.kin[i];
-        dd[i] = p_tip - w.tips[i];
-        mu[i] = m + dd[i].cross(f);
-        for c in 0..3 {
-            pc[i][c] = gr * k.dp[c];
-            oc[i][c] = if c < 2 { gr * k.w[c] } else { Vector3::zeros() };
-            vc[i][c] = pc[i][c] + oc[i][c].cross(&dd[i]);
-        }
-    }
-    // Each entry is one dot product with the other segment's column:
+/// Adds `-∂(J_hᵀ W)/∂θ` (the load stiffness of the dead tip wrench) to `w.blocks`, from the
+/// world columns of `evaluate`.
+fn load_stiffness(w: &mut Work, f: &Vector3<f64>) {
+    let n = w.segs.len();
+    // Each entry is one dot product with the other segment's column (rows k of block (i, j)):
     // j < i: Ω_j·a_ik, a = P_ik × F + d_i × (F × Ω_ik) + Ω_ik × μ_i (proximal rotation);
     // j > i: V_j·b_ik, b = F × Ω_ik (distal motion of the tip);
     // j = i: second derivatives of the segment plus Ω_i·(d_i × b_ik).
     for i in 0..n {
-        let k = &w.kin[i];
-        let rt = w.base_r[i].transpose();
-        let (fl, ml) = (rt * f, rt * mu[i]);
+        let si = &w.segs[i];
+        let k = &si.kin;
+        let rt = si.base_r.transpose();
+        let (fl, ml) = (rt * f, rt * si.mu);
+        let mut a_t = Matrix3::zeros();
+        let mut b_t = Matrix3::zeros();
+        let mut db_t = Matrix3::zeros();
         for kk in 0..3 {
-            let b = f.cross(&oc[i][kk]);
-            let db = dd[i].cross(&b);
-            let a = pc[i][kk].cross(f) + db + oc[i][kk].cross(&mu[i]);
-            for j in 0..n {
-                for mm in 0..3 {
-                    let dq = if j < i {
-                        oc[j][mm].dot(&a)
-                    } else if j > i {
-                        vc[j][mm].dot(&b)
-                    } else {
-                        let mut v = fl.dot(&k.ddp[kk][mm]) + oc[i][mm].dot(&db);
-                        if kk < 2 && mm < 2 {
-                            v += ml.dot(&k.dw[kk][mm]);
-                        }
-                        v
-                    };
-                    w.h_theta[(3 * i + kk, 3 * j + mm)] -= dq;
+            let b = f.cross(&si.oc[kk]);
+            let db = si.dd.cross(&b);
+            let a = si.pc[kk].cross(f) + db + si.oc[kk].cross(&si.mu);
+            a_t.set_row(kk, &a.transpose());
+            b_t.set_row(kk, &b.transpose());
+            db_t.set_row(kk, &db.transpose());
+        }
+        let mut own = db_t * Matrix3::from_columns(&si.oc);
+        for kk in 0..3 {
+            for mm in 0..3 {
+                let mut v = fl.dot(&k.ddp[kk][mm]);
+                if kk < 2 && mm < 2 {
+                    v += ml.dot(&k.dw[kk][mm]);
                 }
+                own[(kk, mm)] += v;
             }
+        }
+        for j in 0..n {
+            let delta = if j < i {
+                a_t * Matrix3::from_columns(&w.segs[j].oc)
+            } else if j > i {
+                b_t * Matrix3::from_columns(&w.segs[j].vc)
+            } else {
+                own
+            };
+            w.blocks[i * n + j] -= delta;
         }
     }
 }
@@ -905,6 +905,7 @@ fn newton(
     let n = q0.len();
     let mut q = q0.to_vec();
     let mut trial = q.clone();
+    let mut dx = vec![0.0; 3 * n];
     // Without a tip load the actuator-only start is exact: check it without the Jacobian.
     let mut rn = evaluate(robot, prep, &q, factor, !likely_exact, w);
     let mut out = NewtonOut {
@@ -920,11 +921,7 @@ fn newton(
         evaluate(robot, prep, &q, factor, true, w);
     }
     for _ in 0..opts.max_iterations {
-        let rhs = -&w.g;
-        let Some(dx) = w.h.clone().lu().solve(&rhs) else {
-            break;
-        };
-        if !dx.iter().all(|v| v.is_finite()) {
+        if !solve_in_place(&w.h, &w.g, &mut w.lu, &mut dx) {
             break;
         }
         let mut lambda = 1.0;
@@ -962,6 +959,57 @@ fn newton(
     out.q = q;
     out.residual = rn;
     out
+}
+
+/// Solves `h dx = -g` by Gaussian elimination with partial pivoting in the scratch `lu`
+/// (no allocation after the first call). Returns `false` if `h` is singular or the step is
+/// not finite.
+fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mut [f64]) -> bool {
+    let n = g.len();
+    // Row-major augmented matrix [h | -g].
+    let w = n + 1;
+    lu.clear();
+    for r in 0..n {
+        for c in 0..n {
+            lu.push(h[(r, c)]);
+        }
+        lu.push(-g[r]);
+    }
+    for k in 0..n {
+        let (mut piv, mut best) = (k, lu[k * w + k].abs());
+        for r in k + 1..n {
+            let v = lu[r * w + k].abs();
+            if v > best {
+                piv = r;
+                best = v;
+            }
+        }
+        if !(best > 0.0 && best.is_finite()) {
+            return false;
+        }
+        if piv != k {
+            for c in k..w {
+                lu.swap(k * w + c, piv * w + c);
+            }
+        }
+        let inv = 1.0 / lu[k * w + k];
+        for r in k + 1..n {
+            let f = lu[r * w + k] * inv;
+            if f != 0.0 {
+                for c in k + 1..w {
+                    lu[r * w + c] -= f * lu[k * w + c];
+                }
+            }
+        }
+    }
+    for k in (0..n).rev() {
+        let mut v = lu[k * w + n];
+        for c in k + 1..n {
+            v -= lu[k * w + c] * dx[c];
+        }
+        dx[k] = v / lu[k * w + k];
+    }
+    dx.iter().all(|v| v.is_finite())
 }
 
 fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
