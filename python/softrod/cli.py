@@ -170,6 +170,110 @@ def _cmd_solve(args) -> int:
     return 0
 
 
+def _fmt6(m) -> str:
+    return "\n".join("  [" + ", ".join(f"{v: .4e}" for v in row) + "]" for row in m)
+
+
+def _cmd_compliance(args) -> int:
+    from . import compliance, eigenscrews, tangent_compliance
+    from .robot import load_robot
+
+    robot = load_robot(args.robot)
+    if args.tensions is not None:
+        robot = robot.with_tensions(args.tensions)
+    sol = robot.solve()
+    comp = compliance(sol)
+    print(f"robot: {robot.name} ({args.robot}); tip at {np.round(sol.tip_position * 1e3, 3)} mm")
+    print("twist [dp; dtheta] = C [f; m], wrench applied at the tip (SI units)")
+    print("integrated tip compliance, world frame (seed eq. 6):")
+    print(_fmt6(comp.tip_world))
+    print("integrated tip compliance, body frame (seed eq. 7):")
+    print(_fmt6(comp.tip_body))
+    print(f"condition number (1-norm): {comp.tip_condition:.3e}")
+    g = comp.gamma_c[-1]
+    print(f"gamma_c at the tip (body x, y, z): [{g[0]:.4f}, {g[1]:.4f}, {g[2]:.4f}]")
+    for mode in ("tension", "length"):
+        t = tangent_compliance(sol, mode)
+        print(f"exact tangent tip compliance, tendons at fixed {mode}, world frame:")
+        print(_fmt6(t.world))
+    es = eigenscrews(comp.tip_stiffness_world)
+    print(
+        "eigenstiffnesses of the tip stiffness (world):", ", ".join(f"{v:.4e}" for v in es.values)
+    )
+    print("pitches (m/rad):", ", ".join(f"{v:.4e}" for v in es.pitches))
+    if args.plot or args.gamma_plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .plot import plot_compliance_ellipsoids, plot_gamma_c
+
+        if args.plot:
+            plot_compliance_ellipsoids(
+                sol, comp, title=f"{robot.name}: translational compliance"
+            ).savefig(args.plot, dpi=130)
+            print(f"wrote {args.plot}", file=sys.stderr)
+        if args.gamma_plot:
+            plot_gamma_c(comp, title=f"{robot.name}: dimensionless flexural compliance").savefig(
+                args.gamma_plot, dpi=130
+            )
+            print(f"wrote {args.gamma_plot}", file=sys.stderr)
+    return 0
+
+
+def _cmd_workspace(args) -> int:
+    import time
+
+    from .robot import load_robot
+    from .workspace import tension_grid, workspace_map
+
+    robot = load_robot(args.robot)
+    axes = {}
+    for spec in args.sweep:
+        try:
+            idx, top = spec.split(":")
+            axes[int(idx)] = np.linspace(0.0, float(top), args.n)
+        except ValueError:
+            raise ParameterError(
+                f"invalid parameter `--sweep` = {spec!r}: must be INDEX:MAX_TENSION"
+            ) from None
+        if not 0 <= int(idx) < len(robot.tendons):
+            raise ParameterError(f"invalid parameter `--sweep` = {spec!r}: no tendon {idx}")
+    grid = tension_grid(len(robot.tendons), axes)
+    opts = {
+        k: v
+        for k, v in robot.solver.items()
+        if k in ("integrator", "steps", "rtol", "atol", "tolerance")
+    }
+    t0 = time.perf_counter()
+    wmap = workspace_map(
+        robot.rod, robot.tendons, grid, robot.loads, progress=args.progress, **opts
+    )
+    dt = time.perf_counter() - t0
+    c = wmap.max_translational_compliance
+    ok = wmap.converged
+    print(f"robot: {robot.name} ({args.robot}); {len(grid)} configurations in {dt:.3f} s")
+    print(f"converged: {int(ok.sum())}/{len(grid)}")
+    lo, hi = np.nanmin(c), np.nanmax(c)
+    print(f"largest translational tip compliance (m/N): min {lo:.4e}, max {hi:.4e}")
+    # Centre: the tip closest to the rod's base axis; periphery: the farthest.
+    r = np.linalg.norm(wmap.tip_position[:, :2], axis=1)
+    r[~ok] = np.nan
+    centre, edge = c[np.nanargmin(r)], c[np.nanargmax(r)]
+    print(f"at the centre of the workspace: {centre:.4e}; at the periphery: {edge:.4e}")
+    print(f"periphery / centre: {edge / centre:.2f}")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .plot import plot_workspace_map
+
+        plot_workspace_map(wmap, title=f"{robot.name}: {len(grid)} configurations").savefig(
+            args.plot, dpi=130
+        )
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return 0
+
+
 _TERMS_MODELS = ("yeoh", "ogden")
 
 
@@ -410,6 +514,29 @@ def build_parser() -> argparse.ArgumentParser:
     )
     fi.add_argument("--plot", metavar="FILE", help="PNG of data, fitted curves and residuals")
     fi.set_defaults(func=_cmd_fit)
+
+    co = sub.add_parser(
+        "compliance", help="tip compliance/stiffness of a robot file (integrated and tangent)"
+    )
+    co.add_argument("robot", help="robot description file (TOML)")
+    co.add_argument("--tensions", type=float, nargs="+", help="override the tendon tensions (N)")
+    co.add_argument("--plot", metavar="FILE", help="PNG of compliance ellipsoids along the arm")
+    co.add_argument("--gamma-plot", metavar="FILE", help="PNG of gamma_c(s) per body axis")
+    co.set_defaults(func=_cmd_compliance)
+
+    ws = sub.add_parser("workspace", help="workspace map: sweep tensions, tip stiffness measures")
+    ws.add_argument("robot", help="robot description file (TOML)")
+    ws.add_argument(
+        "--sweep",
+        action="append",
+        required=True,
+        metavar="INDEX:MAX",
+        help="tendon index and largest tension (N), swept from 0; once or twice",
+    )
+    ws.add_argument("--n", type=_positive_int, default=100, help="grid points per swept tendon")
+    ws.add_argument("--plot", metavar="FILE", help="PNG of the map")
+    ws.add_argument("--progress", action="store_true", help="progress bar on stderr")
+    ws.set_defaults(func=_cmd_workspace)
     return p
 
 

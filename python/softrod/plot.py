@@ -246,3 +246,152 @@ def plot_fit(curve, fits, *, labels=None, title: str | None = None, stretch_max=
     ax_r.grid(alpha=0.3)
     fig.suptitle(title or f"Uniaxial fit: {name}")
     return fig
+
+
+# ------------------------------------------------------------------ compliance (issue 4)
+
+
+def _ellipsoid_mesh(center, axes, directions, n: int = 18):
+    """Surface of the ellipsoid with semi-axes ``axes`` along the rows of ``directions``."""
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2 + 1))
+    sphere = np.stack((np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)), axis=-1)
+    pts = (sphere * axes) @ directions
+    return [center[k] + pts[..., k] for k in range(3)]
+
+
+def plot_compliance_ellipsoids(
+    solution,
+    compliance=None,
+    *,
+    nodes: int = 6,
+    which: str = "translational",
+    title: str | None = None,
+    ax=None,
+):
+    """Compliance ellipsoids drawn along the backbone (world frame).
+
+    At each selected node the ellipsoid has the principal compliances of the force-to-
+    translation block (``which="translational"``, m/N) or of the moment-to-rotation block
+    (``"rotational"``, rad/(N m)) of the integrated world compliance as semi-axes, along their
+    eigenvectors, all scaled by one factor so that the largest is 20 % of the arm's extent.
+
+    Args:
+        solution: A :class:`softrod.StaticsSolution`.
+        compliance: Its :func:`softrod.compliance` (computed when omitted).
+        nodes: Number of nodes (evenly spaced along the mesh, base excluded).
+        which: ``"translational"`` or ``"rotational"``.
+        title: Figure title.
+        ax: A 3-D matplotlib axes to draw into (default: a new figure).
+
+    Returns:
+        The matplotlib figure (axes in millimetres).
+    """
+    import matplotlib.pyplot as plt
+
+    from ._core import compliance as _compliance
+
+    if which not in ("translational", "rotational"):
+        raise ValueError("which must be 'translational' or 'rotational'")
+    comp = compliance if compliance is not None else _compliance(solution)
+    blk = slice(0, 3) if which == "translational" else slice(3, 6)
+    p = solution.position * 1e3
+    if ax is None:
+        fig = plt.figure(figsize=(6.5, 6.5), layout="constrained")
+        ax = fig.add_subplot(projection="3d")
+    else:
+        fig = ax.figure
+    idx = np.unique(np.linspace(1, len(p) - 1, nodes).round().astype(int))
+    eig = [np.linalg.eigh(comp.world[k][blk, blk]) for k in idx]
+    largest = max(float(w.max()) for w, _ in eig)
+    extent = max(float(np.ptp(p, axis=0).max()), 1e-9)
+    scale = 0.2 * extent / largest
+    cmap = plt.get_cmap("plasma")
+    ax.plot(p[:, 0], p[:, 1], p[:, 2], color="0.2", lw=2.0)
+    pts = [p]
+    for j, (k, (w, v)) in enumerate(zip(idx, eig, strict=True)):
+        x, y, z = _ellipsoid_mesh(p[k], np.clip(w, 0, None) * scale, v.T)
+        color = cmap(0.15 + 0.7 * j / max(len(idx) - 1, 1))
+        ax.plot_surface(x, y, z, color=color, alpha=0.35, linewidth=0)
+        pts.append(np.column_stack((x.ravel(), y.ravel(), z.ravel())))
+    _set_equal_3d(ax, np.vstack(pts))
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_zlabel("z (mm)")
+    unit = "m/N" if which == "translational" else "rad/(N m)"
+    head = title or f"{which} compliance ellipsoids"
+    ax.set_title(f"{head}\n(semi-axes: principal compliances, 1 mm = {1 / scale:.3g} {unit})")
+    return fig
+
+
+def plot_gamma_c(compliances, *, labels=None, title: str | None = None):
+    """Dimensionless flexural compliance ``gamma_c(s)`` along the arm, one panel per body axis.
+
+    Args:
+        compliances: A :class:`softrod.Compliance` or a sequence of them (e.g. one per
+            actuation level).
+        labels: One legend label per compliance.
+        title: Figure title.
+
+    Returns:
+        The matplotlib figure.
+    """
+    import matplotlib.pyplot as plt
+
+    comps = [compliances] if hasattr(compliances, "gamma_c") else list(compliances)
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.6), layout="constrained", sharex=True)
+    cmap = plt.get_cmap("viridis")
+    for i, c in enumerate(comps):
+        color = cmap(0.1 + 0.8 * i / max(len(comps) - 1, 1))
+        for k, ax in enumerate(axes):
+            ax.plot(
+                c.s * 1e3, c.gamma_c[:, k], color=color, lw=1.8, label=labels[i] if labels else None
+            )
+    for k, ax in enumerate(axes):
+        ax.set_title(f"body {'xyz'[k]}")
+        ax.set_xlabel("s (mm)")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel(r"$\gamma_c = C_{f}\,3EI(0)/L^3$")
+    if labels:
+        axes[0].legend(fontsize="small")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def plot_workspace_map(
+    wmap, *, measure: str = "max_translational_compliance", title: str | None = None
+):
+    """Tip positions of a workspace map coloured by a stiffness measure: top and side views.
+
+    Args:
+        wmap: A :class:`softrod.WorkspaceMap`.
+        measure: ``"max_translational_compliance"`` (m/N, default),
+            ``"min_translational_compliance"``, ``"condition"`` or ``"eigen_stiffness_k"``
+            (k-th eigenstiffness, k = 0..5).
+        title: Figure title.
+
+    Returns:
+        The matplotlib figure (millimetres).
+    """
+    import matplotlib.pyplot as plt
+
+    if measure.startswith("eigen_stiffness_"):
+        values = wmap.eigen_stiffness[:, int(measure.rsplit("_", 1)[1])]
+    else:
+        values = getattr(wmap, measure)
+    ok = wmap.converged & np.isfinite(values)
+    p = wmap.tip_position[ok] * 1e3
+    v = values[ok]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8), layout="constrained")
+    for ax, (i, j), name in zip(axes, ((0, 1), (0, 2)), ("top view", "side view"), strict=True):
+        sc = ax.scatter(p[:, i], p[:, j], c=v, s=6, cmap="viridis")
+        ax.set_xlabel(f"{'xyz'[i]} (mm)")
+        ax.set_ylabel(f"{'xyz'[j]} (mm)")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title(name)
+        ax.grid(alpha=0.3)
+    unit = {"max_translational_compliance": " (m/N)", "min_translational_compliance": " (m/N)"}
+    fig.colorbar(sc, ax=axes, label=measure.replace("_", " ") + unit.get(measure, ""))
+    failed = int((~wmap.converged).sum())
+    fig.suptitle(title or f"workspace map: {ok.sum()} configurations ({failed} not converged)")
+    return fig

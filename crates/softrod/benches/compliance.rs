@@ -50,6 +50,12 @@ fn bench(c: &mut Criterion) {
         g.bench_function("compliance_along_arm", |b| {
             b.iter(|| compliance(&rod, black_box(&sol)).unwrap())
         });
+        g.bench_function("compliance_with_stiffness_and_condition", |b| {
+            b.iter(|| {
+                let c = compliance(&rod, black_box(&sol)).unwrap();
+                (c.stiffness_world(), c.stiffness_body())
+            })
+        });
         g.bench_function("solve_plus_compliance", |b| {
             b.iter(|| {
                 let s = solve_statics(&rod, black_box(&tendons), &loads, &opts).unwrap();

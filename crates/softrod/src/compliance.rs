@@ -54,14 +54,6 @@ pub struct Compliance {
     pub world: Vec<Matrix6<f64>>,
     /// `C_body(s)`.
     pub body: Vec<Matrix6<f64>>,
-    /// `K_world = C_world⁻¹` where `C_world` is positive definite, NaN otherwise (e.g. at
-    /// `s = 0`, or shear and stretch off).
-    pub stiffness_world: Vec<Matrix6<f64>>,
-    /// `K_body = C_body⁻¹`, NaN where not positive definite.
-    pub stiffness_body: Vec<Matrix6<f64>>,
-    /// 1-norm condition number `‖C‖₁ ‖K‖₁` of the world compliance in SI units (infinite
-    /// where `C` is not positive definite).
-    pub condition: Vec<f64>,
     /// Dimensionless flexural compliance per body axis (see [`gamma_c`]).
     pub gamma_c: Vec<[f64; 3]>,
 }
@@ -80,6 +72,18 @@ impl Compliance {
             .last()
             .copied()
             .unwrap_or(Matrix6::repeat(f64::NAN))
+    }
+    /// `K_world = C_world⁻¹` at every node where `C_world` is positive definite, NaN
+    /// otherwise (e.g. at `s = 0`, or with shear and stretch off), with the 1-norm condition
+    /// number `‖C‖₁ ‖K‖₁` of `C_world` (SI units; infinite where not positive definite).
+    /// Computed on demand (Cholesky per node).
+    pub fn stiffness_world(&self) -> (Vec<Matrix6<f64>>, Vec<f64>) {
+        self.world.iter().map(invert_spd).unzip()
+    }
+    /// `K_body = C_body⁻¹` at every node (NaN where not positive definite); the condition
+    /// numbers are those of [`Compliance::stiffness_world`] (the frames differ by a rotation).
+    pub fn stiffness_body(&self) -> Vec<Matrix6<f64>> {
+        self.body.iter().map(|c| invert_spd(c).0).collect()
     }
 }
 
@@ -101,40 +105,47 @@ pub fn element_compliance(rod: &Rod, solution: &StaticsSolution) -> Vec<[f64; 6]
         .collect()
 }
 
-/// Weights `(node, w)` of the fourth-order integral over each panel `[x_j, x_{j+1}]` of the
-/// cubic through the (up to) four nearest nodes.
-fn panel_weights(x: &[f64]) -> Vec<Vec<(usize, f64)>> {
+/// Nodes and weights (`m` of them) of the fourth-order integral over the panel
+/// `[x_j, x_{j+1}]` of the cubic through the (up to) four nearest nodes.
+fn panel_weights(x: &[f64], j: usize) -> ([usize; 4], [f64; 4], usize) {
     const G: [(f64, f64); 3] = [
         (0.112_701_665_379_258_31, 5.0 / 18.0),
         (0.5, 8.0 / 18.0),
         (0.887_298_334_620_741_7, 5.0 / 18.0),
     ];
     let n = x.len();
-    (0..n.saturating_sub(1))
-        .map(|j| {
-            let m = n.min(4);
-            let start = j.saturating_sub(1).min(n - m);
-            let nodes: Vec<usize> = (start..start + m).collect();
-            let (a, b) = (x[j], x[j + 1]);
-            nodes
-                .iter()
-                .map(|&i| {
-                    let mut w = 0.0;
-                    for (c, g) in G {
-                        let t = a + c * (b - a);
-                        let mut l = 1.0;
-                        for &k in &nodes {
-                            if k != i {
-                                l *= (t - x[k]) / (x[i] - x[k]);
-                            }
-                        }
-                        w += g * (b - a) * l;
-                    }
-                    (i, w)
-                })
-                .collect()
-        })
-        .collect()
+    let m = n.min(4);
+    let start = j.saturating_sub(1).min(n - m);
+    let mut nodes = [0usize; 4];
+    let mut weights = [0.0f64; 4];
+    for k in 0..m {
+        nodes[k] = start + k;
+    }
+    let (a, b) = (x[j], x[j + 1]);
+    for k in 0..m {
+        let i = nodes[k];
+        let mut w = 0.0;
+        for (c, g) in G {
+            let t = a + c * (b - a);
+            let mut l = 1.0;
+            for &q in &nodes[..m] {
+                if q != i {
+                    l *= (t - x[q]) / (x[i] - x[q]);
+                }
+            }
+            w += g * (b - a) * l;
+        }
+        weights[k] = w;
+    }
+    (nodes, weights, m)
+}
+
+/// `blockdiag(Rᵀ, Rᵀ) M blockdiag(R, R)` (world to body components of a 6×6 compliance or
+/// stiffness), block by block; exactly symmetric.
+fn rotate_blocks(m: &Matrix6<f64>, r: &Matrix3<f64>) -> Matrix6<f64> {
+    let rt = r.transpose();
+    let b = |i: usize, j: usize| rt * m.fixed_view::<3, 3>(i, j) * r;
+    blocks(&b(0, 0), &b(0, 3), &b(3, 3))
 }
 
 /// The symmetric matrix `[[tt, tr], [trᵀ, rr]]` (symmetrising the diagonal blocks).
@@ -149,16 +160,11 @@ fn blocks(tt: &Matrix3<f64>, tr: &Matrix3<f64>, rr: &Matrix3<f64>) -> Matrix6<f6
     m
 }
 
-fn symmetrise(c: &Matrix6<f64>) -> Matrix6<f64> {
-    (c + c.transpose()) * 0.5
-}
-
 /// `C⁻¹` if `C` is symmetric positive definite (Cholesky), NaN otherwise; and the 1-norm
 /// condition number `‖C‖₁ ‖C⁻¹‖₁` (infinite if `C` is not positive definite).
 pub fn invert_spd(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
-    match c.cholesky() {
-        Some(ch) => {
-            let k = symmetrise(&ch.inverse());
+    match cholesky_inverse(c) {
+        Some(k) => {
             let cond = norm1(c) * norm1(&k);
             if cond.is_finite() {
                 (k, cond)
@@ -168,6 +174,56 @@ pub fn invert_spd(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
         }
         None => (Matrix6::repeat(f64::NAN), f64::INFINITY),
     }
+}
+
+/// Inverse of a symmetric positive definite 6×6 matrix by Cholesky `C = L Lᵀ`,
+/// `C⁻¹ = L⁻ᵀ L⁻¹` (plain arrays: several times faster than the generic routine at this
+/// size); `None` if a pivot is not positive.
+fn cholesky_inverse(c: &Matrix6<f64>) -> Option<Matrix6<f64>> {
+    let mut l = [[0.0f64; 6]; 6];
+    for j in 0..6 {
+        let mut d = c[(j, j)];
+        for k in 0..j {
+            d -= l[j][k] * l[j][k];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return None;
+        }
+        let dj = d.sqrt();
+        l[j][j] = dj;
+        for i in j + 1..6 {
+            let mut v = c[(i, j)];
+            for k in 0..j {
+                v -= l[i][k] * l[j][k];
+            }
+            l[i][j] = v / dj;
+        }
+    }
+    // W = L⁻¹ (lower triangular), by forward substitution.
+    let mut w = [[0.0f64; 6]; 6];
+    for j in 0..6 {
+        w[j][j] = 1.0 / l[j][j];
+        for i in j + 1..6 {
+            let mut v = 0.0;
+            for k in j..i {
+                v -= l[i][k] * w[k][j];
+            }
+            w[i][j] = v / l[i][i];
+        }
+    }
+    // C⁻¹ = Wᵀ W.
+    let mut out = Matrix6::zeros();
+    for i in 0..6 {
+        for j in 0..=i {
+            let mut v = 0.0;
+            for k in i..6 {
+                v += w[k][i] * w[k][j];
+            }
+            out[(i, j)] = v;
+            out[(j, i)] = v;
+        }
+    }
+    Some(out)
 }
 
 /// Matrix 1-norm (largest column sum of absolute values).
@@ -257,11 +313,12 @@ fn compliance_matrices(
         if start > 0 {
             q[start] = q[start - 1];
         }
-        let weights = panel_weights(&solution.s[start..end]);
-        for (j, w) in weights.iter().enumerate() {
+        let x = &solution.s[start..end];
+        for j in 0..x.len() - 1 {
+            let (nodes, weights, m) = panel_weights(x, j);
             let mut acc = q[start + j];
-            for &(i, wi) in w {
-                acc += integrand[start + i] * wi;
+            for k in 0..m {
+                acc += integrand[start + nodes[k]] * weights[k];
             }
             q[start + j + 1] = acc;
         }
@@ -279,9 +336,7 @@ fn compliance_matrices(
         let ctt = qtt + p * qtr.transpose() + ctr * p.transpose();
         let w = blocks(&ctt, &ctr, &qrr);
         // C_body = blockdiag(Rᵀ) C_world blockdiag(R).
-        let r = rotm(i);
-        let rt = r.transpose();
-        body.push(blocks(&(rt * ctt * r), &(rt * ctr * r), &(rt * qrr * r)));
+        body.push(rotate_blocks(&w, &rotm(i)));
         world.push(w);
     }
     Ok((world, body, element))
@@ -295,34 +350,18 @@ fn compliance_matrices(
 /// length.
 pub fn compliance(rod: &Rod, solution: &StaticsSolution) -> Result<Compliance> {
     let (world, body, element) = compliance_matrices(rod, solution, false)?;
-    let n = world.len();
-    let mut out = Compliance {
+    let gk = gamma_c(rod, &Matrix6::identity())[0];
+    let gamma = body
+        .iter()
+        .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
+        .collect();
+    Ok(Compliance {
         s: solution.s.clone(),
         element,
-        world: Vec::with_capacity(n),
-        body: Vec::with_capacity(n),
-        stiffness_world: Vec::with_capacity(n),
-        stiffness_body: Vec::with_capacity(n),
-        condition: Vec::with_capacity(n),
-        gamma_c: Vec::with_capacity(n),
-    };
-    for (i, (w, b)) in world.into_iter().zip(body).enumerate() {
-        let (kw, cond) = invert_spd(&w);
-        // K_body = blockdiag(Rᵀ) K_world blockdiag(R) (the same inverse, rotated).
-        let r = &solution.rotation[i];
-        let rm = Matrix3::new(
-            r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
-        );
-        let ra = rotation_adjoint(&rm.transpose());
-        let kb = ra * kw * ra.transpose();
-        out.gamma_c.push(gamma_c(rod, &b));
-        out.world.push(w);
-        out.body.push(b);
-        out.stiffness_world.push(kw);
-        out.stiffness_body.push(kb);
-        out.condition.push(cond);
-    }
-    Ok(out)
+        world,
+        body,
+        gamma_c: gamma,
+    })
 }
 
 // ------------------------------------------------------------------------ tangent compliance

@@ -1,0 +1,79 @@
+"""Benchmark of the compliance API from Python; prints a table of medians.
+
+Run: ``python benchmarks/bench_compliance.py`` (after ``pip install .``). Cases on the
+two-segment NiTi robot (2 x 0.2 m, E 54 GPa, radius 0.7 mm, six tendons at 10 mm, tensions
+[4, 0, 0, 0, 2, 0] N; RK4, 50 steps): the statics solve alone, the integrated compliance along
+the arm, both together (ratio to the solve), the exact tangent tip compliance, eigenscrews, and a
+10 000-configuration workspace map. The Rust-side numbers come from
+``cargo bench -p softrod --bench compliance``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+from _timing import median_time
+
+import softrod
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--repeats", type=int, default=15)
+    p.add_argument("--quick", action="store_true", help="fewer repeats (smoke run)")
+    args = p.parse_args()
+    reps = 3 if args.quick else args.repeats
+    calls = 30 if args.quick else 200
+
+    robot = softrod.load_robot("examples/robots/niti_two_segment.toml")
+    rows = []
+
+    def med(fn):
+        return median_time(fn, calls=calls, repeats=reps) * 1e6
+
+    def case(name, loads):
+        rod, tendons = robot.rod, robot.tendons
+        sol = softrod.solve_statics(rod, tendons, loads)
+        k = softrod.compliance(sol).tip_stiffness_world
+        solve = med(lambda: softrod.solve_statics(rod, tendons, loads))
+        both = med(lambda: softrod.compliance(softrod.solve_statics(rod, tendons, loads)))
+        rows.append(
+            (
+                name,
+                solve,
+                med(lambda: softrod.compliance(sol)),
+                both,
+                both / solve,
+                med(lambda: softrod.compliance(sol).stiffness_world),
+                med(lambda: softrod.tangent_compliance(sol)),
+                med(lambda: softrod.tangent_compliance(sol, "length")),
+                med(lambda: softrod.eigenscrews(k)),
+            )
+        )
+
+    case("tendons only", None)
+    case("+ 0.05 N tip force", softrod.Loads(tip_force=(0.05, 0.0, 0.0)))
+    print("medians in microseconds (NiTi robot, RK4 50 steps)")
+    print(
+        "| loads | solve | compliance along arm | solve + compliance | ratio "
+        "| + stiffness at every node | tangent (tension) | tangent (length) | eigenscrews |"
+    )
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        cells = " | ".join(f"{v:.2f}" if i == 3 else f"{v:.1f}" for i, v in enumerate(r[1:]))
+        print(f"| {r[0]} | {cells} |")
+    grid = softrod.tension_grid(6, {0: np.linspace(0, 4, 100), 1: np.linspace(0, 4, 100)})
+    times = []
+    for _ in range(3 if args.quick else 7):
+        t0 = time.perf_counter()
+        softrod.workspace_map(robot.rod, robot.tendons, grid)
+        times.append(time.perf_counter() - t0)
+    med_map = statistics.median(times)
+    print(f"\nworkspace map, 10 000 configurations (median of {len(times)}): {med_map:.3f} s")
+
+
+if __name__ == "__main__":
+    main()

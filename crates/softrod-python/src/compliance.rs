@@ -1,0 +1,477 @@
+//! Binding of the compliance module: integrated and tangent compliance of a solved rod,
+//! eigenscrews, workspace maps. Arrays only; the numerics are in `softrod::compliance`,
+//! `softrod::eigenscrew` and `softrod::workspace`.
+
+use numpy::ndarray::Array;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use softrod::nalgebra::Matrix6;
+
+use crate::errors::{param_err, to_py_err};
+use crate::statics::{Loads, Problem, Rod, StaticsSolution, Tendon};
+
+fn mat6<'py>(py: Python<'py>, m: &Matrix6<f64>) -> Bound<'py, PyArray2<f64>> {
+    Array::from_shape_fn((6, 6), |(i, j)| m[(i, j)]).into_pyarray(py)
+}
+
+fn mats6<'py>(py: Python<'py>, v: &[Matrix6<f64>]) -> Bound<'py, PyArray3<f64>> {
+    Array::from_shape_fn((v.len(), 6, 6), |(k, i, j)| v[k][(i, j)]).into_pyarray(py)
+}
+
+fn problem_of<'a>(solution: &'a StaticsSolution) -> PyResult<&'a Problem> {
+    solution.problem.as_deref().ok_or_else(|| {
+        param_err(
+            "solution",
+            "a solution without its problem",
+            "a solution returned by solve_statics",
+        )
+    })
+}
+
+/// Integrated compliance and stiffness at every node of a solution (seed 001, eqs. 6-7).
+#[pyclass(frozen, module = "softrod._core")]
+pub(crate) struct Compliance {
+    inner: softrod::Compliance,
+}
+
+#[pymethods]
+impl Compliance {
+    /// Undeformed arc length of each node (m), shape (N,).
+    #[getter]
+    fn s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.s.clone().into_pyarray(py)
+    }
+    /// Element compliance c(s) (body), shape (N, 6).
+    #[getter]
+    fn element<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let e = &self.inner.element;
+        Array::from_shape_fn((e.len(), 6), |(i, j)| e[i][j]).into_pyarray(py)
+    }
+    /// World-frame compliance at each node, shape (N, 6, 6).
+    #[getter]
+    fn world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        mats6(py, &self.inner.world)
+    }
+    /// Body-frame compliance at each node, shape (N, 6, 6).
+    #[getter]
+    fn body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        mats6(py, &self.inner.body)
+    }
+    /// World-frame stiffness (NaN where C is not positive definite; inverted on access),
+    /// shape (N, 6, 6).
+    #[getter]
+    fn stiffness_world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        mats6(py, &self.inner.stiffness_world().0)
+    }
+    /// Body-frame stiffness (NaN where C is not positive definite), shape (N, 6, 6).
+    #[getter]
+    fn stiffness_body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        mats6(py, &self.inner.stiffness_body())
+    }
+    /// 1-norm condition number of C at each node (SI units; inf where singular), shape (N,).
+    #[getter]
+    fn condition<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.stiffness_world().1.into_pyarray(py)
+    }
+    /// Dimensionless flexural compliance per body axis (x, y, z), shape (N, 3).
+    #[getter]
+    fn gamma_c<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let g = &self.inner.gamma_c;
+        Array::from_shape_fn((g.len(), 3), |(i, j)| g[i][j]).into_pyarray(py)
+    }
+    /// Tip compliance, world frame, shape (6, 6).
+    #[getter]
+    fn tip_world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(py, &self.inner.tip_world())
+    }
+    /// Tip compliance, body frame, shape (6, 6).
+    #[getter]
+    fn tip_body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(py, &self.inner.tip_body())
+    }
+    /// Tip stiffness, world frame, shape (6, 6).
+    #[getter]
+    fn tip_stiffness_world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(
+            py,
+            &softrod::compliance::invert_spd(&self.inner.tip_world()).0,
+        )
+    }
+    /// Tip stiffness, body frame, shape (6, 6).
+    #[getter]
+    fn tip_stiffness_body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(
+            py,
+            &softrod::compliance::invert_spd(&self.inner.tip_body()).0,
+        )
+    }
+    /// 1-norm condition number of the tip compliance.
+    #[getter]
+    fn tip_condition(&self) -> f64 {
+        softrod::compliance::invert_spd(&self.inner.tip_world()).1
+    }
+    fn __len__(&self) -> usize {
+        self.inner.s.len()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Compliance(nodes={}, tip_condition={:.3e})",
+            self.inner.s.len(),
+            self.tip_condition()
+        )
+    }
+}
+
+/// The seed's integrated compliance along a solved rod (world and body frames).
+#[pyfunction]
+pub(crate) fn compliance(
+    py: Python<'_>,
+    solution: PyRef<'_, StaticsSolution>,
+) -> PyResult<Compliance> {
+    let problem = problem_of(&solution)?;
+    let sol = &solution.inner;
+    let inner = py
+        .detach(|| softrod::compliance(&problem.rod, sol))
+        .map_err(to_py_err)?;
+    Ok(Compliance { inner })
+}
+
+/// Exact tangent compliance at one node of a loaded, actuated equilibrium.
+#[pyclass(frozen, module = "softrod._core")]
+pub(crate) struct TangentCompliance {
+    inner: softrod::TangentCompliance,
+    tendons: String,
+}
+
+#[pymethods]
+impl TangentCompliance {
+    /// Node index in the solution.
+    #[getter]
+    fn node(&self) -> usize {
+        self.inner.node
+    }
+    /// Arc length of the node (m).
+    #[getter]
+    fn s(&self) -> f64 {
+        self.inner.s
+    }
+    /// d[dp; dtheta]/d[f; m], world components at the node, shape (6, 6).
+    #[getter]
+    fn world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(py, &self.inner.world)
+    }
+    /// The same in the node's body axes, shape (6, 6).
+    #[getter]
+    fn body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(py, &self.inner.body)
+    }
+    /// Inverse of `world` (NaN if singular), shape (6, 6).
+    #[getter]
+    fn stiffness_world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(py, &self.inner.stiffness_world)
+    }
+    /// Inverse of `body` (NaN if singular), shape (6, 6).
+    #[getter]
+    fn stiffness_body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        mat6(py, &self.inner.stiffness_body)
+    }
+    /// 1-norm condition number (SI units).
+    #[getter]
+    fn condition(&self) -> f64 {
+        self.inner.condition
+    }
+    /// Whether the tangent is symmetric (conservative loads).
+    #[getter]
+    fn symmetric(&self) -> bool {
+        self.inner.symmetric
+    }
+    /// d tension / d[f; m] per tendon, shape (n_tendons, 6); zero rows for tendons at fixed
+    /// tension.
+    #[getter]
+    fn tension_rate<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let t = &self.inner.tension_rate;
+        Array::from_shape_fn((t.len(), 6), |(i, j)| t[i][j]).into_pyarray(py)
+    }
+    /// "tension" or "length".
+    #[getter]
+    fn tendons(&self) -> String {
+        self.tendons.clone()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "TangentCompliance(node={}, s={}, tendons={:?}, condition={:.3e})",
+            self.inner.node, self.inner.s, self.tendons, self.inner.condition
+        )
+    }
+}
+
+/// Exact tangent compliance of the equilibrium `solution` at `node` (default: the tip), with
+/// the tendons at fixed "tension" or fixed "length" (all, or the indices `held`).
+#[pyfunction]
+#[pyo3(signature = (solution, tendons="tension", *, held=None, node=None))]
+pub(crate) fn tangent_compliance(
+    py: Python<'_>,
+    solution: PyRef<'_, StaticsSolution>,
+    tendons: &str,
+    held: Option<Vec<i64>>,
+    node: Option<i64>,
+) -> PyResult<TangentCompliance> {
+    let problem = problem_of(&solution)?;
+    let nt = problem.tendons.len();
+    let held: Vec<usize> = match (tendons, held) {
+        ("tension", None) => Vec::new(),
+        ("tension", Some(_)) => {
+            return Err(param_err("held", "given", "None unless tendons=\"length\""));
+        }
+        ("length", None) => (0..nt).collect(),
+        ("length", Some(h)) => {
+            let mut out = Vec::with_capacity(h.len());
+            for (k, i) in h.into_iter().enumerate() {
+                if i < 0 {
+                    return Err(param_err(&format!("held[{k}]"), i, ">= 0"));
+                }
+                out.push(i as usize);
+            }
+            out
+        }
+        (other, _) => return Err(param_err("tendons", other, "\"tension\" or \"length\"")),
+    };
+    let n = solution.inner.s.len() as i64;
+    let node = match node {
+        None => None,
+        Some(k) if k < 0 && k >= -n => Some((n + k) as usize),
+        Some(k) if k >= 0 => Some(k as usize),
+        Some(k) => return Err(param_err("node", k, "in [-N, N)")),
+    };
+    let sol = &solution.inner;
+    let result = py.detach(|| {
+        softrod::compliance::tangent_compliance_held(
+            &problem.rod,
+            &problem.tendons,
+            &problem.loads,
+            sol,
+            &problem.options,
+            &held,
+            node,
+        )
+    });
+    if let Some(err) = problem.callback_error() {
+        return Err(err);
+    }
+    Ok(TangentCompliance {
+        inner: result.map_err(to_py_err)?,
+        tendons: tendons.to_string(),
+    })
+}
+
+/// Eigenscrew decomposition of a 6x6 stiffness or compliance, with the compliance ellipsoids.
+#[pyclass(frozen, module = "softrod._core")]
+pub(crate) struct Eigenscrews {
+    inner: softrod::Decomposition,
+    kind: String,
+}
+
+#[pymethods]
+impl Eigenscrews {
+    /// Eigenvalues (eigenstiffnesses for a stiffness, eigencompliances for a compliance),
+    /// decreasing, shape (6,).
+    #[getter]
+    fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self.inner.screws.iter().map(|s| s.value).collect();
+        v.into_pyarray(py)
+    }
+    /// Eigenvectors (twists for a stiffness, wrenches for a compliance), one per row,
+    /// shape (6, 6).
+    #[getter]
+    fn vectors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let s = &self.inner.screws;
+        Array::from_shape_fn((6, 6), |(i, j)| s[i].vector[j]).into_pyarray(py)
+    }
+    /// Unit screw-axis directions, shape (6, 3).
+    #[getter]
+    fn directions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let s = &self.inner.screws;
+        Array::from_shape_fn((6, 3), |(i, j)| s[i].direction[j]).into_pyarray(py)
+    }
+    /// Points of the axes closest to the frame origin (m), shape (6, 3).
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let s = &self.inner.screws;
+        Array::from_shape_fn((6, 3), |(i, j)| s[i].point[j]).into_pyarray(py)
+    }
+    /// Pitches (m/rad), shape (6,).
+    #[getter]
+    fn pitches<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self.inner.screws.iter().map(|s| s.pitch).collect();
+        v.into_pyarray(py)
+    }
+    /// Translational compliance ellipsoid semi-axes (m/N), decreasing, shape (3,).
+    #[getter]
+    fn translational_axes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.translational.semi_axes.to_vec().into_pyarray(py)
+    }
+    /// Their unit directions, one per row, shape (3, 3).
+    #[getter]
+    fn translational_directions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let d = &self.inner.translational.directions;
+        Array::from_shape_fn((3, 3), |(i, j)| d[i][j]).into_pyarray(py)
+    }
+    /// Rotational compliance ellipsoid semi-axes (rad/(N m)), decreasing, shape (3,).
+    #[getter]
+    fn rotational_axes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.rotational.semi_axes.to_vec().into_pyarray(py)
+    }
+    /// Their unit directions, one per row, shape (3, 3).
+    #[getter]
+    fn rotational_directions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let d = &self.inner.rotational.directions;
+        Array::from_shape_fn((3, 3), |(i, j)| d[i][j]).into_pyarray(py)
+    }
+    /// "stiffness" or "compliance".
+    #[getter]
+    fn kind(&self) -> String {
+        self.kind.clone()
+    }
+    fn __repr__(&self) -> String {
+        let v: Vec<String> = self
+            .inner
+            .screws
+            .iter()
+            .map(|s| format!("{:.4e}", s.value))
+            .collect();
+        format!(
+            "Eigenscrews(kind={:?}, values=[{}])",
+            self.kind,
+            v.join(", ")
+        )
+    }
+}
+
+/// Eigenscrews of a symmetric positive definite 6x6 `matrix` (kind "stiffness" or
+/// "compliance"; twists [translation; rotation], wrenches [force; moment]).
+#[pyfunction]
+#[pyo3(signature = (matrix, kind="stiffness"))]
+pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyResult<Eigenscrews> {
+    let a = matrix.as_array();
+    if a.shape() != [6, 6] {
+        return Err(param_err(
+            "matrix",
+            format!("shape {:?}", a.shape()),
+            "shape (6, 6)",
+        ));
+    }
+    let m = Matrix6::from_fn(|i, j| a[[i, j]]);
+    let k = match kind {
+        "stiffness" => softrod::MatrixKind::Stiffness,
+        "compliance" => softrod::MatrixKind::Compliance,
+        other => return Err(param_err("kind", other, "\"stiffness\" or \"compliance\"")),
+    };
+    let inner = softrod::eigenscrews(&m, k).map_err(to_py_err)?;
+    Ok(Eigenscrews {
+        inner,
+        kind: kind.to_string(),
+    })
+}
+
+/// One block of a workspace map (used by `softrod.workspace_map`): solves `rod` with
+/// `tendons` (their tensions replaced by each row of `tensions`, shape (M, n_tendons)) and
+/// returns a dict of arrays.
+#[pyfunction]
+#[pyo3(signature = (rod, tendons, tensions, loads=None, *, integrator="rk4", steps=50,
+                    rtol=1e-8, atol=1e-10, tolerance=1e-10, chunk=64))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _workspace_map<'py>(
+    py: Python<'py>,
+    rod: PyRef<'_, Rod>,
+    tendons: Vec<PyRef<'_, Tendon>>,
+    tensions: PyReadonlyArray2<'_, f64>,
+    loads: Option<PyRef<'_, Loads>>,
+    integrator: &str,
+    steps: i64,
+    rtol: f64,
+    atol: f64,
+    tolerance: f64,
+    chunk: i64,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let problem = Problem::new(
+        &rod,
+        &tendons,
+        loads.as_deref(),
+        integrator,
+        steps,
+        rtol,
+        atol,
+        tolerance,
+        30,
+        true,
+        64,
+        None,
+        true,
+    )?;
+    if chunk < 1 {
+        return Err(param_err("chunk", chunk, ">= 1"));
+    }
+    let a = tensions.as_array();
+    if a.ndim() != 2 || a.shape()[1] != problem.tendons.len() {
+        return Err(param_err(
+            "tensions",
+            format!("shape {:?}", a.shape()),
+            &format!("shape (M, {})", problem.tendons.len()),
+        ));
+    }
+    let flat: Vec<f64> = a.iter().copied().collect();
+    let result = py.detach(|| {
+        softrod::workspace_map(
+            &problem.rod,
+            &problem.tendons,
+            &problem.loads,
+            &flat,
+            &problem.options,
+            chunk as usize,
+        )
+    });
+    if let Some(err) = problem.callback_error() {
+        return Err(err);
+    }
+    let samples = result.map_err(to_py_err)?;
+    let m = samples.len();
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item(
+        "converged",
+        samples.iter().map(|s| s.converged).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "tip_position",
+        Array::from_shape_fn((m, 3), |(i, j)| samples[i].tip_position[j]).into_pyarray(py),
+    )?;
+    d.set_item(
+        "max_translational_compliance",
+        samples
+            .iter()
+            .map(|s| s.max_translational_compliance)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item(
+        "min_translational_compliance",
+        samples
+            .iter()
+            .map(|s| s.min_translational_compliance)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item(
+        "eigen_stiffness",
+        Array::from_shape_fn((m, 6), |(i, j)| samples[i].eigen_stiffness[j]).into_pyarray(py),
+    )?;
+    d.set_item(
+        "condition",
+        samples
+            .iter()
+            .map(|s| s.condition)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    Ok(d)
+}

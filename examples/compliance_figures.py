@@ -1,0 +1,47 @@
+"""Figures of docs/compliance.md: ellipsoids along the arm, gamma_c(s), a workspace map.
+
+Run from the repository root: ``python examples/compliance_figures.py``.
+"""
+
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import numpy as np
+
+import softrod
+from softrod.plot import plot_compliance_ellipsoids, plot_gamma_c, plot_workspace_map
+
+robot = softrod.load_robot("examples/robots/niti_two_segment.toml")
+sol = robot.solve()
+comp = softrod.compliance(sol)
+fig = plot_compliance_ellipsoids(
+    sol, comp, nodes=7, title="NiTi robot, tensions [4, 0, 0, 0, 2, 0] N"
+)
+fig.savefig("docs/figures/compliance_ellipsoids.png", dpi=110)
+
+scales = [0.0, 0.5, 1.0, 1.5]
+comps = [
+    softrod.compliance(robot.with_tensions(np.array([4, 0, 0, 0, 2, 0]) * k).solve())
+    for k in scales
+]
+fig = plot_gamma_c(
+    comps,
+    labels=[f"tensions x {k}" for k in scales],
+    title="NiTi robot: dimensionless flexural compliance along the arm",
+)
+fig.savefig("docs/figures/compliance_gamma_c.png", dpi=110)
+for k, c in zip(scales, comps, strict=True):
+    print(f"tensions x {k}: gamma_c at the tip = {np.round(c.gamma_c[-1], 4)}")
+
+grid = softrod.tension_grid(6, {0: np.linspace(0, 4, 100), 1: np.linspace(0, 4, 100)})
+t0 = time.perf_counter()
+wmap = softrod.workspace_map(robot.rod, robot.tendons, grid, progress=True)
+print(f"workspace map: {len(grid)} configurations in {time.perf_counter() - t0:.2f} s")
+c = wmap.max_translational_compliance
+r = np.linalg.norm(wmap.tip_position[:, :2], axis=1)
+centre, edge = c[np.argmin(r)], c[np.argmax(r)]
+print(f"largest translational compliance: centre {centre:.4f} m/N, periphery {edge:.4f} m/N")
+fig = plot_workspace_map(wmap, title="NiTi robot: segment-1 tendons 0 and 1 swept over 0-4 N")
+fig.savefig("docs/figures/compliance_workspace.png", dpi=110)

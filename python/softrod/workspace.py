@@ -1,0 +1,131 @@
+"""Workspace maps (seed 001, Fig. 1d): tendon-tension sweeps with tip stiffness measures.
+
+The compliance itself is computed in the compiled core: :func:`softrod.compliance`,
+:func:`softrod.tangent_compliance`, :func:`softrod.eigenscrews`. This module sweeps tendon
+tensions in blocks (for a progress bar) over :func:`softrod._core._workspace_map`, which solves
+each block in parallel across cores with warm starts.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._core import Loads, Rod, Tendon, _workspace_map
+
+
+@dataclass(frozen=True)
+class WorkspaceMap:
+    """Tip positions and stiffness measures over a sweep of tendon tensions.
+
+    Attributes:
+        tensions: The tensions of every sample (N), shape (M, n_tendons).
+        converged: Whether each sample converged (other fields NaN otherwise), shape (M,).
+        tip_position: Tip positions (m, world), shape (M, 3).
+        max_translational_compliance: Largest eigenvalue of the force-to-translation block of
+            the integrated tip compliance (m/N), shape (M,).
+        min_translational_compliance: Smallest one (m/N), shape (M,).
+        eigen_stiffness: Eigenstiffnesses of the tip stiffness (world frame at the tip),
+            decreasing, shape (M, 6).
+        condition: 1-norm condition number of the tip compliance, shape (M,).
+    """
+
+    tensions: np.ndarray
+    converged: np.ndarray
+    tip_position: np.ndarray
+    max_translational_compliance: np.ndarray
+    min_translational_compliance: np.ndarray
+    eigen_stiffness: np.ndarray
+    condition: np.ndarray
+
+
+def tension_grid(n_tendons: int, axes: dict[int, np.ndarray]) -> np.ndarray:
+    """Tensions on a grid in boustrophedon order (neighbours stay close, for warm starts).
+
+    Args:
+        n_tendons: Number of tendons of the robot.
+        axes: Tendon index -> 1-D array of its tensions (N); other tendons stay at 0. At most
+            two axes.
+
+    Returns:
+        Tensions, shape (product of the axis lengths, n_tendons).
+    """
+    keys = list(axes)
+    if not 1 <= len(keys) <= 2:
+        raise ValueError("axes must name one or two tendons")
+    a = np.asarray(axes[keys[0]], dtype=float)
+    b = np.asarray(axes[keys[1]], dtype=float) if len(keys) == 2 else np.zeros(1)
+    rows = []
+    for i, ta in enumerate(a):
+        for tb in b if i % 2 == 0 else b[::-1]:
+            t = np.zeros(n_tendons)
+            t[keys[0]] = ta
+            if len(keys) == 2:
+                t[keys[1]] = tb
+            rows.append(t)
+    return np.array(rows)
+
+
+def _bar(done: int, total: int, width: int = 40) -> None:
+    k = int(width * done / max(total, 1))
+    sys.stderr.write(f"\rworkspace [{'#' * k}{'.' * (width - k)}] {done}/{total}")
+    if done >= total:
+        sys.stderr.write("\n")
+    sys.stderr.flush()
+
+
+def workspace_map(
+    rod: Rod,
+    tendons,
+    tensions,
+    loads: Loads | None = None,
+    *,
+    chunk: int = 64,
+    block: int = 2000,
+    progress: bool = False,
+    **options,
+) -> WorkspaceMap:
+    """Solves the robot for every row of tensions and measures the tip stiffness.
+
+    Args:
+        rod: The rod.
+        tendons: Its tendons (their tensions are replaced by each row of ``tensions``).
+        tensions: Tensions (N), shape (M, n_tendons); order rows along a path (e.g.
+            :func:`tension_grid`) so that warm starts help.
+        loads: External loads (default none).
+        chunk: Samples solved in order on one thread, each warm-started from the previous.
+        block: Samples per call into the core (the progress bar advances per block).
+        progress: Draw a progress bar on stderr.
+        **options: Solver options of :func:`softrod.solve_statics` (``integrator``,
+            ``steps``, ``rtol``, ``atol``, ``tolerance``).
+
+    Returns:
+        The map; failed samples have ``converged`` False and NaN measures.
+    """
+    tendons: list[Tendon] = list(tendons)
+    t = np.ascontiguousarray(np.atleast_2d(np.asarray(tensions, dtype=float)))
+    parts = []
+    total = len(t)
+    for start in range(0, total, max(int(block), 1)):
+        parts.append(
+            _workspace_map(rod, tendons, t[start : start + block], loads, chunk=chunk, **options)
+        )
+        if progress:
+            _bar(min(start + block, total), total)
+    if not parts:
+        raise ValueError("tensions must have at least one row")
+
+    def cat(key):
+        return np.concatenate([np.asarray(p[key]) for p in parts])
+
+    return WorkspaceMap(
+        tensions=t,
+        converged=cat("converged").astype(bool),
+        tip_position=cat("tip_position"),
+        max_translational_compliance=cat("max_translational_compliance"),
+        min_translational_compliance=cat("min_translational_compliance"),
+        eigen_stiffness=cat("eigen_stiffness"),
+        condition=cat("condition"),
+    )
