@@ -272,10 +272,7 @@ fn frames_are_related_by_the_adjoint_and_k_inverts_c() {
         let ad = rotation_adjoint(&rot_of(&sol, i));
         let w = ad * c.body[i] * ad.transpose();
         assert!((w - c.world[i]).amax() <= 1e-12 * c.world[i].amax());
-        for (cm, km) in [
-            (&c.world[i], &kw[i]),
-            (&c.body[i], &kb[i]),
-        ] {
+        for (cm, km) in [(&c.world[i], &kw[i]), (&c.body[i], &kb[i])] {
             assert!((cm - cm.transpose()).amax() == 0.0);
             assert!(cm.symmetric_eigen().eigenvalues.min() > 0.0);
             // K C = I, columns scaled by units: compare K C with I entry-wise.
@@ -441,4 +438,111 @@ fn fixed_length_tendons_stiffen_the_niti_robot() {
         .tension_rate
         .iter()
         .any(|r| r.iter().any(|v| v.abs() > 0.0)));
+}
+
+/// Twist `[δp; δθ_world]` of the first node at arc length `s` between two solutions.
+fn node_twist(a: &StaticsSolution, b: &StaticsSolution, s: f64) -> Vector6<f64> {
+    let ia = a.s.iter().position(|&x| (x - s).abs() < 1e-12).unwrap();
+    let ib = b.s.iter().position(|&x| (x - s).abs() < 1e-12).unwrap();
+    let dp = Vector3::from(b.position[ib]) - Vector3::from(a.position[ia]);
+    let dr = rot_of(b, ib) * rot_of(a, ia).transpose();
+    let th = Rotation3::from_matrix_unchecked(dr).scaled_axis();
+    Vector6::new(dp.x, dp.y, dp.z, th.x, th.y, th.z)
+}
+
+#[test]
+fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
+    use softrod::PointLoad;
+    let rod = niti();
+    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads::tip_force(Vector3::new(0.1, 0.0, -0.05));
+    let opts = rk4(400);
+    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+    // A node inside segment 2 that is a mesh node of the perturbed problems too.
+    let node = 300;
+    let s = sol.s[node];
+    let t = tangent_compliance(
+        &rod,
+        &tendons,
+        &loads,
+        &sol,
+        &opts,
+        TendonControl::Tension,
+        Some(node),
+    )
+    .unwrap();
+    assert_eq!(t.s, s);
+    let mut fd = Matrix6::zeros();
+    for j in 0..6 {
+        let eps = 1e-3
+            * if j < 3 {
+                0.4 / t.world[(j, j)]
+            } else {
+                1.0 / t.world[(j, j)]
+            };
+        let central = |e: f64| {
+            let mk = |sign: f64| {
+                let mut l = loads.clone();
+                let mut pl = PointLoad::force(s, Vector3::zeros());
+                if j < 3 {
+                    pl.force[j] = sign * e;
+                } else {
+                    pl.moment[j - 3] = sign * e;
+                }
+                l.point_loads.push(pl);
+                let o = SolveOptions {
+                    warm_start: Some(sol.warm_start()),
+                    ..opts
+                };
+                solve_statics(&rod, &tendons, &l, &o).unwrap()
+            };
+            node_twist(&mk(-1.0), &mk(1.0), s) / (2.0 * e)
+        };
+        fd.set_column(j, &((central(0.5 * eps) * 4.0 - central(eps)) / 3.0));
+    }
+    assert_blocks_close(&t.world, &fd, 1e-6, "interior node tangent vs fd");
+}
+
+#[test]
+fn adaptive_tangent_matches_finite_difference() {
+    use softrod::AdaptiveOptions;
+    let rod = niti();
+    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads::tip_force(Vector3::new(0.2, 0.1, 0.0));
+    let opts = SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
+            rtol: 1e-12,
+            atol: 1e-14,
+            ..Default::default()
+        }),
+        tolerance: 1e-12,
+        ..Default::default()
+    };
+    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(
+        &rod,
+        &tendons,
+        &loads,
+        &sol,
+        &opts,
+        TendonControl::Tension,
+        None,
+    )
+    .unwrap();
+    let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
+    assert_blocks_close(&t.world, &fd, 1e-6, "adaptive tangent vs fd");
+    // The same tangent as RK4 with many steps (both converge to the exact one).
+    let r = rk4(800);
+    let sr = solve_statics(&rod, &tendons, &loads, &r).unwrap();
+    let tr = tangent_compliance(
+        &rod,
+        &tendons,
+        &loads,
+        &sr,
+        &r,
+        TendonControl::Tension,
+        None,
+    )
+    .unwrap();
+    assert_blocks_close(&t.world, &tr.world, 1e-6, "adaptive vs rk4 tangent");
 }
