@@ -368,6 +368,18 @@ struct Rule<const S: usize, const SHORT: bool> {
     /// Largest tangent turn (rad) per panel that keeps this rule's backbone error below
     /// `1e-10 L`: its global error is about `L (h kappa)^p / C_p` (`p` the order).
     max_turn: f64,
+    /// Largest relative change of the section radius per panel, `h |R'| / R_min`: the
+    /// curvature varies like `R^-3`, so this bounds the quadrature error of a slowly turning
+    /// but strongly tapered arm (calibrated against an RK4 reference, see the tests).
+    max_taper: f64,
+}
+
+/// How fast the integrand varies along the arm (1/m): the largest tangent turning rate
+/// `|(1 + q) k|` and the taper rate `|R'| / R_min`.
+#[derive(Clone, Copy)]
+struct Rates {
+    turn: f64,
+    taper: f64,
 }
 
 const SQ5: f64 = 2.236_067_977_499_79;
@@ -382,6 +394,7 @@ const LOBATTO3: Rule<3, true> = Rule {
     ],
     b: [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
     max_turn: 0.023,
+    max_taper: 0.006,
 };
 
 /// Lobatto IIIA, 4 stages, order 6.
@@ -405,6 +418,7 @@ const LOBATTO4: Rule<4, false> = Rule {
     ],
     b: [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0],
     max_turn: MAX_PANEL_TURN,
+    max_taper: 0.04,
 };
 
 /// State of the backbone integration: arc length, angle, unit tangent, position, and the
@@ -426,19 +440,21 @@ impl BackboneState {
     /// and order-6 rules that meets its turn bound (fine output spacing favours order 4,
     /// coarse spacing or high curvature order 6).
     #[inline]
-    fn advance_loaded<P: Fn(f64) -> (f64, f64)>(&mut self, profile: &P, b: f64, kappa_max: f64) {
+    fn advance_loaded<P: Fn(f64) -> (f64, f64)>(&mut self, profile: &P, b: f64, rates: Rates) {
         let span = b - self.s;
         if span <= 0.0 {
             return;
         }
-        let turn = span * kappa_max;
-        if turn <= LOBATTO3.max_turn {
+        let (turn, taper) = (span * rates.turn, span * rates.taper);
+        if turn <= LOBATTO3.max_turn && taper <= LOBATTO3.max_taper {
             // One Simpson panel: the common case at fine output spacing.
             self.simpson_panels(profile, b, 1);
             return;
         }
-        let m4 = panel_count(turn * (1.0 / LOBATTO3.max_turn));
-        let m6 = panel_count(turn * (1.0 / LOBATTO4.max_turn));
+        let m4 = panel_count(turn * (1.0 / LOBATTO3.max_turn))
+            .max(panel_count(taper * (1.0 / LOBATTO3.max_taper)));
+        let m6 = panel_count(turn * (1.0 / LOBATTO4.max_turn))
+            .max(panel_count(taper * (1.0 / LOBATTO4.max_taper)));
         // Cost in profile evaluations: 2 per order-4 panel, 3 per order-6 panel.
         if 2 * m4 <= 3 * m6 {
             self.simpson_panels(profile, b, m4);
@@ -552,10 +568,10 @@ impl BackboneState {
         profile: &P,
         b: f64,
         anchor: f64,
-        kappa_max: f64,
+        rates: Rates,
     ) {
         if self.s < anchor {
-            self.advance_loaded(profile, b.min(anchor), kappa_max);
+            self.advance_loaded(profile, b.min(anchor), rates);
             // Renormalise the unit tangent (first-order correction of |t|^2 - 1).
             let fix = 1.5 - 0.5 * (self.cos * self.cos + self.sin * self.sin);
             self.cos *= fix;
@@ -583,7 +599,7 @@ fn integrate_backbone<P: Fn(f64) -> (f64, f64)>(
     samples: &[f64],
     length: f64,
     anchor: f64,
-    kappa_max: f64,
+    rates: Rates,
     out: Out<'_>,
 ) -> (f64, f64, f64) {
     let (k0, q0) = profile(0.0);
@@ -598,14 +614,14 @@ fn integrate_backbone<P: Fn(f64) -> (f64, f64)>(
         q: q0,
     };
     for (i, &si) in samples.iter().enumerate() {
-        st.advance(&profile, si, anchor, kappa_max);
+        st.advance(&profile, si, anchor, rates);
         out.k[i] = st.k;
         out.q[i] = st.q;
         out.theta[i] = st.theta;
         out.x[i] = st.x;
         out.y[i] = st.y;
     }
-    st.advance(&profile, length, anchor, kappa_max);
+    st.advance(&profile, length, anchor, rates);
     (st.x, st.y, st.theta)
 }
 
@@ -619,17 +635,21 @@ fn solve_into(
 ) -> Result<((f64, f64, f64), Option<IntegrationStats>)> {
     arm.check_tension(tension)?;
     let (l, anchor) = (arm.length, arm.anchor);
+    let taper = arm.taper.abs() / arm.radius(0.0).min(arm.radius(anchor));
     match method {
         PlanarMethod::ClosedForm => {
             let turn = |(k, q): (f64, f64)| ((1.0 + q) * k).abs();
-            let kappa_max =
-                turn(arm.closed_form(0.0, tension)).max(turn(arm.closed_form(anchor, tension)));
+            let rates = Rates {
+                turn: turn(arm.closed_form(0.0, tension))
+                    .max(turn(arm.closed_form(anchor, tension))),
+                taper,
+            };
             let tip = integrate_backbone(
                 |s| arm.closed_form(s, tension),
                 samples,
                 l,
                 anchor,
-                kappa_max,
+                rates,
                 out,
             );
             Ok((tip, None))
@@ -642,12 +662,15 @@ fn solve_into(
                 0.0,
                 options,
             )?;
-            let kappa_max = sol.y.iter().fold(0.0f64, |m, k| m.max(k[0].abs()));
+            let rates = Rates {
+                turn: sol.y.iter().fold(0.0f64, |m, k| m.max(k[0].abs())),
+                taper,
+            };
             let profile = |s: f64| {
                 let k = sol.eval(s)[0];
                 (k, arm.strain(s, k, tension))
             };
-            let tip = integrate_backbone(profile, samples, l, anchor, kappa_max, out);
+            let tip = integrate_backbone(profile, samples, l, anchor, rates, out);
             Ok((tip, Some(sol.stats)))
         }
     }
