@@ -962,23 +962,19 @@ fn newton(
 }
 
 /// Solves `h dx = -g` by Gaussian elimination with partial pivoting in the scratch `lu`
-/// (no allocation after the first call). Returns `false` if `h` is singular or the step is
-/// not finite.
+/// (column-major copy of `h`; no allocation after the first call). Returns `false` if `h` is
+/// singular or the step is not finite.
 fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mut [f64]) -> bool {
     let n = g.len();
-    // Row-major augmented matrix [h | -g].
-    let w = n + 1;
     lu.clear();
-    for r in 0..n {
-        for c in 0..n {
-            lu.push(h[(r, c)]);
-        }
-        lu.push(-g[r]);
+    lu.extend_from_slice(h.as_slice());
+    for (d, gv) in dx.iter_mut().zip(g.iter()) {
+        *d = -gv;
     }
     for k in 0..n {
-        let (mut piv, mut best) = (k, lu[k * w + k].abs());
+        let (mut piv, mut best) = (k, lu[k + k * n].abs());
         for r in k + 1..n {
-            let v = lu[r * w + k].abs();
+            let v = lu[r + k * n].abs();
             if v > best {
                 piv = r;
                 best = v;
@@ -988,26 +984,28 @@ fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mu
             return false;
         }
         if piv != k {
-            for c in k..w {
-                lu.swap(k * w + c, piv * w + c);
+            for c in k..n {
+                lu.swap(k + c * n, piv + c * n);
             }
+            dx.swap(k, piv);
         }
-        let inv = 1.0 / lu[k * w + k];
+        let inv = 1.0 / lu[k + k * n];
         for r in k + 1..n {
-            let f = lu[r * w + k] * inv;
+            let f = lu[r + k * n] * inv;
             if f != 0.0 {
-                for c in k + 1..w {
-                    lu[r * w + c] -= f * lu[k * w + c];
+                for c in k + 1..n {
+                    lu[r + c * n] -= f * lu[k + c * n];
                 }
+                dx[r] -= f * dx[k];
             }
         }
     }
     for k in (0..n).rev() {
-        let mut v = lu[k * w + n];
+        let mut v = dx[k];
         for c in k + 1..n {
-            v -= lu[k * w + c] * dx[c];
+            v -= lu[k + c * n] * dx[c];
         }
-        dx[k] = v / lu[k * w + k];
+        dx[k] = v / lu[k + k * n];
     }
     dx.iter().all(|v| v.is_finite())
 }
