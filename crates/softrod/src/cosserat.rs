@@ -56,6 +56,8 @@ use crate::section::SectionProperties;
 use crate::so3::hat;
 use crate::tendon::Tendon;
 
+mod hyperelastic_local;
+
 /// Length of the state `(p, R, N, M)`: 3 + 9 + 3 + 3.
 pub(crate) const STATE: usize = 18;
 /// Length of the state with the six sensitivity columns `(δp, w, δN, δM)` appended.
@@ -160,9 +162,9 @@ impl Lu6 {
 pub(crate) struct Local {
     pub v: Vector3<f64>,
     pub u: Vector3<f64>,
-    /// `Σ τ t_i` (N, body frame).
+    /// `Σ τ t_i` (N, body frame), plus the chambers' fluid force.
     pub tendon_force: Vector3<f64>,
-    /// `Σ τ r_i × t_i` (N m, body frame).
+    /// `Σ τ r_i × t_i` (N m, body frame), plus the chambers' fluid moment.
     pub tendon_moment: Vector3<f64>,
 }
 
@@ -204,6 +206,9 @@ pub(crate) struct Model<'a> {
     /// The section compliance when it does not depend on `s` (linear material, uniform
     /// section), precomputed.
     pub uniform_compliance: Option<[f64; 6]>,
+    /// First material failure met by a local solve (a fibre stretch <= 0, an unstable
+    /// hyperelastic law), reported if the solve fails.
+    pub material_error: std::sync::OnceLock<crate::error::Error>,
 }
 
 impl<'a> Model<'a> {
@@ -356,6 +361,8 @@ pub(crate) struct Evaluator<'m, 'a> {
     pub track_speeds: bool,
     /// Right-hand-side evaluations so far.
     pub evaluations: usize,
+    /// Indices of the pressurised chambers that fill the current interval.
+    chambers: Vec<usize>,
 }
 
 impl<'m, 'a> Evaluator<'m, 'a> {
@@ -373,6 +380,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             tendon_speed: vec![0.0; n],
             track_speeds: false,
             evaluations: 0,
+            chambers: Vec::new(),
         }
     }
 
@@ -392,6 +400,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         }
         self.guess = None;
         self.last_lu = None;
+        self.select_chambers(self.model.breaks[k], b);
     }
 
     /// Records `|p_i'|` of the tension-free tendons for the strains `(v, u)`.
@@ -493,7 +502,15 @@ impl<'m, 'a> Evaluator<'m, 'a> {
     ) -> Local {
         let model = self.model;
         let rod = model.rod;
-        let wb = [nb.x, nb.y, nb.z, mb.x, mb.y, mb.z];
+        let mut wb = [nb.x, nb.y, nb.z, mb.x, mb.y, mb.z];
+        // The chambers' fluid carries part of the total wrench (see `chamber.rs`).
+        let fluid = self.chamber_wrench(s);
+        for k in 0..6 {
+            wb[k] -= fluid[k];
+        }
+        if !rod.material().is_linear() {
+            return self.local_hyperelastic(s, props, &wb, &fluid, tangent);
+        }
         let vs = rod.rest_strain().at(s);
         let us = rod.rest_curvature().at(s);
         let (e, c) = match &model.uniform_compliance {
@@ -515,8 +532,8 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             let out = Local {
                 v: vs + Vector3::new(e[0], e[1], e[2]),
                 u: us + Vector3::new(e[3], e[4], e[5]),
-                tendon_force: Vector3::zeros(),
-                tendon_moment: Vector3::zeros(),
+                tendon_force: Vector3::new(fluid[0], fluid[1], fluid[2]),
+                tendon_moment: Vector3::new(fluid[3], fluid[4], fluid[5]),
             };
             if tangent {
                 self.tangent_diag = c;
@@ -631,8 +648,8 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             tm += r.cross(&w) * a;
             self.tendon_speed[i] = len;
         }
-        out.tendon_force = tf;
-        out.tendon_moment = tm;
+        out.tendon_force = tf + Vector3::new(fluid[0], fluid[1], fluid[2]);
+        out.tendon_moment = tm + Vector3::new(fluid[3], fluid[4], fluid[5]);
         if self.track_speeds {
             self.passive_speeds(s, props, &out.v, &out.u);
         }

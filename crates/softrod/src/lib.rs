@@ -18,6 +18,7 @@
 //!   compliance and stiffness, eigenscrews, workspace maps;
 //! * [`error`]: the crate's one error type.
 
+pub mod chamber;
 pub mod compare;
 pub mod compliance;
 pub mod eigenscrew;
@@ -29,6 +30,7 @@ pub mod pcc;
 pub mod pcc_statics;
 pub mod planar;
 
+pub use chamber::{Chamber, ChamberArea};
 pub use compare::{backbone_distance, BackboneDistance};
 pub use compliance::{
     compliance, tangent_compliance, Compliance, TangentCompliance, TendonControl,

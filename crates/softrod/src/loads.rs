@@ -1,4 +1,5 @@
-//! External loads on a rod: tip wrench, point wrenches, distributed force and moment, gravity.
+//! External loads on a rod: tip wrench, point wrenches, distributed force and moment, gravity;
+//! and the pressure of pneumatic chambers.
 //!
 //! All vectors are in the world frame unless a [`Frame::Body`] is given (body components are
 //! rotated with the rod: follower loads). Forces in N, moments in N m, distributed forces in
@@ -6,6 +7,7 @@
 
 use nalgebra::Vector3;
 
+use crate::chamber::Chamber;
 use crate::error::{Error, Result};
 use crate::rod::Profile;
 
@@ -64,6 +66,9 @@ pub struct Loads {
     /// Gravitational acceleration (m/s², world frame); needs the rod's density. The load is
     /// `rho A(s) g` per unit undeformed length.
     pub gravity: Vector3<f64>,
+    /// Pressurised pneumatic chambers (self-equilibrated internal loads: cap forces, wall
+    /// pressure; see [`crate::chamber`]), validated against the rod when solving.
+    pub chambers: Vec<Chamber>,
 }
 
 fn check_vec(name: &str, v: &Vector3<f64>) -> Result<()> {

@@ -559,6 +559,9 @@ pub(crate) fn build_model<'a>(
     for p in &loads.point_loads {
         breaks.push(p.s);
     }
+    for (start, end) in crate::chamber::validate(&loads.chambers, rod)? {
+        breaks.extend([start, end]);
+    }
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();
     let props0 = rod.section_at(0.0);
@@ -606,7 +609,8 @@ pub(crate) fn build_model<'a>(
             })
             && (loads.tip_frame == Frame::World
                 || (loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros())),
-        uniform_compliance: rod.section().is_uniform().then(|| {
+        material_error: std::sync::OnceLock::new(),
+        uniform_compliance: (rod.section().is_uniform() && rod.material().is_linear()).then(|| {
             rod.material()
                 .compliance(&props0, rod.shear_coefficient(), rod.inextensible())
         }),
@@ -835,6 +839,9 @@ pub fn solve_statics(
     stats.converged = result.converged;
     stats.function_evaluations = evaluations;
     if !result.converged && options.throw {
+        if let Some(e) = model.material_error.get() {
+            return Err(e.clone());
+        }
         return Err(Error::NotConverged {
             what: "shooting Newton (Cosserat rod statics)".into(),
             iterations: stats.iterations,

@@ -1,0 +1,350 @@
+//! Pneumatic chambers and hyperelastic rods against closed forms and independent laws: the
+//! constant-curvature arc of one pressurised chamber, pure elongation under equal pressures,
+//! the uniaxial hyperelastic stretch, the small-strain limit, exactness of the fibre section
+//! for a linear law, and the errors.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::f64::consts::PI;
+
+use softrod::nalgebra::Vector3;
+use softrod::{
+    solve_statics, Chamber, ChamberArea, Error, Hookean, Integrator, LinearElastic, Loads,
+    Material, MooneyRivlin, NeoHookean, Rod, Section, Silicone, SolveOptions, UniaxialLaw,
+    UniaxialModel, Yeoh,
+};
+
+/// Seed-001-like arm: length, outer radius, chamber radius, chamber centroid distance (m).
+const L: f64 = 0.16;
+const R: f64 = 0.012;
+const RC: f64 = 0.0025;
+const D: f64 = 0.6 * R;
+
+fn rk4(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        tolerance: 1e-13,
+        ..Default::default()
+    }
+}
+
+/// Angles of the six chambers: three pairs centred at 90°, 210°, 330°, ±25° within a pair.
+fn angles() -> [f64; 6] {
+    let mut a = [0.0; 6];
+    for (i, c) in [90.0f64, 210.0, 330.0].iter().enumerate() {
+        a[2 * i] = (c - 25.0).to_radians();
+        a[2 * i + 1] = (c + 25.0).to_radians();
+    }
+    a
+}
+
+/// Solid section with the six chamber voids excluded: `(section, A0, I0)` (Ix = Iy = I0).
+fn arm_section() -> (Section, f64, f64) {
+    let ac = PI * RC * RC;
+    let a0 = PI * R * R - 6.0 * ac;
+    let mut ix = PI * R.powi(4) / 4.0;
+    let mut iy = ix;
+    for t in angles() {
+        ix -= PI * RC.powi(4) / 4.0 + ac * (D * t.sin()).powi(2);
+        iy -= PI * RC.powi(4) / 4.0 + ac * (D * t.cos()).powi(2);
+    }
+    assert!((ix - iy).abs() < 1e-12 * ix);
+    let sec = Section::table(&[0.0, L], &[a0; 2], &[ix; 2], &[iy; 2], &[ix + iy; 2]).unwrap();
+    (sec, a0, ix)
+}
+
+fn chambers(p: [f64; 6]) -> Vec<Chamber> {
+    angles()
+        .iter()
+        .zip(p)
+        .map(|(t, p)| Chamber::constant(p, PI * RC * RC, [D * t.cos(), D * t.sin()]).unwrap())
+        .collect()
+}
+
+fn with_chambers(c: Vec<Chamber>) -> Loads {
+    Loads {
+        chambers: c,
+        ..Default::default()
+    }
+}
+
+/// Tip of a rod of length `l` with constant strains `v = (0, 0, lambda)`, `u = (ux, uy, 0)`.
+fn arc_tip(l: f64, lambda: f64, ux: f64, uy: f64) -> [f64; 3] {
+    let k = ux.hypot(uy);
+    let n = Vector3::new(ux / k, uy / k, 0.0);
+    let side = n.cross(&Vector3::z());
+    let p = (Vector3::z() * (k * l).sin() + side * (1.0 - (k * l).cos())) * (lambda / k);
+    [p.x, p.y, p.z]
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+fn silicone_linear() -> LinearElastic {
+    LinearElastic::new(300e3, 0.5).unwrap()
+}
+
+#[test]
+fn one_chamber_bends_linear_arm_into_the_closed_form_arc() {
+    let (sec, a0, i0) = arm_section();
+    let e = 300e3;
+    let rod = Rod::new(L, sec, silicone_linear()).unwrap();
+    let ac = PI * RC * RC;
+    for (k, p) in [(0usize, 20e3), (3, 50e3), (4, 80e3)] {
+        let mut pr = [0.0; 6];
+        pr[k] = p;
+        let loads = with_chambers(chambers(pr));
+        let sol = solve_statics(&rod, &[], &loads, &rk4(400)).unwrap();
+        // Rod's own wrench: axial p A_c, moment p A_c r_c × (-e_z)... = p A_c (y, -x, 0).
+        let t = angles()[k];
+        let (x, y) = (D * t.cos(), D * t.sin());
+        let f = p * ac;
+        let (ux, uy, lambda) = (f * y / (e * i0), -f * x / (e * i0), 1.0 + f / (e * a0));
+        for i in 0..sol.s.len() {
+            assert!((sol.u[i][0] - ux).abs() < 1e-12 * ux.abs().max(1.0));
+            assert!((sol.u[i][1] - uy).abs() < 1e-12 * uy.abs().max(1.0));
+            assert!(sol.u[i][2].abs() < 1e-12);
+            assert!((sol.v[i][2] - lambda).abs() < 1e-12);
+            assert!(sol.v[i][0].abs() < 1e-12 && sol.v[i][1].abs() < 1e-12);
+            assert!((sol.n_body[i][2] - f).abs() < 1e-12 * f);
+        }
+        // Self-equilibrated: no reaction at the base.
+        assert!(sol.base_wrench.iter().all(|w| w.abs() < 1e-12));
+        let tip = arc_tip(L, lambda, ux, uy);
+        let err = dist(sol.tip_position(), tip);
+        assert!(err < 1e-9, "p = {p}: tip error {err:e} m");
+    }
+}
+
+#[test]
+fn equal_pressures_only_elongate() {
+    let (sec, a0, _) = arm_section();
+    let rod = Rod::new(L, sec, silicone_linear()).unwrap();
+    let p = 60e3;
+    let sol = solve_statics(&rod, &[], &with_chambers(chambers([p; 6])), &rk4(100)).unwrap();
+    let lambda = 1.0 + 6.0 * p * PI * RC * RC / (300e3 * a0);
+    for u in &sol.u {
+        assert!(u.iter().all(|c| c.abs() < 1e-12), "{u:?}");
+    }
+    let tip = sol.tip_position();
+    assert!(tip[0].abs() < 1e-12 && tip[1].abs() < 1e-12);
+    assert!((tip[2] - lambda * L).abs() < 1e-12);
+}
+
+#[test]
+fn hyperelastic_elongation_matches_the_uniaxial_solution() {
+    let (sec, a0, _) = arm_section();
+    let ac = PI * RC * RC;
+    for law in [
+        UniaxialModel::from(Silicone::DragonSkin10.yeoh()),
+        UniaxialModel::from(Silicone::Ecoflex0030.neo_hookean()),
+        UniaxialModel::from(MooneyRivlin::new(40e3, 10e3).unwrap()),
+    ] {
+        let rod = Rod::new(L, sec.clone(), law.clone()).unwrap();
+        for p in [10e3, 30e3, 60e3] {
+            let sol = solve_statics(&rod, &[], &with_chambers(chambers([p; 6])), &rk4(50)).unwrap();
+            let lambda = law.stretch_from_axial_force(a0, 6.0 * p * ac).unwrap();
+            let tip = sol.tip_position();
+            assert!(
+                (tip[2] - lambda * L).abs() < 1e-9 && tip[0].abs() < 1e-12,
+                "{law}, p = {p}: tip {tip:?} vs stretch {lambda}"
+            );
+            for v in &sol.v {
+                assert!((v[2] - lambda).abs() < 1e-12);
+            }
+        }
+    }
+}
+
+#[test]
+fn linear_fibre_law_equals_the_linear_material_at_any_load() {
+    // A Hookean uniaxial law makes every fibre linear: the fibre section is then exactly the
+    // linear section (E, G = E/3), for bending, stretch, shear and torsion together.
+    let (sec, _, _) = arm_section();
+    let e = 300e3;
+    let lin = Rod::new(L, sec.clone(), LinearElastic::new(e, 0.5).unwrap()).unwrap();
+    let hyp = Rod::new(L, sec, UniaxialModel::from(Hookean::new(e).unwrap())).unwrap();
+    let loads = Loads {
+        tip_force: Vector3::new(0.3, -0.2, 0.3),
+        tip_moment: Vector3::new(0.0, 0.0, 2e-3),
+        chambers: chambers([0.0, 120e3, 0.0, 0.0, 150e3, 0.0]),
+        ..Default::default()
+    };
+    let a = solve_statics(&lin, &[], &loads, &rk4(200)).unwrap();
+    let b = solve_statics(&hyp, &[], &loads, &rk4(200)).unwrap();
+    let err = dist(a.tip_position(), b.tip_position());
+    assert!(err < 1e-12, "{err:e}");
+    let disp = dist(a.tip_position(), [0.0, 0.0, L]);
+    assert!(disp > 0.02, "the load must be large: {disp}");
+}
+
+#[test]
+fn small_strains_equal_the_linear_rod_with_the_initial_modulus() {
+    let sec = Section::circular(R).unwrap();
+    let laws = [
+        UniaxialModel::from(NeoHookean::new(70e3).unwrap()),
+        UniaxialModel::from(MooneyRivlin::new(40e3, 10e3).unwrap()),
+        UniaxialModel::from(Yeoh::new(25e3, 3e3, -100.0).unwrap()),
+    ];
+    for law in laws {
+        let e0 = law.small_strain_modulus();
+        let lin = Rod::new(L, sec.clone(), LinearElastic::new(e0, 0.5).unwrap()).unwrap();
+        let hyp = Rod::new(L, sec.clone(), law.clone()).unwrap();
+        let mut rel = Vec::new();
+        for scale in [1e-4, 1e-5] {
+            let loads = Loads {
+                tip_force: Vector3::new(0.2, -0.1, 0.5) * scale,
+                chambers: vec![Chamber::constant(2e5 * scale, 2e-5, [0.0, 0.006]).unwrap()],
+                ..Default::default()
+            };
+            let a = solve_statics(&lin, &[], &loads, &rk4(100)).unwrap();
+            let b = solve_statics(&hyp, &[], &loads, &rk4(100)).unwrap();
+            let disp = dist(a.tip_position(), [0.0, 0.0, L]);
+            rel.push(dist(a.tip_position(), b.tip_position()) / disp);
+        }
+        // The difference is of the order of the strain (~1e-5, 1e-6) and vanishes with it.
+        assert!(rel[0] < 1e-4 && rel[1] < 1e-5, "{law}: {rel:?}");
+        assert!(rel[1] < 0.2 * rel[0], "{law}: {rel:?}");
+    }
+}
+
+#[test]
+fn a_partial_chamber_bends_only_its_extent() {
+    let (sec, a0, i0) = arm_section();
+    let e = 300e3;
+    let rod = Rod::new(L, sec, silicone_linear()).unwrap();
+    let (a, b, p) = (0.04, 0.12, 50e3);
+    let ac = PI * RC * RC;
+    let c = Chamber::new(p, ChamberArea::Constant(ac), [0.0, D], a, Some(b)).unwrap();
+    let sol = solve_statics(&rod, &[], &with_chambers(vec![c]), &rk4(400)).unwrap();
+    let (ux, lambda) = (p * ac * D / (e * i0), 1.0 + p * ac / (e * a0));
+    for i in 0..sol.s.len() {
+        let inside = sol.s[i] > a && sol.s[i] < b;
+        let (want_u, want_v) = if inside { (ux, lambda) } else { (0.0, 1.0) };
+        if sol.s[i] != a && sol.s[i] != b {
+            assert!((sol.u[i][0] - want_u).abs() < 1e-12, "s = {}", sol.s[i]);
+            assert!((sol.v[i][2] - want_v).abs() < 1e-12);
+        }
+    }
+    // Tip: straight base part, arc, straight distal part along the rotated tangent.
+    let th = ux * (b - a);
+    let arc = arc_tip(b - a, lambda, ux, 0.0);
+    let want = [
+        0.0,
+        arc[1] - (L - b) * th.sin(),
+        a + arc[2] + (L - b) * th.cos(),
+    ];
+    let err = dist(sol.tip_position(), want);
+    assert!(err < 1e-9, "{err:e}");
+}
+
+#[test]
+fn a_varying_chamber_area_matches_the_local_closed_form() {
+    // A(s) linear: n_z = p A(s) and u_x = p A(s) d / EI pointwise; the base reaction is zero.
+    let (sec, a0, i0) = arm_section();
+    let e = 300e3;
+    let rod = Rod::new(L, sec, silicone_linear()).unwrap();
+    let area = |s: f64| PI * RC * RC * (1.0 - 0.5 * s / L);
+    let c = Chamber::new(
+        40e3,
+        ChamberArea::Function(std::sync::Arc::new(area)),
+        [0.0, D],
+        0.0,
+        None,
+    )
+    .unwrap();
+    let sol = solve_statics(&rod, &[], &with_chambers(vec![c]), &rk4(200)).unwrap();
+    for i in 0..sol.s.len() {
+        let f = 40e3 * area(sol.s[i]);
+        assert!((sol.n_body[i][2] - f).abs() < 1e-12);
+        assert!((sol.u[i][0] - f * D / (e * i0)).abs() < 1e-12);
+        assert!((sol.v[i][2] - 1.0 - f / (e * a0)).abs() < 1e-12);
+    }
+    assert!(sol.base_wrench.iter().all(|w| w.abs() < 1e-12));
+}
+
+fn name_of(e: Error) -> String {
+    match e {
+        Error::InvalidParameter { name, .. } => name,
+        other => panic!("not a parameter error: {other:?}"),
+    }
+}
+
+#[test]
+fn bad_input_names_the_parameter() {
+    assert_eq!(name_of(NeoHookean::new(-1.0).unwrap_err()), "mu");
+    assert_eq!(name_of(Yeoh::new(-1.0, 0.0, 0.0).unwrap_err()), "c10");
+    assert_eq!(
+        name_of(MooneyRivlin::new(-2.0, 1.0).unwrap_err()),
+        "c10 + c01"
+    );
+    assert_eq!(
+        name_of(Chamber::constant(1e3, -1.0, [0.0, 0.0]).unwrap_err()),
+        "area"
+    );
+    assert_eq!(
+        name_of(Chamber::constant(-2e5, 1e-5, [0.0, 0.0]).unwrap_err()),
+        "pressure"
+    );
+    assert_eq!(
+        name_of(Chamber::constant(1e3, 1e-5, [f64::NAN, 0.0]).unwrap_err()),
+        "offset[0]"
+    );
+    let area = ChamberArea::Constant(1e-5);
+    assert_eq!(
+        name_of(Chamber::new(1e3, area.clone(), [0.0, 0.0], 0.1, Some(0.05)).unwrap_err()),
+        "end"
+    );
+    assert_eq!(
+        name_of(Chamber::new(1e3, area.clone(), [0.0, 0.0], -0.1, None).unwrap_err()),
+        "start"
+    );
+
+    let (sec, _, _) = arm_section();
+    let rod = Rod::new(L, sec, silicone_linear()).unwrap();
+    let solve = |c: Chamber| solve_statics(&rod, &[], &with_chambers(vec![c]), &rk4(20));
+    let c = Chamber::new(1e3, area.clone(), [0.0, D], 0.0, Some(2.0 * L)).unwrap();
+    assert_eq!(name_of(solve(c).unwrap_err()), "chambers[0].end");
+    let c = Chamber::new(1e3, area.clone(), [0.0, D], L, None).unwrap();
+    assert_eq!(name_of(solve(c).unwrap_err()), "chambers[0].start");
+    // Offset in mm instead of m.
+    let c = Chamber::constant(1e3, 1e-5, [0.0, 7.2]).unwrap();
+    assert_eq!(name_of(solve(c).unwrap_err()), "chambers[0].offset");
+    let c = Chamber::new(
+        1e3,
+        ChamberArea::Function(std::sync::Arc::new(|s| if s > 0.1 { -1.0 } else { 1e-5 })),
+        [0.0, D],
+        0.0,
+        None,
+    )
+    .unwrap();
+    assert!(name_of(solve(c).unwrap_err()).starts_with("chambers[0].area("));
+}
+
+#[test]
+fn material_failures_during_the_solve_are_named() {
+    let (sec, a0, _) = arm_section();
+    let ac = PI * RC * RC;
+    // A Yeoh set whose nominal stress peaks (dP/dλ < 0 beyond): pressurise past the peak.
+    let law = Yeoh::new(20e3, -2e3, 0.0).unwrap();
+    let p_max = (0..4000)
+        .map(|i| law.nominal_stress(1.0 + i as f64 * 1e-3).unwrap())
+        .fold(0.0f64, f64::max);
+    let rod = Rod::new(L, sec.clone(), UniaxialModel::from(law)).unwrap();
+    let p = 1.5 * p_max * a0 / (6.0 * ac);
+    let err = solve_statics(&rod, &[], &with_chambers(chambers([p; 6])), &rk4(20)).unwrap_err();
+    assert_eq!(name_of(err), "Yeoh parameters");
+    // A compression the law cannot carry: a fibre stretch would reach zero.
+    let rod = Rod::new(L, sec, UniaxialModel::from(Hookean::new(300e3).unwrap())).unwrap();
+    let loads = Loads::tip_force(Vector3::new(0.0, 0.0, -2.0 * 300e3 * a0));
+    let err = solve_statics(&rod, &[], &loads, &rk4(20)).unwrap_err();
+    assert_eq!(name_of(err), "stretch");
+}
+
+#[test]
+fn hyperelastic_material_reports_its_small_strain_moduli() {
+    let m = Material::from(UniaxialModel::from(NeoHookean::new(50e3).unwrap()));
+    assert_eq!(m.small_strain_moduli(), (150e3, 50e3));
+    assert_eq!(m.poisson_ratio(), 0.5);
+    assert!(!m.is_linear());
+}
