@@ -1,7 +1,8 @@
 """Robot description files (TOML): everything the Python API can build, without callables.
 
-A file has the tables ``[rod]`` (with ``[rod.section]`` and ``[rod.material]``), an array of
-``[[tendons]]``, ``[loads]`` (with ``[[loads.point_loads]]``) and ``[solver]``; SI units
+A file has the tables ``[rod]`` (with ``[rod.section]`` and ``[rod.material]``: linear, or
+hyperelastic by law or silicone name), arrays of ``[[tendons]]`` and ``[[chambers]]``
+(pneumatic), ``[loads]`` (with ``[[loads.point_loads]]``) and ``[solver]``; SI units
 throughout. See ``docs/robot-files.md`` for the schema and ``examples/robots/`` for examples.
 Every error names the offending field, e.g. ``tendons[2].tension``.
 """
@@ -12,13 +13,16 @@ import math
 import os
 import sys
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from ._core import (
+    Chamber,
     CircularSection,
     LinearElastic,
     Loads,
+    MooneyRivlin,
+    NeoHookean,
     ParameterError,
     PointLoad,
     Rod,
@@ -28,6 +32,9 @@ from ._core import (
     TaperedCircularSection,
     Tendon,
     TubeSection,
+    UniaxialLaw,
+    Yeoh,
+    silicone,
     solve_statics,
 )
 
@@ -138,20 +145,60 @@ def _section(t: _Fields) -> Section:
     return sec
 
 
-def _material(t: _Fields) -> LinearElastic:
-    kind = t.get("type", "linear")
-    if kind != "linear":
-        raise ParameterError(f"invalid field `{t.name('type')}` = {kind!r}: must be linear")
-    mat = _named(
-        t.path,
-        lambda: LinearElastic(
-            t.number("youngs_modulus", required=True),
-            t.number("poisson_ratio"),
-            shear_modulus=t.number("shear_modulus"),
-        ),
-    )
+_HYPERELASTIC = ("neo_hookean", "mooney_rivlin", "yeoh")
+
+
+def _material(t: _Fields) -> LinearElastic | UniaxialLaw:
+    name = t.get("silicone")
+    kind = t.get("type", "linear" if name is None else "yeoh")
+    if name is not None:
+        if kind not in _HYPERELASTIC:
+            raise ParameterError(
+                f"invalid field `{t.name('type')}` = {kind!r}: with `silicone`, must be "
+                "neo_hookean, mooney_rivlin or yeoh (the law of the library entry)"
+            )
+        try:
+            entry = silicone(str(name))
+        except ParameterError as exc:
+            err = ParameterError(f"invalid field `{t.name('silicone')}`: {exc}")
+            err.parameter = t.name("silicone")
+            raise err from None
+        law = getattr(entry, kind)
+        if law is None:
+            raise ParameterError(
+                f"invalid field `{t.name('type')}` = {kind!r}: the library has no {kind} "
+                f"parameters for {entry.name}"
+            )
+    elif kind == "linear":
+        law = _named(
+            t.path,
+            lambda: LinearElastic(
+                t.number("youngs_modulus", required=True),
+                t.number("poisson_ratio"),
+                shear_modulus=t.number("shear_modulus"),
+            ),
+        )
+    elif kind == "neo_hookean":
+        law = _named(t.path, lambda: NeoHookean(t.number("mu", required=True)))
+    elif kind == "mooney_rivlin":
+        law = _named(
+            t.path,
+            lambda: MooneyRivlin(t.number("c10", required=True), t.number("c01", required=True)),
+        )
+    elif kind == "yeoh":
+        law = _named(
+            t.path,
+            lambda: Yeoh(
+                t.number("c10", required=True), t.number("c20", 0.0), t.number("c30", 0.0)
+            ),
+        )
+    else:
+        raise ParameterError(
+            f"invalid field `{t.name('type')}` = {kind!r}: must be linear, neo_hookean, "
+            "mooney_rivlin or yeoh"
+        )
     t.finish()
-    return mat
+    return law
 
 
 def _pose(t: _Fields) -> Any:
@@ -233,6 +280,33 @@ def _tendon(t: _Fields) -> Tendon:
     return tendon
 
 
+def _chamber(t: _Fields) -> Chamber:
+    offset = t.vector("offset", 2)
+    if offset is None:
+        dist = t.number("distance", required=True)
+        ang = math.radians(t.number("angle_deg", 0.0))
+        offset = [dist * math.cos(ang), dist * math.sin(ang)]
+    area = t.number("area")
+    radius = t.number("radius")
+    if (area is None) == (radius is None):
+        raise ParameterError(
+            f"invalid field `{t.name('area')}`: give either `area` (m^2) or `radius` (m, a "
+            "circular chamber), not both or neither"
+        )
+    if radius is not None:
+        if not radius > 0:
+            raise ParameterError(f"invalid field `{t.name('radius')}` = {radius}: must be > 0 m")
+        area = math.pi * radius * radius
+    chamber = _named(
+        t.path,
+        lambda: Chamber(
+            t.number("pressure", 0.0), area, offset, t.number("start", 0.0), t.number("end")
+        ),
+    )
+    t.finish()
+    return chamber
+
+
 def _loads(t: _Fields) -> Loads:
     points = []
     for i, pl in enumerate(t.get("point_loads", [])):
@@ -265,8 +339,24 @@ def _loads(t: _Fields) -> Loads:
     return loads
 
 
-def _check_across(data: Mapping[str, Any], rod: Rod, tendons: tuple[Tendon, ...]) -> None:
+def _check_across(
+    data: Mapping[str, Any],
+    rod: Rod,
+    tendons: tuple[Tendon, ...],
+    chambers: tuple[Chamber, ...] = (),
+) -> None:
     """Rules that tie fields together, checked at load time rather than at the first solve."""
+    for i, chamber in enumerate(chambers):
+        if chamber.end is not None and chamber.end > rod.length:
+            raise ParameterError(
+                f"invalid field `chambers[{i}].end` = {chamber.end}: must be in (start, "
+                f"rod.length] = ({chamber.start}, {rod.length}] m"
+            )
+        if chamber.start >= rod.length:
+            raise ParameterError(
+                f"invalid field `chambers[{i}].start` = {chamber.start}: must be in "
+                f"[0, rod.length) = [0, {rod.length}) m"
+            )
     for i, tendon in enumerate(tendons):
         if tendon.end is not None and not 0.0 < tendon.end <= rod.length:
             raise ParameterError(
@@ -282,12 +372,13 @@ def _check_across(data: Mapping[str, Any], rod: Rod, tendons: tuple[Tendon, ...]
 
 @dataclass(frozen=True)
 class Robot:
-    """A robot read from a description file: rod, tendons, loads and solver options.
+    """A robot read from a description file: rod, tendons, chambers, loads and solver options.
 
     Attributes:
         name: The file's ``name`` (or its file name).
         rod: The rod model.
         tendons: Tendons, in file order.
+        chambers: Pneumatic chambers, in file order.
         loads: External loads (unloaded when the file has none).
         solver: Keyword arguments for :func:`softrod.solve_statics`.
         description: Free text from the file.
@@ -299,10 +390,27 @@ class Robot:
     loads: Loads = field(default_factory=Loads)
     solver: dict[str, Any] = field(default_factory=dict)
     description: str = ""
+    chambers: tuple[Chamber, ...] = ()
 
     def solve(self, **overrides: Any) -> StaticsSolution:
         """Solves the robot's statics; keyword arguments override the file's solver options."""
-        return solve_statics(self.rod, self.tendons, self.loads, **{**self.solver, **overrides})
+        options = {**self.solver, **overrides}
+        if self.chambers:
+            options.setdefault("chambers", self.chambers)
+        return solve_statics(self.rod, self.tendons, self.loads, **options)
+
+    def with_pressures(self, pressures) -> Robot:
+        """The same robot with new chamber pressures (Pa, gauge), one per chamber."""
+        pressures = list(pressures)
+        if len(pressures) != len(self.chambers):
+            raise ParameterError(
+                f"invalid parameter `pressures` with {len(pressures)} values: must have one per "
+                f"chamber ({len(self.chambers)})"
+            )
+        new = tuple(
+            c.with_pressure(float(p)) for c, p in zip(self.chambers, pressures, strict=True)
+        )
+        return replace(self, chambers=new)
 
     def with_tensions(self, tensions) -> Robot:
         """The same robot with new tendon tensions (N), one per tendon."""
@@ -313,7 +421,7 @@ class Robot:
                 f"tendon ({len(self.tendons)})"
             )
         new = tuple(t.with_tension(float(x)) for t, x in zip(self.tendons, tensions, strict=True))
-        return Robot(self.name, self.rod, new, self.loads, dict(self.solver), self.description)
+        return replace(self, tendons=new, solver=dict(self.solver))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], name: str = "robot") -> Robot:
@@ -323,8 +431,11 @@ class Robot:
         tendons = tuple(
             _tendon(_Fields(t, f"tendons[{i}]")) for i, t in enumerate(top.get("tendons", []))
         )
+        chambers = tuple(
+            _chamber(_Fields(c, f"chambers[{i}]")) for i, c in enumerate(top.get("chambers", []))
+        )
         loads = _loads(_Fields(top.get("loads", {}), "loads"))
-        _check_across(top.table, rod, tendons)
+        _check_across(top.table, rod, tendons, chambers)
         sf = _Fields(top.get("solver", {}), "solver")
         solver = {k: sf.get(k) for k in sorted(set(sf.table) & _SOLVER_KEYS)}
         sf.finish()
@@ -335,6 +446,7 @@ class Robot:
             loads=loads,
             solver=solver,
             description=str(top.get("description", "")),
+            chambers=chambers,
         )
         top.finish()
         return robot

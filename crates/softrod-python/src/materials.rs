@@ -124,7 +124,7 @@ pub(crate) fn law_object(py: Python<'_>, model: UniaxialModel) -> PyResult<Py<Py
 /// `λ = l / l0 = 1 + ε`. Base class of the material laws; not constructed directly.
 #[pyclass(frozen, module = "softrod._core", name = "UniaxialLaw", subclass)]
 pub(crate) struct PyUniaxialLaw {
-    inner: UniaxialModel,
+    pub(crate) inner: UniaxialModel,
 }
 
 #[pymethods]

@@ -288,6 +288,23 @@ impl LinearElastic {
     }
 }
 
+/// A rod material: `LinearElastic`, or a uniaxial hyperelastic law (`NeoHookean`,
+/// `MooneyRivlin`, `Yeoh`, ...; incompressible fibre section, see `docs/pneumatic.md`).
+#[derive(FromPyObject)]
+pub(crate) enum MaterialArg<'py> {
+    Linear(PyRef<'py, LinearElastic>),
+    Law(PyRef<'py, crate::materials::PyUniaxialLaw>),
+}
+
+impl MaterialArg<'_> {
+    fn material(&self) -> softrod::Material {
+        match self {
+            MaterialArg::Linear(m) => m.inner.into(),
+            MaterialArg::Law(l) => l.inner.clone().into(),
+        }
+    }
+}
+
 // ----------------------------------------------------------------------------------- rod
 
 /// A base pose: a 4x4 homogeneous transform, or `(position, rotation)`.
@@ -313,7 +330,7 @@ impl Rod {
     fn new(
         length: f64,
         section: PyRef<'_, PySection>,
-        material: PyRef<'_, LinearElastic>,
+        material: MaterialArg<'_>,
         rest_strain: Option<VectorArg>,
         rest_curvature: Option<VectorArg>,
         inextensible: bool,
@@ -322,8 +339,8 @@ impl Rod {
         shear_coefficient: Option<f64>,
     ) -> PyResult<Self> {
         let slot = ErrorSlot::default();
-        let mut rod =
-            softrod::Rod::new(length, section.inner.clone(), material.inner).map_err(to_py_err)?;
+        let mut rod = softrod::Rod::new(length, section.inner.clone(), material.material())
+            .map_err(to_py_err)?;
         if let Some(v) = rest_strain {
             rod = rod
                 .with_rest_strain(profile(v, &slot, "rest_strain")?)
@@ -544,6 +561,101 @@ impl Tendon {
     }
 }
 
+// ----------------------------------------------------------------------------------- chambers
+
+/// A chamber area argument: a constant (m^2) or a function of s.
+#[derive(FromPyObject)]
+pub(crate) enum AreaArg {
+    Constant(f64),
+    Function(Py<PyAny>),
+}
+
+/// A pneumatic chamber: gauge pressure (Pa), cross-section area (m^2, constant or a function
+/// of s), centroid offset (x, y) (m, body frame) and extent [start, end] (m; end None: the
+/// tip).
+#[pyclass(frozen, module = "softrod._core")]
+#[derive(Clone)]
+pub(crate) struct Chamber {
+    pub(crate) inner: softrod::Chamber,
+    slot: ErrorSlot,
+}
+
+#[pymethods]
+impl Chamber {
+    #[new]
+    #[pyo3(signature = (pressure, area, offset, start=0.0, end=None))]
+    fn new(
+        pressure: f64,
+        area: AreaArg,
+        offset: [f64; 2],
+        start: f64,
+        end: Option<f64>,
+    ) -> PyResult<Self> {
+        let slot = ErrorSlot::default();
+        let area = match area {
+            AreaArg::Constant(a) => softrod::ChamberArea::Constant(a),
+            AreaArg::Function(f) => {
+                Python::attach(|py| {
+                    if !f.bind(py).is_callable() {
+                        return Err(param_err("area", "<object>", "a number or a function of s"));
+                    }
+                    Ok(())
+                })?;
+                let slot = slot.clone();
+                softrod::ChamberArea::Function(Arc::new(move |s| {
+                    call_py::<f64>(&f, &slot, s, "chamber area", f64::NAN)
+                }))
+            }
+        };
+        let inner = softrod::Chamber::new(pressure, area, offset, start, end).map_err(to_py_err)?;
+        Ok(Self { inner, slot })
+    }
+
+    /// The same chamber at another gauge pressure (Pa).
+    fn with_pressure(&self, pressure: f64) -> PyResult<Self> {
+        let inner = self.inner.with_pressure(pressure).map_err(to_py_err)?;
+        Ok(Self {
+            inner,
+            slot: self.slot.clone(),
+        })
+    }
+    /// Gauge pressure (Pa).
+    #[getter]
+    fn pressure(&self) -> f64 {
+        self.inner.pressure()
+    }
+    /// Cross-section area at arc length `s` (m^2).
+    fn area_at(&self, s: f64) -> f64 {
+        self.inner.area_at(s)
+    }
+    /// Centroid offset (x, y) (m, body frame).
+    #[getter]
+    fn offset(&self) -> (f64, f64) {
+        let [x, y] = self.inner.offset();
+        (x, y)
+    }
+    /// Start of the chamber (m).
+    #[getter]
+    fn start(&self) -> f64 {
+        self.inner.start()
+    }
+    /// End of the chamber (m), None for the tip.
+    #[getter]
+    fn end(&self) -> Option<f64> {
+        self.inner.end()
+    }
+    fn __repr__(&self) -> String {
+        let [x, y] = self.inner.offset();
+        format!(
+            "Chamber(pressure={}, area={:?}, offset=({x}, {y}), start={}, end={:?})",
+            self.inner.pressure(),
+            self.inner.area(),
+            self.inner.start(),
+            self.inner.end()
+        )
+    }
+}
+
 // ----------------------------------------------------------------------------------- loads
 
 /// A force (N) and moment (N m) applied at arc length `s` (m), in the world or body frame.
@@ -609,6 +721,7 @@ impl Loads {
                 .map(|f| profile(f, &slot, "distributed_moment"))
                 .transpose()?,
             gravity: Vector3::from(gravity.unwrap_or([0.0; 3])),
+            chambers: Vec::new(),
         };
         Ok(Self { inner, slot })
     }
@@ -622,8 +735,10 @@ impl Loads {
 /// A solved rod, sampled at the integration mesh (SI units, world frame unless `_body`).
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct StaticsSolution {
-    inner: softrod::StaticsSolution,
+    pub(crate) inner: softrod::StaticsSolution,
     cache: [PyOnceLock<Py<PyAny>>; 12],
+    /// The problem it solves (rod, tendons, loads, options), for `softrod.compliance`.
+    pub(crate) problem: Option<Arc<Problem>>,
 }
 
 fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
@@ -792,17 +907,17 @@ pub(crate) enum WarmArg<'py> {
 
 /// A statics problem ready for the core: rod, tendons, loads, options and the error slots of
 /// their Python callables.
-struct Problem {
-    rod: softrod::Rod,
-    tendons: Vec<softrod::Tendon>,
-    loads: softrod::Loads,
-    options: softrod::SolveOptions,
+pub(crate) struct Problem {
+    pub(crate) rod: softrod::Rod,
+    pub(crate) tendons: Vec<softrod::Tendon>,
+    pub(crate) loads: softrod::Loads,
+    pub(crate) options: softrod::SolveOptions,
     slots: Vec<ErrorSlot>,
 }
 
 impl Problem {
     #[allow(clippy::too_many_arguments)]
-    fn new(
+    pub(crate) fn new(
         rod: &Rod,
         tendons: &[PyRef<'_, Tendon>],
         loads: Option<&Loads>,
@@ -871,17 +986,28 @@ impl Problem {
         softrod::solve_statics(&self.rod, &self.tendons, &self.loads, &self.options)
     }
 
+    /// The problem with pneumatic `chambers` (kept in the core's loads).
+    fn with_chambers(mut self, chambers: &[PyRef<'_, Chamber>]) -> Self {
+        self.loads
+            .chambers
+            .extend(chambers.iter().map(|c| c.inner.clone()));
+        self.slots.extend(chambers.iter().map(|c| c.slot.clone()));
+        self
+    }
+
     /// The first exception raised by a Python callable during the solve, if any.
-    fn callback_error(&self) -> Option<PyErr> {
+    pub(crate) fn callback_error(&self) -> Option<PyErr> {
         self.slots.iter().find_map(ErrorSlot::take)
     }
 }
 
-/// Solves the statics of `rod` with `tendons` and `loads` by shooting (see the docs).
+/// Solves the statics of `rod` with `tendons`, `loads` and pneumatic `chambers` by shooting
+/// (see the docs).
 #[pyfunction]
 #[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator="rk4", steps=50,
                     rtol=1e-8, atol=1e-10, tolerance=1e-10, max_iterations=30,
-                    continuation=true, max_load_steps=64, warm_start=None, throw=true))]
+                    continuation=true, max_load_steps=64, warm_start=None, throw=true,
+                    chambers=Vec::new()))]
 pub(crate) fn solve_statics(
     py: Python<'_>,
     rod: PyRef<'_, Rod>,
@@ -897,22 +1023,26 @@ pub(crate) fn solve_statics(
     max_load_steps: i64,
     warm_start: Option<WarmArg<'_>>,
     throw: bool,
+    chambers: Vec<PyRef<'_, Chamber>>,
 ) -> PyResult<StaticsSolution> {
-    let problem = Problem::new(
-        &rod,
-        &tendons,
-        loads.as_deref(),
-        integrator,
-        steps,
-        rtol,
-        atol,
-        tolerance,
-        max_iterations,
-        continuation,
-        max_load_steps,
-        warm_start,
-        throw,
-    )?;
+    let problem = Arc::new(
+        Problem::new(
+            &rod,
+            &tendons,
+            loads.as_deref(),
+            integrator,
+            steps,
+            rtol,
+            atol,
+            tolerance,
+            max_iterations,
+            continuation,
+            max_load_steps,
+            warm_start,
+            throw,
+        )?
+        .with_chambers(&chambers),
+    );
     let result = py.detach(|| problem.solve());
     if let Some(err) = problem.callback_error() {
         return Err(err);
@@ -920,6 +1050,7 @@ pub(crate) fn solve_statics(
     Ok(StaticsSolution {
         inner: result.map_err(to_py_err)?,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
+        problem: Some(problem),
     })
 }
 
