@@ -89,6 +89,12 @@ def test_workspace_map_matches_single_solves(niti):
     m = softrod.workspace_map(robot.rod, robot.tendons, grid, chunk=5, block=5)
     assert m.tip_position.shape == (12, 3) and m.eigen_stiffness.shape == (12, 6)
     assert m.converged.all()
+    assert np.isnan(m.tangent_max_translational_compliance).all()
+    t = softrod.workspace_map(robot.rod, robot.tendons, grid[:3], tangent="length")
+    sol = robot.with_tensions(grid[2]).solve()
+    held = softrod.tangent_compliance(sol, "length").world[:3, :3]
+    e = np.linalg.eigvalsh(0.5 * (held + held.T)).max()
+    assert t.tangent_max_translational_compliance[2] == pytest.approx(e, rel=1e-6)
     for i in (0, 7, 11):
         sol = robot.with_tensions(grid[i]).solve()
         np.testing.assert_allclose(m.tip_position[i], sol.tip_position, atol=1e-9)
@@ -101,8 +107,9 @@ def test_cli_compliance_and_workspace(tmp_path, capsys):
     assert "integrated tip compliance, world frame" in out and "fixed length" in out
     assert ell.stat().st_size > 10_000 and gam.stat().st_size > 10_000
     args = ["workspace", ROBOT, "--sweep", "0:4", "--sweep", "4:2", "--n", "6"]
-    assert main([*args, "--plot", str(wsp), "--progress"]) == 0
+    assert main([*args, "--plot", str(wsp), "--progress", "--tangent", "length"]) == 0
     cap = capsys.readouterr()
     assert "36 configurations" in cap.out and "workspace [" in cap.err
+    assert "tangent, tendons at fixed length" in cap.out
     assert wsp.stat().st_size > 10_000
     assert main(["workspace", ROBOT, "--sweep", "9:4"]) == 2

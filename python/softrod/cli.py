@@ -246,30 +246,44 @@ def _cmd_workspace(args) -> int:
     }
     t0 = time.perf_counter()
     wmap = workspace_map(
-        robot.rod, robot.tendons, grid, robot.loads, progress=args.progress, **opts
+        robot.rod,
+        robot.tendons,
+        grid,
+        robot.loads,
+        progress=args.progress,
+        tangent=args.tangent,
+        **opts,
     )
     dt = time.perf_counter() - t0
-    c = wmap.max_translational_compliance
     ok = wmap.converged
     print(f"robot: {robot.name} ({args.robot}); {len(grid)} configurations in {dt:.3f} s")
     print(f"converged: {int(ok.sum())}/{len(grid)}")
-    lo, hi = np.nanmin(c), np.nanmax(c)
-    print(f"largest translational tip compliance (m/N): min {lo:.4e}, max {hi:.4e}")
     # Centre: the tip closest to the rod's base axis; periphery: the farthest.
     r = np.linalg.norm(wmap.tip_position[:, :2], axis=1)
     r[~ok] = np.nan
-    centre, edge = c[np.nanargmin(r)], c[np.nanargmax(r)]
-    print(f"at the centre of the workspace: {centre:.4e}; at the periphery: {edge:.4e}")
-    print(f"periphery / centre: {edge / centre:.2f}")
+    measures = [("integrated", wmap.max_translational_compliance)]
+    if args.tangent:
+        name = f"tangent, tendons at fixed {args.tangent}"
+        measures.append((name, wmap.tangent_max_translational_compliance))
+    for name, c in measures:
+        lo, hi = np.nanmin(c), np.nanmax(c)
+        centre, edge = c[np.nanargmin(r)], c[np.nanargmax(r)]
+        print(f"largest translational tip compliance ({name}, m/N): min {lo:.4e}, max {hi:.4e}")
+        print(f"  centre of the workspace {centre:.4e}, periphery {edge:.4e}: x{edge / centre:.2f}")
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
         from .plot import plot_workspace_map
 
-        plot_workspace_map(wmap, title=f"{robot.name}: {len(grid)} configurations").savefig(
-            args.plot, dpi=130
+        measure = (
+            "tangent_max_translational_compliance"
+            if args.tangent
+            else "max_translational_compliance"
         )
+        plot_workspace_map(
+            wmap, measure=measure, title=f"{robot.name}: {len(grid)} configurations"
+        ).savefig(args.plot, dpi=130)
         print(f"wrote {args.plot}", file=sys.stderr)
     return 0
 
@@ -536,6 +550,11 @@ def build_parser() -> argparse.ArgumentParser:
     ws.add_argument("--n", type=_positive_int, default=100, help="grid points per swept tendon")
     ws.add_argument("--plot", metavar="FILE", help="PNG of the map")
     ws.add_argument("--progress", action="store_true", help="progress bar on stderr")
+    ws.add_argument(
+        "--tangent",
+        choices=("tension", "length"),
+        help="also the exact tangent compliance (tendons at fixed tension or length)",
+    )
     ws.set_defaults(func=_cmd_workspace)
     return p
 

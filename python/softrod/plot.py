@@ -366,8 +366,9 @@ def plot_workspace_map(
     Args:
         wmap: A :class:`softrod.WorkspaceMap`.
         measure: ``"max_translational_compliance"`` (m/N, default),
-            ``"min_translational_compliance"``, ``"condition"`` or ``"eigen_stiffness_k"``
-            (k-th eigenstiffness, k = 0..5).
+            ``"min_translational_compliance"``, ``"tangent_max_translational_compliance"``
+            (needs ``tangent=`` in :func:`softrod.workspace_map`), ``"condition"`` or
+            ``"eigen_stiffness_k"`` (k-th eigenstiffness, k = 0..5).
         title: Figure title.
 
     Returns:
@@ -390,7 +391,11 @@ def plot_workspace_map(
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(name)
         ax.grid(alpha=0.3)
-    unit = {"max_translational_compliance": " (m/N)", "min_translational_compliance": " (m/N)"}
+    unit = {
+        "max_translational_compliance": " (m/N)",
+        "min_translational_compliance": " (m/N)",
+        "tangent_max_translational_compliance": " (m/N)",
+    }
     fig.colorbar(sc, ax=axes, label=measure.replace("_", " ") + unit.get(measure, ""))
     failed = int((~wmap.converged).sum())
     fig.suptitle(title or f"workspace map: {ok.sum()} configurations ({failed} not converged)")

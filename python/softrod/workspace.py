@@ -30,6 +30,8 @@ class WorkspaceMap:
         eigen_stiffness: Eigenstiffnesses of the tip stiffness (world frame at the tip),
             decreasing, shape (M, 6).
         condition: 1-norm condition number of the tip compliance, shape (M,).
+        tangent_max_translational_compliance: Largest translational compliance (m/N) of the
+            exact tangent tip compliance when requested (``tangent=``), NaN otherwise, (M,).
     """
 
     tensions: np.ndarray
@@ -39,6 +41,7 @@ class WorkspaceMap:
     min_translational_compliance: np.ndarray
     eigen_stiffness: np.ndarray
     condition: np.ndarray
+    tangent_max_translational_compliance: np.ndarray
 
 
 def tension_grid(n_tendons: int, axes: dict[int, np.ndarray]) -> np.ndarray:
@@ -85,6 +88,7 @@ def workspace_map(
     chunk: int = 64,
     block: int = 2000,
     progress: bool = False,
+    tangent: str | None = None,
     **options,
 ) -> WorkspaceMap:
     """Solves the robot for every row of tensions and measures the tip stiffness.
@@ -98,6 +102,8 @@ def workspace_map(
         chunk: Samples solved in order on one thread, each warm-started from the previous.
         block: Samples per call into the core (the progress bar advances per block).
         progress: Draw a progress bar on stderr.
+        tangent: Also compute the exact tangent tip compliance with the tendons at fixed
+            ``"tension"`` or ``"length"`` (about four times the cost of a tendon-only solve).
         **options: Solver options of :func:`softrod.solve_statics` (``integrator``,
             ``steps``, ``rtol``, ``atol``, ``tolerance``).
 
@@ -110,7 +116,15 @@ def workspace_map(
     total = len(t)
     for start in range(0, total, max(int(block), 1)):
         parts.append(
-            _workspace_map(rod, tendons, t[start : start + block], loads, chunk=chunk, **options)
+            _workspace_map(
+                rod,
+                tendons,
+                t[start : start + block],
+                loads,
+                chunk=chunk,
+                tangent=tangent,
+                **options,
+            )
         )
         if progress:
             _bar(min(start + block, total), total)
@@ -128,4 +142,5 @@ def workspace_map(
         min_translational_compliance=cat("min_translational_compliance"),
         eigen_stiffness=cat("eigen_stiffness"),
         condition=cat("condition"),
+        tangent_max_translational_compliance=cat("tangent_max_translational_compliance"),
     )

@@ -19,7 +19,7 @@ fn mats6<'py>(py: Python<'py>, v: &[Matrix6<f64>]) -> Bound<'py, PyArray3<f64>> 
     Array::from_shape_fn((v.len(), 6, 6), |(k, i, j)| v[k][(i, j)]).into_pyarray(py)
 }
 
-fn problem_of<'a>(solution: &'a StaticsSolution) -> PyResult<&'a Problem> {
+fn problem_of(solution: &StaticsSolution) -> PyResult<&Problem> {
     solution.problem.as_deref().ok_or_else(|| {
         param_err(
             "solution",
@@ -379,7 +379,7 @@ pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyRe
 /// returns a dict of arrays.
 #[pyfunction]
 #[pyo3(signature = (rod, tendons, tensions, loads=None, *, integrator="rk4", steps=50,
-                    rtol=1e-8, atol=1e-10, tolerance=1e-10, chunk=64))]
+                    rtol=1e-8, atol=1e-10, tolerance=1e-10, chunk=64, tangent=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _workspace_map<'py>(
     py: Python<'py>,
@@ -393,7 +393,20 @@ pub(crate) fn _workspace_map<'py>(
     atol: f64,
     tolerance: f64,
     chunk: i64,
+    tangent: Option<&str>,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let tangent = match tangent {
+        None => None,
+        Some("tension") => Some(softrod::TendonControl::Tension),
+        Some("length") => Some(softrod::TendonControl::Length),
+        Some(other) => {
+            return Err(param_err(
+                "tangent",
+                other,
+                "None, \"tension\" or \"length\"",
+            ))
+        }
+    };
     let problem = Problem::new(
         &rod,
         &tendons,
@@ -429,6 +442,7 @@ pub(crate) fn _workspace_map<'py>(
             &flat,
             &problem.options,
             chunk as usize,
+            tangent,
         )
     });
     if let Some(err) = problem.callback_error() {
@@ -464,6 +478,14 @@ pub(crate) fn _workspace_map<'py>(
     d.set_item(
         "eigen_stiffness",
         Array::from_shape_fn((m, 6), |(i, j)| samples[i].eigen_stiffness[j]).into_pyarray(py),
+    )?;
+    d.set_item(
+        "tangent_max_translational_compliance",
+        samples
+            .iter()
+            .map(|s| s.tangent_max_translational_compliance)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
     )?;
     d.set_item(
         "condition",

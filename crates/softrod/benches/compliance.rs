@@ -98,6 +98,7 @@ fn bench(c: &mut Criterion) {
                 black_box(&tensions),
                 &opts,
                 DEFAULT_CHUNK,
+                None,
             )
             .unwrap()
         })

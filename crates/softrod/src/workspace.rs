@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use crate::compliance::tip_compliance_world;
+use crate::compliance::{tangent_compliance, tip_compliance_world, TendonControl};
 use crate::eigenscrew::{eigenscrews, MatrixKind};
 use crate::error::{Error, Result};
 use crate::loads::Loads;
@@ -35,6 +35,9 @@ pub struct WorkspaceSample {
     pub eigen_stiffness: [f64; 6],
     /// 1-norm condition number of the tip compliance (SI units).
     pub condition: f64,
+    /// Largest translational compliance (m/N) of the exact tangent tip compliance, when
+    /// requested (NaN otherwise).
+    pub tangent_max_translational_compliance: f64,
 }
 
 impl WorkspaceSample {
@@ -46,6 +49,7 @@ impl WorkspaceSample {
             min_translational_compliance: f64::NAN,
             eigen_stiffness: [f64::NAN; 6],
             condition: f64::NAN,
+            tangent_max_translational_compliance: f64::NAN,
         }
     }
 }
@@ -53,6 +57,8 @@ impl WorkspaceSample {
 /// Solves `rod` with `tendons` and `loads` for every row of `tensions` (row-major,
 /// `n_samples × tendons.len()`, N), replacing the tendons' tensions, and measures the tip
 /// compliance. `chunk` samples (>= 1) are solved in order per thread with warm starts.
+/// With `tangent`, the exact tangent tip compliance (tendons at fixed tension or length) is
+/// computed too (about four times the cost of a tendon-only solve).
 /// Non-converged samples are reported with `converged == false`.
 ///
 /// # Errors
@@ -65,6 +71,7 @@ pub fn workspace_map(
     tensions: &[f64],
     options: &SolveOptions,
     chunk: usize,
+    tangent: Option<TendonControl>,
 ) -> Result<Vec<WorkspaceSample>> {
     let nt = tendons.len();
     if nt == 0 || tensions.len() % nt != 0 {
@@ -122,7 +129,17 @@ pub fn workspace_map(
                 let sample = match solve_statics(rod, &ts, loads, &opts) {
                     Ok(sol) if sol.stats.converged => {
                         warm = Some(sol.warm_start());
-                        measure(rod, &sol)
+                        let mut m = measure(rod, &sol);
+                        if let Some(ctl) = tangent {
+                            let t = tangent_compliance(rod, &ts, loads, &sol, &opts, ctl, None);
+                            if let Ok(t) = t {
+                                let b = t.world.fixed_view::<3, 3>(0, 0).into_owned();
+                                let b = (b + b.transpose()) * 0.5;
+                                m.tangent_max_translational_compliance =
+                                    b.symmetric_eigen().eigenvalues.max();
+                            }
+                        }
+                        m
                     }
                     _ => WorkspaceSample::failed(),
                 };
@@ -153,5 +170,6 @@ fn measure(rod: &Rod, sol: &crate::statics::StaticsSolution) -> WorkspaceSample 
         min_translational_compliance: ctt.eigenvalues.min(),
         eigen_stiffness: eig,
         condition,
+        tangent_max_translational_compliance: f64::NAN,
     }
 }

@@ -1,7 +1,7 @@
 //! Eigenscrews of stiffnesses built from known screws; the workspace map against single solves.
 #![allow(clippy::unwrap_used, missing_docs)]
 
-use softrod::compliance::compliance;
+use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::eigenscrew::{eigenscrews, MatrixKind};
 use softrod::nalgebra::{Matrix6, Vector3, Vector6};
 use softrod::se3::{adjoint, delta};
@@ -107,7 +107,16 @@ fn workspace_map_matches_single_solves() {
             tensions.extend_from_slice(&t);
         }
     }
-    let map = workspace_map(&rod, &tendons, &loads, &tensions, &opts, 7).unwrap();
+    let map = workspace_map(
+        &rod,
+        &tendons,
+        &loads,
+        &tensions,
+        &opts,
+        7,
+        Some(TendonControl::Length),
+    )
+    .unwrap();
     assert_eq!(map.len(), 30);
     for (i, row) in tensions.chunks(6).enumerate() {
         let ts: Vec<Tendon> = tendons
@@ -126,5 +135,13 @@ fn workspace_map_matches_single_solves() {
             .symmetric_eigen()
             .eigenvalues;
         assert!((map[i].max_translational_compliance - ctt.max()).abs() < 1e-8 * ctt.max());
+        let t = tangent_compliance(&rod, &ts, &loads, &sol, &opts, TendonControl::Length, None)
+            .unwrap();
+        let b = t.world.fixed_view::<3, 3>(0, 0).into_owned();
+        let e = ((b + b.transpose()) * 0.5)
+            .symmetric_eigen()
+            .eigenvalues
+            .max();
+        assert!((map[i].tangent_max_translational_compliance - e).abs() < 1e-6 * e);
     }
 }
