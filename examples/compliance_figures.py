@@ -56,3 +56,20 @@ fig = plot_workspace_map(
     title="NiTi robot: exact tangent compliance, all six tendons held at fixed length",
 )
 fig.savefig("docs/figures/compliance_workspace_tangent.png", dpi=110)
+
+# Seed 001's Fig. 1e in kind: the pneumatic arm with pairs 1 and 2 pressurised together.
+arm = softrod.load_robot("examples/robots/seed001_pneumatic_arm.toml")
+pressures = [0, 10, 20, 30, 40]
+comps = []
+for p in pressures:
+    s = arm.with_pressures([p * 1e3] * 4 + [0, 0]).solve()
+    comps.append(softrod.compliance(s))
+    g = comps[-1].gamma_c[-1]
+    z = s.tip_position[2] * 1e3
+    print(f"P1 = P2 = {p:2d} kPa: tip z {z:.2f} mm, gamma_c at the tip {g.round(4)}")
+fig = plot_gamma_c(
+    comps,
+    labels=[f"P1 = P2 = {p} kPa" for p in pressures],
+    title="seed-001 pneumatic arm: dimensionless flexural compliance along the arm",
+)
+fig.savefig("docs/figures/compliance_gamma_c_pneumatic.png", dpi=110)
