@@ -672,8 +672,11 @@ fn check_options(opts: &SolveOptions) -> Result<()> {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming the offending field (loads, tendon terminations outside
-/// `(0, L]`, options); [`Error::NotConverged`] with the Newton iterations and final scaled
-/// residual if the shooting does not converge and `options.throw` is true.
+/// `(0, L]`, chambers outside `[0, L]` or the section, options); [`Error::NotConverged`] with
+/// the Newton iterations and final scaled residual if the shooting does not converge and
+/// `options.throw` is true, unless a hyperelastic material failed on the way: then
+/// [`Error::InvalidParameter`] naming `stretch` (a fibre compressed to zero length) or the
+/// law's parameters (a law that is not monotonic at the stretches reached).
 pub fn solve_statics(
     rod: &Rod,
     tendons: &[Tendon],
