@@ -803,3 +803,32 @@ pub fn tangent_compliance_held(
         tension_rate,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panel_weights_integrate_cubics_exactly_on_uneven_nodes() {
+        let x = [0.0, 0.1, 0.25, 0.3, 0.55, 0.6, 0.9];
+        let f = |t: f64| 2.0 - 3.0 * t + 0.5 * t * t + 4.0 * t * t * t;
+        let big_f = |t: f64| 2.0 * t - 1.5 * t * t + t.powi(3) / 6.0 + t.powi(4);
+        for j in 0..x.len() - 1 {
+            let (nodes, w, m) = panel_weights(&x, j);
+            let q: f64 = (0..m).map(|k| w[k] * f(x[nodes[k]])).sum();
+            let exact = big_f(x[j + 1]) - big_f(x[j]);
+            assert!((q - exact).abs() < 1e-14, "panel {j}: {q} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn cholesky_inverse_inverts_and_rejects_indefinite() {
+        let a = Matrix6::from_fn(|i, j| 1.0 / (1.0 + i as f64 + j as f64));
+        let c = a * a.transpose() + Matrix6::identity() * 1e-3;
+        let (k, cond) = invert_spd(&c);
+        assert!((k * c - Matrix6::identity()).amax() < 1e-9);
+        assert!(cond.is_finite() && cond > 1.0);
+        let (k, cond) = invert_spd(&(-c));
+        assert!(k[(0, 0)].is_nan() && cond.is_infinite());
+    }
+}
