@@ -96,6 +96,12 @@ def test_robot_description():
     soft = pcc.Robot([0.1, 0.1], 0.02).with_chambers(1, [2e-5] * 3, [0.004] * 3, ANGLES)
     assert soft.n_chambers == 3 and soft.axial_stiffness == [None, None]
     assert "segments=2" in repr(soft)
+    sol = pcc.solve(soft, pressures=[2e4, 0.0, 0.0])
+    assert sol.arcs[0, 0] == 0.0 and sol.arcs[1, 0] > 0.0  # only segment 1 bends
+    np.testing.assert_array_equal(sol.arcs[:, 2], [0.1, 0.1])  # inextensible
+    with pytest.raises(ParameterError) as err:
+        pcc.solve(soft, pressures=[1.0])
+    assert err.value.parameter == "pressures.len()"
 
 
 def test_solve_returns_arcs_pose_and_frames():

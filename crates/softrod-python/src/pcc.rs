@@ -698,6 +698,28 @@ pub(crate) enum PccWarm<'py> {
 }
 
 /// Statics of a PCC robot under tensions, pressures and a world-frame tip wrench.
+///
+/// Stationary potential energy of the Cosserat rod restricted to arcs (see docs/pcc.md),
+/// solved by Newton with the exact Jacobian in (u_x, u_y, length) per segment.
+///
+/// Args:
+///     robot: The `Robot`.
+///     tensions: One tension per tendon (N, >= 0), in the order the tendons were added.
+///     pressures: One gauge pressure per chamber (Pa).
+///     tip_force: Tip force (N, world frame, 3 values).
+///     tip_moment: Tip moment (N m, world frame, 3 values).
+///     s: Arc lengths (m, along the deformed chain) of the returned frames.
+///     n_points: Number of uniformly spaced frames when `s` is not given.
+///     tolerance: Scaled residual (rad for bending, strain for stretching).
+///     max_iterations: Newton iterations per load step.
+///     continuation: Step the tip load if the direct solve fails.
+///     max_load_steps: Load steps under continuation.
+///     warm_start: A previous `Solution` or (n, 3) arc rows.
+///     throw: Raise `ConvergenceError` on non-convergence (else return the last iterate).
+///
+/// Returns:
+///     A `Solution`: `arcs` (n, 3) rows (curvature, plane_angle, length), `tip_pose` (4, 4),
+///     `frames` (N, 4, 4) at `s`, `tendon_lengths`, solver statistics.
 #[pyfunction]
 #[pyo3(signature = (robot, tensions=None, pressures=None, *, tip_force=None, tip_moment=None,
                     s=None, n_points=50, tolerance=1e-12, max_iterations=50, continuation=true,
