@@ -10,8 +10,11 @@ file I/O (:mod:`softrod.io`), plots (:mod:`softrod.plot`) and the ``softrod`` co
 from . import pcc
 from ._core import (
     SILICONES,
+    Chamber,
     CircularSection,
+    Compliance,
     ConvergenceError,
+    Eigenscrews,
     FunctionSection,
     Hookean,
     LinearElastic,
@@ -30,6 +33,7 @@ from ._core import (
     Silicone,
     StaticsSolution,
     TableSection,
+    TangentCompliance,
     TaperedCircularSection,
     Tendon,
     TubeSection,
@@ -37,20 +41,27 @@ from ._core import (
     UniaxialLaw,
     Yeoh,
     __version__,
+    compliance,
+    eigenscrews,
     fit_uniaxial,
     silicone,
     solve_statics,
+    tangent_compliance,
 )
 from .compare import BackboneDistance, backbone_distance
 from .io import read_backbone_csv, write_samples_csv
 from .materials import TensileCurve, read_tensile_csv
 from .robot import Robot, load_robot
+from .workspace import WorkspaceMap, tension_grid, workspace_map
 
 __all__ = [
     "SILICONES",
     "BackboneDistance",
+    "Chamber",
     "CircularSection",
+    "Compliance",
     "ConvergenceError",
+    "Eigenscrews",
     "FunctionSection",
     "Hookean",
     "LinearElastic",
@@ -70,15 +81,19 @@ __all__ = [
     "Silicone",
     "StaticsSolution",
     "TableSection",
+    "TangentCompliance",
     "TaperedCircularSection",
     "Tendon",
     "TensileCurve",
     "TubeSection",
     "UniaxialFit",
     "UniaxialLaw",
+    "WorkspaceMap",
     "Yeoh",
     "__version__",
     "backbone_distance",
+    "compliance",
+    "eigenscrews",
     "fit_uniaxial",
     "load_robot",
     "pcc",
@@ -86,5 +101,8 @@ __all__ = [
     "read_tensile_csv",
     "silicone",
     "solve_statics",
+    "tangent_compliance",
+    "tension_grid",
+    "workspace_map",
     "write_samples_csv",
 ]

@@ -205,7 +205,7 @@ class Rod:
         self,
         length: float,
         section: Section,
-        material: LinearElastic,
+        material: LinearElastic | UniaxialLaw,
         rest_strain: _Vec3 | _VecFn | None = None,
         rest_curvature: _Vec3 | _VecFn | None = None,
         inextensible: bool = False,
@@ -335,6 +335,7 @@ def solve_statics(
     max_load_steps: int = 64,
     warm_start: StaticsSolution | Sequence[float] | None = None,
     throw: bool = True,
+    chambers: Sequence[Chamber] = ...,
 ) -> StaticsSolution: ...
 
 # ----------------------------------------------------------------------------- materials
@@ -646,3 +647,139 @@ def pcc_arc_from_pressures_jacobian(
     *,
     coordinates: _Coordinates = "arc",
 ) -> NDArray[np.float64]: ...
+
+# ------------------------------------------------------------------ compliance (issue 4)
+
+@final
+class Compliance:
+    """Integrated compliance and stiffness at every node (twists [translation; rotation],
+    wrenches [force; moment], wrench applied at the node)."""
+
+    @property
+    def s(self) -> NDArray[np.float64]: ...
+    @property
+    def element(self) -> NDArray[np.float64]: ...
+    @property
+    def world(self) -> NDArray[np.float64]: ...
+    @property
+    def body(self) -> NDArray[np.float64]: ...
+    @property
+    def stiffness_world(self) -> NDArray[np.float64]: ...
+    @property
+    def stiffness_body(self) -> NDArray[np.float64]: ...
+    @property
+    def condition(self) -> NDArray[np.float64]: ...
+    @property
+    def gamma_c(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_world(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_body(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_stiffness_world(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_stiffness_body(self) -> NDArray[np.float64]: ...
+    @property
+    def tip_condition(self) -> float: ...
+    def __len__(self) -> int: ...
+
+@final
+class TangentCompliance:
+    """Exact tangent compliance of a loaded, actuated equilibrium at one node."""
+
+    @property
+    def node(self) -> int: ...
+    @property
+    def s(self) -> float: ...
+    @property
+    def world(self) -> NDArray[np.float64]: ...
+    @property
+    def body(self) -> NDArray[np.float64]: ...
+    @property
+    def stiffness_world(self) -> NDArray[np.float64]: ...
+    @property
+    def stiffness_body(self) -> NDArray[np.float64]: ...
+    @property
+    def condition(self) -> float: ...
+    @property
+    def symmetric(self) -> bool: ...
+    @property
+    def tension_rate(self) -> NDArray[np.float64]: ...
+    @property
+    def tendons(self) -> str: ...
+
+@final
+class Eigenscrews:
+    """Eigenscrew decomposition of a 6x6 stiffness or compliance, with compliance ellipsoids."""
+
+    @property
+    def values(self) -> NDArray[np.float64]: ...
+    @property
+    def vectors(self) -> NDArray[np.float64]: ...
+    @property
+    def directions(self) -> NDArray[np.float64]: ...
+    @property
+    def points(self) -> NDArray[np.float64]: ...
+    @property
+    def pitches(self) -> NDArray[np.float64]: ...
+    @property
+    def translational_axes(self) -> NDArray[np.float64]: ...
+    @property
+    def translational_directions(self) -> NDArray[np.float64]: ...
+    @property
+    def rotational_axes(self) -> NDArray[np.float64]: ...
+    @property
+    def rotational_directions(self) -> NDArray[np.float64]: ...
+    @property
+    def kind(self) -> str: ...
+
+def compliance(solution: StaticsSolution) -> Compliance: ...
+def tangent_compliance(
+    solution: StaticsSolution,
+    tendons: Literal["tension", "length"] = "tension",
+    *,
+    held: Sequence[int] | None = None,
+    node: int | None = None,
+) -> TangentCompliance: ...
+def eigenscrews(
+    matrix: NDArray[np.float64], kind: Literal["stiffness", "compliance"] = "stiffness"
+) -> Eigenscrews: ...
+def _workspace_map(
+    rod: Rod,
+    tendons: Sequence[Tendon],
+    tensions: NDArray[np.float64],
+    loads: Loads | None = None,
+    *,
+    integrator: Literal["rk4", "adaptive"] = "rk4",
+    steps: int = 50,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    tolerance: float = 1e-10,
+    chunk: int = 64,
+    tangent: Literal["tension", "length"] | None = None,
+) -> dict[str, NDArray[np.float64]]: ...
+
+# ----------------------------------------------------------------------------- chambers
+
+@final
+class Chamber:
+    """A pneumatic chamber: gauge pressure (Pa), area (m^2), centroid offset (m), extent (m)."""
+
+    def __init__(
+        self,
+        pressure: float,
+        area: float | Callable[[float], float],
+        offset: tuple[float, float] | Sequence[float],
+        start: float = 0.0,
+        end: float | None = None,
+    ) -> None: ...
+    def with_pressure(self, pressure: float) -> Chamber: ...
+    @property
+    def pressure(self) -> float: ...
+    def area_at(self, s: float) -> float: ...
+    @property
+    def offset(self) -> tuple[float, float]: ...
+    @property
+    def start(self) -> float: ...
+    @property
+    def end(self) -> float | None: ...

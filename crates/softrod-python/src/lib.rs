@@ -6,6 +6,7 @@
 
 use pyo3::prelude::*;
 
+mod compliance;
 mod convert;
 mod errors;
 mod materials;
@@ -38,6 +39,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statics::LinearElastic>()?;
     m.add_class::<statics::Rod>()?;
     m.add_class::<statics::Tendon>()?;
+    m.add_class::<statics::Chamber>()?;
     m.add_class::<statics::PointLoad>()?;
     m.add_class::<statics::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
@@ -55,6 +57,13 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(materials::silicone, m)?)?;
     m.add("SILICONES", materials::silicone_names(m.py())?)?;
     m.add_function(wrap_pyfunction!(statics::_time_solve_statics, m)?)?;
+    m.add_class::<compliance::Compliance>()?;
+    m.add_class::<compliance::TangentCompliance>()?;
+    m.add_class::<compliance::Eigenscrews>()?;
+    m.add_function(wrap_pyfunction!(compliance::compliance, m)?)?;
+    m.add_function(wrap_pyfunction!(compliance::tangent_compliance, m)?)?;
+    m.add_function(wrap_pyfunction!(compliance::eigenscrews, m)?)?;
+    m.add_function(wrap_pyfunction!(compliance::_workspace_map, m)?)?;
     m.add_class::<pcc::PccRobot>()?;
     m.add_class::<pcc::PccSolution>()?;
     m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;
