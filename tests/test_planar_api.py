@@ -42,6 +42,15 @@ def test_ode_method_and_tolerances():
     assert np.max(np.abs(ode.curvature - cf.curvature)) / cf.curvature.max() < 1e-8
 
 
+def test_strided_arrays_are_accepted():
+    arm = PlanarCableArm(**SEED)
+    tensions = np.linspace(0.0, 3.0, 12)
+    strided = arm.solve_many(tensions[::3], n_points=5)
+    np.testing.assert_array_equal(strided.x, arm.solve_many(tensions[::3].copy(), n_points=5).x)
+    grid = np.linspace(0.0, 0.27, 10).reshape(5, 2)
+    np.testing.assert_array_equal(arm.solve(1.0, s=grid[:, 0]).s, grid[:, 0])
+
+
 def test_custom_samples():
     arm = PlanarCableArm(**SEED)
     s = np.array([0.0, 0.1, 0.2])
