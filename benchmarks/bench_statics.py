@@ -51,7 +51,7 @@ def main() -> None:
 
     rod, tendons = two_segment_robot()
     cold = softrod.solve_statics(rod, tendons)
-    case("two-segment NiTi, cold (RK4, 50 steps)", rod, tendons)
+    case("two-segment NiTi, cold (RK4, 40 steps)", rod, tendons)
     nudged = [t.with_tension(t.tension * 1.02) for t in tendons]
     case("two-segment NiTi, warm after +2 % tension", rod, nudged, warm_start=cold)
     loads = softrod.Loads(tip_force=(0.05, 0.0, 0.0))
@@ -72,7 +72,7 @@ def main() -> None:
     print("-" * (width + 42))
     for name, rust, py, over in rows:
         print(f"{name:<{width}}  {rust:10.1f}  {py:11.1f}  {over:13.1f}")
-    print(f"two-segment tip error, RK4 50 steps vs adaptive rtol 1e-12: {err:.2e} m")
+    print(f"two-segment tip error, RK4 40 steps vs adaptive rtol 1e-12: {err:.2e} m")
 
 
 if __name__ == "__main__":

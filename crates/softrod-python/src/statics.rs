@@ -1004,7 +1004,7 @@ impl Problem {
 /// Solves the statics of `rod` with `tendons`, `loads` and pneumatic `chambers` by shooting
 /// (see the docs).
 #[pyfunction]
-#[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator="rk4", steps=50,
+#[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator="rk4", steps=40,
                     rtol=1e-8, atol=1e-10, tolerance=1e-10, max_iterations=30,
                     continuation=true, max_load_steps=64, warm_start=None, throw=true,
                     chambers=Vec::new()))]
@@ -1058,7 +1058,7 @@ pub(crate) fn solve_statics(
 /// wall time (s), so that the Python overhead of `solve_statics` can be measured.
 #[pyfunction]
 #[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, repeats=1000, integrator="rk4",
-                    steps=50, rtol=1e-8, atol=1e-10, tolerance=1e-10, warm_start=None))]
+                    steps=40, rtol=1e-8, atol=1e-10, tolerance=1e-10, warm_start=None))]
 pub(crate) fn _time_solve_statics(
     py: Python<'_>,
     rod: PyRef<'_, Rod>,
