@@ -358,7 +358,7 @@ const SHORT_CIS_MAX: f64 = 0.03;
 
 /// A Lobatto IIIA collocation rule with `S` stages (nodes include both panel ends, so the
 /// first stage reuses the previous panel's last evaluation).
-struct Rule<const S: usize, const SHORT: bool> {
+struct Rule<const S: usize> {
     /// Nodes in `[0, 1]`.
     c: [f64; S],
     /// Stage matrix rows 2..=S (row 1 is zero).
@@ -385,7 +385,7 @@ struct Rates {
 const SQ5: f64 = 2.236_067_977_499_79;
 
 /// Lobatto IIIA, 3 stages (Simpson), order 4: error `L (h kappa)^4 / 2880`.
-const LOBATTO3: Rule<3, true> = Rule {
+const LOBATTO3: Rule<3> = Rule {
     c: [0.0, 0.5, 1.0],
     a: [
         [0.0, 0.0, 0.0],
@@ -398,7 +398,7 @@ const LOBATTO3: Rule<3, true> = Rule {
 };
 
 /// Lobatto IIIA, 4 stages, order 6.
-const LOBATTO4: Rule<4, false> = Rule {
+const LOBATTO4: Rule<4> = Rule {
     c: [0.0, (5.0 - SQ5) / 10.0, (5.0 + SQ5) / 10.0, 1.0],
     a: [
         [0.0, 0.0, 0.0, 0.0],
@@ -459,7 +459,7 @@ impl BackboneState {
         if 2 * m4 <= 3 * m6 {
             self.simpson_panels(profile, b, m4);
         } else {
-            self.panels(profile, b, m6, &LOBATTO4);
+            self.lobatto4_panels(profile, b, m6);
         }
     }
 
@@ -498,55 +498,44 @@ impl BackboneState {
         }
     }
 
-    /// `m` equal panels of `rule` over `[self.s, b]`.
+    /// `m` equal panels of [`LOBATTO4`] over `[self.s, b]`, written out by hand like
+    /// [`Self::simpson_panels`] (high curvature or coarse output spacing).
     #[inline(always)]
-    fn panels<P: Fn(f64) -> (f64, f64), const S: usize, const SHORT: bool>(
-        &mut self,
-        profile: &P,
-        b: f64,
-        m: usize,
-        rule: &Rule<S, SHORT>,
-    ) {
+    fn lobatto4_panels<P: Fn(f64) -> (f64, f64)>(&mut self, profile: &P, b: f64, m: usize) {
+        const C: [f64; 4] = LOBATTO4.c;
+        const A1: [f64; 4] = LOBATTO4.a[1];
+        const A2: [f64; 4] = LOBATTO4.a[2];
+        const W: [f64; 4] = LOBATTO4.b;
         let h = (b - self.s) / m as f64;
         let a0 = self.s;
+        let (mut f0, mut g0) = ((1.0 + self.q) * self.k, 1.0 + self.q);
         for p in 0..m {
             let s0 = a0 + p as f64 * h;
             let s_end = if p + 1 == m { b } else { s0 + h };
-            let (k0, q0) = (self.k, self.q);
-            let kq: [(f64, f64); S] = std::array::from_fn(|j| {
-                if j == 0 {
-                    (k0, q0)
-                } else if j == S - 1 {
-                    profile(s_end)
-                } else {
-                    profile(s0 + rule.c[j] * h)
-                }
-            });
-            let f: [f64; S] = std::array::from_fn(|j| (1.0 + kq[j].1) * kq[j].0);
+            let (k1, q1) = profile(s0 + C[1] * h);
+            let (k2, q2) = profile(s0 + C[2] * h);
+            let (k3, q3) = profile(s_end);
+            let (g1, g2, g3) = (1.0 + q1, 1.0 + q2, 1.0 + q3);
+            let (f1, f2, f3) = (g1 * k1, g2 * k2, g3 * k3);
+            let d1 = h * (A1[0] * f0 + A1[1] * f1 + A1[2] * f2 + A1[3] * f3);
+            let d2 = h * (A2[0] * f0 + A2[1] * f1 + A2[2] * f2 + A2[3] * f3);
+            let d3 = h * (W[0] * f0 + W[1] * f1 + W[2] * f2 + W[3] * f3);
+            let (c1, s1) = small_angle_cis::<false>(d1);
+            let (c2, s2) = small_angle_cis::<false>(d2);
+            let (c3, s3) = small_angle_cis::<false>(d3);
             let (c0, s0_) = (self.cos, self.sin);
-            // Stage angles relative to the panel start, and the rotated tangents.
-            let cis: [(f64, f64, f64); S] = std::array::from_fn(|j| {
-                if j == 0 {
-                    return (c0, s0_, 0.0);
-                }
-                let dth = h * rule.a[j].iter().zip(&f).map(|(a, f)| a * f).sum::<f64>();
-                let (c, s) = small_angle_cis::<SHORT>(dth);
-                (c0 * c - s0_ * s, s0_ * c + c0 * s, dth)
-            });
-            let (mut dx, mut dy) = (0.0, 0.0);
-            for j in 0..S {
-                let w = rule.b[j] * (1.0 + kq[j].1);
-                dx += w * cis[j].0;
-                dy += w * cis[j].1;
-            }
-            self.x += h * dx;
-            self.y += h * dy;
-            let (ce, se, dth) = cis[S - 1];
-            self.cos = ce;
-            self.sin = se;
-            self.theta += dth;
+            let (x1, y1) = (c0 * c1 - s0_ * s1, s0_ * c1 + c0 * s1);
+            let (x2, y2) = (c0 * c2 - s0_ * s2, s0_ * c2 + c0 * s2);
+            let (x3, y3) = (c0 * c3 - s0_ * s3, s0_ * c3 + c0 * s3);
+            let (w0, w1, w2, w3) = (W[0] * h * g0, W[1] * h * g1, W[2] * h * g2, W[3] * h * g3);
+            self.x += w0 * c0 + w1 * x1 + w2 * x2 + w3 * x3;
+            self.y += w0 * s0_ + w1 * y1 + w2 * y2 + w3 * y3;
+            self.cos = x3;
+            self.sin = y3;
+            self.theta += d3;
             self.s = s_end;
-            (self.k, self.q) = kq[S - 1];
+            (self.k, self.q) = (k3, q3);
+            (f0, g0) = (f3, g3);
         }
     }
 
