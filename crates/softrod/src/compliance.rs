@@ -18,6 +18,9 @@
 //!   re-run the constitutive solves) it is integrated on the solved mesh by a fourth-order
 //!   cumulative quadrature (per panel, the cubic through the four nearest nodes of the same
 //!   interval): the same order as RK4, exact for the straight rod, and free of new solves.
+//!   [`compliance`] and [`pcc_compliance`] both build a [`Configuration`] (nodes with arc
+//!   length, pose and element compliance) and call the same integration: the PCC path samples
+//!   the arcs of a [`PccStaticsSolution`] with the rod's section and material.
 //! * [`tangent_compliance`]: the exact tangent of the loaded, actuated equilibrium, from the
 //!   linearised boundary-value problem (variational equations of the shooting method, plus
 //!   columns for the applied wrench and, with tendons held at fixed length, for the tensions
@@ -34,6 +37,7 @@ use crate::cosserat::{put3, rot, v3, Evaluator, Model, FULL, STATE};
 use crate::error::{Error, Result};
 use crate::integrate::{dp54, rk4_step};
 use crate::loads::Loads;
+use crate::pcc_statics::{PccRobot, PccStaticsSolution};
 use crate::rod::Rod;
 use crate::se3::rotation_adjoint;
 use crate::so3::hat;
@@ -245,7 +249,8 @@ pub fn invert_general(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
 /// The integrated compliance at the last node only (world frame, at the tip), without the
 /// per-node inverses: the cheap path of [`crate::workspace::workspace_map`].
 pub fn tip_compliance_world(rod: &Rod, solution: &StaticsSolution) -> Result<Matrix6<f64>> {
-    compliance_matrices(rod, solution, true).map(|(w, _, _)| w[w.len() - 1])
+    compliance_matrices(&Configuration::from_statics(rod, solution)?, true)
+        .map(|(w, _)| w[w.len() - 1])
 }
 
 /// Dimensionless flexural compliance `γ_c = diag(C_body,tt) · 3 E I(0) / L³` per body axis
@@ -259,37 +264,182 @@ pub fn gamma_c(rod: &Rod, body: &Matrix6<f64>) -> [f64; 3] {
     [body[(0, 0)] * k, body[(1, 1)] * k, body[(2, 2)] * k]
 }
 
-/// World and body compliances (all nodes, or only the last with `tip_only`) and the element
-/// compliances.
-#[allow(clippy::type_complexity)]
-fn compliance_matrices(
-    rod: &Rod,
-    solution: &StaticsSolution,
-    tip_only: bool,
-) -> Result<(Vec<Matrix6<f64>>, Vec<Matrix6<f64>>, Vec<[f64; 6]>)> {
-    let n = solution.s.len();
-    if n == 0 || solution.position.len() != n || solution.rotation.len() != n {
+/// Largest bending angle per quadrature panel (rad) of the PCC path ([`pcc_compliance`]):
+/// on an arc the fourth-order quadrature converges as `0.06 (θ/n)⁴` relative (measured against
+/// Castigliano, see docs/pcc.md), so 0.005 rad per panel is below 1e-10 of each block's scale
+/// (and ~1e-9 of its smaller entries).
+pub const PCC_PANEL_ANGLE: f64 = 0.005;
+
+/// Fewest quadrature panels per PCC segment (a straight segment's integrand is a quadratic
+/// in `s`, integrated exactly by any number of panels).
+pub const PCC_MIN_PANELS: usize = 8;
+
+/// A configuration to integrate the compliance along, as nodes (the one input of the
+/// integrated compliance, provided by the Cosserat and the PCC models alike).
+///
+/// `s` is the undeformed arc length (m, non-decreasing; a repeated value starts a new
+/// interval, e.g. at a load or a segment break); at each node, the backbone position (m,
+/// world), the rotation (body → world) and the element compliance `c(s)` (body, per
+/// undeformed length).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Configuration {
+    /// Undeformed arc length of each node (m).
+    pub s: Vec<f64>,
+    /// Backbone position of each node (m, world).
+    pub position: Vec<Vector3<f64>>,
+    /// Rotation of each node (body → world).
+    pub rotation: Vec<Matrix3<f64>>,
+    /// Element compliance `c(s)` of each node (body).
+    pub element: Vec<[f64; 6]>,
+}
+
+impl Configuration {
+    /// The solved mesh of a Cosserat solution of `rod`, with the material's tangent at the
+    /// solved wrench ([`element_compliance`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ
+    /// in length.
+    pub fn from_statics(rod: &Rod, solution: &StaticsSolution) -> Result<Self> {
+        let n = solution.s.len();
+        if n == 0 || solution.position.len() != n || solution.rotation.len() != n {
+            return Err(Error::invalid(
+                "solution",
+                format!("{n} nodes"),
+                "a solution with nodes",
+            ));
+        }
+        Ok(Self {
+            s: solution.s.clone(),
+            position: solution
+                .position
+                .iter()
+                .map(|p| Vector3::from(*p))
+                .collect(),
+            rotation: solution
+                .rotation
+                .iter()
+                .map(|r| {
+                    Matrix3::new(
+                        r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1],
+                        r[2][2],
+                    )
+                })
+                .collect(),
+            element: element_compliance(rod, solution),
+        })
+    }
+
+    /// The arcs of a PCC solution of `robot`, sampled at `panels + 1` nodes per segment
+    /// (default: `max(PCC_MIN_PANELS, ⌈θ / PCC_PANEL_ANGLE⌉)` for a bending angle `θ`; the
+    /// segment's junction nodes repeated), placed at the base pose of `rod`, with the
+    /// element compliance of `rod`'s section and (linear) material.
+    ///
+    /// A segment of rest length `ℓ0` and deformed length `ℓ` is uniformly stretched, so the
+    /// node at undeformed `σ` of the segment is at deformed arc length `σ ℓ / ℓ0`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `rod` if its material is not linear or its length
+    /// differs from the robot's total rest length (relative 1e-9), `solution` if its segment
+    /// count differs from the robot's, `panels` if zero.
+    pub fn from_pcc(
+        rod: &Rod,
+        robot: &PccRobot,
+        solution: &PccStaticsSolution,
+        panels: Option<usize>,
+    ) -> Result<Self> {
+        if !rod.material().is_linear() {
+            return Err(Error::invalid(
+                "rod",
+                "a hyperelastic material",
+                "a linear elastic rod (the PCC statics is linear)",
+            ));
+        }
+        let segs = robot.segments();
+        if solution.segments.len() != segs.len() {
+            return Err(Error::invalid(
+                "solution",
+                format!("{} segments", solution.segments.len()),
+                format!("a solution of the robot ({} segments)", segs.len()),
+            ));
+        }
+        let total: f64 = segs.iter().map(|s| s.rest_length()).sum();
+        if (total - rod.length()).abs() > 1e-9 * total {
+            return Err(Error::invalid(
+                "rod",
+                format!("length {} m", rod.length()),
+                format!("the robot's total rest length, {total} m"),
+            ));
+        }
+        if panels == Some(0) {
+            return Err(Error::invalid("panels", 0, ">= 1"));
+        }
+        let base = rod.base_pose();
+        let (rb, pb) = (base.rotation(), base.position());
+        let k = rod.shear_coefficient();
+        let mut out = Self {
+            s: Vec::new(),
+            position: Vec::new(),
+            rotation: Vec::new(),
+            element: Vec::new(),
+        };
+        let (mut s0, mut frame_r, mut frame_p) = (0.0, rb, pb);
+        for (seg, body) in solution.segments.iter().zip(segs) {
+            let l0 = body.rest_length();
+            let panels = panels.unwrap_or_else(|| {
+                let n = (seg.bending_angle().abs() / PCC_PANEL_ANGLE).ceil();
+                (n as usize).max(PCC_MIN_PANELS)
+            });
+            for j in 0..=panels {
+                let f = j as f64 / panels as f64;
+                let t = seg.pose_at(f * seg.length())?;
+                let r = t.fixed_view::<3, 3>(0, 0).into_owned();
+                let p = Vector3::new(t[(0, 3)], t[(1, 3)], t[(2, 3)]);
+                let sigma = if j == panels { s0 + l0 } else { s0 + f * l0 };
+                out.s.push(sigma);
+                out.position.push(frame_p + frame_r * p);
+                out.rotation.push(frame_r * r);
+                out.element.push(rod.material().compliance(
+                    &rod.section_at(sigma.min(rod.length())),
+                    k,
+                    rod.inextensible(),
+                ));
+            }
+            s0 += l0;
+            frame_p = out.position[out.position.len() - 1];
+            frame_r = out.rotation[out.rotation.len() - 1];
+        }
+        Ok(out)
+    }
+}
+
+/// World and body compliances, node by node.
+type WorldBody = (Vec<Matrix6<f64>>, Vec<Matrix6<f64>>);
+
+/// World and body compliances (all nodes, or only the last with `tip_only`) of a
+/// configuration: the one integrated-compliance computation of both models.
+fn compliance_matrices(config: &Configuration, tip_only: bool) -> Result<WorldBody> {
+    let n = config.s.len();
+    if n == 0
+        || config.position.len() != n
+        || config.rotation.len() != n
+        || config.element.len() != n
+    {
         return Err(Error::invalid(
-            "solution",
+            "configuration",
             format!("{n} nodes"),
-            "a solution with nodes",
+            "nodes with equally long arrays",
         ));
     }
-    let element = element_compliance(rod, solution);
-    let pos = |i: usize| Vector3::from(solution.position[i]);
-    let rotm = |i: usize| {
-        let r = &solution.rotation[i];
-        Matrix3::new(
-            r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
-        )
-    };
+    let pos = |i: usize| config.position[i];
+    let rotm = |i: usize| config.rotation[i];
     let p0 = pos(0);
     // Integrand Ad c Adᵀ with Ad = [[R, P R], [0, R]], P = (p - p(0))^: with
     // A = R c_v Rᵀ and B = R c_u Rᵀ it is [[A + P B Pᵀ, P B], [B Pᵀ, B]].
     let integrand: Vec<Matrix6<f64>> = (0..n)
         .map(|i| {
             let r = rotm(i);
-            let e = &element[i];
+            let e = &config.element[i];
             let a = r * Matrix3::from_diagonal(&Vector3::new(e[0], e[1], e[2])) * r.transpose();
             let b = r * Matrix3::from_diagonal(&Vector3::new(e[3], e[4], e[5])) * r.transpose();
             let pb = hat(&(pos(i) - p0)) * b;
@@ -307,13 +457,13 @@ fn compliance_matrices(
     let mut start = 0;
     while start < n {
         let mut end = start + 1;
-        while end < n && solution.s[end] != solution.s[end - 1] {
+        while end < n && config.s[end] != config.s[end - 1] {
             end += 1;
         }
         if start > 0 {
             q[start] = q[start - 1];
         }
-        let x = &solution.s[start..end];
+        let x = &config.s[start..end];
         for j in 0..x.len() - 1 {
             let (nodes, weights, m) = panel_weights(x, j);
             let mut acc = q[start + j];
@@ -339,7 +489,30 @@ fn compliance_matrices(
         body.push(rotate_blocks(&w, &rotm(i)));
         world.push(w);
     }
-    Ok((world, body, element))
+    Ok((world, body))
+}
+
+/// The seed's integrated compliance (eqs. 6–7) at every node of a configuration of `rod`
+/// (see the module documentation for the formula and the quadrature); `rod` scales
+/// [`Compliance::gamma_c`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `configuration` if it has no nodes or its arrays
+/// differ in length.
+pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Compliance> {
+    let (world, body) = compliance_matrices(&config, false)?;
+    let gk = gamma_c(rod, &Matrix6::identity())[0];
+    let gamma = body
+        .iter()
+        .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
+        .collect();
+    Ok(Compliance {
+        s: config.s,
+        element: config.element,
+        world,
+        body,
+        gamma_c: gamma,
+    })
 }
 
 /// The seed's integrated compliance (eqs. 6–7) at every node of `solution`, a solution of
@@ -349,19 +522,23 @@ fn compliance_matrices(
 /// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ in
 /// length.
 pub fn compliance(rod: &Rod, solution: &StaticsSolution) -> Result<Compliance> {
-    let (world, body, element) = compliance_matrices(rod, solution, false)?;
-    let gk = gamma_c(rod, &Matrix6::identity())[0];
-    let gamma = body
-        .iter()
-        .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
-        .collect();
-    Ok(Compliance {
-        s: solution.s.clone(),
-        element,
-        world,
-        body,
-        gamma_c: gamma,
-    })
+    configuration_compliance(rod, Configuration::from_statics(rod, solution)?)
+}
+
+/// The seed's integrated compliance along the arcs of a PCC solution (same computation as
+/// [`compliance`], on [`Configuration::from_pcc`] with `panels` per segment, default from
+/// [`PCC_PANEL_ANGLE`]); `rod` gives the section and material of `c(s)` and the base
+/// pose. The nodes' `s` is the undeformed arc length, junctions repeated.
+///
+/// # Errors
+/// As [`Configuration::from_pcc`].
+pub fn pcc_compliance(
+    rod: &Rod,
+    robot: &PccRobot,
+    solution: &PccStaticsSolution,
+    panels: Option<usize>,
+) -> Result<Compliance> {
+    configuration_compliance(rod, Configuration::from_pcc(rod, robot, solution, panels)?)
 }
 
 // ------------------------------------------------------------------------ tangent compliance

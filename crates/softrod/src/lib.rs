@@ -33,7 +33,8 @@ pub mod planar;
 pub use chamber::{Chamber, ChamberArea};
 pub use compare::{backbone_distance, BackboneDistance};
 pub use compliance::{
-    compliance, tangent_compliance, Compliance, TangentCompliance, TendonControl,
+    compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
+    TendonControl,
 };
 pub use eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
 pub use error::{Error, Result};

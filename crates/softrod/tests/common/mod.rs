@@ -1,0 +1,100 @@
+//! Independent oracles shared by the compliance tests (written from closed-form geometry,
+//! not from the library): Castigliano's compliance of a circular arc and a block-wise
+//! comparison of 6×6 compliances.
+#![allow(dead_code, missing_docs)]
+
+use std::f64::consts::PI;
+
+use softrod::nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+/// Entry-wise comparison, each 3×3 block relative to that block's largest entry of `exact`
+/// (zero entries of `exact` must be below `tol` times the block scale).
+pub fn assert_blocks_close(got: &Matrix6<f64>, exact: &Matrix6<f64>, tol: f64, what: &str) {
+    for bi in 0..2 {
+        for bj in 0..2 {
+            let e = exact.fixed_view::<3, 3>(3 * bi, 3 * bj);
+            let g = got.fixed_view::<3, 3>(3 * bi, 3 * bj);
+            let scale = e.amax().max(g.amax());
+            if scale == 0.0 {
+                continue;
+            }
+            for i in 0..3 {
+                for j in 0..3 {
+                    let (x, y) = (g[(i, j)], e[(i, j)]);
+                    let err = if y.abs() > 1e-3 * scale {
+                        ((x - y) / y).abs()
+                    } else {
+                        (x - y).abs() / scale
+                    };
+                    assert!(
+                        err <= tol,
+                        "{what}: block ({bi},{bj}) entry ({i},{j}): {x:e} vs {y:e} (err {err:e})"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Gauss–Legendre nodes and weights on [-1, 1] (Newton on P_n), independent of the library.
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (1..=n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+/// Castigliano: C_ij = ∫ Σ_k B_ki B_kj / S_k ds with B the map from the tip wrench to the
+/// section's internal wrench (local components) of the stress-free arc of curvature `kappa`
+/// about body y; written from the arc's closed-form geometry.
+pub fn castigliano_arc(kappa: f64, l: f64, stiff: [f64; 6]) -> Matrix6<f64> {
+    let p = |s: f64| {
+        let t = kappa * s;
+        Vector3::new((1.0 - t.cos()) / kappa, 0.0, t.sin() / kappa)
+    };
+    let r = |s: f64| {
+        let t = kappa * s;
+        Matrix3::new(t.cos(), 0.0, t.sin(), 0.0, 1.0, 0.0, -t.sin(), 0.0, t.cos())
+    };
+    let gl = gauss_legendre(30);
+    let panels = 16;
+    let mut c = Matrix6::zeros();
+    for k in 0..panels {
+        let (a, b) = (
+            l * k as f64 / panels as f64,
+            l * (k + 1) as f64 / panels as f64,
+        );
+        for &(x, w) in &gl {
+            let s = 0.5 * (a + b) + 0.5 * (b - a) * x;
+            let rt = r(s).transpose();
+            let d = p(l) - p(s);
+            // Section force = R^T F; section moment = R^T (M + d × F).
+            let mut bm = Matrix6::zeros();
+            let dx = Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
+            bm.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
+            bm.fixed_view_mut::<3, 3>(3, 0).copy_from(&(rt * dx));
+            bm.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
+            let sinv =
+                Matrix6::from_diagonal(&Vector6::from_iterator(stiff.iter().map(|v| 1.0 / v)));
+            c += bm.transpose() * sinv * bm * (0.5 * (b - a) * w);
+        }
+    }
+    c
+}
