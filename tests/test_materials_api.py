@@ -477,3 +477,35 @@ def test_plot_fit_draws_data_fits_and_residuals():
     # A single fit and custom labels work too.
     fig = plot_fit(curve, fits[1], labels=["mine"], title="t")
     assert "mine" in [ln.get_label() for ln in fig.axes[0].get_lines()]
+
+
+def test_study_command_runs_both_materials_and_writes_figures(tmp_path, capsys):
+    from pathlib import Path
+
+    from softrod.cli import main
+    from softrod.study import seed001_study
+
+    robot = Path(__file__).resolve().parent.parent / "examples/robots/seed001_pneumatic_arm.toml"
+    res = seed001_study(robot, levels=2, max_pressure=30e3, out_dir=tmp_path, log=None)
+    assert set(res) == {"hyperelastic", "linear"}
+    for r in res.values():
+        assert r.pressures.shape == (8, 3) and np.all(np.isfinite(r.max_compliance))
+        assert r.gamma_c_tip.shape == (5, 3) and r.centre_periphery_ratio > 0
+    assert len(list(tmp_path.glob("seed001_*.png"))) == 4
+    assert (
+        main(
+            [
+                "study",
+                str(robot),
+                "--levels",
+                "2",
+                "--max-pressure",
+                "2e4",
+                "--out",
+                str(tmp_path / "cli"),
+            ]
+        )
+        == 0
+    )
+    assert "centre -> periphery" in capsys.readouterr().out
+    assert main(["study", str(robot), "--max-pressure", "-1"]) == 2

@@ -408,6 +408,13 @@ def _cmd_fit(args) -> int:
     return 0
 
 
+def _cmd_study(args) -> int:
+    from .study import seed001_study
+
+    seed001_study(args.robot, levels=args.levels, max_pressure=args.max_pressure, out_dir=args.out)
+    return 0
+
+
 def _positive_int(text: str) -> int:
     try:
         return int(text)
@@ -556,6 +563,37 @@ def build_parser() -> argparse.ArgumentParser:
         help="also the exact tangent compliance (tendons at fixed tension or length)",
     )
     ws.set_defaults(func=_cmd_workspace)
+    st = sub.add_parser(
+        "study",
+        help="seed 001's study: workspace stiffness map and gamma_c vs pressure, "
+        "hyperelastic vs linear",
+    )
+    st.add_argument(
+        "robot",
+        nargs="?",
+        default="examples/robots/seed001_pneumatic_arm.toml",
+        metavar="ROBOT.toml",
+        help="robot with three chamber pairs (default: %(default)s)",
+    )
+    st.add_argument(
+        "--levels",
+        type=_positive_int,
+        default=13,
+        help="pressure levels per pair (default: %(default)s)",
+    )
+    st.add_argument(
+        "--max-pressure",
+        type=float,
+        default=60e3,
+        help="largest pair pressure, Pa (default: %(default)s)",
+    )
+    st.add_argument(
+        "--out",
+        default="softrod-study",
+        metavar="DIR",
+        help="folder for the figures (default: %(default)s)",
+    )
+    st.set_defaults(func=_cmd_study)
     return p
 
 

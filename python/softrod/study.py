@@ -1,0 +1,224 @@
+"""Seed 001's study of a pneumatic arm: stiffness over the workspace and ``gamma_c`` vs pressure.
+
+For a robot with three chamber pairs (pressures P1, P2, P3 on chambers 0-1, 2-3, 4-5), solved
+twice — with its hyperelastic material and with the linear material of the same small-strain
+modulus — :func:`seed001_study` sweeps the pair pressures over a grid, takes the tip compliance
+of every configuration (seed eq. 6), decomposes it into eigenscrews and maps the largest
+translational compliance (the translational ellipsoid's largest semi-axis) over the workspace
+(seed Fig. 1d); then it computes ``gamma_c(s)`` along the arm as P1 and P2 rise together
+(seed Fig. 1e). ``softrod study ROBOT.toml`` runs it from the command line.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import sys
+import time
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from ._core import ConvergenceError, ParameterError, UniaxialLaw
+from .robot import Robot, _Fields, _material, tomllib
+
+__all__ = ["StudyResult", "seed001_study"]
+
+
+@dataclass
+class StudyResult:
+    """Numbers of one material's study.
+
+    Attributes:
+        material: ``"hyperelastic"`` or ``"linear"``.
+        pressures: Pair pressures of the workspace grid (Pa), shape (n, 3).
+        tip_position: Tip positions (m), shape (n, 3); NaN where a solve failed.
+        max_compliance: Largest translational tip compliance (m/N, eigenscrew ellipsoid).
+        centre_periphery_ratio: Largest compliance at the workspace periphery (tip farthest
+            from the axis) over that at its centre (nearest).
+        gamma_c_pressures: Pressures of the ``gamma_c`` curves (Pa, P1 = P2).
+        gamma_c_tip: ``gamma_c`` at the tip per curve, shape (k, 3).
+        elongation: Tip height at equal pressures over the unpressurised one, per grid level.
+    """
+
+    material: str
+    pressures: np.ndarray
+    tip_position: np.ndarray
+    max_compliance: np.ndarray
+    centre_periphery_ratio: float
+    gamma_c_pressures: np.ndarray
+    gamma_c_tip: np.ndarray
+    compliances: list[Any]
+    elongation: np.ndarray
+
+
+def _linear_twin(data: dict[str, Any]) -> tuple[dict[str, Any], float]:
+    """The same robot description with the linear material of the law's small-strain modulus."""
+    mat_table = data["rod"]["material"]
+    law = _material(_Fields(mat_table, "rod.material"))
+    if isinstance(law, UniaxialLaw):
+        e0 = law.small_strain_modulus
+    else:
+        e0 = law.youngs_modulus
+    twin = {
+        **data,
+        "rod": {**data["rod"], "material": {"youngs_modulus": e0, "poisson_ratio": 0.5}},
+    }
+    return twin, e0
+
+
+def _pair_pressures(p: tuple[float, float, float]) -> list[float]:
+    return [p[0], p[0], p[1], p[1], p[2], p[2]]
+
+
+def _run(robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray) -> StudyResult:
+    from . import compliance, eigenscrews
+
+    grid = np.array(list(itertools.product(levels, repeat=3)))
+    tips = np.full((len(grid), 3), np.nan)
+    cmax = np.full(len(grid), np.nan)
+    for i, p in enumerate(grid):
+        try:
+            sol = robot.with_pressures(_pair_pressures(tuple(p))).solve()
+        except (ConvergenceError, ParameterError):
+            continue
+        screws = eigenscrews(compliance(sol).tip_world, "compliance")
+        tips[i] = sol.tip_position
+        cmax[i] = float(np.max(screws.translational_axes))
+    r = np.hypot(tips[:, 0], tips[:, 1])
+    ok = np.isfinite(cmax)
+    centre = cmax[ok][np.argmin(r[ok])]
+    edge = cmax[ok][np.argmax(r[ok])]
+    comps = [
+        compliance(robot.with_pressures(_pair_pressures((p, p, 0.0))).solve()) for p in gamma_p
+    ]
+    base = np.flatnonzero(np.all(grid == 0.0, axis=1))[0]
+    equal = [np.flatnonzero(np.all(grid == lv, axis=1))[0] for lv in levels]
+    return StudyResult(
+        material=material,
+        pressures=grid,
+        tip_position=tips,
+        max_compliance=cmax,
+        centre_periphery_ratio=float(edge / centre),
+        gamma_c_pressures=np.asarray(gamma_p),
+        gamma_c_tip=np.array([c.gamma_c[-1] for c in comps]),
+        compliances=comps,
+        elongation=tips[equal, 2] / tips[base, 2],
+    )
+
+
+def seed001_study(
+    robot_path: str | os.PathLike[str],
+    *,
+    levels: int = 13,
+    max_pressure: float = 60e3,
+    gamma_pressures: tuple[float, ...] = (0.0, 10e3, 20e3, 30e3, 40e3),
+    out_dir: str | os.PathLike[str] | None = None,
+    log=sys.stdout,
+) -> dict[str, StudyResult]:
+    """Runs seed 001's study on a three-chamber-pair robot, hyperelastic and linear.
+
+    Args:
+        robot_path: Robot description file with six chambers (pairs 0-1, 2-3, 4-5) and a
+            hyperelastic (or linear) material.
+        levels: Pressure levels per pair on ``[0, max_pressure]`` (``levels**3`` configurations
+            per material).
+        max_pressure: Largest pair pressure (Pa).
+        gamma_pressures: P1 = P2 pressures (Pa) of the ``gamma_c(s)`` curves.
+        out_dir: Folder for the figures (``seed001_workspace_<material>.png``,
+            ``seed001_gamma_c_<material>.png``); ``None`` draws nothing.
+        log: Where the summary is printed (``None``: silent).
+
+    Returns:
+        The results by material, ``"hyperelastic"`` and ``"linear"``.
+
+    Raises:
+        ParameterError: A robot without exactly six chambers, or bad arguments.
+    """
+    if levels < 2:
+        raise ParameterError(f"invalid parameter `levels` = {levels}: must be >= 2")
+    if not (np.isfinite(max_pressure) and max_pressure > 0):
+        raise ParameterError(
+            f"invalid parameter `max_pressure` = {max_pressure}: must be finite and > 0 Pa"
+        )
+    with open(robot_path, "rb") as fh:
+        data = tomllib.load(fh)
+    name = os.path.splitext(os.path.basename(robot_path))[0]
+    robot = Robot.from_dict(data, name=name)
+    if len(robot.chambers) != 6:
+        raise ParameterError(
+            f"invalid parameter `robot_path` = {os.fspath(robot_path)!r}: the study needs six "
+            f"chambers (three pairs), the file has {len(robot.chambers)}"
+        )
+    twin_data, e0 = _linear_twin(data)
+    models = {"hyperelastic": robot, "linear": Robot.from_dict(twin_data, name=name + "-linear")}
+    grid = np.linspace(0.0, max_pressure, levels)
+    out: dict[str, StudyResult] = {}
+    for material, rb in models.items():
+        t0 = time.perf_counter()
+        res = _run(rb, material, grid, np.asarray(gamma_pressures))
+        out[material] = res
+        if log is not None:
+            print(
+                f"{material} ({'E0' if material == 'linear' else 'law'}"
+                f"{f' = {e0 / 1e3:.1f} kPa' if material == 'linear' else ''}): "
+                f"{len(res.pressures)} pressure sets in {time.perf_counter() - t0:.1f} s; "
+                f"largest translational tip compliance centre -> periphery "
+                f"x {res.centre_periphery_ratio:.2f}",
+                file=log,
+            )
+            for p, g in zip(res.gamma_c_pressures, res.gamma_c_tip, strict=True):
+                print(
+                    f"  P1 = P2 = {p / 1e3:4.0f} kPa: gamma_c at the tip (body x, y, z) = "
+                    f"{np.array2string(g, precision=4)}",
+                    file=log,
+                )
+            print(
+                f"  equal pressures 0 -> {max_pressure / 1e3:.0f} kPa: tip height x "
+                f"{res.elongation[-1]:.3f}, largest compliance x "
+                f"{_equal_ratio(res, grid):.3f}",
+                file=log,
+            )
+    if out_dir is not None:
+        _figures(out, grid, out_dir, log)
+    return out
+
+
+def _equal_ratio(res: StudyResult, grid: np.ndarray) -> float:
+    base = np.flatnonzero(np.all(res.pressures == 0.0, axis=1))[0]
+    top = np.flatnonzero(np.all(res.pressures == grid[-1], axis=1))[0]
+    return float(res.max_compliance[top] / res.max_compliance[base])
+
+
+def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .plot import plot_gamma_c, plot_workspace_map
+
+    os.makedirs(out_dir, exist_ok=True)
+    for material, res in out.items():
+        ok = np.isfinite(res.max_compliance)
+        wmap = SimpleNamespace(
+            tip_position=res.tip_position,
+            max_translational_compliance=res.max_compliance,
+            converged=ok,
+        )
+        f1 = plot_workspace_map(
+            wmap,
+            title=f"{material}: largest translational tip compliance (m/N), "
+            f"P1, P2, P3 in 0-{grid[-1] / 1e3:.0f} kPa",
+        )
+        p1 = os.path.join(out_dir, f"seed001_workspace_{material}.png")
+        f1.savefig(p1, dpi=110)
+        f2 = plot_gamma_c(
+            res.compliances,
+            labels=[f"P1 = P2 = {p / 1e3:.0f} kPa" for p in res.gamma_c_pressures],
+            title=f"{material}: dimensionless flexural compliance along the arm",
+        )
+        p2 = os.path.join(out_dir, f"seed001_gamma_c_{material}.png")
+        f2.savefig(p2, dpi=110)
+        if log is not None:
+            print(f"wrote {p1}\nwrote {p2}", file=log)
