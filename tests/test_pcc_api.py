@@ -165,3 +165,21 @@ def test_errors_name_the_parameter(call, parameter):
     with pytest.raises(ParameterError) as err:
         call()
     assert err.value.parameter == parameter
+
+
+def test_compliance_of_a_pcc_solution_is_the_cosserat_compliance_type():
+    e, r, length, d = 2e9, 0.01, 0.5, 0.008
+    robot = pcc.Robot.solid_circle([length], r, e, extensible=False).with_tendons(0, [d], [0.0])
+    ei = e * np.pi * r**4 / 4
+    sol = pcc.solve(robot, [np.pi / 2 * ei / (d * length)])
+    rod = softrod.Rod(length, softrod.CircularSection(r), softrod.LinearElastic(e, 0.3))
+    c = softrod.compliance(sol, rod)
+    assert isinstance(c, softrod.Compliance)
+    assert c.world.shape == (len(c), 6, 6) and c.s[-1] == pytest.approx(length)
+    assert len(softrod.compliance(sol, rod, panels=10)) == 11
+    with pytest.raises(softrod.ParameterError):
+        softrod.compliance(sol)  # the PCC path needs the rod's section and material
+    with pytest.raises(softrod.ParameterError):
+        softrod.compliance(sol, rod, panels=0)
+    with pytest.raises(softrod.ParameterError):
+        softrod.compliance(softrod.solve_statics(rod), rod)

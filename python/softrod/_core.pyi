@@ -733,7 +733,9 @@ class Eigenscrews:
     @property
     def kind(self) -> str: ...
 
-def compliance(solution: StaticsSolution) -> Compliance: ...
+def compliance(
+    solution: StaticsSolution | PccSolution, rod: Rod | None = None, *, panels: int | None = None
+) -> Compliance: ...
 def tangent_compliance(
     solution: StaticsSolution,
     tendons: Literal["tension", "length"] = "tension",

@@ -13,7 +13,9 @@ straight).
 
 Statics (:func:`solve`): stationary potential energy of the Cosserat rod restricted to arcs,
 tendons passing through proximal segments, pneumatic chambers, and a world-frame tip force and
-moment; Newton with the exact Jacobian. Errors are :class:`softrod.ParameterError` naming the
+moment; Newton with the exact Jacobian. The integrated compliance along a solution is
+:func:`softrod.compliance` ``(solution, rod)`` (the same computation as for a Cosserat solution;
+``rod`` gives the section and material). Errors are :class:`softrod.ParameterError` naming the
 parameter, and :class:`softrod.ConvergenceError`.
 
 Example:

@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 use softrod::nalgebra::Matrix6;
 
 use crate::errors::{param_err, to_py_err};
+use crate::pcc::PccSolution;
 use crate::statics::{Loads, Problem, Rod, StaticsSolution, Tendon};
 
 fn mat6<'py>(py: Python<'py>, m: &Matrix6<f64>) -> Bound<'py, PyArray2<f64>> {
@@ -123,17 +124,49 @@ impl Compliance {
     }
 }
 
-/// The seed's integrated compliance along a solved rod (world and body frames).
+/// A Cosserat or a PCC solution.
+#[derive(FromPyObject)]
+pub(crate) enum AnySolution<'py> {
+    Cosserat(PyRef<'py, StaticsSolution>),
+    Pcc(PyRef<'py, PccSolution>),
+}
+
+/// The seed's integrated compliance along a solved rod (world and body frames), Cosserat or
+/// PCC (same computation; the PCC arcs take `rod`'s section and material).
 #[pyfunction]
+#[pyo3(signature = (solution, rod=None, *, panels=None))]
 pub(crate) fn compliance(
     py: Python<'_>,
-    solution: PyRef<'_, StaticsSolution>,
+    solution: AnySolution<'_>,
+    rod: Option<PyRef<'_, Rod>>,
+    panels: Option<i64>,
 ) -> PyResult<Compliance> {
-    let problem = problem_of(&solution)?;
-    let sol = &solution.inner;
-    let inner = py
-        .detach(|| softrod::compliance(&problem.rod, sol))
-        .map_err(to_py_err)?;
+    let inner = match solution {
+        AnySolution::Cosserat(solution) => {
+            if rod.is_some() {
+                return Err(param_err(
+                    "rod",
+                    "a Rod",
+                    "None for a Cosserat solution (it carries its rod)",
+                ));
+            }
+            let problem = problem_of(&solution)?;
+            let sol = &solution.inner;
+            py.detach(|| softrod::compliance(&problem.rod, sol))
+        }
+        AnySolution::Pcc(solution) => {
+            let rod = rod.ok_or_else(|| {
+                param_err("rod", "None", "the Rod giving the section and material")
+            })?;
+            let panels = match panels {
+                Some(p) if p < 1 => return Err(param_err("panels", p, ">= 1")),
+                p => p.map(|p| p as usize),
+            };
+            let (r, robot, sol) = (&rod.inner, &solution.robot, &solution.inner);
+            py.detach(|| softrod::pcc_compliance(r, robot, sol, panels))
+        }
+    }
+    .map_err(to_py_err)?;
     Ok(Compliance { inner })
 }
 

@@ -83,7 +83,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m
     )?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tendon_tensions, m)?)?;
-    m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tendon_tensions_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        pcc::pcc_arc_from_tendon_tensions_jacobian,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_pressures, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_pressures_jacobian, m)?)?;
     Ok(())

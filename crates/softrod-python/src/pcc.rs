@@ -598,7 +598,9 @@ impl PccRobot {
 /// A solved PCC robot.
 #[pyclass(frozen, module = "softrod._core", name = "PccSolution")]
 pub(crate) struct PccSolution {
-    inner: statics::PccStaticsSolution,
+    pub(crate) inner: statics::PccStaticsSolution,
+    /// The robot it solves (rest lengths for the compliance).
+    pub(crate) robot: CoreRobot,
     s: Vec<f64>,
     frames: Vec<Matrix4<f64>>,
 }
@@ -806,5 +808,10 @@ pub(crate) fn pcc_solve<'py>(
             Ok((sol, s, frames))
         })
         .map_err(to_py_err)?;
-    Ok(PccSolution { inner, s, frames })
+    Ok(PccSolution {
+        inner,
+        robot: model.clone(),
+        s,
+        frames,
+    })
 }
