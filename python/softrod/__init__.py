@@ -51,6 +51,7 @@ from ._core import (
 from .compare import BackboneDistance, backbone_distance
 from .io import read_backbone_csv, write_samples_csv
 from .materials import TensileCurve, read_tensile_csv
+from .models import ModelComparison, ModelResult, compare_models
 from .robot import Robot, load_robot
 from .workspace import WorkspaceMap, tension_grid, workspace_map
 
@@ -67,6 +68,8 @@ __all__ = [
     "LinearElastic",
     "Linearised",
     "Loads",
+    "ModelComparison",
+    "ModelResult",
     "MooneyRivlin",
     "NeoHookean",
     "Ogden",
@@ -92,6 +95,7 @@ __all__ = [
     "Yeoh",
     "__version__",
     "backbone_distance",
+    "compare_models",
     "compliance",
     "eigenscrews",
     "fit_uniaxial",

@@ -415,6 +415,23 @@ def _cmd_study(args) -> int:
     return 0
 
 
+def _cmd_compare(args) -> int:
+    from .models import compare_models
+
+    comp = compare_models(args.robot, tensions=args.tensions, repeats=args.repeats)
+    print(f"robot: {comp.robot} ({args.robot}); differences relative to Cosserat")
+    print(comp.table())
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .plot import plot_models
+
+        plot_models(comp).savefig(args.plot, dpi=130)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return 0
+
+
 def _positive_int(text: str) -> int:
     try:
         return int(text)
@@ -544,6 +561,20 @@ def build_parser() -> argparse.ArgumentParser:
     co.add_argument("--plot", metavar="FILE", help="PNG of compliance ellipsoids along the arm")
     co.add_argument("--gamma-plot", metavar="FILE", help="PNG of gamma_c(s) per body axis")
     co.set_defaults(func=_cmd_compliance)
+
+    cm = sub.add_parser(
+        "compare", help="solve a robot file with every applicable model (Cosserat, PCC, planar)"
+    )
+    cm.add_argument("robot", metavar="ROBOT.toml", help="robot description file (TOML)")
+    cm.add_argument("--tensions", type=float, nargs="+", help="override the tendon tensions (N)")
+    cm.add_argument("--plot", metavar="FILE", help="PNG of the overlaid backbones")
+    cm.add_argument(
+        "--repeats",
+        type=_positive_int,
+        default=5,
+        help="timed solves per model, median reported (default: %(default)s)",
+    )
+    cm.set_defaults(func=_cmd_compare)
 
     ws = sub.add_parser("workspace", help="workspace map: sweep tensions, tip stiffness measures")
     ws.add_argument("robot", help="robot description file (TOML)")

@@ -382,6 +382,9 @@ class Robot:
         loads: External loads (unloaded when the file has none).
         solver: Keyword arguments for :func:`softrod.solve_statics`.
         description: Free text from the file.
+        source: The parsed description it was built from (tables as read; the tensions and
+            pressures of ``tendons`` and ``chambers`` take precedence), used by
+            :func:`softrod.compare_models` to map the robot onto simpler models.
     """
 
     name: str
@@ -391,6 +394,7 @@ class Robot:
     solver: dict[str, Any] = field(default_factory=dict)
     description: str = ""
     chambers: tuple[Chamber, ...] = ()
+    source: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def solve(self, **overrides: Any) -> StaticsSolution:
         """Solves the robot's statics; keyword arguments override the file's solver options."""
@@ -447,6 +451,7 @@ class Robot:
             solver=solver,
             description=str(top.get("description", "")),
             chambers=chambers,
+            source=data,
         )
         top.finish()
         return robot

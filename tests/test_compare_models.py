@@ -1,0 +1,98 @@
+"""softrod.compare_models and `softrod compare`: the call, the table, exit codes, the plot."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod.cli import main
+from softrod.plot import plot_models
+
+ROBOTS = Path(__file__).resolve().parent.parent / "examples" / "robots"
+NITI = ROBOTS / "niti_two_segment.toml"
+SEED000 = ROBOTS / "seed000_arm.toml"
+
+
+def _loaded_rod(tip_force):
+    return softrod.Robot.from_dict(
+        {
+            "name": "loaded",
+            "rod": {
+                "length": 0.3,
+                "section": {"radius": 0.001},
+                "material": {"youngs_modulus": 50e9, "poisson_ratio": 0.3},
+            },
+            "tendons": [{"distance": 0.005, "angle_deg": 45, "tension": 2.0}],
+            "loads": {"tip_force": tip_force},
+        }
+    )
+
+
+def test_niti_robot_pcc_applies_and_is_exact_planar_does_not():
+    comp = softrod.compare_models(NITI, repeats=1)
+    assert [r.model for r in comp.results] == ["cosserat", "pcc", "planar"]
+    ref, p = comp["cosserat"], comp["pcc"]
+    assert ref.applies and ref.tip_error == 0.0 and ref.positions.shape[1] == 3
+    assert p.applies and "2 segment" in p.note
+    # Unloaded tendon-driven PCC is the Cosserat solution: only the RK4 error is left.
+    assert p.tip_error < 1e-8 and p.angle_error < 1e-8 and p.backbone_max < 1e-8
+    assert p.positions.shape == (len(np.unique(ref.solution.s)), 3)
+    assert p.solve_time > 0 and ref.solve_time > 0
+    assert not comp["planar"].applies and "6 tendons" in comp["planar"].note
+    with pytest.raises(KeyError):
+        comp["nope"]
+
+
+def test_seed000_arm_planar_applies_pcc_does_not():
+    comp = softrod.compare_models(softrod.load_robot(SEED000), repeats=2)
+    pl = comp["planar"]
+    assert pl.applies and pl.tip_rotation is None and "anchor=L" in pl.note
+    assert 0 < pl.tip_error < 0.05 and 0 < pl.angle_error < 0.5
+    assert pl.backbone_max >= pl.backbone_mean > 0
+    assert not comp["pcc"].applies and "tapered" in comp["pcc"].note
+
+
+def test_tip_load_keeps_pcc_rules_out_planar_and_tensions_override():
+    comp = softrod.compare_models(_loaded_rod([0.2, 0.0, 0.0]), repeats=1)
+    assert comp["pcc"].applies and comp["pcc"].tip_error > 1e-5  # the ansatz is not exact
+    assert not comp["planar"].applies and "external loads" in comp["planar"].note
+    zero = softrod.compare_models(_loaded_rod([0.0, 0.0, 0.0]), tensions=[0.0], repeats=1)
+    assert np.allclose(zero["cosserat"].tip_position, [0, 0, 0.3])
+    assert "not at a constant offset" not in zero["pcc"].note
+
+
+def test_bad_arguments_raise_parameter_error():
+    with pytest.raises(softrod.ParameterError):
+        softrod.compare_models(NITI, repeats=0)
+    with pytest.raises(softrod.ParameterError):
+        softrod.compare_models(NITI, tensions=[1.0])
+
+
+def test_table_lists_models_and_reasons():
+    text = softrod.compare_models(SEED000, repeats=1).table()
+    lines = text.splitlines()
+    assert lines[0].split()[0] == "model" and "time (ms)" in lines[0]
+    assert lines[2].startswith("cosserat") and lines[3].startswith("planar")
+    assert "pcc: does not apply: a tapered section" in text
+
+
+def test_cli_prints_table_writes_plot_and_exits(tmp_path, capsys):
+    png = tmp_path / "models.png"
+    assert main(["compare", str(NITI), "--repeats", "1", "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "niti-two-segment" in out and "\npcc " in out
+    assert "planar: does not apply" in out
+    assert png.read_bytes()[:4] == b"\x89PNG" and png.stat().st_size > 10_000
+    assert main(["compare", str(NITI), "--tensions", "1", "2"]) == 2
+    assert main(["compare", str(tmp_path / "missing.toml")]) == 1
+    assert main(["compare", str(SEED000), "--tensions", "1", "--repeats", "1"]) == 0
+    assert "\nplanar " in capsys.readouterr().out
+
+
+def test_plot_models_draws_every_applicable_model():
+    fig = plot_models(softrod.compare_models(SEED000, repeats=1))
+    ax = fig.axes[0]
+    labels = [ln.get_label() for ln in ax.get_lines()]
+    assert labels[0] == "cosserat" and labels[1].startswith("planar (tip")
+    assert "pcc" in ax.get_legend().get_title().get_text()
