@@ -96,3 +96,42 @@ def test_plot_models_draws_every_applicable_model():
     labels = [ln.get_label() for ln in ax.get_lines()]
     assert labels[0] == "cosserat" and labels[1].startswith("planar (tip")
     assert "pcc" in ax.get_legend().get_title().get_text()
+
+
+def test_mappings_follow_the_base_pose_and_chambers_split_segments():
+    c, s = np.cos(0.5), np.sin(0.5)
+    base = {"position": [0.1, 0.2, -0.3], "rotation": [[c, -s, 0], [s, c, 0], [0, 0, 1]]}
+
+    def arm(pose, angle):
+        rod = {
+            "length": 0.27,
+            "section": {"type": "tapered", "base_radius": 0.015, "tip_radius": 0.0074},
+            "material": {"youngs_modulus": 110e3, "poisson_ratio": 0.5},
+        }
+        if pose:
+            rod["base_pose"] = base
+        tendon = {"routing": "radius_proportional", "ratio": 1 / 3, "angle_deg": angle}
+        return softrod.Robot.from_dict({"rod": rod, "tendons": [{**tendon, "tension": 2.0}]})
+
+    # Rotating and shifting the base, or turning the tendon, moves both models rigidly.
+    ref = softrod.compare_models(arm(False, 0), repeats=1)["planar"]
+    for pose, angle in [(True, 0), (True, 60), (False, -120)]:
+        got = softrod.compare_models(arm(pose, angle), repeats=1)["planar"]
+        assert got.tip_error == pytest.approx(ref.tip_error, rel=1e-6)
+        assert got.angle_error == pytest.approx(ref.angle_error, rel=1e-6)
+    chambers = softrod.Robot.from_dict(
+        {
+            "rod": {
+                "length": 0.3,
+                "base_pose": base,
+                "section": {"radius": 0.01},
+                "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.45},
+            },
+            "chambers": [
+                {"pressure": 3e3, "radius": 0.003, "distance": 0.005, "angle_deg": 30, "end": 0.15},
+                {"pressure": 2e3, "radius": 0.003, "distance": 0.005, "start": 0.15},
+            ],
+        }
+    )
+    p = softrod.compare_models(chambers, repeats=1)["pcc"]
+    assert p.applies and "2 segment" in p.note and p.tip_error < 1e-9
