@@ -14,8 +14,9 @@
 //!   and a library of named silicones;
 //! * [`fit`]: least-squares fitting of those laws to uniaxial test data;
 //! * [`se3`]: the adjoint and the twist/wrench ordering (owned here, used everywhere);
-//! * [`compliance`], [`eigenscrew`], [`workspace`]: seed 001, configuration-dependent
-//!   compliance and stiffness, eigenscrews, workspace maps;
+//! * [`compliance`](mod@compliance), [`eigenscrew`], [`workspace`]: seed 001,
+//!   configuration-dependent compliance and stiffness (Cosserat and PCC configurations),
+//!   eigenscrews, workspace maps;
 //! * [`error`]: the crate's one error type.
 
 pub mod chamber;

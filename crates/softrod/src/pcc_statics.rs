@@ -5,8 +5,9 @@
 //! Each segment `i` is a Cosserat rod of rest length `ℓ0`, bending stiffness `E I` and axial
 //! stiffness `E A` (or inextensible), *restricted* to constant-curvature, twist-free,
 //! shear-free shapes. Its configuration is the bending vector `θ = ℓ u = (θ_x, θ_y)` (rad, body
-//! frame; `u` the curvature vector per deformed length, [`ArcCoordinates::CurvatureVector`]) and
-//! the length `ℓ`. The Cosserat energy of such a shape is, with the curvature per *undeformed*
+//! frame; `u` the curvature vector per deformed length,
+//! [`ArcCoordinates::CurvatureVector`](crate::pcc::ArcCoordinates::CurvatureVector)) and the
+//! length `ℓ`. The Cosserat energy of such a shape is, with the curvature per *undeformed*
 //! length `θ/ℓ0` (as in the Cosserat engine) and the axial strain `ℓ/ℓ0 - 1`,
 //!
 //! ```text
@@ -24,7 +25,8 @@
 //! g(q) = ∂U/∂q + Σ τ ∂L/∂q - Σ p A ∂L_c/∂q - J_h(q)ᵀ [F; M] = 0,
 //! ```
 //!
-//! with `J_h` the tip's hybrid Jacobian ([`JacobianFrame::Hybrid`]). In `θ` coordinates the
+//! with `J_h` the tip's hybrid Jacobian
+//! ([`JacobianFrame::Hybrid`](crate::pcc::JacobianFrame::Hybrid)). In `θ` coordinates the
 //! energy is quadratic and the actuator terms are constant: only the tip load is nonlinear.
 //!
 //! **Why energy and not a moment balance per segment.** Without external loads every section
