@@ -62,6 +62,16 @@ def test_tip_load_keeps_pcc_rules_out_planar_and_tensions_override():
     assert "not at a constant offset" not in zero["pcc"].note
 
 
+def test_a_robot_without_description_is_compared_with_cosserat_only():
+    from dataclasses import replace
+
+    robot = replace(softrod.load_robot(NITI), source={})
+    comp = softrod.compare_models(robot, repeats=1)
+    assert comp["cosserat"].applies
+    assert not comp["pcc"].applies and "Robot.from_dict" in comp["pcc"].note
+    assert not comp["planar"].applies
+
+
 def test_bad_arguments_raise_parameter_error():
     with pytest.raises(softrod.ParameterError):
         softrod.compare_models(NITI, repeats=0)

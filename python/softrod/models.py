@@ -29,6 +29,10 @@ __all__ = ["ModelComparison", "ModelResult", "compare_models"]
 DEFAULT_REPEATS = 5
 #: Relative tolerance on a tendon end at the tip (planar anchor) and on segment breaks (m/m).
 _END_TOLERANCE = 1e-12
+_NO_SOURCE = (
+    "the robot has no description to map (build it with load_robot or Robot.from_dict; "
+    "sections, materials and routings are read from it)"
+)
 
 
 @dataclass(frozen=True)
@@ -378,7 +382,10 @@ def compare_models(
     )
     results = [ref]
     s_nodes = np.unique(np.asarray(sol.s))
-    for build in (_pcc, _planar):
+    for model, build in (("pcc", _pcc), ("planar", _planar)):
+        if not robot.source:
+            results.append(ModelResult(model, False, _NO_SOURCE))
+            continue
         r = build(robot, s_nodes, int(repeats))
         if r.applies:
             d = backbone_distance(r.positions, ref.positions)
