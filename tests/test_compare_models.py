@@ -47,7 +47,7 @@ def test_niti_robot_pcc_applies_and_is_exact_planar_does_not():
 def test_seed000_arm_planar_applies_pcc_does_not():
     comp = softrod.compare_models(softrod.load_robot(SEED000), repeats=2)
     pl = comp["planar"]
-    assert pl.applies and pl.tip_rotation is None and "anchor=L" in pl.note
+    assert pl.applies and pl.tip_rotation is None and "anchor=0.27)" in pl.note
     assert 0 < pl.tip_error < 0.05 and 0 < pl.angle_error < 0.5
     assert pl.backbone_max >= pl.backbone_mean > 0
     assert not comp["pcc"].applies and "tapered" in comp["pcc"].note
@@ -145,3 +145,16 @@ def test_mappings_follow_the_base_pose_and_chambers_split_segments():
     )
     p = softrod.compare_models(chambers, repeats=1)["pcc"]
     assert p.applies and "2 segment" in p.note and p.tip_error < 1e-9
+
+
+def test_planar_anchor_is_the_tendon_end():
+    robot = softrod.load_robot(SEED000)
+    data = {**robot.source, "tendons": [{**robot.source["tendons"][0], "end": 0.2}]}
+    comp = softrod.compare_models(softrod.Robot.from_dict(data), repeats=1)
+    pl = comp["planar"]
+    assert pl.applies and "anchor=0.2)" in pl.note
+    # Both arms run straight beyond the anchor; they differ by millimetres, as at full length.
+    assert (
+        0 < pl.tip_error < 0.05
+        and pl.tip_error < softrod.compare_models(SEED000)["planar"].tip_error
+    )
