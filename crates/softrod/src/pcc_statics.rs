@@ -62,7 +62,7 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
-use crate::error::{check_finite, check_positive, Error, Result};
+use crate::error::{check_finite, check_newton_options, check_positive, Error, Result};
 use crate::pcc::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
 
 /// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
@@ -1013,27 +1013,7 @@ fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mu
 }
 
 fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
-    if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
-        return Err(Error::invalid(
-            "tolerance",
-            opts.tolerance,
-            "finite and > 0",
-        ));
-    }
-    if opts.max_iterations == 0 {
-        return Err(Error::invalid(
-            "max_iterations",
-            opts.max_iterations,
-            ">= 1",
-        ));
-    }
-    if opts.max_load_steps == 0 {
-        return Err(Error::invalid(
-            "max_load_steps",
-            opts.max_load_steps,
-            ">= 1",
-        ));
-    }
+    check_newton_options(opts.tolerance, opts.max_iterations, opts.max_load_steps)?;
     if let Some(ws) = &opts.warm_start {
         if ws.len() != robot.bodies.len() {
             return Err(Error::invalid(

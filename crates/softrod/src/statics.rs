@@ -19,7 +19,7 @@
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use crate::cosserat::{rot, v3, ActiveTendon, Evaluator, Model, FULL, STATE};
-use crate::error::{Error, Result};
+use crate::error::{check_newton_options, Error, Result};
 use crate::integrate::{dp54, rk4_step_in_place, AdaptiveOptions, Rk4Workspace};
 use crate::loads::{Frame, Loads};
 use crate::rod::Rod;
@@ -632,27 +632,7 @@ fn check_options(opts: &SolveOptions) -> Result<()> {
             a.validated()?;
         }
     }
-    if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
-        return Err(Error::invalid(
-            "tolerance",
-            opts.tolerance,
-            "finite and > 0",
-        ));
-    }
-    if opts.max_iterations == 0 {
-        return Err(Error::invalid(
-            "max_iterations",
-            opts.max_iterations,
-            ">= 1",
-        ));
-    }
-    if opts.max_load_steps == 0 {
-        return Err(Error::invalid(
-            "max_load_steps",
-            opts.max_load_steps,
-            ">= 1",
-        ));
-    }
+    check_newton_options(opts.tolerance, opts.max_iterations, opts.max_load_steps)?;
     if let Some(w) = &opts.warm_start {
         for (k, v) in w.base_wrench.iter().enumerate() {
             if !v.is_finite() {
