@@ -131,6 +131,43 @@ fn step_containing(mesh: &[f64], t: f64) -> Option<usize> {
     Some(pos.clamp(1, n - 1) - 1)
 }
 
+/// Initial step size (Hairer–Nørsett–Wanner's heuristic) from the first `controlled`
+/// components of the state `y0` and its derivative `k1`, within `[tiny, |span|]`.
+fn initial_step<const N: usize>(
+    y0: &[f64; N],
+    k1: &[f64; N],
+    controlled: usize,
+    span: f64,
+    tiny: f64,
+    opts: &AdaptiveOptions,
+) -> f64 {
+    let scale = |j: usize| opts.atol + opts.rtol * y0[j].abs();
+    let d0 = (0..controlled)
+        .map(|j| (y0[j] / scale(j)).abs())
+        .fold(0.0, f64::max);
+    let d1 = (0..controlled)
+        .map(|j| (k1[j] / scale(j)).abs())
+        .fold(0.0, f64::max);
+    let h = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6 * span.abs()
+    } else {
+        0.01 * d0 / d1
+    };
+    h.min(span.abs()).max(tiny)
+}
+
+/// The signed step from `t` toward `t1` (direction `dir`) of size at most `h`, stretched to land
+/// exactly on `t1` when less than `tiny` would remain.
+#[inline]
+fn clipped_step(t: f64, t1: f64, h: f64, dir: f64, tiny: f64) -> f64 {
+    let hs = h.min((t1 - t).abs()) * dir;
+    if (t1 - (t + hs)) * dir <= tiny {
+        t1 - t
+    } else {
+        hs
+    }
+}
+
 #[inline]
 fn axpy<const N: usize>(y: &[f64; N], h: f64, terms: &[(f64, &[f64; N])]) -> [f64; N] {
     let mut out = *y;
@@ -185,19 +222,7 @@ where
     let tiny = 16.0 * f64::EPSILON * t0.abs().max(t1.abs()).max(f64::MIN_POSITIVE);
 
     // Initial step (Hairer–Nørsett–Wanner's heuristic, order 3).
-    let scale = |y: &[f64; N], j: usize| opts.atol + opts.rtol * y[j].abs();
-    let d0 = (0..N)
-        .map(|j| (y0[j] / scale(&y0, j)).abs())
-        .fold(0.0, f64::max);
-    let d1 = (0..N)
-        .map(|j| (k1[j] / scale(&y0, j)).abs())
-        .fold(0.0, f64::max);
-    let mut h = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6
-    } else {
-        0.01 * d0 / d1
-    };
-    h = h.min(span.abs()).max(tiny);
+    let mut h = initial_step(&y0, &k1, N, span, tiny, &opts);
 
     let (mut t, mut y) = (t0, y0);
     let mut attempts = 0usize;
@@ -211,10 +236,7 @@ where
                 residual: last_err,
             });
         }
-        let mut hs = h.min((t1 - t).abs()) * dir;
-        if (t1 - (t + hs)) * dir <= tiny {
-            hs = t1 - t;
-        }
+        let hs = clipped_step(t, t1, h, dir, tiny);
         let k2 = f(t + 0.5 * hs, &axpy(&y, hs, &[(0.5, &k1)]));
         let k3 = f(t + 0.75 * hs, &axpy(&y, hs, &[(0.75, &k2)]));
         let y_new = axpy(
@@ -529,19 +551,7 @@ where
     stats.evaluations += 1;
     let dir = span.signum();
     let tiny = 16.0 * f64::EPSILON * t0.abs().max(t1.abs()).max(f64::MIN_POSITIVE);
-    let scale = |y: &[f64; N], j: usize| opts.atol + opts.rtol * y[j].abs();
-    let d0 = (0..controlled)
-        .map(|j| (y0[j] / scale(&y0, j)).abs())
-        .fold(0.0, f64::max);
-    let d1 = (0..controlled)
-        .map(|j| (k1[j] / scale(&y0, j)).abs())
-        .fold(0.0, f64::max);
-    let mut h = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6 * span.abs()
-    } else {
-        0.01 * d0 / d1
-    };
-    h = h.min(span.abs()).max(tiny);
+    let mut h = initial_step(&y0, &k1, controlled, span, tiny, &opts);
     let (mut t, mut y) = (t0, y0);
     let mut attempts = 0usize;
     let mut last_err = f64::NAN;
@@ -554,10 +564,7 @@ where
                 residual: last_err,
             });
         }
-        let mut hs = h.min((t1 - t).abs()) * dir;
-        if (t1 - (t + hs)) * dir <= tiny {
-            hs = t1 - t;
-        }
+        let hs = clipped_step(t, t1, h, dir, tiny);
         let k2 = f(t + dp::C[1] * hs, &axpy(&y, hs, &[(dp::A21, &k1)]));
         let k3 = f(
             t + dp::C[2] * hs,
