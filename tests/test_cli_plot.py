@@ -89,3 +89,12 @@ def test_plot_draws_one_backbone_per_solution():
     line = ax.get_lines()[0]
     np.testing.assert_allclose(line.get_xdata(), sols[0].x * 1e3)
     assert len(plot_planar(arm, sols, profiles=False).axes) == 1
+
+
+def test_cli_closes_the_figures_it_opens(tmp_path):
+    import matplotlib.pyplot as plt
+
+    mine = plt.figure()
+    assert main(["planar", "-t", "1", "--plot", str(tmp_path / "p.png")]) == 0
+    assert main(["demo", "--plot", str(tmp_path / "d.png")]) == 0
+    assert plt.get_fignums() == [mine.number]  # the caller's figure stays open

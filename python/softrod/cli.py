@@ -628,11 +628,25 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _run_closing_figures(args) -> int:
+    """Runs a command and closes the figures it opened (only those: an in-process caller keeps
+    its own)."""
+    plt = sys.modules.get("matplotlib.pyplot")
+    before = set(plt.get_fignums()) if plt else set()
+    try:
+        return args.func(args)
+    finally:
+        plt = sys.modules.get("matplotlib.pyplot")
+        if plt is not None:
+            for num in set(plt.get_fignums()) - before:
+                plt.close(num)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``softrod`` console script; returns the exit status."""
     args = build_parser().parse_args(argv)
     try:
-        return args.func(args)
+        return _run_closing_figures(args)
     except ParameterError as exc:
         print(f"softrod: error: {exc}", file=sys.stderr)
         return 2

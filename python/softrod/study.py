@@ -196,6 +196,8 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     from .plot import plot_gamma_c, plot_workspace_map
 
     os.makedirs(out_dir, exist_ok=True)
@@ -213,6 +215,7 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
         )
         p1 = os.path.join(out_dir, f"seed001_workspace_{material}.png")
         f1.savefig(p1, dpi=110)
+        plt.close(f1)
         f2 = plot_gamma_c(
             res.compliances,
             labels=[f"P1 = P2 = {p / 1e3:.0f} kPa" for p in res.gamma_c_pressures],
@@ -220,5 +223,6 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
         )
         p2 = os.path.join(out_dir, f"seed001_gamma_c_{material}.png")
         f2.savefig(p2, dpi=110)
+        plt.close(f2)
         if log is not None:
             print(f"wrote {p1}\nwrote {p2}", file=log)
