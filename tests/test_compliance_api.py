@@ -113,3 +113,52 @@ def test_cli_compliance_and_workspace(tmp_path, capsys):
     assert "tangent, tendons at fixed length" in cap.out
     assert wsp.stat().st_size > 10_000
     assert main(["workspace", ROBOT, "--sweep", "9:4"]) == 2
+
+
+def test_fixed_length_tangent_matches_a_finite_difference_with_held_lengths():
+    """Independent check of tendons held at fixed length: perturb the tip force, re-solve the
+    tensions of the held tendons (0 and 4) so that their path lengths stay put, and difference
+    the tip position; the linearised BVP must give the same translational block."""
+    from pathlib import Path
+
+    robot = softrod.load_robot(
+        Path(__file__).resolve().parent.parent / "examples/robots/niti_two_segment.toml"
+    )
+    held = [0, 4]
+    tight = dict(integrator="adaptive", rtol=1e-12, atol=1e-14)
+    tens0 = np.array([t.tension for t in robot.tendons])
+    sol0 = robot.solve(**tight)
+    lengths0 = sol0.tendon_lengths[held]
+    tangent = softrod.tangent_compliance(sol0, "length", held=held).world[:3, :3]
+
+    def solve(force, tens):
+        r = robot.with_tensions(tens)
+        return softrod.solve_statics(r.rod, r.tendons, softrod.Loads(tip_force=force), **tight)
+
+    def held_solve(force):
+        tens = tens0.copy()
+        for _ in range(8):
+            sol = solve(force, tens)
+            res = sol.tendon_lengths[held] - lengths0
+            if np.max(np.abs(res)) < 1e-14:
+                return sol
+            jac = np.zeros((2, 2))
+            for j, k in enumerate(held):
+                d = np.zeros_like(tens)
+                d[k] = 1e-4
+                up = solve(force, tens + d).tendon_lengths[held]
+                down = solve(force, tens - d).tendon_lengths[held]
+                jac[:, j] = (up - down) / 2e-4
+            tens[held] -= np.linalg.solve(jac, res)
+        raise AssertionError("held-length tension solve did not converge")
+
+    h = 1e-4
+    fd = np.zeros((3, 3))
+    for a in range(3):
+        e = np.zeros(3)
+        e[a] = h
+        fd[:, a] = (held_solve(e).tip_position - held_solve(-e).tip_position) / (2 * h)
+    assert np.max(np.abs(fd - tangent)) <= 1e-6 * np.max(np.abs(tangent))
+    # And the held tendons make the tip stiffer than free tensions.
+    free = softrod.tangent_compliance(sol0, "tension").world[:3, :3]
+    assert np.linalg.eigvalsh(tangent)[-1] < np.linalg.eigvalsh(free)[-1]
