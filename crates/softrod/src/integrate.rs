@@ -131,6 +131,49 @@ fn step_containing(mesh: &[f64], t: f64) -> Option<usize> {
     Some(pos.clamp(1, n - 1) - 1)
 }
 
+const BS23: &str = "ode23 (Bogacki-Shampine) integration";
+const DP54: &str = "Dormand-Prince 5(4) integration";
+
+fn not_converged(method: &str, detail: &str, iterations: usize, residual: f64) -> Error {
+    Error::NotConverged {
+        what: format!("{method}{detail}"),
+        iterations,
+        residual,
+    }
+}
+
+/// Max norm over the first `controlled` components of the local error estimate `e(j)`, each
+/// scaled by `atol + rtol * max(|y_j|, |y_new,j|)` (1 = at tolerance), as in MATLAB's solvers.
+#[inline]
+fn scaled_error<const N: usize>(
+    y: &[f64; N],
+    y_new: &[f64; N],
+    controlled: usize,
+    opts: &AdaptiveOptions,
+    e: impl Fn(usize) -> f64,
+) -> f64 {
+    (0..controlled).fold(0.0f64, |m, j| {
+        let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
+        m.max((e(j) / sc).abs())
+    })
+}
+
+/// Factor of the next step after a scaled error `err` for a pair whose propagated solution has
+/// order `order` (error ~ `h^order`): `0.9 err^(-1/order)`, within `[0.2, 5]` after an accepted
+/// step and `[0.1, 0.9]` after a rejected one.
+#[inline]
+fn step_factor(err: f64, order: f64, accepted: bool) -> f64 {
+    if accepted && err == 0.0 {
+        return 5.0;
+    }
+    let f = 0.9 * err.powf(-1.0 / order);
+    if accepted {
+        f.clamp(0.2, 5.0)
+    } else {
+        f.clamp(0.1, 0.9)
+    }
+}
+
 /// Initial step size (Hairer–Nørsett–Wanner's heuristic) from the first `controlled`
 /// components of the state `y0` and its derivative `k1`, within `[tiny, |span|]`.
 fn initial_step<const N: usize>(
@@ -230,11 +273,7 @@ where
     while (t1 - t) * dir > tiny {
         attempts += 1;
         if attempts > opts.max_steps {
-            return Err(Error::NotConverged {
-                what: "ode23 (Bogacki-Shampine) integration".into(),
-                iterations: attempts - 1,
-                residual: last_err,
-            });
+            return Err(not_converged(BS23, "", attempts - 1, last_err));
         }
         let hs = clipped_step(t, t1, h, dir, tiny);
         let k2 = f(t + 0.5 * hs, &axpy(&y, hs, &[(0.5, &k1)]));
@@ -247,20 +286,16 @@ where
         let t_new = if hs == t1 - t { t1 } else { t + hs };
         let k4 = f(t_new, &y_new);
         stats.evaluations += 3;
-        let mut err = 0.0f64;
-        for j in 0..N {
-            let e = hs
-                * (-5.0 / 72.0 * k1[j] + 1.0 / 12.0 * k2[j] + 1.0 / 9.0 * k3[j]
-                    - 1.0 / 8.0 * k4[j]);
-            let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
-            err = err.max((e / sc).abs());
-        }
+        let err = scaled_error(&y, &y_new, N, &opts, |j| {
+            hs * (-5.0 / 72.0 * k1[j] + 1.0 / 12.0 * k2[j] + 1.0 / 9.0 * k3[j] - 1.0 / 8.0 * k4[j])
+        });
         if !err.is_finite() || y_new.iter().any(|v| !v.is_finite()) {
-            return Err(Error::NotConverged {
-                what: "ode23 (Bogacki-Shampine) integration: non-finite state".into(),
-                iterations: attempts,
-                residual: f64::INFINITY,
-            });
+            return Err(not_converged(
+                BS23,
+                ": non-finite state",
+                attempts,
+                f64::INFINITY,
+            ));
         }
         last_err = err;
         if err <= 1.0 {
@@ -271,21 +306,12 @@ where
             sol.t.push(t);
             sol.y.push(y);
             sol.dy.push(k1);
-            let fac = if err == 0.0 {
-                5.0
-            } else {
-                (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
-            };
-            h = hs.abs() * fac;
+            h = hs.abs() * step_factor(err, 3.0, true);
         } else {
             stats.rejected += 1;
-            h = hs.abs() * (0.9 * err.powf(-1.0 / 3.0)).clamp(0.1, 0.9);
+            h = hs.abs() * step_factor(err, 3.0, false);
             if h <= tiny {
-                return Err(Error::NotConverged {
-                    what: "ode23 (Bogacki-Shampine) integration: step size underflow".into(),
-                    iterations: attempts,
-                    residual: err,
-                });
+                return Err(not_converged(BS23, ": step size underflow", attempts, err));
             }
         }
     }
@@ -558,11 +584,7 @@ where
     while (t1 - t) * dir > tiny {
         attempts += 1;
         if attempts > opts.max_steps {
-            return Err(Error::NotConverged {
-                what: "Dormand-Prince 5(4) integration".into(),
-                iterations: attempts - 1,
-                residual: last_err,
-            });
+            return Err(not_converged(DP54, "", attempts - 1, last_err));
         }
         let hs = clipped_step(t, t1, h, dir, tiny);
         let k2 = f(t + dp::C[1] * hs, &axpy(&y, hs, &[(dp::A21, &k1)]));
@@ -619,24 +641,21 @@ where
         );
         let k7 = f(t_new, &y_new);
         stats.evaluations += 6;
-        let mut err = 0.0f64;
-        for j in 0..controlled {
-            let e = hs
-                * (dp::E[0] * k1[j]
-                    + dp::E[2] * k3[j]
-                    + dp::E[3] * k4[j]
-                    + dp::E[4] * k5[j]
-                    + dp::E[5] * k6[j]
-                    + dp::E[6] * k7[j]);
-            let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
-            err = err.max((e / sc).abs());
-        }
+        let err = scaled_error(&y, &y_new, controlled, &opts, |j| {
+            hs * (dp::E[0] * k1[j]
+                + dp::E[2] * k3[j]
+                + dp::E[3] * k4[j]
+                + dp::E[4] * k5[j]
+                + dp::E[5] * k6[j]
+                + dp::E[6] * k7[j])
+        });
         if !err.is_finite() || y_new.iter().any(|v| !v.is_finite()) {
-            return Err(Error::NotConverged {
-                what: "Dormand-Prince 5(4) integration: non-finite state".into(),
-                iterations: attempts,
-                residual: f64::INFINITY,
-            });
+            return Err(not_converged(
+                DP54,
+                ": non-finite state",
+                attempts,
+                f64::INFINITY,
+            ));
         }
         last_err = err;
         if err <= 1.0 {
@@ -664,21 +683,12 @@ where
             sol.t.push(t);
             sol.y.push(y);
             sol.dense.push(rc);
-            let fac = if err == 0.0 {
-                5.0
-            } else {
-                (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
-            };
-            h = hs.abs() * fac;
+            h = hs.abs() * step_factor(err, 5.0, true);
         } else {
             stats.rejected += 1;
-            h = hs.abs() * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9);
+            h = hs.abs() * step_factor(err, 5.0, false);
             if h <= tiny {
-                return Err(Error::NotConverged {
-                    what: "Dormand-Prince 5(4) integration: step size underflow".into(),
-                    iterations: attempts,
-                    residual: err,
-                });
+                return Err(not_converged(DP54, ": step size underflow", attempts, err));
             }
         }
     }
