@@ -1,6 +1,6 @@
 //! Binding of the compliance module: integrated and tangent compliance of a solved rod,
 //! eigenscrews, workspace maps. Arrays only; the numerics are in `softrod::compliance`,
-//! `softrod::eigenscrew` and `softrod::workspace`.
+//! `softrod::compliance::eigenscrew` and `softrod::batch::workspace`.
 
 use numpy::ndarray::Array;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};

@@ -12,7 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use softrod::fit::{FitOptions, ModelKind, StrainMeasure, StressMeasure, UniaxialData};
+use softrod::model::material::fit::{FitOptions, ModelKind, StrainMeasure, StressMeasure, UniaxialData};
 use softrod::{Error, UniaxialLaw as _, UniaxialModel};
 
 use crate::errors::{param_err, to_py_err};

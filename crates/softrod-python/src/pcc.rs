@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use softrod::nalgebra::{Matrix4, Vector3};
 use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegment};
-use softrod::pcc_statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
+use softrod::pcc::statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
 
 use crate::errors::{param_err, to_py_err};
 

@@ -83,10 +83,10 @@ fn profile(arg: VectorArg, slot: &ErrorSlot, what: &'static str) -> PyResult<sof
     }
 }
 
-fn frame_from(name: &str, frame: &str) -> PyResult<softrod::loads::Frame> {
+fn frame_from(name: &str, frame: &str) -> PyResult<softrod::model::loads::Frame> {
     match frame {
-        "world" => Ok(softrod::loads::Frame::World),
-        "body" => Ok(softrod::loads::Frame::Body),
+        "world" => Ok(softrod::model::loads::Frame::World),
+        "body" => Ok(softrod::model::loads::Frame::Body),
         other => Err(param_err(name, other, "\"world\" or \"body\"")),
     }
 }
@@ -215,7 +215,7 @@ impl FunctionSection {
         let inner = softrod::Section::function(Arc::new(move |s| {
             let [area, ix, iy, j] =
                 call_py::<[f64; 4]>(&function, &s2, s, "section function", [f64::NAN; 4]);
-            softrod::section::SectionProperties {
+            softrod::model::section::SectionProperties {
                 area,
                 ix,
                 iy,
@@ -443,7 +443,7 @@ pub(crate) struct Tendon {
     slot: ErrorSlot,
 }
 
-fn offset_fn(f: Py<PyAny>, slot: &ErrorSlot, what: &'static str) -> softrod::tendon::OffsetFn {
+fn offset_fn(f: Py<PyAny>, slot: &ErrorSlot, what: &'static str) -> softrod::model::tendon::OffsetFn {
     let slot = slot.clone();
     Arc::new(move |s| call_py::<[f64; 2]>(&f, &slot, s, what, [f64::NAN; 2]))
 }

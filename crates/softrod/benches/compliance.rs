@@ -7,7 +7,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::nalgebra::Vector3;
-use softrod::workspace::{workspace_map, DEFAULT_CHUNK};
+use softrod::batch::workspace::{workspace_map, DEFAULT_CHUNK};
 use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
 use std::hint::black_box;
 

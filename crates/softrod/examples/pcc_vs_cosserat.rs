@@ -10,7 +10,7 @@
 
 use softrod::nalgebra::Vector3;
 use softrod::pcc::{ElasticSegment, PccTendons};
-use softrod::pcc_statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
 use softrod::{
     solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon,
 };

@@ -19,58 +19,44 @@
 //!   eigenscrews, workspace maps;
 //! * [`error`]: the crate's one error type.
 
-pub mod chamber;
-pub mod compare;
+pub mod batch;
 pub mod compliance;
-pub mod eigenscrew;
+pub mod cosserat;
 pub mod error;
-pub mod fit;
-pub mod hyperelastic;
 pub mod integrate;
+pub mod math;
+pub mod model;
 pub mod pcc;
-pub mod pcc_statics;
 pub mod planar;
 
-pub use chamber::{Chamber, ChamberArea};
-pub use compare::{backbone_distance, BackboneDistance};
+pub use batch::compare::{backbone_distance, BackboneDistance};
+pub use batch::workspace::{workspace_map, WorkspaceSample};
+pub use compliance::eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
 pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
-pub use eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
+pub use cosserat::statics::{
+    solve_statics, Integrator, SolveOptions, SolverStats, StaticsSolution, WarmStart,
+};
 pub use error::{Error, Result};
-pub use fit::{
+pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use model::chamber::{Chamber, ChamberArea};
+pub use model::loads::{Frame, Loads, PointLoad};
+pub use model::material::fit::{
     fit_stats, fit_uniaxial, FitOptions, FitStats, ModelKind, StrainMeasure, StressMeasure,
     UniaxialData, UniaxialFit,
 };
-pub use hyperelastic::{
+pub use model::material::hyperelastic::{
     Hookean, Linearised, MooneyRivlin, NeoHookean, Ogden, Silicone, UniaxialLaw, UniaxialModel,
     Yeoh,
 };
-pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use model::material::{LinearElastic, Material};
+pub use model::rod::{Pose, Profile, Rod};
+pub use model::section::{Section, SectionProperties};
+pub use model::tendon::{Routing, Tendon};
+pub use nalgebra;
 pub use planar::{
     solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,
     PlanarSolution,
 };
-
-pub mod cosserat;
-pub mod loads;
-pub mod material;
-pub mod rod;
-pub mod se3;
-pub mod section;
-pub mod so3;
-pub mod statics;
-pub mod tendon;
-pub mod workspace;
-
-pub use loads::{Frame, Loads, PointLoad};
-pub use material::{LinearElastic, Material};
-pub use nalgebra;
-pub use rod::{Pose, Profile, Rod};
-pub use section::{Section, SectionProperties};
-pub use statics::{
-    solve_statics, Integrator, SolveOptions, SolverStats, StaticsSolution, WarmStart,
-};
-pub use tendon::{Routing, Tendon};
-pub use workspace::{workspace_map, WorkspaceSample};

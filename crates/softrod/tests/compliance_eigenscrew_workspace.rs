@@ -2,11 +2,11 @@
 #![allow(clippy::unwrap_used, missing_docs)]
 
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
-use softrod::eigenscrew::{eigenscrews, MatrixKind};
+use softrod::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use softrod::nalgebra::{Matrix6, Vector3, Vector6};
-use softrod::se3::{adjoint, delta};
-use softrod::so3::exp_so3;
-use softrod::workspace::workspace_map;
+use softrod::math::se3::{adjoint, delta};
+use softrod::math::so3::exp_so3;
+use softrod::batch::workspace::workspace_map;
 use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
 
 /// Unit twist about the axis through `c` along unit `a` with pitch `h`: `[c × a + h a; a]`.

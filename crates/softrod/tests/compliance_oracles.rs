@@ -11,8 +11,8 @@ use std::f64::consts::PI;
 
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
-use softrod::se3::rotation_adjoint;
-use softrod::so3::exp_so3;
+use softrod::math::se3::rotation_adjoint;
+use softrod::math::so3::exp_so3;
 use softrod::{
     solve_statics, Integrator, LinearElastic, Loads, Pose, Profile, Rod, Section, SolveOptions,
     StaticsSolution, Tendon,

@@ -11,8 +11,8 @@ use common::{assert_blocks_close, castigliano_arc};
 use softrod::compliance::{compliance, pcc_compliance, PCC_PANEL_ANGLE};
 use softrod::nalgebra::Vector3;
 use softrod::pcc::ElasticSegment;
-use softrod::pcc_statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon};
-use softrod::so3::exp_so3;
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon};
+use softrod::math::so3::exp_so3;
 use softrod::{
     solve_statics, Integrator, LinearElastic, Loads, Pose, Rod, Section, SolveOptions, Tendon,
 };
@@ -42,7 +42,7 @@ fn tendon_robot(extensible: bool, angle: f64) -> PccRobot {
     .unwrap()
 }
 
-fn solve(robot: &PccRobot, tension: f64) -> softrod::pcc_statics::PccStaticsSolution {
+fn solve(robot: &PccRobot, tension: f64) -> softrod::pcc::statics::PccStaticsSolution {
     let loads = PccLoads {
         tensions: vec![tension],
         ..Default::default()

@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::pcc::{arc_from_pressures, ElasticSegment, PccChambers, PccSegment, PccTendons};
-use softrod::pcc_statics::{
+use softrod::pcc::statics::{
     pcc_equilibrium, solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon,
 };
 use softrod::{
@@ -68,7 +68,7 @@ fn tip_rotation(s: &StaticsSolution) -> Matrix3<f64> {
     Matrix3::from_fn(|i, j| r[i][j])
 }
 
-fn pcc_tip(sol: &softrod::pcc_statics::PccStaticsSolution) -> (Vector3<f64>, Matrix3<f64>) {
+fn pcc_tip(sol: &softrod::pcc::statics::PccStaticsSolution) -> (Vector3<f64>, Matrix3<f64>) {
     let t = sol.tip_pose;
     (
         Vector3::new(t[(0, 3)], t[(1, 3)], t[(2, 3)]),

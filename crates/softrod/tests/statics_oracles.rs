@@ -305,7 +305,7 @@ fn base_pose_rotation_rotates_the_solution() {
         Some(0.25),
     )
     .unwrap();
-    let q = softrod::so3::exp_so3(&Vector3::new(0.7, -1.9, 0.4));
+    let q = softrod::math::so3::exp_so3(&Vector3::new(0.7, -1.9, 0.4));
     let t0 = Vector3::new(0.1, -0.2, 0.05);
     let f = Vector3::new(0.02, -0.05, 0.01);
     let base = Rod::new(l, Section::tapered_circular(r, 0.6 * r).unwrap(), mat).unwrap();

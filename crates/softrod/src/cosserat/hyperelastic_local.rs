@@ -1,7 +1,7 @@
 //! The local constitutive solve for hyperelastic rods, and the chambers' share of the wrench.
 //!
 //! With a nonlinear section law `F(e)` (body wrench of the elastic strain `e = x - x*`,
-//! `x = (v, u)`, see [`crate::material`]) the implicit equation at `s` is
+//! `x = (v, u)`, see [`crate::model::material`]) the implicit equation at `s` is
 //! `F(x - x*) + T(x) = W - W_c`: rod, tendons and chamber fluid share the total body wrench
 //! `W`. It is solved by Newton's method on the scaled residual
 //! `G(x) = c0 ⊙ (F + T - W + W_c)` (`c0` the small-strain compliance; in the inextensible limit
@@ -13,17 +13,17 @@
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-use super::{Evaluator, Local, Lu6, LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+use super::equations::{Evaluator, Local, Lu6, LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 use crate::error::Error;
-use crate::hyperelastic::UniaxialLaw;
-use crate::section::SectionProperties;
+use crate::model::material::hyperelastic::UniaxialLaw;
+use crate::model::section::SectionProperties;
 
 /// Most step halvings of the local Newton iteration (keeping every fibre stretch positive).
 const MAX_HALVINGS: usize = 40;
 
 impl Evaluator<'_, '_> {
     /// Selects the chambers that fill the current interval `[a, b]`.
-    pub(super) fn select_chambers(&mut self, a: f64, b: f64) {
+    pub(crate) fn select_chambers(&mut self, a: f64, b: f64) {
         self.chambers.clear();
         for (i, c) in self.model.loads.chambers.iter().enumerate() {
             let end = c.end().unwrap_or(self.model.length);
@@ -35,7 +35,7 @@ impl Evaluator<'_, '_> {
 
     /// Body-frame wrench carried by the fluid of the active chambers at `s` (zero without).
     #[inline]
-    pub(super) fn chamber_wrench(&self, s: f64) -> [f64; 6] {
+    pub(crate) fn chamber_wrench(&self, s: f64) -> [f64; 6] {
         let mut w = [0.0; 6];
         for &i in &self.chambers {
             let c = self.model.loads.chambers[i].fluid_wrench(s, self.model.factor);
@@ -54,7 +54,7 @@ impl Evaluator<'_, '_> {
     /// The local solve for a hyperelastic rod (see the module documentation); `wb` is the
     /// total body wrench minus the chambers' share. NaN strains if it fails, with the reason
     /// recorded in the model.
-    pub(super) fn local_hyperelastic(
+    pub(crate) fn local_hyperelastic(
         &mut self,
         s: f64,
         props: &SectionProperties,
@@ -249,15 +249,15 @@ mod tests {
 
     use nalgebra::{Matrix6, Vector3, Vector6};
 
-    use super::super::{Evaluator, Model, FULL, STATE};
-    use crate::chamber::{Chamber, ChamberArea};
-    use crate::hyperelastic::{Silicone, UniaxialModel};
-    use crate::loads::{Frame, Loads, PointLoad};
-    use crate::rod::Rod;
-    use crate::section::Section;
-    use crate::so3::reorthonormalise;
-    use crate::statics::build_model;
-    use crate::tendon::Tendon;
+    use crate::cosserat::equations::{Evaluator, Model, FULL, STATE};
+    use crate::model::chamber::{Chamber, ChamberArea};
+    use crate::model::material::hyperelastic::{Silicone, UniaxialModel};
+    use crate::model::loads::{Frame, Loads, PointLoad};
+    use crate::model::rod::Rod;
+    use crate::model::section::Section;
+    use crate::math::so3::reorthonormalise;
+    use crate::cosserat::statics::build_model;
+    use crate::model::tendon::Tendon;
 
     /// One shooting pass with fixed-step RK4 (`steps` per interval): scaled residual and, with
     /// `N == FULL`, its Jacobian from the variational equations.
@@ -286,7 +286,7 @@ mod tests {
                 (0..N).for_each(|j| y4[j] += h * k3[j]);
                 let k4 = ev.rhs(t + h, &y4);
                 (0..N).for_each(|j| y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]));
-                let r = reorthonormalise(&super::super::rot(&y));
+                let r = reorthonormalise(&crate::cosserat::equations::rot(&y));
                 y[3..12].copy_from_slice(r.as_slice());
             }
             if k + 2 < nb {

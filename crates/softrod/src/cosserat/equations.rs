@@ -50,13 +50,12 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::loads::{Frame, Loads};
-use crate::rod::Rod;
-use crate::section::SectionProperties;
-use crate::so3::hat;
-use crate::tendon::Tendon;
+use crate::model::loads::{Frame, Loads};
+use crate::model::rod::Rod;
+use crate::model::section::SectionProperties;
+use crate::math::so3::hat;
+use crate::model::tendon::Tendon;
 
-mod hyperelastic_local;
 
 /// Length of the state `(p, R, N, M)`: 3 + 9 + 3 + 3.
 pub(crate) const STATE: usize = 18;
@@ -169,7 +168,7 @@ pub(crate) struct Local {
 }
 
 impl Local {
-    fn nan() -> Self {
+    pub(crate) fn nan() -> Self {
         Self {
             v: Vector3::repeat(f64::NAN),
             u: Vector3::repeat(f64::NAN),
@@ -214,7 +213,7 @@ pub(crate) struct Model<'a> {
 impl<'a> Model<'a> {
     /// Distributed force `λ (f(s) + rho A(s) g)` (N/m, world).
     #[inline]
-    fn distributed_force(&self, s: f64, props: &SectionProperties) -> Vector3<f64> {
+    pub(crate) fn distributed_force(&self, s: f64, props: &SectionProperties) -> Vector3<f64> {
         let mut f = match &self.loads.distributed_force {
             Some(p) => p.at(s),
             None => Vector3::zeros(),
@@ -339,21 +338,21 @@ impl<'a> Model<'a> {
 pub(crate) struct Evaluator<'m, 'a> {
     pub model: &'m Model<'a>,
     /// Indices of the tendons that pass through the current interval with nonzero tension.
-    active: Vec<usize>,
+    pub(crate) active: Vec<usize>,
     /// Indices of the tendons that pass through the current interval without tension (their
     /// paths are still followed for their lengths).
-    passive: Vec<usize>,
+    pub(crate) passive: Vec<usize>,
     /// Scratch: offsets `(r, r', τ)` of the active tendons at the current `s`.
-    offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
+    pub(crate) offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
     /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
-    guess: Option<Vector6<f64>>,
+    pub(crate) guess: Option<Vector6<f64>>,
     /// Factorised local Jacobian `I + C D` of the last local Newton iteration (chord steps).
-    last_lu: Option<Lu6>,
+    pub(crate) last_lu: Option<Lu6>,
     /// Tangent `d(v, u)/d(n_b, m_b)` of the last [`Evaluator::local`] call made with
     /// `tangent = true`: the compliance `C` (`tangent_diag`), premultiplied by `(I + C D)⁻¹`
     /// when tendons are active (`tangent_lu` holds the factorised `I + C D`).
-    tangent_diag: [f64; 6],
-    tangent_lu: Option<Lu6>,
+    pub(crate) tangent_diag: [f64; 6],
+    pub(crate) tangent_lu: Option<Lu6>,
     /// `|w_i| = |p_i'|` of every tendon at the last evaluation (only updated while
     /// `track_speeds` is set; stale for tendons that end before the current interval).
     pub tendon_speed: Vec<f64>,
@@ -362,7 +361,7 @@ pub(crate) struct Evaluator<'m, 'a> {
     /// Right-hand-side evaluations so far.
     pub evaluations: usize,
     /// Indices of the pressurised chambers that fill the current interval.
-    chambers: Vec<usize>,
+    pub(crate) chambers: Vec<usize>,
 }
 
 impl<'m, 'a> Evaluator<'m, 'a> {
@@ -405,7 +404,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
 
     /// Records `|p_i'|` of the tension-free tendons for the strains `(v, u)`.
     #[inline]
-    fn passive_speeds(
+    pub(crate) fn passive_speeds(
         &mut self,
         s: f64,
         props: &SectionProperties,
@@ -427,7 +426,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
     /// `dT_F/dv = A`, `dT_F/du = -A r̂ = -a (r̂ + t qᵀ)`, `dT_M/dv = r̂ A = a (r̂ - q tᵀ)`,
     /// `dT_M/du = -r̂ A r̂ = -a (r rᵀ - |r|² I + q qᵀ)`.
     #[inline]
-    fn tendon_sums(
+    pub(crate) fn tendon_sums(
         &self,
         x: &Vector6<f64>,
         c: &[f64; 6],

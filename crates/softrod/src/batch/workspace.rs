@@ -9,12 +9,12 @@
 use rayon::prelude::*;
 
 use crate::compliance::{tangent_compliance, tip_compliance_world, TendonControl};
-use crate::eigenscrew::{eigenscrews, MatrixKind};
+use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::error::{Error, Result};
-use crate::loads::Loads;
-use crate::rod::Rod;
-use crate::statics::{solve_statics, SolveOptions};
-use crate::tendon::Tendon;
+use crate::model::loads::Loads;
+use crate::model::rod::Rod;
+use crate::cosserat::statics::{solve_statics, SolveOptions};
+use crate::model::tendon::Tendon;
 
 /// Default number of samples per warm-started chunk.
 pub const DEFAULT_CHUNK: usize = 64;
@@ -151,7 +151,7 @@ pub fn workspace_map(
     Ok(out.into_iter().flatten().collect())
 }
 
-fn measure(rod: &Rod, sol: &crate::statics::StaticsSolution) -> WorkspaceSample {
+fn measure(rod: &Rod, sol: &crate::cosserat::statics::StaticsSolution) -> WorkspaceSample {
     let Ok(c) = tip_compliance_world(rod, sol) else {
         return WorkspaceSample::failed();
     };

@@ -21,7 +21,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::{check_positive, Error, Result};
-use crate::hyperelastic::{
+use crate::model::material::hyperelastic::{
     check_stretch, ogden_term, Linearised, MooneyRivlin, NeoHookean, Ogden, UniaxialLaw,
     UniaxialModel, Yeoh,
 };

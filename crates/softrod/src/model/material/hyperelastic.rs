@@ -371,7 +371,7 @@ fn i1_minus_3(stretch: f64) -> f64 {
 
 /// Linear elastic uniaxial law (Hooke's law) in engineering measures: `P = E (λ − 1)`, the law
 /// of a rod with axial stiffness `E A0`; true stress `σ = λ P` by incompressibility. (Named
-/// `Hookean`, not `LinearElastic`, which is the rod-section material of `crate::material`.)
+/// `Hookean`, not `LinearElastic`, which is the rod-section material of `crate::model::material`.)
 ///
 /// Note that `dσ/dε = E (2λ − 1)` is not constant (only `dP/dλ = E` is) and turns negative
 /// below `λ = 1/2`, while the force stays monotonic.
@@ -420,7 +420,7 @@ impl UniaxialLaw for Hookean {
 
 /// A linearised law: the linear law `P = E_l (λ − 1)` whose modulus `E_l` is the secant
 /// modulus of a nonlinear curve at a reference strain (seed 001, II.B.1: "100 % modulus"), or a
-/// straight line through the origin fitted to data (`crate::fit::fit_uniaxial` with
+/// straight line through the origin fitted to data (`crate::model::material::fit::fit_uniaxial` with
 /// `ModelKind::Linearised`). The reference strain records where the line is exact (or the
 /// largest strain of the fitted data).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -973,7 +973,7 @@ into_model!(Hookean, Linearised, NeoHookean, MooneyRivlin, Yeoh, Ogden);
 /// Named silicones with sourced hyperelastic parameters.
 ///
 /// Every parameter set is a least-squares fit by
-/// [`crate::fit::fit_uniaxial`] (nominal stress, unweighted, exact linear solve) to the measured
+/// [`crate::model::material::fit::fit_uniaxial`] (nominal stress, unweighted, exact linear solve) to the measured
 /// tensile curve of the Soft Robotics Materials Database, restricted to stretch `λ <= 3`
 /// (engineering strain <= 200 %, see [`Silicone::fit_stretch_range`]):
 ///

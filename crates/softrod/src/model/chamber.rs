@@ -40,7 +40,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use crate::error::{check_finite, check_non_negative, check_positive, Error, Result};
-use crate::rod::{Rod, FUNCTION_CHECKS};
+use crate::model::rod::{Rod, FUNCTION_CHECKS};
 
 /// Standard atmospheric pressure (Pa): the lowest gauge pressure a chamber can hold (vacuum).
 pub const ATMOSPHERIC_PRESSURE: f64 = 101_325.0;

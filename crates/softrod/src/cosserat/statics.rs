@@ -18,13 +18,13 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::cosserat::{rot, v3, ActiveTendon, Evaluator, Model, FULL, STATE};
+use crate::cosserat::equations::{rot, v3, ActiveTendon, Evaluator, Model, FULL, STATE};
 use crate::error::{check_newton_options, Error, Result};
 use crate::integrate::{dp54, rk4_step_in_place, AdaptiveOptions, Rk4Workspace};
-use crate::loads::{Frame, Loads};
-use crate::rod::Rod;
-use crate::so3::{hat, quaternion_xyzw, reorthonormalise};
-use crate::tendon::Tendon;
+use crate::model::loads::{Frame, Loads};
+use crate::model::rod::Rod;
+use crate::math::so3::{hat, quaternion_xyzw, reorthonormalise};
+use crate::model::tendon::Tendon;
 
 /// Default number of RK4 steps over the whole rod (split among the intervals in proportion
 /// to their length, at least one each).
@@ -559,7 +559,7 @@ pub(crate) fn build_model<'a>(
     for p in &loads.point_loads {
         breaks.push(p.s);
     }
-    for (start, end) in crate::chamber::validate(&loads.chambers, rod)? {
+    for (start, end) in crate::model::chamber::validate(&loads.chambers, rod)? {
         breaks.extend([start, end]);
     }
     breaks.sort_by(f64::total_cmp);
@@ -576,8 +576,8 @@ pub(crate) fn build_model<'a>(
     // Tendon offsets must be finite (user functions) and inside... finite at the checks.
     for (i, t) in tendons.iter().enumerate() {
         let end = prepared[i].end;
-        for k in 0..=crate::rod::FUNCTION_CHECKS {
-            let s = end * k as f64 / crate::rod::FUNCTION_CHECKS as f64;
+        for k in 0..=crate::model::rod::FUNCTION_CHECKS {
+            let s = end * k as f64 / crate::model::rod::FUNCTION_CHECKS as f64;
             let (r, rp) = t.routing().offset(s, &rod.section_at(s));
             if !(r.iter().chain(rp.iter()).all(|v| v.is_finite())) {
                 return Err(Error::invalid(

@@ -63,7 +63,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
 use crate::error::{check_finite, check_newton_options, check_positive, Error, Result};
-use crate::pcc::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
+use crate::pcc::kinematics::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
 
 /// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
 /// (rad) and axial residual `|g_ℓ| / E A` (strain).

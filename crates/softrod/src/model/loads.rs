@@ -7,9 +7,9 @@
 
 use nalgebra::Vector3;
 
-use crate::chamber::Chamber;
+use crate::model::chamber::Chamber;
 use crate::error::{Error, Result};
-use crate::rod::Profile;
+use crate::model::rod::Profile;
 
 /// Frame in which a load's components are given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -67,7 +67,7 @@ pub struct Loads {
     /// `rho A(s) g` per unit undeformed length.
     pub gravity: Vector3<f64>,
     /// Pressurised pneumatic chambers (self-equilibrated internal loads: cap forces, wall
-    /// pressure; see [`crate::chamber`]), validated against the rod when solving.
+    /// pressure; see [`crate::model::chamber`]), validated against the rod when solving.
     pub chambers: Vec<Chamber>,
 }
 

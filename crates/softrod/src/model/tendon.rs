@@ -16,7 +16,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use crate::error::{check_non_negative, check_positive, Error, Result};
-use crate::section::SectionProperties;
+use crate::model::section::SectionProperties;
 
 /// A user function `s (m) -> (x, y)` (m, body frame); it must be thread-safe.
 pub type OffsetFn = Arc<dyn Fn(f64) -> [f64; 2] + Send + Sync>;

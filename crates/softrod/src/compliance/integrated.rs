@@ -1,6 +1,6 @@
 //! Configuration-dependent compliance and stiffness along a solved rod (seed 001).
 //!
-//! Conventions ([`crate::se3`]): twists `[δp; δθ]`, wrenches `[f; m]`, `t = C w`, `w = K t`.
+//! Conventions ([`crate::math::se3`]): twists `[δp; δθ]`, wrenches `[f; m]`, `t = C w`, `w = K t`.
 //! At a node `s` the **world** compliance relates a wrench applied at the node's position with
 //! world components to the node's twist in world components (`δθ` with `δR = δθ̂ R`); the
 //! **body** compliance does the same in the node's body axes (`δR = R δθ̂`):
@@ -33,16 +33,16 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::cosserat::{put3, rot, v3, Evaluator, Model, FULL, STATE};
+use crate::cosserat::equations::{put3, rot, v3, Evaluator, Model, FULL, STATE};
 use crate::error::{Error, Result};
 use crate::integrate::{dp54, rk4_step};
-use crate::loads::Loads;
-use crate::pcc_statics::{PccRobot, PccStaticsSolution};
-use crate::rod::Rod;
-use crate::se3::rotation_adjoint;
-use crate::so3::hat;
-use crate::statics::{build_model, project, rk4_plan, Integrator, SolveOptions, StaticsSolution};
-use crate::tendon::Tendon;
+use crate::model::loads::Loads;
+use crate::pcc::statics::{PccRobot, PccStaticsSolution};
+use crate::model::rod::Rod;
+use crate::math::se3::rotation_adjoint;
+use crate::math::so3::hat;
+use crate::cosserat::statics::{build_model, project, rk4_plan, Integrator, SolveOptions, StaticsSolution};
+use crate::model::tendon::Tendon;
 
 /// Most tendons that can be held at fixed length by [`tangent_compliance`].
 pub const MAX_HELD_TENDONS: usize = 8;
@@ -247,7 +247,7 @@ pub fn invert_general(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
 }
 
 /// The integrated compliance at the last node only (world frame, at the tip), without the
-/// per-node inverses: the cheap path of [`crate::workspace::workspace_map`].
+/// per-node inverses: the cheap path of [`crate::batch::workspace::workspace_map`].
 pub fn tip_compliance_world(rod: &Rod, solution: &StaticsSolution) -> Result<Matrix6<f64>> {
     compliance_matrices(&Configuration::from_statics(rod, solution)?, true)
         .map(|(w, _)| w[w.len() - 1])

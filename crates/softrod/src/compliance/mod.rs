@@ -1,0 +1,6 @@
+//! Configuration-dependent compliance: integrated, tangent, eigenscrews.
+
+pub mod eigenscrew;
+mod integrated;
+
+pub use integrated::*;

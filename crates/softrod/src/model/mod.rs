@@ -1,0 +1,8 @@
+//! The robot description: rod, section, material laws, tendons, chambers and loads.
+
+pub mod chamber;
+pub mod loads;
+pub mod material;
+pub mod rod;
+pub mod section;
+pub mod tendon;

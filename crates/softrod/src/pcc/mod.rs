@@ -1,0 +1,6 @@
+//! Piecewise-constant-curvature kinematics, actuation maps and statics.
+
+pub mod kinematics;
+pub mod statics;
+
+pub use kinematics::*;
