@@ -8,6 +8,9 @@
 //!
 //! Run: `cargo run --release -p softrod --example pcc_vs_cosserat`.
 
+#[path = "../tests/common/robot.rs"]
+mod common;
+
 use softrod::nalgebra::Vector3;
 use softrod::pcc::{ElasticSegment, PccTendons};
 use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
@@ -34,14 +37,10 @@ fn main() -> softrod::Result<()> {
         .map(|i| {
             let b: f64 = angles[i % 3];
             let end = (i < 3).then_some(seg);
-            Tendon::constant([d * b.cos(), d * b.sin()], tensions[i], end)
+            common::tendon([d * b.cos(), d * b.sin()], tensions[i], end)
         })
         .collect::<softrod::Result<Vec<_>>>()?;
-    let cosserat_options = SolveOptions {
-        integrator: Integrator::Rk4 { steps: 400 },
-        tolerance: 1e-12,
-        ..Default::default()
-    };
+    let cosserat_options = SolveOptions { integrator: Integrator::Rk4 { steps: 400 }, newton: softrod::NewtonOptions { tolerance: 1e-12, ..SolveOptions::default().newton }, ..Default::default() };
 
     println!("| tip force F_y (N) | PCC tip (mm) | Cosserat tip (mm) | distance (mm) | distance / tip motion |");
     println!("| ---: | --- | --- | ---: | ---: |");
@@ -63,14 +62,11 @@ fn main() -> softrod::Result<()> {
             },
         )?;
         warm_pcc = Some(pcc.warm_start());
-        let cos = solve_statics(
+        let cos = common::solve(
             &rod,
             &tendons,
             &Loads::tip_force(force),
-            &SolveOptions {
-                warm_start: warm_cosserat,
-                ..cosserat_options
-            },
+            &SolveOptions { warm_start: warm_cosserat, ..cosserat_options },
         )?;
         warm_cosserat = Some(cos.warm_start());
         let t = pcc.tip_pose;

@@ -28,6 +28,7 @@ pub mod math;
 pub mod model;
 pub mod pcc;
 pub mod planar;
+pub mod solve;
 
 pub use batch::compare::{backbone_distance, BackboneDistance};
 pub use batch::workspace::{workspace_map, WorkspaceSample};
@@ -36,9 +37,7 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
-pub use cosserat::statics::{
-    solve_statics, Integrator, SolveOptions, SolverStats, StaticsSolution, WarmStart,
-};
+pub use cosserat::statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
 pub use model::chamber::{Chamber, ChamberArea};
@@ -55,6 +54,8 @@ pub use model::material::{LinearElastic, Material};
 pub use model::rod::{Pose, Profile, Rod};
 pub use model::section::{Section, SectionProperties};
 pub use model::tendon::{Routing, Tendon};
+pub use model::{Actuation, RobotModel, TendonInput};
+pub use solve::{NewtonOptions, SolverStats};
 pub use nalgebra;
 pub use planar::{
     solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,

@@ -1,6 +1,8 @@
 //! Eigenscrews of stiffnesses built from known screws; the workspace map against single solves.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use softrod::nalgebra::{Matrix6, Vector3, Vector6};
@@ -73,11 +75,11 @@ fn eigenscrews_recover_the_screws_a_stiffness_was_built_from() {
     }
 }
 
-fn two_segment(tensions: [f64; 6]) -> Vec<Tendon> {
+fn two_segment(tensions: [f64; 6]) -> Vec<common::Tensioned> {
     (0..6)
         .map(|i| {
             let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
+            common::tendon(
                 [0.01 * ang.cos(), 0.01 * ang.sin()],
                 tensions[i],
                 Some(if i < 3 { 0.2 } else { 0.4 }),
@@ -107,10 +109,10 @@ fn workspace_map_matches_single_solves() {
             tensions.extend_from_slice(&t);
         }
     }
+    let (model, base) = common::split(&rod, &tendons, &[], &loads).unwrap();
     let map = workspace_map(
-        &rod,
-        &tendons,
-        &loads,
+        &model,
+        &base,
         &tensions,
         &opts,
         7,
@@ -119,23 +121,23 @@ fn workspace_map_matches_single_solves() {
     .unwrap();
     assert_eq!(map.len(), 30);
     for (i, row) in tensions.chunks(6).enumerate() {
-        let ts: Vec<Tendon> = tendons
+        let ts: Vec<common::Tensioned> = tendons
             .iter()
             .zip(row)
             .map(|(t, &tau)| t.with_tension(tau).unwrap())
             .collect();
-        let sol = solve_statics(&rod, &ts, &loads, &opts).unwrap();
+        let sol = common::solve(&rod, &ts, &loads, &opts).unwrap();
         let tip = Vector3::from(sol.tip_position());
         assert!(map[i].converged);
         assert!((Vector3::from(map[i].tip_position) - tip).norm() < 1e-9);
-        let c = compliance(&rod, &sol).unwrap().tip_world();
+        let c = compliance(&sol).unwrap().tip_world();
         let ctt = c
             .fixed_view::<3, 3>(0, 0)
             .into_owned()
             .symmetric_eigen()
             .eigenvalues;
         assert!((map[i].max_translational_compliance - ctt.max()).abs() < 1e-8 * ctt.max());
-        let t = tangent_compliance(&rod, &ts, &loads, &sol, &opts, TendonControl::Length, None)
+        let t = tangent_compliance(&sol, TendonControl::Length, None)
             .unwrap();
         let b = t.world.fixed_view::<3, 3>(0, 0).into_owned();
         let e = ((b + b.transpose()) * 0.5)

@@ -24,11 +24,7 @@ const RADIUS: f64 = 0.01;
 const LENGTH: f64 = 0.5;
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions {
-        integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
-        ..Default::default()
-    }
+    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
 }
 
 fn rot_of(sol: &StaticsSolution, i: usize) -> Matrix3<f64> {
@@ -76,8 +72,8 @@ fn straight_cantilever_matches_timoshenko_closed_form() {
     )
     .unwrap()
     .with_base_pose(base);
-    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
-    let c = compliance(&rod, &sol).unwrap();
+    let sol = common::solve(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
+    let c = compliance(&sol).unwrap();
     let (ei, gj, ea, gas) = section_constants(rod.shear_coefficient());
     let exact = timoshenko(LENGTH, ei, gj, ea, Some(gas));
     assert_blocks_close(&c.tip_body(), &exact, 1e-10, "tip body");
@@ -105,8 +101,8 @@ fn gamma_c_is_one_at_the_tip_without_shear() {
     )
     .unwrap()
     .with_inextensible(true);
-    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
-    let c = compliance(&rod, &sol).unwrap();
+    let sol = common::solve(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
+    let c = compliance(&sol).unwrap();
     let g = c.gamma_c.last().unwrap();
     assert!((g[0] - 1.0).abs() < 1e-12, "{g:?}");
     assert!((g[1] - 1.0).abs() < 1e-12, "{g:?}");
@@ -138,19 +134,19 @@ fn arc_rod(angle: f64) -> Rod {
 fn stress_free_arc_matches_castigliano() {
     for angle in [PI / 2.0, PI, 1.5 * PI] {
         let rod = arc_rod(angle);
-        let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(2000)).unwrap();
-        let c = compliance(&rod, &sol).unwrap();
+        let sol = common::solve(&rod, &[], &Loads::default(), &rk4(2000)).unwrap();
+        let c = compliance(&sol).unwrap();
         let (ei, gj, ea, gas) = section_constants(rod.shear_coefficient());
         let exact = castigliano_arc(angle / LENGTH, LENGTH, [gas, gas, ea, ei, ei, gj]);
         assert_blocks_close(&c.tip_world(), &exact, 1e-8, &format!("arc {angle}"));
     }
 }
 
-fn two_segment(tensions: [f64; 6]) -> Vec<Tendon> {
+fn two_segment(tensions: [f64; 6]) -> Vec<common::Tensioned> {
     (0..6)
         .map(|i| {
             let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
+            common::tendon(
                 [0.01 * ang.cos(), 0.01 * ang.sin()],
                 tensions[i],
                 Some(if i < 3 { 0.2 } else { 0.4 }),
@@ -174,8 +170,8 @@ fn frames_are_related_by_the_adjoint_and_k_inverts_c() {
     let rod = niti();
     let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
-    let sol = solve_statics(&rod, &tendons, &loads, &rk4(50)).unwrap();
-    let c = compliance(&rod, &sol).unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &rk4(50)).unwrap();
+    let c = compliance(&sol).unwrap();
     let (kw, cond) = c.stiffness_world();
     let kb = c.stiffness_body();
     assert!(cond[0].is_infinite() && kw[0][(0, 0)].is_nan());
@@ -211,7 +207,7 @@ fn tip_twist(a: &StaticsSolution, b: &StaticsSolution) -> Vector6<f64> {
 /// Richardson-extrapolated over steps `h` and `h/2` (fourth order in the step).
 fn fd_tip_compliance(
     rod: &Rod,
-    tendons: &[Tendon],
+    tendons: &[common::Tensioned],
     loads: &Loads,
     opts: &SolveOptions,
     sol: &StaticsSolution,
@@ -227,12 +223,9 @@ fn fd_tip_compliance(
             plus.tip_moment[j - 3] += eps;
             minus.tip_moment[j - 3] -= eps;
         }
-        let o = SolveOptions {
-            warm_start: Some(sol.warm_start()),
-            ..*opts
-        };
-        let sp = solve_statics(rod, tendons, &plus, &o).unwrap();
-        let sm = solve_statics(rod, tendons, &minus, &o).unwrap();
+        let o = SolveOptions { warm_start: Some(sol.warm_start()), ..*opts };
+        let sp = common::solve(rod, tendons, &plus, &o).unwrap();
+        let sm = common::solve(rod, tendons, &minus, &o).unwrap();
         tip_twist(&sm, &sp) / (2.0 * eps)
     };
     let mut c = Matrix6::zeros();
@@ -256,9 +249,9 @@ fn unloaded_integrated_tangent_and_finite_difference_agree() {
         let rod = arc_rod(angle);
         let opts = rk4(400);
         let loads = Loads::default();
-        let sol = solve_statics(&rod, &[], &loads, &opts).unwrap();
-        let c = compliance(&rod, &sol).unwrap().tip_world();
-        let t = tangent_compliance(&rod, &[], &loads, &sol, &opts, TendonControl::Tension, None)
+        let sol = common::solve(&rod, &[], &loads, &opts).unwrap();
+        let c = compliance(&sol).unwrap().tip_world();
+        let t = tangent_compliance(&sol, TendonControl::Tension, None)
             .unwrap();
         let fd = fd_tip_compliance(&rod, &[], &loads, &opts, &sol, &c);
         assert_blocks_close(
@@ -281,13 +274,8 @@ fn loaded_tangent_matches_finite_difference() {
         ..Default::default()
     };
     let opts = rk4(400);
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let t = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(&sol,
         TendonControl::Tension,
         None,
     )
@@ -295,7 +283,7 @@ fn loaded_tangent_matches_finite_difference() {
     let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
     assert_blocks_close(&t.world, &fd, 1e-6, "loaded tangent vs fd");
     // The seed's integrated compliance differs under load and actuation.
-    let c = compliance(&rod, &sol).unwrap().tip_world();
+    let c = compliance(&sol).unwrap().tip_world();
     let rel = (c - t.world).amax() / t.world.amax();
     assert!(rel > 1e-3, "{rel}");
 }
@@ -306,23 +294,13 @@ fn fixed_length_tendons_stiffen_the_niti_robot() {
     let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::default();
     let opts = rk4(50);
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let ten = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let ten = tangent_compliance(&sol,
         TendonControl::Tension,
         None,
     )
     .unwrap();
-    let len = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
+    let len = tangent_compliance(&sol,
         TendonControl::Length,
         None,
     )
@@ -369,16 +347,11 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
     let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.1, 0.0, -0.05));
     let opts = rk4(400);
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
     // A node inside segment 2 that is a mesh node of the perturbed problems too.
     let node = 300;
     let s = sol.s[node];
-    let t = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
+    let t = tangent_compliance(&sol,
         TendonControl::Tension,
         Some(node),
     )
@@ -402,11 +375,8 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
                     pl.moment[j - 3] = sign * e;
                 }
                 l.point_loads.push(pl);
-                let o = SolveOptions {
-                    warm_start: Some(sol.warm_start()),
-                    ..opts
-                };
-                solve_statics(&rod, &tendons, &l, &o).unwrap()
+                let o = SolveOptions { warm_start: Some(sol.warm_start()), ..opts };
+                common::solve(&rod, &tendons, &l, &o).unwrap()
             };
             node_twist(&mk(-1.0), &mk(1.0), s) / (2.0 * e)
         };
@@ -421,22 +391,13 @@ fn adaptive_tangent_matches_finite_difference() {
     let rod = niti();
     let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.2, 0.1, 0.0));
-    let opts = SolveOptions {
-        integrator: Integrator::Adaptive(AdaptiveOptions {
+    let opts = SolveOptions { integrator: Integrator::Adaptive(AdaptiveOptions {
             rtol: 1e-12,
             atol: 1e-14,
             ..Default::default()
-        }),
-        tolerance: 1e-12,
-        ..Default::default()
-    };
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let t = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
+        }), newton: softrod::NewtonOptions { tolerance: 1e-12, ..SolveOptions::default().newton }, ..Default::default() };
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(&sol,
         TendonControl::Tension,
         None,
     )
@@ -445,13 +406,8 @@ fn adaptive_tangent_matches_finite_difference() {
     assert_blocks_close(&t.world, &fd, 1e-6, "adaptive tangent vs fd");
     // The same tangent as RK4 with many steps (both converge to the exact one).
     let r = rk4(800);
-    let sr = solve_statics(&rod, &tendons, &loads, &r).unwrap();
-    let tr = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sr,
-        &r,
+    let sr = common::solve(&rod, &tendons, &loads, &r).unwrap();
+    let tr = tangent_compliance(&sr,
         TendonControl::Tension,
         None,
     )

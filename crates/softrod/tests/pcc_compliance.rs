@@ -101,15 +101,11 @@ fn pcc_and_cosserat_compliance_agree_on_an_unloaded_tendon_segment() {
             let pcc = solve(&robot, tension);
             let cos_rod = rod.clone().with_inextensible(!extensible);
             let tendon =
-                Tendon::constant([OFFSET * beta.cos(), OFFSET * beta.sin()], tension, None)
+                common::tendon([OFFSET * beta.cos(), OFFSET * beta.sin()], tension, None)
                     .unwrap();
-            let options = SolveOptions {
-                integrator: Integrator::Rk4 { steps: 800 },
-                tolerance: 1e-13,
-                ..Default::default()
-            };
-            let sol = solve_statics(&cos_rod, &[tendon], &Loads::default(), &options).unwrap();
-            let c_cos = compliance(&cos_rod, &sol).unwrap().tip_world();
+            let options = SolveOptions { integrator: Integrator::Rk4 { steps: 800 }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() };
+            let sol = common::solve(&cos_rod, &[tendon], &Loads::default(), &options).unwrap();
+            let c_cos = compliance(&sol).unwrap().tip_world();
             let c_pcc = pcc_compliance(&cos_rod, &robot, &pcc, None)
                 .unwrap()
                 .tip_world();

@@ -4,6 +4,8 @@
 //! the Euler–Bernoulli cantilever, the pneumatic closed form, and rotation invariance.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use std::f64::consts::PI;
 
 use softrod::nalgebra::{Matrix3, Vector3};
@@ -26,11 +28,7 @@ const ANGLES_DEG: [f64; 3] = [90.0, -30.0, 210.0];
 const TENSIONS: [f64; 6] = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions {
-        integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
-        ..Default::default()
-    }
+    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
 }
 
 fn niti_pcc(extensible: bool) -> PccRobot {
@@ -45,7 +43,7 @@ fn niti_pcc(extensible: bool) -> PccRobot {
         .unwrap()
 }
 
-fn niti_cosserat(extensible: bool, tensions: &[f64]) -> (Rod, Vec<Tendon>) {
+fn niti_cosserat(extensible: bool, tensions: &[f64]) -> (Rod, Vec<common::Tensioned>) {
     let rod = Rod::new(
         2.0 * SEG,
         Section::circular(NITI_R).unwrap(),
@@ -57,7 +55,7 @@ fn niti_cosserat(extensible: bool, tensions: &[f64]) -> (Rod, Vec<Tendon>) {
         .map(|i| {
             let b = ANGLES_DEG[i % 3].to_radians();
             let end = if i < 3 { Some(SEG) } else { None };
-            Tendon::constant([OFFSET * b.cos(), OFFSET * b.sin()], tensions[i], end).unwrap()
+            common::tendon([OFFSET * b.cos(), OFFSET * b.sin()], tensions[i], end).unwrap()
         })
         .collect();
     (rod, tendons)
@@ -105,13 +103,13 @@ fn unloaded_tendon_segment_is_the_cosserat_arc_exactly() {
         )
         .unwrap()
         .with_inextensible(!extensible);
-        let ts: Vec<Tendon> = (0..3)
+        let ts: Vec<common::Tensioned> = (0..3)
             .map(|i| {
                 let (d, b) = (tendons.distances()[i], tendons.angles()[i]);
-                Tendon::constant([d * b.cos(), d * b.sin()], tensions[i], None).unwrap()
+                common::tendon([d * b.cos(), d * b.sin()], tensions[i], None).unwrap()
             })
             .collect();
-        let cos = solve_statics(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
+        let cos = common::solve(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
         let (p, rot) = pcc_tip(&pcc);
         let pc = Vector3::from(cos.tip_position());
         let dp = (p - pc).norm() / l;
@@ -146,7 +144,7 @@ fn unloaded_two_segment_niti_robot_matches_cosserat_exactly() {
         };
         let pcc = solve_pcc_statics(&robot, &loads, &PccSolveOptions::default()).unwrap();
         let (rod, ts) = niti_cosserat(extensible, &TENSIONS);
-        let cos = solve_statics(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
+        let cos = common::solve(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
         let (p, rot) = pcc_tip(&pcc);
         let dp = (p - Vector3::from(cos.tip_position())).norm() / (2.0 * SEG);
         let dr = (rot - tip_rotation(&cos)).amax();
@@ -207,8 +205,8 @@ fn tip_moment_about_the_bending_axis_is_exact() {
     )
     .unwrap()
     .with_inextensible(true);
-    let t = Tendon::constant([0.0, 0.005], tau, None).unwrap();
-    let cos = solve_statics(&rod, &[t], &Loads::tip_moment(loads.tip_moment), &rk4(400)).unwrap();
+    let t = common::tendon([0.0, 0.005], tau, None).unwrap();
+    let cos = common::solve(&rod, &[t], &Loads::tip_moment(loads.tip_moment), &rk4(400)).unwrap();
     let (p, _) = pcc_tip(&pcc);
     let dp = (p - Vector3::from(cos.tip_position())).norm() / l;
     println!("tip moment: θ {theta:.6} rad, |Δp|/L vs Cosserat {dp:.2e}");
@@ -474,11 +472,8 @@ fn pcc_and_cosserat_diverge_as_the_tip_load_grows() {
         )
         .unwrap();
         warm_pcc = Some(pcc.warm_start());
-        let opts = SolveOptions {
-            warm_start: warm,
-            ..rk4(400)
-        };
-        let cos = solve_statics(&rod, &ts, &Loads::tip_force(force), &opts).unwrap();
+        let opts = SolveOptions { warm_start: warm, ..rk4(400) };
+        let cos = common::solve(&rod, &ts, &Loads::tip_force(force), &opts).unwrap();
         warm = Some(cos.warm_start());
         let (p, _) = pcc_tip(&pcc);
         let pc = Vector3::from(cos.tip_position());

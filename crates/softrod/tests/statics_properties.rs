@@ -3,6 +3,8 @@
 //! positions), and the rod's base wrench differs from it by exactly the tendons' pull.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use softrod::nalgebra::Vector3;
 use softrod::{
     solve_statics, LinearElastic, Loads, PointLoad, Rod, Routing, Section, SolveOptions, Tendon,
@@ -72,7 +74,7 @@ fn random_problems_satisfy_global_equilibrium() {
             } else {
                 Some(g.range(0.2, 1.0) * l)
             };
-            tendons.push(Tendon::new(routing, g.range(0.0, 2.0) * ei / (l * r0), end).unwrap());
+            tendons.push(common::tendon_with(routing, g.range(0.0, 2.0) * ei / (l * r0), end).unwrap());
         }
         let mut loads = Loads {
             tip_force: g.vec(f_ref),
@@ -90,11 +92,8 @@ fn random_problems_satisfy_global_equilibrium() {
             moment: g.vec(f_ref * l),
             frame: softrod::Frame::World,
         });
-        let opts = SolveOptions {
-            throw: false,
-            ..Default::default()
-        };
-        let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+        let opts = SolveOptions { newton: softrod::NewtonOptions { throw: false, ..SolveOptions::default().newton }, ..Default::default() };
+        let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
         if !sol.stats.converged {
             continue;
         }

@@ -31,21 +31,14 @@
 //! K. Oliver-Butler, J. Till, C. Rucker, "Continuum robot stiffness under external loads and
 //! prescribed tendon displacements", IEEE Trans. Robotics 35(2), 2019.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 
-use crate::cosserat::equations::{put3, rot, v3, Evaluator, Model, FULL, STATE};
+use crate::cosserat::statics::StaticsSolution;
 use crate::error::{Error, Result};
-use crate::integrate::{dp54, rk4_step};
-use crate::model::loads::Loads;
-use crate::pcc::statics::{PccRobot, PccStaticsSolution};
-use crate::model::rod::Rod;
-use crate::math::se3::rotation_adjoint;
+use crate::math::linalg::invert_spd;
 use crate::math::so3::hat;
-use crate::cosserat::statics::{build_model, project, rk4_plan, Integrator, SolveOptions, StaticsSolution};
-use crate::model::tendon::Tendon;
-
-/// Most tendons that can be held at fixed length by [`tangent_compliance`].
-pub const MAX_HELD_TENDONS: usize = 8;
+use crate::model::rod::Rod;
+use crate::pcc::statics::{PccRobot, PccStaticsSolution};
 
 /// The integrated compliance and stiffness at every node of a solution.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,7 +86,8 @@ impl Compliance {
 
 /// Element compliance `c(s)` at every node: the material's tangent compliance at the solved
 /// body wrench of the rod (same shear coefficient as the statics).
-pub fn element_compliance(rod: &Rod, solution: &StaticsSolution) -> Vec<[f64; 6]> {
+pub fn element_compliance(solution: &StaticsSolution) -> Vec<[f64; 6]> {
+    let rod = solution.model.rod();
     let k = rod.shear_coefficient();
     solution
         .s
@@ -164,92 +158,10 @@ fn blocks(tt: &Matrix3<f64>, tr: &Matrix3<f64>, rr: &Matrix3<f64>) -> Matrix6<f6
     m
 }
 
-/// `C⁻¹` if `C` is symmetric positive definite (Cholesky), NaN otherwise; and the 1-norm
-/// condition number `‖C‖₁ ‖C⁻¹‖₁` (infinite if `C` is not positive definite).
-pub fn invert_spd(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
-    match cholesky_inverse(c) {
-        Some(k) => {
-            let cond = norm1(c) * norm1(&k);
-            if cond.is_finite() {
-                (k, cond)
-            } else {
-                (Matrix6::repeat(f64::NAN), f64::INFINITY)
-            }
-        }
-        None => (Matrix6::repeat(f64::NAN), f64::INFINITY),
-    }
-}
-
-/// Inverse of a symmetric positive definite 6×6 matrix by Cholesky `C = L Lᵀ`,
-/// `C⁻¹ = L⁻ᵀ L⁻¹` (plain arrays: several times faster than the generic routine at this
-/// size); `None` if a pivot is not positive.
-fn cholesky_inverse(c: &Matrix6<f64>) -> Option<Matrix6<f64>> {
-    let mut l = [[0.0f64; 6]; 6];
-    for j in 0..6 {
-        let mut d = c[(j, j)];
-        for k in 0..j {
-            d -= l[j][k] * l[j][k];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return None;
-        }
-        let dj = d.sqrt();
-        l[j][j] = dj;
-        for i in j + 1..6 {
-            let mut v = c[(i, j)];
-            for k in 0..j {
-                v -= l[i][k] * l[j][k];
-            }
-            l[i][j] = v / dj;
-        }
-    }
-    // W = L⁻¹ (lower triangular), by forward substitution.
-    let mut w = [[0.0f64; 6]; 6];
-    for j in 0..6 {
-        w[j][j] = 1.0 / l[j][j];
-        for i in j + 1..6 {
-            let mut v = 0.0;
-            for k in j..i {
-                v -= l[i][k] * w[k][j];
-            }
-            w[i][j] = v / l[i][i];
-        }
-    }
-    // C⁻¹ = Wᵀ W.
-    let mut out = Matrix6::zeros();
-    for i in 0..6 {
-        for j in 0..=i {
-            let mut v = 0.0;
-            for k in i..6 {
-                v += w[k][i] * w[k][j];
-            }
-            out[(i, j)] = v;
-            out[(j, i)] = v;
-        }
-    }
-    Some(out)
-}
-
-/// Matrix 1-norm (largest column sum of absolute values).
-fn norm1(m: &Matrix6<f64>) -> f64 {
-    m.column_iter()
-        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
-
-/// `C⁻¹` by LU (NaN if singular) and the 1-norm condition number of `C`, for matrices that
-/// need not be symmetric (tangents under follower loads).
-pub fn invert_general(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
-    match c.try_inverse() {
-        Some(k) => (k, norm1(c) * norm1(&k)),
-        None => (Matrix6::repeat(f64::NAN), f64::INFINITY),
-    }
-}
-
 /// The integrated compliance at the last node only (world frame, at the tip), without the
 /// per-node inverses: the cheap path of [`crate::batch::workspace::workspace_map`].
-pub fn tip_compliance_world(rod: &Rod, solution: &StaticsSolution) -> Result<Matrix6<f64>> {
-    compliance_matrices(&Configuration::from_statics(rod, solution)?, true)
+pub fn tip_compliance_world(solution: &StaticsSolution) -> Result<Matrix6<f64>> {
+    compliance_matrices(&Configuration::from_statics(solution)?, true)
         .map(|(w, _)| w[w.len() - 1])
 }
 
@@ -294,13 +206,13 @@ pub struct Configuration {
 }
 
 impl Configuration {
-    /// The solved mesh of a Cosserat solution of `rod`, with the material's tangent at the
-    /// solved wrench ([`element_compliance`]).
+    /// The solved mesh of a Cosserat solution, with the material's tangent at the solved
+    /// wrench ([`element_compliance`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ
     /// in length.
-    pub fn from_statics(rod: &Rod, solution: &StaticsSolution) -> Result<Self> {
+    pub fn from_statics(solution: &StaticsSolution) -> Result<Self> {
         let n = solution.s.len();
         if n == 0 || solution.position.len() != n || solution.rotation.len() != n {
             return Err(Error::invalid(
@@ -326,7 +238,7 @@ impl Configuration {
                     )
                 })
                 .collect(),
-            element: element_compliance(rod, solution),
+            element: element_compliance(solution),
         })
     }
 
@@ -515,14 +427,14 @@ pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Comp
     })
 }
 
-/// The seed's integrated compliance (eqs. 6–7) at every node of `solution`, a solution of
-/// `rod` (see the module documentation for the formula and the quadrature).
+/// The seed's integrated compliance (eqs. 6–7) at every node of `solution` (see the module
+/// documentation for the formula and the quadrature).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ in
 /// length.
-pub fn compliance(rod: &Rod, solution: &StaticsSolution) -> Result<Compliance> {
-    configuration_compliance(rod, Configuration::from_statics(rod, solution)?)
+pub fn compliance(solution: &StaticsSolution) -> Result<Compliance> {
+    configuration_compliance(solution.model.rod(), Configuration::from_statics(solution)?)
 }
 
 /// The seed's integrated compliance along the arcs of a PCC solution (same computation as
@@ -541,446 +453,6 @@ pub fn pcc_compliance(
     configuration_compliance(rod, Configuration::from_pcc(rod, robot, solution, panels)?)
 }
 
-// ------------------------------------------------------------------------ tangent compliance
-
-/// How the tendons behave under the extra wrench of [`tangent_compliance`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum TendonControl {
-    /// Tensions held fixed (force-controlled actuators).
-    #[default]
-    Tension,
-    /// Path lengths of all tendons held fixed (displacement-controlled actuators): the
-    /// tensions change; the linearisation treats the tendons as bilateral (a tension may go
-    /// negative, i.e. slack, without the model noticing).
-    Length,
-}
-
-/// The exact tangent compliance at one node.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TangentCompliance {
-    /// Index of the node in the solution.
-    pub node: usize,
-    /// Its undeformed arc length (m).
-    pub s: f64,
-    /// `d[δp; δθ]/d[f; m]`, world components, wrench applied at the node.
-    pub world: Matrix6<f64>,
-    /// The same in the node's body axes.
-    pub body: Matrix6<f64>,
-    /// `world⁻¹` (NaN if not positive definite).
-    pub stiffness_world: Matrix6<f64>,
-    /// `body⁻¹` (NaN if not positive definite).
-    pub stiffness_body: Matrix6<f64>,
-    /// 1-norm condition number (SI units).
-    pub condition: f64,
-    /// Whether the tangent is symmetric to 1e-6 relative (it is at equilibria of conservative
-    /// loads; follower loads make it non-symmetric).
-    pub symmetric: bool,
-    /// `dτ_i/d[f; m]` (N/N, N/(N m)), one row per tendon; zero rows under
-    /// [`TendonControl::Tension`].
-    pub tension_rate: Vec<[f64; 6]>,
-}
-
-/// Columns of the tangent pass: 6 base-wrench, up to `MAX_HELD_TENDONS` tension, 6 load.
-const MAX_COLUMNS: usize = 12 + MAX_HELD_TENDONS;
-/// Offset of the tendon-length sensitivities (column-major, `MAX_HELD_TENDONS` per column).
-const LENGTHS: usize = STATE + 12 * MAX_COLUMNS;
-/// Size of the tangent pass state.
-const TN: usize = LENGTHS + MAX_COLUMNS * MAX_HELD_TENDONS;
-
-struct TangentPass<'m, 'a> {
-    ev: Evaluator<'m, 'a>,
-    /// Indices of the held tendons.
-    held: Vec<usize>,
-    /// Current interval.
-    interval: usize,
-}
-
-impl TangentPass<'_, '_> {
-    fn ncol(&self) -> usize {
-        12 + self.held.len()
-    }
-
-    /// `(t, r × t)` of tendon `i` (body) at strains `(v, u)`.
-    fn tendon_direction(
-        &self,
-        i: usize,
-        s: f64,
-        v: &Vector3<f64>,
-        u: &Vector3<f64>,
-    ) -> Vector6<f64> {
-        let model = self.ev.model;
-        let props = model.rod.section_at(s);
-        let (r, rp) = model.tendons[i].tendon.routing().offset(s, &props);
-        let r = Vector3::new(r[0], r[1], 0.0);
-        let w = v + u.cross(&r) + Vector3::new(rp[0], rp[1], 0.0);
-        let t = w / w.norm();
-        let q = r.cross(&t);
-        Vector6::new(t.x, t.y, t.z, q.x, q.y, q.z)
-    }
-
-    fn rhs(&mut self, s: f64, y: &[f64; TN]) -> [f64; TN] {
-        let mut yf = [0.0; FULL];
-        yf[..STATE].copy_from_slice(&y[..STATE]);
-        let d = self.ev.rhs::<FULL>(s, &yf);
-        let sm = self.ev.tangent();
-        let mut out = [0.0; TN];
-        out[..STATE].copy_from_slice(&d[..STATE]);
-        let r = rot(y);
-        let ri = r.try_inverse().unwrap_or_else(|| r.transpose());
-        let pd = v3(&d, 0);
-        let v = ri * pd;
-        let uh = ri * Matrix3::from_column_slice(&d[3..12]);
-        let u = Vector3::new(
-            0.5 * (uh[(2, 1)] - uh[(1, 2)]),
-            0.5 * (uh[(0, 2)] - uh[(2, 0)]),
-            0.5 * (uh[(1, 0)] - uh[(0, 1)]),
-        );
-        let (nw, mw) = (v3(y, 12), v3(y, 15));
-        let (nb, mb) = (r.tr_mul(&nw), r.tr_mul(&mw));
-        let b_end = self.ev.model.breaks[self.interval + 1];
-        let dirs: Vec<Option<Vector6<f64>>> = self
-            .held
-            .iter()
-            .map(|&i| {
-                (self.ev.model.tendons[i].end >= b_end).then(|| self.tendon_direction(i, s, &v, &u))
-            })
-            .collect();
-        let nh = self.held.len();
-        for c in 0..self.ncol() {
-            let b = STATE + 12 * c;
-            let w = v3(y, b + 3);
-            let dn = v3(y, b + 6);
-            let dm = v3(y, b + 9);
-            let dnb = nb.cross(&w) + r.tr_mul(&dn);
-            let dmb = mb.cross(&w) + r.tr_mul(&dm);
-            let mut e = Vector6::new(dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z);
-            if (6..6 + nh).contains(&c) {
-                if let Some(t) = &dirs[c - 6] {
-                    e -= t;
-                }
-            }
-            let e = sm * e;
-            let (dv, du) = (
-                e.fixed_rows::<3>(0).into_owned(),
-                e.fixed_rows::<3>(3).into_owned(),
-            );
-            let dpd = r * (w.cross(&v) + dv);
-            let wd = w.cross(&u) + du;
-            let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
-            put3(&mut out, b, &dpd);
-            put3(&mut out, b + 3, &wd);
-            put3(&mut out, b + 9, &dmd);
-            for (h, t) in dirs.iter().enumerate() {
-                if let Some(t) = t {
-                    out[LENGTHS + c * MAX_HELD_TENDONS + h] = t.dot(&e);
-                }
-            }
-        }
-        out
-    }
-
-    /// Packs the state and columns `c0..c0 + 6` into a FULL-layout array.
-    fn pack(y: &[f64; TN], c0: usize) -> [f64; FULL] {
-        let mut f = [0.0; FULL];
-        f[..STATE].copy_from_slice(&y[..STATE]);
-        for k in 0..6 {
-            let (src, dst) = (STATE + 12 * (c0 + k), STATE + 12 * k);
-            if c0 + k < MAX_COLUMNS {
-                f[dst..dst + 12].copy_from_slice(&y[src..src + 12]);
-            }
-        }
-        f
-    }
-
-    /// Point-load jumps at the interior break `b`, for the state and every column.
-    fn jump(&self, b: f64, y: &mut [f64; TN]) {
-        let model: &Model<'_> = self.ev.model;
-        let ncol = self.ncol();
-        let mut state = [0.0; STATE];
-        let mut c0 = 0;
-        while c0 < ncol {
-            let mut f = Self::pack(y, c0);
-            model.jump(b, &mut f);
-            if c0 == 0 {
-                state.copy_from_slice(&f[..STATE]);
-            }
-            for k in 0..6.min(ncol - c0) {
-                let (src, dst) = (STATE + 12 * k, STATE + 12 * (c0 + k));
-                y[dst..dst + 12].copy_from_slice(&f[src..src + 12]);
-            }
-            c0 += 6;
-        }
-        y[..STATE].copy_from_slice(&state);
-    }
-
-    /// Residual Jacobian columns (scaled as the shooting residual) of every column.
-    fn residual_columns(&self, y: &[f64; TN]) -> Vec<Vector6<f64>> {
-        let ncol = self.ncol();
-        let mut cols = Vec::with_capacity(ncol);
-        let mut c0 = 0;
-        while c0 < ncol {
-            let f = Self::pack(y, c0);
-            if let (_, Some(j)) = self.ev.model.residual(&f) {
-                for k in 0..6.min(ncol - c0) {
-                    cols.push(j.column(k).into_owned());
-                }
-            }
-            c0 += 6;
-        }
-        cols
-    }
-}
-
-/// The exact tangent compliance of the equilibrium `solution` of `rod`, `tendons` and `loads`
-/// (solved with `options`) at node `node` (default: the tip): the derivative of the node's
-/// twist `[δp; δθ]` with respect to a dead wrench `[f; m]` applied at the node's position,
-/// with the tendons held at fixed tension or at fixed length.
-///
-/// The linearised boundary-value problem is integrated once with the solver's integrator and
-/// mesh: the six shooting columns (base wrench), one column per held tendon (tension), six
-/// columns for the applied wrench (started at the node), with the tendon path-length
-/// sensitivities `δℓ_i = ∫ t_iᵀ (δv + δu × r_i) ds` appended; the unknowns (base wrench, held
-/// tensions) solve the linearised tip conditions and `δℓ_i = 0`.
-///
-/// # Errors
-/// [`Error::InvalidParameter`] for a node out of range, more than [`MAX_HELD_TENDONS`]
-/// tendons under [`TendonControl::Length`], or problem data the solver rejects;
-/// [`Error::NotConverged`] if the integration fails or the linear system is singular.
-pub fn tangent_compliance(
-    rod: &Rod,
-    tendons: &[Tendon],
-    loads: &Loads,
-    solution: &StaticsSolution,
-    options: &SolveOptions,
-    control: TendonControl,
-    node: Option<usize>,
-) -> Result<TangentCompliance> {
-    let held: Vec<usize> = match control {
-        TendonControl::Tension => Vec::new(),
-        TendonControl::Length => (0..tendons.len()).collect(),
-    };
-    tangent_compliance_held(rod, tendons, loads, solution, options, &held, node)
-}
-
-/// [`tangent_compliance`] with only the tendons `held` (indices into `tendons`) at fixed
-/// length, the others at fixed tension (e.g. hold only the tensioned tendons: a slack tendon
-/// cannot push).
-///
-/// # Errors
-/// As [`tangent_compliance`]; [`Error::InvalidParameter`] naming `held` for an index out of
-/// range or repeated.
-pub fn tangent_compliance_held(
-    rod: &Rod,
-    tendons: &[Tendon],
-    loads: &Loads,
-    solution: &StaticsSolution,
-    options: &SolveOptions,
-    held: &[usize],
-    node: Option<usize>,
-) -> Result<TangentCompliance> {
-    let n = solution.s.len();
-    let node = node.unwrap_or(n.saturating_sub(1));
-    if node >= n {
-        return Err(Error::invalid("node", node, format!("in [0, {n})")));
-    }
-    for (k, &i) in held.iter().enumerate() {
-        if i >= tendons.len() || held[..k].contains(&i) {
-            return Err(Error::invalid(
-                format!("held[{k}]"),
-                i,
-                format!("distinct tendon indices in [0, {})", tendons.len()),
-            ));
-        }
-    }
-    let held = held.to_vec();
-    if held.len() > MAX_HELD_TENDONS {
-        return Err(Error::invalid(
-            "tendons",
-            held.len(),
-            format!("at most {MAX_HELD_TENDONS} tendons held at fixed length"),
-        ));
-    }
-    let model = build_model(rod, tendons, loads)?;
-    let target = solution.s[node];
-    let nh = held.len();
-    let mut tension_rate = vec![[0.0; 6]; tendons.len()];
-    if target <= 0.0 {
-        let z = Matrix6::zeros();
-        let nan = Matrix6::repeat(f64::NAN);
-        return Ok(TangentCompliance {
-            node,
-            s: target,
-            world: z,
-            body: z,
-            stiffness_world: nan,
-            stiffness_body: nan,
-            condition: f64::INFINITY,
-            symmetric: true,
-            tension_rate,
-        });
-    }
-    let fm = model.f_ref * model.length;
-    let bw = solution.base_wrench;
-    let x = Vector6::new(
-        bw[0] / model.f_ref,
-        bw[1] / model.f_ref,
-        bw[2] / model.f_ref,
-        bw[3] / fm,
-        bw[4] / fm,
-        bw[5] / fm,
-    );
-    let mut pass = TangentPass {
-        ev: Evaluator::new(&model),
-        held,
-        interval: 0,
-    };
-    let ncol = pass.ncol();
-    let mut y = [0.0; TN];
-    y[..FULL].copy_from_slice(&model.initial::<FULL>(&x));
-    let load0 = 6 + nh;
-    // Pose columns (δp, R w) of the unknowns at the node and its rotation.
-    let mut recorded: Option<(Vec<Vector6<f64>>, Matrix3<f64>)> = None;
-    let mut at_node = |s: f64, y: &mut [f64; TN]| {
-        if recorded.is_none() && s == target {
-            let r = rot(y);
-            let cols = (0..load0)
-                .map(|c| {
-                    let b = STATE + 12 * c;
-                    let (dp, w) = (v3(y, b), r * v3(y, b + 3));
-                    Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
-                })
-                .collect();
-            recorded = Some((cols, r));
-            for k in 0..6 {
-                let b = STATE + 12 * (load0 + k) + if k < 3 { 6 + k } else { 9 + k - 3 };
-                y[b] = -1.0;
-            }
-        }
-    };
-    let breaks = model.breaks.clone();
-    let fail = |what: &str| Error::NotConverged {
-        what: format!("tangent compliance: {what}"),
-        iterations: 0,
-        residual: f64::INFINITY,
-    };
-    match options.integrator {
-        Integrator::Rk4 { steps } => {
-            let plan = rk4_plan(&breaks, steps);
-            for k in 0..breaks.len() - 1 {
-                let (a, b) = (breaks[k], breaks[k + 1]);
-                pass.ev.set_interval(k);
-                pass.interval = k;
-                let m = plan[k];
-                let h = (b - a) / m as f64;
-                for i in 0..m {
-                    let t = a + h * i as f64;
-                    let mut f = |s: f64, yy: &[f64; TN]| pass.rhs(s, yy);
-                    y = rk4_step(&mut f, t, &y, h);
-                    project(&mut y);
-                    if !y.iter().all(|v| v.is_finite()) {
-                        return Err(fail("non-finite state"));
-                    }
-                    at_node(if i + 1 == m { b } else { t + h }, &mut y);
-                }
-                if k + 2 < breaks.len() {
-                    pass.jump(b, &mut y);
-                }
-            }
-        }
-        Integrator::Adaptive(opts) => {
-            for k in 0..breaks.len() - 1 {
-                let (a, b) = (breaks[k], breaks[k + 1]);
-                pass.ev.set_interval(k);
-                pass.interval = k;
-                let mut pieces = vec![a];
-                if target > a && target < b {
-                    pieces.push(target);
-                }
-                pieces.push(b);
-                for w in pieces.windows(2) {
-                    let sol = dp54(
-                        |s, yy: &[f64; TN]| pass.rhs(s, yy),
-                        w[0],
-                        y,
-                        w[1],
-                        opts,
-                        STATE,
-                        project,
-                    )?;
-                    y = sol.y[sol.y.len() - 1];
-                    at_node(w[1], &mut y);
-                }
-                if k + 2 < breaks.len() {
-                    pass.jump(b, &mut y);
-                }
-            }
-        }
-    }
-    let Some((pose_cols, r_node)) = recorded else {
-        return Err(Error::invalid(
-            "node",
-            node,
-            "a node of the solution's mesh (solve and tangent with the same integrator)",
-        ));
-    };
-    let jcols = pass.residual_columns(&y);
-    if jcols.len() != ncol {
-        return Err(fail("residual Jacobian"));
-    }
-    // Linear system in z = [δx (scaled base wrench); δτ (held)].
-    let dim = 6 + nh;
-    let mut a = DMatrix::zeros(dim, dim);
-    let mut rhs = DMatrix::zeros(dim, 6);
-    for c in 0..ncol {
-        let mut col = DVector::zeros(dim);
-        for i in 0..6 {
-            col[i] = jcols[c][i];
-        }
-        for h in 0..nh {
-            col[6 + h] = y[LENGTHS + c * MAX_HELD_TENDONS + h];
-        }
-        if c < load0 {
-            a.set_column(c, &col);
-        } else {
-            rhs.set_column(c - load0, &(-col));
-        }
-    }
-    let z = a
-        .lu()
-        .solve(&rhs)
-        .ok_or_else(|| fail("singular linearised problem"))?;
-    let mut world = Matrix6::zeros();
-    for i in 0..6 {
-        let mut t = Vector6::zeros();
-        for (c, p) in pose_cols.iter().enumerate() {
-            t += p * z[(c, i)];
-        }
-        world.set_column(i, &t);
-    }
-    for (h, &ti) in pass.held.iter().enumerate() {
-        for i in 0..6 {
-            tension_rate[ti][i] = z[(6 + h, i)];
-        }
-    }
-    let rt = rotation_adjoint(&r_node.transpose());
-    let body = rt * world * rt.transpose();
-    let asym = (world - world.transpose()).amax();
-    let symmetric = asym <= 1e-6 * world.amax();
-    let (kw, condition) = invert_general(&world);
-    let (kb, _) = invert_general(&body);
-    Ok(TangentCompliance {
-        node,
-        s: target,
-        world,
-        body,
-        stiffness_world: kw,
-        stiffness_body: kb,
-        condition,
-        symmetric,
-        tension_rate,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -996,16 +468,5 @@ mod tests {
             let exact = big_f(x[j + 1]) - big_f(x[j]);
             assert!((q - exact).abs() < 1e-14, "panel {j}: {q} vs {exact}");
         }
-    }
-
-    #[test]
-    fn cholesky_inverse_inverts_and_rejects_indefinite() {
-        let a = Matrix6::from_fn(|i, j| 1.0 / (1.0 + i as f64 + j as f64));
-        let c = a * a.transpose() + Matrix6::identity() * 1e-3;
-        let (k, cond) = invert_spd(&c);
-        assert!((k * c - Matrix6::identity()).amax() < 1e-9);
-        assert!(cond.is_finite() && cond > 1.0);
-        let (k, cond) = invert_spd(&(-c));
-        assert!(k[(0, 0)].is_nan() && cond.is_infinite());
     }
 }

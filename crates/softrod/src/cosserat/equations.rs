@@ -48,19 +48,29 @@
 //! D. C. Rucker, R. J. Webster III, IEEE Trans. Robotics 27(6), 2011, eqs. (1)–(18).
 //! J. Till, V. Aloi, D. C. Rucker, Int. J. Robotics Research 38(6), 2019 (shooting).
 
+//!
+//! Extra sensitivity columns (the tangent compliance, held tendons) follow the same
+//! variational equations; a column for the tension of tendon `i` is forced by `-(t_i, r_i × t_i)`
+//! in the body wrench of the constitutive solve (`∂n_b/∂τ_i` at fixed strains), and the
+//! sensitivity of the tendon path length is `δℓ_i = ∫ t_iᵀ (δv + δu × r_i) ds`.
+
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::model::loads::{Frame, Loads};
-use crate::model::rod::Rod;
+use crate::error::Error;
+use crate::integrate::march::Piecewise;
+use crate::integrate::System;
+use crate::math::linalg::Lu6;
+use crate::math::so3::{hat, reorthonormalise};
+use crate::model::loads::Frame;
 use crate::model::section::SectionProperties;
-use crate::math::so3::hat;
-use crate::model::tendon::Tendon;
-
+use crate::model::RobotModel;
 
 /// Length of the state `(p, R, N, M)`: 3 + 9 + 3 + 3.
 pub(crate) const STATE: usize = 18;
-/// Length of the state with the six sensitivity columns `(δp, w, δN, δM)` appended.
-pub(crate) const FULL: usize = STATE + 6 * 12;
+/// Length of one sensitivity column `(δp, w, δN, δM)`.
+pub(crate) const COLUMN: usize = 12;
+/// Length of the state with the six shooting columns appended.
+pub(crate) const FULL: usize = STATE + 6 * COLUMN;
 
 /// Relative step tolerance of the local (constitutive) Newton iteration.
 pub const LOCAL_TOLERANCE: f64 = 1e-14;
@@ -84,79 +94,43 @@ pub(crate) fn rot(y: &[f64]) -> Matrix3<f64> {
     Matrix3::from_column_slice(&y[3..12])
 }
 
-/// LU factorisation with partial pivoting of a 6×6 matrix (row-major arrays, no allocation;
-/// several times faster than the generic routine for this size).
-#[derive(Clone, Copy)]
-pub(crate) struct Lu6 {
-    a: [[f64; 6]; 6],
-    inv_diag: [f64; 6],
-    perm: [usize; 6],
+/// Re-orthonormalises the rotation part of a state.
+#[inline]
+pub(crate) fn project<const N: usize>(y: &mut [f64; N]) {
+    let r = reorthonormalise(&rot(y));
+    y[3..12].copy_from_slice(r.as_slice());
 }
 
-impl Lu6 {
-    /// Factorises `m`; `None` if it is singular to working precision or not finite.
-    #[inline]
-    pub fn new(m: &Matrix6<f64>) -> Option<Self> {
-        let mut a = [[0.0; 6]; 6];
-        for i in 0..6 {
-            for j in 0..6 {
-                a[i][j] = m[(i, j)];
-            }
-        }
-        let mut perm = [0, 1, 2, 3, 4, 5];
-        let mut inv_diag = [0.0; 6];
-        for k in 0..6 {
-            let mut p = k;
-            let mut best = a[k][k].abs();
-            for i in k + 1..6 {
-                if a[i][k].abs() > best {
-                    best = a[i][k].abs();
-                    p = i;
-                }
-            }
-            if !(best > 0.0 && best.is_finite()) {
-                return None;
-            }
-            if p != k {
-                a.swap(p, k);
-                perm.swap(p, k);
-            }
-            let inv = 1.0 / a[k][k];
-            inv_diag[k] = inv;
-            for i in k + 1..6 {
-                let f = a[i][k] * inv;
-                a[i][k] = f;
-                for j in k + 1..6 {
-                    a[i][j] -= f * a[k][j];
-                }
-            }
-        }
-        Some(Self { a, inv_diag, perm })
-    }
+/// The tangent `d(v, u)/d(n_b, m_b)` of one constitutive solve: `(I + C D)⁻¹ C` with active
+/// tendons (`lu` the factorised `I + C D`), `C` (`diag`) without.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Tangent {
+    pub diag: [f64; 6],
+    pub lu: Option<Lu6>,
+}
 
-    /// Solves `M x = b`.
+impl Tangent {
+    /// `d(v, u)` for the body-wrench perturbation `e`.
     #[inline]
-    pub fn solve(&self, b: &[f64; 6]) -> [f64; 6] {
-        let mut x = [0.0; 6];
-        for i in 0..6 {
-            let mut v = b[self.perm[i]];
-            for j in 0..i {
-                v -= self.a[i][j] * x[j];
-            }
-            x[i] = v;
+    pub fn apply(&self, e: &[f64; 6]) -> [f64; 6] {
+        let c = &self.diag;
+        let cw = [
+            c[0] * e[0],
+            c[1] * e[1],
+            c[2] * e[2],
+            c[3] * e[3],
+            c[4] * e[4],
+            c[5] * e[5],
+        ];
+        match &self.lu {
+            None => cw,
+            Some(lu) => lu.solve(&cw),
         }
-        for i in (0..6).rev() {
-            let mut v = x[i];
-            for j in i + 1..6 {
-                v -= self.a[i][j] * x[j];
-            }
-            x[i] = v * self.inv_diag[i];
-        }
-        x
     }
 }
 
-/// The local solution at one `s`: strains and tendon load sums (body frame).
+/// The local solution at one `s`: strains, tendon and fluid load sums (body frame), and the
+/// tangent when it was asked for.
 #[derive(Clone, Copy)]
 pub(crate) struct Local {
     pub v: Vector3<f64>,
@@ -165,6 +139,7 @@ pub(crate) struct Local {
     pub tendon_force: Vector3<f64>,
     /// `Σ τ r_i × t_i` (N m, body frame), plus the chambers' fluid moment.
     pub tendon_moment: Vector3<f64>,
+    pub tangent: Option<Tangent>,
 }
 
 impl Local {
@@ -174,232 +149,329 @@ impl Local {
             u: Vector3::repeat(f64::NAN),
             tendon_force: Vector3::zeros(),
             tendon_moment: Vector3::zeros(),
+            tangent: None,
         }
     }
 }
 
-/// A prepared tendon: termination and scaled tension.
-pub(crate) struct ActiveTendon<'a> {
-    pub tendon: &'a Tendon,
-    pub end: f64,
+/// The equations of one configuration: the model, the tendon tensions (N) and chamber
+/// pressures (Pa) of the actuation, and the load factor `λ` that scales the external loads
+/// (the actuation is always applied in full).
+#[derive(Clone, Copy)]
+pub(crate) struct Equations<'a> {
+    pub model: &'a RobotModel,
+    pub tensions: &'a [f64],
+    pub pressures: &'a [f64],
+    pub load_factor: f64,
 }
 
-/// The validated problem at one load factor.
-pub(crate) struct Model<'a> {
-    pub rod: &'a Rod,
-    pub tendons: Vec<ActiveTendon<'a>>,
-    pub loads: &'a Loads,
-    pub shear_coefficient: f64,
-    /// `rho g` (N/m³), if gravity is on.
-    pub rho_g: Option<Vector3<f64>>,
-    /// Load factor `λ` multiplying every load and tension.
-    pub factor: f64,
-    /// Force scale (N) of the shooting unknowns and residual; moments use `f_ref L`.
-    pub f_ref: f64,
-    pub length: f64,
-    /// Interval end points `0 = b_0 < b_1 < ... = L`.
-    pub breaks: Vec<f64>,
-    /// Whether no force is applied along the rod (only world-frame tip loads and moments):
-    /// then `N ≡ 0` for a zero base force.
-    pub force_free: bool,
-    /// The section compliance when it does not depend on `s` (linear material, uniform
-    /// section), precomputed.
-    pub uniform_compliance: Option<[f64; 6]>,
-    /// First material failure met by a local solve (a fibre stretch <= 0, an unstable
-    /// hyperelastic law), reported if the solve fails.
-    pub material_error: std::sync::OnceLock<crate::error::Error>,
+/// What a sensitivity column is a derivative with respect to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Column {
+    /// A component of the base wrench or of an applied wrench: no forcing term.
+    Free,
+    /// The tension of tendon `i`.
+    Tension(usize),
 }
 
-impl<'a> Model<'a> {
+/// Scratch of the evaluations of one solve (the workspace): per-interval tendon and chamber
+/// sets, warm starts of the local iteration, stage quadratures.
+pub(crate) struct Workspace {
+    /// Indices of the tendons that pass through the current interval with nonzero tension.
+    pub active: Vec<usize>,
+    /// Indices of the tendons that pass through the current interval without tension.
+    pub passive: Vec<usize>,
+    /// Offsets `(r, r', τ)` of the active tendons at the current `s`.
+    pub offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
+    /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
+    pub guess: Option<Vector6<f64>>,
+    /// Factorised local Jacobian of the last local Newton iteration (chord steps).
+    pub last_lu: Option<Lu6>,
+    /// `|p_i'|` of every tendon at the last evaluation (zero for tendons not in the interval).
+    pub tendon_speed: Vec<f64>,
+    /// Right-hand-side evaluations so far.
+    pub evaluations: usize,
+    /// Indices of the pressurised chambers that fill the current interval.
+    pub chambers: Vec<usize>,
+    /// Current interval.
+    pub interval: usize,
+    /// The sensitivity columns integrated with the state (at most `(N - STATE) / COLUMN`).
+    pub columns: Vec<Column>,
+    /// Tendons whose path-length sensitivities are integrated for every column.
+    pub length_tendons: Vec<usize>,
+    /// Quadrature integrands of the current stage: tendon speeds, then per column the
+    /// path-length sensitivities of `length_tendons`.
+    pub integrand: Vec<f64>,
+    /// The integrands of each stage of the current step.
+    pub stages: Vec<Vec<f64>>,
+    /// The integrals so far: tendon lengths (m), then path-length sensitivities.
+    pub integral: Vec<f64>,
+    /// Whether the tendon speeds (and so the tendon-length quadrature) are recorded at every
+    /// evaluation (the speeds of the tensioned tendons always are).
+    pub track_lengths: bool,
+    /// First material failure met by a local solve, reported if the solve fails.
+    pub material_error: Option<Error>,
+}
+
+impl Workspace {
+    pub fn new(n_tendons: usize) -> Self {
+        Self {
+            active: Vec::with_capacity(n_tendons),
+            passive: Vec::with_capacity(n_tendons),
+            offsets: Vec::with_capacity(n_tendons),
+            guess: None,
+            last_lu: None,
+            tendon_speed: vec![0.0; n_tendons],
+            evaluations: 0,
+            chambers: Vec::new(),
+            interval: 0,
+            columns: Vec::new(),
+            length_tendons: Vec::new(),
+            integrand: vec![0.0; n_tendons],
+            stages: Vec::new(),
+            integral: vec![0.0; n_tendons],
+            track_lengths: false,
+            material_error: None,
+        }
+    }
+
+    /// Sets the columns and the tendons whose length sensitivities are integrated, and resets
+    /// the quadratures.
+    pub fn set_columns(&mut self, columns: &[Column], length_tendons: &[usize]) {
+        self.columns.clear();
+        self.columns.extend_from_slice(columns);
+        self.length_tendons.clear();
+        self.length_tendons.extend_from_slice(length_tendons);
+        let m = self.tendon_speed.len() + columns.len() * length_tendons.len();
+        self.integrand.resize(m, 0.0);
+        self.reset_quadrature();
+    }
+
+    /// Zeroes the integrals (before a pass).
+    pub fn reset_quadrature(&mut self) {
+        self.integral.clear();
+        self.integral.resize(self.integrand.len(), 0.0);
+    }
+}
+
+/// Evaluates the right-hand side of the equations in a workspace.
+pub(crate) struct Evaluator<'e, 'w> {
+    pub eq: Equations<'e>,
+    pub ws: &'w mut Workspace,
+}
+
+impl<'e> Equations<'e> {
     /// Distributed force `λ (f(s) + rho A(s) g)` (N/m, world).
     #[inline]
-    pub(crate) fn distributed_force(&self, s: f64, props: &SectionProperties) -> Vector3<f64> {
-        let mut f = match &self.loads.distributed_force {
+    pub fn distributed_force(&self, s: f64, props: &SectionProperties) -> Vector3<f64> {
+        let loads = self.model.loads();
+        let mut f = match &loads.distributed_force {
             Some(p) => p.at(s),
             None => Vector3::zeros(),
         };
-        if let Some(g) = &self.rho_g {
+        if let Some(g) = self.model.rho_g() {
             f += g * props.area;
         }
-        f * self.factor
+        f * self.load_factor
     }
 
     #[inline]
     fn distributed_moment(&self, s: f64) -> Vector3<f64> {
-        match &self.loads.distributed_moment {
-            Some(p) => p.at(s) * self.factor,
+        match &self.model.loads().distributed_moment {
+            Some(p) => p.at(s) * self.load_factor,
             None => Vector3::zeros(),
         }
     }
 
     /// Initial state for the scaled base wrench `x` (`N(0) = f_ref x[0..3]`,
-    /// `M(0) = f_ref L x[3..6]`), with identity sensitivity seeds when `N == FULL`.
-    pub fn initial<const N: usize>(&self, x: &Vector6<f64>) -> [f64; N] {
+    /// `M(0) = f_ref L x[3..6]`), with identity seeds for the first six columns when they
+    /// fit in `N`.
+    pub fn initial<const N: usize>(&self, x: &[f64]) -> [f64; N] {
         let mut y = [0.0; N];
-        let pose = self.rod.base_pose();
+        let pose = self.model.rod().base_pose();
         put3(&mut y, 0, &pose.position());
         y[3..12].copy_from_slice(pose.rotation().as_slice());
-        let fm = self.f_ref * self.length;
+        let f_ref = self.model.force_scale();
+        let fm = f_ref * self.model.length();
         for k in 0..3 {
-            y[12 + k] = self.f_ref * x[k];
+            y[12 + k] = f_ref * x[k];
             y[15 + k] = fm * x[3 + k];
         }
-        if N == FULL {
+        if N >= FULL {
             for k in 0..3 {
-                y[STATE + 12 * k + 6 + k] = self.f_ref;
-                y[STATE + 12 * (k + 3) + 9 + k] = fm;
+                y[STATE + COLUMN * k + 6 + k] = f_ref;
+                y[STATE + COLUMN * (k + 3) + 9 + k] = fm;
             }
         }
         y
     }
 
-    /// World-frame force and moment (and their sensitivity columns) of a load given in
-    /// `frame`, applied where the state is `y`.
+    /// World-frame force and moment (and, for the first `ncol` columns, their sensitivities)
+    /// of a load given in `frame`, applied where the state is `y`.
     #[inline]
     fn applied<const N: usize>(
         &self,
         y: &[f64; N],
+        ncol: usize,
         force: &Vector3<f64>,
         moment: &Vector3<f64>,
         frame: Frame,
-    ) -> (Vector3<f64>, Vector3<f64>, [[Vector3<f64>; 2]; 6]) {
-        let (f, m) = (force * self.factor, moment * self.factor);
-        let mut d = [[Vector3::zeros(); 2]; 6];
+        d: &mut [[Vector3<f64>; 2]],
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let (f, m) = (force * self.load_factor, moment * self.load_factor);
         match frame {
-            Frame::World => (f, m, d),
+            Frame::World => (f, m),
             Frame::Body => {
                 let r = rot(y);
-                if N == FULL {
-                    for (k, dk) in d.iter_mut().enumerate() {
-                        let w = v3(y, STATE + 12 * k + 3);
-                        dk[0] = r * w.cross(&f);
-                        dk[1] = r * w.cross(&m);
-                    }
+                for (k, dk) in d.iter_mut().enumerate().take(ncol) {
+                    let w = v3(y, STATE + COLUMN * k + 3);
+                    dk[0] += r * w.cross(&f);
+                    dk[1] += r * w.cross(&m);
                 }
-                (r * f, r * m, d)
+                (r * f, r * m)
             }
         }
     }
 
-    /// Applies the point loads at the interior break `sigma` (crossing it toward the tip).
-    pub fn jump<const N: usize>(&self, sigma: f64, y: &mut [f64; N]) {
-        for pl in self.loads.point_loads.iter().filter(|p| p.s == sigma) {
-            let (f, m, d) = self.applied(y, &pl.force, &pl.moment, pl.frame);
+    /// Applies the point loads at the interior break `sigma` (crossing it toward the tip) to
+    /// the state and its first `ncol` columns.
+    pub fn jump<const N: usize>(&self, sigma: f64, y: &mut [f64; N], ncol: usize) {
+        let loads = self.model.loads();
+        let mut d = vec![[Vector3::zeros(); 2]; ncol];
+        for pl in loads.point_loads.iter().filter(|p| p.s == sigma) {
+            d.iter_mut().for_each(|x| *x = [Vector3::zeros(); 2]);
+            let (f, m) = self.applied(y, ncol, &pl.force, &pl.moment, pl.frame, &mut d);
             let (n1, m1) = (v3(y, 12) - f, v3(y, 15) - m);
             put3(y, 12, &n1);
             put3(y, 15, &m1);
-            if N == FULL {
-                for (k, dk) in d.iter().enumerate() {
-                    let b = STATE + 12 * k;
-                    let (dn1, dm1) = (v3(y, b + 6) - dk[0], v3(y, b + 9) - dk[1]);
-                    put3(y, b + 6, &dn1);
-                    put3(y, b + 9, &dm1);
-                }
+            for (k, dk) in d.iter().enumerate() {
+                let b = STATE + COLUMN * k;
+                let (dn1, dm1) = (v3(y, b + 6) - dk[0], v3(y, b + 9) - dk[1]);
+                put3(y, b + 6, &dn1);
+                put3(y, b + 9, &dm1);
             }
         }
     }
 
-    /// Scaled tip residual `[(N(L) - F)/f_ref; (M(L) - M)/(f_ref L)]` and, when `N == FULL`,
-    /// its Jacobian with respect to the scaled base wrench.
-    pub fn residual<const N: usize>(&self, y: &[f64; N]) -> (Vector6<f64>, Option<Matrix6<f64>>) {
-        let lw = &self.loads;
-        let (mut f, mut m, mut d) = self.applied(y, &lw.tip_force, &lw.tip_moment, lw.tip_frame);
-        for pl in lw.point_loads.iter().filter(|p| p.s == self.length) {
-            let (f2, m2, d2) = self.applied(y, &pl.force, &pl.moment, pl.frame);
+    /// Scaled tip residual `[(N(L) - F)/f_ref; (M(L) - M)/(f_ref L)]` and its derivative
+    /// along each of the first `ncol` columns.
+    pub fn residual<const N: usize>(&self, y: &[f64; N], ncol: usize) -> (Vector6<f64>, Vec<Vector6<f64>>) {
+        let lw = self.model.loads();
+        let mut d = vec![[Vector3::zeros(); 2]; ncol];
+        let (mut f, mut m) = self.applied(y, ncol, &lw.tip_force, &lw.tip_moment, lw.tip_frame, &mut d);
+        let l = self.model.length();
+        for pl in lw.point_loads.iter().filter(|p| p.s == l) {
+            let (f2, m2) = self.applied(y, ncol, &pl.force, &pl.moment, pl.frame, &mut d);
             f += f2;
             m += m2;
-            for k in 0..6 {
-                d[k][0] += d2[k][0];
-                d[k][1] += d2[k][1];
-            }
         }
-        let fm = self.f_ref * self.length;
-        let rf = (v3(y, 12) - f) / self.f_ref;
+        let f_ref = self.model.force_scale();
+        let fm = f_ref * l;
+        let rf = (v3(y, 12) - f) / f_ref;
         let rm = (v3(y, 15) - m) / fm;
         let r = Vector6::new(rf.x, rf.y, rf.z, rm.x, rm.y, rm.z);
-        if N != FULL {
-            return (r, None);
+        let cols = (0..ncol)
+            .map(|k| {
+                let b = STATE + COLUMN * k;
+                let jf = (v3(y, b + 6) - d[k][0]) / f_ref;
+                let jm = (v3(y, b + 9) - d[k][1]) / fm;
+                Vector6::new(jf.x, jf.y, jf.z, jm.x, jm.y, jm.z)
+            })
+            .collect();
+        (r, cols)
+    }
+
+    /// `∂r/∂λ` of the scaled tip residual at fixed unknowns, when the external loads do not
+    /// change the internal force along the rod (world-frame tip and point moments, tip force):
+    /// minus the scaled applied tip wrench. `None` otherwise.
+    pub fn load_derivative_force_free(&self) -> Option<Vector6<f64>> {
+        let lw = self.model.loads();
+        if !self.model.force_free() || lw.tip_frame == Frame::Body {
+            return None;
         }
-        let mut j = Matrix6::zeros();
-        for k in 0..6 {
-            let b = STATE + 12 * k;
-            let jf = (v3(y, b + 6) - d[k][0]) / self.f_ref;
-            let jm = (v3(y, b + 9) - d[k][1]) / fm;
-            for i in 0..3 {
-                j[(i, k)] = jf[i];
-                j[(i + 3, k)] = jm[i];
-            }
+        if lw.point_loads.iter().any(|p| p.frame == Frame::Body && p.moment != Vector3::zeros()) {
+            return None;
         }
-        (r, Some(j))
+        if lw.distributed_moment.is_some() {
+            return None;
+        }
+        let l = self.model.length();
+        let mut m = lw.tip_moment;
+        let f = lw.tip_force;
+        // A world-frame moment applied along the rod reaches the tip unchanged (N ≡ const).
+        for p in lw.point_loads.iter() {
+            m += p.moment;
+        }
+        let f_ref = self.model.force_scale();
+        let fm = f_ref * l;
+        Some(Vector6::new(
+            -f.x / f_ref,
+            -f.y / f_ref,
+            -f.z / f_ref,
+            -m.x / fm,
+            -m.y / fm,
+            -m.z / fm,
+        ))
     }
 }
 
-/// Evaluates the right-hand side; holds the per-interval set of active tendons and scratch.
-pub(crate) struct Evaluator<'m, 'a> {
-    pub model: &'m Model<'a>,
-    /// Indices of the tendons that pass through the current interval with nonzero tension.
-    pub(crate) active: Vec<usize>,
-    /// Indices of the tendons that pass through the current interval without tension (their
-    /// paths are still followed for their lengths).
-    pub(crate) passive: Vec<usize>,
-    /// Scratch: offsets `(r, r', τ)` of the active tendons at the current `s`.
-    pub(crate) offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
-    /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
-    pub(crate) guess: Option<Vector6<f64>>,
-    /// Factorised local Jacobian `I + C D` of the last local Newton iteration (chord steps).
-    pub(crate) last_lu: Option<Lu6>,
-    /// Tangent `d(v, u)/d(n_b, m_b)` of the last [`Evaluator::local`] call made with
-    /// `tangent = true`: the compliance `C` (`tangent_diag`), premultiplied by `(I + C D)⁻¹`
-    /// when tendons are active (`tangent_lu` holds the factorised `I + C D`).
-    pub(crate) tangent_diag: [f64; 6],
-    pub(crate) tangent_lu: Option<Lu6>,
-    /// `|w_i| = |p_i'|` of every tendon at the last evaluation (only updated while
-    /// `track_speeds` is set; stale for tendons that end before the current interval).
-    pub tendon_speed: Vec<f64>,
-    /// Whether [`Evaluator::local`] records the tendon speeds.
-    pub track_speeds: bool,
-    /// Right-hand-side evaluations so far.
-    pub evaluations: usize,
-    /// Indices of the pressurised chambers that fill the current interval.
-    pub(crate) chambers: Vec<usize>,
-}
-
-impl<'m, 'a> Evaluator<'m, 'a> {
-    pub fn new(model: &'m Model<'a>) -> Self {
-        let n = model.tendons.len();
-        Self {
-            model,
-            active: Vec::with_capacity(n),
-            passive: Vec::with_capacity(n),
-            offsets: Vec::with_capacity(n),
-            guess: None,
-            last_lu: None,
-            tangent_diag: [0.0; 6],
-            tangent_lu: None,
-            tendon_speed: vec![0.0; n],
-            track_speeds: false,
-            evaluations: 0,
-            chambers: Vec::new(),
-        }
-    }
-
-    /// Selects the tendons active on interval `k` (those ending at or beyond its end).
+impl Evaluator<'_, '_> {
+    /// Selects the tendons and chambers active on interval `k`.
     pub fn set_interval(&mut self, k: usize) {
-        let b = self.model.breaks[k + 1];
-        self.active.clear();
-        self.passive.clear();
-        for (i, t) in self.model.tendons.iter().enumerate() {
-            if t.end >= b {
-                if t.tendon.tension() * self.model.factor > 0.0 {
-                    self.active.push(i);
+        let model = self.eq.model;
+        let breaks = model.breaks();
+        let (a, b) = (breaks[k], breaks[k + 1]);
+        let ws = &mut *self.ws;
+        ws.interval = k;
+        ws.active.clear();
+        ws.passive.clear();
+        for (i, &end) in model.tendon_ends().iter().enumerate() {
+            ws.tendon_speed[i] = 0.0;
+            if end >= b {
+                if self.eq.tensions[i] > 0.0 {
+                    ws.active.push(i);
                 } else {
-                    self.passive.push(i);
+                    ws.passive.push(i);
                 }
             }
         }
-        self.guess = None;
-        self.last_lu = None;
-        self.select_chambers(self.model.breaks[k], b);
+        ws.guess = None;
+        ws.last_lu = None;
+        ws.chambers.clear();
+        for (i, &(start, end)) in model.chamber_extents().iter().enumerate() {
+            if start <= a && end >= b && self.eq.pressures[i] != 0.0 {
+                ws.chambers.push(i);
+            }
+        }
+    }
+
+    /// Body-frame wrench carried by the fluid of the active chambers at `s` (zero without).
+    #[inline]
+    pub(crate) fn chamber_wrench(&self, s: f64) -> [f64; 6] {
+        let mut w = [0.0; 6];
+        let chambers = self.eq.model.chambers();
+        for &i in &self.ws.chambers {
+            let c = chambers[i].fluid_wrench(s, self.eq.pressures[i]);
+            for k in 0..6 {
+                w[k] += c[k];
+            }
+        }
+        w
+    }
+
+    /// Offsets `(r, r', τ)` of the active tendons at `s` into the workspace.
+    #[inline]
+    pub(crate) fn load_offsets(&mut self, s: f64, props: &SectionProperties) {
+        let tendons = self.eq.model.tendons();
+        self.ws.offsets.clear();
+        for &i in &self.ws.active {
+            let (r, rp) = tendons[i].routing().offset(s, props);
+            self.ws.offsets.push((
+                Vector3::new(r[0], r[1], 0.0),
+                Vector3::new(rp[0], rp[1], 0.0),
+                self.eq.tensions[i],
+            ));
+        }
     }
 
     /// Records `|p_i'|` of the tension-free tendons for the strains `(v, u)`.
@@ -411,12 +483,33 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         v: &Vector3<f64>,
         u: &Vector3<f64>,
     ) {
-        for &i in &self.passive {
-            let (r, rp) = self.model.tendons[i].tendon.routing().offset(s, props);
+        if !self.ws.track_lengths {
+            return;
+        }
+        let tendons = self.eq.model.tendons();
+        for &i in &self.ws.passive {
+            let (r, rp) = tendons[i].routing().offset(s, props);
             let r = Vector3::new(r[0], r[1], 0.0);
             let rp = Vector3::new(rp[0], rp[1], 0.0);
-            self.tendon_speed[i] = (v + u.cross(&r) + rp).norm();
+            self.ws.tendon_speed[i] = (v + u.cross(&r) + rp).norm();
         }
+    }
+
+    /// `(t, r × t)` of tendon `i` (body) at strains `(v, u)`.
+    pub(crate) fn tendon_direction(
+        &self,
+        i: usize,
+        s: f64,
+        props: &SectionProperties,
+        v: &Vector3<f64>,
+        u: &Vector3<f64>,
+    ) -> Vector6<f64> {
+        let (r, rp) = self.eq.model.tendons()[i].routing().offset(s, props);
+        let r = Vector3::new(r[0], r[1], 0.0);
+        let w = v + u.cross(&r) + Vector3::new(rp[0], rp[1], 0.0);
+        let t = w / w.norm();
+        let q = r.cross(&t);
+        Vector6::new(t.x, t.y, t.z, q.x, q.y, q.z)
     }
 
     /// Tendon load sums `(Σ τ t, Σ τ r × t)` at the strains `x = (v, u)`, and, if `jac`, the
@@ -443,7 +536,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         let mut tq = Matrix3::zeros();
         let mut qq = Matrix3::zeros();
         let mut rr = Matrix3::zeros();
-        for (r, rp, tau) in &self.offsets {
+        for (r, rp, tau) in &self.ws.offsets {
             let w = v + u.cross(r) + rp;
             let inv_len = 1.0 / w.norm();
             let t = w * inv_len;
@@ -483,9 +576,8 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         (sums, Some(h))
     }
 
-    /// Solves the constitutive equations at `s` for the body wrench `(nb, mb)`; with
-    /// `tangent`, also stores `d(v, u)/d(nb, mb)` for [`Evaluator::rhs`].
-    /// Returns NaN strains if the local iteration fails.
+    /// Solves the constitutive equations at `s` for the total body wrench `(nb, mb)`; with
+    /// `tangent`, also returns `d(v, u)/d(nb, mb)`. NaN strains if the local iteration fails.
     ///
     /// The iteration on `G(x) = x - x* - C (W - T(x)) = 0` starts from the previous solution
     /// and takes chord steps with the previous factorised Jacobian while they contract fast
@@ -499,8 +591,8 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         mb: &Vector3<f64>,
         tangent: bool,
     ) -> Local {
-        let model = self.model;
-        let rod = model.rod;
+        let model = self.eq.model;
+        let rod = model.rod();
         let mut wb = [nb.x, nb.y, nb.z, mb.x, mb.y, mb.z];
         // The chambers' fluid carries part of the total wrench (see `chamber.rs`).
         let fluid = self.chamber_wrench(s);
@@ -512,7 +604,7 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         }
         let vs = rod.rest_strain().at(s);
         let us = rod.rest_curvature().at(s);
-        let (e, c) = match &model.uniform_compliance {
+        let (e, c) = match model.uniform_compliance() {
             Some(c) => {
                 let mut e = [0.0; 6];
                 for k in 0..6 {
@@ -522,47 +614,33 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             }
             None => rod.material().elastic_strain(
                 props,
-                model.shear_coefficient,
+                rod.shear_coefficient(),
                 rod.inextensible(),
                 &wb,
             ),
         };
-        if self.active.is_empty() {
+        if self.ws.active.is_empty() {
             let out = Local {
                 v: vs + Vector3::new(e[0], e[1], e[2]),
                 u: us + Vector3::new(e[3], e[4], e[5]),
                 tendon_force: Vector3::new(fluid[0], fluid[1], fluid[2]),
                 tendon_moment: Vector3::new(fluid[3], fluid[4], fluid[5]),
+                tangent: tangent.then_some(Tangent { diag: c, lu: None }),
             };
-            if tangent {
-                self.tangent_diag = c;
-                self.tangent_lu = None;
-            }
-            if self.track_speeds {
-                self.passive_speeds(s, props, &out.v, &out.u);
-            }
+            self.passive_speeds(s, props, &out.v, &out.u);
             return out;
         }
-        self.offsets.clear();
-        for &i in &self.active {
-            let t = &model.tendons[i];
-            let (r, rp) = t.tendon.routing().offset(s, props);
-            self.offsets.push((
-                Vector3::new(r[0], r[1], 0.0),
-                Vector3::new(rp[0], rp[1], 0.0),
-                t.tendon.tension() * model.factor,
-            ));
-        }
+        self.load_offsets(s, props);
         let cd = Vector6::from_column_slice(&c);
         let xs = Vector6::new(vs.x, vs.y, vs.z, us.x, us.y, us.z);
         let wv = Vector6::from_column_slice(&wb);
-        let mut x = match self.guess {
+        let mut x = match self.ws.guess {
             Some(g) => g,
             None => {
                 // Straight tendons: t_i = e_z.
                 let mut tf = Vector3::zeros();
                 let mut tm = Vector3::zeros();
-                for (r, _, tau) in &self.offsets {
+                for (r, _, tau) in &self.ws.offsets {
                     tf.z += tau;
                     tm += r.cross(&Vector3::z()) * *tau;
                 }
@@ -571,17 +649,17 @@ impl<'m, 'a> Evaluator<'m, 'a> {
         };
         let mut last_step = f64::INFINITY;
         let mut converged = false;
-        let mut chord = self.last_lu.is_some();
+        let mut chord = self.ws.last_lu.is_some();
         for _ in 0..LOCAL_MAX_ITERATIONS {
             let (tw, h) = self.tendon_sums(&x, &c, !chord);
             let g = x - xs - cd.component_mul(&(wv - tw));
             if let Some(h) = h {
                 match Lu6::new(&h) {
-                    Some(lu) => self.last_lu = Some(lu),
+                    Some(lu) => self.ws.last_lu = Some(lu),
                     None => return Local::nan(),
                 }
             }
-            let Some(lu) = &self.last_lu else {
+            let Some(lu) = &self.ws.last_lu else {
                 return Local::nan();
             };
             let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
@@ -625,122 +703,176 @@ impl<'m, 'a> Evaluator<'m, 'a> {
             u: Vector3::new(x[3], x[4], x[5]),
             tendon_force: Vector3::zeros(),
             tendon_moment: Vector3::zeros(),
+            tangent: None,
         };
         if tangent {
-            // (I + C D)⁻¹ C at the solution: keep the factorisation for the sensitivities.
+            // (I + C D)⁻¹ C at the solution.
             let (_, h) = self.tendon_sums(&x, &c, true);
             let Some(lu) = h.as_ref().and_then(Lu6::new) else {
                 return Local::nan();
             };
-            self.tangent_diag = c;
-            self.tangent_lu = Some(lu);
-            self.last_lu = Some(lu);
+            out.tangent = Some(Tangent {
+                diag: c,
+                lu: Some(lu),
+            });
+            self.ws.last_lu = Some(lu);
         }
-        // Tendon loads and speeds |p_i'| at the solution.
+        self.finish_tendons(s, props, &mut out, &fluid);
+        self.ws.guess = Some(x);
+        out
+    }
+
+    /// Tendon loads and speeds `|p_i'|` at the local solution `out`, plus the fluid's share.
+    #[inline]
+    pub(crate) fn finish_tendons(
+        &mut self,
+        s: f64,
+        props: &SectionProperties,
+        out: &mut Local,
+        fluid: &[f64; 6],
+    ) {
         let (mut tf, mut tm) = (Vector3::zeros(), Vector3::zeros());
-        for (k, &i) in self.active.iter().enumerate() {
-            let (r, rp, tau) = &self.offsets[k];
+        for (k, &i) in self.ws.active.iter().enumerate() {
+            let (r, rp, tau) = &self.ws.offsets[k];
             let w = out.v + out.u.cross(r) + rp;
             let len = w.norm();
             let a = *tau / len;
             tf += w * a;
             tm += r.cross(&w) * a;
-            self.tendon_speed[i] = len;
+            self.ws.tendon_speed[i] = len;
         }
         out.tendon_force = tf + Vector3::new(fluid[0], fluid[1], fluid[2]);
         out.tendon_moment = tm + Vector3::new(fluid[3], fluid[4], fluid[5]);
-        if self.track_speeds {
-            self.passive_speeds(s, props, &out.v, &out.u);
-        }
-        self.guess = Some(x);
-        out
+        let (v, u) = (out.v, out.u);
+        self.passive_speeds(s, props, &v, &u);
     }
 
-    /// Tangent `d(v, u)/d(n_b, m_b)` of the constitutive solve (`(I + C D)⁻¹ C` with active
-    /// tendons) left by the last [`Evaluator::rhs`] call with sensitivities (`N == FULL`);
-    /// used by `compliance.rs`.
-    pub(crate) fn tangent(&self) -> Matrix6<f64> {
-        let c = &self.tangent_diag;
-        match &self.tangent_lu {
-            Some(lu) => {
-                let mut m = Matrix6::zeros();
-                for j in 0..6 {
-                    let mut e = [0.0; 6];
-                    e[j] = c[j];
-                    let col = lu.solve(&e);
-                    for i in 0..6 {
-                        m[(i, j)] = col[i];
-                    }
-                }
-                m
-            }
-            None => Matrix6::from_diagonal(&Vector6::from_column_slice(c)),
-        }
-    }
-
-    /// Right-hand side of the state (`N == STATE`) or of the state with sensitivities
-    /// (`N == FULL`).
-    #[inline]
-    pub fn rhs<const N: usize>(&mut self, s: f64, y: &[f64; N]) -> [f64; N] {
-        let mut out = [0.0; N];
-        self.rhs_into(s, y, &mut out);
-        out
-    }
-
-    /// [`Evaluator::rhs`] written into `out` (every component), for in-place integrators.
+    /// The right-hand side of the state and of the active columns (`N >= STATE + COLUMN
+    /// ncol`), and the stage integrands (tendon speeds, path-length sensitivities).
     #[inline]
     pub fn rhs_into<const N: usize>(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) {
-        self.evaluations += 1;
-        let model = self.model;
-        let props = model.rod.section_at(s);
+        self.ws.evaluations += 1;
+        let eq = self.eq;
+        let props = eq.model.rod().section_at(s);
         let r = rot(y);
         let nw = v3(y, 12);
         let mw = v3(y, 15);
         let nb = r.tr_mul(&nw);
         let mb = r.tr_mul(&mw);
-        let loc = self.local(s, &props, &nb, &mb, N == FULL);
+        let ncol = self.ws.columns.len().min((N - STATE) / COLUMN);
+        let loc = self.local(s, &props, &nb, &mb, ncol > 0);
         let (v, u) = (loc.v, loc.u);
         let pd = r * v;
         let rd = r * hat(&u);
-        let nd = -model.distributed_force(s, &props);
-        let md = -pd.cross(&nw) - model.distributed_moment(s);
+        let nd = -eq.distributed_force(s, &props);
+        let md = -pd.cross(&nw) - eq.distributed_moment(s);
         put3(out, 0, &pd);
         out[3..12].copy_from_slice(rd.as_slice());
         put3(out, 12, &nd);
         put3(out, 15, &md);
-        if N == FULL {
-            for k in 0..6 {
-                let b = STATE + 12 * k;
-                let w = v3(y, b + 3);
-                let dn = v3(y, b + 6);
-                let dm = v3(y, b + 9);
-                let dnb = nb.cross(&w) + r.tr_mul(&dn);
-                let dmb = mb.cross(&w) + r.tr_mul(&dm);
-                let c = &self.tangent_diag;
-                let cw = [
-                    c[0] * dnb.x,
-                    c[1] * dnb.y,
-                    c[2] * dnb.z,
-                    c[3] * dmb.x,
-                    c[4] * dmb.y,
-                    c[5] * dmb.z,
-                ];
-                let d = match &self.tangent_lu {
-                    None => cw,
-                    Some(lu) => lu.solve(&cw),
+        let nt = self.ws.tendon_speed.len();
+        self.ws.integrand[..nt].copy_from_slice(&self.ws.tendon_speed);
+        if ncol == 0 {
+            return;
+        }
+        let tangent = loc.tangent.unwrap_or(Tangent {
+            diag: [f64::NAN; 6],
+            lu: None,
+        });
+        let b_end = eq.model.breaks()[self.ws.interval + 1];
+        let ends = eq.model.tendon_ends();
+        let nl = self.ws.length_tendons.len();
+        let needs_dirs = nl > 0 || self.ws.columns.iter().any(|c| matches!(c, Column::Tension(_)));
+        let dir = |this: &Self, i: usize| -> Option<Vector6<f64>> {
+            (ends[i] >= b_end).then(|| this.tendon_direction(i, s, &props, &v, &u))
+        };
+        let length_dirs: Vec<Option<Vector6<f64>>> = if needs_dirs {
+            self.ws.length_tendons.iter().map(|&i| dir(self, i)).collect()
+        } else {
+            Vec::new()
+        };
+        for c in 0..ncol {
+            let b = STATE + COLUMN * c;
+            let w = v3(y, b + 3);
+            let dn = v3(y, b + 6);
+            let dm = v3(y, b + 9);
+            let dnb = nb.cross(&w) + r.tr_mul(&dn);
+            let dmb = mb.cross(&w) + r.tr_mul(&dm);
+            let mut e = [dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z];
+            if let Column::Tension(i) = self.ws.columns[c] {
+                if let Some(t) = dir(self, i) {
+                    for k in 0..6 {
+                        e[k] -= t[k];
+                    }
+                }
+            }
+            let d = tangent.apply(&e);
+            let (dv, du) = (
+                Vector3::new(d[0], d[1], d[2]),
+                Vector3::new(d[3], d[4], d[5]),
+            );
+            let dpd = r * (w.cross(&v) + dv);
+            let wd = w.cross(&u) + du;
+            let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
+            put3(out, b, &dpd);
+            put3(out, b + 3, &wd);
+            put3(out, b + 6, &Vector3::zeros());
+            put3(out, b + 9, &dmd);
+            for (h, t) in length_dirs.iter().enumerate() {
+                self.ws.integrand[nt + c * nl + h] = match t {
+                    Some(t) => t.dot(&Vector6::from(d)),
+                    None => 0.0,
                 };
-                let (dv, du) = (
-                    Vector3::new(d[0], d[1], d[2]),
-                    Vector3::new(d[3], d[4], d[5]),
-                );
-                let dpd = r * (w.cross(&v) + dv);
-                let wd = w.cross(&u) + du;
-                let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
-                put3(out, b, &dpd);
-                put3(out, b + 3, &wd);
-                put3(out, b + 6, &Vector3::zeros());
-                put3(out, b + 9, &dmd);
             }
         }
+        for k in STATE + COLUMN * ncol..N {
+            out[k] = 0.0;
+        }
+    }
+}
+
+impl<const N: usize> System<N> for Evaluator<'_, '_> {
+    #[inline]
+    fn rhs(&mut self, t: f64, y: &[f64; N], dy: &mut [f64; N]) {
+        self.rhs_into(t, y, dy);
+    }
+    #[inline]
+    fn stage_evaluated(&mut self, stage: usize) {
+        let ws = &mut *self.ws;
+        if ws.stages.len() <= stage {
+            ws.stages.resize(stage + 1, Vec::new());
+        }
+        ws.stages[stage].clear();
+        ws.stages[stage].extend_from_slice(&ws.integrand);
+    }
+    #[inline]
+    fn step_accepted(&mut self, weights: &[f64], fsal: bool) {
+        let ws = &mut *self.ws;
+        for (i, &w) in weights.iter().enumerate() {
+            if w != 0.0 {
+                for (acc, g) in ws.integral.iter_mut().zip(&ws.stages[i]) {
+                    *acc += w * g;
+                }
+            }
+        }
+        if fsal {
+            let last = weights.len() - 1;
+            let (first, rest) = ws.stages.split_at_mut(1);
+            first[0].clone_from(&rest[last - 1]);
+        }
+    }
+    #[inline]
+    fn project(&mut self, y: &mut [f64; N]) {
+        project(y);
+    }
+}
+
+impl<const N: usize> Piecewise<N> for Evaluator<'_, '_> {
+    fn enter_interval(&mut self, k: usize) {
+        self.set_interval(k);
+    }
+    fn jump(&mut self, s: f64, y: &mut [f64; N]) {
+        let ncol = self.ws.columns.len().min((N - STATE) / COLUMN);
+        self.eq.jump(s, y, ncol);
     }
 }

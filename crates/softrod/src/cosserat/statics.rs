@@ -1,30 +1,34 @@
-//! Steady-state shape of a Cosserat rod with tendons and external loads, by shooting.
+//! Steady-state shape of a Cosserat rod with tendons, chambers and external loads, by shooting.
 //!
-//! [`solve_statics`] finds the unknown total base wrench `(N(0), M(0))` (world frame) such that
-//! the integrated internal wrench matches the tip loads, with damped Newton iterations on an
-//! exact Jacobian (variational equations integrated with the state, see `cosserat.rs`). If the
-//! direct solve fails, or its first Newton step is larger than [`DIRECT_STEP_LIMIT`] (a strongly
-//! nonlinear problem, where Newton may land on an unstable equilibrium branch such as a looped
-//! elastica), it restarts from the unloaded rod and steps the load factor from 0 to 1
-//! (continuation with a secant predictor), refusing load steps that change the shape by more
-//! than [`MAX_LOAD_STEP_TURN`], so that the solution found is the one connected to the
-//! unloaded rod. The ODE is integrated piecewise between the breaks at tendon terminations
-//! and point loads, either with fixed-step RK4 (the seed's method) or with the adaptive
+//! [`solve_statics`] finds the total base wrench `(N(0), M(0))` (world frame) that meets the
+//! tip conditions ([`super::shooting`]). The actuation is always applied in full: with the
+//! total-wrench form a tendon or a chamber adds nothing to the base wrench, so the actuated,
+//! unloaded rod is solved exactly by a zero base wrench in one pass. The external loads are
+//! then applied along the load factor `λ` from 0 to 1: first directly, from the exact tangent
+//! predictor `dx/dλ = -J⁻¹ ∂r/∂λ` at the unloaded rod, with Broyden updates of the Jacobian
+//! between exact evaluations; if that fails, or the predictor step is larger than
+//! [`DIRECT_STEP_LIMIT`] (a strongly nonlinear problem, where Newton may land on another
+//! equilibrium branch), by continuation in `λ`, refusing load steps that change the shape by
+//! more than [`MAX_LOAD_STEP_TURN`], so that the solution found is the one connected to the
+//! unloaded, actuated rod. The ODE is integrated between the breaks at tendon terminations,
+//! chamber ends and point loads with fixed-step RK4 (the seed's method) or the adaptive
 //! Dormand–Prince 5(4) pair; rotation matrices are re-orthonormalised after every step.
-//!
-//! The Newton residual and unknowns are scaled by `F = E I(0) / L²` (forces) and `F L`
-//! (moments), so [`SolveOptions::tolerance`] is dimensionless: a residual `ε` leaves a tip
-//! error of about `ε L / 3`.
 
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use std::sync::Arc;
 
-use crate::cosserat::equations::{rot, v3, ActiveTendon, Evaluator, Model, FULL, STATE};
-use crate::error::{check_newton_options, Error, Result};
-use crate::integrate::{dp54, rk4_step_in_place, AdaptiveOptions, Rk4Workspace};
-use crate::model::loads::{Frame, Loads};
-use crate::model::rod::Rod;
-use crate::math::so3::{hat, quaternion_xyzw, reorthonormalise};
-use crate::model::tendon::Tendon;
+use nalgebra::{Matrix3, Matrix6, Vector3};
+
+use super::equations::{rot, v3, Equations, Evaluator, Workspace};
+use super::shooting::{Node, Shooting};
+use crate::error::{Error, Result};
+use crate::integrate::march::rk4_plan;
+use crate::integrate::AdaptiveOptions;
+use crate::math::so3::quaternion_xyzw;
+use crate::model::{Actuation, RobotModel};
+use crate::solve::{
+    continuation, max_norm, newton, Armijo, ContinuationSettings, Evaluated, LineSearch,
+    NewtonOptions, NewtonOutcome, NewtonSettings, Problem, SolverStats,
+};
 
 /// Default number of RK4 steps over the whole rod (split among the intervals in proportion
 /// to their length, at least one each).
@@ -39,9 +43,7 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 30;
 pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
 /// Most step halvings of the Newton line search.
 pub const MAX_LINE_SEARCH_HALVINGS: usize = 12;
-/// Sufficient-decrease constant of the line search (Armijo, on the residual norm).
-pub const ARMIJO: f64 = 1e-4;
-/// Largest first Newton step (max norm of the scaled base wrench, about the bending in rad it
+/// Largest predictor step (max norm of the scaled base wrench, about the bending in rad it
 /// predicts) taken directly when continuation is enabled; beyond it the load is stepped, so
 /// that the solution stays on the equilibrium branch connected to the unloaded rod.
 pub const DIRECT_STEP_LIMIT: f64 = 4.0;
@@ -49,8 +51,6 @@ pub const DIRECT_STEP_LIMIT: f64 = 4.0;
 /// half of it, in units of the rod length, in position). Larger jumps may switch equilibrium
 /// branch, so the step is halved.
 pub const MAX_LOAD_STEP_TURN: f64 = 1.0;
-/// Smallest load-factor increment of the continuation before giving up.
-pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
 
 /// The ODE integrator used by the shooting method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,6 +78,19 @@ impl Default for Integrator {
 pub struct WarmStart {
     /// Total base wrench `[N(0); M(0)]` (N, N m; world frame) including the tendons' share.
     pub base_wrench: [f64; 6],
+    /// The shooting Jacobian (scaled unknowns and residual) at that solution, if known: the
+    /// first Jacobian of the new solve.
+    pub jacobian: Option<Matrix6<f64>>,
+}
+
+impl WarmStart {
+    /// A warm start from a base wrench alone.
+    pub fn wrench(base_wrench: [f64; 6]) -> Self {
+        Self {
+            base_wrench,
+            jacobian: None,
+        }
+    }
 }
 
 /// Options of [`solve_statics`] (keyword arguments in Python).
@@ -85,61 +98,75 @@ pub struct WarmStart {
 pub struct SolveOptions {
     /// ODE integrator.
     pub integrator: Integrator,
-    /// Tolerance on the scaled residual (max norm), > 0. With the adaptive integrator the
-    /// residual is only resolved down to the integration error, `10 rtol (1 + |x|)`.
-    pub tolerance: f64,
-    /// Newton iterations per solve (per load step), >= 1.
-    pub max_iterations: usize,
-    /// Whether to fall back on load stepping when the direct solve fails.
-    pub continuation: bool,
-    /// Load steps (attempted) under continuation, >= 1.
-    pub max_load_steps: usize,
-    /// Initial guess of the base wrench; `None` starts from zero (the unloaded rod).
+    /// Nonlinear solve. The tolerance is on the scaled shooting residual; with the adaptive
+    /// integrator it is only resolved down to the integration error, `10 rtol (1 + |x|)`.
+    pub newton: NewtonOptions,
+    /// Initial guess of the base wrench; `None` starts from the unloaded rod.
     pub warm_start: Option<WarmStart>,
-    /// `true`: non-convergence is [`Error::NotConverged`]; `false`: the last iterate is
-    /// returned with `stats.converged == false`.
-    pub throw: bool,
 }
 
 impl Default for SolveOptions {
     fn default() -> Self {
         Self {
             integrator: Integrator::default(),
-            tolerance: DEFAULT_TOLERANCE,
-            max_iterations: DEFAULT_MAX_ITERATIONS,
-            continuation: true,
-            max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+            newton: NewtonOptions {
+                tolerance: DEFAULT_TOLERANCE,
+                max_iterations: DEFAULT_MAX_ITERATIONS,
+                continuation: true,
+                max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+                throw: true,
+            },
             warm_start: None,
-            throw: true,
         }
     }
 }
 
-/// Solver statistics.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolverStats {
-    /// Newton iterations (accepted steps), over all load steps.
-    pub iterations: usize,
-    /// Final scaled residual (max norm, dimensionless).
-    pub residual: f64,
-    /// Right-hand-side evaluations.
-    pub function_evaluations: usize,
-    /// Whether the residual met the tolerance.
-    pub converged: bool,
-    /// Load steps taken by the continuation (0: solved directly).
-    pub load_steps: usize,
-    /// Fraction of the loads (and tensions) the returned shape carries: 1 when converged; for
-    /// a non-converged result under continuation, the last load factor reached.
-    pub load_factor: f64,
+impl SolveOptions {
+    /// Checks the options.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `integrator.steps`, `rtol`, `atol`, `max_steps`,
+    /// `tolerance`, `max_iterations`, `max_load_steps` or `warm_start.base_wrench[k]`.
+    pub fn validate(&self) -> Result<()> {
+        match self.integrator {
+            Integrator::Rk4 { steps } => {
+                if steps == 0 || steps > MAX_RK4_STEPS {
+                    return Err(Error::invalid(
+                        "integrator.steps",
+                        steps,
+                        format!("in [1, {MAX_RK4_STEPS}]"),
+                    ));
+                }
+            }
+            Integrator::Adaptive(a) => {
+                a.validated()?;
+            }
+        }
+        self.newton.validate()?;
+        if let Some(w) = &self.warm_start {
+            for (k, v) in w.base_wrench.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(Error::invalid(
+                        format!("warm_start.base_wrench[{k}]"),
+                        v,
+                        "finite",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
-/// A solved rod, sampled at the integration mesh.
+/// A solved rod, sampled at the integration mesh, with the model, actuation and options it
+/// was solved with (so that [`crate::compliance::compliance`] and
+/// [`crate::compliance::tangent_compliance`] need nothing else).
 ///
 /// Every array has one entry per sample. At an interval break (tendon termination, point
 /// load) the sample appears twice with the same `s`: the values just before and just after
 /// the jump. Vectors are `[x, y, z]`; rotations are body → world matrices; quaternions are
 /// scalar-last `[x, y, z, w]` with `w >= 0`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct StaticsSolution {
     /// Undeformed arc length (m).
     pub s: Vec<f64>,
@@ -167,6 +194,14 @@ pub struct StaticsSolution {
     pub base_wrench: [f64; 6],
     /// Solver statistics.
     pub stats: SolverStats,
+    /// The model solved.
+    pub model: Arc<RobotModel>,
+    /// The actuation it was solved for.
+    pub actuation: Actuation,
+    /// The options it was solved with.
+    pub options: SolveOptions,
+    /// The (exact or updated) shooting Jacobian at the solution, in scaled unknowns.
+    pub jacobian: Option<Matrix6<f64>>,
 }
 
 impl StaticsSolution {
@@ -175,655 +210,225 @@ impl StaticsSolution {
         self.position.last().copied().unwrap_or([f64::NAN; 3])
     }
 
-    /// Warm start for a nearby problem.
+    /// Warm start for a nearby problem (base wrench and Jacobian).
     pub fn warm_start(&self) -> WarmStart {
         WarmStart {
             base_wrench: self.base_wrench,
+            jacobian: self.jacobian,
         }
+    }
+
+    /// Tension of every tendon (N).
+    pub fn tensions(&self) -> Vec<f64> {
+        self.actuation.tension_values(self.model.tendons().len())
+    }
+
+    /// Pressure of every chamber (Pa).
+    pub fn pressures(&self) -> Vec<f64> {
+        self.actuation.pressure_values(self.model.chambers().len())
     }
 }
 
-/// A recorded mesh node.
-#[derive(Clone, Copy)]
-struct Node {
-    s: f64,
-    interval: usize,
-    y: [f64; STATE],
-}
-
-/// Per-interval step counts of the RK4 plan.
-pub(crate) fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
-    let l = breaks[breaks.len() - 1];
-    breaks
-        .windows(2)
-        .map(|w| ((steps as f64 * (w[1] - w[0]) / l).round() as usize).max(1))
-        .collect()
-}
-
-fn head(y: &[f64]) -> [f64; STATE] {
-    let mut h = [0.0; STATE];
-    h.copy_from_slice(&y[..STATE]);
-    h
-}
-
-pub(crate) fn project<const N: usize>(y: &mut [f64; N]) {
-    let r = reorthonormalise(&rot(y));
-    y[3..12].copy_from_slice(r.as_slice());
-}
-
-/// The outcome of one shooting pass.
-struct Pass {
-    residual: Vector6<f64>,
-    jacobian: Option<Matrix6<f64>>,
-    /// Chord `p(L) - p(0)` (m, world).
-    chord: Vector3<f64>,
-}
-
-/// Scratch shared by the passes of one solve.
-struct Workspace {
-    nodes: Vec<Node>,
-    tendon_lengths: Vec<f64>,
-}
-
-/// Integrates from the base with unknowns `x` over all intervals, recording nodes.
-fn shoot<const N: usize>(
-    ev: &mut Evaluator<'_, '_>,
-    x: &Vector6<f64>,
-    integrator: &Integrator,
-    plan: &[usize],
-    ws: &mut Workspace,
-) -> Result<Pass> {
-    let model = ev.model;
-    let breaks = &model.breaks;
-    ws.nodes.clear();
-    ws.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
-    let mut y: [f64; N] = model.initial(x);
-    let mut rk = Rk4Workspace::<N>::default();
-    for k in 0..breaks.len() - 1 {
-        let (a, b) = (breaks[k], breaks[k + 1]);
-        ev.set_interval(k);
-        ws.nodes.push(Node {
-            s: a,
-            interval: k,
-            y: head(&y),
-        });
-        match integrator {
-            Integrator::Rk4 { .. } => {
-                let n = plan[k];
-                let h = (b - a) / n as f64;
-                for i in 0..n {
-                    let t = a + h * i as f64;
-                    let mut f = |s: f64, yy: &[f64; N], dy: &mut [f64; N]| ev.rhs_into(s, yy, dy);
-                    rk4_step_in_place(&mut f, t, &mut y, h, &mut rk);
-                    project(&mut y);
-                    if !y[..STATE].iter().all(|v| v.is_finite()) {
-                        return Err(Error::NotConverged {
-                            what: "rod integration: non-finite state".into(),
-                            iterations: i,
-                            residual: f64::INFINITY,
-                        });
-                    }
-                    ws.nodes.push(Node {
-                        s: if i + 1 == n { b } else { t + h },
-                        interval: k,
-                        y: head(&y),
-                    });
-                }
-            }
-            Integrator::Adaptive(opts) => {
-                let sol = dp54(
-                    |s, yy: &[f64; N]| ev.rhs(s, yy),
-                    a,
-                    y,
-                    b,
-                    *opts,
-                    STATE,
-                    project,
-                )?;
-                // Tendon lengths: 3-point Gauss–Legendre on each step with the dense output.
-                const G: [(f64, f64); 3] = [
-                    (0.112_701_665_379_258_31, 5.0 / 18.0),
-                    (0.5, 8.0 / 18.0),
-                    (0.887_298_334_620_741_7, 5.0 / 18.0),
-                ];
-                ev.track_speeds = true;
-                for i in 1..sol.t.len() {
-                    let (t0, t1) = (sol.t[i - 1], sol.t[i]);
-                    if !ws.tendon_lengths.is_empty() {
-                        for (c, wg) in G {
-                            let s = t0 + c * (t1 - t0);
-                            let yy = sol.eval(s);
-                            let r = rot(&yy);
-                            let props = model.rod.section_at(s);
-                            let nb = r.tr_mul(&v3(&yy, 12));
-                            let mb = r.tr_mul(&v3(&yy, 15));
-                            ev.local(s, &props, &nb, &mb, false);
-                            for (i, t) in model.tendons.iter().enumerate() {
-                                if t.end >= b {
-                                    ws.tendon_lengths[i] += wg * (t1 - t0) * ev.tendon_speed[i];
-                                }
-                            }
-                        }
-                    }
-                    ws.nodes.push(Node {
-                        s: t1,
-                        interval: k,
-                        y: head(&sol.y[i]),
-                    });
-                }
-                ev.track_speeds = false;
-                y = sol.y[sol.y.len() - 1];
-            }
-        }
-        if k + 2 < breaks.len() {
-            model.jump(b, &mut y);
-        }
-    }
-    let (residual, jacobian) = model.residual(&y);
-    let chord = v3(&y, 0) - model.rod.base_pose().position();
-    Ok(Pass {
-        residual,
+/// Newton settings of the shooting. Broyden's update of the Jacobian is used with the fixed
+/// RK4 mesh (the residual is then a smooth function of the unknowns); with the adaptive
+/// integrator the residual carries the integration error and exact Jacobians are evaluated.
+fn settings(broyden: bool, jacobian: Option<&[f64]>) -> NewtonSettings<'_> {
+    NewtonSettings {
+        line_search: LineSearch {
+            factor: 0.5,
+            max_halvings: MAX_LINE_SEARCH_HALVINGS,
+        },
+        condition: Armijo::default(),
+        first_step_limit: None,
+        residual_first: false,
+        broyden,
         jacobian,
-        chord,
-    })
-}
-
-fn shoot_any(
-    ev: &mut Evaluator<'_, '_>,
-    x: &Vector6<f64>,
-    sens: bool,
-    integrator: &Integrator,
-    plan: &[usize],
-    ws: &mut Workspace,
-) -> Result<Pass> {
-    if sens {
-        shoot::<FULL>(ev, x, integrator, plan, ws)
-    } else {
-        shoot::<STATE>(ev, x, integrator, plan, ws)
     }
 }
 
-/// Outcome of the Newton iteration at one load factor.
-struct NewtonOut {
-    x: Vector6<f64>,
-    residual: f64,
-    converged: bool,
-    iterations: usize,
-    /// Whether the workspace holds the pass at `x`.
-    recorded: bool,
-    /// Size of a first Newton step refused for exceeding the step limit (0 otherwise).
-    first_step: f64,
-}
-
-fn norm(r: &Vector6<f64>) -> f64 {
-    if r.iter().all(|v| v.is_finite()) {
-        r.amax()
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// Damped Newton on the scaled base wrench, from `x0`.
-fn newton(
-    ev: &mut Evaluator<'_, '_>,
-    x0: Vector6<f64>,
-    try_cheap: bool,
-    step_limit: Option<f64>,
-    opts: &SolveOptions,
-    plan: &[usize],
-    ws: &mut Workspace,
-) -> NewtonOut {
-    let tol_of = |x: &Vector6<f64>| match opts.integrator {
-        Integrator::Rk4 { .. } => opts.tolerance,
-        Integrator::Adaptive(a) => opts.tolerance.max(10.0 * a.rtol * (1.0 + x.amax())),
-    };
-    let mut x = x0;
-    let mut out = NewtonOut {
-        x,
-        residual: f64::INFINITY,
-        converged: false,
-        iterations: 0,
-        recorded: false,
-        first_step: 0.0,
-    };
-    // A cheap first pass without sensitivities when the guess may already solve the problem
-    // (warm starts; tendon-only loading, for which the total base wrench is exactly zero).
-    let (mut r, mut rn) = (Vector6::repeat(f64::NAN), f64::INFINITY);
-    if try_cheap {
-        if let Ok(p) = shoot_any(ev, &x, false, &opts.integrator, plan, ws) {
-            r = p.residual;
-            rn = norm(&r);
-        }
-        out.residual = rn;
-        out.recorded = rn.is_finite();
-        if rn <= tol_of(&x) {
-            out.converged = true;
-            return out;
-        }
-    }
-    // With a zero base force and no force applied along the rod, N(s) = 0 everywhere, and
-    // the variational equations integrate in closed form: δN(L) = δN(0) and
-    // δM(L) = δM(0) - (p(L) - p(0)) × δN(0). The exact Jacobian then comes from a pass
-    // without sensitivities.
-    let analytic = ev.model.force_free && x.fixed_rows::<3>(0).iter().all(|v| *v == 0.0);
-    let mut jac = match shoot_any(ev, &x, !analytic, &opts.integrator, plan, ws) {
-        Ok(p) if norm(&p.residual).is_finite() => {
-            r = p.residual;
-            rn = norm(&r);
-            if analytic {
-                let mut j = Matrix6::identity();
-                let h = hat(&p.chord) / ev.model.length;
-                for a in 0..3 {
-                    for b in 0..3 {
-                        j[(3 + a, b)] = -h[(a, b)];
-                    }
-                }
-                Some(j)
-            } else {
-                p.jacobian
-            }
-        }
-        _ => None,
-    };
-    out.recorded = jac.is_some();
-    out.residual = rn;
-    let mut r_prev = f64::INFINITY;
-    for _ in 0..opts.max_iterations {
-        let Some(j) = jac else {
-            break;
+/// The direct solve at full load: from the warm start, or from the tangent predictor at the
+/// unloaded rod. Returns the outcome and, for a cold start, the unloaded Jacobian and the
+/// size of a predictor step refused by the step limit.
+fn direct(
+    p: &mut Shooting<'_>,
+    options: &SolveOptions,
+    x0: &[f64; 6],
+) -> (NewtonOutcome, Option<Vec<f64>>, f64) {
+    let opts = &options.newton;
+    let limit = opts.continuation.then_some(DIRECT_STEP_LIMIT);
+    let broyden = matches!(options.integrator, Integrator::Rk4 { .. });
+    let settings = |_: bool, j| settings(broyden, j);
+    if let Some(w) = &options.warm_start {
+        let j = w.jacobian.map(|m| m.as_slice().to_vec());
+        let s = NewtonSettings {
+            first_step_limit: limit,
+            residual_first: true,
+            ..settings(true, j.as_deref())
         };
-        let Some(dx) = j.lu().solve(&(-r)) else {
-            break;
+        return (newton(p, x0, 1.0, opts, &s), None, 0.0);
+    }
+    if p.eq.model.loads().is_unloaded() {
+        // Nothing to apply: x = 0 solves the actuated rod exactly.
+        let s = NewtonSettings {
+            residual_first: true,
+            ..settings(true, None)
         };
-        if !dx.iter().all(|v| v.is_finite()) {
-            break;
-        }
-        if let Some(limit) = step_limit {
-            if out.iterations == 0 && dx.amax() > limit {
-                // Too far from the guess for Newton to stay on the equilibrium branch that is
-                // connected to it: leave it to the continuation.
-                out.first_step = dx.amax();
-                break;
+        return (newton(p, x0, 1.0, opts, &s), None, 0.0);
+    }
+    // The unloaded, actuated rod: x = 0 is exact at λ = 0, its Jacobian is closed form.
+    let mut r = [0.0; 6];
+    let mut j0 = vec![0.0; 36];
+    if p.evaluate(x0, 0.0, Some(&mut j0), &mut r) != Evaluated::Jacobian {
+        let s = NewtonSettings {
+            residual_first: true,
+            ..settings(true, None)
+        };
+        return (newton(p, x0, 1.0, opts, &s), None, 0.0);
+    }
+    let mut drdl = [0.0; 6];
+    let mut guess = *x0;
+    if p.load_derivative(x0, 0.0, &mut drdl) {
+        let mut lu = crate::math::linalg::DenseLu::default();
+        let mut t = drdl.map(|v| -v);
+        if lu.factor(6, &j0) && lu.solve_in_place(&mut t) {
+            let step = max_norm(&t);
+            if limit.is_some_and(|l| step > l) {
+                let refused = NewtonOutcome {
+                    x: x0.to_vec(),
+                    residual: f64::INFINITY,
+                    converged: false,
+                    iterations: 0,
+                    first_step: step,
+                    jacobian: None,
+                    at_x: false,
+                };
+                return (refused, Some(j0), step);
             }
-        }
-        // Under quadratic convergence the next residual is about rn³ / r_prev²; when that is
-        // far below the tolerance, try the full step without sensitivities first (it is then
-        // the last pass).
-        if r_prev.is_finite() && rn < 0.1 * r_prev && rn * (rn / r_prev).powi(2) < 0.5 * tol_of(&x)
-        {
-            let xt = x + dx;
-            if let Ok(p) = shoot_any(ev, &xt, false, &opts.integrator, plan, ws) {
-                let rt = norm(&p.residual);
-                if rt <= tol_of(&xt) {
-                    out.iterations += 1;
-                    out.x = xt;
-                    out.residual = rt;
-                    out.recorded = true;
-                    out.converged = true;
-                    return out;
-                }
+            for k in 0..6 {
+                guess[k] += t[k];
             }
-        }
-        r_prev = rn;
-        let mut lambda = 1.0;
-        let mut accepted = false;
-        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
-            let xt = x + dx * lambda;
-            if let Ok(p) = shoot_any(ev, &xt, true, &opts.integrator, plan, ws) {
-                let rt = norm(&p.residual);
-                if rt <= (1.0 - ARMIJO * lambda) * rn || rt <= tol_of(&xt) {
-                    x = xt;
-                    r = p.residual;
-                    rn = rt;
-                    jac = p.jacobian;
-                    accepted = true;
-                    break;
-                }
-            }
-            lambda *= 0.5;
-        }
-        out.recorded = accepted;
-        if !accepted {
-            break;
-        }
-        out.iterations += 1;
-        out.x = x;
-        out.residual = rn;
-        if rn <= tol_of(&x) {
-            out.converged = true;
-            return out;
         }
     }
-    out.x = x;
-    out.residual = rn;
-    out
-}
-
-/// Positions and rotations at the nodes of the pass held by the workspace.
-fn shape_of(ws: &Workspace) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
-    ws.nodes.iter().map(|n| (v3(&n.y, 0), rot(&n.y))).collect()
-}
-
-/// Whether two shapes differ by at most [`MAX_LOAD_STEP_TURN`] in rotation (rad) and
-/// `MAX_LOAD_STEP_TURN L / 2` in position, node by node on a common mesh (RK4), at the tip
-/// otherwise (adaptive meshes differ between passes).
-fn shape_change_is_small(
-    a: &[(Vector3<f64>, Matrix3<f64>)],
-    b: &[(Vector3<f64>, Matrix3<f64>)],
-    length: f64,
-) -> bool {
-    let close = |(p0, r0): &(Vector3<f64>, Matrix3<f64>),
-                 (p1, r1): &(Vector3<f64>, Matrix3<f64>)| {
-        let c = ((r0.tr_mul(r1).trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
-        c.acos() <= MAX_LOAD_STEP_TURN && (p1 - p0).norm() <= 0.5 * MAX_LOAD_STEP_TURN * length
+    let s = NewtonSettings {
+        residual_first: true,
+        first_step_limit: if guess == *x0 { limit } else { None },
+        ..settings(true, Some(&j0))
     };
-    if a.len() == b.len() {
-        a.iter().zip(b).all(|(x, y)| close(x, y))
-    } else {
-        match (a.last(), b.last()) {
-            (Some(x), Some(y)) => close(x, y),
-            _ => false,
-        }
+    let mut out = newton(p, &guess, 1.0, opts, &s);
+    if !out.converged && !out.residual.is_finite() && guess != *x0 {
+        // The predictor left the domain of the equations: Newton from the unloaded rod.
+        let s = NewtonSettings {
+            first_step_limit: limit,
+            ..settings(true, Some(&j0))
+        };
+        out = newton(p, x0, 1.0, opts, &s);
     }
+    let first = out.first_step;
+    (out, Some(j0), first)
 }
 
-/// Validates the inputs and builds the model at load factor 1.
-pub(crate) fn build_model<'a>(
-    rod: &'a Rod,
-    tendons: &'a [Tendon],
-    loads: &'a Loads,
-) -> Result<Model<'a>> {
-    let l = rod.length();
-    loads.validate(l, rod.density())?;
-    let mut prepared = Vec::with_capacity(tendons.len());
-    let mut breaks = vec![0.0, l];
-    for (i, t) in tendons.iter().enumerate() {
-        let end = t.end().unwrap_or(l);
-        if !(end.is_finite() && end > 0.0 && end <= l) {
-            return Err(Error::invalid(
-                format!("tendons[{i}].end"),
-                end,
-                format!("in (0, length] = (0, {l}] m"),
-            ));
-        }
-        if t.tension() < 0.0 || !t.tension().is_finite() {
-            return Err(Error::invalid(
-                format!("tendons[{i}].tension"),
-                t.tension(),
-                "finite and >= 0 N",
-            ));
-        }
-        breaks.push(end);
-        prepared.push(ActiveTendon { tendon: t, end });
-    }
-    for p in &loads.point_loads {
-        breaks.push(p.s);
-    }
-    for (start, end) in crate::model::chamber::validate(&loads.chambers, rod)? {
-        breaks.extend([start, end]);
-    }
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup();
-    let props0 = rod.section_at(0.0);
-    let f_ref = rod.material().bending_stiffness(&props0) / (l * l);
-    if !(f_ref.is_finite() && f_ref > 0.0) {
-        return Err(Error::invalid(
-            "section(0)",
-            format!("{props0:?}"),
-            "positive and finite",
-        ));
-    }
-    // Tendon offsets must be finite (user functions) and inside... finite at the checks.
-    for (i, t) in tendons.iter().enumerate() {
-        let end = prepared[i].end;
-        for k in 0..=crate::model::rod::FUNCTION_CHECKS {
-            let s = end * k as f64 / crate::model::rod::FUNCTION_CHECKS as f64;
-            let (r, rp) = t.routing().offset(s, &rod.section_at(s));
-            if !(r.iter().chain(rp.iter()).all(|v| v.is_finite())) {
-                return Err(Error::invalid(
-                    format!("tendons[{i}].offset({s})"),
-                    format!("{r:?}, {rp:?}"),
-                    "finite",
-                ));
-            }
-        }
-    }
-    Ok(Model {
-        rod,
-        tendons: prepared,
-        loads,
-        shear_coefficient: rod.shear_coefficient(),
-        rho_g: rod
-            .density()
-            .filter(|_| loads.gravity != Vector3::zeros())
-            .map(|rho| loads.gravity * rho),
-        factor: 1.0,
-        f_ref,
-        length: l,
-        breaks,
-        force_free: loads.distributed_force.is_none()
-            && loads.gravity == Vector3::zeros()
-            && loads.point_loads.iter().all(|p| {
-                p.force == Vector3::zeros()
-                    && (p.frame == Frame::World || p.moment == Vector3::zeros())
-            })
-            && (loads.tip_frame == Frame::World
-                || (loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros())),
-        material_error: std::sync::OnceLock::new(),
-        uniform_compliance: (rod.section().is_uniform() && rod.material().is_linear()).then(|| {
-            rod.material()
-                .compliance(&props0, rod.shear_coefficient(), rod.inextensible())
-        }),
-    })
-}
-
-fn check_options(opts: &SolveOptions) -> Result<()> {
-    match opts.integrator {
-        Integrator::Rk4 { steps } => {
-            if steps == 0 || steps > MAX_RK4_STEPS {
-                return Err(Error::invalid(
-                    "integrator.steps",
-                    steps,
-                    format!("in [1, {MAX_RK4_STEPS}]"),
-                ));
-            }
-        }
-        Integrator::Adaptive(a) => {
-            a.validated()?;
-        }
-    }
-    check_newton_options(opts.tolerance, opts.max_iterations, opts.max_load_steps)?;
-    if let Some(w) = &opts.warm_start {
-        for (k, v) in w.base_wrench.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(Error::invalid(
-                    format!("warm_start.base_wrench[{k}]"),
-                    v,
-                    "finite",
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Solves the statics of `rod` actuated by `tendons` under `loads`
-/// (`solve_statics(rod, tendons=(), loads=None, ...)` in Python).
+/// Solves the statics of `model` under `actuation` (`solve_statics(rod, tendons=(),
+/// loads=None, ...)` in Python, which builds both).
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] naming the offending field (loads, tendon terminations outside
-/// `(0, L]`, chambers outside `[0, L]` or the section, options); [`Error::NotConverged`] with
-/// the Newton iterations and final scaled residual if the shooting does not converge and
-/// `options.throw` is true, unless a hyperelastic material failed on the way: then
-/// [`Error::InvalidParameter`] naming `stretch` (a fibre compressed to zero length) or the
-/// law's parameters (a law that is not monotonic at the stretches reached).
+/// [`Error::InvalidParameter`] naming the offending input (`tensions[i]`, `pressures[i]`,
+/// their counts, options); [`Error::NotConverged`] with the iterations and final scaled
+/// residual if the shooting does not converge and `options.newton.throw` is true, unless a
+/// hyperelastic material failed on the way: then [`Error::InvalidParameter`] naming `stretch`
+/// (a fibre compressed to zero length) or the law's parameters (a law that is not monotonic at
+/// the stretches reached).
 pub fn solve_statics(
-    rod: &Rod,
-    tendons: &[Tendon],
-    loads: &Loads,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
     options: &SolveOptions,
 ) -> Result<StaticsSolution> {
-    check_options(options)?;
-    let mut model = build_model(rod, tendons, loads)?;
+    options.validate()?;
+    let (nt, nc) = (model.tendons().len(), model.chambers().len());
+    actuation.validate(nt, nc)?;
+    let tensions = actuation.tension_values(nt);
+    let pressures = actuation.pressure_values(nc);
     let plan = match options.integrator {
-        Integrator::Rk4 { steps } => rk4_plan(&model.breaks, steps),
+        Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
         Integrator::Adaptive(_) => Vec::new(),
     };
-    let fm = model.f_ref * model.length;
+    let eq = Equations {
+        model,
+        tensions: &tensions,
+        pressures: &pressures,
+        load_factor: 1.0,
+    };
+    let mut p = Shooting::new(eq, options.integrator, plan);
+    let f_ref = model.force_scale();
+    let fm = f_ref * model.length();
     let x0 = match &options.warm_start {
         Some(w) => {
             let b = &w.base_wrench;
-            Vector6::new(
-                b[0] / model.f_ref,
-                b[1] / model.f_ref,
-                b[2] / model.f_ref,
+            [
+                b[0] / f_ref,
+                b[1] / f_ref,
+                b[2] / f_ref,
                 b[3] / fm,
                 b[4] / fm,
                 b[5] / fm,
-            )
+            ]
         }
-        None => Vector6::zeros(),
+        None => [0.0; 6],
     };
-    let mut ws = Workspace {
-        nodes: Vec::new(),
-        tendon_lengths: vec![0.0; tendons.len()],
-    };
-    let mut evaluations = 0usize;
+    let opts = &options.newton;
     let mut stats = SolverStats {
-        iterations: 0,
-        residual: f64::INFINITY,
-        function_evaluations: 0,
-        converged: false,
-        load_steps: 0,
         load_factor: 1.0,
+        ..SolverStats::default()
     };
-
-    let direct = {
-        let mut ev = Evaluator::new(&model);
-        let unloaded = loads.tip_force == Vector3::zeros()
-            && loads.tip_moment == Vector3::zeros()
-            && loads.point_loads.is_empty()
-            && loads.distributed_force.is_none()
-            && loads.distributed_moment.is_none()
-            && model.rho_g.is_none();
-        let try_cheap = options.warm_start.is_some() || unloaded;
-        let limit = options.continuation.then_some(DIRECT_STEP_LIMIT);
-        let out = newton(&mut ev, x0, try_cheap, limit, options, &plan, &mut ws);
-        evaluations += ev.evaluations;
-        out
-    };
-    stats.iterations = direct.iterations;
-    let mut result = direct;
-
-    if !result.converged && options.continuation {
-        // Load stepping from the unloaded rod (x = 0 is exact at load factor 0), with a secant
-        // predictor; a step fails (and is halved) if Newton does not converge or its first
-        // step exceeds the step limit.
-        let mut lambda = 0.0f64;
-        let mut dl = if result.first_step > 0.0 {
-            (0.8 * DIRECT_STEP_LIMIT / result.first_step).clamp(MIN_LOAD_INCREMENT, 0.5)
+    let (mut result, j0, first_step) = direct(&mut p, options, &x0);
+    stats.iterations = result.iterations;
+    if !result.converged && opts.continuation {
+        // Step the external loads from the unloaded rod (x = 0 is exact at λ = 0).
+        let zero = [0.0; 6];
+        let j0 = match j0 {
+            Some(j) => Some(j),
+            None => {
+                let mut j = vec![0.0; 36];
+                let mut r = [0.0; 6];
+                (p.evaluate(&zero, 0.0, Some(&mut j), &mut r) == Evaluated::Jacobian).then_some(j)
+            }
+        };
+        let first = if first_step > 0.0 {
+            (0.8 * DIRECT_STEP_LIMIT / first_step).clamp(crate::solve::MIN_LOAD_INCREMENT, 0.5)
         } else {
             0.25
         };
-        let mut x = Vector6::zeros();
-        let mut prev: Option<(Vector6<f64>, f64)> = None;
-        // Tip pose of the last accepted load step (the unloaded rod to begin with).
-        model.factor = 0.0;
-        let mut tip = {
-            let mut ev = Evaluator::new(&model);
-            let pass = shoot::<STATE>(&mut ev, &x, &options.integrator, &plan, &mut ws);
-            evaluations += ev.evaluations;
-            pass.ok().map(|_| shape_of(&ws))
+        let start = ContinuationSettings {
+            x0: &zero,
+            jacobian0: j0.as_deref(),
+            first_increment: first,
+            max_increment: 0.5,
         };
-        let mut steps = 0usize;
-        let mut last = None;
-        while steps < options.max_load_steps {
-            let target = (lambda + dl).min(1.0);
-            model.factor = target;
-            let guess = match prev {
-                Some((xp, dlp)) => x + (x - xp) * ((target - lambda) / dlp),
-                None => x,
-            };
-            let mut ev = Evaluator::new(&model);
-            let out = newton(
-                &mut ev,
-                guess,
-                false,
-                Some(DIRECT_STEP_LIMIT),
-                options,
-                &plan,
-                &mut ws,
-            );
-            evaluations += ev.evaluations;
-            stats.iterations += out.iterations;
-            steps += 1;
-            // A load step must not move the tip by more than MAX_LOAD_STEP_TURN (rotation, rad)
-            // or MAX_LOAD_STEP_TURN L (position): larger jumps may switch equilibrium branch.
-            let new_tip = if out.converged {
-                Some(shape_of(&ws))
-            } else {
-                None
-            };
-            let small = match (&tip, &new_tip) {
-                (Some(a), Some(b)) => shape_change_is_small(a, b, model.length),
-                _ => false,
-            };
-            if out.converged && small {
-                tip = new_tip;
-                prev = Some((x, target - lambda));
-                lambda = target;
-                x = out.x;
-                let done = lambda >= 1.0;
-                last = Some(out);
-                if done {
-                    break;
-                }
-                dl = (dl * 2.0).min(0.5);
-            } else {
-                dl *= 0.5;
-                last = Some(NewtonOut {
-                    converged: false,
-                    ..out
-                });
-                if dl < MIN_LOAD_INCREMENT {
-                    break;
-                }
-            }
-        }
-        stats.load_steps = steps;
-        stats.load_factor = lambda;
-        if let Some(out) = last {
-            if out.converged && lambda >= 1.0 {
-                result = out;
-            } else {
-                // Report the last converged load step.
-                model.factor = lambda;
-                result = NewtonOut {
-                    x,
-                    converged: false,
-                    recorded: false,
-                    ..out
-                };
-            }
-        }
+        let s = NewtonSettings {
+            first_step_limit: Some(DIRECT_STEP_LIMIT),
+            ..settings(matches!(options.integrator, Integrator::Rk4 { .. }), None)
+        };
+        let c = continuation(&mut p, &start, opts, &s);
+        stats.iterations += c.iterations;
+        stats.load_steps = c.steps;
+        stats.load_factor = c.load_factor;
+        result = c.outcome;
     }
-    // Make sure the workspace holds the pass at the final unknowns (at the load factor they
-    // belong to).
-    if !result.recorded {
-        let mut ev = Evaluator::new(&model);
-        if let Ok(p) = shoot::<STATE>(&mut ev, &result.x, &options.integrator, &plan, &mut ws) {
-            if !result.converged && stats.load_factor >= 1.0 {
-                result.residual = norm(&p.residual);
-            }
+    // The recorded pass must be the one at the returned unknowns (and their load factor).
+    if !result.at_x {
+        let mut r = [0.0; 6];
+        if p.evaluate(&result.x, stats.load_factor, None, &mut r) != Evaluated::Failed
+            && !result.converged
+            && stats.load_factor >= 1.0
+        {
+            result.residual = max_norm(&r);
         }
-        evaluations += ev.evaluations;
     }
     stats.residual = result.residual;
     stats.converged = result.converged;
-    stats.function_evaluations = evaluations;
-    if !result.converged && options.throw {
-        if let Some(e) = model.material_error.get() {
-            return Err(e.clone());
+    stats.function_evaluations = p.evaluations;
+    if !result.converged && opts.throw {
+        if let Some(e) = p.ws.material_error.take() {
+            return Err(e);
         }
         return Err(Error::NotConverged {
             what: "shooting Newton (Cosserat rod statics)".into(),
@@ -831,17 +436,24 @@ pub fn solve_statics(
             residual: result.residual,
         });
     }
-    let x = result.x;
+    let x = &result.x;
     let base_wrench = [
-        x[0] * model.f_ref,
-        x[1] * model.f_ref,
-        x[2] * model.f_ref,
+        x[0] * f_ref,
+        x[1] * f_ref,
+        x[2] * f_ref,
         x[3] * fm,
         x[4] * fm,
         x[5] * fm,
     ];
-    let rk4 = matches!(options.integrator, Integrator::Rk4 { .. });
-    Ok(assemble(&model, &ws, base_wrench, stats, rk4))
+    let jacobian = result
+        .jacobian
+        .as_ref()
+        .map(|j| Matrix6::from_column_slice(j));
+    let mut sol = assemble(&mut p, model, base_wrench, stats);
+    sol.actuation = actuation.clone();
+    sol.options = *options;
+    sol.jacobian = jacobian;
+    Ok(sol)
 }
 
 fn arr(v: &Vector3<f64>) -> [f64; 3] {
@@ -856,15 +468,15 @@ fn rows(r: &Matrix3<f64>) -> [[f64; 3]; 3] {
     ]
 }
 
-/// Derived quantities at the recorded nodes.
+/// Derived quantities at the recorded nodes of the last pass (which is at the solution).
 fn assemble(
-    model: &Model<'_>,
-    ws: &Workspace,
+    p: &mut Shooting<'_>,
+    shared: &Arc<RobotModel>,
     base_wrench: [f64; 6],
     stats: SolverStats,
-    rk4: bool,
 ) -> StaticsSolution {
-    let n = ws.nodes.len();
+    let n = p.nodes.len();
+    let model = p.eq.model;
     let mut sol = StaticsSolution {
         s: Vec::with_capacity(n),
         position: Vec::with_capacity(n),
@@ -876,20 +488,30 @@ fn assemble(
         m_body: Vec::with_capacity(n),
         v: Vec::with_capacity(n),
         u: Vec::with_capacity(n),
-        tendon_lengths: ws.tendon_lengths.clone(),
+        tendon_lengths: p.lengths.clone(),
         base_wrench,
         stats,
+        model: Arc::clone(shared),
+        actuation: Actuation::default(),
+        options: SolveOptions::default(),
+        jacobian: None,
     };
-    let mut ev = Evaluator::new(model);
-    ev.track_speeds = true;
-    let nt = model.tendons.len();
-    // Tendon speeds |p_i'| at the nodes of the current interval, per tendon (RK4 quadrature).
-    let mut speeds: Vec<Vec<f64>> = vec![Vec::new(); nt];
+    let mut ws = Workspace::new(model.tendons().len());
+    let mut ev = Evaluator {
+        eq: p.eq,
+        ws: &mut ws,
+    };
+    let rk4 = matches!(p.integrator, Integrator::Rk4 { .. });
     if rk4 {
         sol.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
     }
+    ev.ws.track_lengths = true;
+    let nt = model.tendons().len();
+    // Tendon speeds |p_i'| at the nodes of the current interval (RK4: Simpson on the nodes).
+    let mut speeds: Vec<Vec<f64>> = vec![Vec::new(); nt];
     let mut current = usize::MAX;
-    for (j, node) in ws.nodes.iter().enumerate() {
+    let nodes: &[Node] = &p.nodes;
+    for (j, node) in nodes.iter().enumerate() {
         if node.interval != current {
             ev.set_interval(node.interval);
             current = node.interval;
@@ -899,7 +521,7 @@ fn assemble(
         let r = rot(y);
         let nb_tot = r.tr_mul(&v3(y, 12));
         let mb_tot = r.tr_mul(&v3(y, 15));
-        let props = model.rod.section_at(node.s);
+        let props = model.rod().section_at(node.s);
         let loc = ev.local(node.s, &props, &nb_tot, &mb_tot, false);
         let nb = nb_tot - loc.tendon_force;
         let mb = mb_tot - loc.tendon_moment;
@@ -915,16 +537,16 @@ fn assemble(
         sol.u.push(arr(&loc.u));
         if rk4 && nt > 0 {
             let k = node.interval;
-            let b = model.breaks[k + 1];
-            for (i, t) in model.tendons.iter().enumerate() {
-                if t.end >= b {
-                    speeds[i].push(ev.tendon_speed[i]);
+            let b = model.breaks()[k + 1];
+            for (i, &end) in model.tendon_ends().iter().enumerate() {
+                if end >= b {
+                    speeds[i].push(ev.ws.tendon_speed[i]);
                 }
             }
-            let last_of_interval = ws.nodes.get(j + 1).is_none_or(|n| n.interval != k);
+            let last_of_interval = nodes.get(j + 1).is_none_or(|n| n.interval != k);
             if last_of_interval {
-                let h = (b - model.breaks[k])
-                    / (ws.nodes.iter().filter(|n| n.interval == k).count() - 1).max(1) as f64;
+                let count = nodes.iter().filter(|n| n.interval == k).count();
+                let h = (b - model.breaks()[k]) / (count - 1).max(1) as f64;
                 for (i, sp) in speeds.iter().enumerate() {
                     if !sp.is_empty() {
                         sol.tendon_lengths[i] += uniform_quadrature(sp, h);

@@ -6,3 +6,8 @@ pub mod material;
 pub mod rod;
 pub mod section;
 pub mod tendon;
+pub mod actuation;
+pub mod robot;
+
+pub use actuation::{Actuation, TendonInput};
+pub use robot::RobotModel;

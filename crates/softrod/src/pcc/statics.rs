@@ -62,7 +62,8 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
-use crate::error::{check_finite, check_newton_options, check_positive, Error, Result};
+use crate::error::{check_finite, check_positive, Error, Result};
+use crate::math::series::arc_fns;
 use crate::pcc::kinematics::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
 
 /// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
@@ -78,11 +79,6 @@ pub const MAX_LINE_SEARCH_HALVINGS: usize = 20;
 pub const ARMIJO: f64 = 1e-4;
 /// Smallest load-factor increment of the continuation before giving up.
 pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
-/// `θ²` (rad²) below which the arc functions are summed as series (12 terms: error below
-/// `1e-20` for `θ² < 1`); above it the closed forms lose at most `~1e-14` relative.
-const SERIES_BOUND: f64 = 1.0;
-/// Number of series terms.
-const SERIES_TERMS: usize = 13;
 
 /// A tendon of a multi-segment robot: straight, at the constant body offset
 /// `distance (cos angle, sin angle)` (m, rad from body x toward body y) in every segment it
@@ -328,102 +324,6 @@ pub struct PccEquilibrium {
     pub jacobian: DMatrix<f64>,
     /// Scaled residual (max norm), as compared with [`PccSolveOptions::tolerance`].
     pub scaled_residual: f64,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Arc functions of x = θ².
-// ---------------------------------------------------------------------------------------------
-
-/// `S = sin θ/θ`, `B = (1 - cos θ)/θ²`, `C = (θ - sin θ)/θ³` and their derivatives in `x = θ²`.
-#[derive(Debug, Clone, Copy)]
-struct ArcFns {
-    s: f64,
-    s1: f64,
-    s2: f64,
-    b: f64,
-    b1: f64,
-    b2: f64,
-    c: f64,
-    c1: f64,
-}
-
-/// Coefficients `(-1)^k / (2k + n)!` of the series of `S` (`n = 1`), `B` (2) and `C` (3).
-const fn series_coefficients(n: u32) -> [f64; SERIES_TERMS] {
-    let mut c = [0.0; SERIES_TERMS];
-    let mut fact = 1.0;
-    let mut i = 2;
-    while i <= n {
-        fact *= i as f64;
-        i += 1;
-    }
-    c[0] = 1.0 / fact;
-    let mut k = 1;
-    while k < SERIES_TERMS {
-        let m = (2 * k as u32 + n) as f64;
-        c[k] = -c[k - 1] / ((m - 1.0) * m);
-        k += 1;
-    }
-    c
-}
-
-const SERIES_S: [f64; SERIES_TERMS] = series_coefficients(1);
-const SERIES_B: [f64; SERIES_TERMS] = series_coefficients(2);
-const SERIES_C: [f64; SERIES_TERMS] = series_coefficients(3);
-
-/// `Σ_k c_k x^k` and its first two derivatives, by Horner's rule.
-#[inline]
-fn series(c: &[f64; SERIES_TERMS], x: f64) -> (f64, f64, f64) {
-    let (mut f, mut f1, mut f2) = (0.0, 0.0, 0.0);
-    for k in (0..SERIES_TERMS).rev() {
-        let kf = k as f64;
-        f = f * x + c[k];
-        if k >= 1 {
-            f1 = f1 * x + kf * c[k];
-        }
-        if k >= 2 {
-            f2 = f2 * x + kf * (kf - 1.0) * c[k];
-        }
-    }
-    (f, f1, f2)
-}
-
-fn arc_fns(x: f64) -> ArcFns {
-    if x < SERIES_BOUND {
-        let (s, s1, s2) = series(&SERIES_S, x);
-        let (b, b1, b2) = series(&SERIES_B, x);
-        let (c, c1, _) = series(&SERIES_C, x);
-        return ArcFns {
-            s,
-            s1,
-            s2,
-            b,
-            b1,
-            b2,
-            c,
-            c1,
-        };
-    }
-    let th = x.sqrt();
-    let (sn, cs) = th.sin_cos();
-    let ix = 1.0 / x;
-    let s = sn / th;
-    let s1 = 0.5 * (cs - s) * ix;
-    let s2 = 0.5 * (-0.5 * s - 3.0 * s1) * ix;
-    let b = (1.0 - cs) * ix;
-    let b1 = (0.5 * s - b) * ix;
-    let b2 = (0.5 * s1 - 2.0 * b1) * ix;
-    let c = (1.0 - s) * ix;
-    let c1 = (-s1 - c) * ix;
-    ArcFns {
-        s,
-        s1,
-        s2,
-        b,
-        b1,
-        b2,
-        c,
-        c1,
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1013,7 +913,14 @@ fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mu
 }
 
 fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
-    check_newton_options(opts.tolerance, opts.max_iterations, opts.max_load_steps)?;
+    crate::solve::NewtonOptions {
+        tolerance: opts.tolerance,
+        max_iterations: opts.max_iterations,
+        continuation: opts.continuation,
+        max_load_steps: opts.max_load_steps,
+        throw: opts.throw,
+    }
+    .validate()?;
     if let Some(ws) = &opts.warm_start {
         if ws.len() != robot.bodies.len() {
             return Err(Error::invalid(
