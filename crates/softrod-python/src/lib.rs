@@ -2,7 +2,9 @@
 //!
 //! This crate only converts arrays, maps the core's one error type to Python exceptions (in
 //! `errors::to_py_err`) and releases the GIL around solves. All numerics live in the `softrod`
-//! crate. One module per area of the API: `planar`, `statics`; conversions in `convert`.
+//! crate. It is split like the core: `model` (the robot description), `statics`,
+//! `compliance`, `pcc`, `planar`, `materials`; argument conversions in `convert`, errors in
+//! `errors`.
 
 use pyo3::prelude::*;
 
@@ -12,6 +14,7 @@ mod errors;
 mod materials;
 mod pcc;
 mod planar;
+mod model;
 mod statics;
 
 /// The compiled core of softrod.
@@ -30,20 +33,21 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;
     m.add_function(wrap_pyfunction!(planar::backbone_distance, m)?)?;
-    m.add_class::<statics::PySection>()?;
-    m.add_class::<statics::CircularSection>()?;
-    m.add_class::<statics::TaperedCircularSection>()?;
-    m.add_class::<statics::TubeSection>()?;
-    m.add_class::<statics::TableSection>()?;
-    m.add_class::<statics::FunctionSection>()?;
-    m.add_class::<statics::LinearElastic>()?;
-    m.add_class::<statics::Rod>()?;
-    m.add_class::<statics::Tendon>()?;
-    m.add_class::<statics::Chamber>()?;
-    m.add_class::<statics::PointLoad>()?;
-    m.add_class::<statics::Loads>()?;
+    m.add_class::<model::PySection>()?;
+    m.add_class::<model::CircularSection>()?;
+    m.add_class::<model::TaperedCircularSection>()?;
+    m.add_class::<model::TubeSection>()?;
+    m.add_class::<model::TableSection>()?;
+    m.add_class::<model::FunctionSection>()?;
+    m.add_class::<model::LinearElastic>()?;
+    m.add_class::<model::Rod>()?;
+    m.add_class::<model::Tendon>()?;
+    m.add_class::<model::Chamber>()?;
+    m.add_class::<model::PointLoad>()?;
+    m.add_class::<model::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(model::_rebuild, m)?)?;
     m.add_class::<materials::PyUniaxialLaw>()?;
     m.add_class::<materials::Hookean>()?;
     m.add_class::<materials::Linearised>()?;
