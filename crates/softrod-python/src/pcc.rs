@@ -783,12 +783,14 @@ pub(crate) fn pcc_solve<'py>(
         }
     };
     let options = PccSolveOptions {
-        tolerance,
-        max_iterations: max_iterations as usize,
-        continuation,
-        max_load_steps: max_load_steps as usize,
+        newton: softrod::NewtonOptions {
+            tolerance,
+            max_iterations: max_iterations as usize,
+            continuation,
+            max_load_steps: max_load_steps as usize,
+            throw,
+        },
         warm_start: warm,
-        throw,
     };
     let samples = match s {
         Some(s) => Some(s.to_vec()?),

@@ -511,10 +511,14 @@ fn non_convergence_is_reported_or_returned() {
         tip_force: Vector3::new(0.0, -1.0, 0.0),
         ..Default::default()
     };
+    let d = PccSolveOptions::default();
     let opts = PccSolveOptions {
-        max_iterations: 1,
-        continuation: false,
-        ..Default::default()
+        newton: softrod::NewtonOptions {
+            max_iterations: 1,
+            continuation: false,
+            ..d.newton
+        },
+        ..d
     };
     match solve_pcc_statics(&robot, &loads, &opts) {
         Err(Error::NotConverged { iterations, .. }) => assert_eq!(iterations, 1),
@@ -524,8 +528,11 @@ fn non_convergence_is_reported_or_returned() {
         &robot,
         &loads,
         &PccSolveOptions {
-            throw: false,
-            ..opts
+            newton: softrod::NewtonOptions {
+                throw: false,
+                ..opts.newton
+            },
+            ..opts.clone()
         },
     )
     .unwrap();
@@ -610,7 +617,10 @@ fn invalid_inputs_name_the_parameter() {
         "warm_start.len()"
     );
     let opts = PccSolveOptions {
-        tolerance: 0.0,
+        newton: softrod::NewtonOptions {
+            tolerance: 0.0,
+            ..PccSolveOptions::default().newton
+        },
         ..Default::default()
     };
     assert_eq!(

@@ -54,7 +54,8 @@
 //! # Straight segments
 //! Every function of `θ = κ ℓ` that is `0/0` at `θ = 0` is evaluated in a form without
 //! cancellation (`(1 - cos θ)/θ² = sinc²(θ/2)/2`, `sin θ / θ = sinc(θ/2) cos(θ/2)`) or by its
-//! Taylor series below [`SERIES_THRESHOLD`], so poses and Jacobians are finite and smooth
+//! Taylor series below [`SERIES_BOUND`](crate::math::series::SERIES_BOUND) (the arc series shared
+//! with the PCC statics), so poses and Jacobians are finite and smooth
 //! through `κ = 0`. The plane angle itself is undefined at `κ = 0`: inverse maps return `φ = 0`
 //! there, and Jacobians *into* `(κ, φ, ℓ)` are only defined for `κ ≠ 0` (use the curvature
 //! vector coordinates, which are smooth).
@@ -66,15 +67,7 @@
 use nalgebra::{Matrix2xX, Matrix3, Matrix3xX, Matrix4, Matrix6x3, Matrix6xX, MatrixXx3, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
-
-/// `|θ|` (rad) below which `(θ cos θ - sin θ)/θ²` is evaluated by its Taylor series.
-///
-/// The direct form loses `eps/θ²` relative accuracy; the four-term series is accurate to
-/// `1e-15` relative below this bound.
-pub const SERIES_THRESHOLD: f64 = 0.1;
-
-/// `|x|` below which `sin(x)/x` is evaluated as `1 - x²/6` (error `x⁴/120 < 1e-18`).
-const SINC_SERIES: f64 = 1e-4;
+use crate::math::series::{arc_fns, arc_sb};
 
 /// Relative tolerance on the smallest eigenvalue of the normal equations of the tendon
 /// displacement map: layouts below it cannot resolve the arc parameters.
@@ -166,35 +159,25 @@ struct ArcTrig {
     c2: f64,
 }
 
+/// The trigonometric functions of `θ` from the one arc series ([`crate::math::series`]).
 #[inline]
 fn arc_trig(theta: f64) -> ArcTrig {
-    let h = 0.5 * theta;
-    let (sh, ch) = h.sin_cos();
-    let sinc_h = if h.abs() < SINC_SERIES {
-        1.0 - h * h * (1.0 / 6.0)
-    } else {
-        sh / h
-    };
-    let omc = 2.0 * sh * sh;
+    let x = theta * theta;
+    let (s, b) = arc_sb(x);
+    let omc = x * b;
     ArcTrig {
-        sin: 2.0 * sh * ch,
+        sin: theta * s,
         cos: 1.0 - omc,
         omc,
-        s1: sinc_h * ch,
-        c2: 0.5 * sinc_h * sinc_h,
+        s1: s,
+        c2: b,
     }
 }
 
-/// `(θ cos θ - sin θ)/θ² = d(sin θ/θ)/dθ`, by series below [`SERIES_THRESHOLD`].
+/// `(θ cos θ - sin θ)/θ² = d(sin θ/θ)/dθ = 2 θ dS/dx`.
 #[inline]
-fn dsinc(theta: f64, t: &ArcTrig) -> f64 {
-    if theta.abs() < SERIES_THRESHOLD {
-        let x2 = theta * theta;
-        // -θ/3 + θ³/30 - θ⁵/840 + θ⁷/45360 (next term θ⁹/3991680).
-        -theta * (1.0 / 3.0 - x2 * (1.0 / 30.0 - x2 * (1.0 / 840.0 - x2 * (1.0 / 45360.0))))
-    } else {
-        (t.cos - t.s1) / theta
-    }
+fn dsinc(theta: f64) -> f64 {
+    2.0 * theta * arc_fns(theta * theta).s1
 }
 
 fn check_length(name: &str, length: f64) -> Result<f64> {
@@ -353,7 +336,7 @@ impl PccSegment {
         let th = k * l;
         let t = arc_trig(th);
         let g = t.s1 - t.c2; // d/dθ (1 - cos θ)/θ
-        let h = dsinc(th, &t); // d/dθ sin θ/θ
+        let h = dsinc(th); // d/dθ sin θ/θ
         let l2 = l * l;
         let tip = self.rigid_at(l);
         // ∂/∂κ.
@@ -508,7 +491,7 @@ pub fn arc_from_tip_with_length(position: &Vector3<f64>, length: f64) -> Result<
             l * th * t.c2,
             l * t.s1,
             l * (t.s1 - t.c2),
-            l * dsinc(th, &t),
+            l * dsinc(th),
         )
     };
     let dist2 = |th: f64| {

@@ -64,6 +64,10 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
 use crate::math::series::arc_fns;
+use crate::solve::{
+    continuation, newton, Armijo, ContinuationSettings, Evaluated, LineSearch, NewtonOptions,
+    NewtonSettings, Problem, SolverStats,
+};
 use crate::pcc::kinematics::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
 
 /// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
@@ -75,10 +79,6 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 50;
 pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
 /// Most step halvings of the Newton line search.
 pub const MAX_LINE_SEARCH_HALVINGS: usize = 20;
-/// Sufficient-decrease constant of the line search (Armijo, on the residual norm).
-pub const ARMIJO: f64 = 1e-4;
-/// Smallest load-factor increment of the continuation before giving up.
-pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
 
 /// A tendon of a multi-segment robot: straight, at the constant body offset
 /// `distance (cos angle, sin angle)` (m, rad from body x toward body y) in every segment it
@@ -234,46 +234,27 @@ pub struct PccLoads {
 /// Options of [`solve_pcc_statics`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PccSolveOptions {
-    /// Tolerance on the scaled residual (max norm), > 0.
-    pub tolerance: f64,
-    /// Newton iterations per solve (per load step), >= 1.
-    pub max_iterations: usize,
-    /// Whether to fall back on stepping the tip load when the direct solve fails.
-    pub continuation: bool,
-    /// Load steps (attempted) under continuation, >= 1.
-    pub max_load_steps: usize,
+    /// Nonlinear solve; the tolerance is on the scaled residual (bending `|g_θ| ℓ0 / E I` in
+    /// rad, axial `|g_ℓ| / E A`); continuation steps the tip load.
+    pub newton: NewtonOptions,
     /// Initial guess, one segment per robot segment; `None` starts from the actuator-only
     /// solution (exact without a tip load).
     pub warm_start: Option<Vec<PccSegment>>,
-    /// `true`: non-convergence is [`Error::NotConverged`]; `false`: the last iterate is
-    /// returned with `stats.converged == false`.
-    pub throw: bool,
 }
 
 impl Default for PccSolveOptions {
     fn default() -> Self {
         Self {
-            tolerance: DEFAULT_TOLERANCE,
-            max_iterations: DEFAULT_MAX_ITERATIONS,
-            continuation: true,
-            max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+            newton: NewtonOptions {
+                tolerance: DEFAULT_TOLERANCE,
+                max_iterations: DEFAULT_MAX_ITERATIONS,
+                continuation: true,
+                max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+                throw: true,
+            },
             warm_start: None,
-            throw: true,
         }
     }
-}
-
-/// Solver statistics of [`solve_pcc_statics`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PccSolverStats {
-    /// Newton iterations (accepted steps), over all load steps.
-    pub iterations: usize,
-    /// Final scaled residual (max norm: rad for bending, strain for stretch).
-    pub residual: f64,
-    /// Whether the residual met the tolerance.
-    pub converged: bool,
-    /// Load steps taken by the continuation (0: solved directly).
-    pub load_steps: usize,
 }
 
 /// A solved PCC robot.
@@ -286,7 +267,7 @@ pub struct PccStaticsSolution {
     /// Path length of every tendon from the base to its termination (m).
     pub tendon_lengths: Vec<f64>,
     /// Solver statistics.
-    pub stats: PccSolverStats,
+    pub stats: SolverStats,
 }
 
 impl PccStaticsSolution {
@@ -524,8 +505,6 @@ struct Work {
     blocks: Vec<Matrix3<f64>>,
     g: DVector<f64>,
     h: DMatrix<f64>,
-    /// Elimination scratch of the Newton step.
-    lu: Vec<f64>,
 }
 
 impl Work {
@@ -535,7 +514,6 @@ impl Work {
             blocks: Vec::new(),
             g: DVector::zeros(3 * n),
             h: DMatrix::zeros(0, 0),
-            lu: Vec::new(),
         }
     }
 }
@@ -787,140 +765,64 @@ pub fn pcc_equilibrium(
     })
 }
 
-/// Outcome of the Newton iteration at one load factor.
-struct NewtonOut {
+/// The PCC equilibrium as a [`Problem`] in `(u_x, u_y, ℓ)` per segment (unknowns) with the
+/// tip load scaled by the load factor; its norm is the scaled residual.
+struct Equilibrium<'a> {
+    robot: &'a PccRobot,
+    prep: &'a Prepared,
+    work: Work,
     q: Vec<[f64; 3]>,
-    residual: f64,
-    converged: bool,
-    iterations: usize,
+    /// Scaled residual of the last evaluation.
+    scaled: f64,
+    evaluations: usize,
 }
 
-fn newton(
-    robot: &PccRobot,
-    prep: &Prepared,
-    q0: &[[f64; 3]],
-    factor: f64,
-    likely_exact: bool,
-    opts: &PccSolveOptions,
-    w: &mut Work,
-) -> NewtonOut {
-    let n = q0.len();
-    let mut q = q0.to_vec();
-    let mut trial = q.clone();
-    let mut dx = vec![0.0; 3 * n];
-    // Without a tip load the actuator-only start is exact: check it without the Jacobian.
-    let mut rn = evaluate(robot, prep, &q, factor, !likely_exact, w);
-    let mut out = NewtonOut {
-        q: q.clone(),
-        residual: rn,
-        converged: rn <= opts.tolerance,
-        iterations: 0,
-    };
-    if out.converged || !rn.is_finite() {
-        return out;
+impl Problem for Equilibrium<'_> {
+    fn dim(&self) -> usize {
+        3 * self.q.len()
     }
-    if likely_exact {
-        evaluate(robot, prep, &q, factor, true, w);
-    }
-    for _ in 0..opts.max_iterations {
-        if !solve_in_place(&w.h, &w.g, &mut w.lu, &mut dx) {
-            break;
-        }
-        let mut lambda = 1.0;
-        let mut accepted = false;
-        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
-            let mut ok = true;
-            for i in 0..n {
-                for c in 0..3 {
-                    trial[i][c] = q[i][c] + lambda * dx[3 * i + c];
-                }
-                ok &= trial[i][2] > 0.0;
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
+        let n = self.q.len();
+        for i in 0..n {
+            self.q[i] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
+            if !(self.q[i][2] > 0.0) {
+                return Evaluated::Failed;
             }
-            if ok {
-                let rt = evaluate(robot, prep, &trial, factor, true, w);
-                if rt <= (1.0 - ARMIJO * lambda) * rn || rt <= opts.tolerance {
-                    q.copy_from_slice(&trial);
-                    rn = rt;
-                    accepted = true;
-                    break;
-                }
+        }
+        self.evaluations += 1;
+        let want = jacobian.is_some();
+        self.scaled = evaluate(self.robot, self.prep, &self.q, lambda, want, &mut self.work);
+        r.copy_from_slice(self.work.g.as_slice());
+        if !self.scaled.is_finite() {
+            return Evaluated::Failed;
+        }
+        match jacobian {
+            Some(j) => {
+                j.copy_from_slice(self.work.h.as_slice());
+                Evaluated::Jacobian
             }
-            lambda *= 0.5;
-        }
-        if !accepted {
-            // Restore the workspace to the last accepted iterate.
-            evaluate(robot, prep, &q, factor, true, w);
-            break;
-        }
-        out.iterations += 1;
-        if rn <= opts.tolerance {
-            out.converged = true;
-            break;
+            None => Evaluated::Residual,
         }
     }
-    out.q = q;
-    out.residual = rn;
-    out
+
+    fn norm(&self, _r: &[f64]) -> f64 {
+        self.scaled
+    }
 }
 
-/// Solves `h dx = -g` by Gaussian elimination with partial pivoting in the scratch `lu`
-/// (column-major copy of `h`; no allocation after the first call). Returns `false` if `h` is
-/// singular or the step is not finite.
-fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mut [f64]) -> bool {
-    let n = g.len();
-    lu.clear();
-    lu.extend_from_slice(h.as_slice());
-    for (d, gv) in dx.iter_mut().zip(g.iter()) {
-        *d = -gv;
-    }
-    for k in 0..n {
-        let (mut piv, mut best) = (k, lu[k + k * n].abs());
-        for r in k + 1..n {
-            let v = lu[r + k * n].abs();
-            if v > best {
-                piv = r;
-                best = v;
-            }
-        }
-        if !(best > 0.0 && best.is_finite()) {
-            return false;
-        }
-        if piv != k {
-            for c in k..n {
-                lu.swap(k + c * n, piv + c * n);
-            }
-            dx.swap(k, piv);
-        }
-        let inv = 1.0 / lu[k + k * n];
-        for r in k + 1..n {
-            let f = lu[r + k * n] * inv;
-            if f != 0.0 {
-                for c in k + 1..n {
-                    lu[r + c * n] -= f * lu[k + c * n];
-                }
-                dx[r] -= f * dx[k];
-            }
-        }
-    }
-    for k in (0..n).rev() {
-        let mut v = dx[k];
-        for c in k + 1..n {
-            v -= lu[k + c * n] * dx[c];
-        }
-        dx[k] = v / lu[k + k * n];
-    }
-    dx.iter().all(|v| v.is_finite())
+fn flat(q: &[[f64; 3]]) -> Vec<f64> {
+    q.iter().flatten().copied().collect()
 }
 
 fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
-    crate::solve::NewtonOptions {
-        tolerance: opts.tolerance,
-        max_iterations: opts.max_iterations,
-        continuation: opts.continuation,
-        max_load_steps: opts.max_load_steps,
-        throw: opts.throw,
-    }
-    .validate()?;
+    opts.newton.validate()?;
     if let Some(ws) = &opts.warm_start {
         if ws.len() != robot.bodies.len() {
             return Err(Error::invalid(
@@ -999,54 +901,69 @@ pub fn solve_pcc_statics(
             .collect(),
         None => q_act.clone(),
     };
-    let mut w = Work::new(n);
-    let mut stats = PccSolverStats::default();
+    let mut p = Equilibrium {
+        robot,
+        prep: &prep,
+        work: Work::new(n),
+        q: q0.clone(),
+        scaled: f64::INFINITY,
+        evaluations: 0,
+    };
+    let opts = &options.newton;
+    let mut stats = SolverStats {
+        load_factor: 1.0,
+        ..SolverStats::default()
+    };
     let unloaded = prep.force == Vector3::zeros() && prep.moment == Vector3::zeros();
-    let likely_exact = unloaded && options.warm_start.is_none();
-    let mut result = newton(robot, &prep, &q0, 1.0, likely_exact, options, &mut w);
+    let settings = NewtonSettings {
+        line_search: LineSearch {
+            factor: 0.5,
+            max_halvings: MAX_LINE_SEARCH_HALVINGS,
+        },
+        condition: Armijo::default(),
+        first_step_limit: None,
+        // Without a tip load the actuator-only start is exact: check it without the Jacobian.
+        residual_first: unloaded && options.warm_start.is_none(),
+        broyden: false,
+        jacobian: None,
+    };
+    let mut result = newton(&mut p, &flat(&q0), 1.0, opts, &settings);
     stats.iterations = result.iterations;
-    if !result.converged && options.continuation {
-        let (mut lambda, mut dl) = (0.0f64, 0.25f64);
-        let mut q = q_act;
-        let mut steps = 0usize;
-        let mut last = None;
-        while steps < options.max_load_steps {
-            let target = (lambda + dl).min(1.0);
-            let out = newton(robot, &prep, &q, target, false, options, &mut w);
-            stats.iterations += out.iterations;
-            steps += 1;
-            if out.converged {
-                lambda = target;
-                q.clone_from(&out.q);
-                let done = lambda >= 1.0;
-                last = Some(out);
-                if done {
-                    break;
-                }
-                dl = (dl * 2.0).min(0.5);
-            } else {
-                dl *= 0.5;
-                if dl < MIN_LOAD_INCREMENT {
-                    break;
-                }
-            }
-        }
-        stats.load_steps = steps;
-        if let Some(out) = last.filter(|_| lambda >= 1.0) {
-            result = out;
+    if !result.converged && opts.continuation {
+        let x_act = flat(&q_act);
+        let start = ContinuationSettings {
+            x0: &x_act,
+            jacobian0: None,
+            first_increment: 0.25,
+            max_increment: 0.5,
+        };
+        let c = continuation(&mut p, &start, opts, &NewtonSettings {
+            residual_first: false,
+            ..settings
+        });
+        stats.iterations += c.iterations;
+        stats.load_steps = c.steps;
+        stats.load_factor = c.load_factor;
+        if c.load_factor >= 1.0 {
+            result = c.outcome;
         }
     }
     stats.residual = result.residual;
     stats.converged = result.converged;
-    if !result.converged && options.throw {
+    stats.function_evaluations = p.evaluations;
+    if !result.converged && opts.throw {
         return Err(Error::NotConverged {
             what: "PCC statics Newton".into(),
             iterations: stats.iterations,
             residual: result.residual,
         });
     }
-    let segments = result
-        .q
+    let q: Vec<[f64; 3]> = result
+        .x
+        .chunks(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    let segments = q
         .iter()
         .map(|qi| PccSegment::from_curvature_vector(qi[0], qi[1], qi[2]))
         .collect::<Result<Vec<_>>>()?;
@@ -1054,7 +971,7 @@ pub fn solve_pcc_statics(
         .tendons
         .iter()
         .map(|t| {
-            result.q[..=t.last_segment]
+            q[..=t.last_segment]
                 .iter()
                 .map(|qi| {
                     let (a, b) = (qi[2] * qi[0], qi[2] * qi[1]);

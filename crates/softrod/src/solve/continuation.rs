@@ -5,7 +5,7 @@
 //! (the problem's [`Problem::close`] safeguard), doubling it after a success.
 
 use super::newton::{newton, NewtonOutcome, NewtonSettings};
-use super::{max_norm, NewtonOptions, Problem, MIN_LOAD_INCREMENT};
+use super::{NewtonOptions, Problem, MIN_LOAD_INCREMENT};
 use crate::math::linalg::DenseLu;
 
 /// Where the continuation starts and how it steps.
@@ -71,7 +71,7 @@ pub fn continuation<P: Problem + ?Sized>(
     let mut out = Continued {
         outcome: NewtonOutcome {
             x: x.clone(),
-            residual: max_norm(&r),
+            residual: problem.norm(&r),
             converged: false,
             iterations: 0,
             first_step: 0.0,

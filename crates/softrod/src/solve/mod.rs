@@ -91,7 +91,12 @@ pub trait Problem {
     /// [`Evaluated::Jacobian`]).
     fn evaluate(&mut self, x: &[f64], lambda: f64, jacobian: Option<&mut [f64]>, r: &mut [f64])
         -> Evaluated;
-    /// Tolerance on the max norm of the residual at `x` (the option, or the resolution of the
+    /// The norm the tolerance applies to, of the residual `r` of the last evaluation; the max
+    /// norm by default.
+    fn norm(&self, r: &[f64]) -> f64 {
+        max_norm(r)
+    }
+    /// Tolerance on the norm of the residual at `x` (the option, or the resolution of the
     /// problem's discretisation).
     fn tolerance(&self, x: &[f64], tolerance: f64) -> f64 {
         let _ = x;

@@ -118,7 +118,7 @@ pub fn newton<P: Problem + ?Sized>(
     if ev == Evaluated::Failed {
         return out;
     }
-    let mut rn = max_norm(&r);
+    let mut rn = problem.norm(&r);
     out.residual = rn;
     out.at_x = true;
     let mut have_j = ev == Evaluated::Jacobian;
@@ -141,7 +141,7 @@ pub fn newton<P: Problem + ?Sized>(
             out.at_x = false;
             return out;
         }
-        rn = max_norm(&r);
+        rn = problem.norm(&r);
     }
     let mut exact = settings.jacobian.is_none() || ev == Evaluated::Jacobian;
     let mut lu = DenseLu::default();
@@ -159,7 +159,7 @@ pub fn newton<P: Problem + ?Sized>(
                 out.at_x = false;
                 break;
             }
-            rn = max_norm(&r);
+            rn = problem.norm(&r);
             exact = true;
             out.at_x = true;
         }
@@ -190,7 +190,7 @@ pub fn newton<P: Problem + ?Sized>(
             let rtn = if ev == Evaluated::Failed {
                 f64::INFINITY
             } else {
-                max_norm(&rt)
+                problem.norm(&rt)
             };
             if rtn <= tol(problem, &xt) || settings.condition.accept(1.0, rn, rtn) {
                 // J += (Δr - J Δx) Δxᵀ / (Δxᵀ Δx), with Δx = dx.
@@ -242,7 +242,7 @@ pub fn newton<P: Problem + ?Sized>(
             let ev = problem.evaluate(&xt, lambda, None, &mut rt);
             out.at_x = false;
             if ev != Evaluated::Failed {
-                let rtn = max_norm(&rt);
+                let rtn = problem.norm(&rt);
                 if rtn <= tol(problem, &xt) {
                     x.copy_from_slice(&xt);
                     rn = rtn;
@@ -265,7 +265,7 @@ pub fn newton<P: Problem + ?Sized>(
             if ev != Evaluated::Jacobian {
                 continue;
             }
-            let rtn = max_norm(&rt);
+            let rtn = problem.norm(&rt);
             if settings.condition.accept(alpha, rn, rtn) || rtn <= tol(problem, &xt) {
                 x.copy_from_slice(&xt);
                 r.copy_from_slice(&rt);
