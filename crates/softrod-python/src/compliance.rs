@@ -328,6 +328,7 @@ pub(crate) fn tangent_compliance<'py>(
 pub(crate) struct Eigenscrews {
     inner: softrod::Decomposition,
     kind: String,
+    matrix: Py<PyAny>,
 }
 
 #[pymethods]
@@ -404,13 +405,25 @@ impl Eigenscrews {
             v.join(", ")
         )
     }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("eigenscrews")?;
+        let e = slf.get();
+        let args = (e.matrix.clone_ref(py), e.kind.clone()).into_pyobject(py)?;
+        PyTuple::new(py, [f, args.into_any()])
+    }
 }
 
 /// Eigenscrews of a symmetric positive definite 6x6 `matrix` (kind "stiffness" or
 /// "compliance"; twists [translation; rotation], wrenches [force; moment]).
 #[pyfunction]
 #[pyo3(signature = (matrix, kind="stiffness"))]
-pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyResult<Eigenscrews> {
+pub(crate) fn eigenscrews(
+    py: Python<'_>,
+    matrix: PyReadonlyArray2<'_, f64>,
+    kind: &str,
+) -> PyResult<Eigenscrews> {
+    let copy = matrix.as_array().to_owned().into_pyarray(py).into_any().unbind();
     let a = matrix.as_array();
     if a.shape() != [6, 6] {
         return Err(param_err(
@@ -429,6 +442,7 @@ pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyRe
     Ok(Eigenscrews {
         inner,
         kind: kind.to_string(),
+        matrix: copy,
     })
 }
 

@@ -58,6 +58,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<materials::UniaxialFit>()?;
     m.add_class::<materials::Silicone>()?;
     m.add_function(wrap_pyfunction!(materials::fit_uniaxial, m)?)?;
+    m.add_function(wrap_pyfunction!(materials::_uniaxial_fit, m)?)?;
     m.add_function(wrap_pyfunction!(materials::silicone, m)?)?;
     m.add("SILICONES", materials::silicone_names(m.py())?)?;
     m.add_function(wrap_pyfunction!(statics::_time_solve_statics, m)?)?;
@@ -72,6 +73,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<pcc::PccSolution>()?;
     m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_poses, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::_pcc_robot, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_frames, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_chain_pose, m)?)?;

@@ -181,6 +181,20 @@ impl PyUniaxialLaw {
     fn __repr__(&self) -> String {
         self.inner.to_string()
     }
+    /// Pickles as the constructor of its class called with its parameters (exact).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let rebuild = py.import("softrod._core")?.getattr("_rebuild")?;
+        let inner = PyTuple::new(
+            py,
+            [
+                slf.get_type().into_any(),
+                PyTuple::empty(py).into_any(),
+                parameters(py, &slf.get().inner)?.into_any(),
+            ],
+        )?;
+        PyTuple::new(py, [rebuild, inner.into_any()])
+    }
 }
 
 /// Linear law `P = E (λ − 1)` with Young's modulus `youngs_modulus` (Pa).
@@ -397,6 +411,23 @@ pub(crate) struct UniaxialFit {
 
 #[pymethods]
 impl UniaxialFit {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = slf.get();
+        let func = py.import("softrod._core")?.getattr("_uniaxial_fit")?;
+        let args = (
+            f.law.clone_ref(py),
+            f.rms,
+            f.r_squared,
+            f.max_abs_residual,
+            f.points,
+            f.iterations,
+            f.stress_measure,
+            f.stretch_range,
+        )
+            .into_pyobject(py)?;
+        PyTuple::new(py, [func, args.into_any()])
+    }
     /// The fitted law (a `UniaxialLaw` subclass: `NeoHookean`, `Yeoh`, ...).
     #[getter]
     fn model(&self, py: Python<'_>) -> Py<PyAny> {
@@ -548,6 +579,37 @@ pub(crate) fn fit_uniaxial(
     })
 }
 
+/// A fit from its parts (the pickled form of `UniaxialFit`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _uniaxial_fit(
+    law: &Bound<'_, PyUniaxialLaw>,
+    rms: f64,
+    r_squared: f64,
+    max_abs_residual: f64,
+    points: usize,
+    iterations: usize,
+    stress_measure: &str,
+    stretch_range: (f64, f64),
+) -> PyResult<UniaxialFit> {
+    let stress_measure = match stress_measure {
+        "nominal" => "nominal",
+        "true" => "true",
+        other => return Err(param_err("stress_measure", other, "\"nominal\" or \"true\"")),
+    };
+    Ok(UniaxialFit {
+        model: law.get().inner.clone(),
+        law: law.clone().into_any().unbind(),
+        rms,
+        r_squared,
+        max_abs_residual,
+        points,
+        iterations,
+        stress_measure,
+        stretch_range,
+    })
+}
+
 // ----------------------------------------------------------------------------------- library
 
 /// A named silicone of the library, with sourced parameters (see `softrod.silicone`).
@@ -593,6 +655,12 @@ impl Silicone {
     }
     fn __repr__(&self) -> String {
         format!("Silicone({:?})", self.inner.name())
+    }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("silicone")?;
+        let args = PyTuple::new(py, [slf.get().inner.name()])?;
+        PyTuple::new(py, [f, args.into_any()])
     }
 }
 
