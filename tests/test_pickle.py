@@ -45,7 +45,9 @@ SECTIONS = [
     softrod.CircularSection(1e-3),
     softrod.TaperedCircularSection(1.2e-3, 0.8e-3),
     softrod.TubeSection(1.2e-3, 0.4e-3),
-    softrod.TableSection([0.0, 0.5], [3e-6, 2e-6], [8e-13, 6e-13], [8e-13, 6e-13], [1.6e-12, 1.2e-12]),
+    softrod.TableSection(
+        [0.0, 0.5], [3e-6, 2e-6], [8e-13, 6e-13], [8e-13, 6e-13], [1.6e-12, 1.2e-12]
+    ),
     softrod.FunctionSection(_section_fn),
 ]
 
@@ -130,7 +132,9 @@ def test_pcc_and_planar_types_pickle():
     )
     back = round_trip(robot)
     sol = pcc.solve(robot, [1.0, 0.5, 0.2], tip_force=(0.01, 0.0, 0.0))
-    np.testing.assert_array_equal(pcc.solve(back, [1.0, 0.5, 0.2], tip_force=(0.01, 0.0, 0.0)).arcs, sol.arcs)
+    np.testing.assert_array_equal(
+        pcc.solve(back, [1.0, 0.5, 0.2], tip_force=(0.01, 0.0, 0.0)).arcs, sol.arcs
+    )
     np.testing.assert_array_equal(round_trip(sol).frames, sol.frames)
     assert pcc.Robot is pcc.PccRobot
     arm = softrod.PlanarCableArm.seed_arm()

@@ -26,7 +26,6 @@ Example:
 """
 
 from ._core import PccRobot, PccSolution
-from ._core import pcc_arc_poses as arc_poses
 from ._core import pcc_arc_frames as arc_frames
 from ._core import pcc_arc_from_pressures as arc_from_pressures
 from ._core import pcc_arc_from_pressures_jacobian as arc_from_pressures_jacobian
@@ -40,6 +39,7 @@ from ._core import pcc_arc_from_tip as arc_from_tip
 from ._core import pcc_arc_from_tip_with_length as arc_from_tip_with_length
 from ._core import pcc_arc_jacobian as arc_jacobian
 from ._core import pcc_arc_pose as arc_pose
+from ._core import pcc_arc_poses as arc_poses
 from ._core import pcc_chain_frames as chain_frames
 from ._core import pcc_chain_jacobian as chain_jacobian
 from ._core import pcc_chain_pose as chain_pose
