@@ -89,18 +89,12 @@ impl Compliance {
     /// Tip stiffness, world frame, shape (6, 6).
     #[getter]
     fn tip_stiffness_world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        mat6(
-            py,
-            &invert_spd(&self.inner.tip_world()).0,
-        )
+        mat6(py, &invert_spd(&self.inner.tip_world()).0)
     }
     /// Tip stiffness, body frame, shape (6, 6).
     #[getter]
     fn tip_stiffness_body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        mat6(
-            py,
-            &invert_spd(&self.inner.tip_body()).0,
-        )
+        mat6(py, &invert_spd(&self.inner.tip_body()).0)
     }
     /// 1-norm condition number of the tip compliance.
     #[getter]
@@ -423,7 +417,12 @@ pub(crate) fn eigenscrews(
     matrix: PyReadonlyArray2<'_, f64>,
     kind: &str,
 ) -> PyResult<Eigenscrews> {
-    let copy = matrix.as_array().to_owned().into_pyarray(py).into_any().unbind();
+    let copy = matrix
+        .as_array()
+        .to_owned()
+        .into_pyarray(py)
+        .into_any()
+        .unbind();
     let a = matrix.as_array();
     if a.shape() != [6, 6] {
         return Err(param_err(

@@ -34,7 +34,12 @@ fn describe(obj: &Bound<'_, PyAny>) -> String {
 }
 
 /// `n` floats from a sequence or a 1-d array, naming `name` on failure.
-pub(crate) fn floats_n(obj: &Bound<'_, PyAny>, name: &str, n: usize, what: &str) -> PyResult<Vec<f64>> {
+pub(crate) fn floats_n(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    n: usize,
+    what: &str,
+) -> PyResult<Vec<f64>> {
     let v = match obj.extract::<Floats<'_>>() {
         Ok(Floats::Scalar(_)) | Err(_) => None,
         Ok(f) => Some(f.to_vec()?),

@@ -12,9 +12,9 @@ mod compliance;
 mod convert;
 mod errors;
 mod materials;
+mod model;
 mod pcc;
 mod planar;
-mod model;
 mod statics;
 
 /// The compiled core of softrod.

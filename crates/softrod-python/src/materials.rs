@@ -12,7 +12,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use softrod::model::material::fit::{FitOptions, ModelKind, StrainMeasure, StressMeasure, UniaxialData};
+use softrod::model::material::fit::{
+    FitOptions, ModelKind, StrainMeasure, StressMeasure, UniaxialData,
+};
 use softrod::{Error, UniaxialLaw as _, UniaxialModel};
 
 use crate::errors::{param_err, to_py_err};
@@ -595,7 +597,13 @@ pub(crate) fn _uniaxial_fit(
     let stress_measure = match stress_measure {
         "nominal" => "nominal",
         "true" => "true",
-        other => return Err(param_err("stress_measure", other, "\"nominal\" or \"true\"")),
+        other => {
+            return Err(param_err(
+                "stress_measure",
+                other,
+                "\"nominal\" or \"true\"",
+            ))
+        }
     };
     Ok(UniaxialFit {
         model: law.get().inner.clone(),

@@ -14,8 +14,8 @@ use std::sync::{Arc, Mutex};
 use numpy::ndarray::Array;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
-use pyo3::IntoPyObjectExt;
 use pyo3::types::{PyDict, PyTuple};
+use pyo3::IntoPyObjectExt;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 
@@ -221,7 +221,11 @@ pub(crate) struct TaperedCircularSection {
 #[pymethods]
 impl TaperedCircularSection {
     #[new]
-    fn new(py: Python<'_>, base_radius: f64, tip_radius: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        py: Python<'_>,
+        base_radius: f64,
+        tip_radius: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let inner =
             softrod::Section::tapered_circular(base_radius, tip_radius).map_err(to_py_err)?;
         let items = [
@@ -596,7 +600,11 @@ pub(crate) struct Tendon {
     args: Args,
 }
 
-fn offset_fn(f: Py<PyAny>, slot: &ErrorSlot, what: &'static str) -> softrod::model::tendon::OffsetFn {
+fn offset_fn(
+    f: Py<PyAny>,
+    slot: &ErrorSlot,
+    what: &'static str,
+) -> softrod::model::tendon::OffsetFn {
     let slot = slot.clone();
     Arc::new(move |s| call_py::<[f64; 2]>(&f, &slot, s, what, [f64::NAN; 2]))
 }
@@ -679,11 +687,9 @@ impl Tendon {
         tension: f64,
         end: Option<f64>,
     ) -> PyResult<Self> {
-        let inner = softrod::Tendon::new(
-            softrod::Routing::RadiusProportional { ratio, angle },
-            end,
-        )
-        .map_err(to_py_err)?;
+        let inner =
+            softrod::Tendon::new(softrod::Routing::RadiusProportional { ratio, angle }, end)
+                .map_err(to_py_err)?;
         let tension = check_tension(tension)?;
         let args = Args::new(
             py,
@@ -1033,7 +1039,8 @@ impl Loads {
                 .transpose()?,
             gravity: v(gravity, "gravity")?,
         };
-        let opt = |a: Option<&Bound<'_, PyAny>>| a.map_or_else(|| py.None(), |b| b.clone().unbind());
+        let opt =
+            |a: Option<&Bound<'_, PyAny>>| a.map_or_else(|| py.None(), |b| b.clone().unbind());
         let args = Args::new(
             py,
             &[

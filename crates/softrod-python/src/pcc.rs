@@ -11,12 +11,15 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 use softrod::nalgebra::{Matrix4, Vector3};
-use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegment};
 use softrod::pcc::statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
+use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegment};
 
 use crate::errors::{param_err, to_py_err};
 
 use crate::convert::Floats;
+
+/// A chamber group `(segment, areas, distances, angles)` (m², m, rad).
+type ChamberGroup = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// Frames sampled along a solution when neither `s` nor `n_points` is given.
 const DEFAULT_FRAMES: usize = 50;
@@ -619,11 +622,18 @@ impl PccRobot {
 
     /// Chamber groups as `(segment, areas, distances, angles)`.
     #[getter]
-    fn chambers(&self) -> Vec<(usize, Vec<f64>, Vec<f64>, Vec<f64>)> {
+    fn chambers(&self) -> Vec<ChamberGroup> {
         self.inner
             .chambers()
             .iter()
-            .map(|(seg, c)| (*seg, c.areas().to_vec(), c.distances().to_vec(), c.angles().to_vec()))
+            .map(|(seg, c)| {
+                (
+                    *seg,
+                    c.areas().to_vec(),
+                    c.distances().to_vec(),
+                    c.angles().to_vec(),
+                )
+            })
             .collect()
     }
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
@@ -660,7 +670,7 @@ impl PccRobot {
 pub(crate) fn _pcc_robot(
     bodies: Vec<(f64, f64, Option<f64>)>,
     tendons: Vec<(f64, f64, usize)>,
-    chambers: Vec<(usize, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    chambers: Vec<ChamberGroup>,
 ) -> PyResult<PccRobot> {
     let segs = bodies
         .iter()
@@ -844,7 +854,9 @@ pub(crate) fn pcc_solve<'py>(
     warm_start: Option<Bound<'py, PyAny>>,
     throw: Option<bool>,
 ) -> PyResult<PccSolution> {
-    let o = |v: &Option<Bound<'py, PyAny>>| v.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind());
+    let o = |v: &Option<Bound<'py, PyAny>>| {
+        v.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind())
+    };
     let call = crate::model::Args::new(
         py,
         &[
@@ -865,12 +877,20 @@ pub(crate) fn pcc_solve<'py>(
     )?;
     let floats = |v: Option<Bound<'py, PyAny>>, name: &str| -> PyResult<Option<Floats<'py>>> {
         v.map(|b| {
-            b.extract::<Floats<'py>>()
-                .map_err(|_| param_err(name, "<object>", "floats (a number, a sequence or an array)"))
+            b.extract::<Floats<'py>>().map_err(|_| {
+                param_err(
+                    name,
+                    "<object>",
+                    "floats (a number, a sequence or an array)",
+                )
+            })
         })
         .transpose()
     };
-    let (tensions, pressures) = (floats(tensions, "tensions")?, floats(pressures, "pressures")?);
+    let (tensions, pressures) = (
+        floats(tensions, "tensions")?,
+        floats(pressures, "pressures")?,
+    );
     let (tip_force, tip_moment, s) = (
         floats(tip_force, "tip_force")?,
         floats(tip_moment, "tip_moment")?,

@@ -61,8 +61,13 @@ pub(crate) struct PlanarCableArm {
 }
 
 fn extract_floats<'py>(b: &Bound<'py, PyAny>, name: &str) -> PyResult<Floats<'py>> {
-    b.extract()
-        .map_err(|_| param_err(name, "<object>", "floats (a number, a sequence or an array)"))
+    b.extract().map_err(|_| {
+        param_err(
+            name,
+            "<object>",
+            "floats (a number, a sequence or an array)",
+        )
+    })
 }
 
 /// The call `arm.<method>(first, n_points=..., s=..., ...)` of a solution, for pickling.
@@ -79,13 +84,20 @@ fn call_args<'py>(
     max_steps: i64,
 ) -> PyResult<(Py<PyAny>, Args)> {
     let py = arm.py();
-    let first_name = if method_name == "solve" { "tension" } else { "tensions" };
+    let first_name = if method_name == "solve" {
+        "tension"
+    } else {
+        "tensions"
+    };
     let args = Args::new(
         py,
         &[
             (first_name, first),
             ("n_points", obj(py, n_points)?),
-            ("s", s.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind())),
+            (
+                "s",
+                s.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind()),
+            ),
             ("method", obj(py, method)?),
             ("rtol", obj(py, rtol)?),
             ("atol", obj(py, atol)?),
@@ -296,7 +308,17 @@ impl PlanarCableArm {
         atol: f64,
         max_steps: i64,
     ) -> PyResult<PlanarSolution> {
-        let call = call_args(slf, "solve", obj(py, tension)?, n_points, &s, method, rtol, atol, max_steps)?;
+        let call = call_args(
+            slf,
+            "solve",
+            obj(py, tension)?,
+            n_points,
+            &s,
+            method,
+            rtol,
+            atol,
+            max_steps,
+        )?;
         let s = s.map(|b| extract_floats(&b, "s")).transpose()?;
         let this = slf.get();
         let samples = samples_from(this.inner.length(), n_points, s)?;
@@ -351,7 +373,17 @@ impl PlanarCableArm {
         atol: f64,
         max_steps: i64,
     ) -> PyResult<PlanarBatch> {
-        let call = call_args(slf, "solve_many", tensions.clone().unbind(), n_points, &s, method, rtol, atol, max_steps)?;
+        let call = call_args(
+            slf,
+            "solve_many",
+            tensions.clone().unbind(),
+            n_points,
+            &s,
+            method,
+            rtol,
+            atol,
+            max_steps,
+        )?;
         let s = s.map(|b| extract_floats(&b, "s")).transpose()?;
         let t = extract_floats(&tensions, "tensions")?.to_vec()?;
         let this = slf.get();

@@ -64,7 +64,10 @@ fn statics(c: &mut Criterion) {
     for (suffix, loads) in [
         ("", Loads::default()),
         // The same robot with a small tip force, so that Newton iterations are needed.
-        ("_with_tip_force", Loads::tip_force(Vector3::new(0.05, 0.0, 0.0))),
+        (
+            "_with_tip_force",
+            Loads::tip_force(Vector3::new(0.05, 0.0, 0.0)),
+        ),
     ] {
         let model = niti(loads);
         let prev = solve_statics(&model, &act, &opts).unwrap();

@@ -10,10 +10,7 @@ mod common;
 
 use softrod::compliance::{compliance, tangent_compliance, tangent_compliance_held, TendonControl};
 use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution,
-    Tendon,
-};
+use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution};
 
 fn two_segment(tensions: [f64; 6]) -> Vec<common::Tensioned> {
     (0..6)
@@ -54,7 +51,10 @@ fn finite_difference(
             p.tip_moment[j - 3] += eps;
             m.tip_moment[j - 3] -= eps;
         }
-        let o = SolveOptions { warm_start: Some(sol.warm_start()), ..*opts };
+        let o = SolveOptions {
+            warm_start: Some(sol.warm_start()),
+            ..*opts
+        };
         let (a, b) = (
             common::solve(rod, tendons, &m, &o).unwrap(),
             common::solve(rod, tendons, &p, &o).unwrap(),
@@ -106,7 +106,14 @@ fn main() {
         LinearElastic::new(54e9, 0.3).unwrap(),
     )
     .unwrap();
-    let opts = SolveOptions { integrator: Integrator::Rk4 { steps: 200 }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() };
+    let opts = SolveOptions {
+        integrator: Integrator::Rk4 { steps: 200 },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    };
     println!("Two-segment NiTi robot, tensions = scale x [4, 0, 0, 0, 2, 0] N, world tip force [f_x, 0, 0] N;");
     println!("largest translational tip compliance (m/N) and block-relative differences.\n");
     println!("| scale | f_x (N) | integrated | tangent (tension) | finite diff. | integrated vs tangent | tangent vs FD | tangent (all 6 lengths held) | ratio | tangent (tensioned held) | ratio |");
@@ -118,20 +125,10 @@ fn main() {
             let loads = Loads::tip_force(Vector3::new(fx, 0.0, 0.0));
             let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
             let c = compliance(&sol).unwrap().tip_world();
-            let ten = tangent_compliance(&sol,
-                TendonControl::Tension,
-                None,
-            )
-            .unwrap();
-            let len = tangent_compliance(&sol,
-                TendonControl::Length,
-                None,
-            )
-            .unwrap();
+            let ten = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
+            let len = tangent_compliance(&sol, TendonControl::Length, None).unwrap();
             let tensioned: Vec<usize> = (0..6).filter(|&i| t[i] > 0.0).collect();
-            let part =
-                tangent_compliance_held(&sol, &tensioned, None)
-                    .unwrap();
+            let part = tangent_compliance_held(&sol, &tensioned, None).unwrap();
             let fd = finite_difference(&rod, &tendons, &loads, &opts, &sol, &ten.world);
             println!(
                 "| {scale:.1} | {fx:.1} | {:.5} | {:.5} | {:.5} | {:.2e} | {:.2e} | {:.5} | {:.3} | {:.5} | {:.3} |",

@@ -12,11 +12,9 @@
 mod common;
 
 use softrod::nalgebra::Vector3;
-use softrod::pcc::{ElasticSegment, PccTendons};
 use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::pcc::{ElasticSegment, PccTendons};
+use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions};
 
 fn main() -> softrod::Result<()> {
     let (e, nu, r, seg, d) = (54e9, 0.3, 0.0007, 0.2, 0.01);
@@ -40,7 +38,14 @@ fn main() -> softrod::Result<()> {
             common::tendon([d * b.cos(), d * b.sin()], tensions[i], end)
         })
         .collect::<softrod::Result<Vec<_>>>()?;
-    let cosserat_options = SolveOptions { integrator: Integrator::Rk4 { steps: 400 }, newton: softrod::NewtonOptions { tolerance: 1e-12, ..SolveOptions::default().newton }, ..Default::default() };
+    let cosserat_options = SolveOptions {
+        integrator: Integrator::Rk4 { steps: 400 },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-12,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    };
 
     println!("| tip force F_y (N) | PCC tip (mm) | Cosserat tip (mm) | distance (mm) | distance / tip motion |");
     println!("| ---: | --- | --- | ---: | ---: |");
@@ -66,7 +71,10 @@ fn main() -> softrod::Result<()> {
             &rod,
             &tendons,
             &Loads::tip_force(force),
-            &SolveOptions { warm_start: warm_cosserat, ..cosserat_options },
+            &SolveOptions {
+                warm_start: warm_cosserat,
+                ..cosserat_options
+            },
         )?;
         warm_cosserat = Some(cos.warm_start());
         let t = pcc.tip_pose;

@@ -66,8 +66,13 @@ fn main() {
         let ph = 2.0 * std::f64::consts::PI * rng.next();
         let r = (1.0 - z * z).sqrt();
         let force = Vector3::new(mag * r * ph.cos(), mag * r * ph.sin(), mag * z);
-        let model =
-            RobotModel::new(rod.clone(), tendons.clone(), vec![], Loads::tip_force(force)).unwrap();
+        let model = RobotModel::new(
+            rod.clone(),
+            tendons.clone(),
+            vec![],
+            Loads::tip_force(force),
+        )
+        .unwrap();
         let s = solve_statics(&model, &Actuation::tensions(&t), &opts);
         let (ok, tip, it, ls, lam, eig) = match &s {
             Ok(s) => {
@@ -83,7 +88,14 @@ fn main() {
                     f64::NAN
                 };
                 let st = &s.stats;
-                (st.converged, s.tip_position(), st.iterations, st.load_steps, st.load_factor, eig)
+                (
+                    st.converged,
+                    s.tip_position(),
+                    st.iterations,
+                    st.load_steps,
+                    st.load_factor,
+                    eig,
+                )
             }
             Err(_) => (false, [f64::NAN; 3], 0, 0, 0.0, f64::NAN),
         };

@@ -3,23 +3,30 @@
 //! tip of the two-segment NiTi tendon robot.
 //!
 //! Run: `cargo run --release -p softrod --example statics_tables`.
-#![allow(clippy::unwrap_used)]
+#![allow(clippy::unwrap_used, clippy::too_many_lines)]
 
 #[path = "../tests/common/robot.rs"]
 mod common;
 
 use softrod::integrate::AdaptiveOptions;
 use softrod::{
-    solve_planar, solve_statics, uniform_samples, Integrator, LinearElastic, Loads, PlanarCableArm,
-    PlanarMethod, Rod, Routing, Section, SolveOptions, Tendon,
+    solve_planar, uniform_samples, Integrator, LinearElastic, Loads, PlanarCableArm, PlanarMethod,
+    Rod, Routing, Section, SolveOptions,
 };
 
 fn tight() -> SolveOptions {
-    SolveOptions { integrator: Integrator::Adaptive(AdaptiveOptions {
+    SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
             rtol: 1e-12,
             atol: 1e-15,
             max_steps: 1_000_000,
-        }), newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+        }),
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn main() {
@@ -126,7 +133,10 @@ fn main() {
         r[0], r[1], r[2]
     );
     for steps in [20, 30, 40, 50, 80] {
-        let opts = SolveOptions { integrator: Integrator::Rk4 { steps }, ..Default::default() };
+        let opts = SolveOptions {
+            integrator: Integrator::Rk4 { steps },
+            ..Default::default()
+        };
         let sol = common::solve(&rod, &tendons, &Loads::default(), &opts).unwrap();
         let t = sol.tip_position();
         let e = ((t[0] - r[0]).powi(2) + (t[1] - r[1]).powi(2) + (t[2] - r[2]).powi(2)).sqrt();

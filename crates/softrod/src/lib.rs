@@ -55,9 +55,9 @@ pub use model::rod::{Pose, Profile, Rod};
 pub use model::section::{Section, SectionProperties};
 pub use model::tendon::{Routing, Tendon};
 pub use model::{Actuation, RobotModel, TendonInput};
-pub use solve::{NewtonOptions, SolverStats};
 pub use nalgebra;
 pub use planar::{
     solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,
     PlanarSolution,
 };
+pub use solve::{NewtonOptions, SolverStats};

@@ -3,13 +3,13 @@
 
 mod common;
 
-use softrod::compliance::{compliance, tangent_compliance, TendonControl};
+use softrod::batch::workspace::workspace_map;
 use softrod::compliance::eigenscrew::{eigenscrews, MatrixKind};
-use softrod::nalgebra::{Matrix6, Vector3, Vector6};
+use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::math::se3::{adjoint, delta};
 use softrod::math::so3::exp_so3;
-use softrod::batch::workspace::workspace_map;
-use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
+use softrod::nalgebra::{Matrix6, Vector3, Vector6};
+use softrod::{LinearElastic, Loads, Rod, Section, SolveOptions};
 
 /// Unit twist about the axis through `c` along unit `a` with pitch `h`: `[c × a + h a; a]`.
 fn twist(a: Vector3<f64>, c: Vector3<f64>, h: f64) -> Vector6<f64> {
@@ -137,8 +137,7 @@ fn workspace_map_matches_single_solves() {
             .symmetric_eigen()
             .eigenvalues;
         assert!((map[i].max_translational_compliance - ctt.max()).abs() < 1e-8 * ctt.max());
-        let t = tangent_compliance(&sol, TendonControl::Length, None)
-            .unwrap();
+        let t = tangent_compliance(&sol, TendonControl::Length, None).unwrap();
         let b = t.world.fixed_view::<3, 3>(0, 0).into_owned();
         let e = ((b + b.transpose()) * 0.5)
             .symmetric_eigen()

@@ -10,12 +10,12 @@ use common::{assert_blocks_close, castigliano_arc};
 use std::f64::consts::PI;
 
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
-use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
 use softrod::math::se3::rotation_adjoint;
 use softrod::math::so3::exp_so3;
+use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
 use softrod::{
     solve_statics, Integrator, LinearElastic, Loads, Pose, Profile, Rod, Section, SolveOptions,
-    StaticsSolution, Tendon,
+    StaticsSolution,
 };
 
 const E: f64 = 2.0e9;
@@ -24,7 +24,14 @@ const RADIUS: f64 = 0.01;
 const LENGTH: f64 = 0.5;
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn rot_of(sol: &StaticsSolution, i: usize) -> Matrix3<f64> {
@@ -223,7 +230,10 @@ fn fd_tip_compliance(
             plus.tip_moment[j - 3] += eps;
             minus.tip_moment[j - 3] -= eps;
         }
-        let o = SolveOptions { warm_start: Some(sol.warm_start()), ..*opts };
+        let o = SolveOptions {
+            warm_start: Some(sol.warm_start()),
+            ..*opts
+        };
         let sp = common::solve(rod, tendons, &plus, &o).unwrap();
         let sm = common::solve(rod, tendons, &minus, &o).unwrap();
         tip_twist(&sm, &sp) / (2.0 * eps)
@@ -251,8 +261,7 @@ fn unloaded_integrated_tangent_and_finite_difference_agree() {
         let loads = Loads::default();
         let sol = common::solve(&rod, &[], &loads, &opts).unwrap();
         let c = compliance(&sol).unwrap().tip_world();
-        let t = tangent_compliance(&sol, TendonControl::Tension, None)
-            .unwrap();
+        let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
         let fd = fd_tip_compliance(&rod, &[], &loads, &opts, &sol, &c);
         assert_blocks_close(
             &t.world,
@@ -275,11 +284,7 @@ fn loaded_tangent_matches_finite_difference() {
     };
     let opts = rk4(400);
     let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
-    let t = tangent_compliance(&sol,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
     let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
     assert_blocks_close(&t.world, &fd, 1e-6, "loaded tangent vs fd");
     // The seed's integrated compliance differs under load and actuation.
@@ -325,7 +330,10 @@ fn held_length_tip(
                 jac[(i, k)] = (sp.tendon_lengths[i] - s.tendon_lengths[i]) / h;
             }
         }
-        let dt = jac.lu().solve(&softrod::nalgebra::DVector::from_vec(r)).unwrap();
+        let dt = jac
+            .lu()
+            .solve(&softrod::nalgebra::DVector::from_vec(r))
+            .unwrap();
         for k in 0..n {
             t[k] -= dt[k];
         }
@@ -432,11 +440,7 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
     // A node inside segment 2 that is a mesh node of the perturbed problems too.
     let node = 300;
     let s = sol.s[node];
-    let t = tangent_compliance(&sol,
-        TendonControl::Tension,
-        Some(node),
-    )
-    .unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Tension, Some(node)).unwrap();
     assert_eq!(t.s, s);
     let mut fd = Matrix6::zeros();
     for j in 0..6 {
@@ -456,7 +460,10 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
                     pl.moment[j - 3] = sign * e;
                 }
                 l.point_loads.push(pl);
-                let o = SolveOptions { warm_start: Some(sol.warm_start()), ..opts };
+                let o = SolveOptions {
+                    warm_start: Some(sol.warm_start()),
+                    ..opts
+                };
                 common::solve(&rod, &tendons, &l, &o).unwrap()
             };
             node_twist(&mk(-1.0), &mk(1.0), s) / (2.0 * e)
@@ -472,26 +479,25 @@ fn adaptive_tangent_matches_finite_difference() {
     let rod = niti();
     let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.2, 0.1, 0.0));
-    let opts = SolveOptions { integrator: Integrator::Adaptive(AdaptiveOptions {
+    let opts = SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
             rtol: 1e-12,
             atol: 1e-14,
             ..Default::default()
-        }), newton: softrod::NewtonOptions { tolerance: 1e-12, ..SolveOptions::default().newton }, ..Default::default() };
+        }),
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-12,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    };
     let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
-    let t = tangent_compliance(&sol,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
     let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
     assert_blocks_close(&t.world, &fd, 1e-6, "adaptive tangent vs fd");
     // The same tangent as RK4 with many steps (both converge to the exact one).
     let r = rk4(800);
     let sr = common::solve(&rod, &tendons, &loads, &r).unwrap();
-    let tr = tangent_compliance(&sr,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let tr = tangent_compliance(&sr, TendonControl::Tension, None).unwrap();
     assert_blocks_close(&t.world, &tr.world, 1e-6, "adaptive vs rk4 tangent");
 }

@@ -9,13 +9,11 @@ use std::f64::consts::PI;
 
 use common::{assert_blocks_close, castigliano_arc};
 use softrod::compliance::{compliance, pcc_compliance, PCC_PANEL_ANGLE};
-use softrod::nalgebra::Vector3;
-use softrod::pcc::ElasticSegment;
-use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon};
 use softrod::math::so3::exp_so3;
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Pose, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::nalgebra::Vector3;
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon};
+use softrod::pcc::ElasticSegment;
+use softrod::{Integrator, LinearElastic, Loads, Pose, Rod, Section, SolveOptions};
 
 const E: f64 = 2.0e9;
 const NU: f64 = 0.3;
@@ -101,9 +99,15 @@ fn pcc_and_cosserat_compliance_agree_on_an_unloaded_tendon_segment() {
             let pcc = solve(&robot, tension);
             let cos_rod = rod.clone().with_inextensible(!extensible);
             let tendon =
-                common::tendon([OFFSET * beta.cos(), OFFSET * beta.sin()], tension, None)
-                    .unwrap();
-            let options = SolveOptions { integrator: Integrator::Rk4 { steps: 800 }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() };
+                common::tendon([OFFSET * beta.cos(), OFFSET * beta.sin()], tension, None).unwrap();
+            let options = SolveOptions {
+                integrator: Integrator::Rk4 { steps: 800 },
+                newton: softrod::NewtonOptions {
+                    tolerance: 1e-13,
+                    ..SolveOptions::default().newton
+                },
+                ..Default::default()
+            };
             let sol = common::solve(&cos_rod, &[tendon], &Loads::default(), &options).unwrap();
             let c_cos = compliance(&sol).unwrap().tip_world();
             let c_pcc = pcc_compliance(&cos_rod, &robot, &pcc, None)

@@ -9,13 +9,12 @@ mod common;
 use std::f64::consts::PI;
 
 use softrod::nalgebra::{Matrix3, Vector3};
-use softrod::pcc::{arc_from_pressures, ElasticSegment, PccChambers, PccSegment, PccTendons};
 use softrod::pcc::statics::{
     pcc_equilibrium, solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon,
 };
+use softrod::pcc::{arc_from_pressures, ElasticSegment, PccChambers, PccSegment, PccTendons};
 use softrod::{
-    solve_statics, Error, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions,
-    StaticsSolution, Tendon,
+    Error, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution,
 };
 
 // The two-segment NiTi robot of the issue.
@@ -28,7 +27,14 @@ const ANGLES_DEG: [f64; 3] = [90.0, -30.0, 210.0];
 const TENSIONS: [f64; 6] = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn niti_pcc(extensible: bool) -> PccRobot {
@@ -472,7 +478,10 @@ fn pcc_and_cosserat_diverge_as_the_tip_load_grows() {
         )
         .unwrap();
         warm_pcc = Some(pcc.warm_start());
-        let opts = SolveOptions { warm_start: warm, ..rk4(400) };
+        let opts = SolveOptions {
+            warm_start: warm,
+            ..rk4(400)
+        };
         let cos = common::solve(&rod, &ts, &Loads::tip_force(force), &opts).unwrap();
         warm = Some(cos.warm_start());
         let (p, _) = pcc_tip(&pcc);

@@ -10,9 +10,9 @@ use std::f64::consts::PI;
 
 use softrod::nalgebra::Vector3;
 use softrod::{
-    ChamberArea, Error, StaticsSolution, Hookean, Integrator, LinearElastic, Loads,
-    Material, MooneyRivlin, NeoHookean, Rod, Section, Silicone, SolveOptions, UniaxialLaw,
-    UniaxialModel, Yeoh,
+    ChamberArea, Error, Hookean, Integrator, LinearElastic, Loads, Material, MooneyRivlin,
+    NeoHookean, Rod, Section, Silicone, SolveOptions, StaticsSolution, UniaxialLaw, UniaxialModel,
+    Yeoh,
 };
 
 /// Seed-001-like arm: length, outer radius, chamber radius, chamber centroid distance (m).
@@ -22,7 +22,14 @@ const RC: f64 = 0.0025;
 const D: f64 = 0.6 * R;
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 /// Angles of the six chambers: three pairs centred at 90°, 210°, 330°, ±25° within a pair.
@@ -174,11 +181,14 @@ fn linear_fibre_law_equals_the_linear_material_at_any_load() {
     let e = 300e3;
     let lin = Rod::new(L, sec.clone(), LinearElastic::new(e, 0.5).unwrap()).unwrap();
     let hyp = Rod::new(L, sec, UniaxialModel::from(Hookean::new(e).unwrap())).unwrap();
-    let loads = Loaded { loads: Loads {
-        tip_force: Vector3::new(0.3, -0.2, 0.3),
-        tip_moment: Vector3::new(0.0, 0.0, 2e-3),
-        ..Default::default()
-    }, chambers: chambers([0.0, 120e3, 0.0, 0.0, 150e3, 0.0]) };
+    let loads = Loaded {
+        loads: Loads {
+            tip_force: Vector3::new(0.3, -0.2, 0.3),
+            tip_moment: Vector3::new(0.0, 0.0, 2e-3),
+            ..Default::default()
+        },
+        chambers: chambers([0.0, 120e3, 0.0, 0.0, 150e3, 0.0]),
+    };
     let a = solve_p(&lin, &loads, &rk4(200)).unwrap();
     let b = solve_p(&hyp, &loads, &rk4(200)).unwrap();
     let err = dist(a.tip_position(), b.tip_position());
@@ -201,10 +211,13 @@ fn small_strains_equal_the_linear_rod_with_the_initial_modulus() {
         let hyp = Rod::new(L, sec.clone(), law.clone()).unwrap();
         let mut rel = Vec::new();
         for scale in [1e-4, 1e-5] {
-            let loads = Loaded { loads: Loads {
-                tip_force: Vector3::new(0.2, -0.1, 0.5) * scale,
-                ..Default::default()
-            }, chambers: vec![common::constant_chamber(2e5 * scale, 2e-5, [0.0, 0.006]).unwrap()] };
+            let loads = Loaded {
+                loads: Loads {
+                    tip_force: Vector3::new(0.2, -0.1, 0.5) * scale,
+                    ..Default::default()
+                },
+                chambers: vec![common::constant_chamber(2e5 * scale, 2e-5, [0.0, 0.006]).unwrap()],
+            };
             let a = solve_p(&lin, &loads, &rk4(100)).unwrap();
             let b = solve_p(&hyp, &loads, &rk4(100)).unwrap();
             let disp = dist(a.tip_position(), [0.0, 0.0, L]);
@@ -367,19 +380,17 @@ fn tangent_compliance_of_a_pressurised_hyperelastic_arm_matches_finite_differenc
     let loads = with_chambers(chambers([30e3, 30e3, 15e3, 15e3, 0.0, 0.0]));
     let opts = rk4(100);
     let sol = solve_p(&rod, &loads, &opts).unwrap();
-    let t = softrod::tangent_compliance(
-        &sol,
-        softrod::TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let t = softrod::tangent_compliance(&sol, softrod::TendonControl::Tension, None).unwrap();
     assert!(t.symmetric);
     let tip = |w: [f64; 6]| {
-        let l = Loaded { loads: Loads {
-            tip_force: Vector3::new(w[0], w[1], w[2]),
-            tip_moment: Vector3::new(w[3], w[4], w[5]),
-            ..Default::default()
-        }, chambers: loads.chambers.clone() };
+        let l = Loaded {
+            loads: Loads {
+                tip_force: Vector3::new(w[0], w[1], w[2]),
+                tip_moment: Vector3::new(w[3], w[4], w[5]),
+                ..Default::default()
+            },
+            chambers: loads.chambers.clone(),
+        };
         let s = solve_p(&rod, &l, &opts).unwrap();
         (s.tip_position(), s.rotation[s.s.len() - 1])
     };

@@ -8,8 +8,8 @@ use std::sync::Arc;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::{
-    solve_statics, Error, Integrator, LinearElastic, Loads, PointLoad, Pose, Profile, Rod, Routing,
-    Section, SectionProperties, SolveOptions, Tendon, WarmStart,
+    Error, Integrator, LinearElastic, Loads, PointLoad, Pose, Profile, Rod, Routing, Section,
+    SectionProperties, SolveOptions, WarmStart,
 };
 
 fn name_of<T: std::fmt::Debug>(r: softrod::Result<T>) -> String {
@@ -125,7 +125,12 @@ fn bad_tendons_are_named() {
     for tension in [-1.0, f64::NAN] {
         let t = common::tendon([0.001, 0.0], tension, None).unwrap();
         assert_eq!(
-            name_of(common::solve(&rod(), &[t], &Loads::default(), &SolveOptions::default())),
+            name_of(common::solve(
+                &rod(),
+                &[t],
+                &Loads::default(),
+                &SolveOptions::default()
+            )),
             "tensions[0]"
         );
     }
@@ -134,10 +139,7 @@ fn bad_tendons_are_named() {
         "offset[1]"
     );
     for end in [0.0, -0.1, f64::NAN] {
-        assert_eq!(
-            name_of(common::tendon([0.001, 0.0], 1.0, Some(end))),
-            "end"
-        );
+        assert_eq!(name_of(common::tendon([0.001, 0.0], 1.0, Some(end))), "end");
     }
     let helix = |pitch| {
         common::tendon_with(
@@ -210,23 +212,47 @@ fn bad_loads_and_options_are_named() {
     };
     assert!(name_of(solve(&l, &d)).starts_with("loads.distributed_force("));
     let l = Loads::default();
-    let o = SolveOptions { integrator: Integrator::Rk4 { steps: 0 }, ..d };
+    let o = SolveOptions {
+        integrator: Integrator::Rk4 { steps: 0 },
+        ..d
+    };
     assert_eq!(name_of(solve(&l, &o)), "integrator.steps");
-    let o = SolveOptions { integrator: Integrator::Rk4 { steps: usize::MAX }, ..d };
+    let o = SolveOptions {
+        integrator: Integrator::Rk4 { steps: usize::MAX },
+        ..d
+    };
     assert_eq!(name_of(solve(&l, &o)), "integrator.steps");
-    let o = SolveOptions { newton: softrod::NewtonOptions { tolerance: f64::NAN, ..d.newton }, ..d };
+    let o = SolveOptions {
+        newton: softrod::NewtonOptions {
+            tolerance: f64::NAN,
+            ..d.newton
+        },
+        ..d
+    };
     assert_eq!(name_of(solve(&l, &o)), "tolerance");
-    let o = SolveOptions { newton: softrod::NewtonOptions { max_iterations: 0, ..d.newton }, ..d };
+    let o = SolveOptions {
+        newton: softrod::NewtonOptions {
+            max_iterations: 0,
+            ..d.newton
+        },
+        ..d
+    };
     assert_eq!(name_of(solve(&l, &o)), "max_iterations");
-    let o = SolveOptions { warm_start: Some(WarmStart {
+    let o = SolveOptions {
+        warm_start: Some(WarmStart {
             base_wrench: [0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0],
             jacobian: None,
-        }), ..d };
+        }),
+        ..d
+    };
     assert_eq!(name_of(solve(&l, &o)), "warm_start.base_wrench[2]");
-    let o = SolveOptions { integrator: Integrator::Adaptive(softrod::integrate::AdaptiveOptions {
+    let o = SolveOptions {
+        integrator: Integrator::Adaptive(softrod::integrate::AdaptiveOptions {
             rtol: -1.0,
             ..Default::default()
-        }), ..d };
+        }),
+        ..d
+    };
     assert_eq!(name_of(solve(&l, &o)), "rtol");
 }
 
@@ -245,7 +271,15 @@ fn extreme_inputs_never_panic() {
                 .unwrap();
                 let t = common::tendon([0.0015, 0.0], tau, Some(0.2)).unwrap();
                 let loads = Loads::tip_force(Vector3::new(f, 0.0, -f));
-                let opts = SolveOptions { integrator: Integrator::Rk4 { steps: 3 }, newton: softrod::NewtonOptions { max_load_steps: 4, max_iterations: 5, ..SolveOptions::default().newton }, ..Default::default() };
+                let opts = SolveOptions {
+                    integrator: Integrator::Rk4 { steps: 3 },
+                    newton: softrod::NewtonOptions {
+                        max_load_steps: 4,
+                        max_iterations: 5,
+                        ..SolveOptions::default().newton
+                    },
+                    ..Default::default()
+                };
                 let r = common::solve(&rod, &[t], &loads, &opts);
                 if let Ok(sol) = &r {
                     assert!(sol.stats.converged);
@@ -254,7 +288,13 @@ fn extreme_inputs_never_panic() {
                     &rod,
                     &[],
                     &loads,
-                    &SolveOptions { newton: softrod::NewtonOptions { throw: false, ..opts.newton }, ..opts },
+                    &SolveOptions {
+                        newton: softrod::NewtonOptions {
+                            throw: false,
+                            ..opts.newton
+                        },
+                        ..opts
+                    },
                 );
                 assert!(r2.is_ok() || matches!(r2, Err(Error::NotConverged { .. })));
             }

@@ -10,20 +10,34 @@ use std::f64::consts::PI;
 use softrod::integrate::AdaptiveOptions;
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::{
-    solve_statics, Error, Frame, Integrator, LinearElastic, Loads, Rod, Routing, Section,
-    SolveOptions, StaticsSolution, Tendon,
+    Error, Frame, Integrator, LinearElastic, Loads, Rod, Routing, Section, SolveOptions,
+    StaticsSolution,
 };
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn adaptive(rtol: f64) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Adaptive(AdaptiveOptions {
+    SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
             rtol,
             atol: rtol * 1e-3,
             max_steps: 1_000_000,
-        }), newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+        }),
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -167,7 +181,10 @@ fn warm_start_reaches_the_cold_solution_in_fewer_iterations() {
     .unwrap();
     let changed = niti_tendons(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
     let cold = common::solve(&rod, &changed, &loads, &rk4(40)).unwrap();
-    let warm_opts = SolveOptions { warm_start: Some(a.warm_start()), ..rk4(40) };
+    let warm_opts = SolveOptions {
+        warm_start: Some(a.warm_start()),
+        ..rk4(40)
+    };
     let warm = common::solve(&rod, &changed, &loads, &warm_opts).unwrap();
     println!(
         "iterations: cold {}, warm {}; evaluations: cold {}, warm {}",
@@ -261,7 +278,14 @@ fn non_convergence_is_an_error_or_an_inspectable_result() {
     .unwrap()
     .with_inextensible(true);
     let loads = Loads::tip_force(Vector3::new(0.5, 0.0, 0.0)); // alpha ~ 1.4e2: hard
-    let opts = SolveOptions { newton: softrod::NewtonOptions { max_iterations: 2, continuation: false, ..SolveOptions::default().newton }, ..Default::default() };
+    let opts = SolveOptions {
+        newton: softrod::NewtonOptions {
+            max_iterations: 2,
+            continuation: false,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    };
     match common::solve(&rod, &[], &loads, &opts) {
         Err(Error::NotConverged {
             iterations,
@@ -277,7 +301,13 @@ fn non_convergence_is_an_error_or_an_inspectable_result() {
         &rod,
         &[],
         &loads,
-        &SolveOptions { newton: softrod::NewtonOptions { throw: false, ..opts.newton }, ..opts },
+        &SolveOptions {
+            newton: softrod::NewtonOptions {
+                throw: false,
+                ..opts.newton
+            },
+            ..opts
+        },
     )
     .unwrap();
     assert!(!sol.stats.converged);

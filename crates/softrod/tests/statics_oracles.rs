@@ -9,20 +9,32 @@ use std::f64::consts::PI;
 
 use softrod::integrate::AdaptiveOptions;
 use softrod::nalgebra::{Matrix3, Vector3};
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions};
 
 fn rk4(steps: usize) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Rk4 { steps }, newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn adaptive(rtol: f64) -> SolveOptions {
-    SolveOptions { integrator: Integrator::Adaptive(AdaptiveOptions {
+    SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions {
             rtol,
             atol: rtol * 1e-3,
             max_steps: 1_000_000,
-        }), newton: softrod::NewtonOptions { tolerance: 1e-13, ..SolveOptions::default().newton }, ..Default::default() }
+        }),
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
+        ..Default::default()
+    }
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

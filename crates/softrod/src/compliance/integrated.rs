@@ -161,8 +161,7 @@ fn blocks(tt: &Matrix3<f64>, tr: &Matrix3<f64>, rr: &Matrix3<f64>) -> Matrix6<f6
 /// The integrated compliance at the last node only (world frame, at the tip), without the
 /// per-node inverses: the cheap path of [`crate::batch::workspace::workspace_map`].
 pub fn tip_compliance_world(solution: &StaticsSolution) -> Result<Matrix6<f64>> {
-    compliance_matrices(&Configuration::from_statics(solution)?, true)
-        .map(|(w, _)| w[w.len() - 1])
+    compliance_matrices(&Configuration::from_statics(solution)?, true).map(|(w, _)| w[w.len() - 1])
 }
 
 /// Dimensionless flexural compliance `γ_c = diag(C_body,tt) · 3 E I(0) / L³` per body axis

@@ -7,6 +7,5 @@ mod tangent;
 
 pub use integrated::*;
 pub use tangent::{
-    tangent_compliance, tangent_compliance_held, TangentCompliance, TendonControl,
-    COLUMNS_PER_PASS,
+    tangent_compliance, tangent_compliance_held, TangentCompliance, TendonControl, COLUMNS_PER_PASS,
 };

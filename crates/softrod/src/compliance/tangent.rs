@@ -31,8 +31,6 @@ const fn width(c: usize) -> usize {
     STATE + COLUMN * c
 }
 
-
-
 /// How the tendons behave under the extra wrench of [`tangent_compliance`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum TendonControl {
@@ -126,25 +124,32 @@ fn pass<const N: usize>(
     }
     let mut ev = Evaluator { eq, ws: &mut ws };
     let mut at_node: Option<(Vec<Vector6<f64>>, Matrix3<f64>)> = None;
-    let y = march(&mut ev, model.breaks(), &[target], y0, scheme, |_, s, _, y| {
-        if at_node.is_none() && s == target {
-            let r = rot(y);
-            let pose = (0..seeds.len())
-                .map(|c| {
-                    let b = STATE + COLUMN * c;
-                    let (dp, w) = (v3(y, b), r * v3(y, b + 3));
-                    Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
-                })
-                .collect();
-            at_node = Some((pose, r));
-            for (c, seed) in seeds.iter().enumerate() {
-                if let Seed::Load(k) = seed {
-                    let b = STATE + COLUMN * c + if *k < 3 { 6 + k } else { 9 + k - 3 };
-                    y[b] = -1.0;
+    let y = march(
+        &mut ev,
+        model.breaks(),
+        &[target],
+        y0,
+        scheme,
+        |_, s, _, y| {
+            if at_node.is_none() && s == target {
+                let r = rot(y);
+                let pose = (0..seeds.len())
+                    .map(|c| {
+                        let b = STATE + COLUMN * c;
+                        let (dp, w) = (v3(y, b), r * v3(y, b + 3));
+                        Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
+                    })
+                    .collect();
+                at_node = Some((pose, r));
+                for (c, seed) in seeds.iter().enumerate() {
+                    if let Seed::Load(k) = seed {
+                        let b = STATE + COLUMN * c + if *k < 3 { 6 + k } else { 9 + k - 3 };
+                        y[b] = -1.0;
+                    }
                 }
             }
-        }
-    })?;
+        },
+    )?;
     let (_, residual) = eq.residual(&y, seeds.len());
     let nt = model.tendons().len();
     let nl = held.len();
@@ -211,7 +216,6 @@ pub fn tangent_compliance_held(
         }
     }
     let target = solution.s[node];
-    let nh = held.len();
     let mut tension_rate = vec![[0.0; 6]; nt];
     if target <= 0.0 {
         let z = Matrix6::zeros();
@@ -263,36 +267,83 @@ pub fn tangent_compliance_held(
         .chain(held.iter().map(|&i| Seed::Tension(i)))
         .chain((0..6).map(Seed::Load))
         .collect();
-    let (mut residual, mut lengths, mut pose) = (Vec::new(), Vec::new(), Vec::new());
-    let mut r_node = None;
+    let columns = integrate_columns(eq, scheme, &x, &seeds, held, target).map_err(|e| match e {
+        Error::InvalidParameter { .. } => Error::invalid(
+            "node",
+            node,
+            "a node of the solution's mesh (solve and tangent with the same integrator)",
+        ),
+        other => other,
+    })?;
+    let world = solve_linearised(&columns, held, &mut tension_rate)?;
+    let r_node = columns.rotation.unwrap_or_else(Matrix3::identity);
+    let rt = rotation_adjoint(&r_node.transpose());
+    let body = rt * world * rt.transpose();
+    let asym = (world - world.transpose()).amax();
+    let symmetric = asym <= 1e-6 * world.amax();
+    let (kw, condition) = invert_general(&world);
+    let (kb, _) = invert_general(&body);
+    Ok(TangentCompliance {
+        node,
+        s: target,
+        world,
+        body,
+        stiffness_world: kw,
+        stiffness_body: kb,
+        condition,
+        symmetric,
+        tension_rate,
+    })
+}
+
+/// Every column of the linearised problem, integrated [`COLUMNS_PER_PASS`] at a time.
+fn integrate_columns(
+    eq: Equations<'_>,
+    scheme: Scheme<'_>,
+    x: &[f64; 6],
+    seeds: &[Seed],
+    held: &[usize],
+    target: f64,
+) -> Result<Pass> {
+    let mut all = Pass {
+        residual: Vec::new(),
+        lengths: Vec::new(),
+        pose: Vec::new(),
+        rotation: None,
+    };
     for chunk in seeds.chunks(COLUMNS_PER_PASS) {
         let p = if chunk.len() <= 12 {
-            pass::<{ width(12) }>(eq, scheme, &x, chunk, held, target)?
+            pass::<{ width(12) }>(eq, scheme, x, chunk, held, target)?
         } else {
-            pass::<{ width(COLUMNS_PER_PASS) }>(eq, scheme, &x, chunk, held, target)?
+            pass::<{ width(COLUMNS_PER_PASS) }>(eq, scheme, x, chunk, held, target)?
         };
         if p.rotation.is_none() {
-            return Err(Error::invalid(
-                "node",
-                node,
-                "a node of the solution's mesh (solve and tangent with the same integrator)",
-            ));
+            return Err(Error::invalid("node", target, "a node of the mesh"));
         }
-        r_node = p.rotation;
-        residual.extend(p.residual);
-        lengths.extend(p.lengths);
-        pose.extend(p.pose);
+        all.rotation = p.rotation;
+        all.residual.extend(p.residual);
+        all.lengths.extend(p.lengths);
+        all.pose.extend(p.pose);
     }
-    let Some(r_node) = r_node else {
-        return Err(Error::invalid("node", node, "a node of the solution's mesh"));
-    };
+    Ok(all)
+}
+
+/// Solves the linearised tip conditions and held lengths for the base wrench and the held
+/// tensions, per applied wrench component: the world compliance at the node, and the tension
+/// rates of the held tendons into `tension_rate`.
+fn solve_linearised(
+    columns: &Pass,
+    held: &[usize],
+    tension_rate: &mut [[f64; 6]],
+) -> Result<Matrix6<f64>> {
     let fail = |what: &str| Error::NotConverged {
         what: format!("tangent compliance: {what}"),
         iterations: 0,
         residual: f64::INFINITY,
     };
+    let (residual, lengths, pose) = (&columns.residual, &columns.lengths, &columns.pose);
     // Linear system in z = [δx (scaled base wrench); δτ (held)], column-major.
-    let dim = 6 + nh;
+    let dim = 6 + held.len();
     let mut a = vec![0.0; dim * dim];
     for c in 0..dim {
         a[c * dim..c * dim + 6].copy_from_slice(residual[c].as_slice());
@@ -318,21 +369,5 @@ pub fn tangent_compliance_held(
             tension_rate[ti][i] = z[6 + h];
         }
     }
-    let rt = rotation_adjoint(&r_node.transpose());
-    let body = rt * world * rt.transpose();
-    let asym = (world - world.transpose()).amax();
-    let symmetric = asym <= 1e-6 * world.amax();
-    let (kw, condition) = invert_general(&world);
-    let (kb, _) = invert_general(&body);
-    Ok(TangentCompliance {
-        node,
-        s: target,
-        world,
-        body,
-        stiffness_world: kw,
-        stiffness_body: kb,
-        condition,
-        symmetric,
-        tension_rate,
-    })
+    Ok(world)
 }

@@ -355,10 +355,15 @@ impl<'e> Equations<'e> {
 
     /// Scaled tip residual `[(N(L) - F)/f_ref; (M(L) - M)/(f_ref L)]` and its derivative
     /// along each of the first `ncol` columns.
-    pub fn residual<const N: usize>(&self, y: &[f64; N], ncol: usize) -> (Vector6<f64>, Vec<Vector6<f64>>) {
+    pub fn residual<const N: usize>(
+        &self,
+        y: &[f64; N],
+        ncol: usize,
+    ) -> (Vector6<f64>, Vec<Vector6<f64>>) {
         let lw = self.model.loads();
         let mut d = vec![[Vector3::zeros(); 2]; ncol];
-        let (mut f, mut m) = self.applied(y, ncol, &lw.tip_force, &lw.tip_moment, lw.tip_frame, &mut d);
+        let (mut f, mut m) =
+            self.applied(y, ncol, &lw.tip_force, &lw.tip_moment, lw.tip_frame, &mut d);
         let l = self.model.length();
         for pl in lw.point_loads.iter().filter(|p| p.s == l) {
             let (f2, m2) = self.applied(y, ncol, &pl.force, &pl.moment, pl.frame, &mut d);
@@ -389,7 +394,11 @@ impl<'e> Equations<'e> {
         if !self.model.force_free() || lw.tip_frame == Frame::Body {
             return None;
         }
-        if lw.point_loads.iter().any(|p| p.frame == Frame::Body && p.moment != Vector3::zeros()) {
+        if lw
+            .point_loads
+            .iter()
+            .any(|p| p.frame == Frame::Body && p.moment != Vector3::zeros())
+        {
             return None;
         }
         if lw.distributed_moment.is_some() {
@@ -634,7 +643,7 @@ impl Evaluator<'_, '_> {
         let cd = Vector6::from_column_slice(&c);
         let xs = Vector6::new(vs.x, vs.y, vs.z, us.x, us.y, us.z);
         let wv = Vector6::from_column_slice(&wb);
-        let mut x = match self.ws.guess {
+        let x = match self.ws.guess {
             Some(g) => g,
             None => {
                 // Straight tendons: t_i = e_z.
@@ -647,57 +656,9 @@ impl Evaluator<'_, '_> {
                 xs + cd.component_mul(&(wv - Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)))
             }
         };
-        let mut last_step = f64::INFINITY;
-        let mut converged = false;
-        let mut chord = self.ws.last_lu.is_some();
-        for _ in 0..LOCAL_MAX_ITERATIONS {
-            let (tw, h) = self.tendon_sums(&x, &c, !chord);
-            let g = x - xs - cd.component_mul(&(wv - tw));
-            if let Some(h) = h {
-                match Lu6::new(&h) {
-                    Some(lu) => self.ws.last_lu = Some(lu),
-                    None => return Local::nan(),
-                }
-            }
-            let Some(lu) = &self.ws.last_lu else {
-                return Local::nan();
-            };
-            let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
-            x -= dx;
-            if !x.iter().all(|v| v.is_finite()) {
-                return Local::nan();
-            }
-            let step = dx.amax();
-            let tol = LOCAL_TOLERANCE * (1.0 + x.amax());
-            if step <= tol {
-                converged = true;
-                break;
-            }
-            if chord {
-                // Chord steps converge linearly with ratio rho: the error left after this step
-                // is about step rho / (1 - rho). Switch to Newton unless they contract fast.
-                if last_step.is_finite() {
-                    let rho = step / last_step;
-                    if rho > 0.1 {
-                        chord = false;
-                    } else if step * rho / (1.0 - rho) <= tol {
-                        converged = true;
-                        break;
-                    }
-                }
-            } else {
-                // Quadratic convergence: the error after this step is about |dx|³ / |dx_prev|².
-                let predicted = step * (step / last_step).powi(2);
-                if last_step.is_finite() && step < 1e-3 * last_step && predicted <= tol {
-                    converged = true;
-                    break;
-                }
-            }
-            last_step = step;
-        }
-        if !converged {
+        let Some(x) = self.local_iteration(x, &xs, &cd, &wv, &c) else {
             return Local::nan();
-        }
+        };
         let mut out = Local {
             v: Vector3::new(x[0], x[1], x[2]),
             u: Vector3::new(x[3], x[4], x[5]),
@@ -720,6 +681,59 @@ impl Evaluator<'_, '_> {
         self.finish_tendons(s, props, &mut out, &fluid);
         self.ws.guess = Some(x);
         out
+    }
+
+    /// The local Newton (or chord) iteration on `G(x) = x - x* - C (W - T(x)) = 0` from `x`;
+    /// `None` if it fails.
+    #[inline]
+    fn local_iteration(
+        &mut self,
+        mut x: Vector6<f64>,
+        xs: &Vector6<f64>,
+        cd: &Vector6<f64>,
+        wv: &Vector6<f64>,
+        c: &[f64; 6],
+    ) -> Option<Vector6<f64>> {
+        let mut last_step = f64::INFINITY;
+        let mut chord = self.ws.last_lu.is_some();
+        for _ in 0..LOCAL_MAX_ITERATIONS {
+            let (tw, h) = self.tendon_sums(&x, c, !chord);
+            let g = x - xs - cd.component_mul(&(wv - tw));
+            if let Some(h) = h {
+                self.ws.last_lu = Some(Lu6::new(&h)?);
+            }
+            let lu = self.ws.last_lu.as_ref()?;
+            let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
+            x -= dx;
+            if !x.iter().all(|v| v.is_finite()) {
+                return None;
+            }
+            let step = dx.amax();
+            let tol = LOCAL_TOLERANCE * (1.0 + x.amax());
+            if step <= tol {
+                return Some(x);
+            }
+            if chord {
+                // Chord steps converge linearly with ratio rho: the error left after this step
+                // is about step rho / (1 - rho). Switch to Newton unless they contract fast.
+                if last_step.is_finite() {
+                    let rho = step / last_step;
+                    if rho > 0.1 {
+                        chord = false;
+                    } else if step * rho / (1.0 - rho) <= tol {
+                        return Some(x);
+                    }
+                }
+            } else {
+                // Quadratic convergence: the error after this step is about |dx|³ / |dx_prev|².
+                let predicted = step * (step / last_step).powi(2);
+                if last_step.is_finite() && step < 1e-3 * last_step && predicted <= tol {
+                    return Some(x);
+                }
+            }
+            last_step = step;
+        }
+        None
     }
 
     /// Tendon loads and speeds `|p_i'|` at the local solution `out`, plus the fluid's share.
@@ -782,12 +796,21 @@ impl Evaluator<'_, '_> {
         let b_end = eq.model.breaks()[self.ws.interval + 1];
         let ends = eq.model.tendon_ends();
         let nl = self.ws.length_tendons.len();
-        let needs_dirs = nl > 0 || self.ws.columns.iter().any(|c| matches!(c, Column::Tension(_)));
+        let needs_dirs = nl > 0
+            || self
+                .ws
+                .columns
+                .iter()
+                .any(|c| matches!(c, Column::Tension(_)));
         let dir = |this: &Self, i: usize| -> Option<Vector6<f64>> {
             (ends[i] >= b_end).then(|| this.tendon_direction(i, s, &props, &v, &u))
         };
         let length_dirs: Vec<Option<Vector6<f64>>> = if needs_dirs {
-            self.ws.length_tendons.iter().map(|&i| dir(self, i)).collect()
+            self.ws
+                .length_tendons
+                .iter()
+                .map(|&i| dir(self, i))
+                .collect()
         } else {
             Vec::new()
         };

@@ -14,8 +14,8 @@
 use nalgebra::{Matrix6, Vector3, Vector6};
 
 use super::equations::{Evaluator, Local, Tangent, LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
-use crate::math::linalg::Lu6;
 use crate::error::Error;
+use crate::math::linalg::Lu6;
 use crate::model::material::hyperelastic::UniaxialLaw;
 use crate::model::section::SectionProperties;
 
@@ -94,7 +94,7 @@ impl Evaluator<'_, '_> {
             ev.ws.guess = None;
             Local::nan()
         };
-        let (mut g, mut h) = match eval(self, &x) {
+        let (g, h) = match eval(self, &x) {
             Some(gh) => gh,
             None => {
                 // The warm start is not admissible: restart from the rest strain.
@@ -105,38 +105,8 @@ impl Evaluator<'_, '_> {
                 }
             }
         };
-        let mut converged = false;
-        // Whether a step was shortened because a fibre stretch would not be positive.
-        let mut hit_zero = false;
-        for _ in 0..LOCAL_MAX_ITERATIONS {
-            let Some(lu) = Lu6::new(&h) else {
-                break;
-            };
-            let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
-            if !dx.iter().all(|v| v.is_finite()) {
-                break;
-            }
-            let mut t = 1.0;
-            let mut next = None;
-            for _ in 0..MAX_HALVINGS {
-                let xt = x - dx * t;
-                if let Some(gh) = eval(self, &xt) {
-                    next = Some((xt, gh));
-                    break;
-                }
-                hit_zero = true;
-                t *= 0.5;
-            }
-            let Some((xt, (gt, ht))) = next else {
-                break;
-            };
-            x = xt;
-            (g, h) = (gt, ht);
-            if dx.amax() * t <= LOCAL_TOLERANCE * (1.0 + x.amax()) {
-                converged = true;
-                break;
-            }
-        }
+        let this = &*self;
+        let (x, h, converged, hit_zero) = damped_newton(|x| eval(this, x), x, g, h);
         let e: [f64; 6] = (x - xs).into();
         let (Some(law), Some(state)) = (
             material.uniaxial_law(),
@@ -144,42 +114,10 @@ impl Evaluator<'_, '_> {
         ) else {
             return fail(self, format!("hyperelastic section at s = {s} m"));
         };
-        // Stability: the fibre forces must increase with the stretch (at the solution, or where
-        // the iteration stopped).
-        for &lf in &state.stretch {
-            let slope = law.nominal_slope_unchecked(lf);
-            if !(slope > 0.0 && slope.is_finite()) {
-                self.material_error(Error::invalid(
-                    format!("{} parameters", law.model_name()),
-                    law,
-                    format!(
-                        "a stable law at the stretches reached (dP/dstretch > 0): \
-                         dP/dstretch = {slope:.4e} Pa at fibre stretch {lf:.6} (s = {s} m)"
-                    ),
-                ));
-                self.ws.guess = None;
-                return Local::nan();
-            }
-        }
-        if !converged {
-            if hit_zero {
-                let least = state.stretch.iter().fold(f64::INFINITY, |m, v| m.min(*v));
-                self.material_error(Error::invalid(
-                    "stretch",
-                    format!("{least:.3e}"),
-                    format!(
-                        "> 0 at every fibre of the section at s = {s} m: the loads and \
-                         pressures compress the rod toward zero length (body wrench of the \
-                         rod {wb:?} N, N m)"
-                    ),
-                ));
-                self.ws.guess = None;
-                return Local::nan();
-            }
-            return fail(
-                self,
-                format!("hyperelastic section solve at s = {s} m (body wrench {wb:?})"),
-            );
+        if let Err(e) = check_fibres(law, &state.stretch, s, converged, hit_zero, wb) {
+            self.material_error(e);
+            self.ws.guess = None;
+            return Local::nan();
         }
         let mut out = Local {
             v: Vector3::new(x[0], x[1], x[2]),
@@ -203,3 +141,90 @@ impl Evaluator<'_, '_> {
     }
 }
 
+/// The material failures of a hyperelastic section solve at `s`: a law that is not stable at
+/// the stretches reached, a fibre compressed to zero length (`hit_zero`), or no convergence.
+fn check_fibres(
+    law: &crate::model::material::hyperelastic::UniaxialModel,
+    stretch: &[f64],
+    s: f64,
+    converged: bool,
+    hit_zero: bool,
+    wb: &[f64; 6],
+) -> Result<(), Error> {
+    // Stability: the fibre forces must increase with the stretch (at the solution, or where
+    // the iteration stopped).
+    for &lf in stretch {
+        let slope = law.nominal_slope_unchecked(lf);
+        if !(slope > 0.0 && slope.is_finite()) {
+            return Err(Error::invalid(
+                format!("{} parameters", law.model_name()),
+                law,
+                format!(
+                    "a stable law at the stretches reached (dP/dstretch > 0): \
+                     dP/dstretch = {slope:.4e} Pa at fibre stretch {lf:.6} (s = {s} m)"
+                ),
+            ));
+        }
+    }
+    if converged {
+        return Ok(());
+    }
+    if hit_zero {
+        let least = stretch.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+        return Err(Error::invalid(
+            "stretch",
+            format!("{least:.3e}"),
+            format!(
+                "> 0 at every fibre of the section at s = {s} m: the loads and \
+                 pressures compress the rod toward zero length (body wrench of the \
+                 rod {wb:?} N, N m)"
+            ),
+        ));
+    }
+    Err(Error::NotConverged {
+        what: format!("hyperelastic section solve at s = {s} m (body wrench {wb:?})"),
+        iterations: LOCAL_MAX_ITERATIONS,
+        residual: f64::NAN,
+    })
+}
+
+/// Newton's method on the local residual `eval(x) = (g, ∂g/∂x)` from `x` (with `g`, `h` at
+/// `x`), halving a step while a fibre stretch would not be positive. Returns the last iterate,
+/// its Jacobian, whether it converged and whether a step was shortened.
+fn damped_newton(
+    eval: impl Fn(&Vector6<f64>) -> Option<(Vector6<f64>, Matrix6<f64>)>,
+    mut x: Vector6<f64>,
+    mut g: Vector6<f64>,
+    mut h: Matrix6<f64>,
+) -> (Vector6<f64>, Matrix6<f64>, bool, bool) {
+    let mut hit_zero = false;
+    for _ in 0..LOCAL_MAX_ITERATIONS {
+        let Some(lu) = Lu6::new(&h) else {
+            break;
+        };
+        let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
+        if !dx.iter().all(|v| v.is_finite()) {
+            break;
+        }
+        let mut t = 1.0;
+        let mut next = None;
+        for _ in 0..MAX_HALVINGS {
+            let xt = x - dx * t;
+            if let Some(gh) = eval(&xt) {
+                next = Some((xt, gh));
+                break;
+            }
+            hit_zero = true;
+            t *= 0.5;
+        }
+        let Some((xt, (gt, ht))) = next else {
+            break;
+        };
+        x = xt;
+        (g, h) = (gt, ht);
+        if dx.amax() * t <= LOCAL_TOLERANCE * (1.0 + x.amax()) {
+            return (x, h, true, hit_zero);
+        }
+    }
+    (x, h, false, hit_zero)
+}

@@ -33,6 +33,9 @@ fn head<const N: usize>(y: &[f64; N]) -> [f64; STATE] {
     h
 }
 
+/// What a pass returns: the scaled residual, its derivative along each column, the chord.
+pub(crate) type PassOutput = (Vector6<f64>, Vec<Vector6<f64>>, Vector3<f64>);
+
 /// The shooting problem of one model and actuation, with its workspace and the nodes of the
 /// last pass.
 pub(crate) struct Shooting<'a> {
@@ -79,11 +82,7 @@ impl<'a> Shooting<'a> {
     /// nodes; with `N == FULL` the six base-wrench columns are integrated too. Returns the
     /// scaled residual, its Jacobian columns (empty without columns) and the chord
     /// `p(L) - p(0)`.
-    pub fn pass<const N: usize>(
-        &mut self,
-        x: &[f64],
-        lambda: f64,
-    ) -> Result<(Vector6<f64>, Vec<Vector6<f64>>, Vector3<f64>)> {
+    pub fn pass<const N: usize>(&mut self, x: &[f64], lambda: f64) -> Result<PassOutput> {
         self.eq.load_factor = lambda;
         let columns: &[Column] = if N >= FULL { &[Column::Free; 6] } else { &[] };
         self.ws.set_columns(columns, &[]);
@@ -357,7 +356,10 @@ mod tests {
         let x = [0.3, -0.2, 0.5, 0.1, -0.15, 0.05];
         let mut r = [0.0; 6];
         let mut jac = [0.0; 36];
-        assert_eq!(p.evaluate(&x, 1.0, Some(&mut jac), &mut r), Evaluated::Jacobian);
+        assert_eq!(
+            p.evaluate(&x, 1.0, Some(&mut jac), &mut r),
+            Evaluated::Jacobian
+        );
         let h = 1e-6;
         let mut err = 0.0f64;
         let scale = jac.iter().fold(0.0f64, |m, v| m.max(v.abs()));

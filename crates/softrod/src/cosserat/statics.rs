@@ -382,36 +382,7 @@ pub fn solve_statics(
     let (mut result, j0, first_step) = direct(&mut p, options, &x0);
     stats.iterations = result.iterations;
     if !result.converged && opts.continuation {
-        // Step the external loads from the unloaded rod (x = 0 is exact at λ = 0).
-        let zero = [0.0; 6];
-        let j0 = match j0 {
-            Some(j) => Some(j),
-            None => {
-                let mut j = vec![0.0; 36];
-                let mut r = [0.0; 6];
-                (p.evaluate(&zero, 0.0, Some(&mut j), &mut r) == Evaluated::Jacobian).then_some(j)
-            }
-        };
-        let first = if first_step > 0.0 {
-            (0.8 * DIRECT_STEP_LIMIT / first_step).clamp(crate::solve::MIN_LOAD_INCREMENT, 0.5)
-        } else {
-            0.25
-        };
-        let start = ContinuationSettings {
-            x0: &zero,
-            jacobian0: j0.as_deref(),
-            first_increment: first,
-            max_increment: 0.5,
-        };
-        let s = NewtonSettings {
-            first_step_limit: Some(DIRECT_STEP_LIMIT),
-            ..settings(matches!(options.integrator, Integrator::Rk4 { .. }), None)
-        };
-        let c = continuation(&mut p, &start, opts, &s);
-        stats.iterations += c.iterations;
-        stats.load_steps = c.steps;
-        stats.load_factor = c.load_factor;
-        result = c.outcome;
+        result = step_loads(&mut p, options, j0, first_step, &mut stats);
     }
     // The recorded pass must be the one at the returned unknowns (and their load factor).
     if !result.at_x {
@@ -454,6 +425,46 @@ pub fn solve_statics(
     sol.options = *options;
     sol.jacobian = jacobian;
     Ok(sol)
+}
+
+/// Steps the external loads from the unloaded rod (x = 0 is exact at λ = 0) by continuation,
+/// from the refused predictor step `first_step` (0: none); the steps taken go into `stats`.
+fn step_loads(
+    p: &mut Shooting<'_>,
+    options: &SolveOptions,
+    j0: Option<Vec<f64>>,
+    first_step: f64,
+    stats: &mut SolverStats,
+) -> NewtonOutcome {
+    let zero = [0.0; 6];
+    let j0 = match j0 {
+        Some(j) => Some(j),
+        None => {
+            let mut j = vec![0.0; 36];
+            let mut r = [0.0; 6];
+            (p.evaluate(&zero, 0.0, Some(&mut j), &mut r) == Evaluated::Jacobian).then_some(j)
+        }
+    };
+    let first = if first_step > 0.0 {
+        (0.8 * DIRECT_STEP_LIMIT / first_step).clamp(crate::solve::MIN_LOAD_INCREMENT, 0.5)
+    } else {
+        0.25
+    };
+    let start = ContinuationSettings {
+        x0: &zero,
+        jacobian0: j0.as_deref(),
+        first_increment: first,
+        max_increment: 0.5,
+    };
+    let s = NewtonSettings {
+        first_step_limit: Some(DIRECT_STEP_LIMIT),
+        ..settings(matches!(options.integrator, Integrator::Rk4 { .. }), None)
+    };
+    let c = continuation(p, &start, &options.newton, &s);
+    stats.iterations += c.iterations;
+    stats.load_steps = c.steps;
+    stats.load_factor = c.load_factor;
+    c.outcome
 }
 
 fn arr(v: &Vector3<f64>) -> [f64; 3] {

@@ -222,6 +222,57 @@ fn initial_step<const N: usize>(
     h.min(span.abs()).max(tiny)
 }
 
+/// Max norm over the first `controlled` components of the local error estimate
+/// `h Σ e_i k_i`, each scaled by `atol + rtol max(|y_j|, |y_new,j|)` (1 = at tolerance).
+fn error_norm<const N: usize, const S: usize>(
+    tab: &Tableau<S>,
+    st: &Stages<N, S>,
+    (y, y_new): (&[f64; N], &[f64; N]),
+    h: f64,
+    controlled: usize,
+    opts: &AdaptiveOptions,
+) -> f64 {
+    let mut err = 0.0f64;
+    for j in 0..controlled {
+        let mut e = 0.0;
+        for (i, k) in st.k.iter().enumerate() {
+            if tab.e[i] != 0.0 {
+                e += tab.e[i] * k[j];
+            }
+        }
+        let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
+        err = err.max((h * e / sc).abs());
+    }
+    err
+}
+
+/// The coefficients of the continuous extension of an accepted step (see
+/// [`DenseSolution::dense`]).
+fn dense_coefficients<const N: usize, const S: usize>(
+    tab: &Tableau<S>,
+    st: &Stages<N, S>,
+    (y, y_new): (&[f64; N], &[f64; N]),
+    h: f64,
+    dense: &mut [[f64; N]; 5],
+) {
+    let k_last = &st.k[S - 1];
+    for j in 0..N {
+        let dy = y_new[j] - y[j];
+        let bspl = h * st.k[0][j] - dy;
+        dense[0][j] = y[j];
+        dense[1][j] = dy;
+        dense[2][j] = bspl;
+        dense[3][j] = dy - h * k_last[j] - bspl;
+        let mut d = 0.0;
+        for (i, k) in st.k.iter().enumerate() {
+            if tab.d[i] != 0.0 {
+                d += tab.d[i] * k[j];
+            }
+        }
+        dense[4][j] = h * d;
+    }
+}
+
 /// The accepted steps of an adaptive integration with the tableau's continuous extension.
 #[derive(Debug, Clone)]
 pub struct DenseSolution<const N: usize> {
@@ -273,7 +324,7 @@ pub struct AcceptedStep<'a, const N: usize> {
     pub dense: &'a [[f64; N]; 5],
 }
 
-/// Integrates `sys` from `(t0, y0)` to `t1` (`t1 < t0` integrates backward) with the embedded
+/// Integrates `sys` over `[t0, t1]` from `y0` (`t1 < t0` integrates backward) with the embedded
 /// pair `tab` and the one step-size controller: the first `controlled` components enter the
 /// error estimate (e.g. a state without its sensitivities), each kept below
 /// `atol + rtol max(|y_n|, |y_{n+1}|)` (max norm). After every accepted step the state is
@@ -286,9 +337,8 @@ pub struct AcceptedStep<'a, const N: usize> {
 pub fn adaptive<const N: usize, const S: usize, Y: System<N>>(
     tab: &Tableau<S>,
     sys: &mut Y,
-    t0: f64,
+    [t0, t1]: [f64; 2],
     y0: [f64; N],
-    t1: f64,
     options: &AdaptiveOptions,
     controlled: usize,
     mut on_step: impl FnMut(&mut Y, &mut [f64; N], &AcceptedStep<'_, N>),
@@ -305,11 +355,7 @@ pub fn adaptive<const N: usize, const S: usize, Y: System<N>>(
         ));
     }
     if tab.error_order == 0 || !tab.fsal {
-        return Err(Error::invalid(
-            "tableau",
-            tab.name,
-            "an FSAL embedded pair",
-        ));
+        return Err(Error::invalid("tableau", tab.name, "an FSAL embedded pair"));
     }
     let mut stats = IntegrationStats::default();
     let span = t1 - t0;
@@ -344,17 +390,7 @@ pub fn adaptive<const N: usize, const S: usize, Y: System<N>>(
         let t_new = if hs == t1 - t { t1 } else { t + hs };
         let y_new = step(tab, sys, t, &y, hs, t_new, &mut st);
         stats.evaluations += S - 1;
-        let mut err = 0.0f64;
-        for j in 0..controlled {
-            let mut e = 0.0;
-            for (i, k) in st.k.iter().enumerate() {
-                if tab.e[i] != 0.0 {
-                    e += tab.e[i] * k[j];
-                }
-            }
-            let sc = opts.atol + opts.rtol * y[j].abs().max(y_new[j].abs());
-            err = err.max((hs * e / sc).abs());
-        }
+        let err = error_norm(tab, &st, (&y, &y_new), hs, controlled, &opts);
         if !err.is_finite() || y_new.iter().any(|v| !v.is_finite()) {
             return Err(not_converged(
                 tab.name,
@@ -365,22 +401,7 @@ pub fn adaptive<const N: usize, const S: usize, Y: System<N>>(
         }
         last_err = err;
         if err <= 1.0 {
-            let k_last = &st.k[S - 1];
-            for j in 0..N {
-                let dy = y_new[j] - y[j];
-                let bspl = hs * st.k[0][j] - dy;
-                dense[0][j] = y[j];
-                dense[1][j] = dy;
-                dense[2][j] = bspl;
-                dense[3][j] = dy - hs * k_last[j] - bspl;
-                let mut d = 0.0;
-                for (i, k) in st.k.iter().enumerate() {
-                    if tab.d[i] != 0.0 {
-                        d += tab.d[i] * k[j];
-                    }
-                }
-                dense[4][j] = hs * d;
-            }
+            dense_coefficients(tab, &st, (&y, &y_new), hs, &mut dense);
             sys.step_accepted(&weights(tab, hs), true);
             let t_prev = t;
             t = t_new;
@@ -421,9 +442,8 @@ pub fn adaptive<const N: usize, const S: usize, Y: System<N>>(
 pub fn adaptive_dense<const N: usize, const S: usize, Y: System<N>>(
     tab: &Tableau<S>,
     sys: &mut Y,
-    t0: f64,
+    [t0, t1]: [f64; 2],
     y0: [f64; N],
-    t1: f64,
     options: &AdaptiveOptions,
     controlled: usize,
 ) -> Result<DenseSolution<N>> {
@@ -433,7 +453,7 @@ pub fn adaptive_dense<const N: usize, const S: usize, Y: System<N>>(
         dense: Vec::new(),
         stats: IntegrationStats::default(),
     };
-    let (_, stats) = adaptive(tab, sys, t0, y0, t1, options, controlled, |_, y, step| {
+    let (_, stats) = adaptive(tab, sys, [t0, t1], y0, options, controlled, |_, y, step| {
         sol.t.push(step.t1);
         sol.y.push(*y);
         sol.dense.push(*step.dense);
@@ -454,7 +474,16 @@ mod tests {
     }
 
     fn fixed_error<const S: usize>(tab: &Tableau<S>, steps: usize) -> f64 {
-        let y = fixed(tab, &mut oscillator(), 0.0, [0.0, 1.0], 3.0, steps, |_, _, _| {}).unwrap();
+        let y = fixed(
+            tab,
+            &mut oscillator(),
+            0.0,
+            [0.0, 1.0],
+            3.0,
+            steps,
+            |_, _, _| {},
+        )
+        .unwrap();
         (y[0] - 3.0f64.sin()).abs()
     }
 
@@ -462,9 +491,24 @@ mod tests {
     #[test]
     fn each_tableau_converges_with_its_order() {
         for (name, p, e1, e2) in [
-            ("rk4", RK4.order, fixed_error(&RK4, 40), fixed_error(&RK4, 80)),
-            ("bs3", BS3.order, fixed_error(&BS3, 40), fixed_error(&BS3, 80)),
-            ("dp5", DP5.order, fixed_error(&DP5, 40), fixed_error(&DP5, 80)),
+            (
+                "rk4",
+                RK4.order,
+                fixed_error(&RK4, 40),
+                fixed_error(&RK4, 80),
+            ),
+            (
+                "bs3",
+                BS3.order,
+                fixed_error(&BS3, 40),
+                fixed_error(&BS3, 80),
+            ),
+            (
+                "dp5",
+                DP5.order,
+                fixed_error(&DP5, 40),
+                fixed_error(&DP5, 80),
+            ),
         ] {
             let observed = (e1 / e2).log2();
             assert!(
@@ -490,11 +534,22 @@ mod tests {
             (h * e).abs()
         }
         for (name, q, r) in [
-            ("bs3", BS3.error_order, estimate(&BS3, 0.02) / estimate(&BS3, 0.01)),
-            ("dp5", DP5.error_order, estimate(&DP5, 0.04) / estimate(&DP5, 0.02)),
+            (
+                "bs3",
+                BS3.error_order,
+                estimate(&BS3, 0.02) / estimate(&BS3, 0.01),
+            ),
+            (
+                "dp5",
+                DP5.error_order,
+                estimate(&DP5, 0.04) / estimate(&DP5, 0.02),
+            ),
         ] {
             let observed = r.log2();
-            assert!((observed - q as f64).abs() < 0.25, "{name}: {observed} vs {q}");
+            assert!(
+                (observed - q as f64).abs() < 0.25,
+                "{name}: {observed} vs {q}"
+            );
         }
     }
 
@@ -506,12 +561,13 @@ mod tests {
                 atol: rtol * 1e-3,
                 ..Default::default()
             };
-            let dp = adaptive_dense(&DP5, &mut oscillator(), 0.0, [0.0, 1.0], 6.0, &opts, 2).unwrap();
+            let dp =
+                adaptive_dense(&DP5, &mut oscillator(), [0.0, 6.0], [0.0, 1.0], &opts, 2).unwrap();
             assert!((dp.y.last().unwrap()[0] - 6.0f64.sin()).abs() < 10.0 * rtol);
             assert!((dp.eval(2.345)[0] - 2.345f64.sin()).abs() < 10.0 * rtol);
             // Final-value problem: y' = cos t, y(2) = sin 2, integrated back to 0.
             let mut f = FnSystem(|t: f64, _y: &[f64; 1]| [t.cos()]);
-            let bs = adaptive_dense(&BS3, &mut f, 2.0, [2.0f64.sin()], 0.0, &opts, 1).unwrap();
+            let bs = adaptive_dense(&BS3, &mut f, [2.0, 0.0], [2.0f64.sin()], &opts, 1).unwrap();
             assert_eq!(*bs.t.last().unwrap(), 0.0);
             assert!(bs.y.last().unwrap()[0].abs() < 100.0 * rtol);
             assert!((bs.eval(1.0)[0] - 1.0f64.sin()).abs() < 100.0 * rtol);
@@ -526,7 +582,7 @@ mod tests {
         };
         let mut f = FnSystem(|_t: f64, y: &[f64; 1]| *y);
         assert!(matches!(
-            adaptive_dense(&BS3, &mut f, 0.0, [1.0], 1.0, &bad, 1),
+            adaptive_dense(&BS3, &mut f, [0.0, 1.0], [1.0], &bad, 1),
             Err(Error::InvalidParameter { .. })
         ));
         let few = AdaptiveOptions {
@@ -534,10 +590,17 @@ mod tests {
             ..Default::default()
         };
         let mut g = FnSystem(|t: f64, _y: &[f64; 1]| [(50.0 * t).sin()]);
-        let r = adaptive_dense(&BS3, &mut g, 0.0, [0.0], 10.0, &few, 1);
+        let r = adaptive_dense(&BS3, &mut g, [0.0, 10.0], [0.0], &few, 1);
         assert!(matches!(r, Err(Error::NotConverged { iterations: 3, .. })));
         assert!(matches!(
-            adaptive_dense(&RK4, &mut f, 0.0, [1.0], 1.0, &AdaptiveOptions::default(), 1),
+            adaptive_dense(
+                &RK4,
+                &mut f,
+                [0.0, 1.0],
+                [1.0],
+                &AdaptiveOptions::default(),
+                1
+            ),
             Err(Error::InvalidParameter { .. })
         ));
     }

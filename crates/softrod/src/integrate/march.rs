@@ -76,9 +76,8 @@ pub fn march<const N: usize, Y: Piecewise<N>>(
                     let (end, _) = adaptive(
                         &DP5,
                         sys,
-                        start,
+                        [start, stop],
                         y,
-                        stop,
                         &options,
                         controlled,
                         |sys, y, step| node(sys, step.t1, k, y),

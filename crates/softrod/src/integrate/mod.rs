@@ -88,4 +88,3 @@ pub struct IntegrationStats {
     /// Right-hand-side evaluations.
     pub evaluations: usize,
 }
-

@@ -271,7 +271,9 @@ mod tests {
 
     #[test]
     fn lu6_and_dense_lu_solve_the_same_system() {
-        let m = Matrix6::from_fn(|i, j| ((i * 7 + j * 3) % 5) as f64 - 1.5 + if i == j { 4.0 } else { 0.0 });
+        let m = Matrix6::from_fn(|i, j| {
+            ((i * 7 + j * 3) % 5) as f64 - 1.5 + if i == j { 4.0 } else { 0.0 }
+        });
         let b = [1.0, -2.0, 0.5, 3.0, 0.0, -1.0];
         let x = Lu6::new(&m).unwrap().solve(&b);
         let mut d = DenseLu::default();

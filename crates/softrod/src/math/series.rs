@@ -131,7 +131,10 @@ fn poly(c: &[f64], x: f64) -> f64 {
 #[inline]
 pub fn arc_sb(x: f64) -> (f64, f64) {
     if x < SERIES_BOUND {
-        return (poly(&SERIES_S[..POSE_TERMS], x), poly(&SERIES_B[..POSE_TERMS], x));
+        return (
+            poly(&SERIES_S[..POSE_TERMS], x),
+            poly(&SERIES_B[..POSE_TERMS], x),
+        );
     }
     let th = x.sqrt();
     let (sh, ch) = (0.5 * th).sin_cos();

@@ -138,8 +138,8 @@ impl RobotModel {
             })
             && (loads.tip_frame == Frame::World
                 || (loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros()));
-        let uniform_compliance = (rod.section().is_uniform() && rod.material().is_linear())
-            .then(|| {
+        let uniform_compliance =
+            (rod.section().is_uniform() && rod.material().is_linear()).then(|| {
                 rod.material()
                     .compliance(&props0, rod.shear_coefficient(), rod.inextensible())
             });

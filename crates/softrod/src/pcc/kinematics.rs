@@ -487,12 +487,7 @@ pub fn arc_from_tip_with_length(position: &Vector3<f64>, length: f64) -> Result<
     // Tip in the bending plane and its θ-derivative, per unit length.
     let plane = |th: f64| {
         let t = arc_trig(th);
-        (
-            l * th * t.c2,
-            l * t.s1,
-            l * (t.s1 - t.c2),
-            l * dsinc(th),
-        )
+        (l * th * t.c2, l * t.s1, l * (t.s1 - t.c2), l * dsinc(th))
     };
     let dist2 = |th: f64| {
         let (px, pz, _, _) = plane(th);

@@ -64,11 +64,13 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
 use crate::math::series::arc_fns;
+use crate::pcc::kinematics::{
+    chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons,
+};
 use crate::solve::{
     continuation, newton, Armijo, ContinuationSettings, Evaluated, LineSearch, NewtonOptions,
     NewtonSettings, Problem, SolverStats,
 };
-use crate::pcc::kinematics::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
 
 /// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
 /// (rad) and axial residual `|g_ℓ| / E A` (strain).
@@ -602,54 +604,7 @@ fn evaluate(
         w.g[3 * i + 2] = ux * ga + uy * gb + gl;
     }
     if jacobian {
-        if w.h.nrows() != 3 * n {
-            w.blocks = vec![Matrix3::zeros(); n * n];
-            w.h = DMatrix::zeros(3 * n, 3 * n);
-        }
-        for (i, body) in robot.bodies.iter().enumerate() {
-            let l0 = body.rest_length();
-            let kb = body.bending_stiffness() / l0;
-            let ka = body.axial_stiffness().map_or(0.0, |ea| ea / l0);
-            for j in 0..n {
-                w.blocks[i * n + j] = if i == j {
-                    Matrix3::from_diagonal(&Vector3::new(kb, kb, ka))
-                } else {
-                    Matrix3::zeros()
-                };
-            }
-        }
-        if loaded {
-            load_stiffness(w, &f);
-        }
-        for i in 0..n {
-            let (uxi, uyi, li) = (q[i][0], q[i][1], q[i][2]);
-            for j in 0..n {
-                let (uxj, uyj, lj) = (q[j][0], q[j][1], q[j][2]);
-                let b = &w.blocks[i * n + j];
-                // B J: columns ℓ_j b0, ℓ_j b1, u_x b0 + u_y b1 + b2.
-                let mut bj = Matrix3::zeros();
-                for r in 0..3 {
-                    bj[(r, 0)] = lj * b[(r, 0)];
-                    bj[(r, 1)] = lj * b[(r, 1)];
-                    bj[(r, 2)] = uxj * b[(r, 0)] + uyj * b[(r, 1)] + b[(r, 2)];
-                }
-                // Jᵀ (B J): rows ℓ_i r0, ℓ_i r1, u_x r0 + u_y r1 + r2.
-                let mut blk = Matrix3::zeros();
-                for c in 0..3 {
-                    blk[(0, c)] = li * bj[(0, c)];
-                    blk[(1, c)] = li * bj[(1, c)];
-                    blk[(2, c)] = uxi * bj[(0, c)] + uyi * bj[(1, c)] + bj[(2, c)];
-                }
-                if i == j {
-                    let [ga, gb, _] = w.segs[i].g_theta;
-                    blk[(0, 2)] += ga;
-                    blk[(2, 0)] += ga;
-                    blk[(1, 2)] += gb;
-                    blk[(2, 1)] += gb;
-                }
-                w.h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&blk);
-            }
-        }
+        assemble_jacobian(robot, q, &f, loaded, w);
     }
     // Inextensible segments: the ℓ row is the constraint ℓ = ℓ0.
     for (i, body) in robot.bodies.iter().enumerate() {
@@ -666,6 +621,66 @@ fn evaluate(
         }
     }
     scaled
+}
+
+/// `∂g/∂q` in curvature-vector coordinates into `w.h`: the elastic blocks, the load stiffness
+/// of the tip wrench (force `f`, when `loaded`), mapped from `θ` coordinates.
+fn assemble_jacobian(
+    robot: &PccRobot,
+    q: &[[f64; 3]],
+    f: &Vector3<f64>,
+    loaded: bool,
+    w: &mut Work,
+) {
+    let n = q.len();
+    if w.h.nrows() != 3 * n {
+        w.blocks = vec![Matrix3::zeros(); n * n];
+        w.h = DMatrix::zeros(3 * n, 3 * n);
+    }
+    for (i, body) in robot.bodies.iter().enumerate() {
+        let l0 = body.rest_length();
+        let kb = body.bending_stiffness() / l0;
+        let ka = body.axial_stiffness().map_or(0.0, |ea| ea / l0);
+        for j in 0..n {
+            w.blocks[i * n + j] = if i == j {
+                Matrix3::from_diagonal(&Vector3::new(kb, kb, ka))
+            } else {
+                Matrix3::zeros()
+            };
+        }
+    }
+    if loaded {
+        load_stiffness(w, f);
+    }
+    for i in 0..n {
+        let (uxi, uyi, li) = (q[i][0], q[i][1], q[i][2]);
+        for j in 0..n {
+            let (uxj, uyj, lj) = (q[j][0], q[j][1], q[j][2]);
+            let b = &w.blocks[i * n + j];
+            // B J: columns ℓ_j b0, ℓ_j b1, u_x b0 + u_y b1 + b2.
+            let mut bj = Matrix3::zeros();
+            for r in 0..3 {
+                bj[(r, 0)] = lj * b[(r, 0)];
+                bj[(r, 1)] = lj * b[(r, 1)];
+                bj[(r, 2)] = uxj * b[(r, 0)] + uyj * b[(r, 1)] + b[(r, 2)];
+            }
+            // Jᵀ (B J): rows ℓ_i r0, ℓ_i r1, u_x r0 + u_y r1 + r2.
+            let mut blk = Matrix3::zeros();
+            for c in 0..3 {
+                blk[(0, c)] = li * bj[(0, c)];
+                blk[(1, c)] = li * bj[(1, c)];
+                blk[(2, c)] = uxi * bj[(0, c)] + uyi * bj[(1, c)] + bj[(2, c)];
+            }
+            if i == j {
+                let [ga, gb, _] = w.segs[i].g_theta;
+                blk[(0, 2)] += ga;
+                blk[(2, 0)] += ga;
+                blk[(1, 2)] += gb;
+                blk[(2, 1)] += gb;
+            }
+            w.h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&blk);
+        }
+    }
 }
 
 /// Adds `-∂(J_hᵀ W)/∂θ` (the load stiffness of the dead tip wrench) to `w.blocks`, from the
@@ -792,7 +807,7 @@ impl Problem for Equilibrium<'_> {
         let n = self.q.len();
         for i in 0..n {
             self.q[i] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
-            if !(self.q[i][2] > 0.0) {
+            if self.q[i][2].is_nan() || self.q[i][2] <= 0.0 {
                 return Evaluated::Failed;
             }
         }
@@ -937,10 +952,15 @@ pub fn solve_pcc_statics(
             first_increment: 0.25,
             max_increment: 0.5,
         };
-        let c = continuation(&mut p, &start, opts, &NewtonSettings {
-            residual_first: false,
-            ..settings
-        });
+        let c = continuation(
+            &mut p,
+            &start,
+            opts,
+            &NewtonSettings {
+                residual_first: false,
+                ..settings
+            },
+        );
         stats.iterations += c.iterations;
         stats.load_steps = c.steps;
         stats.load_factor = c.load_factor;
@@ -958,11 +978,7 @@ pub fn solve_pcc_statics(
             residual: result.residual,
         });
     }
-    let q: Vec<[f64; 3]> = result
-        .x
-        .chunks(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
+    let q: Vec<[f64; 3]> = result.x.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     let segments = q
         .iter()
         .map(|qi| PccSegment::from_curvature_vector(qi[0], qi[1], qi[2]))

@@ -649,9 +649,8 @@ fn solve_into(
             let sol = adaptive_dense(
                 &BS3,
                 &mut rhs,
-                anchor,
+                [anchor, 0.0],
                 [arm.final_value(tension)],
-                0.0,
                 &options,
                 1,
             )?;

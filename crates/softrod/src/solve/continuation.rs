@@ -60,7 +60,9 @@ pub fn continuation<P: Problem + ?Sized>(
     let _ = problem.evaluate(&x, 0.0, None, &mut r);
     problem.commit();
     let mut lambda = 0.0f64;
-    let mut dl = start.first_increment.clamp(MIN_LOAD_INCREMENT, start.max_increment);
+    let mut dl = start
+        .first_increment
+        .clamp(MIN_LOAD_INCREMENT, start.max_increment);
     let mut drdl = vec![0.0; n];
     let mut slope: Option<Vec<f64>> = match start.jacobian0 {
         Some(j) if problem.load_derivative(&x, 0.0, &mut drdl) => tangent(j, &drdl),

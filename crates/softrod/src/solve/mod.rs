@@ -41,13 +41,25 @@ impl NewtonOptions {
     /// [`Error::InvalidParameter`] naming `tolerance`, `max_iterations` or `max_load_steps`.
     pub fn validate(&self) -> Result<()> {
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(Error::invalid("tolerance", self.tolerance, "finite and > 0"));
+            return Err(Error::invalid(
+                "tolerance",
+                self.tolerance,
+                "finite and > 0",
+            ));
         }
         if self.max_iterations == 0 {
-            return Err(Error::invalid("max_iterations", self.max_iterations, ">= 1"));
+            return Err(Error::invalid(
+                "max_iterations",
+                self.max_iterations,
+                ">= 1",
+            ));
         }
         if self.max_load_steps == 0 {
-            return Err(Error::invalid("max_load_steps", self.max_load_steps, ">= 1"));
+            return Err(Error::invalid(
+                "max_load_steps",
+                self.max_load_steps,
+                ">= 1",
+            ));
         }
         Ok(())
     }
@@ -89,8 +101,13 @@ pub trait Problem {
     /// Residual `r(x, λ)` into `r`; with `jacobian`, also `∂r/∂x` (column-major `dim × dim`).
     /// A problem may fill the Jacobian unasked when it is free (returning
     /// [`Evaluated::Jacobian`]).
-    fn evaluate(&mut self, x: &[f64], lambda: f64, jacobian: Option<&mut [f64]>, r: &mut [f64])
-        -> Evaluated;
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated;
     /// The norm the tolerance applies to, of the residual `r` of the last evaluation; the max
     /// norm by default.
     fn norm(&self, r: &[f64]) -> f64 {

@@ -92,6 +92,187 @@ pub struct NewtonOutcome {
 /// Contraction of the residual below which a Broyden step keeps the updated Jacobian.
 const BROYDEN_CONTRACTION: f64 = 0.5;
 
+/// The iterate of [`newton`]: unknowns, residual and its norm, the Jacobian (exact, or
+/// updated by Broyden's formula), and scratch.
+struct Iterate {
+    x: Vec<f64>,
+    r: Vec<f64>,
+    jac: Vec<f64>,
+    rn: f64,
+    exact: bool,
+    xt: Vec<f64>,
+    rt: Vec<f64>,
+    jt: Vec<f64>,
+}
+
+/// The first evaluations at `x0`: the residual (alone first when asked), then a Jacobian
+/// (given, or evaluated). `None` if an evaluation fails or the start already solves.
+fn start<P: Problem + ?Sized>(
+    problem: &mut P,
+    x0: &[f64],
+    lambda: f64,
+    options: &NewtonOptions,
+    settings: &NewtonSettings<'_>,
+    out: &mut NewtonOutcome,
+) -> Option<Iterate> {
+    let n = problem.dim();
+    let mut it = Iterate {
+        x: x0.to_vec(),
+        r: vec![0.0; n],
+        jac: vec![0.0; n * n],
+        rn: f64::INFINITY,
+        exact: false,
+        xt: vec![0.0; n],
+        rt: vec![0.0; n],
+        jt: vec![0.0; n * n],
+    };
+    let want = !settings.residual_first && settings.jacobian.is_none();
+    let ev = problem.evaluate(&it.x, lambda, want.then_some(&mut it.jac[..]), &mut it.r);
+    if ev == Evaluated::Failed {
+        return None;
+    }
+    it.rn = problem.norm(&it.r);
+    out.residual = it.rn;
+    out.at_x = true;
+    let mut have_j = ev == Evaluated::Jacobian;
+    it.exact = have_j;
+    if !have_j {
+        if let Some(j) = settings.jacobian {
+            it.jac.copy_from_slice(j);
+            have_j = true;
+        }
+    }
+    if it.rn <= problem.tolerance(&it.x, options.tolerance) {
+        out.converged = true;
+        out.jacobian = have_j.then(|| it.jac.clone());
+        return None;
+    }
+    if !it.rn.is_finite() {
+        return None;
+    }
+    if !have_j {
+        if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian {
+            out.at_x = false;
+            return None;
+        }
+        it.rn = problem.norm(&it.r);
+        it.exact = true;
+    }
+    Some(it)
+}
+
+/// What a Broyden step did.
+enum Broyden {
+    /// Accepted; `true` when the residual fell slowly (evaluate the Jacobian next).
+    Accepted(bool),
+    /// Refused: the residual did not fall enough.
+    Refused,
+}
+
+/// A full step `dx` with the residual alone; on sufficient decrease, Broyden's update
+/// `J += (Δr - J Δx) Δxᵀ / (Δxᵀ Δx)`.
+fn broyden_step<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    settings: &NewtonSettings<'_>,
+    tol: f64,
+) -> Broyden {
+    let n = dx.len();
+    for k in 0..n {
+        it.xt[k] = it.x[k] + dx[k];
+    }
+    let ev = problem.evaluate(&it.xt, lambda, None, &mut it.rt);
+    let rtn = if ev == Evaluated::Failed {
+        f64::INFINITY
+    } else {
+        problem.norm(&it.rt)
+    };
+    if !(rtn <= tol || settings.condition.accept(1.0, it.rn, rtn)) {
+        return Broyden::Refused;
+    }
+    let dd: f64 = dx.iter().map(|v| v * v).sum();
+    if dd > 0.0 {
+        let mut u = vec![0.0; n];
+        for i in 0..n {
+            let mut jdx = 0.0;
+            for k in 0..n {
+                jdx += it.jac[i + k * n] * dx[k];
+            }
+            u[i] = (it.rt[i] - it.r[i] - jdx) / dd;
+        }
+        for c in 0..n {
+            for i in 0..n {
+                it.jac[i + c * n] += u[i] * dx[c];
+            }
+        }
+    }
+    let slow = rtn > BROYDEN_CONTRACTION * it.rn;
+    it.x.copy_from_slice(&it.xt);
+    it.r.copy_from_slice(&it.rt);
+    it.rn = rtn;
+    it.exact = false;
+    Broyden::Accepted(slow)
+}
+
+/// Backtracking line search along the exact Newton direction `dx`, evaluating exact
+/// Jacobians; `true` if a step was accepted.
+fn line_search<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    settings: &NewtonSettings<'_>,
+    options: &NewtonOptions,
+) -> bool {
+    for alpha in settings.line_search.lengths() {
+        for k in 0..dx.len() {
+            it.xt[k] = it.x[k] + alpha * dx[k];
+        }
+        if problem.evaluate(&it.xt, lambda, Some(&mut it.jt), &mut it.rt) != Evaluated::Jacobian {
+            continue;
+        }
+        let rtn = problem.norm(&it.rt);
+        if settings.condition.accept(alpha, it.rn, rtn)
+            || rtn <= problem.tolerance(&it.xt, options.tolerance)
+        {
+            it.x.copy_from_slice(&it.xt);
+            it.r.copy_from_slice(&it.rt);
+            it.jac.copy_from_slice(&it.jt);
+            it.rn = rtn;
+            it.exact = true;
+            return true;
+        }
+    }
+    false
+}
+
+/// Under quadratic convergence the next residual is about `rn³ / r_prev²`: when that is far
+/// below the tolerance, the full step is tried with the residual alone (the last evaluation).
+/// `true` if it meets the tolerance (the iterate is then updated).
+fn last_step<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    options: &NewtonOptions,
+) -> bool {
+    for k in 0..dx.len() {
+        it.xt[k] = it.x[k] + dx[k];
+    }
+    if problem.evaluate(&it.xt, lambda, None, &mut it.rt) == Evaluated::Failed {
+        return false;
+    }
+    let rtn = problem.norm(&it.rt);
+    if rtn <= problem.tolerance(&it.xt, options.tolerance) {
+        it.x.copy_from_slice(&it.xt);
+        it.rn = rtn;
+        return true;
+    }
+    false
+}
+
 /// Damped Newton on `problem` at load factor `lambda` from `x0`.
 pub fn newton<P: Problem + ?Sized>(
     problem: &mut P,
@@ -101,11 +282,8 @@ pub fn newton<P: Problem + ?Sized>(
     settings: &NewtonSettings<'_>,
 ) -> NewtonOutcome {
     let n = problem.dim();
-    let mut x = x0.to_vec();
-    let mut r = vec![0.0; n];
-    let mut jac = vec![0.0; n * n];
     let mut out = NewtonOutcome {
-        x: x.clone(),
+        x: x0.to_vec(),
         residual: f64::INFINITY,
         converged: false,
         iterations: 0,
@@ -113,183 +291,90 @@ pub fn newton<P: Problem + ?Sized>(
         jacobian: None,
         at_x: false,
     };
-    let want = !settings.residual_first && settings.jacobian.is_none();
-    let ev = problem.evaluate(&x, lambda, want.then_some(&mut jac[..]), &mut r);
-    if ev == Evaluated::Failed {
+    let Some(mut it) = start(problem, x0, lambda, options, settings, &mut out) else {
         return out;
-    }
-    let mut rn = problem.norm(&r);
-    out.residual = rn;
-    out.at_x = true;
-    let mut have_j = ev == Evaluated::Jacobian;
-    if !have_j {
-        if let Some(j) = settings.jacobian {
-            jac.copy_from_slice(j);
-            have_j = true;
-        }
-    }
-    if rn <= problem.tolerance(&x, options.tolerance) {
-        out.converged = true;
-        out.jacobian = have_j.then(|| jac.clone());
-        return out;
-    }
-    if !rn.is_finite() {
-        return out;
-    }
-    if !have_j {
-        if problem.evaluate(&x, lambda, Some(&mut jac), &mut r) != Evaluated::Jacobian {
-            out.at_x = false;
-            return out;
-        }
-        rn = problem.norm(&r);
-    }
-    let mut exact = settings.jacobian.is_none() || ev == Evaluated::Jacobian;
+    };
     let mut lu = DenseLu::default();
     let mut dx = vec![0.0; n];
-    let mut xt = vec![0.0; n];
-    let mut rt = vec![0.0; n];
-    let mut jt = vec![0.0; n * n];
     let mut r_prev = f64::INFINITY;
     let mut refresh = false;
-    let mut iteration = 0;
-    while iteration < options.max_iterations {
-        if refresh && !exact {
+    while out.iterations < options.max_iterations {
+        if refresh && !it.exact {
             // Evaluate the exact Jacobian at the current iterate.
-            if problem.evaluate(&x, lambda, Some(&mut jac), &mut r) != Evaluated::Jacobian {
+            if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian
+            {
                 out.at_x = false;
                 break;
             }
-            rn = problem.norm(&r);
-            exact = true;
+            it.rn = problem.norm(&it.r);
+            it.exact = true;
             out.at_x = true;
         }
         refresh = false;
-        if !lu.factor(n, &jac) {
+        if !lu.factor(n, &it.jac) {
             break;
         }
         for k in 0..n {
-            dx[k] = -r[k];
+            dx[k] = -it.r[k];
         }
         if !lu.solve_in_place(&mut dx) {
             break;
         }
         if let Some(limit) = settings.first_step_limit {
-            if iteration == 0 && out.iterations == 0 && max_norm(&dx) > limit {
+            if out.iterations == 0 && max_norm(&dx) > limit {
                 out.first_step = max_norm(&dx);
                 break;
             }
         }
-        let tol = |p: &P, x: &[f64]| p.tolerance(x, options.tolerance);
-        if settings.broyden || !exact {
-            // A full step with the residual alone; Broyden's update of the Jacobian.
-            for k in 0..n {
-                xt[k] = x[k] + dx[k];
-            }
-            let ev = problem.evaluate(&xt, lambda, None, &mut rt);
+        let tol = problem.tolerance(&it.x, options.tolerance);
+        if settings.broyden || !it.exact {
+            let was_exact = it.exact;
             out.at_x = false;
-            let rtn = if ev == Evaluated::Failed {
-                f64::INFINITY
-            } else {
-                problem.norm(&rt)
-            };
-            if rtn <= tol(problem, &xt) || settings.condition.accept(1.0, rn, rtn) {
-                // J += (Δr - J Δx) Δxᵀ / (Δxᵀ Δx), with Δx = dx.
-                let dd: f64 = dx.iter().map(|v| v * v).sum();
-                if dd > 0.0 {
-                    let mut u = vec![0.0; n];
-                    for i in 0..n {
-                        let mut jdx = 0.0;
-                        for k in 0..n {
-                            jdx += jac[i + k * n] * dx[k];
-                        }
-                        u[i] = (rt[i] - r[i] - jdx) / dd;
+            match broyden_step(problem, &mut it, &dx, lambda, settings, tol) {
+                Broyden::Accepted(slow) => {
+                    refresh = slow;
+                    out.at_x = true;
+                    out.iterations += 1;
+                    if it.rn <= problem.tolerance(&it.x, options.tolerance) {
+                        out.converged = true;
+                        break;
                     }
-                    for c in 0..n {
-                        for i in 0..n {
-                            jac[i + c * n] += u[i] * dx[c];
-                        }
-                    }
+                    continue;
                 }
-                refresh = rtn > BROYDEN_CONTRACTION * rn;
-                x.copy_from_slice(&xt);
-                r.copy_from_slice(&rt);
-                r_prev = rn;
-                rn = rtn;
-                exact = false;
-                out.at_x = true;
-                out.iterations += 1;
-                iteration += 1;
-                if rn <= tol(problem, &x) {
-                    out.converged = true;
-                    break;
+                Broyden::Refused if !was_exact => {
+                    // The updated Jacobian failed: evaluate the exact one and retry.
+                    refresh = true;
+                    continue;
                 }
-                continue;
-            }
-            if !exact {
-                // The updated Jacobian failed: evaluate the exact one and retry.
-                refresh = true;
-                continue;
+                Broyden::Refused => {}
             }
         } else if r_prev.is_finite()
-            && rn < 0.1 * r_prev
-            && rn * (rn / r_prev).powi(2) < 0.5 * tol(problem, &x)
+            && it.rn < 0.1 * r_prev
+            && it.rn * (it.rn / r_prev).powi(2) < 0.5 * tol
         {
-            // Under quadratic convergence the next residual is about rn³ / r_prev²: when far
-            // below the tolerance, try the full step with the residual alone (the last pass).
-            for k in 0..n {
-                xt[k] = x[k] + dx[k];
-            }
-            let ev = problem.evaluate(&xt, lambda, None, &mut rt);
             out.at_x = false;
-            if ev != Evaluated::Failed {
-                let rtn = problem.norm(&rt);
-                if rtn <= tol(problem, &xt) {
-                    x.copy_from_slice(&xt);
-                    rn = rtn;
-                    out.iterations += 1;
-                    out.at_x = true;
-                    out.converged = true;
-                    break;
-                }
-            }
-        }
-        // Exact Newton direction, backtracking line search with exact Jacobians.
-        r_prev = rn;
-        let mut accepted = false;
-        for alpha in settings.line_search.lengths() {
-            for k in 0..n {
-                xt[k] = x[k] + alpha * dx[k];
-            }
-            let ev = problem.evaluate(&xt, lambda, Some(&mut jt), &mut rt);
-            out.at_x = false;
-            if ev != Evaluated::Jacobian {
-                continue;
-            }
-            let rtn = problem.norm(&rt);
-            if settings.condition.accept(alpha, rn, rtn) || rtn <= tol(problem, &xt) {
-                x.copy_from_slice(&xt);
-                r.copy_from_slice(&rt);
-                jac.copy_from_slice(&jt);
-                rn = rtn;
-                exact = true;
-                accepted = true;
+            if last_step(problem, &mut it, &dx, lambda, options) {
+                out.iterations += 1;
                 out.at_x = true;
+                out.converged = true;
                 break;
             }
         }
-        if !accepted {
+        r_prev = it.rn;
+        out.at_x = false;
+        if !line_search(problem, &mut it, &dx, lambda, settings, options) {
             break;
         }
+        out.at_x = true;
         out.iterations += 1;
-        iteration += 1;
-        if rn <= tol(problem, &x) {
+        if it.rn <= problem.tolerance(&it.x, options.tolerance) {
             out.converged = true;
             break;
         }
     }
-    out.x = x;
-    out.residual = rn;
-    out.jacobian = Some(jac);
+    out.x = it.x;
+    out.residual = it.rn;
+    out.jacobian = Some(it.jac);
     out
 }
 
@@ -392,7 +477,10 @@ mod tests {
             factor: 0.5,
             max_halvings: 3,
         };
-        assert_eq!(ls.lengths().collect::<Vec<_>>(), vec![1.0, 0.5, 0.25, 0.125]);
+        assert_eq!(
+            ls.lengths().collect::<Vec<_>>(),
+            vec![1.0, 0.5, 0.25, 0.125]
+        );
         let a = Armijo { c: 0.1 };
         assert!(a.accept(1.0, 1.0, 0.9) && !a.accept(1.0, 1.0, 0.95));
         assert!(a.accept(0.5, 1.0, 0.95));

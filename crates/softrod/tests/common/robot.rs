@@ -6,8 +6,8 @@
 use std::sync::Arc;
 
 use softrod::{
-    solve_statics, Actuation, Chamber, ChamberArea, LinearElastic, Loads, Result, RobotModel,
-    Rod, Routing, Section, SolveOptions, StaticsSolution, Tendon,
+    solve_statics, Actuation, Chamber, ChamberArea, LinearElastic, Loads, Result, RobotModel, Rod,
+    Routing, Section, SolveOptions, StaticsSolution, Tendon,
 };
 
 /// A tendon and the tension it is pulled with (N).
