@@ -12,20 +12,6 @@ use softrod::compliance::{compliance, tangent_compliance, tangent_compliance_hel
 use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
 use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution};
 
-fn two_segment(tensions: [f64; 6]) -> Vec<common::Tensioned> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            common::tendon(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
 fn rot(sol: &StaticsSolution) -> Matrix3<f64> {
     let r = sol.rotation.last().unwrap();
     Matrix3::new(
@@ -121,7 +107,7 @@ fn main() {
     for scale in [0.0, 0.5, 1.0] {
         for fx in [0.0, 0.1, 0.3] {
             let t = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0].map(|v| v * scale);
-            let tendons = two_segment(t);
+            let tendons = common::niti_tendons(&t);
             let loads = Loads::tip_force(Vector3::new(fx, 0.0, 0.0));
             let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
             let c = compliance(&sol).unwrap().tip_world();

@@ -4,19 +4,21 @@
 //!
 //! Conventions used everywhere: SI units; arc length `s` along the undeformed backbone;
 //! the body z axis is the rod tangent; wrenches are `[force; moment]` and twists
-//! `[translation; rotation]`.
+//! `[translation; rotation]` ([`math::se3`] owns the adjoint).
 //!
-//! Modules:
-//! * [`planar`]: seed 000, the planar tapered cable-driven arm (closed form and final-value ODE);
-//! * [`compare`]: distances between backbones at equal arm index;
-//! * [`integrate`]: ODE integrators shared by every model;
-//! * [`hyperelastic`]: uniaxial material laws (linear, Neo-Hookean, Mooney–Rivlin, Yeoh, Ogden)
-//!   and a library of named silicones;
-//! * [`fit`]: least-squares fitting of those laws to uniaxial test data;
-//! * [`se3`]: the adjoint and the twist/wrench ordering (owned here, used everywhere);
-//! * [`compliance`](mod@compliance), [`eigenscrew`], [`workspace`]: seed 001,
-//!   configuration-dependent compliance and stiffness (Cosserat and PCC configurations),
-//!   eigenscrews, workspace maps;
+//! The crate is laid out as the architecture (see `docs/architecture.md`):
+//! * [`model`]: the validated, immutable [`RobotModel`] (rod, section, material, tendon
+//!   routings, chamber geometry, loads) and the [`Actuation`] input (tensions, pressures);
+//! * [`cosserat`]: the Cosserat-rod statics, [`solve_statics`]`(&model, &actuation,
+//!   &options)`, whose [`StaticsSolution`] keeps its model, actuation and options;
+//! * [`compliance`](mod@compliance): integrated and tangent compliance, eigenscrews;
+//! * [`pcc`]: piecewise-constant-curvature kinematics, actuation maps and statics;
+//! * [`planar`]: the planar tapered cable arm (closed form and final-value ODE);
+//! * [`batch`]: workspace maps and backbone distances;
+//! * [`integrate`]: the one Runge–Kutta driver (RK4, Bogacki–Shampine, Dormand–Prince
+//!   tableaus) and the march over breaks;
+//! * [`solve`]: the one nonlinear solver (Newton, Broyden, line search, continuation);
+//! * [`math`]: rotations, the adjoint, small linear algebra, the arc series;
 //! * [`error`]: the crate's one error type.
 
 pub mod batch;

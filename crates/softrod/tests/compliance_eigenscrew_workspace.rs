@@ -75,29 +75,10 @@ fn eigenscrews_recover_the_screws_a_stiffness_was_built_from() {
     }
 }
 
-fn two_segment(tensions: [f64; 6]) -> Vec<common::Tensioned> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            common::tendon(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
 #[test]
 fn workspace_map_matches_single_solves() {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = two_segment([0.0; 6]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[0.0; 6]);
     let loads = Loads::default();
     let opts = SolveOptions::default();
     let mut tensions = Vec::new();

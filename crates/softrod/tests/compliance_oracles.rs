@@ -149,33 +149,10 @@ fn stress_free_arc_matches_castigliano() {
     }
 }
 
-fn two_segment(tensions: [f64; 6]) -> Vec<common::Tensioned> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            common::tendon(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
-fn niti() -> Rod {
-    Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap()
-}
-
 #[test]
 fn frames_are_related_by_the_adjoint_and_k_inverts_c() {
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
     let sol = common::solve(&rod, &tendons, &loads, &rk4(50)).unwrap();
     let c = compliance(&sol).unwrap();
@@ -275,8 +252,8 @@ fn unloaded_integrated_tangent_and_finite_difference_agree() {
 
 #[test]
 fn loaded_tangent_matches_finite_difference() {
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads {
         tip_force: Vector3::new(0.3, -0.2, -0.1),
         tip_moment: Vector3::new(0.0, 0.002, 0.001),
@@ -347,8 +324,8 @@ fn held_length_tip(
 /// tensions (all tendons tensioned, so that none goes slack).
 #[test]
 fn fixed_length_tangent_matches_the_resolved_finite_difference() {
-    let rod = niti();
-    let tendons = two_segment([4.0, 1.0, 1.5, 0.5, 2.0, 0.8]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 1.0, 1.5, 0.5, 2.0, 0.8]);
     let loads = Loads::tip_force(Vector3::new(0.02, -0.01, 0.0));
     let opts = rk4(200);
     let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
@@ -382,7 +359,7 @@ fn fixed_length_tangent_matches_the_resolved_finite_difference() {
 /// intervals (each holds its own stretch of the rod).
 #[test]
 fn ten_held_tendons_match_the_resolved_finite_difference() {
-    let rod = niti();
+    let rod = common::niti_rod();
     let tendons: Vec<common::Tensioned> = (0..10)
         .map(|k| {
             let a = (36.0 * k as f64).to_radians();
@@ -432,8 +409,8 @@ fn node_twist(a: &StaticsSolution, b: &StaticsSolution, s: f64) -> Vector6<f64> 
 #[test]
 fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
     use softrod::PointLoad;
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.1, 0.0, -0.05));
     let opts = rk4(400);
     let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
@@ -476,8 +453,8 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
 #[test]
 fn adaptive_tangent_matches_finite_difference() {
     use softrod::AdaptiveOptions;
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.2, 0.1, 0.0));
     let opts = SolveOptions {
         integrator: Integrator::Adaptive(AdaptiveOptions {

@@ -45,29 +45,6 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// The two-segment NiTi robot of the benchmark.
-fn niti() -> Rod {
-    Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap()
-}
-
-fn niti_tendons(tensions: &[f64; 6]) -> Vec<common::Tensioned> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            common::tendon(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
 /// A 3-D test problem: tapered soft rod, helical tendon ending mid-way, tip force.
 fn helix_problem() -> (Rod, Vec<common::Tensioned>, Loads) {
     let rod = Rod::new(
@@ -146,8 +123,8 @@ fn adaptive_integrator_meets_its_tolerance() {
 
 #[test]
 fn two_segment_robot_default_options_are_accurate() {
-    let rod = niti();
-    let tendons = niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let tight = common::solve(&rod, &tendons, &Loads::default(), &adaptive(1e-12)).unwrap();
     let sol = common::solve(&rod, &tendons, &Loads::default(), &SolveOptions::default()).unwrap();
     let e = dist(sol.tip_position(), tight.tip_position());
@@ -170,16 +147,16 @@ fn two_segment_robot_default_options_are_accurate() {
 
 #[test]
 fn warm_start_reaches_the_cold_solution_in_fewer_iterations() {
-    let rod = niti();
+    let rod = common::niti_rod();
     let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
     let a = common::solve(
         &rod,
-        &niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]),
+        &common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]),
         &loads,
         &rk4(40),
     )
     .unwrap();
-    let changed = niti_tendons(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
+    let changed = common::niti_tendons(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
     let cold = common::solve(&rod, &changed, &loads, &rk4(40)).unwrap();
     let warm_opts = SolveOptions {
         warm_start: Some(a.warm_start()),
@@ -324,8 +301,8 @@ fn tendon_termination_applies_point_force_and_moment() {
     // jumps there, the 2 N tendon that continues has a kink in its path and adds the point
     // force tau (t+ - t-) of a tensioned string over a kink (its distributed load -tau t'
     // integrated across the jump).
-    let rod = niti();
-    let tendons = niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.02, 0.01, 0.0));
     let sol = common::solve(&rod, &tendons, &loads, &rk4(40)).unwrap();
     let i = sol.s.iter().position(|&s| s == 0.2).unwrap();

@@ -129,8 +129,9 @@ impl Tangent {
     }
 }
 
-/// The local solution at one `s`: strains, tendon and fluid load sums (body frame), and the
-/// tangent when it was asked for.
+/// The local solution at one `s`: strains, tendon and fluid load sums (body frame). The
+/// tangent, when asked for, is left in [`Workspace::tangent`] (a large value, not copied
+/// around) for the variational columns of the same evaluation.
 #[derive(Clone, Copy)]
 pub(crate) struct Local {
     pub v: Vector3<f64>,
@@ -139,7 +140,6 @@ pub(crate) struct Local {
     pub tendon_force: Vector3<f64>,
     /// `Σ τ r_i × t_i` (N m, body frame), plus the chambers' fluid moment.
     pub tendon_moment: Vector3<f64>,
-    pub tangent: Option<Tangent>,
 }
 
 impl Local {
@@ -149,7 +149,6 @@ impl Local {
             u: Vector3::repeat(f64::NAN),
             tendon_force: Vector3::zeros(),
             tendon_moment: Vector3::zeros(),
-            tangent: None,
         }
     }
 }
@@ -209,6 +208,9 @@ pub(crate) struct Workspace {
     /// Whether the tendon speeds (and so the tendon-length quadrature) are recorded at every
     /// evaluation (the speeds of the tensioned tendons always are).
     pub track_lengths: bool,
+    /// Tangent of the last local solve asked for it (read by the variational columns of the
+    /// same evaluation).
+    pub tangent: Tangent,
     /// First material failure met by a local solve, reported if the solve fails.
     pub material_error: Option<Error>,
 }
@@ -231,6 +233,10 @@ impl Workspace {
             stages: Vec::new(),
             integral: vec![0.0; n_tendons],
             track_lengths: false,
+            tangent: Tangent {
+                diag: [f64::NAN; 6],
+                lu: None,
+            },
             material_error: None,
         }
     }
@@ -634,8 +640,10 @@ impl Evaluator<'_, '_> {
                 u: us + Vector3::new(e[3], e[4], e[5]),
                 tendon_force: Vector3::new(fluid[0], fluid[1], fluid[2]),
                 tendon_moment: Vector3::new(fluid[3], fluid[4], fluid[5]),
-                tangent: tangent.then_some(Tangent { diag: c, lu: None }),
             };
+            if tangent {
+                self.ws.tangent = Tangent { diag: c, lu: None };
+            }
             self.passive_speeds(s, props, &out.v, &out.u);
             return out;
         }
@@ -664,7 +672,6 @@ impl Evaluator<'_, '_> {
             u: Vector3::new(x[3], x[4], x[5]),
             tendon_force: Vector3::zeros(),
             tendon_moment: Vector3::zeros(),
-            tangent: None,
         };
         if tangent {
             // (I + C D)⁻¹ C at the solution.
@@ -672,10 +679,10 @@ impl Evaluator<'_, '_> {
             let Some(lu) = h.as_ref().and_then(Lu6::new) else {
                 return Local::nan();
             };
-            out.tangent = Some(Tangent {
+            self.ws.tangent = Tangent {
                 diag: c,
                 lu: Some(lu),
-            });
+            };
             self.ws.last_lu = Some(lu);
         }
         self.finish_tendons(s, props, &mut out, &fluid);
@@ -789,10 +796,9 @@ impl Evaluator<'_, '_> {
         if ncol == 0 {
             return;
         }
-        let tangent = loc.tangent.unwrap_or(Tangent {
-            diag: [f64::NAN; 6],
-            lu: None,
-        });
+        if !loc.v.x.is_finite() {
+            self.ws.tangent.diag = [f64::NAN; 6];
+        }
         let b_end = eq.model.breaks()[self.ws.interval + 1];
         let ends = eq.model.tendon_ends();
         let nl = self.ws.length_tendons.len();
@@ -829,7 +835,7 @@ impl Evaluator<'_, '_> {
                     }
                 }
             }
-            let d = tangent.apply(&e);
+            let d = self.ws.tangent.apply(&e);
             let (dv, du) = (
                 Vector3::new(d[0], d[1], d[2]),
                 Vector3::new(d[3], d[4], d[5]),

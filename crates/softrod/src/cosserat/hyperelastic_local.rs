@@ -124,16 +124,15 @@ impl Evaluator<'_, '_> {
             u: Vector3::new(x[3], x[4], x[5]),
             tendon_force: Vector3::zeros(),
             tendon_moment: Vector3::zeros(),
-            tangent: None,
         };
         if tangent {
             let Some(lu) = Lu6::new(&h) else {
                 return Local::nan();
             };
-            out.tangent = Some(Tangent {
+            self.ws.tangent = Tangent {
                 diag: c,
                 lu: Some(lu),
-            });
+            };
         }
         self.finish_tendons(s, props, &mut out, fluid);
         self.ws.guess = Some(x);

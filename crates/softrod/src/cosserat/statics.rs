@@ -309,10 +309,11 @@ fn direct(
             }
         }
     }
+    // The unloaded Jacobian is a poor one at full load: Newton evaluates its own at the
+    // predicted point.
     let s = NewtonSettings {
-        residual_first: true,
         first_step_limit: if guess == *x0 { limit } else { None },
-        ..settings(true, Some(&j0))
+        ..settings(true, None)
     };
     let mut out = newton(p, &guess, 1.0, opts, &s);
     if !out.converged && !out.residual.is_finite() && guess != *x0 {

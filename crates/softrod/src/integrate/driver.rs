@@ -61,17 +61,32 @@ fn stages<const N: usize, const S: usize, Y: System<N>>(
     st: &mut Stages<N, S>,
 ) {
     for i in 1..S {
-        let mut w = [0.0; S];
+        // The nonzero coefficients of row i (one for RK4's stages).
+        let mut terms = [(0usize, 0.0f64); S];
+        let mut m = 0;
         for j in 0..i {
-            w[j] = h * tab.a[i][j];
+            if tab.a[i][j] != 0.0 {
+                terms[m] = (j, h * tab.a[i][j]);
+                m += 1;
+            }
         }
         let (done, rest) = st.k.split_at_mut(i);
-        for c in 0..N {
-            let mut v = y[c];
-            for (wj, kj) in w.iter().zip(done.iter()) {
-                v += wj * kj[c];
+        match &terms[..m] {
+            [(j, w)] => {
+                let kj = &done[*j];
+                for c in 0..N {
+                    st.tmp[c] = y[c] + w * kj[c];
+                }
             }
-            st.tmp[c] = v;
+            terms => {
+                for c in 0..N {
+                    let mut v = y[c];
+                    for (j, w) in terms {
+                        v += w * done[*j][c];
+                    }
+                    st.tmp[c] = v;
+                }
+            }
         }
         let ti = if tab.c[i] == 1.0 {
             t_end

@@ -1321,6 +1321,28 @@ fn chamber_loading(chambers: &PccChambers) -> impl Fn(usize) -> Loading + '_ {
     }
 }
 
+/// `(u_x, u_y, ℓ)` of the checked `tensions` (N).
+fn tension_arc(
+    tensions: &[f64],
+    tendons: &PccTendons,
+    body: &ElasticSegment,
+) -> Result<(f64, f64, f64)> {
+    check_count("tensions", tensions.len(), tendons.len())?;
+    check_values("tensions", tensions, true)?;
+    elastic_arc("tensions", tensions, tendon_loading(tendons), body)
+}
+
+/// `(u_x, u_y, ℓ)` of the checked `pressures` (Pa).
+fn pressure_arc(
+    pressures: &[f64],
+    chambers: &PccChambers,
+    body: &ElasticSegment,
+) -> Result<(f64, f64, f64)> {
+    check_count("pressures", pressures.len(), chambers.len())?;
+    check_values("pressures", pressures, false)?;
+    elastic_arc("pressures", pressures, chamber_loading(chambers), body)
+}
+
 /// The arc of a linear elastic uniform segment `body` pulled by `tensions` (N, >= 0) in
 /// `tendons` (moment balance at the tip, tendon forces taken along the tangent):
 /// `E I κ (cos φ, sin φ) = Σ τ_i d_i (cos β_i, sin β_i)`, axial strain `-Σ τ_i / E A`
@@ -1335,9 +1357,7 @@ pub fn arc_from_tendon_tensions(
     tendons: &PccTendons,
     body: &ElasticSegment,
 ) -> Result<PccSegment> {
-    check_count("tensions", tensions.len(), tendons.len())?;
-    check_values("tensions", tensions, true)?;
-    let (ux, uy, l) = elastic_arc("tensions", tensions, tendon_loading(tendons), body)?;
+    let (ux, uy, l) = tension_arc(tensions, tendons, body)?;
     PccSegment::from_curvature_vector(ux, uy, l)
 }
 
@@ -1352,9 +1372,7 @@ pub fn arc_from_tendon_tensions_jacobian(
     body: &ElasticSegment,
     coordinates: ArcCoordinates,
 ) -> Result<Matrix3xX<f64>> {
-    check_count("tensions", tensions.len(), tendons.len())?;
-    check_values("tensions", tensions, true)?;
-    let (ux, uy, _) = elastic_arc("tensions", tensions, tendon_loading(tendons), body)?;
+    let (ux, uy, _) = tension_arc(tensions, tendons, body)?;
     let j = elastic_jacobian(tendons.len(), tendon_loading(tendons), body);
     to_coordinates(j, ux, uy, coordinates)
 }
@@ -1372,9 +1390,7 @@ pub fn arc_from_pressures(
     chambers: &PccChambers,
     body: &ElasticSegment,
 ) -> Result<PccSegment> {
-    check_count("pressures", pressures.len(), chambers.len())?;
-    check_values("pressures", pressures, false)?;
-    let (ux, uy, l) = elastic_arc("pressures", pressures, chamber_loading(chambers), body)?;
+    let (ux, uy, l) = pressure_arc(pressures, chambers, body)?;
     PccSegment::from_curvature_vector(ux, uy, l)
 }
 
@@ -1389,9 +1405,7 @@ pub fn arc_from_pressures_jacobian(
     body: &ElasticSegment,
     coordinates: ArcCoordinates,
 ) -> Result<Matrix3xX<f64>> {
-    check_count("pressures", pressures.len(), chambers.len())?;
-    check_values("pressures", pressures, false)?;
-    let (ux, uy, _) = elastic_arc("pressures", pressures, chamber_loading(chambers), body)?;
+    let (ux, uy, _) = pressure_arc(pressures, chambers, body)?;
     let j = elastic_jacobian(chambers.len(), chamber_loading(chambers), body);
     to_coordinates(j, ux, uy, coordinates)
 }

@@ -421,34 +421,11 @@ fn check_vector(name: &str, v: &Vector3<f64>) -> Result<()> {
 }
 
 fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
-    let nt = robot.n_tendons();
-    let nc = robot.n_chambers();
-    if !(loads.tensions.is_empty() || loads.tensions.len() == nt) {
-        return Err(Error::invalid(
-            "tensions.len()",
-            loads.tensions.len(),
-            format!("the number of tendons, {nt} (or 0 for none)"),
-        ));
-    }
-    if !(loads.pressures.is_empty() || loads.pressures.len() == nc) {
-        return Err(Error::invalid(
-            "pressures.len()",
-            loads.pressures.len(),
-            format!("the number of chambers, {nc} (or 0 for none)"),
-        ));
-    }
-    for (i, &t) in loads.tensions.iter().enumerate() {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Error::invalid(
-                format!("tensions[{i}]"),
-                t,
-                "finite and >= 0 N",
-            ));
-        }
-    }
-    for (i, &p) in loads.pressures.iter().enumerate() {
-        check_finite(&format!("pressures[{i}]"), p)?;
-    }
+    let (nt, nc) = (robot.n_tendons(), robot.n_chambers());
+    // The same inputs as the Cosserat statics, checked the same way.
+    crate::model::Actuation::tensions(&loads.tensions)
+        .with_pressures(&loads.pressures)
+        .validate(nt, nc)?;
     check_vector("tip_force", &loads.tip_force)?;
     check_vector("tip_moment", &loads.tip_moment)?;
     let mut actuation = vec![[0.0; 3]; robot.bodies.len()];
