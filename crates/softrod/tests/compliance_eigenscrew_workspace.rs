@@ -9,7 +9,7 @@ use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::math::se3::{adjoint, delta};
 use softrod::math::so3::exp_so3;
 use softrod::nalgebra::{Matrix6, Vector3, Vector6};
-use softrod::{LinearElastic, Loads, Rod, Section, SolveOptions};
+use softrod::{Loads, SolveOptions};
 
 /// Unit twist about the axis through `c` along unit `a` with pitch `h`: `[c × a + h a; a]`.
 fn twist(a: Vector3<f64>, c: Vector3<f64>, h: f64) -> Vector6<f64> {
