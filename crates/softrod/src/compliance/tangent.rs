@@ -314,6 +314,8 @@ fn integrate_columns(
     for chunk in seeds.chunks(COLUMNS_PER_PASS) {
         let p = if chunk.len() <= 12 {
             pass::<{ width(12) }>(eq, scheme, x, chunk, held, target)?
+        } else if chunk.len() <= 18 {
+            pass::<{ width(18) }>(eq, scheme, x, chunk, held, target)?
         } else {
             pass::<{ width(COLUMNS_PER_PASS) }>(eq, scheme, x, chunk, held, target)?
         };

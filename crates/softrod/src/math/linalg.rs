@@ -95,6 +95,7 @@ pub struct DenseLu {
     n: usize,
     lu: Vec<f64>,
     perm: Vec<usize>,
+    scratch: Vec<f64>,
 }
 
 impl DenseLu {
@@ -140,10 +141,12 @@ impl DenseLu {
     }
 
     /// Solves `A x = b` in place (`b` of length `n`); `false` if the result is not finite.
-    pub fn solve_in_place(&self, b: &mut [f64]) -> bool {
+    pub fn solve_in_place(&mut self, b: &mut [f64]) -> bool {
         let n = self.n;
         let lu = &self.lu;
-        let mut x: Vec<f64> = self.perm.iter().map(|&p| b[p]).collect();
+        let x = &mut self.scratch;
+        x.clear();
+        x.extend(self.perm.iter().map(|&p| b[p]));
         for i in 0..n {
             let mut v = x[i];
             for j in 0..i {
@@ -158,7 +161,7 @@ impl DenseLu {
             }
             x[i] = v / lu[i + i * n];
         }
-        b[..n].copy_from_slice(&x);
+        b[..n].copy_from_slice(x);
         x.iter().all(|v| v.is_finite())
     }
 }
@@ -168,9 +171,30 @@ impl DenseLu {
 /// `None` if a pivot is not positive.
 pub fn spd_inverse_on(c: &Matrix6<f64>, free: &[usize]) -> Option<Matrix6<f64>> {
     let n = free.len();
+    let sub = Matrix6::from_fn(|i, j| {
+        if i < n && j < n {
+            c[(free[i], free[j])]
+        } else {
+            0.0
+        }
+    });
+    let inv = cholesky_inverse(&sub, n)?;
+    let mut out = Matrix6::zeros();
+    for (i, &a) in free.iter().enumerate() {
+        for (j, &b) in free.iter().enumerate() {
+            out[(a, b)] = inv[(i, j)];
+        }
+    }
+    Some(out)
+}
+
+/// The one Cholesky inverse: `C⁻¹` of the leading `n × n` block of `c` (symmetric positive
+/// definite; the rest of the result is zero), `None` if a pivot is not positive.
+#[inline(always)]
+fn cholesky_inverse(c: &Matrix6<f64>, n: usize) -> Option<Matrix6<f64>> {
     let mut l = [[0.0f64; 6]; 6];
     for j in 0..n {
-        let mut d = c[(free[j], free[j])];
+        let mut d = c[(j, j)];
         for k in 0..j {
             d -= l[j][k] * l[j][k];
         }
@@ -180,7 +204,7 @@ pub fn spd_inverse_on(c: &Matrix6<f64>, free: &[usize]) -> Option<Matrix6<f64>> 
         let dj = d.sqrt();
         l[j][j] = dj;
         for i in j + 1..n {
-            let mut v = c[(free[i], free[j])];
+            let mut v = c[(i, j)];
             for k in 0..j {
                 v -= l[i][k] * l[j][k];
             }
@@ -207,11 +231,16 @@ pub fn spd_inverse_on(c: &Matrix6<f64>, free: &[usize]) -> Option<Matrix6<f64>> 
             for k in i..n {
                 v += w[k][i] * w[k][j];
             }
-            out[(free[i], free[j])] = v;
-            out[(free[j], free[i])] = v;
+            out[(i, j)] = v;
+            out[(j, i)] = v;
         }
     }
     Some(out)
+}
+
+/// `C⁻¹` of a symmetric positive definite 6×6 matrix (Cholesky), `None` if it is not.
+pub fn spd_inverse(c: &Matrix6<f64>) -> Option<Matrix6<f64>> {
+    cholesky_inverse(c, 6)
 }
 
 /// Matrix 1-norm (largest column sum of absolute values).
@@ -224,7 +253,7 @@ pub fn norm1(m: &Matrix6<f64>) -> f64 {
 /// `C⁻¹` if `C` is symmetric positive definite (Cholesky), NaN otherwise; and the 1-norm
 /// condition number `‖C‖₁ ‖C⁻¹‖₁` (infinite if `C` is not positive definite).
 pub fn invert_spd(c: &Matrix6<f64>) -> (Matrix6<f64>, f64) {
-    match spd_inverse_on(c, &[0, 1, 2, 3, 4, 5]) {
+    match spd_inverse(c) {
         Some(k) => {
             let cond = norm1(c) * norm1(&k);
             if cond.is_finite() {

@@ -6,11 +6,12 @@
 //! straight segment); above it the closed forms lose at most `~1e-14` relative. The PCC
 //! kinematics ([`crate::pcc`]) and the PCC statics use these functions and nothing else.
 
-/// `θ²` (rad²) below which the arc functions are summed as series (12 terms: error below
-/// `1e-20` for `θ² < 1`); above it the closed forms lose at most `~1e-14` relative.
-pub const SERIES_BOUND: f64 = 1.0;
+/// `θ²` (rad²) below which the arc functions are summed as series (7 terms: error below
+/// `1e-25` for `θ² < 0.01`); above it the closed forms of the values lose at most `~1e-13`
+/// relative, those of the second derivatives `~1e-11`.
+pub const SERIES_BOUND: f64 = 0.01;
 /// Number of series terms.
-pub const SERIES_TERMS: usize = 13;
+pub const SERIES_TERMS: usize = 7;
 
 // ---------------------------------------------------------------------------------------------
 
@@ -117,9 +118,27 @@ pub fn arc_fns(x: f64) -> ArcFns {
     }
 }
 
-/// Terms of the `S` and `B` series of [`arc_sb`]: the first neglected one is below `4e-19`
-/// for `x < 1`.
-const POSE_TERMS: usize = 10;
+/// `dS/dx` alone (the tip Jacobian of an arc needs nothing else), from the same series and
+/// closed forms.
+#[inline]
+pub fn arc_s1(x: f64) -> f64 {
+    if x < SERIES_BOUND {
+        let c = &SERIES_S[1..POSE_TERMS + 1];
+        // d/dx Σ c_k x^k = Σ k c_k x^(k-1).
+        return c
+            .iter()
+            .enumerate()
+            .rev()
+            .fold(0.0, |f, (k, ck)| f * x + (k + 1) as f64 * ck);
+    }
+    let th = x.sqrt();
+    let (sn, cs) = th.sin_cos();
+    0.5 * (cs - sn / th) / x
+}
+
+/// Terms of the `S` and `B` series of [`arc_sb`] and [`arc_s1`]: the first neglected one is
+/// below `3e-18` relative for `x < 0.01`.
+const POSE_TERMS: usize = 5;
 
 /// `Σ_k c_k x^k` by Horner's rule.
 #[inline]
@@ -151,10 +170,12 @@ mod tests {
         let x = SERIES_BOUND;
         let th = x.sqrt();
         assert!((series(&SERIES_S, x).0 - th.sin() / th).abs() < 1e-15);
-        assert!((series(&SERIES_B, x).0 - (1.0 - th.cos()) / x).abs() < 1e-15);
-        assert!((series(&SERIES_C, x).0 - (th - th.sin()) / (th * x)).abs() < 1e-15);
+        let half = (0.5 * th).sin();
+        assert!((series(&SERIES_B, x).0 - 2.0 * half * half / x).abs() < 1e-15);
+        // θ - sin θ cancels: the closed form of C is good to ~1e-13 at the bound.
+        assert!((series(&SERIES_C, x).0 - (th - th.sin()) / (th * x)).abs() < 1e-12);
         // Central differences of S, B, C in x at a few points on both sides of the bound.
-        for x in [0.01f64, 0.3, 2.0, 9.0] {
+        for x in [0.001f64, 0.005, 0.3, 2.0, 9.0] {
             let h = 1e-5 * x.max(1e-3);
             let (p, m, f) = (arc_fns(x + h), arc_fns(x - h), arc_fns(x));
             assert!(((p.s - m.s) / (2.0 * h) - f.s1).abs() < 1e-8);
@@ -164,9 +185,11 @@ mod tests {
             assert!(((p.b1 - m.b1) / (2.0 * h) - f.b2).abs() < 1e-7);
             let th = x.sqrt();
             assert!((f.s - th.sin() / th).abs() < 1e-15);
-            assert!((f.b - (1.0 - th.cos()) / x).abs() < 1e-14);
+            let half = (0.5 * th).sin();
+            assert!((f.b - 2.0 * half * half / x).abs() < 1e-15);
             let (s, b) = arc_sb(x);
             assert!((s - f.s).abs() < 1e-16 && (b - f.b).abs() < 1e-16);
+            assert!((arc_s1(x) - f.s1).abs() < 1e-15);
         }
     }
 }

@@ -67,7 +67,7 @@
 use nalgebra::{Matrix2xX, Matrix3, Matrix3xX, Matrix4, Matrix6x3, Matrix6xX, MatrixXx3, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
-use crate::math::series::{arc_fns, arc_sb};
+use crate::math::series::{arc_s1, arc_sb};
 
 /// Relative tolerance on the smallest eigenvalue of the normal equations of the tendon
 /// displacement map: layouts below it cannot resolve the arc parameters.
@@ -177,7 +177,7 @@ fn arc_trig(theta: f64) -> ArcTrig {
 /// `(θ cos θ - sin θ)/θ² = d(sin θ/θ)/dθ = 2 θ dS/dx`.
 #[inline]
 fn dsinc(theta: f64) -> f64 {
-    2.0 * theta * arc_fns(theta * theta).s1
+    2.0 * theta * arc_s1(theta * theta)
 }
 
 fn check_length(name: &str, length: f64) -> Result<f64> {

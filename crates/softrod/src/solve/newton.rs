@@ -119,15 +119,24 @@ fn start<P: Problem + ?Sized>(
     let mut it = Iterate {
         x: x0.to_vec(),
         r: vec![0.0; n],
-        jac: vec![0.0; n * n],
+        jac: if settings.residual_first && settings.jacobian.is_none() {
+            Vec::new()
+        } else {
+            vec![0.0; n * n]
+        },
         rn: f64::INFINITY,
         exact: false,
-        xt: vec![0.0; n],
-        rt: vec![0.0; n],
-        jt: vec![0.0; n * n],
+        // Scratch of the iterations, allocated once the start does not solve.
+        xt: Vec::new(),
+        rt: Vec::new(),
+        jt: Vec::new(),
     };
     let want = !settings.residual_first && settings.jacobian.is_none();
     let ev = problem.evaluate(&it.x, lambda, want.then_some(&mut it.jac[..]), &mut it.r);
+    if ev == Evaluated::Residual && settings.jacobian.is_none() {
+        // Not needed unless the start fails.
+        it.jac.clear();
+    }
     if ev == Evaluated::Failed {
         return None;
     }
@@ -150,6 +159,10 @@ fn start<P: Problem + ?Sized>(
     if !it.rn.is_finite() {
         return None;
     }
+    it.jac.resize(n * n, 0.0);
+    it.xt.resize(n, 0.0);
+    it.rt.resize(n, 0.0);
+    it.jt.resize(n * n, 0.0);
     if !have_j {
         if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian {
             out.at_x = false;
@@ -237,9 +250,9 @@ fn line_search<P: Problem + ?Sized>(
         if settings.condition.accept(alpha, it.rn, rtn)
             || rtn <= problem.tolerance(&it.xt, options.tolerance)
         {
-            it.x.copy_from_slice(&it.xt);
-            it.r.copy_from_slice(&it.rt);
-            it.jac.copy_from_slice(&it.jt);
+            std::mem::swap(&mut it.x, &mut it.xt);
+            std::mem::swap(&mut it.r, &mut it.rt);
+            std::mem::swap(&mut it.jac, &mut it.jt);
             it.rn = rtn;
             it.exact = true;
             return true;
