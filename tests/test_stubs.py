@@ -72,3 +72,17 @@ def test_solve_signature_matches_stub():
             defaults = [ast.literal_eval(d) for d in fn.args.defaults + fn.args.kw_defaults]
             real = [p.default for p in sig.parameters.values() if p.default is not p.empty]
             assert defaults == real
+
+
+def test_package_layout_and_earlier_module_paths():
+    import softrod.analysis
+    import softrod.cli
+    import softrod.io
+    import softrod.plot
+    import softrod.study
+    import softrod.workspace
+
+    assert softrod.study.seed001_study is softrod.analysis.study.seed001_study
+    assert softrod.workspace.workspace_map is softrod.workspace_map
+    assert callable(softrod.cli.main) and callable(softrod.plot.plot_rod)
+    assert softrod.io.read_backbone_csv is softrod.read_backbone_csv

@@ -3,8 +3,8 @@
 SI units everywhere (m, N, Pa, rad). See https://softrod docs in ``docs/`` for the models.
 
 The numerics live in the compiled core ``softrod._core``; this package re-exports it and adds
-file I/O (:mod:`softrod.io`), plots (:mod:`softrod.plot`) and the ``softrod`` command line
-(:mod:`softrod.cli`).
+file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`softrod.plot`)
+and the ``softrod`` command line (:mod:`softrod.cli`).
 """
 
 from . import pcc
@@ -48,12 +48,20 @@ from ._core import (
     solve_statics,
     tangent_compliance,
 )
-from .compare import BackboneDistance, backbone_distance
+from .analysis import (
+    BackboneDistance,
+    ModelComparison,
+    ModelResult,
+    TensileCurve,
+    WorkspaceMap,
+    backbone_distance,
+    compare_models,
+    read_tensile_csv,
+    tension_grid,
+    workspace_map,
+)
 from .io import read_backbone_csv, write_samples_csv
-from .materials import TensileCurve, read_tensile_csv
-from .models import ModelComparison, ModelResult, compare_models
 from .robot import Robot, load_robot
-from .workspace import WorkspaceMap, tension_grid, workspace_map
 
 __all__ = [
     "SILICONES",
@@ -110,3 +118,25 @@ __all__ = [
     "workspace_map",
     "write_samples_csv",
 ]
+
+
+# Module paths of earlier releases, kept importable: ``softrod.study``, ``softrod.workspace``,
+# ``softrod.models``, ``softrod.compare`` and ``softrod.materials`` now live in ``analysis``.
+def _alias_modules() -> None:
+    import sys
+
+    from .analysis import compare, materials, models, study
+    from .analysis import workspace as _workspace
+
+    for name, module in {
+        "compare": compare,
+        "materials": materials,
+        "models": models,
+        "study": study,
+        "workspace": _workspace,
+    }.items():
+        sys.modules[f"{__name__}.{name}"] = module
+        globals()[name] = module
+
+
+_alias_modules()

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._core import ParameterError, UniaxialFit, fit_uniaxial
+from .._core import ParameterError, UniaxialFit, fit_uniaxial
 
 __all__ = ["TensileCurve", "read_tensile_csv"]
 

@@ -17,12 +17,12 @@ import sys
 import time
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, Literal, TextIO
 
 import numpy as np
 
-from ._core import ConvergenceError, ParameterError, UniaxialLaw
-from .robot import Robot, _Fields, _material, tomllib
+from .._core import ConvergenceError, ParameterError, UniaxialLaw
+from ..robot import Robot, _Fields, _material, tomllib
 
 __all__ = ["StudyResult", "seed001_study"]
 
@@ -74,7 +74,7 @@ def _pair_pressures(p: tuple[float, float, float]) -> list[float]:
 
 
 def _run(robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray) -> StudyResult:
-    from . import compliance, eigenscrews
+    from .. import compliance, eigenscrews
 
     grid = np.array(list(itertools.product(levels, repeat=3)))
     tips = np.full((len(grid), 3), np.nan)
@@ -116,7 +116,7 @@ def seed001_study(
     max_pressure: float = 60e3,
     gamma_pressures: tuple[float, ...] = (0.0, 10e3, 20e3, 30e3, 40e3),
     out_dir: str | os.PathLike[str] | None = None,
-    log=sys.stdout,
+    log: TextIO | Literal["stdout"] | None = "stdout",
 ) -> dict[str, StudyResult]:
     """Runs seed 001's study on a three-chamber-pair robot, hyperelastic and linear.
 
@@ -129,7 +129,8 @@ def seed001_study(
         gamma_pressures: P1 = P2 pressures (Pa) of the ``gamma_c(s)`` curves.
         out_dir: Folder for the figures (``seed001_workspace_<material>.png``,
             ``seed001_gamma_c_<material>.png``); ``None`` draws nothing.
-        log: Where the summary is printed (``None``: silent).
+        log: Where the summary is printed: ``"stdout"`` (the current ``sys.stdout``, the
+            default), an open text file, or ``None`` (silent).
 
     Returns:
         The results by material, ``"hyperelastic"`` and ``"linear"``.
@@ -137,6 +138,8 @@ def seed001_study(
     Raises:
         ParameterError: A robot without exactly six chambers, or bad arguments.
     """
+    if isinstance(log, str) and log == "stdout":
+        log = sys.stdout
     if levels < 2:
         raise ParameterError(f"invalid parameter `levels` = {levels}: must be >= 2")
     if not (np.isfinite(max_pressure) and max_pressure > 0):
@@ -198,7 +201,7 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .plot import plot_gamma_c, plot_workspace_map
+    from ..plot import plot_gamma_c, plot_workspace_map
 
     os.makedirs(out_dir, exist_ok=True)
     for material, res in out.items():

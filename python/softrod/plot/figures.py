@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._core import PlanarCableArm, PlanarSolution
+from .._core import PlanarCableArm, PlanarSolution
 
 __all__ = ["plot_fit", "plot_planar", "plot_rod"]
 
@@ -288,7 +288,7 @@ def plot_compliance_ellipsoids(
     """
     import matplotlib.pyplot as plt
 
-    from ._core import compliance as _compliance
+    from .._core import compliance as _compliance
 
     if which not in ("translational", "rotational"):
         raise ValueError("which must be 'translational' or 'rotational'")

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._core import Loads, Rod, Tendon, _workspace_map
+from .._core import Loads, Rod, Tendon, _workspace_map
 
 
 @dataclass(frozen=True)

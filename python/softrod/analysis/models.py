@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from . import pcc
-from ._core import ParameterError, PlanarCableArm
+from .. import pcc
+from .._core import ParameterError, PlanarCableArm
+from ..robot import Robot, load_robot
 from .compare import backbone_distance
-from .robot import Robot, load_robot
 
 __all__ = ["ModelComparison", "ModelResult", "compare_models"]
 

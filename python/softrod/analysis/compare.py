@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
-from ._core import ParameterError
+from .. import _core
+from .._core import ParameterError
 
 __all__ = ["BackboneDistance", "backbone_distance"]
 
