@@ -3,11 +3,12 @@
 SI units everywhere (m, N, Pa, rad). See https://softrod docs in ``docs/`` for the models.
 
 The numerics live in the compiled core ``softrod._core``; this package re-exports it and adds
-file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`softrod.plot`)
-and the ``softrod`` command line (:mod:`softrod.cli`).
+file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`softrod.plot`),
+backbones from photographs (:mod:`softrod.vision`) and the ``softrod`` command line
+(:mod:`softrod.cli`).
 """
 
-from . import pcc
+from . import pcc, vision
 from ._core import (
     SILICONES,
     Chamber,
@@ -62,10 +63,13 @@ from .analysis import (
 )
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
+from .vision import Backbone, BackboneQuality, extract_backbone
 
 __all__ = [
     "SILICONES",
+    "Backbone",
     "BackboneDistance",
+    "BackboneQuality",
     "Chamber",
     "CircularSection",
     "Compliance",
@@ -106,6 +110,7 @@ __all__ = [
     "compare_models",
     "compliance",
     "eigenscrews",
+    "extract_backbone",
     "fit_uniaxial",
     "load_robot",
     "pcc",
@@ -115,6 +120,7 @@ __all__ = [
     "solve_statics",
     "tangent_compliance",
     "tension_grid",
+    "vision",
     "workspace_map",
     "write_samples_csv",
 ]
