@@ -148,7 +148,7 @@ def render_backbone(
         blur: Gaussian blur sigma (px).
         noise: Gaussian noise sigma (fraction of full scale).
         n_blobs: Number of distractors (0 to 5): two floats, a marker, a bubble ring, and a
-            float 4-7 px beyond the tip.
+            float 3-5 px + 2 blur sigmas beyond the tip.
         touching: Moves the first float onto the arm's side at mid-length (overlapping it).
         clamp: Fraction of the arm length hidden by a clamp over the base (0 for none).
         rgb: Returns an RGB image (tinted silicone on a tinted floor) instead of grey.
@@ -204,8 +204,8 @@ def render_backbone(
     for k, (kind, axes, level) in enumerate(specs):
         for _ in range(2000):
             ang = rng.uniform(0, np.pi)
-            if k == 4:  # near the tip: beyond its end face, 4-7 px of floor in between
-                gap = rng.uniform(4.0, 7.0)
+            if k == 4:  # near the tip: beyond its end face, a few px of floor in between
+                gap = rng.uniform(3.0, 5.0) + 2 * blur
                 c = (
                     centre[-1]
                     + tip_dir * (gap + axes[0])
@@ -223,7 +223,7 @@ def render_backbone(
                 (poly[:, 0] > 1) & (poly[:, 0] < w - 2) & (poly[:, 1] > 1) & (poly[:, 1] < h - 2)
             )
             pc = np.clip(np.round(poly).astype(int), 0, [w - 1, h - 1])
-            clear = dist[pc[:, 1], pc[:, 0]].min() > 4.0 + 2 * blur
+            clear = dist[pc[:, 1], pc[:, 0]].min() > (2.5 if k == 4 else 4.0) + 2 * blur
             near_base = np.hypot(*(c - base)) < 3 * r0
             if inside.all() and not near_base and (clear or (k == 0 and touching)):
                 break

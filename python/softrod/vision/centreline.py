@@ -35,7 +35,8 @@ SECTION_STEP = 1.0
 MAX_ROUNDS = 12
 #: The ends have stopped growing when neither moved by more than this in a round (px).
 GROWN = 3.0
-#: The fit has converged when no centre moves by more than this (px) and the ends are still.
+#: The fit has converged when the curve moves across itself by less than this (px), or by
+#: less than a quarter of the midpoints' scatter, between rounds.
 CONVERGED = 0.05
 #: A cross-section's half-width is an outlier beyond max(this (px), 4 robust sigmas).
 OUTLIER_FLOOR = 0.75
@@ -48,6 +49,11 @@ END_ZONE = 2.0
 TREND_SPACING = 8.0
 #: Tukey biweight constant, in robust sigmas.
 TUKEY = 4.685
+#: Half-width of the window around the half-peak crossing where the steepest edge is sought
+#: (px), at most half the half-width; arms thinner than 6 px keep the crossings.
+EDGE_WINDOW = 3.0
+#: Invalid cross-sections in a row that end the curve.
+GAP = 3
 #: Huber constant, in robust sigmas of the midpoints about the curve.
 HUBER = 1.345
 
@@ -179,18 +185,43 @@ def _sections(signal, mask, curve, u, reach, peak_min, step):
     em, okm = _first_below(minus, level, step)
     inside = _sample(mask.astype(np.float64), pts) > 0.5
     ok = okp & okm & (peak > peak_min) & inside
-    return pts, nrm, ep, -em, ok, peak
+    gp, gm = _steepest(plus, ep, step), _steepest(minus, em, step)
+    return pts, nrm, ep, -em, ok, peak, gp, -gm
+
+
+def _steepest(v: np.ndarray, edge: np.ndarray, step: float) -> np.ndarray:
+    """Sub-sample position of the steepest descent of each profile within EDGE_WINDOW px of
+    its half-peak crossing ``edge`` (parabola through the three samples around the maximum);
+    the crossing itself where the window does not fit."""
+    g = -np.gradient(v, step, axis=1)
+    j = np.arange(v.shape[1])[None, :]
+    c = edge[:, None] / step
+    half = 0.5 * float(np.nanmedian(edge))
+    w = min(EDGE_WINDOW, half) / step
+    g = np.where((np.abs(j - c) <= w) & np.isfinite(g), g, -np.inf)
+    k = np.clip(np.argmax(g, axis=1), 1, v.shape[1] - 2)
+    rows = np.arange(len(v))
+    a, b, d = g[rows, k - 1], g[rows, k], g[rows, k + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        den = a - 2 * b + d
+        shift = np.where(np.isfinite(den) & (den < 0), 0.5 * (a - d) / den, 0.0)
+    out = (k + np.clip(shift, -0.5, 0.5)) * step
+    good = np.isfinite(b) & (half >= 1.5)
+    return np.where(good, out, edge)
 
 
 def _contiguous(ok: np.ndarray, lo: int, hi: int) -> np.ndarray:
-    """Drops samples before ``lo`` / after ``hi`` beyond the first invalid one going outward."""
+    """Drops the samples before ``lo`` / after ``hi`` beyond the first run of GAP invalid ones
+    going outward (isolated noisy cross-sections do not stop the curve)."""
     keep = ok.copy()
-    bad = np.nonzero(~ok[:lo])[0]
-    if bad.size:
-        keep[: bad[-1] + 1] = False
-    bad = np.nonzero(~ok[hi:])[0]
-    if bad.size:
-        keep[hi + bad[0] :] = False
+    run = np.convolve(~ok, np.ones(GAP, dtype=int), mode="valid") == GAP  # run starts
+    starts = np.nonzero(run)[0]
+    below = starts[starts + GAP <= lo]
+    if below.size:
+        keep[: below[-1] + GAP] = False
+    above = starts[starts >= hi]
+    if above.size:
+        keep[above[0] :] = False
     return keep
 
 
@@ -269,7 +300,7 @@ def fit_centreline(
     hw_lo = hw_hi = hw0
     outliers = 0
     grow = True  # extend the ends while cross-sections find the arm, then refine in place
-    for _ in range(MAX_ROUNDS):
+    for rnd in range(MAX_ROUNDS):
         n_lo = int(np.ceil(max(3.0, hw_lo) / SECTION_STEP)) if grow else 0
         n_hi = int(np.ceil(max(3.0, hw_hi) / SECTION_STEP)) if grow else 0
         core = np.append(np.arange(lo_u, hi_u, SECTION_STEP), hi_u)
@@ -281,7 +312,8 @@ def fit_centreline(
             ]
         )
         i_lo, i_hi = n_lo, n_lo + len(core)
-        pts, nrm, lp, lm, ok, peak = _sections(signal, mask, curve, us, reach, peak_min, step)
+        sections = _sections(signal, mask, curve, us, reach, peak_min, step)
+        pts, nrm, lp, lm, ok, peak, gp, gm = sections
         idx = np.nonzero(ok)[0]
         if idx.size < 4:
             raise ValueError("no cross-section of the arm could be measured")
@@ -316,7 +348,10 @@ def fit_centreline(
         u_fit = us[sel]
         old, old_lo, old_hi = curve, lo_u, hi_u
         curve, res = _robust_fit(u_fit, centres, spacing(half[use], knot_spacing))
-        hw_curve = _Curve(u_fit, half[use, None], 2.0 * spacing(half[use], knot_spacing))
+        # Half-widths from the steepest edges: the half-peak crossings are shifted by shading.
+        steep = 0.5 * (gp[sel] - gm[sel])
+        hw_spacing = 2.0 * spacing(half[use], knot_spacing)
+        hw_curve = _Curve(u_fit, _robust_trend(u_fit, steep, hw_spacing)[:, None], hw_spacing)
         hw = hw_curve.spline(u_fit)[:, 0]
         lo_u, hi_u = curve.u0, curve.u1
         hw_lo, hw_hi = float(hw[0]), float(hw[-1])
@@ -324,15 +359,15 @@ def fit_centreline(
         a, b = max(lo_u, old_lo), min(hi_u, old_hi)
         margin = END_ZONE * float(np.median(hw))
         a, b = a + margin, b - margin
-        if grow:
-            grow = max(abs(lo_u - old_lo), abs(hi_u - old_hi)) > GROWN
+        if grow:  # the first round measures on the skeleton's rough curve: keep growing
+            grow = rnd == 0 or max(abs(lo_u - old_lo), abs(hi_u - old_hi)) > GROWN
         elif b > a:
             uu = np.linspace(a, b, 200)
             p_new, _ = curve(uu)
             p_old, t_old = old(uu)
             dp = p_new - p_old
             moved = np.abs(dp[:, 0] * t_old[:, 1] - dp[:, 1] * t_old[:, 0])  # across the curve
-            if moved.max() < CONVERGED:
+            if moved.max() < max(CONVERGED, 0.25 * float(np.sqrt(np.mean(res**2)))):
                 break
     else:
         warnings.append(f"the tube fit did not settle in {MAX_ROUNDS} rounds")
