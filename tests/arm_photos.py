@@ -187,7 +187,8 @@ def render_backbone(
     img = floor + 0.015 * tex / tex.std()
     img = img * (1 - cov) + arm * cov
 
-    # Distractors, placed clear of the arm (4 px gap at least) except when asked to touch.
+    # Distractors, placed clear of the arm and of each other (4 px + 2 blur sigmas at least),
+    # except the float asked to touch the arm.
     dist = ndimage.distance_transform_edt(cov < 0.01)
     r0, rl = r_px[0], r_px[-1]
     arm_like = 0.72 if background == "dark" else 0.2
@@ -225,7 +226,8 @@ def render_backbone(
             pc = np.clip(np.round(poly).astype(int), 0, [w - 1, h - 1])
             clear = dist[pc[:, 1], pc[:, 0]].min() > (2.5 if k == 4 else 4.0) + 2 * blur
             near_base = np.hypot(*(c - base)) < 3 * r0
-            if inside.all() and not near_base and (clear or (k == 0 and touching)):
+            apart = all(np.hypot(*(c - c2)) > axes[0] + a2[0] + 4 + 2 * blur for _, c2, a2 in blobs)
+            if inside.all() and apart and not near_base and (clear or (k == 0 and touching)):
                 break
         else:
             raise RuntimeError(f"no room for distractor {k}")

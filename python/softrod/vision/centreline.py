@@ -179,7 +179,8 @@ def _sections(signal, mask, curve, u, reach, peak_min, step):
     plus = _sample(signal, pts[:, None, :] + lam[None, :, None] * nrm[:, None, :])
     minus = _sample(signal, pts[:, None, :] - lam[None, :, None] * nrm[:, None, :])
     core = max(1, int(np.ceil(1.0 / step)))
-    peak = np.nanmax(np.concatenate([plus[:, : core + 1], minus[:, : core + 1]], axis=1), axis=1)
+    near = np.concatenate([plus[:, : core + 1], minus[:, : core + 1]], axis=1)
+    peak = np.where(np.isnan(near), -np.inf, near).max(axis=1)  # -inf: off the image
     level = 0.5 * peak
     ep, okp = _first_below(plus, level, step)
     em, okm = _first_below(minus, level, step)
@@ -425,7 +426,7 @@ def _end_point(signal, p, out, h, step) -> tuple[np.ndarray | None, str]:
     offs = np.linspace(-0.4, 0.4, 5) * h
     lines = p + t[:, None, None] * out + offs[None, :, None] * nrm
     v = _sample(signal, lines)
-    prof = np.where(np.isnan(v).any(axis=1), np.nan, np.nanmean(v, axis=1))
+    prof = v.mean(axis=1)  # NaN where any line is off the image
     inside = prof[(t >= -back) & (t <= -1.0)]
     if inside.size == 0 or np.all(np.isnan(inside)):
         return None, "end edge"

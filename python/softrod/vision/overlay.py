@@ -75,4 +75,16 @@ def plot_backbone_overlay(backbone: Backbone, image, *, ax=None, title: str | No
             + (f", {len(q.warnings)} warning(s)" if q.warnings else "")
         )
     ax.set_title(title, fontsize=9)
+    if q.warnings:
+        ax.text(
+            0.01,
+            0.01,
+            "\n".join(f"warning: {w}" for w in q.warnings),
+            transform=ax.transAxes,
+            fontsize=7,
+            color="#7a0000",
+            va="bottom",
+            ha="left",
+            bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none"},
+        )
     return fig

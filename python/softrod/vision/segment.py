@@ -47,13 +47,18 @@ def read_image(image: str | os.PathLike[str] | ArrayLike) -> np.ndarray:
         path = os.fspath(image)
         if not os.path.isfile(path):
             raise parameter_error("image", f"{path!r} is not a file")
+        import warnings
+
         from skimage import io
 
         try:
-            arr = np.asarray(io.imread(path))
+            with warnings.catch_warnings():  # imageio's plugin probing on odd files
+                warnings.simplefilter("ignore")
+                arr = np.asarray(io.imread(path))
         except Exception as exc:  # imageio raises many types for non-image content
+            reason = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
             raise parameter_error(
-                "image", f"{path!r} is not a readable image ({type(exc).__name__}: {exc})"
+                "image", f"{path!r} is not a readable image ({type(exc).__name__}: {reason})"
             ) from None
     else:
         try:
