@@ -350,10 +350,13 @@ def fit_centreline(
         old, old_lo, old_hi = curve, lo_u, hi_u
         curve, res = _robust_fit(u_fit, centres, spacing(half[use], knot_spacing))
         # Half-widths from the steepest edges: the half-peak crossings are shifted by shading.
+        # Sections with a rejected edge are left out.
         steep = 0.5 * (gp[sel] - gm[sel])
+        two = ~bad[use] if (~bad[use]).sum() >= 8 else np.ones(len(sel), dtype=bool)
         hw_spacing = 2.0 * spacing(half[use], knot_spacing)
-        hw_curve = _Curve(u_fit, _robust_trend(u_fit, steep, hw_spacing)[:, None], hw_spacing)
-        hw = hw_curve.spline(u_fit)[:, 0]
+        trend = _robust_trend(u_fit[two], steep[two], hw_spacing)
+        hw_curve = _Curve(u_fit[two], trend[:, None], hw_spacing)
+        hw = hw_curve.spline(np.clip(u_fit, hw_curve.u0, hw_curve.u1))[:, 0]
         lo_u, hi_u = curve.u0, curve.u1
         hw_lo, hw_hi = float(hw[0]), float(hw[-1])
         reach = 1.5 * float(hw.max()) + 6
