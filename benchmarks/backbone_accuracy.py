@@ -4,7 +4,8 @@ Run from the repository root: ``python benchmarks/backbone_accuracy.py`` (a minu
 Prints, for every case of the tests (``tests/test_backbone.py``, same renders and seeds), the
 centreline's RMS and maximum distance (px) from the true backbone over 95 % of the arm
 length, the tip distance (px) and the half-width error (px, mean and max over the middle
-90 %); writes ``docs/figures/backbone_overlay.png``.
+90 %); writes ``docs/figures/backbone_overlay.png`` and the sample photo of the docs,
+``data/photos/seed000-arm-2N.jpg`` (the seed-000 arm at 2 N, 0.3 MP, JPEG quality 90).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+import imageio.v3 as iio
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -91,6 +93,20 @@ def main() -> None:
         photo = render_seed_arm(3.0, "1MP", background=background, blur=2.0, noise=0.05, seed=7)
         bb = softrod.extract_backbone(photo.image, base=photo.base)
         _row(f"1MP, {background} floor, blur 2 px, noise 5 %", photo, bb)
+
+    # The docs' sample photo, saved as a camera would (JPEG), and what comes out of it.
+    photo = render_seed_arm(2.0, "0.3MP", seed=11)
+    out = ROOT / "data" / "photos" / "seed000-arm-2N.jpg"
+    out.parent.mkdir(exist_ok=True)
+    iio.imwrite(out, photo.image, quality=90)
+    bb = softrod.extract_backbone(
+        out, scale=photo.scale, base=photo.base, direction=photo.direction
+    )
+    _row("the sample photo, read back from JPEG", photo, bb)
+    print(
+        f"sample photo: scale {photo.scale!r} m/px, base {photo.base.tolist()} px, "
+        f"direction {photo.direction.tolist()}"
+    )
 
     # The figure: a photo with a clamp over the base and a float on the arm.
     photo = render_seed_arm(3.0, "0.3MP", clamp=0.04, touching=True, seed=9)
