@@ -63,7 +63,7 @@ from .analysis import (
 )
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
-from .vision import Backbone, BackboneQuality, extract_backbone
+from .vision import Backbone, BackboneQuality
 
 __all__ = [
     "SILICONES",
@@ -146,3 +146,17 @@ def _alias_modules() -> None:
 
 
 _alias_modules()
+
+
+def __getattr__(name: str):
+    # ``extract_backbone`` loads the image-processing stack on first use (see softrod.vision).
+    if name == "extract_backbone":
+        from .vision import extract_backbone
+
+        globals()[name] = extract_backbone
+        return extract_backbone
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -1,18 +1,20 @@
 """The arm's centreline to sub-pixel accuracy: skeleton, then a tube fit on the edges.
 
-1. A first guess: the skeleton of the arm's mask (reduced so that the arm stays a few pixels
-   wide), its longest path, trimmed by a half-width at each end where the skeleton forks toward
-   the corners of the end faces.
+1. A first guess: the skeleton of the arm's mask (reduced so that the arm stays 8-16 px wide),
+   its longest path, trimmed by 1.5 local half-widths at each end where the skeleton forks
+   toward the corners of the end faces.
 2. A tube fit: the curve is a least-squares cubic B-spline in arc length. Across it, at every
    pixel of length, the flattened signal is sampled along the normal; the two edges are where the
    profile falls to half of its peak, walking outward from the curve (linear interpolation
    between samples). The centre is midway between the edges along the normal: for a round arm
    seen from above the silhouette is exactly the union of the segments c(s) +- r(s) n(s), so the
    midpoint is the backbone and the half-distance its radius, taper included. A cross-section
-   whose half-width jumps from the running median (a float or a marker touching one side) keeps
-   the other edge and the median half-width. The spline is refitted to the midpoints with Huber
-   weights, and the loop repeats, extending the curve at its ends while cross-sections still
-   find the arm, until it stops moving.
+   whose half-width leaves its robust trend (a float or a marker touching one side) keeps the
+   edge that agrees with the trend and the trend's half-width; near the ends such sections are
+   dropped instead (there they reach an end face). The spline is refitted to the midpoints with
+   Huber weights; the curve grows at its ends while cross-sections still find the arm, then is
+   refined in place until it stops moving. Half-widths come from the steepest descent of each
+   profile near its half-peak crossing, which shading shifts.
 3. The ends: along the extended centreline, averaged over a few lines parallel to it, the
    signal falls to half its value on the arm at the end face; or the line leaves the image first
    (an arm entering from the border).
@@ -172,7 +174,8 @@ def _robust_trend(u: np.ndarray, x: np.ndarray, spacing: float) -> np.ndarray:
 
 
 def _sections(signal, mask, curve, u, reach, peak_min, step):
-    """Edges across the curve at parameters ``u``: points, normals, edge offsets, validity."""
+    """Cross-sections of the curve at parameters ``u`` (``mask`` as floats): points, normals,
+    half-peak edge offsets (+, -), validity, peaks, steepest-edge offsets (+, -)."""
     pts, tan = curve(u)
     nrm = np.column_stack([tan[:, 1], -tan[:, 0]])  # +90 deg as seen on the image
     lam = np.arange(0.0, reach + step, step)
@@ -184,7 +187,7 @@ def _sections(signal, mask, curve, u, reach, peak_min, step):
     level = 0.5 * peak
     ep, okp = _first_below(plus, level, step)
     em, okm = _first_below(minus, level, step)
-    inside = _sample(mask.astype(np.float64), pts) > 0.5
+    inside = _sample(mask, pts) > 0.5
     ok = okp & okm & (peak > peak_min) & inside
     gp, gm = _steepest(plus, ep, step), _steepest(minus, em, step)
     return pts, nrm, ep, -em, ok, peak, gp, -gm
@@ -236,6 +239,43 @@ def _robust_fit(u, pts, spacing) -> tuple[_Curve, np.ndarray]:
     return curve, res
 
 
+def _first_guess(mask: np.ndarray, knot_spacing: float | None) -> tuple[_Curve, float]:
+    """The skeleton's longest path as a first curve, and the mean half-width (px)."""
+    area = int(mask.sum())
+    edge = area - int(ndimage.binary_erosion(mask).sum())
+    hw0 = max(area / max(edge, 1), 0.5)  # a long strip: area / perimeter
+    k = max(1, int(hw0 // 4))
+    rows, cols = np.nonzero(mask)
+    r0, c0 = max(rows.min() - 2 * k, 0), max(cols.min() - 2 * k, 0)
+    crop = mask[r0 : rows.max() + 2 * k + 1, c0 : cols.max() + 2 * k + 1]
+    if k > 1:
+        h, w = (crop.shape[0] // k + 1) * k, (crop.shape[1] // k + 1) * k
+        pad = np.zeros((h, w), dtype=bool)
+        pad[: crop.shape[0], : crop.shape[1]] = crop
+        small = pad.reshape(h // k, k, w // k, k).mean(axis=(1, 3)) > 0.5
+    else:
+        small = crop
+    path_small = _skeleton_path(small)
+    if len(path_small) < 2:
+        raise ValueError("the arm's mask is too small to hold a centreline")
+    ri, ci = path_small[:, 1].astype(int), path_small[:, 0].astype(int)
+    depth = ndimage.distance_transform_edt(small)[ri, ci] * k
+    path = path_small * k + (k - 1) / 2 + np.array([c0, r0])
+    u = _chord(path)
+    if u[-1] < 2:
+        raise ValueError("the arm's mask is too small to hold a centreline")
+    # Trim each end by 1.5 local half-widths: the skeleton forks toward the end-face corners.
+    quarter = max(len(u) // 4, 1)
+    trim0 = min(1.5 * float(depth[:quarter].max()), 0.25 * u[-1])
+    trim1 = min(1.5 * float(depth[-quarter:].max()), 0.25 * u[-1])
+    sel = (u >= trim0) & (u <= u[-1] - trim1)
+    if sel.sum() < 4:
+        sel = np.ones(len(u), dtype=bool)
+    path, u = path[sel], u[sel] - u[sel][0]
+    spacing0 = knot_spacing or float(np.clip(1.5 * hw0, 6.0, 40.0))
+    return _Curve(u, path, max(spacing0, 2.0 * k)), hw0
+
+
 def fit_centreline(
     signal: np.ndarray,
     mask: np.ndarray,
@@ -256,45 +296,9 @@ def fit_centreline(
         ValueError: The mask is too small to hold a curve (caught by the caller).
     """
     warnings: list[str] = []
-    area = int(mask.sum())
-    edge = area - int(ndimage.binary_erosion(mask).sum())
-    hw0 = max(area / max(edge, 1), 0.5)
-    k = max(1, int(hw0 // 4))
-    rows, cols = np.nonzero(mask)
-    r0, c0 = max(rows.min() - 2 * k, 0), max(cols.min() - 2 * k, 0)
-    crop = mask[r0 : rows.max() + 2 * k + 1, c0 : cols.max() + 2 * k + 1]
-    if k > 1:
-        h, w = (crop.shape[0] // k + 1) * k, (crop.shape[1] // k + 1) * k
-        pad = np.zeros((h, w), dtype=bool)
-        pad[: crop.shape[0], : crop.shape[1]] = crop
-        small = pad.reshape(h // k, k, w // k, k).mean(axis=(1, 3)) > 0.5
-    else:
-        small = crop
-    path_small = _skeleton_path(small)
-    if len(path_small) < 2:
-        raise ValueError("the arm's mask is too small to hold a centreline")
-    depth = (
-        ndimage.distance_transform_edt(small)[
-            path_small[:, 1].astype(int), path_small[:, 0].astype(int)
-        ]
-        * k
-    )
-    path = path_small * k + (k - 1) / 2 + np.array([c0, r0])
-    u = _chord(path)
-    if u[-1] < 2:
-        raise ValueError("the arm's mask is too small to hold a centreline")
-    # Trim each end by 1.5 local half-widths: the skeleton forks toward the end-face corners.
-    quarter = max(len(u) // 4, 1)
-    trim0 = min(1.5 * float(depth[:quarter].max()), 0.25 * u[-1])
-    trim1 = min(1.5 * float(depth[-quarter:].max()), 0.25 * u[-1])
-    sel = (u >= trim0) & (u <= u[-1] - trim1)
-    if sel.sum() < 4:
-        sel = np.ones(len(u), dtype=bool)
-    path, u = path[sel], u[sel] - u[sel][0]
-    spacing0 = knot_spacing or float(np.clip(1.5 * hw0, 6.0, 40.0))
-    curve = _Curve(u, path, max(spacing0, 2.0 * k))
-
-    step = min(0.5, max(hw0 / 6, 0.1))
+    curve, hw0 = _first_guess(mask, knot_spacing)
+    mask_f = mask.astype(np.float64)
+    step = min(0.5, max(hw0 / 6, 0.1))  # profile sampling (px): finer for thin arms
     reach = 2.2 * hw0 + 6
     peak_min = 0.5 * threshold
     lo_u, hi_u = curve.u0, curve.u1
@@ -313,7 +317,7 @@ def fit_centreline(
             ]
         )
         i_lo, i_hi = n_lo, n_lo + len(core)
-        sections = _sections(signal, mask, curve, us, reach, peak_min, step)
+        sections = _sections(signal, mask_f, curve, us, reach, peak_min, step)
         pts, nrm, lp, lm, ok, peak, gp, gm = sections
         idx = np.nonzero(ok)[0]
         if idx.size < 4:
@@ -348,12 +352,12 @@ def fit_centreline(
         centres = pts[sel] + mid[use, None] * nrm[sel]
         u_fit = us[sel]
         old, old_lo, old_hi = curve, lo_u, hi_u
-        curve, res = _robust_fit(u_fit, centres, spacing(half[use], knot_spacing))
+        curve, res = _robust_fit(u_fit, centres, _knot_spacing(half[use], knot_spacing))
         # Half-widths from the steepest edges: the half-peak crossings are shifted by shading.
         # Sections with a rejected edge are left out.
         steep = 0.5 * (gp[sel] - gm[sel])
         two = ~bad[use] if (~bad[use]).sum() >= 8 else np.ones(len(sel), dtype=bool)
-        hw_spacing = 2.0 * spacing(half[use], knot_spacing)
+        hw_spacing = 2.0 * _knot_spacing(half[use], knot_spacing)
         trend = _robust_trend(u_fit[two], steep[two], hw_spacing)
         hw_curve = _Curve(u_fit[two], trend[:, None], hw_spacing)
         hw = hw_curve.spline(np.clip(u_fit, hw_curve.u0, hw_curve.u1))[:, 0]
@@ -416,7 +420,7 @@ def fit_centreline(
     )
 
 
-def spacing(half: np.ndarray, knot_spacing: float | None) -> float:
+def _knot_spacing(half: np.ndarray, knot_spacing: float | None) -> float:
     """Knot spacing of the centreline spline (px): given, or 1.5 half-widths in [6, 40]."""
     return knot_spacing or float(np.clip(1.5 * np.median(half), 6.0, 40.0))
 
