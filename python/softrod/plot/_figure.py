@@ -162,6 +162,17 @@ def nice_number(x: float) -> float:
     return float(10**e)
 
 
+def nice_ceil(x: float) -> float:
+    """The smallest of 1, 2, 2.5 or 5 times a power of ten that is at least ``x`` (> 0)."""
+    if not x > 0 or not np.isfinite(x):
+        return 1.0
+    e = np.floor(np.log10(x))
+    for m in (1.0, 2.0, 2.5, 5.0, 10.0):
+        if m * 10**e >= x * (1 - 1e-12):
+            return float(m * 10**e)
+    return float(10 ** (e + 1))
+
+
 def set_equal_3d(ax, pts: np.ndarray, pad: float = 0.04) -> np.ndarray:
     """Equal-aspect cube limits around ``pts`` (n, 3); returns the limits, shape (3, 2)."""
     pts = np.asarray(pts, dtype=float).reshape(-1, 3)

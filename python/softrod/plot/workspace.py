@@ -73,7 +73,7 @@ def plot_workspace_map(
     actuation=None,
     actuation_labels: Sequence[str] | None = None,
     title: str | None = None,
-    gridsize: int = 36,
+    gridsize: int | None = None,
     size: tuple[float, float] | None = None,
     dpi: float | None = None,
     style=None,
@@ -93,7 +93,7 @@ def plot_workspace_map(
             columns that do not vary are left out.
         actuation_labels: Axis label of each actuation column (default ``"T0 (N)"``, ...).
         title: Figure title (default: the number of configurations and failures).
-        gridsize: Hexagons across a binned panel.
+        gridsize: Hexagons across a binned panel (default: from the number of samples).
         size: Figure size (width, height) in inches.
         dpi: Resolution (dots per inch).
         style: A matplotlib style name or file.
@@ -148,7 +148,16 @@ def plot_workspace_map(
         has_act = bool(cols)
         fig = new_figure(size, (13.5 if has_act else 11, 4.6), dpi)
         n_panels = 3 if has_act else 2
-        spec = fig.add_gridspec(1, n_panels)
+        if mode == "surface":
+            n_panels = 2
+            spec = fig.add_gridspec(1, 2, width_ratios=(1, 1.25))
+        else:
+            spec = fig.add_gridspec(1, n_panels)
+        hexes = (
+            int(np.clip(np.sqrt(max(int(ok.sum()), 1)) / 1.6, 8, 60))
+            if gridsize is None
+            else gridsize
+        )
         panels = []
         mappable = None
         if has_act:
@@ -169,16 +178,26 @@ def plot_workspace_map(
                 ax_a.set_ylabel(actuation_labels[cols[1]])
                 ax_a.set_title("actuation space")
             else:
-                mappable = ax_a.hexbin(
-                    a[:, cols[0]],
-                    a[:, cols[1]],
-                    C=v,
-                    gridsize=gridsize // 2,
-                    cmap=cmap,
-                    norm=norm,
-                    reduce_C_function=np.mean,
-                    mincnt=1,
-                )
+                ua, ia = np.unique(a[:, cols[0]], return_inverse=True)
+                ub, ib = np.unique(a[:, cols[1]], return_inverse=True)
+                if len(ua) <= 200 and len(ub) <= 200:  # a grid: mean over the other actuators
+                    total = np.zeros((len(ub), len(ua)))
+                    count = np.zeros_like(total)
+                    np.add.at(total, (ib, ia), v)
+                    np.add.at(count, (ib, ia), 1.0)
+                    img = np.where(count > 0, total / np.maximum(count, 1), np.nan)
+                    mappable = ax_a.pcolormesh(ua, ub, img, cmap=cmap, norm=norm, shading="nearest")
+                else:
+                    mappable = ax_a.hexbin(
+                        a[:, cols[0]],
+                        a[:, cols[1]],
+                        C=v,
+                        gridsize=hexes,
+                        cmap=cmap,
+                        norm=norm,
+                        reduce_C_function=np.mean,
+                        mincnt=1,
+                    )
                 ax_a.set_ylabel(actuation_labels[cols[1]])
                 others = [actuation_labels[c] for c in cols[2:]]
                 ax_a.set_title(
@@ -188,7 +207,7 @@ def plot_workspace_map(
             ax_a.set_xlabel(actuation_labels[cols[0]])
             ax_a.grid(alpha=0.3)
         if mode == "surface":
-            ax3 = fig.add_subplot(spec[n_panels - 2 :], projection="3d")
+            ax3 = fig.add_subplot(spec[1], projection="3d")
             ua, ub, ia, ib = grid
             shape = (len(ua), len(ub))
             x = np.full(shape, np.nan)
@@ -200,6 +219,8 @@ def plot_workspace_map(
                 x, y, z, facecolors=colors, shade=False, linewidth=0.2, edgecolor=(0, 0, 0, 0.15)
             )
             surf.set_gid("workspace-surface")
+            span = np.array([np.nanmax(q) - np.nanmin(q) for q in (x, y, z)])
+            ax3.set_box_aspect(np.maximum(span, 0.25 * span.max()))  # true proportions
             ax3.set_xlabel("x (mm)")
             ax3.set_ylabel("y (mm)")
             ax3.set_zlabel("z (mm)")
@@ -218,7 +239,7 @@ def plot_workspace_map(
                         p[:, i],
                         p[:, j],
                         C=v,
-                        gridsize=gridsize,
+                        gridsize=hexes,
                         cmap=cmap,
                         norm=norm,
                         reduce_C_function=np.mean,
@@ -229,7 +250,7 @@ def plot_workspace_map(
                 ax.set_xlabel(f"{'xyz'[i]} (mm)")
                 ax.set_ylabel(f"{'xyz'[j]} (mm)")
                 ax.set_aspect("equal", adjustable="datalim")
-                ax.set_title(name + ("" if mode == "curve" else " (hexagons: mean of the tips)"))
+                ax.set_title(name + ("" if mode == "curve" else " (hexagons: mean over tips)"))
                 ax.grid(alpha=0.3)
                 panels.append(ax)
         from matplotlib.cm import ScalarMappable
