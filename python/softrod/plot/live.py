@@ -153,8 +153,29 @@ class LiveView:
         self._check_port(port)
         self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.url = f"http://{host}:{self.server.get_port()}"
+        self._set_camera(first)
+        c0 = float(
+            np.linalg.eigvalsh(0.5 * (self._compliance[:3, :3] + self._compliance[:3, :3].T)).max()
+        )
+        #: Force (N) whose tip displacements the ellipsoid shows (a tenth of the rod length
+        #: along the largest compliance of the first configuration).
+        self.ellipsoid_force = float(_nice(0.1 * length / max(c0, 1e-30)))
         self._build_gui()
         self._render(first, solve_time=0.0)
+
+    def _set_camera(self, sol) -> None:
+        """Looks at the rod from the side its bending plane faces (see ``bending_view``)."""
+        from .views import bending_view
+
+        p = np.asarray(sol.position)
+        centre = 0.5 * (p.min(axis=0) + p.max(axis=0))
+        size = max(float(np.ptp(p, axis=0).max()), float(self._base.rod.length))
+        normal = bending_view(sol).normal
+        self.server.scene.set_up_direction("+z")
+        cam = self.server.initial_camera
+        cam.position = tuple(centre + 2.2 * size * normal)
+        cam.look_at = tuple(centre)
+        cam.up = (0.0, 0.0, 1.0)
 
     # ------------------------------------------------------------------ set-up
 
@@ -433,7 +454,7 @@ class LiveView:
         if not np.all(np.isfinite(c)):
             return
         w, v = np.linalg.eigh(0.5 * (c + c.T))
-        axes = np.clip(w, 0, None) * self.max_force  # displacement (m) under |f| = max_force
+        axes = np.clip(w, 0, None) * self.ellipsoid_force  # tip displacement (m) under |f|
         n = 24
         uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, n + 1), np.linspace(0, np.pi, n // 2 + 1))
         sphere = np.stack((np.cos(uu) * np.sin(vv), np.sin(uu) * np.sin(vv), np.cos(vv)), -1)
@@ -461,7 +482,7 @@ class LiveView:
             np.linalg.eigvalsh(0.5 * (self._compliance[:3, :3] + self._compliance[:3, :3].T)).max()
         )
         lines.append(
-            f"**ellipsoid**: tip displacement under |f| = {self.max_force:.3g} N "
+            f"**ellipsoid**: tip displacements under |f| = {self.ellipsoid_force:.3g} N "
             f"(largest compliance {c:.3g} m/N)"
         )
         return "\n\n".join(lines)
