@@ -14,7 +14,7 @@ import pytest
 import softrod
 
 pytest.importorskip("viser")
-from softrod.plot.live import serve  # noqa: E402
+from softrod.plot.live import serve
 
 NITI = Path(__file__).resolve().parent.parent / "examples" / "robots" / "niti_two_segment.toml"
 #: Budget from the end of a solve to the scene update sent to the browser (s).

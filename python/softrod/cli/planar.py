@@ -95,7 +95,10 @@ def _cmd_demo(args) -> int:
     args.method, args.rtol, args.atol, args.n_points = "closed-form", 1e-8, 1e-10, 201
     args.json, args.csv = False, None
     sols = _solve_all(arm, DEMO_TENSIONS, args)
-    print("softrod demo: seed-000 tapered cable-driven arm, closed form, 201 samples")
+    print(
+        "softrod demo: the tapered cable-driven arm of the planar cable-arm paper, closed form, "
+        "201 samples"
+    )
     print(_describe(arm))
     print(_table(arm, sols))
     ode = arm.solve(DEMO_TENSIONS[-1], method="ode", rtol=1e-10, atol=1e-12)
