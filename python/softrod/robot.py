@@ -374,6 +374,8 @@ def _check_across(
 class Robot:
     """A robot read from a description file: rod, tendons, chambers, loads and solver options.
 
+    SI units throughout (m, N, Pa, rad); tensions in N, pressures in Pa (gauge).
+
     Attributes:
         name: The file's ``name`` (or its file name).
         rod: The rod model.

@@ -73,7 +73,7 @@ class ModelResult:
 
 @dataclass(frozen=True)
 class ModelComparison:
-    """Every model's result for one robot, Cosserat first.
+    """Every model's result for one robot, Cosserat first (SI units: m, rad, s).
 
     Attributes:
         robot: The robot's name.

@@ -5,7 +5,8 @@ Subcommands (one module each family; :func:`build_parser` lists them all):
     solve, compliance, workspace
                          robot description files (:mod:`softrod.cli.robot`);
     materials, fit       the silicone library and tensile-curve fits (:mod:`softrod.cli.materials`);
-    compare, study       models side by side and the compliance study (:mod:`softrod.cli.models`).
+    compare, study       models side by side and the compliance study (:mod:`softrod.cli.models`);
+    view                 the live 3-D view in the browser (:mod:`softrod.cli.view`).
 
 Bad input exits with status 2 and a one-line message naming the parameter; non-convergence
 exits with status 3.
@@ -18,10 +19,10 @@ import sys
 from collections.abc import Sequence
 
 from .._core import ConvergenceError, ParameterError
-from . import materials, models, planar, robot
+from . import materials, models, planar, robot, view
 
 #: The command modules, in the order their subcommands are listed in ``softrod --help``.
-COMMAND_MODULES = (planar, robot, materials, models)
+COMMAND_MODULES = (planar, robot, materials, models, view)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import json
-import sys
 
 from .._core import ParameterError
+from ._common import add_figure_options, figure_options, save_figure
 
 _TERMS_MODELS = ("yeoh", "ogden")
 
@@ -121,9 +121,8 @@ def _cmd_fit(args) -> int:
         matplotlib.use("Agg")
         from ..plot import plot_fit
 
-        fig = plot_fit(curve, fits)
-        fig.savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        fig = plot_fit(curve, fits, **figure_options(args))
+        save_figure(fig, args.plot, args=args)
     return 0
 
 
@@ -170,5 +169,6 @@ def register(sub) -> None:
     fi.add_argument(
         "--stress-unit", default="Pa", help="plain files: Pa (default), kPa, MPa or GPa"
     )
-    fi.add_argument("--plot", metavar="FILE", help="PNG of data, fitted curves and residuals")
+    fi.add_argument("--plot", metavar="FILE", help="figure of data, fitted curves and residuals")
     fi.set_defaults(func=_cmd_fit)
+    add_figure_options(fi, "plot")

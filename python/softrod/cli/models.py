@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import sys
-
-from ._common import _positive_int
+from ._common import _positive_int, add_figure_options, figure_options, save_figure
 
 
 def _cmd_study(args) -> int:
@@ -26,8 +24,7 @@ def _cmd_compare(args) -> int:
         matplotlib.use("Agg")
         from ..plot import plot_models
 
-        plot_models(comp).savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        save_figure(plot_models(comp, **figure_options(args)), args.plot, args=args)
     return 0
 
 
@@ -38,7 +35,7 @@ def register(sub) -> None:
     )
     cm.add_argument("robot", metavar="ROBOT.toml", help="robot description file (TOML)")
     cm.add_argument("--tensions", type=float, nargs="+", help="override the tendon tensions (N)")
-    cm.add_argument("--plot", metavar="FILE", help="PNG of the overlaid backbones")
+    cm.add_argument("--plot", metavar="FILE", help="figure of the overlaid backbones")
     cm.add_argument(
         "--repeats",
         type=_positive_int,
@@ -46,10 +43,11 @@ def register(sub) -> None:
         help="timed solves per model, median reported (default: %(default)s)",
     )
     cm.set_defaults(func=_cmd_compare)
+    add_figure_options(cm, "plot")
     st = sub.add_parser(
         "study",
-        help="seed 001's study: workspace stiffness map and gamma_c vs pressure, "
-        "hyperelastic vs linear",
+        help="the configuration-based compliance study: workspace stiffness map and gamma_c "
+        "vs pressure, hyperelastic vs linear",
     )
     st.add_argument(
         "robot",

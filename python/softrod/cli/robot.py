@@ -8,7 +8,8 @@ import sys
 import numpy as np
 
 from .._core import ParameterError
-from ._common import _fmt6, _positive_int
+from ..plot._figure import fmt_vector
+from ._common import _fmt6, _positive_int, add_figure_options, figure_options, save_figure
 
 
 def _cmd_solve(args) -> int:
@@ -52,11 +53,10 @@ def _cmd_solve(args) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..plot import plot_rod
+        from ..plot import plot_robot
 
-        fig = plot_rod(sol, title=f"{robot.name}: tip at {np.round(p * 1e3, 2)} mm")
-        fig.savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        fig = plot_robot(robot, sol, projections=args.projections, **figure_options(args))
+        save_figure(fig, args.plot, args=args)
     return 0
 
 
@@ -69,7 +69,8 @@ def _cmd_compliance(args) -> int:
         robot = robot.with_tensions(args.tensions)
     sol = robot.solve()
     comp = compliance(sol)
-    print(f"robot: {robot.name} ({args.robot}); tip at {np.round(sol.tip_position * 1e3, 3)} mm")
+    tip = fmt_vector(sol.tip_position, scale=1e3, unit="mm", digits=6)
+    print(f"robot: {robot.name} ({args.robot}); tip at {tip}")
     print("twist [dp; dtheta] = C [f; m], wrench applied at the tip (SI units)")
     print("integrated tip compliance, world frame (seed eq. 6):")
     print(_fmt6(comp.tip_world))
@@ -94,15 +95,22 @@ def _cmd_compliance(args) -> int:
         from ..plot import plot_compliance_ellipsoids, plot_gamma_c
 
         if args.plot:
-            plot_compliance_ellipsoids(
-                sol, comp, title=f"{robot.name}: translational compliance"
-            ).savefig(args.plot, dpi=130)
-            print(f"wrote {args.plot}", file=sys.stderr)
-        if args.gamma_plot:
-            plot_gamma_c(comp, title=f"{robot.name}: dimensionless flexural compliance").savefig(
-                args.gamma_plot, dpi=130
+            fig = plot_compliance_ellipsoids(
+                sol,
+                comp,
+                s=args.at,
+                robot=robot,
+                title=f"{robot.name}: translational compliance",
+                **figure_options(args),
             )
-            print(f"wrote {args.gamma_plot}", file=sys.stderr)
+            save_figure(fig, args.plot, args=args)
+        if args.gamma_plot:
+            fig = plot_gamma_c(
+                comp,
+                title=f"{robot.name}: dimensionless flexural compliance",
+                **figure_options(args),
+            )
+            save_figure(fig, args.gamma_plot, args=args)
     return 0
 
 
@@ -167,10 +175,13 @@ def _cmd_workspace(args) -> int:
             if args.tangent
             else "max_translational_compliance"
         )
-        plot_workspace_map(
-            wmap, measure=measure, title=f"{robot.name}: {len(grid)} configurations"
-        ).savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        fig = plot_workspace_map(
+            wmap,
+            measure=measure,
+            title=f"{robot.name}: {len(grid)} configurations",
+            **figure_options(args),
+        )
+        save_figure(fig, args.plot, args=args)
     return 0
 
 
@@ -185,18 +196,32 @@ def register(sub) -> None:
         metavar="T",
         help="override the tendon tensions (N), one per tendon",
     )
-    so.add_argument("--plot", metavar="FILE", help="PNG of the 3-D backbone")
+    so.add_argument(
+        "--plot", metavar="FILE", help="figure of the robot: tube, tendons, disks, chambers"
+    )
+    so.add_argument(
+        "--projections", action="store_true", help="add the top, front and side projections"
+    )
     so.add_argument("--csv", metavar="FILE", help="write the solution samples to CSV")
     so.add_argument("--json", metavar="FILE", help="write the solution to JSON")
     so.set_defaults(func=_cmd_solve)
+    add_figure_options(so, "plot")
     co = sub.add_parser(
         "compliance", help="tip compliance/stiffness of a robot file (integrated and tangent)"
     )
     co.add_argument("robot", help="robot description file (TOML)")
     co.add_argument("--tensions", type=float, nargs="+", help="override the tendon tensions (N)")
-    co.add_argument("--plot", metavar="FILE", help="PNG of compliance ellipsoids along the arm")
-    co.add_argument("--gamma-plot", metavar="FILE", help="PNG of gamma_c(s) per body axis")
+    co.add_argument("--plot", metavar="FILE", help="figure of compliance ellipsoids along the arm")
+    co.add_argument(
+        "--at",
+        type=float,
+        nargs="+",
+        metavar="S",
+        help="arc lengths (m) of the ellipsoids (default: six nodes along the arm)",
+    )
+    co.add_argument("--gamma-plot", metavar="FILE", help="figure of gamma_c(s) per body axis")
     co.set_defaults(func=_cmd_compliance)
+    add_figure_options(co, "plot", "gamma_plot")
     ws = sub.add_parser("workspace", help="workspace map: sweep tensions, tip stiffness measures")
     ws.add_argument("robot", help="robot description file (TOML)")
     ws.add_argument(
@@ -207,7 +232,7 @@ def register(sub) -> None:
         help="tendon index and largest tension (N), swept from 0; once or twice",
     )
     ws.add_argument("--n", type=_positive_int, default=100, help="grid points per swept tendon")
-    ws.add_argument("--plot", metavar="FILE", help="PNG of the map")
+    ws.add_argument("--plot", metavar="FILE", help="figure of the map beside the tension space")
     ws.add_argument("--progress", action="store_true", help="progress bar on stderr")
     ws.add_argument(
         "--tangent",
@@ -215,3 +240,4 @@ def register(sub) -> None:
         help="also the exact tangent compliance (tendons at fixed tension or length)",
     )
     ws.set_defaults(func=_cmd_workspace)
+    add_figure_options(ws, "plot")
