@@ -109,7 +109,7 @@ def test_cli_compliance_and_workspace(tmp_path, capsys):
     args = ["workspace", ROBOT, "--sweep", "0:4", "--sweep", "4:2", "--n", "6"]
     assert main([*args, "--plot", str(wsp), "--progress", "--tangent", "length"]) == 0
     cap = capsys.readouterr()
-    assert "36 configurations" in cap.out and "workspace [" in cap.err
+    assert "36 configurations" in cap.out and "workspace:" in cap.err and "36/36" in cap.err
     assert "tangent, tendons at fixed length" in cap.out
     assert wsp.stat().st_size > 10_000
     assert main(["workspace", ROBOT, "--sweep", "9:4"]) == 2

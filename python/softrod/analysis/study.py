@@ -74,13 +74,24 @@ def _pair_pressures(p: tuple[float, float, float]) -> list[float]:
     return [p[0], p[0], p[1], p[1], p[2], p[2]]
 
 
-def _run(robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray) -> StudyResult:
+def _run(
+    robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray, progress: bool | None
+) -> StudyResult:
     from .. import compliance, eigenscrews
 
     grid = np.array(list(itertools.product(levels, repeat=3)))
     tips = np.full((len(grid), 3), np.nan)
     cmax = np.full(len(grid), np.nan)
-    for i, p in enumerate(grid):
+    from tqdm.auto import tqdm
+
+    bar = tqdm(
+        grid,
+        desc=f"study ({material})",
+        unit="config",
+        disable=None if progress is None else not progress,
+        file=sys.stderr,
+    )
+    for i, p in enumerate(bar):
         try:
             sol = robot.with_pressures(_pair_pressures(tuple(p))).solve()
         except (ConvergenceError, ParameterError):
@@ -118,6 +129,7 @@ def seed001_study(
     gamma_pressures: tuple[float, ...] = (0.0, 10e3, 20e3, 30e3, 40e3),
     out_dir: str | os.PathLike[str] | None = None,
     log: TextIO | Literal["stdout"] | None = "stdout",
+    progress: bool | None = False,
 ) -> dict[str, StudyResult]:
     """Runs seed 001's study on a three-chamber-pair robot, hyperelastic and linear.
 
@@ -130,6 +142,8 @@ def seed001_study(
         gamma_pressures: P1 = P2 pressures (Pa) of the ``gamma_c(s)`` curves.
         out_dir: Folder for the figures (``seed001_workspace_<material>.png``,
             ``seed001_gamma_c_<material>.png``); ``None`` draws nothing.
+        progress: Progress bars (tqdm) on stderr: True, False, or None for only when stderr
+            is a terminal.
         log: Where the summary is printed: ``"stdout"`` (the current ``sys.stdout``, the
             default), an open text file, or ``None`` (silent).
 
@@ -159,7 +173,7 @@ def seed001_study(
     out: dict[str, StudyResult] = {}
     for material, rb in models.items():
         t0 = time.perf_counter()
-        res = _run(rb, material, grid, np.asarray(gamma_pressures))
+        res = _run(rb, material, grid, np.asarray(gamma_pressures), progress)
         out[material] = res
         if log is not None:
             print(

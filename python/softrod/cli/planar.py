@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 
 from .._core import PlanarCableArm, PlanarSolution
-from ._common import _positive_int
+from ._common import _positive_int, files
 
 SEED = PlanarCableArm.seed_arm()
 DEMO_TENSIONS = (0.5, 1.0, 2.0, 3.0, 4.0)
@@ -118,6 +118,7 @@ def register(sub) -> None:
         metavar="FILE",
         help="PNG of backbones and profiles (default: %(default)s)",
     )
+    files(d, outputs=("plot",), figures=("plot",))
     d.set_defaults(func=_cmd_demo)
     pl = sub.add_parser("planar", help="planar tapered cable-driven arm (seed 000)")
     pl.add_argument("--length", type=float, default=SEED.length, help="arm length L (m)")
@@ -149,10 +150,16 @@ def register(sub) -> None:
         default=201,
         help="arc-length samples (default: %(default)s)",
     )
-    pl.add_argument("--method", choices=("closed-form", "ode"), default="closed-form")
+    pl.add_argument(
+        "--method",
+        choices=("closed-form", "ode"),
+        default="closed-form",
+        help="closed form (default) or the published final-value ODE",
+    )
     pl.add_argument("--rtol", type=float, default=1e-8, help="ODE relative tolerance")
     pl.add_argument("--atol", type=float, default=1e-10, help="ODE absolute tolerance (1/m)")
-    pl.add_argument("--plot", metavar="FILE", help="PNG of backbones and profiles")
+    pl.add_argument("--plot", metavar="FILE", help="figure of backbones and profiles")
     pl.add_argument("--csv", metavar="FILE", help="write all samples to CSV")
     pl.add_argument("--json", action="store_true", help="print arm and samples as JSON")
+    files(pl, outputs=("csv", "plot"), figures=("plot",))
     pl.set_defaults(func=_cmd_planar)
