@@ -1,7 +1,5 @@
 """softrod.compare_models and `softrod compare`: the call, the table, exit codes, the plot."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -9,7 +7,7 @@ import softrod
 from softrod.cli import main
 from softrod.plot import plot_models
 
-ROBOTS = Path(__file__).resolve().parent.parent / "examples" / "robots"
+ROBOTS = softrod.examples.ROBOTS
 NITI = ROBOTS / "niti_two_segment.toml"
 SEED000 = ROBOTS / "seed000_arm.toml"
 

@@ -10,7 +10,7 @@ import pytest
 import softrod
 from softrod.cli import main
 
-ROBOT = "examples/robots/niti_two_segment.toml"
+ROBOT = str(softrod.examples.path("niti_two_segment"))
 
 
 @pytest.fixture(scope="module")
@@ -119,11 +119,8 @@ def test_fixed_length_tangent_matches_a_finite_difference_with_held_lengths():
     """Independent check of tendons held at fixed length: perturb the tip force, re-solve the
     tensions of the held tendons (0 and 4) so that their path lengths stay put, and difference
     the tip position; the linearised BVP must give the same translational block."""
-    from pathlib import Path
 
-    robot = softrod.load_robot(
-        Path(__file__).resolve().parent.parent / "examples/robots/niti_two_segment.toml"
-    )
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
     held = [0, 4]
     tight = dict(integrator="adaptive", rtol=1e-12, atol=1e-14)
     tens0 = np.array([t.tension for t in robot.tendons])
