@@ -193,8 +193,6 @@ def _cmd_workspace(args) -> int:
     if args.n < 1:
         raise bad("--n", args.n, "must be >= 1")
     robot = load_actuated(args)
-    if len(robot.tendons) == 0:
-        raise bad("ROBOT", args.robot, "has no tendons to sweep")
     if robot.chambers:
         raise bad(
             "ROBOT",
@@ -202,6 +200,8 @@ def _cmd_workspace(args) -> int:
             "has chambers, which workspace maps do not model yet (sweep tensions of a "
             "tendon-only robot, or use `softrod study` for pressures)",
         )
+    if len(robot.tendons) == 0:
+        raise bad("ROBOT", args.robot, "has no tendons to sweep")
     axes = _sweep_axes(args.sweep, len(robot.tendons), args.n)
     grid = tension_grid(len(robot.tendons), axes)
     opts = {
