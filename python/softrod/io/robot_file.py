@@ -16,6 +16,7 @@ are checked once the fields are valid, with the same kind of errors.
 from __future__ import annotations
 
 import difflib
+import math
 import os
 import sys
 import typing
@@ -481,8 +482,25 @@ class FieldError:
         return f"{where}: {self.message}"
 
 
+def _toml_text(value: Any) -> str:
+    """A value as it reads in a TOML file (``true``, ``"2"``, ``inf``, ``[1.0, 2.0]``)."""
+    import json
+
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_text(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return "{ " + ", ".join(f"{k} = {_toml_text(v)}" for k, v in value.items()) + " }"
+    return repr(value)
+
+
 def _short(value: Any, limit: int = 60) -> str:
-    text = repr(value)
+    text = _toml_text(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
@@ -501,14 +519,14 @@ def raise_errors(errors: Sequence[FieldError], source: str | None = None) -> typ
     """Raises one :class:`ParameterError` carrying every error (``errors``), the first
     location (``parameter``) and the file (``source``)."""
     errors = list(errors)
-    where = f" in {source!r}" if source else ""
+    head = f"{source}: " if source else ""
     if len(errors) == 1 and not errors[0].location:
-        text = f"invalid robot file{f' {source!r}' if source else ''}: {errors[0].message}"
+        text = f"{head}invalid robot file: {errors[0].message}"
     elif len(errors) == 1:
-        text = f"invalid field {errors[0]}{where}"
+        text = f"{head}invalid field {errors[0]}"
     else:
         lines = "\n".join(f"  {e}" for e in errors)
-        text = f"{len(errors)} invalid fields{where}:\n{lines}"
+        text = f"{head}{len(errors)} invalid fields:\n{lines}"
     exc = ParameterError(text)
     exc.errors = errors
     exc.parameter = errors[0].location if errors else ""
