@@ -186,17 +186,23 @@ def test_compliance_without_tendons_prints_one_tangent(tmp_path, capsys):
     assert "no tendons" in out and "fixed length" not in out
 
 
-def test_compliance_computes_everything_before_printing(tmp_path, capsys):
-    # Ten tendons: the tangent at fixed length may be refused by the core; then nothing is
-    # printed, not half a report.
+def _ten_tendons(tmp_path, tension):
     rows = "".join(
-        f"[[tendons]]\ndistance = 0.0005\nangle_deg = {36 * i}\ntension = 0.1\n" for i in range(10)
+        f"[[tendons]]\ndistance = 0.0005\nangle_deg = {36 * i}\ntension = {tension}\n"
+        for i in range(10)
     )
     f = tmp_path / "ten.toml"
     f.write_text(
         "[rod]\nlength = 0.3\n[rod.section]\nradius = 0.001\n[rod.material]\n"
         "youngs_modulus = 1e9\npoisson_ratio = 0.4\n" + rows
     )
+    return f
+
+
+def test_compliance_computes_everything_before_printing(tmp_path, capsys):
+    # Ten tendons: the tangent at fixed length may be refused by the core; then nothing is
+    # printed, not half a report.
+    f = _ten_tendons(tmp_path, 0.1)
     status, out, err = _run(["compliance", f], capsys)
     if status != 0:
         assert status in (2, 3) and out == ""
@@ -206,14 +212,7 @@ def test_compliance_computes_everything_before_printing(tmp_path, capsys):
 
 
 def test_workspace_refuses_an_all_nan_map(tmp_path, capsys):
-    rows = "".join(
-        f"[[tendons]]\ndistance = 0.0005\nangle_deg = {36 * i}\ntension = 0.0\n" for i in range(10)
-    )
-    f = tmp_path / "ten.toml"
-    f.write_text(
-        "[rod]\nlength = 0.3\n[rod.section]\nradius = 0.001\n[rod.material]\n"
-        "youngs_modulus = 1e9\npoisson_ratio = 0.4\n" + rows
-    )
+    f = _ten_tendons(tmp_path, 0.0)
     png = tmp_path / "map.png"
     argv = ["workspace", f, "--sweep", "0:1", "--n", "3", "--tangent", "length", "--plot", png]
     status, out, err = _run(argv, capsys)

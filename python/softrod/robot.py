@@ -256,15 +256,7 @@ class Robot:
                 Python callable, or properties the model objects do not expose yet).
         """
         if self._spec is None:
-            spec = _objects.describe(
-                self._rod,
-                self._tendons,
-                self._chambers,
-                self._loads if self._loads_given else None,
-                self._solver,
-                self._name,
-                self._description,
-            )
+            spec = _objects.describe(*self._parts())
             object.__setattr__(self, "_spec", spec)
         return self._spec
 
@@ -323,29 +315,25 @@ class Robot:
             object.__setattr__(new, k, v)
         return new
 
-    def with_tensions(self, tensions: Sequence[float] | np.ndarray) -> Robot:
-        """The same robot with new tendon tensions (N), one per tendon."""
-        tendons = self._tensioned(tensions)
+    def _with_actuation(self, field: str, key: str, items: tuple) -> Robot:
+        """A copy with new tendons or chambers, their tensions or pressures also written into
+        the description (when there is one)."""
         spec = self._spec
         if spec is not None:
             tables = [
-                t.model_copy(update={"tension": float(new.tension)})
-                for t, new in zip(spec.tendons, tendons, strict=True)
+                t.model_copy(update={key: float(getattr(new, key))})
+                for t, new in zip(getattr(spec, field), items, strict=True)
             ]
-            spec = spec.model_copy(update={"tendons": tables})
-        return self._replace(tendons=tendons, spec=spec)
+            spec = spec.model_copy(update={field: tables})
+        return self._replace(**{field: items, "spec": spec})
+
+    def with_tensions(self, tensions: Sequence[float] | np.ndarray) -> Robot:
+        """The same robot with new tendon tensions (N), one per tendon."""
+        return self._with_actuation("tendons", "tension", self._tensioned(tensions))
 
     def with_pressures(self, pressures: Sequence[float] | np.ndarray) -> Robot:
         """The same robot with new chamber pressures (Pa, gauge), one per chamber."""
-        chambers = self._pressurised(pressures)
-        spec = self._spec
-        if spec is not None:
-            tables = [
-                c.model_copy(update={"pressure": float(new.pressure)})
-                for c, new in zip(spec.chambers, chambers, strict=True)
-            ]
-            spec = spec.model_copy(update={"chambers": tables})
-        return self._replace(chambers=chambers, spec=spec)
+        return self._with_actuation("chambers", "pressure", self._pressurised(pressures))
 
     # ------------------------------------------------------------------ design parameters
 
@@ -477,18 +465,24 @@ class Robot:
             f"chambers={len(self._chambers)})"
         )
 
-    def __reduce__(self):
-        if self._spec is not None:
-            return (_from_pickled_spec, (self._spec,))
-        parts = (
+    def _parts(self) -> tuple:
+        """The constructor arguments: rod, tendons, chambers, loads, solver, name,
+        description."""
+        loads = self._loads if self._loads_given else None
+        return (
             self._rod,
             self._tendons,
             self._chambers,
-            self._loads if self._loads_given else None,
+            loads,
             self._solver,
             self._name,
             self._description,
         )
+
+    def __reduce__(self):
+        if self._spec is not None:
+            return (_from_pickled_spec, (self._spec,))
+        parts = self._parts()
         try:
             pickle.dumps(parts)
         except (TypeError, pickle.PicklingError, AttributeError):
