@@ -7,7 +7,7 @@ file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`s
 and the ``softrod`` command line (:mod:`softrod.cli`).
 """
 
-from . import pcc
+from . import examples, pcc
 from ._core import (
     SILICONES,
     Chamber,
@@ -106,6 +106,7 @@ __all__ = [
     "compare_models",
     "compliance",
     "eigenscrews",
+    "examples",
     "fit_uniaxial",
     "load_robot",
     "pcc",

@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 
 from .._core import PlanarCableArm, PlanarSolution
-from ._common import _positive_int, add_figure_options, figure_options, save_figure
+from ._common import _positive_int, add_figure_options, figure_options, files, save_figure
 
 SEED = PlanarCableArm.seed_arm()
 DEMO_TENSIONS = (0.5, 1.0, 2.0, 3.0, 4.0)
@@ -122,6 +122,7 @@ def register(sub) -> None:
         metavar="FILE",
         help="figure of backbones and profiles (default: %(default)s)",
     )
+    files(d, outputs=("plot",), figures=("plot",))
     d.set_defaults(func=_cmd_demo)
     add_figure_options(d, "plot")
     pl = sub.add_parser(
@@ -156,11 +157,17 @@ def register(sub) -> None:
         default=201,
         help="arc-length samples (default: %(default)s)",
     )
-    pl.add_argument("--method", choices=("closed-form", "ode"), default="closed-form")
+    pl.add_argument(
+        "--method",
+        choices=("closed-form", "ode"),
+        default="closed-form",
+        help="closed form (default) or the published final-value ODE",
+    )
     pl.add_argument("--rtol", type=float, default=1e-8, help="ODE relative tolerance")
     pl.add_argument("--atol", type=float, default=1e-10, help="ODE absolute tolerance (1/m)")
     pl.add_argument("--plot", metavar="FILE", help="figure of backbones and profiles")
     pl.add_argument("--csv", metavar="FILE", help="write all samples to CSV")
     pl.add_argument("--json", action="store_true", help="print arm and samples as JSON")
+    files(pl, outputs=("csv", "plot"), figures=("plot",))
     pl.set_defaults(func=_cmd_planar)
     add_figure_options(pl, "plot")
