@@ -8,7 +8,7 @@ backbones from photographs (:mod:`softrod.vision`) and the ``softrod`` command l
 (:mod:`softrod.cli`).
 """
 
-from . import pcc, vision
+from . import examples, pcc, vision
 from ._core import (
     SILICONES,
     Chamber,
@@ -110,6 +110,7 @@ __all__ = [
     "compare_models",
     "compliance",
     "eigenscrews",
+    "examples",
     "extract_backbone",
     "fit_uniaxial",
     "load_robot",

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import json
-import sys
 
 from .._core import ParameterError
+from ._common import add_figure_options, figure_options, files, save_figure
 
 _TERMS_MODELS = ("yeoh", "ogden")
 
@@ -70,7 +70,9 @@ def _cmd_materials(args) -> int:
 def _cmd_fit(args) -> int:
     from pathlib import Path
 
-    from ..analysis.materials import _bad, read_tensile_csv
+    from .._core import ConvergenceError
+    from ..analysis.materials import _bad, check_fit, read_tensile_csv
+    from . import one_line
 
     if not Path(args.file).is_file():
         raise _bad("FILE", repr(args.file), "an existing file")
@@ -91,18 +93,27 @@ def _cmd_fit(args) -> int:
         )
     print(
         f"data: {args.file}: {len(curve)} points, {curve.strain_measure} strain, "
-        f"{curve.stress_measure} stress, stretch {stretch.min():.4g} to {stretch.max():.4g}"
+        f"{curve.stress_measure} stress, stretch {stretch.min():.4g} to {stretch.max():.4g}, "
+        f"initial slope {curve.initial_slope() / 1e3:.4g} kPa"
     )
-    fits = []
+    fits, rows = [], []
     for model in args.model:
         key = model.lower().replace("_", "-")
         terms = args.terms if (len(args.model) == 1 or key in _TERMS_MODELS) else None
-        fit = curve.fit(
-            model, terms=terms, nonnegative=args.nonnegative, stretch_range=stretch_range
-        )
+        try:
+            fit = curve.fit(
+                model, terms=terms, nonnegative=args.nonnegative, stretch_range=stretch_range
+            )
+        except (ParameterError, ConvergenceError) as exc:
+            if len(args.model) == 1:
+                raise
+            print(f"\n{model}: fit failed: {one_line(exc)}")
+            rows.append({"model": model, "ok": False, "error": one_line(exc)})
+            continue
         fits.append(fit)
         law = fit.model
         lo, hi = fit.stretch_range
+        check = check_fit(curve, fit)
         print(f"\n{law.model_name}: {_fmt_parameters(fit.parameters)}")
         print(f"  small-strain modulus E0 = {law.small_strain_modulus:.6g} Pa")
         print(f"  fitted points: {fit.points}, stretch {lo:.4g} to {hi:.4g}")
@@ -112,25 +123,85 @@ def _cmd_fit(args) -> int:
         )
         try:
             law.check_stable(lo, hi)
+            stable = True
             print("  stable on the fitted range (dP/dstretch > 0): yes")
         except ParameterError as exc:
-            print(f"  stable on the fitted range (dP/dstretch > 0): no ({exc})")
+            stable = False
+            print(f"  stable on the fitted range (dP/dstretch > 0): no ({one_line(exc)})")
+        print(f"  {check.summary()}")
+        rows.append(
+            {
+                "model": law.model_name,
+                "ok": True,
+                "parameters": fit.parameters,
+                "small_strain_modulus": law.small_strain_modulus,
+                "initial_slope": check.initial_slope,
+                "modulus_ratio": check.modulus_ratio,
+                "stable": stable,
+                "tangent_positive": check.tangent_positive,
+                "plausible": check.plausible,
+                "rms": fit.rms,
+                "r_squared": fit.r_squared,
+                "max_abs_residual": fit.max_abs_residual,
+                "points": fit.points,
+                "stretch_range": [lo, hi],
+            }
+        )
+    if not fits:
+        raise ParameterError(f"no model could be fitted to {args.file} (see the lines above)")
+    if args.csv:
+        from ._common import write_csv
+
+        header = [
+            "model",
+            "ok",
+            "small_strain_modulus",
+            "initial_slope",
+            "modulus_ratio",
+            "plausible",
+            "stable",
+            "rms",
+            "r_squared",
+            "parameters",
+            "error",
+        ]
+        write_csv(
+            args.csv,
+            header,
+            [
+                [
+                    r["model"],
+                    int(r["ok"]),
+                    *(r.get(k, "") for k in header[2:5]),
+                    int(r.get("plausible", False)),
+                    int(r.get("stable", False)),
+                    r.get("rms", ""),
+                    r.get("r_squared", ""),
+                    json.dumps(r.get("parameters", {})),
+                    r.get("error", ""),
+                ]
+                for r in rows
+            ],
+        )
+    if args.json:
+        from ._common import write_json
+
+        write_json(args.json, {"data": str(args.file), "fits": rows})
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
         from ..plot import plot_fit
 
-        fig = plot_fit(curve, fits)
-        fig.savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        fig = plot_fit(curve, fits, **figure_options(args))
+        save_figure(fig, args.plot, args=args)
     return 0
 
 
 def register(sub) -> None:
     """Adds the subcommands of this module to the ``softrod`` parser."""
     ma = sub.add_parser("materials", help="the silicone library: parameters and sources")
-    ma.add_argument("--json", action="store_true", help="print the library as JSON")
+    ma.add_argument("--json", action="store_true", help="print the library as JSON on stdout")
     ma.set_defaults(func=_cmd_materials)
     fi = sub.add_parser("fit", help="fit material laws to a uniaxial tensile curve (CSV)")
     fi.add_argument(
@@ -170,5 +241,9 @@ def register(sub) -> None:
     fi.add_argument(
         "--stress-unit", default="Pa", help="plain files: Pa (default), kPa, MPa or GPa"
     )
-    fi.add_argument("--plot", metavar="FILE", help="PNG of data, fitted curves and residuals")
+    fi.add_argument("--plot", metavar="FILE", help="figure of data, fitted curves and residuals")
+    fi.add_argument("--csv", metavar="FILE", help="write one row per model to CSV")
+    fi.add_argument("--json", metavar="FILE", help="write every fit to JSON")
+    files(fi, inputs=("file",), outputs=("csv", "json", "plot"), figures=("plot",))
     fi.set_defaults(func=_cmd_fit)
+    add_figure_options(fi, "plot")

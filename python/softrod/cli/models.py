@@ -2,32 +2,105 @@
 
 from __future__ import annotations
 
-import sys
+import numpy as np
 
-from ._common import _positive_int
+from ._common import (
+    _positive_int,
+    add_actuation,
+    add_data_outputs,
+    add_figure_options,
+    bad,
+    figure_options,
+    files,
+    finite_float,
+    load_actuated,
+    save_figure,
+    use_agg,
+    write_csv,
+    write_json,
+)
 
 
 def _cmd_study(args) -> int:
     from ..analysis.study import seed001_study
+    from ..robot import load_robot
 
-    seed001_study(args.robot, levels=args.levels, max_pressure=args.max_pressure, out_dir=args.out)
+    if args.levels < 2:
+        raise bad("--levels", args.levels, "must be >= 2")
+    robot = load_robot(args.robot)
+    results = seed001_study(
+        robot,
+        levels=args.levels,
+        max_pressure=args.max_pressure,
+        out_dir=args.out,
+        progress=True if args.progress else None,
+    )
+    if args.csv:
+        header = ["material", "p1", "p2", "p3", "x", "y", "z", "max_translational_compliance"]
+        rows = [
+            [material, *map(float, p), *map(float, tip), float(c)]
+            for material, res in results.items()
+            for p, tip, c in zip(res.pressures, res.tip_position, res.max_compliance, strict=True)
+        ]
+        write_csv(args.csv, header, rows)
+    if args.json:
+        write_json(
+            args.json,
+            {
+                material: {
+                    "pressures": res.pressures,
+                    "tip_position": res.tip_position,
+                    "max_translational_compliance": res.max_compliance,
+                    "centre_periphery_ratio": res.centre_periphery_ratio,
+                    "gamma_c_pressures": res.gamma_c_pressures,
+                    "gamma_c_tip": res.gamma_c_tip,
+                    "elongation": res.elongation,
+                }
+                for material, res in results.items()
+            },
+        )
     return 0
 
 
 def _cmd_compare(args) -> int:
     from ..analysis.models import compare_models
 
-    comp = compare_models(args.robot, tensions=args.tensions, repeats=args.repeats)
+    robot = load_actuated(args)
+    comp = compare_models(robot, repeats=args.repeats)
     print(f"robot: {comp.robot} ({args.robot}); differences relative to Cosserat")
     print(comp.table())
+    fields = ("tip_error", "angle_error", "backbone_max", "backbone_mean", "solve_time")
+    if args.csv:
+        header = ["model", "applies", "tip_x", "tip_y", "tip_z", *fields, "note"]
+        rows = []
+        for r in comp.results:
+            tip = r.tip_position if r.tip_position is not None else np.full(3, np.nan)
+            values = [float(getattr(r, f)) for f in fields]
+            rows.append([r.model, int(r.applies), *map(float, tip), *values, r.note])
+        write_csv(args.csv, header, rows)
+    if args.json:
+        write_json(
+            args.json,
+            {
+                "robot": comp.robot,
+                "models": [
+                    {
+                        "model": r.model,
+                        "applies": r.applies,
+                        "note": r.note,
+                        "tip_position": r.tip_position,
+                        "positions": r.positions,
+                        **{f: getattr(r, f) for f in fields},
+                    }
+                    for r in comp.results
+                ],
+            },
+        )
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
+        use_agg()
         from ..plot import plot_models
 
-        plot_models(comp).savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        save_figure(plot_models(comp, **figure_options(args)), args.plot, args=args)
     return 0
 
 
@@ -36,27 +109,32 @@ def register(sub) -> None:
     cm = sub.add_parser(
         "compare", help="solve a robot file with every applicable model (Cosserat, PCC, planar)"
     )
-    cm.add_argument("robot", metavar="ROBOT.toml", help="robot description file (TOML)")
-    cm.add_argument("--tensions", type=float, nargs="+", help="override the tendon tensions (N)")
-    cm.add_argument("--plot", metavar="FILE", help="PNG of the overlaid backbones")
+    cm.add_argument(
+        "robot", metavar="ROBOT", help="robot description file (TOML) or a shipped example's name"
+    )
+    add_actuation(cm)
+    cm.add_argument("--plot", metavar="FILE", help="figure of the overlaid backbones")
     cm.add_argument(
         "--repeats",
         type=_positive_int,
         default=5,
         help="timed solves per model, median reported (default: %(default)s)",
     )
+    add_data_outputs(cm, "one row per model (tip, differences, time)")
+    files(cm, inputs=("robot",), outputs=("csv", "json", "plot"), figures=("plot",))
     cm.set_defaults(func=_cmd_compare)
+    add_figure_options(cm, "plot")
     st = sub.add_parser(
         "study",
-        help="seed 001's study: workspace stiffness map and gamma_c vs pressure, "
-        "hyperelastic vs linear",
+        help="the configuration-based compliance study: workspace stiffness map and gamma_c "
+        "vs pressure, hyperelastic vs linear",
     )
     st.add_argument(
         "robot",
         nargs="?",
-        default="examples/robots/seed001_pneumatic_arm.toml",
-        metavar="ROBOT.toml",
-        help="robot with three chamber pairs (default: %(default)s)",
+        default="seed001_pneumatic_arm",
+        metavar="ROBOT",
+        help="robot with three chamber pairs, a file or a shipped example (default: %(default)s)",
     )
     st.add_argument(
         "--levels",
@@ -66,7 +144,7 @@ def register(sub) -> None:
     )
     st.add_argument(
         "--max-pressure",
-        type=float,
+        type=finite_float,
         default=60e3,
         help="largest pair pressure, Pa (default: %(default)s)",
     )
@@ -76,4 +154,11 @@ def register(sub) -> None:
         metavar="DIR",
         help="folder for the figures (default: %(default)s)",
     )
+    st.add_argument(
+        "--progress",
+        action="store_true",
+        help="progress bar on stderr (default: only when stderr is a terminal)",
+    )
+    add_data_outputs(st, "every pressure set of both materials (pressures, tip, compliance)")
+    files(st, inputs=("robot",), outputs=("csv", "json", "out"))
     st.set_defaults(func=_cmd_study)

@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 
 from .._core import PlanarCableArm, PlanarSolution
-from ._common import _positive_int
+from ._common import _positive_int, add_figure_options, figure_options, files, save_figure
 
 SEED = PlanarCableArm.seed_arm()
 DEMO_TENSIONS = (0.5, 1.0, 2.0, 3.0, 4.0)
@@ -58,9 +58,8 @@ def _write_outputs(arm, sols, args) -> None:
         matplotlib.use("Agg")
         from ..plot import plot_planar
 
-        fig = plot_planar(arm, sols)
-        fig.savefig(args.plot, dpi=130)
-        print(f"wrote {args.plot}", file=sys.stderr)
+        fig = plot_planar(arm, sols, **figure_options(args))
+        save_figure(fig, args.plot, args=args)
 
 
 def _arm_dict(arm: PlanarCableArm) -> dict[str, float]:
@@ -96,7 +95,10 @@ def _cmd_demo(args) -> int:
     args.method, args.rtol, args.atol, args.n_points = "closed-form", 1e-8, 1e-10, 201
     args.json, args.csv = False, None
     sols = _solve_all(arm, DEMO_TENSIONS, args)
-    print("softrod demo: seed-000 tapered cable-driven arm, closed form, 201 samples")
+    print(
+        "softrod demo: the tapered cable-driven arm of the planar cable-arm paper, closed form, "
+        "201 samples"
+    )
     print(_describe(arm))
     print(_table(arm, sols))
     ode = arm.solve(DEMO_TENSIONS[-1], method="ode", rtol=1e-10, atol=1e-12)
@@ -111,15 +113,21 @@ def _cmd_demo(args) -> int:
 
 def register(sub) -> None:
     """Adds the subcommands of this module to the ``softrod`` parser."""
-    d = sub.add_parser("demo", help="seed-000 arm at several tensions: table and PNG")
+    d = sub.add_parser(
+        "demo", help="the tapered cable-driven arm at several tensions: table and figure"
+    )
     d.add_argument(
         "--plot",
         default="softrod-demo.png",
         metavar="FILE",
-        help="PNG of backbones and profiles (default: %(default)s)",
+        help="figure of backbones and profiles (default: %(default)s)",
     )
+    files(d, outputs=("plot",), figures=("plot",))
     d.set_defaults(func=_cmd_demo)
-    pl = sub.add_parser("planar", help="planar tapered cable-driven arm (seed 000)")
+    add_figure_options(d, "plot")
+    pl = sub.add_parser(
+        "planar", help="planar tapered cable-driven arm (closed form or final-value ODE)"
+    )
     pl.add_argument("--length", type=float, default=SEED.length, help="arm length L (m)")
     pl.add_argument("--base-radius", type=float, default=SEED.base_radius, help="R0 (m)")
     pl.add_argument("--tip-radius", type=float, default=SEED.tip_radius, help="RL (m)")
@@ -149,10 +157,17 @@ def register(sub) -> None:
         default=201,
         help="arc-length samples (default: %(default)s)",
     )
-    pl.add_argument("--method", choices=("closed-form", "ode"), default="closed-form")
+    pl.add_argument(
+        "--method",
+        choices=("closed-form", "ode"),
+        default="closed-form",
+        help="closed form (default) or the published final-value ODE",
+    )
     pl.add_argument("--rtol", type=float, default=1e-8, help="ODE relative tolerance")
     pl.add_argument("--atol", type=float, default=1e-10, help="ODE absolute tolerance (1/m)")
-    pl.add_argument("--plot", metavar="FILE", help="PNG of backbones and profiles")
+    pl.add_argument("--plot", metavar="FILE", help="figure of backbones and profiles")
     pl.add_argument("--csv", metavar="FILE", help="write all samples to CSV")
     pl.add_argument("--json", action="store_true", help="print arm and samples as JSON")
+    files(pl, outputs=("csv", "plot"), figures=("plot",))
     pl.set_defaults(func=_cmd_planar)
+    add_figure_options(pl, "plot")
