@@ -5,7 +5,7 @@ Prints, for every case of the tests (``tests/test_backbone.py``, same renders an
 centreline's RMS and maximum distance (px) from the true backbone over 95 % of the arm
 length, the tip distance (px) and the half-width error (px, mean and max over the middle
 90 %); writes ``docs/figures/backbone_overlay.png`` and the sample photo of the docs,
-``data/photos/seed000-arm-2N.jpg`` (the seed-000 arm at 2 N, 0.3 MP, JPEG quality 90).
+``photos/cable-arm-2N.jpg`` of the package data (the arm at 2 N, 0.3 MP, JPEG quality 90).
 """
 
 from __future__ import annotations
@@ -96,7 +96,7 @@ def main() -> None:
 
     # The docs' sample photo, saved as a camera would (JPEG), and what comes out of it.
     photo = render_seed_arm(2.0, "0.3MP", seed=11)
-    out = ROOT / "data" / "photos" / "seed000-arm-2N.jpg"
+    out = ROOT / "python" / "softrod" / "examples" / "data" / "photos" / "cable-arm-2N.jpg"
     out.parent.mkdir(exist_ok=True)
     iio.imwrite(out, photo.image, quality=90)
     bb = softrod.extract_backbone(
@@ -118,7 +118,7 @@ def main() -> None:
     )
     softrod.vision.plot_backbone_overlay(bb, photo.image, ax=axes[0])
     axes[0].set_title(
-        "seed-000 arm at T = 3 N, rendered: clamp over the base, float on the "
+        "the cable arm at T = 3 N, rendered: clamp over the base, float on the "
         "arm, four distractors",
         fontsize=9,
     )

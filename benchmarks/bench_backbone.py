@@ -1,10 +1,10 @@
 """Benchmark of backbone extraction from photos; prints a table of medians and accuracies.
 
 Run: ``python benchmarks/bench_backbone.py`` (after ``pip install .``). The photos are the
-tests' renders of the seed-000 arm (``tests/arm_photos.py``): shading, blur, noise, uneven
-lighting and five distractors. Side by side, the same photos through a plain pipeline that
-stops at the skeleton (global Otsu threshold, largest component, full-resolution skeleton,
-longest path), to show what the tube fit costs and buys.
+tests' renders of the planar cable-arm paper's arm (``tests/arm_photos.py``): shading, blur,
+noise, uneven lighting and five distractors. Side by side, the same photos through a plain
+pipeline that stops at the skeleton (global Otsu threshold, largest component, full-resolution
+skeleton, longest path), to show what the tube fit costs and buys.
 """
 
 from __future__ import annotations

@@ -29,7 +29,7 @@ import softrod
 ARM = softrod.PlanarCableArm.seed_arm()
 
 #: Image sizes of the accuracy tests: ~0.3 MP and ~1 MP, with the scale that fits every
-#: tension of the seed arm in the frame (m per pixel).
+#: tension of the planar cable-arm paper's arm in the frame (m per pixel).
 SIZES = {
     "0.3MP": ((480, 640), 0.27 / 560),
     "1MP": ((864, 1152), 0.27 / 1010),
@@ -282,7 +282,8 @@ def render_backbone(
 
 
 def render_seed_arm(tension: float, size: str = "0.3MP", **kwargs) -> Photo:
-    """A photo of the seed-000 arm (``PlanarCableArm.seed_arm()``) at a cable tension (N)."""
+    """A photo of the planar cable-arm paper's arm (``PlanarCableArm.seed_arm()``) at a cable
+    tension (N)."""
     shape, scale = SIZES[size]
     sol = ARM.solve(tension, 4001)
     return render_backbone(

@@ -410,3 +410,13 @@ def test_bad_arguments_raise_named_errors(kwargs, name, backbone):
     with pytest.raises(ParameterError) as exc:
         softrod.extract_backbone(photo.image, **kwargs)
     assert exc.value.parameter == name
+
+
+def test_shipped_sample_photo_lands_on_the_model():
+    # The docs' photo: the paper's arm at 2 N rendered at 0.27 / 560 m per pixel, saved as JPEG.
+    path = softrod.examples.data_path("photos/cable-arm-2N.jpg")
+    scale = 0.27 / 560
+    bb = softrod.extract_backbone(path, scale=scale, base=(30.0, 396.04), direction=(1.0, 0.0))
+    assert bb.quality.ok and bb.quality.discarded_components == 4
+    d = softrod.backbone_distance(bb, ARM.solve(2.0))
+    assert d.max <= 0.5 * scale

@@ -1,4 +1,5 @@
-"""Comparing backbones at equal arm index (fraction of arm length), as seed 000 did."""
+"""Comparing backbones at equal arm index (fraction of arm length), as the planar cable-arm
+paper did."""
 
 from __future__ import annotations
 

@@ -6,31 +6,27 @@ import json
 import os
 import sys
 
-from ..vision.backbone import parameter_error
+from ._common import add_figure_options, bad, figure_options, files, save_figure, use_agg
 
 
 def _same_file(a: str, b: str) -> bool:
     try:
         return os.path.samefile(a, b)
     except OSError:
-        return os.path.abspath(a) == os.path.abspath(b)
+        return os.path.realpath(a) == os.path.realpath(b)
 
 
 def _check_outputs(args) -> None:
-    """Refuses an output that is the photo itself, or an existing file without --overwrite."""
-    seen: dict[str, str] = {}
+    """Refuses an output that is the photo itself, or an existing file without --overwrite
+    (the checks every command shares, :func:`softrod.cli._common.check_files`, ran before)."""
     for flag in ("csv", "json", "plot"):
         path = getattr(args, flag)
         if not path:
             continue
         if _same_file(path, args.photo):
-            raise parameter_error(f"--{flag}", f"{path!r} is the input photo")
+            raise bad(f"--{flag}", path, "is the input PHOTO; refusing to overwrite it")
         if not args.overwrite and os.path.exists(path):
-            raise parameter_error(f"--{flag}", f"{path!r} exists (pass --overwrite to replace it)")
-        key = os.path.abspath(path)
-        if key in seen:
-            raise parameter_error(f"--{flag}", f"{path!r} is also the --{seen[key]} output")
-        seen[key] = flag
+            raise bad(f"--{flag}", path, "exists (pass --overwrite to replace it)")
 
 
 def _summary(bb) -> str:
@@ -57,7 +53,7 @@ def _cmd_backbone(args) -> int:
     from ..vision import extract_backbone, read_image
 
     if not os.path.isfile(args.photo):
-        raise parameter_error("PHOTO", f"{args.photo!r} is not a file")
+        raise bad("PHOTO", args.photo, "is not a file")
     _check_outputs(args)
     image = read_image(args.photo)
     bb = extract_backbone(
@@ -77,10 +73,10 @@ def _cmd_backbone(args) -> int:
         print(f"wrote {args.json}", file=sys.stderr)
     if args.plot:
         from ..vision import plot_backbone_overlay
-        from ._common import save_figure, use_agg
 
         use_agg()
-        save_figure(plot_backbone_overlay(bb, image), args.plot)
+        fig = plot_backbone_overlay(bb, image, **figure_options(args))
+        save_figure(fig, args.plot, args=args)
     return 0
 
 
@@ -118,8 +114,10 @@ def register(sub) -> None:
     p.add_argument("--points", type=int, metavar="N", help="number of output points")
     p.add_argument("--csv", metavar="FILE", help="write the points (and half-widths) to CSV")
     p.add_argument("--json", metavar="FILE", help="write the backbone and its report to JSON")
-    p.add_argument("--plot", metavar="FILE", help="PNG of the curve and edges over the photo")
+    p.add_argument("--plot", metavar="FILE", help="figure of the curve and edges over the photo")
     p.add_argument(
         "--overwrite", action="store_true", help="replace existing output files (never PHOTO)"
     )
     p.set_defaults(func=_cmd_backbone)
+    files(p, outputs=("csv", "json", "plot"), figures=("plot",))
+    add_figure_options(p, "plot")

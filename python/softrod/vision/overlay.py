@@ -9,7 +9,16 @@ from .backbone import Backbone
 __all__ = ["plot_backbone_overlay"]
 
 
-def plot_backbone_overlay(backbone: Backbone, image, *, ax=None, title: str | None = None):
+def plot_backbone_overlay(
+    backbone: Backbone,
+    image,
+    *,
+    ax=None,
+    title: str | None = None,
+    size: tuple[float, float] | None = None,
+    dpi: float | None = None,
+    style=None,
+):
     """Draws the photo with the centreline, the fitted edges (+- half-width), base and tip.
 
     Args:
@@ -17,18 +26,28 @@ def plot_backbone_overlay(backbone: Backbone, image, *, ax=None, title: str | No
         image: The photograph (array or path) the backbone came from.
         ax: Matplotlib axes to draw in; default a new figure.
         title: Axes title; default a one-line summary of the quality report.
+        size: Figure size (width, height) in inches (new figure only).
+        dpi: Resolution (dots per inch).
+        style: A matplotlib style name or file.
 
     Returns:
-        The matplotlib figure.
+        The matplotlib figure (axes in pixels: column across, row downward).
     """
-    import matplotlib.pyplot as plt
+    from ..plot._figure import figure_style
 
+    with figure_style(style):
+        return _overlay(backbone, image, ax, title, size, dpi)
+
+
+def _overlay(backbone, image, ax, title, size, dpi):
+    from ..plot._figure import new_figure
     from .segment import read_image
 
     arr = read_image(image)
     if ax is None:
         h, w = arr.shape[:2]
-        fig, ax = plt.subplots(figsize=(8.0, 8.0 * h / w + 0.5), layout="constrained")
+        fig = new_figure(size, (8.0, 8.0 * h / w + 0.5), dpi)
+        ax = fig.add_subplot()
     else:
         fig = ax.figure
     ax.imshow(arr, cmap="gray" if arr.ndim == 2 else None, interpolation="nearest")
