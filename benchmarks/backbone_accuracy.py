@@ -23,7 +23,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
-from arm_photos import ARM, SIZES, centreline_errors, render_backbone, render_seed_arm  # noqa: E402
+from arm_photos import SIZES, centreline_errors, render_seed_arm, thin_radius  # noqa: E402
 
 import softrod  # noqa: E402
 
@@ -72,20 +72,10 @@ def main() -> None:
             photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
         )
         _row(f"1MP, {background} floor, float touching the arm", photo, bb)
-    shape, scale = SIZES["0.3MP"]
-    sol = ARM.solve(2.0, 4001)
+    scale = SIZES["0.3MP"][1]
     for background in ("dark", "light"):
-        photo = render_backbone(
-            sol.x,
-            sol.y,
-            sol.angle,
-            (2.5 - sol.s / ARM.length) * scale,
-            sol.s,
-            shape=shape,
-            scale=scale,
-            background=background,
-            blur=1.0,
-            seed=3,
+        photo = render_seed_arm(
+            2.0, radius=lambda s: thin_radius(s, scale), background=background, blur=1.0, seed=3
         )
         bb = softrod.extract_backbone(photo.image, base=photo.base)
         _row(f"thin arm (5 to 3 px wide), {background} floor", photo, bb)

@@ -281,14 +281,30 @@ def render_backbone(
     )
 
 
-def render_seed_arm(tension: float, size: str = "0.3MP", **kwargs) -> Photo:
+def render_seed_arm(
+    tension: float,
+    size: str = "0.3MP",
+    *,
+    shape: tuple[int, int] | None = None,
+    scale: float | None = None,
+    radius=None,
+    **kwargs,
+) -> Photo:
     """A photo of the planar cable-arm paper's arm (``PlanarCableArm.seed_arm()``) at a cable
-    tension (N)."""
-    shape, scale = SIZES[size]
+    tension (N): ``size`` picks the image shape and scale (or give ``shape`` and ``scale``),
+    ``radius(s)`` (m) replaces the arm's taper, and the other keywords go to
+    :func:`render_backbone`."""
+    shape0, scale0 = SIZES[size]
     sol = ARM.solve(tension, 4001)
+    r = ARM.radius(sol.s) if radius is None else radius(sol.s)
     return render_backbone(
-        sol.x, sol.y, sol.angle, ARM.radius(sol.s), sol.s, shape=shape, scale=scale, **kwargs
+        sol.x, sol.y, sol.angle, r, sol.s, shape=shape or shape0, scale=scale or scale0, **kwargs
     )
+
+
+def thin_radius(s, scale: float):
+    """A thin arm's radius (m) at arc length ``s``: 2.5 px at the base to 1.5 px at the tip."""
+    return (2.5 - np.asarray(s) / ARM.length) * scale
 
 
 def point_to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:

@@ -4,7 +4,7 @@ import pickle
 
 import numpy as np
 import pytest
-from arm_photos import ARM, SIZES, centreline_errors, render_backbone, render_seed_arm
+from arm_photos import ARM, SIZES, centreline_errors, render_seed_arm, thin_radius
 
 import softrod
 from softrod import ParameterError
@@ -60,21 +60,9 @@ def test_metric_frame_straight_arm_along_known_direction():
     # the base, y vanishes, the length is L and the half-width is the cone's radius.
     ang = np.deg2rad(30.0)
     d = np.array([np.cos(ang), -np.sin(ang)])  # up and to the right on the image
-    shape, scale = SIZES["0.3MP"]
-    sol = ARM.solve(0.0, 2001)
+    scale = SIZES["0.3MP"][1]
     base = np.array([70.0, 400.0])
-    photo = render_backbone(
-        sol.x,
-        sol.y,
-        sol.angle,
-        ARM.radius(sol.s),
-        sol.s,
-        shape=shape,
-        scale=scale,
-        base=base,
-        direction=d,
-        seed=2,
-    )
+    photo = render_seed_arm(0.0, "0.3MP", base=base, direction=d, seed=2)
     bb = softrod.extract_backbone(photo.image, scale=scale, base=base, direction=d)
     assert bb.unit == "m" and bb.quality.direction_source == "given"
     np.testing.assert_allclose(bb.points[0], [0.0, 0.0], atol=0.5 * scale)
@@ -97,16 +85,11 @@ def test_metric_frame_straight_arm_along_known_direction():
 def test_metric_y_is_turned_plus_90_degrees_as_seen_on_the_image(direction, side):
     # An arm that visibly curls to one side of its direction on the image: y > 0 exactly when
     # it curls to the side the frame's definition names (top of the image for rightward).
-    shape, scale = (600, 600), 0.27 / 420
-    sol = ARM.solve(2.0, 2001)
+    scale = 0.27 / 420
     base = {"up": (60, 420), "right": (150, 60), "down": (540, 180), "left": (450, 540)}[side]
-    photo = render_backbone(
-        sol.x,
-        sol.y,
-        sol.angle,
-        ARM.radius(sol.s),
-        sol.s,
-        shape=shape,
+    photo = render_seed_arm(
+        2.0,
+        shape=(600, 600),
         scale=scale,
         base=np.array(base, float),
         direction=direction,
@@ -119,7 +102,7 @@ def test_metric_y_is_turned_plus_90_degrees_as_seen_on_the_image(direction, side
     assert seen > 50  # the render curls toward `side`
     bb = softrod.extract_backbone(photo.image, scale=scale, base=base, direction=direction)
     assert bb.tip[1] > 0.05
-    np.testing.assert_allclose(bb.tip, [sol.x[-1], sol.y[-1]], atol=2.0 * scale)
+    np.testing.assert_allclose(bb.tip, [photo.x[-1], photo.y[-1]], atol=2.0 * scale)
 
 
 def test_ordering_without_base_border_and_wider_end():
@@ -178,21 +161,10 @@ def test_distractor_touching_the_arm(background):
 
 
 def test_thin_arm_of_a_few_pixels():
-    shape, scale = SIZES["0.3MP"]
-    sol = ARM.solve(2.0, 4001)
-    radius = (2.5 - 1.0 * sol.s / ARM.length) * scale  # 5 px wide at the base, 3 at the tip
+    scale = SIZES["0.3MP"][1]
     for background in ("dark", "light"):
-        photo = render_backbone(
-            sol.x,
-            sol.y,
-            sol.angle,
-            radius,
-            sol.s,
-            shape=shape,
-            scale=scale,
-            background=background,
-            blur=1.0,
-            seed=3,
+        photo = render_seed_arm(
+            2.0, radius=lambda s: thin_radius(s, scale), background=background, blur=1.0, seed=3
         )
         bb = softrod.extract_backbone(photo.image, base=photo.base)
         err = centreline_errors(photo, bb.pixels)
@@ -237,20 +209,7 @@ def test_rgb_photo():
 def test_mask_overrides_segmentation():
     photo = render_seed_arm(2.0, "0.3MP", seed=14)
     # The true silhouette, rendered without blur, noise or distractors: a mask from elsewhere.
-    sol = ARM.solve(2.0, 4001)
-    clean = render_backbone(
-        sol.x,
-        sol.y,
-        sol.angle,
-        ARM.radius(sol.s),
-        sol.s,
-        shape=photo.image.shape,
-        scale=photo.scale,
-        blur=1e-3,
-        noise=0.0,
-        n_blobs=0,
-        seed=14,
-    )
+    clean = render_seed_arm(2.0, "0.3MP", blur=1e-3, noise=0.0, n_blobs=0, seed=14)
     mask = clean.image > 0.5 * (int(clean.image.max()) + int(clean.image.min()))
     bb = softrod.extract_backbone(np.zeros_like(photo.image), mask=mask, base=photo.base)
     assert bb.quality.polarity == "mask"
