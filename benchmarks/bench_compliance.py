@@ -28,7 +28,7 @@ def main() -> None:
     reps = 3 if args.quick else args.repeats
     calls = 30 if args.quick else 200
 
-    robot = softrod.load_robot("examples/robots/niti_two_segment.toml")
+    robot = softrod.examples.load("niti_two_segment")
     rows = []
 
     def med(fn):

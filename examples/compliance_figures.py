@@ -13,7 +13,7 @@ import numpy as np
 import softrod
 from softrod.plot import plot_compliance_ellipsoids, plot_gamma_c, plot_workspace_map
 
-robot = softrod.load_robot("examples/robots/niti_two_segment.toml")
+robot = softrod.examples.load("niti_two_segment")
 sol = robot.solve()
 comp = softrod.compliance(sol)
 fig = plot_compliance_ellipsoids(
@@ -58,7 +58,7 @@ fig = plot_workspace_map(
 fig.savefig("docs/figures/compliance_workspace_tangent.png", dpi=110)
 
 # Seed 001's Fig. 1e in kind: the pneumatic arm with pairs 1 and 2 pressurised together.
-arm = softrod.load_robot("examples/robots/seed001_pneumatic_arm.toml")
+arm = softrod.examples.load("seed001_pneumatic_arm")
 pressures = [0, 10, 20, 30, 40]
 comps = []
 for p in pressures:

@@ -24,7 +24,7 @@ from softrod import (
 )
 
 ROOT = Path(__file__).resolve().parents[1]
-ARM = ROOT / "examples" / "robots" / "seed001_pneumatic_arm.toml"
+ARM = softrod.examples.path("seed001_pneumatic_arm")
 
 
 def test_chamber_fields_and_repr():
@@ -168,7 +168,8 @@ def _robot(material, chamber=None):
     [
         ({"type": "neo_hookean", "mu": -1.0}, "rod.material"),
         ({"type": "yeoh"}, "rod.material.c10"),
-        ({"type": "ogden"}, "rod.material.type"),
+        ({"type": "ogdn"}, "rod.material.type"),
+        ({"type": "ogden"}, "rod.material.mu"),
         ({"silicone": "Dragon Skin 99"}, "rod.material.silicone"),
         ({"silicone": "Dragon Skin 10", "type": "linear"}, "rod.material.type"),
         ({"type": "mooney_rivlin", "c10": 1e4, "c01": 1e3, "c20": 1.0}, "rod.material.c20"),

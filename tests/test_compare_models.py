@@ -1,7 +1,5 @@
 """softrod.compare_models and `softrod compare`: the call, the table, exit codes, the plot."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -9,7 +7,7 @@ import softrod
 from softrod.cli import main
 from softrod.plot import plot_models
 
-ROBOTS = Path(__file__).resolve().parent.parent / "examples" / "robots"
+ROBOTS = softrod.examples.ROBOTS
 NITI = ROBOTS / "niti_two_segment.toml"
 SEED000 = ROBOTS / "seed000_arm.toml"
 
@@ -62,13 +60,14 @@ def test_tip_load_keeps_pcc_rules_out_planar_and_tensions_override():
     assert "not at a constant offset" not in zero["pcc"].note
 
 
-def test_a_robot_without_description_is_compared_with_cosserat_only():
-    from dataclasses import replace
-
-    robot = replace(softrod.load_robot(NITI), source={})
+def test_a_robot_that_cannot_be_described_is_compared_with_cosserat_only():
+    # A section given by a Python function has no description to map onto PCC or planar.
+    section = softrod.FunctionSection(lambda s: (3.1e-6, 7.8e-13, 7.8e-13, 1.6e-12))
+    rod = softrod.Rod(0.3, section, softrod.LinearElastic(50e9, 0.3))
+    robot = softrod.Robot(rod, tendons=[softrod.Tendon((0.005, 0.0), 1.0)])
     comp = softrod.compare_models(robot, repeats=1)
     assert comp["cosserat"].applies
-    assert not comp["pcc"].applies and "Robot.from_dict" in comp["pcc"].note
+    assert not comp["pcc"].applies and "cannot" in comp["pcc"].note
     assert not comp["planar"].applies
 
 

@@ -10,7 +10,7 @@ import pytest
 import softrod
 from softrod.cli import main
 
-ROBOT = "examples/robots/niti_two_segment.toml"
+ROBOT = str(softrod.examples.path("niti_two_segment"))
 
 
 @pytest.fixture(scope="module")
@@ -109,7 +109,7 @@ def test_cli_compliance_and_workspace(tmp_path, capsys):
     args = ["workspace", ROBOT, "--sweep", "0:4", "--sweep", "4:2", "--n", "6"]
     assert main([*args, "--plot", str(wsp), "--progress", "--tangent", "length"]) == 0
     cap = capsys.readouterr()
-    assert "36 configurations" in cap.out and "workspace [" in cap.err
+    assert "36 configurations" in cap.out and "workspace:" in cap.err and "36/36" in cap.err
     assert "tangent, tendons at fixed length" in cap.out
     assert wsp.stat().st_size > 10_000
     assert main(["workspace", ROBOT, "--sweep", "9:4"]) == 2
@@ -119,11 +119,8 @@ def test_fixed_length_tangent_matches_a_finite_difference_with_held_lengths():
     """Independent check of tendons held at fixed length: perturb the tip force, re-solve the
     tensions of the held tendons (0 and 4) so that their path lengths stay put, and difference
     the tip position; the linearised BVP must give the same translational block."""
-    from pathlib import Path
 
-    robot = softrod.load_robot(
-        Path(__file__).resolve().parent.parent / "examples/robots/niti_two_segment.toml"
-    )
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
     held = [0, 4]
     tight = dict(integrator="adaptive", rtol=1e-12, atol=1e-14)
     tens0 = np.array([t.tension for t in robot.tendons])

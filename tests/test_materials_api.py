@@ -5,7 +5,6 @@ tangents, fit accuracy) is tested in Rust (crates/softrod/tests/hyperelastic.rs)
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,7 +27,7 @@ from softrod import (
 from softrod.cli import main
 from softrod.plot import plot_fit
 
-DATA = Path(__file__).resolve().parent.parent / "data" / "silicone-tensile"
+DATA = softrod.examples.DATA / "silicone-tensile"
 DRAGON_SKIN_10 = DATA / "Dragon Skin 10 MEDIUM.csv"
 
 LAWS = [
@@ -480,12 +479,11 @@ def test_plot_fit_draws_data_fits_and_residuals():
 
 
 def test_study_command_runs_both_materials_and_writes_figures(tmp_path, capsys):
-    from pathlib import Path
 
     from softrod.cli import main
     from softrod.study import seed001_study
 
-    robot = Path(__file__).resolve().parent.parent / "examples/robots/seed001_pneumatic_arm.toml"
+    robot = softrod.examples.path("seed001_pneumatic_arm")
     res = seed001_study(robot, levels=2, max_pressure=30e3, out_dir=tmp_path, log=None)
     assert set(res) == {"hyperelastic", "linear"}
     for r in res.values():

@@ -1,7 +1,6 @@
 """Robot description files (TOML) and ``softrod solve``: loading, field-named errors, outputs."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,7 +9,7 @@ import softrod
 from softrod.cli import main
 from softrod.robot import Robot, load_robot
 
-ROBOTS = Path(__file__).resolve().parent.parent / "examples" / "robots"
+ROBOTS = softrod.examples.ROBOTS
 NITI = ROBOTS / "niti_two_segment.toml"
 
 MINIMAL = """

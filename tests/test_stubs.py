@@ -152,3 +152,17 @@ def test_every_public_signature_matches_the_stub():
                 _compare(fn, real, f"{node.name}.{fn.name}", drop_first=True)
                 checked += 1
     assert checked > 60, checked
+
+
+def test_package_layout_and_earlier_module_paths():
+    import softrod.analysis
+    import softrod.cli
+    import softrod.io
+    import softrod.plot
+    import softrod.study
+    import softrod.workspace
+
+    assert softrod.study.seed001_study is softrod.analysis.study.seed001_study
+    assert softrod.workspace.workspace_map is softrod.workspace_map
+    assert callable(softrod.cli.main) and callable(softrod.plot.plot_rod)
+    assert softrod.io.read_backbone_csv is softrod.read_backbone_csv

@@ -3,11 +3,12 @@
 SI units everywhere (m, N, Pa, rad). See https://softrod docs in ``docs/`` for the models.
 
 The numerics live in the compiled core ``softrod._core``; this package re-exports it and adds
-file I/O (:mod:`softrod.io`), plots (:mod:`softrod.plot`) and the ``softrod`` command line
+file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`softrod.plot`),
+backbones from photographs (:mod:`softrod.vision`) and the ``softrod`` command line
 (:mod:`softrod.cli`).
 """
 
-from . import pcc
+from . import examples, pcc, vision
 from ._core import (
     SILICONES,
     Chamber,
@@ -48,16 +49,27 @@ from ._core import (
     solve_statics,
     tangent_compliance,
 )
-from .compare import BackboneDistance, backbone_distance
+from .analysis import (
+    BackboneDistance,
+    ModelComparison,
+    ModelResult,
+    TensileCurve,
+    WorkspaceMap,
+    backbone_distance,
+    compare_models,
+    read_tensile_csv,
+    tension_grid,
+    workspace_map,
+)
 from .io import read_backbone_csv, write_samples_csv
-from .materials import TensileCurve, read_tensile_csv
-from .models import ModelComparison, ModelResult, compare_models
 from .robot import Robot, load_robot
-from .workspace import WorkspaceMap, tension_grid, workspace_map
+from .vision import Backbone, BackboneQuality
 
 __all__ = [
     "SILICONES",
+    "Backbone",
     "BackboneDistance",
+    "BackboneQuality",
     "Chamber",
     "CircularSection",
     "Compliance",
@@ -98,6 +110,8 @@ __all__ = [
     "compare_models",
     "compliance",
     "eigenscrews",
+    "examples",
+    "extract_backbone",
     "fit_uniaxial",
     "load_robot",
     "pcc",
@@ -107,6 +121,43 @@ __all__ = [
     "solve_statics",
     "tangent_compliance",
     "tension_grid",
+    "vision",
     "workspace_map",
     "write_samples_csv",
 ]
+
+
+# Module paths of earlier releases, kept importable: ``softrod.study``, ``softrod.workspace``,
+# ``softrod.models``, ``softrod.compare`` and ``softrod.materials`` now live in ``analysis``.
+def _alias_modules() -> None:
+    import sys
+
+    from .analysis import compare, materials, models, study
+    from .analysis import workspace as _workspace
+
+    for name, module in {
+        "compare": compare,
+        "materials": materials,
+        "models": models,
+        "study": study,
+        "workspace": _workspace,
+    }.items():
+        sys.modules[f"{__name__}.{name}"] = module
+        globals()[name] = module
+
+
+_alias_modules()
+
+
+def __getattr__(name: str):
+    # ``extract_backbone`` loads the image-processing stack on first use (see softrod.vision).
+    if name == "extract_backbone":
+        from .vision import extract_backbone
+
+        globals()[name] = extract_backbone
+        return extract_backbone
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

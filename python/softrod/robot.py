@@ -1,478 +1,561 @@
-"""Robot description files (TOML): everything the Python API can build, without callables.
+"""Robots: a rod with tendons, chambers, loads and solver options, from a file or from code.
 
-A file has the tables ``[rod]`` (with ``[rod.section]`` and ``[rod.material]``: linear, or
-hyperelastic by law or silicone name), arrays of ``[[tendons]]`` and ``[[chambers]]``
-(pneumatic), ``[loads]`` (with ``[[loads.point_loads]]``) and ``[solver]``; SI units
-throughout. See ``docs/robot-files.md`` for the schema and ``examples/robots/`` for examples.
-Every error names the offending field, e.g. ``tendons[2].tension``.
+A robot file (TOML) has the tables ``[rod]`` (with ``[rod.section]`` and ``[rod.material]``),
+arrays of ``[[tendons]]`` and ``[[chambers]]``, ``[loads]`` and ``[solver]``; SI units
+throughout. Its schema is :class:`softrod.io.robot_file.RobotFile` (``docs/robot-files.md``);
+every error names its location in the file (``tendons[2].distance``), all errors at once.
+
+A :class:`Robot` is immutable: :meth:`Robot.solve` takes the actuation (tendon tensions,
+chamber pressures) as input, :meth:`Robot.with_parameters` returns a new validated robot with
+design parameters changed (named by their path in the file), :meth:`Robot.to_toml` writes it
+back, and it pickles.
 """
 
 from __future__ import annotations
 
-import math
 import os
-import sys
-from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+import pickle
+import re
+from collections.abc import Mapping, Sequence
 from typing import Any
+
+import numpy as np
 
 from ._core import (
     Chamber,
-    CircularSection,
-    LinearElastic,
     Loads,
-    MooneyRivlin,
-    NeoHookean,
     ParameterError,
-    PointLoad,
     Rod,
-    Section,
     StaticsSolution,
-    TableSection,
-    TaperedCircularSection,
     Tendon,
-    TubeSection,
-    UniaxialLaw,
-    Yeoh,
-    silicone,
     solve_statics,
 )
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
+from .io import objects as _objects
+from .io import robot_file as _rf
+from .io.robot_file import FieldError, RobotFile
 
 __all__ = ["Robot", "load_robot"]
 
-_SOLVER_KEYS = {
-    "integrator",
-    "steps",
-    "rtol",
-    "atol",
-    "tolerance",
-    "max_iterations",
-    "continuation",
-    "max_load_steps",
-}
+_PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)\Z")
 
 
-class _Fields:
-    """Reads one TOML table, remembering its path for error messages."""
-
-    def __init__(self, table: Any, path: str):
-        if not isinstance(table, Mapping):
-            raise ParameterError(f"invalid field `{path}`: must be a table, got {table!r}")
-        self.table, self.path, self.used = table, path, set()
-
-    def name(self, key: str) -> str:
-        return f"{self.path}.{key}" if self.path else key
-
-    def get(self, key: str, default: Any = None, *, required: bool = False) -> Any:
-        self.used.add(key)
-        if key not in self.table:
-            if required:
-                raise ParameterError(f"missing field `{self.name(key)}`")
-            return default
-        return self.table[key]
-
-    def number(self, key: str, default: Any = None, *, required: bool = False) -> Any:
-        v = self.get(key, default, required=required)
-        if v is None:
-            return None
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise ParameterError(f"invalid field `{self.name(key)}` = {v!r}: must be a number")
-        return float(v)
-
-    def vector(self, key: str, n: int, default: Any = None) -> Any:
-        v = self.get(key, default)
-        if v is None:
-            return None
-        if not (
-            isinstance(v, list)
-            and len(v) == n
-            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
-        ):
-            raise ParameterError(f"invalid field `{self.name(key)}` = {v!r}: must be {n} numbers")
-        return [float(x) for x in v]
-
-    def finish(self) -> None:
-        extra = sorted(set(self.table) - self.used)
-        if extra:
-            raise ParameterError(
-                f"unknown field `{self.name(extra[0])}` (known: {', '.join(sorted(self.used))})"
-            )
+def _parse_path(path: str) -> list[str | int]:
+    """``"tendons[2].distance"`` -> ``["tendons", 2, "distance"]``."""
+    if not isinstance(path, str) or not path:
+        raise _bad_path(path, "a path such as `tendons[0].tension`")
+    out: list[str | int] = []
+    for part in path.split("."):
+        m = _PATH_PART.match(part)
+        if m is None:
+            raise _bad_path(path, "names and [index] joined by dots, e.g. `tendons[0].tension`")
+        out.append(m.group(1))
+        out.extend(int(i) for i in re.findall(r"\[(\d+)\]", m.group(2)))
+    return out
 
 
-def _named(path: str, make):
-    """Runs a constructor, prefixing the field path to any ParameterError."""
+def _bad_path(path: Any, expected: str) -> ParameterError:
+    exc = ParameterError(f"invalid parameter path {path!r}: must be {expected}")
+    exc.parameter = str(path)
+    return exc
+
+
+def _plain(value: Any) -> Any:
+    """NumPy scalars and arrays as Python numbers and lists (the schema is strict)."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _check_sequence(value: Any, kind: type, name: str) -> tuple:
+    if isinstance(value, kind):
+        value = (value,)
     try:
-        return make()
-    except ParameterError as exc:
-        param = getattr(exc, "parameter", "")
-        err = ParameterError(f"invalid field `{path}`: {exc}")
-        err.parameter = f"{path}.{param}" if param else path
-        raise err from None
-
-
-def _section(t: _Fields) -> Section:
-    kind = t.get("type", "circular")
-    p = t.path
-    if kind == "circular":
-        sec = _named(p, lambda: CircularSection(t.number("radius", required=True)))
-    elif kind == "tapered":
-        sec = _named(
-            p,
-            lambda: TaperedCircularSection(
-                t.number("base_radius", required=True), t.number("tip_radius", required=True)
-            ),
-        )
-    elif kind == "tube":
-        sec = _named(
-            p,
-            lambda: TubeSection(
-                t.number("outer_radius", required=True), t.number("inner_radius", 0.0)
-            ),
-        )
-    elif kind == "table":
-        cols = [t.get(k, required=True) for k in ("s", "area", "ix", "iy", "j")]
-        sec = _named(p, lambda: TableSection(*cols))
-    else:
-        raise ParameterError(
-            f"invalid field `{t.name('type')}` = {kind!r}: must be circular, tapered, tube or table"
-        )
-    t.finish()
-    return sec
-
-
-_HYPERELASTIC = ("neo_hookean", "mooney_rivlin", "yeoh")
-
-
-def _material(t: _Fields) -> LinearElastic | UniaxialLaw:
-    name = t.get("silicone")
-    kind = t.get("type", "linear" if name is None else "yeoh")
-    if name is not None:
-        if kind not in _HYPERELASTIC:
-            raise ParameterError(
-                f"invalid field `{t.name('type')}` = {kind!r}: with `silicone`, must be "
-                "neo_hookean, mooney_rivlin or yeoh (the law of the library entry)"
+        items = tuple(value)
+    except TypeError:
+        raise TypeError(
+            f"invalid parameter `{name}`: must be a sequence of {kind.__name__}"
+        ) from None
+    for i, item in enumerate(items):
+        if not isinstance(item, kind):
+            raise TypeError(
+                f"invalid parameter `{name}[{i}]` = {item!r}: must be a softrod.{kind.__name__}"
             )
-        try:
-            entry = silicone(str(name))
-        except ParameterError as exc:
-            err = ParameterError(f"invalid field `{t.name('silicone')}`: {exc}")
-            err.parameter = t.name("silicone")
-            raise err from None
-        law = getattr(entry, kind)
-        if law is None:
-            raise ParameterError(
-                f"invalid field `{t.name('type')}` = {kind!r}: the library has no {kind} "
-                f"parameters for {entry.name}"
-            )
-    elif kind == "linear":
-        law = _named(
-            t.path,
-            lambda: LinearElastic(
-                t.number("youngs_modulus", required=True),
-                t.number("poisson_ratio"),
-                shear_modulus=t.number("shear_modulus"),
-            ),
-        )
-    elif kind == "neo_hookean":
-        law = _named(t.path, lambda: NeoHookean(t.number("mu", required=True)))
-    elif kind == "mooney_rivlin":
-        law = _named(
-            t.path,
-            lambda: MooneyRivlin(t.number("c10", required=True), t.number("c01", required=True)),
-        )
-    elif kind == "yeoh":
-        law = _named(
-            t.path,
-            lambda: Yeoh(
-                t.number("c10", required=True), t.number("c20", 0.0), t.number("c30", 0.0)
-            ),
-        )
-    else:
-        raise ParameterError(
-            f"invalid field `{t.name('type')}` = {kind!r}: must be linear, neo_hookean, "
-            "mooney_rivlin or yeoh"
-        )
-    t.finish()
-    return law
+    return items
 
 
-def _pose(t: _Fields) -> Any:
-    pose = t.get("base_pose")
-    if pose is None:
-        return None
-    pf = _Fields(pose, t.name("base_pose"))
-    pos = pf.vector("position", 3, [0.0, 0.0, 0.0])
-    rot = pf.get("rotation", [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-    if not (
-        isinstance(rot, list)
-        and len(rot) == 3
-        and all(isinstance(r, list) and len(r) == 3 for r in rot)
-    ):
-        raise ParameterError(f"invalid field `{pf.name('rotation')}`: must be a 3x3 matrix")
-    pf.finish()
-    return (pos, rot)
-
-
-def _rod(t: _Fields) -> Rod:
-    section = _section(_Fields(t.get("section", required=True), t.name("section")))
-    material = _material(_Fields(t.get("material", required=True), t.name("material")))
-    rod = _named(
-        t.path,
-        lambda: Rod(
-            t.number("length", required=True),
-            section,
-            material,
-            rest_strain=t.vector("rest_strain", 3),
-            rest_curvature=t.vector("rest_curvature", 3),
-            inextensible=bool(t.get("inextensible", False)),
-            density=t.number("density"),
-            base_pose=_pose(t),
-            shear_coefficient=t.number("shear_coefficient"),
-        ),
-    )
-    t.finish()
-    return rod
-
-
-def _tendon(t: _Fields) -> Tendon:
-    routing = t.get("routing", "constant")
-    tension = t.number("tension", 0.0)
-    end = t.number("end")
-    if routing == "constant":
-        offset = t.vector("offset", 2)
-        if offset is None:
-            dist = t.number("distance", required=True)
-            ang = math.radians(t.number("angle_deg", 0.0))
-            offset = [dist * math.cos(ang), dist * math.sin(ang)]
-        tendon = _named(t.path, lambda: Tendon(offset, tension, end))
-    elif routing == "radius_proportional":
-        tendon = _named(
-            t.path,
-            lambda: Tendon.radius_proportional(
-                t.number("ratio", required=True),
-                math.radians(t.number("angle_deg", 0.0)),
-                tension,
-                end,
-            ),
-        )
-    elif routing == "helical":
-        tendon = _named(
-            t.path,
-            lambda: Tendon.helical(
-                t.number("radius", required=True),
-                t.number("pitch", required=True),
-                tension,
-                math.radians(t.number("phase_deg", 0.0)),
-                end,
-            ),
-        )
-    else:
-        raise ParameterError(
-            f"invalid field `{t.name('routing')}` = {routing!r}: must be constant, "
-            "radius_proportional or helical"
-        )
-    t.finish()
-    return tendon
-
-
-def _chamber(t: _Fields) -> Chamber:
-    offset = t.vector("offset", 2)
-    if offset is None:
-        dist = t.number("distance", required=True)
-        ang = math.radians(t.number("angle_deg", 0.0))
-        offset = [dist * math.cos(ang), dist * math.sin(ang)]
-    area = t.number("area")
-    radius = t.number("radius")
-    if (area is None) == (radius is None):
-        raise ParameterError(
-            f"invalid field `{t.name('area')}`: give either `area` (m^2) or `radius` (m, a "
-            "circular chamber), not both or neither"
-        )
-    if radius is not None:
-        if not radius > 0:
-            raise ParameterError(f"invalid field `{t.name('radius')}` = {radius}: must be > 0 m")
-        area = math.pi * radius * radius
-    chamber = _named(
-        t.path,
-        lambda: Chamber(
-            t.number("pressure", 0.0), area, offset, t.number("start", 0.0), t.number("end")
-        ),
-    )
-    t.finish()
-    return chamber
-
-
-def _loads(t: _Fields) -> Loads:
-    points = []
-    for i, pl in enumerate(t.get("point_loads", [])):
-        pf = _Fields(pl, f"{t.path}.point_loads[{i}]")
-        points.append(
-            _named(
-                pf.path,
-                lambda pf=pf: PointLoad(
-                    pf.number("s", required=True),
-                    pf.vector("force", 3, [0.0] * 3),
-                    pf.vector("moment", 3, [0.0] * 3),
-                    pf.get("frame", "world"),
-                ),
-            )
-        )
-        pf.finish()
-    loads = _named(
-        t.path,
-        lambda: Loads(
-            tip_force=t.vector("tip_force", 3),
-            tip_moment=t.vector("tip_moment", 3),
-            gravity=t.vector("gravity", 3),
-            tip_frame=t.get("tip_frame", "world"),
-            point_loads=points,
-            distributed_force=t.vector("distributed_force", 3),
-            distributed_moment=t.vector("distributed_moment", 3),
-        ),
-    )
-    t.finish()
-    return loads
-
-
-def _check_across(
-    data: Mapping[str, Any],
-    rod: Rod,
-    tendons: tuple[Tendon, ...],
-    chambers: tuple[Chamber, ...] = (),
-) -> None:
-    """Rules that tie fields together, checked at load time rather than at the first solve."""
-    for i, chamber in enumerate(chambers):
-        if chamber.end is not None and chamber.end > rod.length:
-            raise ParameterError(
-                f"invalid field `chambers[{i}].end` = {chamber.end}: must be in (start, "
-                f"rod.length] = ({chamber.start}, {rod.length}] m"
-            )
-        if chamber.start >= rod.length:
-            raise ParameterError(
-                f"invalid field `chambers[{i}].start` = {chamber.start}: must be in "
-                f"[0, rod.length) = [0, {rod.length}) m"
-            )
-    for i, tendon in enumerate(tendons):
-        if tendon.end is not None and not 0.0 < tendon.end <= rod.length:
-            raise ParameterError(
-                f"invalid field `tendons[{i}].end` = {tendon.end}: must be in (0, rod.length] = "
-                f"(0, {rod.length}] m"
-            )
-    gravity = data.get("loads", {}).get("gravity")
-    if gravity is not None and any(g != 0 for g in gravity) and rod.density is None:
-        raise ParameterError(
-            "invalid field `loads.gravity`: needs `rod.density` (kg/m^3), which is not given"
-        )
-
-
-@dataclass(frozen=True)
 class Robot:
-    """A robot read from a description file: rod, tendons, chambers, loads and solver options.
+    """A robot: rod, tendons, chambers, external loads and solver options (immutable).
+
+    Build one in code, ``Robot(rod, tendons=[...], chambers=[...], loads=Loads(...))``, or
+    read a file with :func:`load_robot`. Actuation is an input of :meth:`solve`.
+
+    SI units throughout (m, N, Pa, rad); tensions in N, pressures in Pa (gauge).
 
     Attributes:
-        name: The file's ``name`` (or its file name).
+        name: A label (a file's ``name``, or its file name).
         rod: The rod model.
-        tendons: Tendons, in file order.
-        chambers: Pneumatic chambers, in file order.
-        loads: External loads (unloaded when the file has none).
-        solver: Keyword arguments for :func:`softrod.solve_statics`.
-        description: Free text from the file.
-        source: The parsed description it was built from (tables as read; the tensions and
-            pressures of ``tendons`` and ``chambers`` take precedence), used by
-            :func:`softrod.compare_models` to map the robot onto simpler models.
+        tendons: Tendons, in order (their tensions are the default actuation).
+        chambers: Pneumatic chambers, in order (their pressures are the default actuation).
+        loads: External loads.
+        solver: Keyword arguments for :func:`softrod.solve_statics` (a copy).
+        description: Free text.
+        spec: The validated description (:class:`softrod.io.robot_file.RobotFile`).
+        source: The description as the file's tables (a dict, ``spec`` dumped).
     """
 
-    name: str
-    rod: Rod
-    tendons: tuple[Tendon, ...] = ()
-    loads: Loads = field(default_factory=Loads)
-    solver: dict[str, Any] = field(default_factory=dict)
-    description: str = ""
-    chambers: tuple[Chamber, ...] = ()
-    source: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    __slots__ = (
+        "_chambers",
+        "_description",
+        "_loads",
+        "_loads_given",
+        "_name",
+        "_rod",
+        "_solver",
+        "_spec",
+        "_tendons",
+    )
 
-    def solve(self, **overrides: Any) -> StaticsSolution:
-        """Solves the robot's statics; keyword arguments override the file's solver options."""
-        options = {**self.solver, **overrides}
-        if self.chambers:
-            options.setdefault("chambers", self.chambers)
-        return solve_statics(self.rod, self.tendons, self.loads, **options)
+    def __init__(
+        self,
+        rod: Rod,
+        tendons: Sequence[Tendon] = (),
+        chambers: Sequence[Chamber] = (),
+        loads: Loads | None = None,
+        solver: Mapping[str, Any] | None = None,
+        name: str = "robot",
+        description: str = "",
+        source: Mapping[str, Any] | None = None,
+    ) -> None:
+        """Builds a robot from model objects.
 
-    def with_pressures(self, pressures) -> Robot:
-        """The same robot with new chamber pressures (Pa, gauge), one per chamber."""
-        pressures = list(pressures)
-        if len(pressures) != len(self.chambers):
-            raise ParameterError(
-                f"invalid parameter `pressures` with {len(pressures)} values: must have one per "
-                f"chamber ({len(self.chambers)})"
-            )
-        new = tuple(
-            c.with_pressure(float(p)) for c, p in zip(self.chambers, pressures, strict=True)
+        Args:
+            rod: The rod.
+            tendons: Its tendons.
+            chambers: Its pneumatic chambers.
+            loads: External loads (default none).
+            solver: Options of :func:`softrod.solve_statics` (``integrator``, ``steps``, ...),
+                checked like a file's ``[solver]`` table.
+            name: A label.
+            description: Free text.
+            source: A description (the file's tables) to adopt as the robot's ``spec``
+                instead of reading one back from the objects; it must describe them.
+
+        Raises:
+            TypeError: An argument of the wrong type (named).
+            ParameterError: Bad solver options (located, e.g. ``solver.steps``).
+        """
+        if not isinstance(rod, Rod):
+            raise TypeError(f"invalid parameter `rod` = {rod!r}: must be a softrod.Rod")
+        if loads is not None and not isinstance(loads, Loads):
+            raise TypeError(f"invalid parameter `loads` = {loads!r}: must be a softrod.Loads")
+        if not isinstance(name, str) or not isinstance(description, str):
+            raise TypeError("invalid parameter `name` or `description`: must be a string")
+        options = _plain(dict(solver or {}))
+        if options:
+            _rf.validate_robot_dict({"rod": _MINIMAL_ROD, "solver": options})
+        self._set(
+            name,
+            description,
+            rod,
+            _check_sequence(tendons, Tendon, "tendons"),
+            _check_sequence(chambers, Chamber, "chambers"),
+            loads if loads is not None else Loads(),
+            loads is not None,
+            options,
+            None,
         )
-        return replace(self, chambers=new)
+        if source:
+            spec = _rf.validate_robot_dict(_plain(dict(source)))
+            object.__setattr__(self, "_spec", spec.model_copy(update={"name": name}))
 
-    def with_tensions(self, tensions) -> Robot:
-        """The same robot with new tendon tensions (N), one per tendon."""
-        tensions = list(tensions)
-        if len(tensions) != len(self.tendons):
-            raise ParameterError(
-                f"invalid parameter `tensions` with {len(tensions)} values: must have one per "
-                f"tendon ({len(self.tendons)})"
-            )
-        new = tuple(t.with_tension(float(x)) for t, x in zip(self.tendons, tensions, strict=True))
-        return replace(self, tendons=new, solver=dict(self.solver))
+    def _set(self, name, description, rod, tendons, chambers, loads, given, solver, spec):
+        for key, value in (
+            ("_name", name),
+            ("_description", description),
+            ("_rod", rod),
+            ("_tendons", tendons),
+            ("_chambers", chambers),
+            ("_loads", loads),
+            ("_loads_given", given),
+            ("_solver", solver),
+            ("_spec", spec),
+        ):
+            object.__setattr__(self, key, value)
+
+    def __setattr__(self, key: str, value: Any) -> None:
+        raise AttributeError("Robot is immutable (use with_parameters, with_tensions, ...)")
+
+    # ------------------------------------------------------------------ construction
+
+    @classmethod
+    def from_spec(cls, spec: RobotFile, *, name: str = "robot", source: str | None = None) -> Robot:
+        """Builds the robot of a validated description (``name`` if it has none).
+
+        Raises:
+            ParameterError: Every constructor error, located in the file (``errors``).
+        """
+        if spec.name is None:
+            spec = spec.model_copy(update={"name": name})
+        parts = _objects.build(spec, source)
+        robot = object.__new__(cls)
+        robot._set(
+            spec.name,
+            spec.description,
+            parts.rod,
+            parts.tendons,
+            parts.chambers,
+            parts.loads,
+            spec.loads is not None,
+            parts.solver,
+            spec,
+        )
+        return robot
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], name: str = "robot") -> Robot:
-        """Builds a robot from a parsed description (the TOML file's tables)."""
-        top = _Fields(data, "")
-        rod = _rod(_Fields(top.get("rod", required=True), "rod"))
-        tendons = tuple(
-            _tendon(_Fields(t, f"tendons[{i}]")) for i, t in enumerate(top.get("tendons", []))
+        """Builds a robot from a parsed description (the TOML file's tables).
+
+        Raises:
+            ParameterError: Every error of the description (``errors``, each located).
+        """
+        return cls.from_spec(_rf.validate_robot_dict(_plain(data)), name=name)
+
+    @classmethod
+    def from_toml(cls, text: str, name: str = "robot") -> Robot:
+        """Builds a robot from the text of a robot file."""
+        try:
+            data = _rf.tomllib.loads(text)
+        except _rf.tomllib.TOMLDecodeError as exc:
+            _rf.raise_errors([FieldError("", f"not valid TOML: {exc}", kind="type")])
+        return cls.from_dict(data, name=name)
+
+    # ------------------------------------------------------------------ attributes
+
+    name = property(lambda self: self._name, doc="A label.")
+    description = property(lambda self: self._description, doc="Free text.")
+    rod = property(lambda self: self._rod, doc="The rod model.")
+    tendons = property(lambda self: self._tendons, doc="Tendons, in order.")
+    chambers = property(lambda self: self._chambers, doc="Pneumatic chambers, in order.")
+    loads = property(lambda self: self._loads, doc="External loads.")
+
+    @property
+    def solver(self) -> dict[str, Any]:
+        """Keyword arguments for :func:`softrod.solve_statics` (a copy)."""
+        return dict(self._solver)
+
+    @property
+    def spec(self) -> RobotFile:
+        """The validated description of this robot.
+
+        Raises:
+            ParameterError: For a robot built in code whose objects cannot be described (a
+                Python callable, or properties the model objects do not expose yet).
+        """
+        if self._spec is None:
+            spec = _objects.describe(*self._parts())
+            object.__setattr__(self, "_spec", spec)
+        return self._spec
+
+    @property
+    def source(self) -> dict[str, Any]:
+        """The description as the file's tables (empty if the robot cannot be described)."""
+        try:
+            spec = self.spec
+        except ParameterError:
+            return {}
+        return spec.model_dump(mode="python", exclude_unset=True, exclude_none=True)
+
+    # ------------------------------------------------------------------ solving
+
+    def solve(
+        self,
+        tensions: Sequence[float] | np.ndarray | None = None,
+        pressures: Sequence[float] | np.ndarray | None = None,
+        **options: Any,
+    ) -> StaticsSolution:
+        """Solves the statics under an actuation.
+
+        Args:
+            tensions: Tendon tensions (N), one per tendon; default the robot's.
+            pressures: Chamber pressures (Pa, gauge), one per chamber; default the robot's.
+            **options: Options of :func:`softrod.solve_statics` overriding the robot's
+                (``steps``, ``warm_start``, ``throw``, ...).
+
+        Returns:
+            The solution.
+
+        Raises:
+            ParameterError: Bad actuation (wrong count) or options.
+            ConvergenceError: The solver did not converge (unless ``throw=False``).
+        """
+        tendons = self._tendons if tensions is None else self._tensioned(tensions)
+        chambers = self._chambers if pressures is None else self._pressurised(pressures)
+        merged = {**self._solver, **options}
+        if chambers:
+            merged.setdefault("chambers", chambers)
+        return solve_statics(self._rod, tendons, self._loads, **merged)
+
+    def _tensioned(self, tensions: Any) -> tuple[Tendon, ...]:
+        values = _actuation(tensions, len(self._tendons), "tensions", "tendon")
+        return tuple(t.with_tension(x) for t, x in zip(self._tendons, values, strict=True))
+
+    def _pressurised(self, pressures: Any) -> tuple[Chamber, ...]:
+        values = _actuation(pressures, len(self._chambers), "pressures", "chamber")
+        return tuple(c.with_pressure(p) for c, p in zip(self._chambers, values, strict=True))
+
+    def _replace(self, **changes: Any) -> Robot:
+        new = object.__new__(Robot)
+        state = {k: getattr(self, k) for k in Robot.__slots__}
+        state.update({f"_{k}": v for k, v in changes.items()})
+        for k, v in state.items():
+            object.__setattr__(new, k, v)
+        return new
+
+    def _with_actuation(self, field: str, key: str, items: tuple) -> Robot:
+        """A copy with new tendons or chambers, their tensions or pressures also written into
+        the description (when there is one)."""
+        spec = self._spec
+        if spec is not None:
+            tables = [
+                t.model_copy(update={key: float(getattr(new, key))})
+                for t, new in zip(getattr(spec, field), items, strict=True)
+            ]
+            spec = spec.model_copy(update={field: tables})
+        return self._replace(**{field: items, "spec": spec})
+
+    def with_tensions(self, tensions: Sequence[float] | np.ndarray) -> Robot:
+        """The same robot with new tendon tensions (N), one per tendon."""
+        return self._with_actuation("tendons", "tension", self._tensioned(tensions))
+
+    def with_pressures(self, pressures: Sequence[float] | np.ndarray) -> Robot:
+        """The same robot with new chamber pressures (Pa, gauge), one per chamber."""
+        return self._with_actuation("chambers", "pressure", self._pressurised(pressures))
+
+    # ------------------------------------------------------------------ design parameters
+
+    def parameter(self, path: str) -> Any:
+        """One value of the robot's description, by its path in the file.
+
+        Args:
+            path: E.g. ``"rod.material.youngs_modulus"``, ``"tendons[2].distance"``,
+                ``"chambers[1].pressure"``, ``"loads.tip_force"``, ``"rod.length"``.
+
+        Returns:
+            The value (defaults filled in; ``None`` for an optional value not given).
+
+        Raises:
+            ParameterError: A path that is not in the description (with a suggestion).
+        """
+        node: Any = self.spec
+        walked: list[str | int] = []
+        for part in _parse_path(path):
+            if isinstance(part, int):
+                if not isinstance(node, list) or not 0 <= part < len(node):
+                    size = len(node) if isinstance(node, list) else 0
+                    raise _bad_path(
+                        path, f"an index in [0, {size}) for `{_rf.format_location(walked)}`"
+                    )
+                node = node[part]
+            else:
+                fields = type(node).model_fields if isinstance(node, _rf.BaseModel) else {}
+                if part not in fields:
+                    hint = _rf._suggest(part, list(fields))
+                    where = _rf.format_location(walked) or "the robot"
+                    known = (
+                        f"; did you mean `{hint}`?" if hint else f" (known: {', '.join(fields)})"
+                    )
+                    raise _bad_path(path, f"a key of {where}{known}")
+                node = getattr(node, part)
+            walked.append(part)
+        if isinstance(node, _rf.BaseModel):
+            return node.model_dump(mode="python", exclude_none=True)
+        return node
+
+    def with_parameters(self, values: Mapping[str, Any]) -> Robot:
+        """A new robot with parameters of the description changed, validated and rebuilt.
+
+        Args:
+            values: Path -> new value, paths as in the robot file: ``rod.section.tip_radius``,
+                ``tendons[2].distance``, ``rod.material.youngs_modulus``,
+                ``tendons[0].tension``, ``chambers[1].pressure``, a whole table
+                (``rod.material``) or a list entry (``loads.tip_force[2]``).
+
+        Returns:
+            The new robot (this one is unchanged).
+
+        Raises:
+            ParameterError: Any invalid value, unknown key (with a suggestion) or index out
+                of range, all reported at once at their paths.
+        """
+        data = self.spec.model_dump(mode="python", exclude_unset=True, exclude_none=True)
+        errors: list[FieldError] = []
+        for path, value in values.items():
+            try:
+                _set_path(data, _parse_path(path), _plain(value))
+            except ParameterError as exc:
+                errors.append(FieldError(str(path), str(exc), None, "unknown_key"))
+        try:
+            spec = _rf.validate_robot_dict(data)
+        except ParameterError as exc:
+            _rf.raise_errors([*errors, *exc.errors])
+        if errors:
+            _rf.raise_errors(errors)
+        return Robot.from_spec(spec, name=self._name)
+
+    # ------------------------------------------------------------------ files
+
+    def to_toml(self) -> str:
+        """The robot as the text of a robot file (``load_robot`` reads it back equal).
+
+        Raises:
+            ParameterError: For a robot built in code that cannot be described (named).
+        """
+        return _rf.dump_robot_toml(self.spec)
+
+    def write_toml(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> None:
+        """Writes the robot file.
+
+        Args:
+            path: The ``.toml`` file.
+            overwrite: Replace an existing file (default: refuse).
+
+        Raises:
+            FileExistsError: ``path`` exists and ``overwrite`` is false.
+            ParameterError: The robot cannot be described (see :meth:`to_toml`).
+        """
+        text = self.to_toml()
+        with open(path, "w" if overwrite else "x", encoding="utf-8") as fh:
+            fh.write(text)
+
+    # ------------------------------------------------------------------ protocol
+
+    def _described(self) -> RobotFile | None:
+        try:
+            return self.spec
+        except ParameterError:
+            return None
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Robot):
+            return NotImplemented
+        a, b = self._described(), other._described()
+        if a is not None and b is not None:
+            return a == b
+        return (
+            self._name == other._name
+            and self._description == other._description
+            and self._rod is other._rod
+            and len(self._tendons) == len(other._tendons)
+            and all(x is y for x, y in zip(self._tendons, other._tendons, strict=True))
+            and len(self._chambers) == len(other._chambers)
+            and all(x is y for x, y in zip(self._chambers, other._chambers, strict=True))
+            and self._loads is other._loads
+            and self._solver == other._solver
         )
-        chambers = tuple(
-            _chamber(_Fields(c, f"chambers[{i}]")) for i, c in enumerate(top.get("chambers", []))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return (
+            f"Robot(name={self._name!r}, rod={self._rod!r}, tendons={len(self._tendons)}, "
+            f"chambers={len(self._chambers)})"
         )
-        loads = _loads(_Fields(top.get("loads", {}), "loads"))
-        _check_across(top.table, rod, tendons, chambers)
-        sf = _Fields(top.get("solver", {}), "solver")
-        solver = {k: sf.get(k) for k in sorted(set(sf.table) & _SOLVER_KEYS)}
-        sf.finish()
-        robot = cls(
-            name=str(top.get("name", name)),
-            rod=rod,
-            tendons=tendons,
-            loads=loads,
-            solver=solver,
-            description=str(top.get("description", "")),
-            chambers=chambers,
-            source=data,
+
+    def _parts(self) -> tuple:
+        """The constructor arguments: rod, tendons, chambers, loads, solver, name,
+        description."""
+        loads = self._loads if self._loads_given else None
+        return (
+            self._rod,
+            self._tendons,
+            self._chambers,
+            loads,
+            self._solver,
+            self._name,
+            self._description,
         )
-        top.finish()
-        return robot
+
+    def __reduce__(self):
+        if self._spec is not None:
+            return (_from_pickled_spec, (self._spec,))
+        parts = self._parts()
+        try:
+            pickle.dumps(parts)
+        except (TypeError, pickle.PicklingError, AttributeError):
+            try:
+                return (_from_pickled_spec, (self.spec,))
+            except ParameterError as exc:
+                raise pickle.PicklingError(f"cannot pickle this Robot: {exc}") from None
+        return (Robot, parts)
+
+
+def _from_pickled_spec(spec: RobotFile) -> Robot:
+    return Robot.from_spec(spec)
+
+
+_MINIMAL_ROD = {
+    "length": 1.0,
+    "section": {"radius": 1.0},
+    "material": {"youngs_modulus": 1.0},
+}
+
+
+def _actuation(values: Any, n: int, name: str, what: str) -> list[float]:
+    try:
+        out = [float(v) for v in np.asarray(values, dtype=float).ravel()]
+    except (TypeError, ValueError):
+        raise TypeError(f"invalid parameter `{name}` = {values!r}: must be numbers") from None
+    if len(out) != n:
+        exc = ParameterError(
+            f"invalid parameter `{name}` with {len(out)} values: must have one per {what} ({n})"
+        )
+        exc.parameter = name
+        raise exc
+    return out
+
+
+def _set_path(data: dict[str, Any], parts: list[str | int], value: Any) -> None:
+    """Sets ``value`` at a path of nested tables and arrays, creating missing tables."""
+    node: Any = data
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        where = _rf.format_location(parts[: i + 1])
+        if isinstance(part, int):
+            if not isinstance(node, list) or not 0 <= part < len(node):
+                size = len(node) if isinstance(node, list) else 0
+                raise ParameterError(f"no entry `{where}` (the robot has {size})")
+        elif not isinstance(node, dict):
+            raise ParameterError(f"`{_rf.format_location(parts[:i])}` is not a table")
+        if last:
+            node[part] = value
+        else:
+            if isinstance(part, str) and part not in node:
+                node[part] = {}
+            node = node[part]
 
 
 def load_robot(path: str | os.PathLike[str]) -> Robot:
     """Reads a robot description file (TOML).
 
     Args:
-        path: The ``.toml`` file.
+        path: The ``.toml`` file (see :mod:`softrod.examples` for the shipped ones).
 
     Returns:
-        The robot, ready to :meth:`Robot.solve`.
+        The robot, ready to :meth:`Robot.solve`; named by the file's ``name`` or its stem.
 
     Raises:
-        ParameterError: A missing, unknown or invalid field (named in the message), or a file
-            that is not valid TOML.
+        OSError: The file cannot be read.
+        ParameterError: A file that is not UTF-8 TOML, or every missing, unknown or invalid
+            field of it, located (``errors`` lists them, ``parameter`` is the first).
     """
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"invalid robot file {os.fspath(path)!r}: {exc}") from None
-    return Robot.from_dict(data, name=os.path.splitext(os.path.basename(path))[0])
+    name = os.fspath(path)
+    data = _rf.read_robot_toml(path)
+    stem = os.path.splitext(os.path.basename(name))[0]
+    spec = _rf.validate_robot_dict(data, source=name)
+    return Robot.from_spec(spec, name=stem, source=name)

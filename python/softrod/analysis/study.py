@@ -17,12 +17,13 @@ import sys
 import time
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, Literal, TextIO
 
 import numpy as np
 
-from ._core import ConvergenceError, ParameterError, UniaxialLaw
-from .robot import Robot, _Fields, _material, tomllib
+from .._core import ConvergenceError, ParameterError, UniaxialLaw
+from ..io.objects import build_material
+from ..robot import Robot, load_robot
 
 __all__ = ["StudyResult", "seed001_study"]
 
@@ -54,18 +55,18 @@ class StudyResult:
     elongation: np.ndarray
 
 
-def _linear_twin(data: dict[str, Any]) -> tuple[dict[str, Any], float]:
-    """The same robot description with the linear material of the law's small-strain modulus."""
-    mat_table = data["rod"]["material"]
-    law = _material(_Fields(mat_table, "rod.material"))
-    if isinstance(law, UniaxialLaw):
-        e0 = law.small_strain_modulus
-    else:
-        e0 = law.youngs_modulus
-    twin = {
-        **data,
-        "rod": {**data["rod"], "material": {"youngs_modulus": e0, "poisson_ratio": 0.5}},
-    }
+def _linear_twin(robot: Robot) -> tuple[Robot, float]:
+    """The same robot with the linear material of its law's small-strain modulus."""
+    law = getattr(robot.rod, "material", None)
+    if law is None:
+        law = build_material(robot.spec.rod.material, [])
+    e0 = law.small_strain_modulus if isinstance(law, UniaxialLaw) else law.youngs_modulus
+    twin = robot.with_parameters(
+        {
+            "name": f"{robot.name}-linear",
+            "rod.material": {"youngs_modulus": e0, "poisson_ratio": 0.5},
+        }
+    )
     return twin, e0
 
 
@@ -73,13 +74,24 @@ def _pair_pressures(p: tuple[float, float, float]) -> list[float]:
     return [p[0], p[0], p[1], p[1], p[2], p[2]]
 
 
-def _run(robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray) -> StudyResult:
-    from . import compliance, eigenscrews
+def _run(
+    robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray, progress: bool | None
+) -> StudyResult:
+    from .. import compliance, eigenscrews
 
     grid = np.array(list(itertools.product(levels, repeat=3)))
     tips = np.full((len(grid), 3), np.nan)
     cmax = np.full(len(grid), np.nan)
-    for i, p in enumerate(grid):
+    from tqdm.auto import tqdm
+
+    bar = tqdm(
+        grid,
+        desc=f"study ({material})",
+        unit="config",
+        disable=None if progress is None else not progress,
+        file=sys.stderr,
+    )
+    for i, p in enumerate(bar):
         try:
             sol = robot.with_pressures(_pair_pressures(tuple(p))).solve()
         except (ConvergenceError, ParameterError):
@@ -110,18 +122,19 @@ def _run(robot: Robot, material: str, levels: np.ndarray, gamma_p: np.ndarray) -
 
 
 def seed001_study(
-    robot_path: str | os.PathLike[str],
+    robot_path: str | os.PathLike[str] | Robot,
     *,
     levels: int = 13,
     max_pressure: float = 60e3,
     gamma_pressures: tuple[float, ...] = (0.0, 10e3, 20e3, 30e3, 40e3),
     out_dir: str | os.PathLike[str] | None = None,
-    log=sys.stdout,
+    log: TextIO | Literal["stdout"] | None = "stdout",
+    progress: bool | None = False,
 ) -> dict[str, StudyResult]:
     """Runs seed 001's study on a three-chamber-pair robot, hyperelastic and linear.
 
     Args:
-        robot_path: Robot description file with six chambers (pairs 0-1, 2-3, 4-5) and a
+        robot_path: A robot, or its description file, with six chambers (pairs 0-1, 2-3, 4-5) and a
             hyperelastic (or linear) material.
         levels: Pressure levels per pair on ``[0, max_pressure]`` (``levels**3`` configurations
             per material).
@@ -129,7 +142,10 @@ def seed001_study(
         gamma_pressures: P1 = P2 pressures (Pa) of the ``gamma_c(s)`` curves.
         out_dir: Folder for the figures (``seed001_workspace_<material>.png``,
             ``seed001_gamma_c_<material>.png``); ``None`` draws nothing.
-        log: Where the summary is printed (``None``: silent).
+        progress: Progress bars (tqdm) on stderr: True, False, or None for only when stderr
+            is a terminal.
+        log: Where the summary is printed: ``"stdout"`` (the current ``sys.stdout``, the
+            default), an open text file, or ``None`` (silent).
 
     Returns:
         The results by material, ``"hyperelastic"`` and ``"linear"``.
@@ -137,28 +153,27 @@ def seed001_study(
     Raises:
         ParameterError: A robot without exactly six chambers, or bad arguments.
     """
+    if isinstance(log, str) and log == "stdout":
+        log = sys.stdout
     if levels < 2:
         raise ParameterError(f"invalid parameter `levels` = {levels}: must be >= 2")
     if not (np.isfinite(max_pressure) and max_pressure > 0):
         raise ParameterError(
             f"invalid parameter `max_pressure` = {max_pressure}: must be finite and > 0 Pa"
         )
-    with open(robot_path, "rb") as fh:
-        data = tomllib.load(fh)
-    name = os.path.splitext(os.path.basename(robot_path))[0]
-    robot = Robot.from_dict(data, name=name)
+    robot = robot_path if isinstance(robot_path, Robot) else load_robot(robot_path)
     if len(robot.chambers) != 6:
         raise ParameterError(
-            f"invalid parameter `robot_path` = {os.fspath(robot_path)!r}: the study needs six "
-            f"chambers (three pairs), the file has {len(robot.chambers)}"
+            f"invalid parameter `robot_path` = {robot.name!r}: the study needs six "
+            f"chambers (three pairs), the robot has {len(robot.chambers)}"
         )
-    twin_data, e0 = _linear_twin(data)
-    models = {"hyperelastic": robot, "linear": Robot.from_dict(twin_data, name=name + "-linear")}
+    twin, e0 = _linear_twin(robot)
+    models = {"hyperelastic": robot, "linear": twin}
     grid = np.linspace(0.0, max_pressure, levels)
     out: dict[str, StudyResult] = {}
     for material, rb in models.items():
         t0 = time.perf_counter()
-        res = _run(rb, material, grid, np.asarray(gamma_pressures))
+        res = _run(rb, material, grid, np.asarray(gamma_pressures), progress)
         out[material] = res
         if log is not None:
             print(
@@ -198,7 +213,7 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .plot import plot_gamma_c, plot_workspace_map
+    from ..plot import plot_gamma_c, plot_workspace_map
 
     os.makedirs(out_dir, exist_ok=True)
     for material, res in out.items():

@@ -12,16 +12,18 @@ import math
 import os
 import statistics
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from . import pcc
-from ._core import ParameterError, PlanarCableArm
+from .. import pcc
+from .._core import ParameterError, PlanarCableArm
+from ..io import robot_file as rf
+from ..io.robot_file import RobotFile
+from ..robot import Robot, load_robot
 from .compare import backbone_distance
-from .robot import Robot, load_robot
 
 __all__ = ["ModelComparison", "ModelResult", "compare_models"]
 
@@ -29,10 +31,7 @@ __all__ = ["ModelComparison", "ModelResult", "compare_models"]
 DEFAULT_REPEATS = 5
 #: Relative tolerance on segment breaks (m/m): closer tendon ends or chamber bounds merge.
 _END_TOLERANCE = 1e-12
-_NO_SOURCE = (
-    "the robot has no description to map (build it with load_robot or Robot.from_dict; "
-    "sections, materials and routings are read from it)"
-)
+_NO_SOURCE = "the robot's section, material and routings cannot be read back to map it"
 
 
 @dataclass(frozen=True)
@@ -73,7 +72,7 @@ class ModelResult:
 
 @dataclass(frozen=True)
 class ModelComparison:
-    """Every model's result for one robot, Cosserat first.
+    """Every model's result for one robot, Cosserat first (SI units: m, rad, s).
 
     Attributes:
         robot: The robot's name.
@@ -140,42 +139,44 @@ def _tangent_angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(math.atan2(np.linalg.norm(np.cross(a, b)), np.dot(a, b)))
 
 
-def _tables(robot: Robot) -> tuple[dict, list, list, dict]:
-    src = robot.source
-    rod = dict(src.get("rod", {}))
-    return rod, list(src.get("tendons", [])), list(src.get("chambers", [])), src.get("loads", {})
+def _linear_modulus(spec: RobotFile) -> float | None:
+    mat = spec.rod.material
+    return mat.youngs_modulus if isinstance(mat, rf.LinearMaterialSpec) else None
 
 
-def _linear_modulus(rod: Mapping[str, Any]) -> float | None:
-    mat = rod.get("material", {})
-    if mat.get("silicone") is not None or mat.get("type", "linear") != "linear":
-        return None
-    return float(mat["youngs_modulus"])
-
-
-def _offset(t: Mapping[str, Any]) -> tuple[float, float]:
-    """Distance (m) and angle (rad) of a constant-offset tendon or chamber table."""
-    if "offset" in t:
-        x, y = t["offset"]
+def _offset(t: Any) -> tuple[float, float]:
+    """Distance (m) and angle (rad) of a constant-offset tendon or chamber."""
+    if t.offset is not None:
+        x, y = t.offset
         return math.hypot(x, y), math.atan2(y, x)
-    return float(t["distance"]), math.radians(t.get("angle_deg", 0.0))
+    return float(t.distance), math.radians(t.angle_deg or 0.0)
 
 
 def _nonzero(v) -> bool:
     return v is not None and any(float(x) != 0.0 for x in v)
 
 
-def _external_loads(loads: Mapping[str, Any]) -> list[str]:
+def _external_loads(loads: rf.LoadsSpec | None) -> list[str]:
     """Names of the non-zero external loads other than a world-frame tip wrench."""
+    if loads is None:
+        return []
     out = [
-        k for k in ("gravity", "distributed_force", "distributed_moment") if _nonzero(loads.get(k))
+        k
+        for k in ("gravity", "distributed_force", "distributed_moment")
+        if _nonzero(getattr(loads, k))
     ]
-    if loads.get("point_loads"):
+    if loads.point_loads:
         out.append("point_loads")
-    tip = _nonzero(loads.get("tip_force")) or _nonzero(loads.get("tip_moment"))
-    if tip and loads.get("tip_frame", "world") != "world":
+    tip = _nonzero(loads.tip_force) or _nonzero(loads.tip_moment)
+    if tip and loads.tip_frame != "world":
         out.append("a body-frame (follower) tip wrench")
     return out
+
+
+def _tip_wrench(loads: rf.LoadsSpec | None) -> tuple[list[float], list[float]]:
+    if loads is None:
+        return [0.0] * 3, [0.0] * 3
+    return loads.tip_force or [0.0] * 3, loads.tip_moment or [0.0] * 3
 
 
 def _base(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
@@ -183,42 +184,37 @@ def _base(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     return pose[:3, :3], pose[:3, 3]
 
 
-def _planar(robot: Robot, s: np.ndarray, repeats: int) -> ModelResult:
-    rod, tendons, chambers, loads = _tables(robot)
-    sec = rod.get("section", {})
-    kind = sec.get("type", "circular")
+def _planar(robot: Robot, spec: RobotFile, s: np.ndarray, repeats: int) -> ModelResult:
+    rod, tendons = spec.rod, spec.tendons
+    sec = rod.section
+    kind = sec.type
     why = []
-    if len(robot.tendons) != 1:
-        why.append(f"{len(robot.tendons)} tendons (needs exactly one)")
-    elif tendons[0].get("routing", "constant") != "radius_proportional":
+    if len(tendons) != 1:
+        why.append(f"{len(tendons)} tendons (needs exactly one)")
+    elif tendons[0].routing != "radius_proportional":
         why.append("the tendon is not radius-proportional")
     if kind not in ("circular", "tapered"):
         why.append(f"a {kind} section (needs a circular or tapered solid circle)")
-    modulus = _linear_modulus(rod)
+    modulus = _linear_modulus(spec)
     if modulus is None:
         why.append("a hyperelastic material (needs linear elastic)")
-    if chambers:
+    if spec.chambers:
         why.append("pneumatic chambers")
-    if (
-        _external_loads(loads)
-        or _nonzero(loads.get("tip_force"))
-        or _nonzero(loads.get("tip_moment"))
-    ):
+    force, moment = _tip_wrench(spec.loads)
+    if _external_loads(spec.loads) or _nonzero(force) or _nonzero(moment):
         why.append("external loads")
-    if _nonzero(rod.get("rest_strain")) or _nonzero(rod.get("rest_curvature")):
+    if _nonzero(rod.rest_strain) or _nonzero(rod.rest_curvature):
         why.append("a rest strain or curvature")
     if why:
         return ModelResult("planar", False, "; ".join(why))
-    r0 = float(sec["radius"] if kind == "circular" else sec["base_radius"])
-    rl = float(sec["radius"] if kind == "circular" else sec["tip_radius"])
+    r0 = float(sec.radius if kind == "circular" else sec.base_radius)
+    rl = float(sec.radius if kind == "circular" else sec.tip_radius)
     end = robot.tendons[0].end
     anchor = robot.rod.length if end is None else float(end)
-    arm = PlanarCableArm(
-        robot.rod.length, r0, rl, float(tendons[0]["ratio"]), modulus, anchor=anchor
-    )
+    arm = PlanarCableArm(robot.rod.length, r0, rl, float(tendons[0].ratio), modulus, anchor=anchor)
     tension = robot.tendons[0].tension
     sol, dt = _median_time(lambda: arm.solve(tension, s=s), repeats)
-    beta = math.radians(tendons[0].get("angle_deg", 0.0))
+    beta = math.radians(tendons[0].angle_deg)
     d = np.array([math.cos(beta), math.sin(beta), 0.0])
     ez = np.array([0.0, 0.0, 1.0])
     rb, pb = _base(robot)
@@ -227,7 +223,7 @@ def _planar(robot: Robot, s: np.ndarray, repeats: int) -> ModelResult:
     tangent = rb @ (math.cos(th) * ez + math.sin(th) * d)
     note = (
         f"PlanarCableArm(L={robot.rod.length:g}, R0={r0:g}, RL={rl:g}, "
-        f"ratio={tendons[0]['ratio']:.4g}, E={modulus:g}, anchor={anchor:g}); planar y along the "
+        f"ratio={tendons[0].ratio:.4g}, E={modulus:g}, anchor={anchor:g}); planar y along the "
         f"tendon at {math.degrees(beta):g} deg"
     )
     return ModelResult(
@@ -242,24 +238,24 @@ def _planar(robot: Robot, s: np.ndarray, repeats: int) -> ModelResult:
     )
 
 
-def _pcc(robot: Robot, s: np.ndarray, repeats: int) -> ModelResult:
-    rod, tendons, chambers, loads = _tables(robot)
-    sec = rod.get("section", {})
-    kind = sec.get("type", "circular")
+def _pcc(robot: Robot, spec: RobotFile, s: np.ndarray, repeats: int) -> ModelResult:
+    rod, tendons, chambers = spec.rod, spec.tendons, spec.chambers
+    sec = rod.section
+    kind = sec.type
     length = robot.rod.length
     why = []
     if kind != "circular":
         why.append(f"a {kind} section (needs a uniform circular one)")
-    modulus = _linear_modulus(rod)
+    modulus = _linear_modulus(spec)
     if modulus is None:
         why.append("a hyperelastic material (needs linear elastic)")
-    bad = [i for i, t in enumerate(tendons) if t.get("routing", "constant") != "constant"]
+    bad = [i for i, t in enumerate(tendons) if t.routing != "constant"]
     if bad:
         why.append(f"tendons {bad} are not at a constant offset")
-    ext = _external_loads(loads)
+    ext = _external_loads(spec.loads)
     if ext:
         why.append("external loads other than a world tip wrench: " + ", ".join(ext))
-    if _nonzero(rod.get("rest_strain")) or _nonzero(rod.get("rest_curvature")):
+    if _nonzero(rod.rest_strain) or _nonzero(rod.rest_curvature):
         why.append("a rest strain or curvature")
     if why:
         return ModelResult("pcc", False, "; ".join(why))
@@ -281,7 +277,7 @@ def _pcc(robot: Robot, s: np.ndarray, repeats: int) -> ModelResult:
         return int(np.argmin([abs(b - end) for b in breaks[1:]]))
 
     model = pcc.Robot.solid_circle(
-        rest, float(sec["radius"]), modulus, extensible=not robot.rod.inextensible
+        rest, float(sec.radius), modulus, extensible=not robot.rod.inextensible
     )
     for t, table in zip(robot.tendons, tendons, strict=True):
         dist, ang = _offset(table)
@@ -297,8 +293,9 @@ def _pcc(robot: Robot, s: np.ndarray, repeats: int) -> ModelResult:
             )
             pressures.append(c.pressure)
     rb, pb = _base(robot)
-    force = rb.T @ np.asarray(loads.get("tip_force", [0.0] * 3), dtype=float)
-    moment = rb.T @ np.asarray(loads.get("tip_moment", [0.0] * 3), dtype=float)
+    tip_force, tip_moment = _tip_wrench(spec.loads)
+    force = rb.T @ np.asarray(tip_force, dtype=float)
+    moment = rb.T @ np.asarray(tip_moment, dtype=float)
     tensions = [t.tension for t in robot.tendons]
     sol, dt = _median_time(
         lambda: pcc.solve(model, tensions, pressures, tip_force=force, tip_moment=moment),
@@ -380,11 +377,15 @@ def compare_models(
     )
     results = [ref]
     s_nodes = np.unique(np.asarray(sol.s))
+    try:
+        spec = robot.spec
+    except ParameterError as exc:
+        spec, why = None, f"{_NO_SOURCE}: {exc}"
     for model, build in (("pcc", _pcc), ("planar", _planar)):
-        if not robot.source:
-            results.append(ModelResult(model, False, _NO_SOURCE))
+        if spec is None:
+            results.append(ModelResult(model, False, why))
             continue
-        r = build(robot, s_nodes, int(repeats))
+        r = build(robot, spec, s_nodes, int(repeats))
         if r.applies:
             d = backbone_distance(r.positions, ref.positions)
             angle = (

@@ -16,15 +16,28 @@ The laws, the fit and the silicone library are in the compiled core and re-expor
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ._core import ParameterError, UniaxialFit, fit_uniaxial
+from .._core import ParameterError, UniaxialFit, fit_uniaxial
 
-__all__ = ["TensileCurve", "read_tensile_csv"]
+__all__ = ["FitCheck", "TensileCurve", "check_fit", "read_tensile_csv"]
+
+#: Engineering strain below which the data's initial slope is measured.
+INITIAL_STRAIN = 0.1
+#: Fewest points the initial slope is measured on (the smallest strains, if fewer lie below
+#: :data:`INITIAL_STRAIN`).
+INITIAL_POINTS = 3
+#: A fit is plausible at small strain if its small-strain modulus is within this factor of the
+#: data's initial slope (either way).
+PLAUSIBLE_MODULUS_RATIO = 3.0
+#: Stretches at which the sign of a fitted law's tangent is checked, from 1 to the top of the
+#: fitted range.
+TANGENT_SAMPLES = 400
 
 #: Factors from the accepted stress units to Pa.
 STRESS_UNITS = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
@@ -79,6 +92,23 @@ class TensileCurve:
 
     def __len__(self) -> int:
         return len(self.strain)
+
+    def initial_slope(self) -> float:
+        """The data's small-strain modulus (Pa): least-squares slope through the origin of
+        nominal stress against engineering strain over the points below
+        :data:`INITIAL_STRAIN` (at least the :data:`INITIAL_POINTS` smallest strains)."""
+        stretch = self.stretch
+        nominal = np.asarray(self.stress, dtype=float)
+        if self.stress_measure == "true":
+            nominal = nominal / stretch
+        strain = stretch - 1.0
+        order = np.argsort(strain)
+        pick = strain <= INITIAL_STRAIN
+        if pick.sum() < INITIAL_POINTS:
+            pick = np.zeros(len(strain), dtype=bool)
+            pick[order[:INITIAL_POINTS]] = True
+        e, p = strain[pick], nominal[pick]
+        return float(np.sum(p * e) / np.sum(e * e))
 
     def fit(self, model: str = "yeoh", **options) -> UniaxialFit:
         """Fits a law to this curve: :func:`softrod.fit_uniaxial` with the curve's measures.
@@ -221,3 +251,72 @@ def read_tensile_csv(
     if header_at is not None:
         return _read_database(path, lines, header_at, columns)
     return _read_plain(path, lines, strain_measure, stress_measure, strain_unit, stress_unit)
+
+
+@dataclass(frozen=True)
+class FitCheck:
+    """Plausibility of a fitted law against its data.
+
+    Attributes:
+        small_strain_modulus: The law's E0 (Pa).
+        initial_slope: The data's initial slope (Pa), :meth:`TensileCurve.initial_slope`.
+        modulus_ratio: ``small_strain_modulus / initial_slope``.
+        modulus_plausible: The ratio is within :data:`PLAUSIBLE_MODULUS_RATIO` either way.
+        stretch_max: Top of the checked range (the fitted range's upper stretch).
+        tangent_positive: dP/dstretch > 0 on [1, stretch_max].
+        first_negative_stretch: The smallest checked stretch where it is not (else None).
+    """
+
+    small_strain_modulus: float
+    initial_slope: float
+    modulus_ratio: float
+    modulus_plausible: bool
+    stretch_max: float
+    tangent_positive: bool
+    first_negative_stretch: float | None
+
+    @property
+    def plausible(self) -> bool:
+        """Both checks pass."""
+        return self.modulus_plausible and self.tangent_positive
+
+    def summary(self) -> str:
+        """One line: both checks and the verdict."""
+        ratio = self.modulus_ratio
+        tangent = (
+            f"dP/dstretch > 0 on [1, {self.stretch_max:.4g}]"
+            if self.tangent_positive
+            else f"dP/dstretch <= 0 at stretch {self.first_negative_stretch:.4g}"
+        )
+        verdict = "plausible" if self.plausible else "NOT plausible"
+        return (
+            f"{verdict}: E0 / initial slope of the data ({self.initial_slope / 1e3:.4g} kPa) "
+            f"= {ratio:.3g} (accepted within x{PLAUSIBLE_MODULUS_RATIO:g}), {tangent}"
+        )
+
+
+def check_fit(curve: TensileCurve, fit: UniaxialFit) -> FitCheck:
+    """Checks a fit for plausibility: its small-strain modulus against the data's initial
+    slope, and the sign of its tangent from the unstretched state to the top of the fit.
+
+    A fit can have a small residual and still be useless at small strain (a Mooney-Rivlin fit
+    to large stretches with E0 a fiftieth of the measured one) or unstable inside its range.
+    """
+    law = fit.model
+    e0 = float(law.small_strain_modulus)
+    slope = curve.initial_slope()
+    ratio = e0 / slope if slope > 0 else math.inf
+    plausible_modulus = 1.0 / PLAUSIBLE_MODULUS_RATIO <= ratio <= PLAUSIBLE_MODULUS_RATIO
+    top = float(fit.stretch_range[1])
+    stretches = np.linspace(1.0, max(top, 1.0), TANGENT_SAMPLES)
+    tangent = np.asarray(law.nominal_tangent(stretches), dtype=float)
+    bad = np.flatnonzero(~(tangent > 0))
+    return FitCheck(
+        small_strain_modulus=e0,
+        initial_slope=slope,
+        modulus_ratio=ratio,
+        modulus_plausible=bool(plausible_modulus),
+        stretch_max=top,
+        tangent_positive=len(bad) == 0,
+        first_negative_stretch=float(stretches[bad[0]]) if len(bad) else None,
+    )

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ._core import ParameterError, PlanarSolution, StaticsSolution
+from .._core import ParameterError, PlanarSolution, StaticsSolution
 
 __all__ = [
     "read_backbone_csv",

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._core import Loads, Rod, Tendon, _workspace_map
+from .._core import Loads, ParameterError, Rod, Tendon, _workspace_map
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,7 @@ def tension_grid(n_tendons: int, axes: dict[int, np.ndarray]) -> np.ndarray:
     """
     keys = list(axes)
     if not 1 <= len(keys) <= 2:
-        raise ValueError("axes must name one or two tendons")
+        raise ParameterError("invalid parameter `axes`: must name one or two tendons")
     a = np.asarray(axes[keys[0]], dtype=float)
     b = np.asarray(axes[keys[1]], dtype=float) if len(keys) == 2 else np.zeros(1)
     rows = []
@@ -71,14 +71,6 @@ def tension_grid(n_tendons: int, axes: dict[int, np.ndarray]) -> np.ndarray:
     return np.array(rows)
 
 
-def _bar(done: int, total: int, width: int = 40) -> None:
-    k = int(width * done / max(total, 1))
-    sys.stderr.write(f"\rworkspace [{'#' * k}{'.' * (width - k)}] {done}/{total}")
-    if done >= total:
-        sys.stderr.write("\n")
-    sys.stderr.flush()
-
-
 def workspace_map(
     rod: Rod,
     tendons,
@@ -87,7 +79,7 @@ def workspace_map(
     *,
     chunk: int = 64,
     block: int = 2000,
-    progress: bool = False,
+    progress: bool | None = False,
     tangent: str | None = None,
     **options,
 ) -> WorkspaceMap:
@@ -101,7 +93,8 @@ def workspace_map(
         loads: External loads (default none).
         chunk: Samples solved in order on one thread, each warm-started from the previous.
         block: Samples per call into the core (the progress bar advances per block).
-        progress: Draw a progress bar on stderr.
+        progress: Draw a progress bar (tqdm) on stderr: True, False, or None for only when
+            stderr is a terminal.
         tangent: Also compute the exact tangent tip compliance with the tendons at fixed
             ``"tension"`` or ``"length"`` (about four times the cost of a tendon-only solve).
         **options: Solver options of :func:`softrod.solve_statics` (``integrator``,
@@ -110,11 +103,22 @@ def workspace_map(
     Returns:
         The map; failed samples have ``converged`` False and NaN measures.
     """
+    from tqdm.auto import tqdm
+
     tendons: list[Tendon] = list(tendons)
     t = np.ascontiguousarray(np.atleast_2d(np.asarray(tensions, dtype=float)))
     parts = []
     total = len(t)
-    for start in range(0, total, max(int(block), 1)):
+    if int(block) < 1:
+        raise ParameterError(f"invalid parameter `block` = {block}: must be >= 1")
+    bar = tqdm(
+        total=total,
+        desc="workspace",
+        unit="config",
+        disable=(None if progress is None else not progress),
+        file=sys.stderr,
+    )
+    for start in range(0, total, int(block)):
         parts.append(
             _workspace_map(
                 rod,
@@ -126,10 +130,10 @@ def workspace_map(
                 **options,
             )
         )
-        if progress:
-            _bar(min(start + block, total), total)
+        bar.update(min(start + block, total) - start)
+    bar.close()
     if not parts:
-        raise ValueError("tensions must have at least one row")
+        raise ParameterError("invalid parameter `tensions`: must have at least one row")
 
     def cat(key):
         return np.concatenate([np.asarray(p[key]) for p in parts])

@@ -1,0 +1,278 @@
+"""Helpers shared by the command modules: robot arguments, output files, number formats.
+
+Each subcommand declares its file arguments with :func:`files`: ``inputs`` (read), ``outputs``
+(written) and, among them, ``figures`` (written by matplotlib). :func:`check_files` runs on
+them before any work: an output equal to an input or to another output, a figure with an
+extension matplotlib cannot write, or an output in a folder that does not exist is refused
+with a named error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+
+from .._core import ParameterError
+
+
+class UsageError(Exception):
+    """A command line that argparse rejects (exit status 2)."""
+
+
+class NoResultError(Exception):
+    """A computation that produced nothing to report (exit status 3): every sample failed."""
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line, raised instead of exiting."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise UsageError(f"{message} (see `{self.prog} --help`)")
+
+
+def bad(option: str, value: object, expected: str) -> ParameterError:
+    """A ParameterError naming a command-line option, worded like the core's."""
+    exc = ParameterError(f"invalid option `{option}` = {value!r}: {expected}")
+    exc.parameter = option
+    return exc
+
+
+def files(parser: argparse.ArgumentParser, *, inputs=(), outputs=(), figures=()) -> None:
+    """Declares which destinations of ``parser`` are input and output files."""
+    parser.set_defaults(_inputs=tuple(inputs), _outputs=tuple(outputs), _figures=tuple(figures))
+
+
+def option_name(dest: str) -> str:
+    """``gamma_plot`` -> ``--gamma-plot`` (``robot`` and ``file`` stay positional names)."""
+    if dest in ("robot", "file"):
+        return dest.upper()
+    return "--" + dest.replace("_", "-")
+
+
+def resolve_robot(arg: str) -> str:
+    """A robot argument as a file path: an existing file, or the name of a shipped example.
+
+    Raises:
+        FileNotFoundError: A path (with a folder or ``.toml``) that does not exist.
+        ParameterError: A bare name that is no example (with the closest one).
+    """
+    from .. import examples
+
+    if os.path.exists(arg):
+        return arg
+    looks_like_path = os.sep in arg or "/" in arg or arg.endswith(".toml")
+    if arg.removesuffix(".toml") in examples.names():
+        return str(examples.path(arg))
+    if looks_like_path:
+        raise FileNotFoundError(2, "No such file or directory", arg)
+    try:
+        examples.path(arg)
+    except ParameterError as exc:
+        raise bad("ROBOT", arg, f"no such file, and {str(exc).split(': ', 1)[1]}") from None
+    raise AssertionError("unreachable")
+
+
+def _same(a: str, b: str) -> bool:
+    try:
+        if os.path.exists(a) and os.path.exists(b):
+            return os.path.samefile(a, b)
+    except OSError:
+        pass
+    return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_files(args: argparse.Namespace) -> None:
+    """Refuses, before any work, outputs that would destroy an input or another output.
+
+    Raises:
+        ParameterError: Naming the option: an output equal to an input file or to another
+            output, a figure extension matplotlib cannot write, an output that is a folder or
+            whose folder does not exist.
+    """
+    inputs = [(d, getattr(args, d)) for d in getattr(args, "_inputs", ()) if getattr(args, d, None)]
+    outputs = [
+        (d, getattr(args, d)) for d in getattr(args, "_outputs", ()) if getattr(args, d, None)
+    ]
+    figures = set(getattr(args, "_figures", ()))
+    seen: list[tuple[str, str]] = []
+    for dest, path in outputs:
+        name = option_name(dest)
+        path = os.fspath(path)
+        for in_dest, in_path in inputs:
+            if _same(path, os.fspath(in_path)):
+                raise bad(
+                    name, path, f"is the input {option_name(in_dest)}; refusing to overwrite it"
+                )
+        for other, other_path in seen:
+            if _same(path, other_path):
+                raise bad(name, path, f"is also the output of {option_name(other)}")
+        if os.path.isdir(path) and dest != "out":
+            raise bad(name, path, "is a folder (give a file name)")
+        if dest == "out":
+            if os.path.exists(path) and not os.path.isdir(path):
+                raise bad(name, path, "is a file (give a folder)")
+        else:
+            folder = os.path.dirname(os.path.abspath(path))
+            if not os.path.isdir(folder):
+                raise bad(name, path, f"the folder {folder!r} does not exist")
+        if dest in figures:
+            from ..plot._figure import check_figure_path
+
+            check_figure_path(path, name)
+        seen.append((dest, path))
+
+
+#: Resolution of figures written by the command line unless ``--dpi`` says otherwise.
+DEFAULT_DPI = 130
+
+
+def save_figure(fig, path: str, dpi: float | None = DEFAULT_DPI, args=None) -> None:
+    """Writes ``fig`` to ``path`` (format from the extension: png, pdf, svg) and says so on
+    stderr; ``args`` with ``--dpi`` overrides ``dpi``."""
+    from ..plot import save_figure as _save
+
+    if args is not None and getattr(args, "dpi", None) is not None:
+        dpi = args.dpi
+    _save(fig, path, dpi=dpi)
+    print(f"wrote {path}", file=sys.stderr)
+
+
+def figure_options(args) -> dict:
+    """``size``, ``dpi`` and ``style`` keyword arguments of the plot functions from the
+    options added by :func:`add_figure_options`."""
+    size = getattr(args, "size", None)
+    return {
+        "size": tuple(size) if size else None,
+        "dpi": getattr(args, "dpi", None),
+        "style": getattr(args, "style", None),
+    }
+
+
+def add_figure_options(parser: argparse.ArgumentParser, *dests: str) -> None:
+    """Adds ``--dpi``, ``--size W H`` and ``--style`` to a subcommand and checks them before
+    the command does any work (the figure paths ``dests`` are checked with the other files,
+    see :func:`files`). Call it after ``set_defaults(func=...)``."""
+    from ..plot._figure import FIGURE_FORMATS
+
+    g = parser.add_argument_group(
+        "figure options", f"figure formats from the file extension: {', '.join(FIGURE_FORMATS)}"
+    )
+    g.add_argument("--dpi", type=float, help="resolution of PNG figures (default: 130)")
+    g.add_argument("--size", type=float, nargs=2, metavar=("W", "H"), help="figure size in inches")
+    g.add_argument("--style", help="matplotlib style name or .mplstyle file (e.g. seaborn-v0_8)")
+    run = parser.get_default("func")
+
+    def checked(args):
+        from ..plot._figure import check_dpi, check_size, check_style
+
+        check_size(args.size)
+        check_dpi(args.dpi)
+        check_style(args.style)
+        return run(args)
+
+    parser.set_defaults(func=checked)
+
+
+def use_agg() -> None:
+    """Selects matplotlib's non-interactive backend (the CLI only writes files)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    return value
+
+
+def finite_float(text: str) -> float:
+    """An argparse type: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
+    return value
+
+
+def add_actuation(parser: argparse.ArgumentParser) -> None:
+    """``--tensions`` and ``--pressures``: the robot's actuation, overriding the file's."""
+    parser.add_argument(
+        "--tensions",
+        type=finite_float,
+        nargs="+",
+        metavar="T",
+        help="tendon tensions (N), one per tendon, instead of the file's",
+    )
+    parser.add_argument(
+        "--pressures",
+        type=finite_float,
+        nargs="+",
+        metavar="P",
+        help="chamber pressures (Pa, gauge), one per chamber, instead of the file's",
+    )
+
+
+def add_data_outputs(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--csv FILE`` and ``--json FILE``."""
+    parser.add_argument("--csv", metavar="FILE", help=f"write {what} to CSV")
+    parser.add_argument("--json", metavar="FILE", help=f"write {what} to JSON")
+
+
+def load_actuated(args: argparse.Namespace):
+    """The robot of ``args.robot`` with ``--tensions`` / ``--pressures`` applied."""
+    from ..robot import load_robot
+
+    robot = load_robot(args.robot)
+    if getattr(args, "tensions", None) is not None:
+        robot = robot.with_tensions(args.tensions)
+    if getattr(args, "pressures", None) is not None:
+        robot = robot.with_pressures(args.pressures)
+    return robot
+
+
+def write_json(path: str, data: object) -> None:
+    """Writes JSON (NaN as null) and says so on stderr."""
+    import json
+
+    with open(path, "w", encoding="utf-8") as fh:
+        json.dump(_json_safe(data), fh, allow_nan=False)
+    print(f"wrote {path}", file=sys.stderr)
+
+
+def _json_safe(x: object) -> object:
+    import numpy as np
+
+    if isinstance(x, dict):
+        return {str(k): _json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_json_safe(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _json_safe(x.tolist())
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def write_csv(path: str, header: list[str], rows) -> None:
+    """Writes a CSV table (numbers with full precision) and says so on stderr."""
+    import csv
+
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for row in rows:
+            w.writerow([repr(float(v)) if isinstance(v, float) else v for v in row])
+    print(f"wrote {path}", file=sys.stderr)
+
+
+def _fmt6(m) -> str:
+    return "\n".join("  [" + ", ".join(f"{v: .4e}" for v in row) + "]" for row in m)

@@ -1,0 +1,147 @@
+"""Simple obstacle shapes for the figures: planes, spheres, capsules and cylinders (m, world).
+
+Each plotting function that takes ``obstacles=`` accepts these dataclasses, dicts such as
+``{"type": "sphere", "center": [0, 0.05, 0.2], "radius": 0.02}``, or any object with the same
+attributes (e.g. a contact model's obstacles).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._core import ParameterError
+
+__all__ = ["Capsule", "Cylinder", "Plane", "Sphere", "as_obstacle", "obstacle_surface"]
+
+
+@dataclass(frozen=True)
+class Plane:
+    """A plane through ``point`` (m, world, shape (3,)) with unit ``normal`` (shape (3,))."""
+
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """A sphere of ``radius`` (m) about ``center`` (m, world, shape (3,))."""
+
+    center: tuple[float, float, float]
+    radius: float
+
+
+@dataclass(frozen=True)
+class Capsule:
+    """Points within ``radius`` (m) of the segment from ``a`` to ``b`` (m, world, (3,) each)."""
+
+    a: tuple[float, float, float]
+    b: tuple[float, float, float]
+    radius: float
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A closed cylinder of ``radius`` (m) with axis from ``a`` to ``b`` (m, world)."""
+
+    a: tuple[float, float, float]
+    b: tuple[float, float, float]
+    radius: float
+
+
+_KINDS = {"plane": Plane, "sphere": Sphere, "capsule": Capsule, "cylinder": Cylinder}
+
+
+def _bad(i: int, value: object, why: str) -> ParameterError:
+    err = ParameterError(f"invalid parameter `obstacles[{i}]` = {value!r}: {why}")
+    err.parameter = f"obstacles[{i}]"
+    return err
+
+
+def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder:
+    """Converts a dict or a duck-typed object to one of the obstacle dataclasses.
+
+    Raises:
+        ParameterError: Unknown type, missing field or a non-positive radius.
+    """
+    if isinstance(obj, (Plane, Sphere, Capsule, Cylinder)):
+        out = obj
+    elif isinstance(obj, Mapping):
+        kind = str(obj.get("type", "")).lower()
+        if kind not in _KINDS:
+            raise _bad(index, obj, f"`type` must be one of {', '.join(_KINDS)}")
+        fields = {k: v for k, v in obj.items() if k != "type"}
+        try:
+            out = _KINDS[kind](**fields)
+        except TypeError as exc:
+            raise _bad(index, obj, str(exc)) from None
+    elif hasattr(obj, "normal") and hasattr(obj, "point"):
+        out = Plane(obj.point, obj.normal)
+    elif hasattr(obj, "center") and hasattr(obj, "radius"):
+        out = Sphere(obj.center, obj.radius)
+    elif hasattr(obj, "a") and hasattr(obj, "b") and hasattr(obj, "radius"):
+        out = Capsule(obj.a, obj.b, obj.radius)
+    else:
+        raise _bad(index, obj, "must be a Plane, Sphere, Capsule, Cylinder or a dict with `type`")
+    radius = getattr(out, "radius", 1.0)
+    if not float(radius) > 0:
+        raise _bad(index, obj, "the radius must be > 0 m")
+    if isinstance(out, Plane) and not np.linalg.norm(out.normal) > 0:
+        raise _bad(index, obj, "the normal must be nonzero")
+    return out
+
+
+def as_obstacles(obstacles: Sequence | None) -> list:
+    """Every entry of ``obstacles`` through :func:`as_obstacle`."""
+    return [as_obstacle(o, i) for i, o in enumerate(obstacles or ())]
+
+
+def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    axis = axis / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(axis, helper)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(axis, e1)
+
+
+def obstacle_surface(obstacle, extent_centre: np.ndarray, extent: float, n: int = 32):
+    """Grid ``(X, Y, Z)`` (m) of an obstacle's surface; a plane is drawn as a square of side
+    ``extent`` (m) centred on the foot of ``extent_centre`` (m)."""
+    if isinstance(obstacle, Sphere):
+        c = np.asarray(obstacle.center, dtype=float)
+        u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2 + 1))
+        pts = obstacle.radius * np.stack(
+            (np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)), -1
+        )
+        pts = pts + c
+    elif isinstance(obstacle, Plane):
+        normal = np.asarray(obstacle.normal, dtype=float)
+        normal /= np.linalg.norm(normal)
+        p0 = np.asarray(obstacle.point, dtype=float)
+        foot = extent_centre - np.dot(extent_centre - p0, normal) * normal
+        e1, e2 = _basis(normal)
+        a, b = np.meshgrid(np.linspace(-0.5, 0.5, 2), np.linspace(-0.5, 0.5, 2))
+        pts = foot + extent * (a[..., None] * e1 + b[..., None] * e2)
+    else:
+        a, b = np.asarray(obstacle.a, dtype=float), np.asarray(obstacle.b, dtype=float)
+        axis = b - a
+        length = float(np.linalg.norm(axis))
+        e1, e2 = _basis(axis)
+        t = axis / length
+        theta = np.linspace(0, 2 * np.pi, n)
+        if isinstance(obstacle, Capsule):
+            # Meridian: hemisphere at a, cylinder, hemisphere at b.
+            phi = np.linspace(-np.pi / 2, np.pi / 2, n // 2)
+            half = len(phi) // 2
+            r_sin = obstacle.radius * np.sin(phi)
+            along = np.concatenate((r_sin[:half], length + r_sin[half:]))
+            rad = obstacle.radius * np.cos(phi)
+        else:
+            along = np.array([0.0, 0.0, length, length])
+            rad = np.array([0.0, obstacle.radius, obstacle.radius, 0.0])
+        th, k = np.meshgrid(theta, np.arange(len(along)))
+        ring = np.cos(th)[..., None] * e1 + np.sin(th)[..., None] * e2
+        pts = a + along[k][..., None] * t + rad[k][..., None] * ring
+    return pts[..., 0], pts[..., 1], pts[..., 2]
