@@ -24,6 +24,9 @@ fn mats6<'py>(py: Python<'py>, v: &[Matrix6<f64>]) -> Bound<'py, PyArray3<f64>> 
 }
 
 /// Integrated compliance and stiffness at every node of a solution (seed 001, eqs. 6-7).
+///
+/// Compliances `C` (6x6: m/N, 1/N, rad/(N m) blocks) map a wrench [f; m] (N, N m) to a twist
+/// [translation (m); rotation (rad)], world and body frames; stiffness `K = C^-1`.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Compliance {
     inner: softrod::Compliance,
@@ -127,6 +130,9 @@ pub(crate) enum AnySolution<'py> {
 
 /// The seed's integrated compliance along a solved rod (world and body frames), Cosserat or
 /// PCC (same computation; the PCC arcs take `rod`'s section and material).
+///
+/// Returns a `Compliance`: 6x6 matrices per node (m/N, 1/N, rad/(N m) blocks) in the world
+/// and body frames, and the dimensionless `gamma_c`.
 #[pyfunction]
 #[pyo3(signature = (solution, rod=None, *, panels=None))]
 pub(crate) fn compliance<'py>(
@@ -184,6 +190,9 @@ pub(crate) fn compliance<'py>(
 }
 
 /// Exact tangent compliance at one node of a loaded, actuated equilibrium.
+///
+/// `world` and `body` are 6x6 (m/N, 1/N, rad/(N m) blocks); `tension_rate` in N/N and
+/// N/(N m) per tendon.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct TangentCompliance {
     inner: softrod::TangentCompliance,
@@ -260,6 +269,9 @@ impl TangentCompliance {
 
 /// Exact tangent compliance of the equilibrium `solution` at `node` (default: the tip), with
 /// the tendons at fixed "tension" or fixed "length" (all, or the indices `held`).
+///
+/// Any number of tendons can be held; returns a `TangentCompliance` (6x6, m/N, 1/N, rad/(N m)
+/// blocks).
 #[pyfunction]
 #[pyo3(signature = (solution, tendons="tension", *, held=None, node=None))]
 pub(crate) fn tangent_compliance<'py>(
@@ -318,6 +330,9 @@ pub(crate) fn tangent_compliance<'py>(
 }
 
 /// Eigenscrew decomposition of a 6x6 stiffness or compliance, with the compliance ellipsoids.
+///
+/// Values in N/m, N/rad (stiffness) or m/N, rad/(N m) (compliance); pitches in m/rad; axis
+/// points in m.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Eigenscrews {
     inner: softrod::Decomposition,

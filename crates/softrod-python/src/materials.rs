@@ -200,6 +200,8 @@ impl PyUniaxialLaw {
 }
 
 /// Linear law `P = E (λ − 1)` with Young's modulus `youngs_modulus` (Pa).
+///
+/// The nominal stress `P` is in Pa, the stretch `λ` dimensionless.
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct Hookean {
     law: softrod::Hookean,
@@ -263,6 +265,8 @@ impl Linearised {
 }
 
 /// Incompressible Neo-Hookean law with initial shear modulus `mu` (Pa).
+///
+/// `W = mu/2 (I1 - 3)`; small-strain Young's modulus `3 mu` (Pa).
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct NeoHookean {
     law: softrod::NeoHookean,
@@ -286,6 +290,8 @@ impl NeoHookean {
 }
 
 /// Incompressible two-parameter Mooney–Rivlin law with `c10`, `c01` (Pa).
+///
+/// `W = c10 (I1 - 3) + c01 (I2 - 3)`; small-strain modulus `6 (c10 + c01)` (Pa).
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct MooneyRivlin {
     law: softrod::MooneyRivlin,
@@ -314,6 +320,8 @@ impl MooneyRivlin {
 }
 
 /// Incompressible Yeoh law with `c10 > 0`, `c20`, `c30` (Pa).
+///
+/// `W = sum_i ci0 (I1 - 3)^i`; small-strain modulus `6 c10` (Pa).
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct Yeoh {
     law: softrod::Yeoh,
@@ -515,6 +523,9 @@ fn parse_stress_measure(name: &str) -> PyResult<(StressMeasure, &'static str)> {
 }
 
 /// Fits a law to uniaxial test data by least squares (see the docs).
+///
+/// `strain` (dimensionless) and `stress` (Pa) arrays; returns a `UniaxialFit` with the law and
+/// its errors (Pa).
 #[pyfunction]
 #[pyo3(signature = (strain, stress, model="neo-hookean", *, strain_measure="engineering",
                     stress_measure="nominal", terms=None, nonnegative=false, stretch_range=None,
@@ -621,6 +632,8 @@ pub(crate) fn _uniaxial_fit(
 // ----------------------------------------------------------------------------------- library
 
 /// A named silicone of the library, with sourced parameters (see `softrod.silicone`).
+///
+/// Its laws are in Pa (Neo-Hookean, Mooney–Rivlin, Yeoh), with the source of the parameters.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Silicone {
     inner: softrod::Silicone,
@@ -673,6 +686,8 @@ impl Silicone {
 }
 
 /// The silicone named `name` (case, spaces, `-` and `_` ignored), e.g. "Dragon Skin 10".
+///
+/// Raises `ParameterError` naming `name` for an unknown silicone; the laws are in Pa.
 #[pyfunction]
 pub(crate) fn silicone(name: &str) -> PyResult<Silicone> {
     let inner = softrod::Silicone::from_name(name).map_err(to_py_err)?;

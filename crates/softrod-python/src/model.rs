@@ -136,6 +136,9 @@ fn profile(
 // ----------------------------------------------------------------------------------- sections
 
 /// A rod's cross-section along its length.
+/// Properties in SI units: area (m^2), second moments and torsion constant (m^4), radius (m);
+/// subclasses `CircularSection`, `TaperedCircularSection`, `TubeSection`, `TableSection`,
+/// `FunctionSection`.
 #[pyclass(frozen, module = "softrod._core", name = "Section", subclass)]
 pub(crate) struct PySection {
     pub(crate) inner: softrod::Section,
@@ -191,6 +194,8 @@ impl PySection {
 }
 
 /// Solid circular section of constant radius (m).
+///
+/// `radius` (m) finite and > 0; area `pi r^2` (m^2), `Ix = Iy = pi r^4 / 4` (m^4).
 #[pyclass(frozen, extends = PySection, module = "softrod._core")]
 pub(crate) struct CircularSection {
     radius: f64,
@@ -212,6 +217,8 @@ impl CircularSection {
 }
 
 /// Solid circular section tapering linearly from `base_radius` to `tip_radius` (m).
+///
+/// Radii (m) finite and > 0; the radius at arc length `s` is `R0 + (RL - R0) s / L` (m).
 #[pyclass(frozen, extends = PySection, module = "softrod._core")]
 pub(crate) struct TaperedCircularSection {
     base_radius: f64,
@@ -252,6 +259,8 @@ impl TaperedCircularSection {
 }
 
 /// Circular tube with `outer_radius` and `inner_radius` (m).
+///
+/// `inner_radius` (m) in `[0, outer_radius)`; 0 is a solid circle.
 #[pyclass(frozen, extends = PySection, module = "softrod._core")]
 pub(crate) struct TubeSection {
     outer_radius: f64,
@@ -320,6 +329,9 @@ impl TableSection {
 }
 
 /// Section given by a function `s (m) -> (area, ix, iy, j)` (SI); slower than the built-ins.
+///
+/// The function returns area (m^2) and `ix`, `iy`, `j` (m^4) at arc length `s` (m); it pickles
+/// when it is a module-level function.
 #[pyclass(frozen, extends = PySection, module = "softrod._core")]
 pub(crate) struct FunctionSection;
 
@@ -353,6 +365,9 @@ impl FunctionSection {
 // ----------------------------------------------------------------------------------- material
 
 /// Linear elastic material: Young's modulus (Pa) and Poisson's ratio, or the shear modulus.
+///
+/// `youngs_modulus` (Pa) > 0; `poisson_ratio` (dimensionless) in (-1, 0.5], or `shear_modulus`
+/// (Pa) instead.
 #[pyclass(frozen, module = "softrod._core")]
 #[derive(Clone)]
 pub(crate) struct LinearElastic {
@@ -442,6 +457,10 @@ fn material(arg: &Bound<'_, PyAny>) -> PyResult<softrod::Material> {
 // ----------------------------------------------------------------------------------- rod
 
 /// A Cosserat rod (immutable): length (m), section, material, rest strains, density, base pose.
+///
+/// Rest strain `v*` (dimensionless) and rest curvature `u*` (1/m) are 3-vectors or functions of
+/// `s` (m); density in kg/m^3; the base pose a 4x4 transform (m). Read-only properties return
+/// the arguments as given (what a writer needs to save the rod).
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Rod {
     pub(crate) inner: softrod::Rod,
@@ -930,6 +949,8 @@ impl Chamber {
 // ----------------------------------------------------------------------------------- loads
 
 /// A force (N) and moment (N m) applied at arc length `s` (m), in the world or body frame.
+///
+/// `frame` "world" (dead load) or "body" (follower load); `s` in (0, L] (m).
 #[pyclass(frozen, module = "softrod._core")]
 #[derive(Clone)]
 pub(crate) struct PointLoad {

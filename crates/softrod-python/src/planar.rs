@@ -55,6 +55,9 @@ fn samples_from(length: f64, n_points: i64, s: Option<Floats<'_>>) -> PyResult<V
 }
 
 /// The seed-000 tapered cable-driven arm (immutable).
+///
+/// Length, radii (m), cable offset ratio (dimensionless), Young's modulus (Pa), cable anchor
+/// (m); `solve(tension)` with the tension in N.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct PlanarCableArm {
     inner: softrod::PlanarCableArm,
@@ -108,6 +111,9 @@ fn call_args<'py>(
 }
 
 /// Samples of one solved planar arm.
+///
+/// Arc length, backbone x, y (m), curvature (1/m), axial strain (dimensionless), tangent
+/// angle (rad), per sample.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct PlanarSolution {
     call: (Py<PyAny>, Args),
@@ -152,6 +158,8 @@ impl PlanarSolution {
 }
 
 /// Many tensions solved on one set of samples; 2-D arrays are `(n_tensions, n_samples)`.
+///
+/// Tensions (N), backbone x, y (m), curvature (1/m), strain (dimensionless), angle (rad).
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct PlanarBatch {
     call: (Py<PyAny>, Args),

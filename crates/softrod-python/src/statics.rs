@@ -141,6 +141,9 @@ impl Problem {
 }
 
 /// A solved rod, sampled at the integration mesh (SI units, world frame unless `_body`).
+///
+/// Positions (m), rotations, internal force (N) and moment (N m), strains, tendon lengths (m),
+/// base wrench (N, N m), solver stats; it pickles (by solving again, bit for bit).
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct StaticsSolution {
     pub(crate) inner: softrod::StaticsSolution,
@@ -340,6 +343,9 @@ pub(crate) fn stats_dict<'py>(
 
 /// Solves the statics of `rod` with `tendons`, `loads` and pneumatic `chambers` by shooting
 /// (see the docs). Options not given keep the core's defaults.
+///
+/// Tendon tensions (N) and chamber pressures (Pa) are the actuation; returns a
+/// `StaticsSolution` (SI units) or raises `ConvergenceError` (with iterations, residual).
 #[pyfunction]
 #[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator=None, steps=None,
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
