@@ -905,11 +905,7 @@ pub(crate) fn pcc_solve<'py>(
     let robot = robot.borrow();
     let d = PccSolveOptions::default();
     let count = |name: &str, v: Option<i64>, default: usize| -> PyResult<usize> {
-        match v {
-            None => Ok(default),
-            Some(k) if k >= 1 => Ok(k as usize),
-            Some(k) => Err(param_err(name, k, ">= 1")),
-        }
+        v.map_or(Ok(default), |k| crate::statics::count(name, k))
     };
     let max_iterations = count("max_iterations", max_iterations, d.newton.max_iterations)?;
     let max_load_steps = count("max_load_steps", max_load_steps, d.newton.max_load_steps)?;

@@ -33,7 +33,8 @@ pub(crate) struct OptionArgs<'py> {
     pub throw: Option<bool>,
 }
 
-fn count(name: &str, v: i64) -> PyResult<usize> {
+/// A count option (>= 1), naming it.
+pub(crate) fn count(name: &str, v: i64) -> PyResult<usize> {
     if v < 1 {
         return Err(param_err(name, v, ">= 1"));
     }

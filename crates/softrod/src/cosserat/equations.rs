@@ -143,6 +143,16 @@ pub(crate) struct Local {
 }
 
 impl Local {
+    /// The strains `x = (v, u)` before the tendon and fluid sums are added.
+    pub(crate) fn strains(x: &Vector6<f64>) -> Self {
+        Self {
+            v: Vector3::new(x[0], x[1], x[2]),
+            u: Vector3::new(x[3], x[4], x[5]),
+            tendon_force: Vector3::zeros(),
+            tendon_moment: Vector3::zeros(),
+        }
+    }
+
     pub(crate) fn nan() -> Self {
         Self {
             v: Vector3::repeat(f64::NAN),
@@ -667,12 +677,7 @@ impl Evaluator<'_, '_> {
         let Some(x) = self.local_iteration(x, &xs, &cd, &wv, &c) else {
             return Local::nan();
         };
-        let mut out = Local {
-            v: Vector3::new(x[0], x[1], x[2]),
-            u: Vector3::new(x[3], x[4], x[5]),
-            tendon_force: Vector3::zeros(),
-            tendon_moment: Vector3::zeros(),
-        };
+        let mut out = Local::strains(&x);
         if tangent {
             // (I + C D)⁻¹ C at the solution.
             let (_, h) = self.tendon_sums(&x, &c, true);

@@ -119,12 +119,7 @@ impl Evaluator<'_, '_> {
             self.ws.guess = None;
             return Local::nan();
         }
-        let mut out = Local {
-            v: Vector3::new(x[0], x[1], x[2]),
-            u: Vector3::new(x[3], x[4], x[5]),
-            tendon_force: Vector3::zeros(),
-            tendon_moment: Vector3::zeros(),
-        };
+        let mut out = Local::strains(&x);
         if tangent {
             let Some(lu) = Lu6::new(&h) else {
                 return Local::nan();
