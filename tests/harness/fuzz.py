@@ -990,10 +990,15 @@ def calls() -> list[Call]:
     return out
 
 
+#: Values always in the sample: the sizes that abort or hang, and raising callbacks.
+ALWAYS = ("size-huge", "int-overflow", "cb-raises")
+
+
 def sample(all_calls: list[Call], n: int, seed: int = 10) -> list[Call]:
-    """A reproducible sample of ``n`` calls that keeps every baseline."""
-    base = [c for c in all_calls if not c.parameter]
-    rest = [c for c in all_calls if c.parameter]
+    """A reproducible sample: every baseline, every call with a value in ``ALWAYS``, and
+    ``n`` other calls drawn at random."""
+    base = [c for c in all_calls if not c.parameter or c.value in ALWAYS]
+    rest = [c for c in all_calls if c.parameter and c.value not in ALWAYS]
     rng = random.Random(seed)
     picked = rng.sample(rest, min(n, len(rest)))
     return sorted(base + picked, key=lambda c: c.index)
