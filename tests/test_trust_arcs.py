@@ -21,9 +21,23 @@ def _xfail(today_fails: bool):
 ADAPTIVE_FAILS = {
     (case, a, r)
     for case in ("precurved", "moment")
-    for a, r in [(0.5, 1e-6), (0.5, 1e-7), (0.5, 1e-8), (0.5, 1e-9), (0.5, 1e-10),
-                 (1.0, 1e-6), (1.0, 1e-7), (1.0, 1e-8), (1.0, 1e-9), (1.0, 1e-10),
-                 (1.5, 1e-6), (1.5, 1e-7), (1.5, 1e-8), (1.5, 1e-9), (1.5, 1e-10)]
+    for a, r in [
+        (0.5, 1e-6),
+        (0.5, 1e-7),
+        (0.5, 1e-8),
+        (0.5, 1e-9),
+        (0.5, 1e-10),
+        (1.0, 1e-6),
+        (1.0, 1e-7),
+        (1.0, 1e-8),
+        (1.0, 1e-9),
+        (1.0, 1e-10),
+        (1.5, 1e-6),
+        (1.5, 1e-7),
+        (1.5, 1e-8),
+        (1.5, 1e-9),
+        (1.5, 1e-10),
+    ]
 }
 DEFAULT_FAILS = {(case, a) for case in ("precurved", "moment") for a in (1.0, 1.5, 2.0)}
 
@@ -64,9 +78,16 @@ def test_default_tangent_compliance_within_1e_6(turns):
 @pytest.mark.parametrize(
     "turns",
     [
-        pytest.param(a, marks=[pytest.mark.xfail(
-            strict=True, reason="issue 10: adaptive compliance is worse than RK4")] if a == 0.5
-            else [])
+        pytest.param(
+            a,
+            marks=[
+                pytest.mark.xfail(
+                    strict=True, reason="issue 10: adaptive compliance is worse than RK4"
+                )
+            ]
+            if a == 0.5
+            else [],
+        )
         for a in (0.5, 1.0, 1.5, 2.0)
     ],
 )

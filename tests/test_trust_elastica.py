@@ -13,16 +13,19 @@ from harness import elastica
 import softrod
 
 ADAPTIVE_BRANCH = pytest.mark.xfail(
-    strict=True, reason="issue 10: the adaptive integrator returns a looped, higher-energy "
+    strict=True,
+    reason="issue 10: the adaptive integrator returns a looped, higher-energy "
     "equilibrium for PL^2/EI >= ~70 with converged=True",
 )
 NEAR_AXIAL = pytest.mark.xfail(
-    strict=True, reason="found with this sweep: for loads pushing within ~8 degrees of the "
+    strict=True,
+    reason="found with this sweep: for loads pushing within ~8 degrees of the "
     "axis and PL^2/EI >= ~5, RK4 too returns an equilibrium off the branch (tip 1.4-1.6 L away; "
     "warm-started continuation in small steps stays on the oracle's branch)",
 )
 NO_LOAD_FACTOR = pytest.mark.xfail(
-    strict=True, reason="issue 10: ConvergenceError carries no load_factor",
+    strict=True,
+    reason="issue 10: ConvergenceError carries no load_factor",
 )
 
 
@@ -47,8 +50,7 @@ def test_no_silent_wrong_branch(sweep, integrator):
 @pytest.mark.parametrize("integrator", [pytest.param("rk4", marks=NO_LOAD_FACTOR), "adaptive"])
 def test_every_failure_is_a_convergence_error_with_its_fields(sweep, integrator):
     errors = [
-        r for r in sweep.records
-        if r.integrator == integrator and r.outcome == "convergence-error"
+        r for r in sweep.records if r.integrator == integrator and r.outcome == "convergence-error"
     ]
     assert all(r.fields for r in errors), errors[:1]
 

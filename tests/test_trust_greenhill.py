@@ -9,7 +9,8 @@ import pytest
 from harness import greenhill
 
 NO_STABILITY = pytest.mark.xfail(
-    strict=True, reason="issue 10: the straight column past its critical length comes back "
+    strict=True,
+    reason="issue 10: the straight column past its critical length comes back "
     "converged with no `stable` flag",
 )
 

@@ -13,7 +13,8 @@ from harness import niti
 import softrod
 
 NO_STABILITY = pytest.mark.xfail(
-    strict=True, reason="issue 10: unstable equilibria are returned as converged, with no "
+    strict=True,
+    reason="issue 10: unstable equilibria are returned as converged, with no "
     "`stable` flag and no warning",
 )
 

@@ -38,7 +38,7 @@ def test_elastica_shooting_equals_bisshopp_drucker_for_transverse_loads():
     alphas = np.logspace(-2, 3, 6)
     path = oracles.elastica_paths([math.pi / 2], alphas)
     for k, a in enumerate(alphas):
-        delta, x, angle = oracles.bisshopp_drucker(a)
+        delta, x, _angle = oracles.bisshopp_drucker(a)
         assert path["x"][0, k] == pytest.approx(delta, abs=1e-10)
         assert path["z"][0, k] == pytest.approx(x, abs=1e-10)
 

@@ -12,7 +12,8 @@ from harness import pcc_random
 from softrod import pcc
 
 SPURIOUS = pytest.mark.xfail(
-    strict=True, reason="issue 10: PCC rejects valid solves by round-off "
+    strict=True,
+    reason="issue 10: PCC rejects valid solves by round-off "
     "(`s[49]` = total length + 1 ulp: must be in [0, length])",
 )
 
