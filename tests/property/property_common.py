@@ -60,3 +60,10 @@ def tip_twist_difference(a, b) -> np.ndarray:
             rotation_vector(np.asarray(a.tip_rotation) @ np.asarray(b.tip_rotation).T),
         ]
     )
+
+
+def assert_finite(sol) -> None:
+    """A converged solution has no NaN or inf in any returned array."""
+    for name in ("s", "position", "rotation", "force", "moment", "v", "u", "base_wrench"):
+        a = np.asarray(getattr(sol, name))
+        assert np.all(np.isfinite(a)), f"converged solution with non-finite `{name}`"

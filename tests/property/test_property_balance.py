@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from harness.balance import balance_error, external_wrench
 from hypothesis import given
-from property_common import PROFILES, profile, solve_or_reject
+from property_common import PROFILES, assert_finite, profile, solve_or_reject
 from robot_strategies import robots
 
 
@@ -21,6 +21,7 @@ def test_force_and_moment_balance(name):
     @given(robots(base=True))
     def check(case):
         sol = solve_or_reject(case, steps=200, tolerance=1e-12)
+        assert_finite(sol)
         scale = case.force_scale()
         base, along = balance_error(
             sol, case.load_spec(), scale, case.length, case.tendon_specs(), case.chamber_specs()
@@ -32,5 +33,16 @@ def test_force_and_moment_balance(name):
         total = np.asarray(sol.base_wrench)
         assert np.max(np.abs(total[:3] - ext_f[0])) < 1e-7 * scale
         assert np.max(np.abs(total[3:] - ext_m[0])) < 1e-7 * scale * case.length
+
+    check()
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_converged_solutions_are_finite(name):
+    @profile(name)
+    @given(robots(base=True))
+    def check(case):
+        for options in ({}, {"integrator": "adaptive"}):
+            assert_finite(solve_or_reject(case, **options))
 
     check()
