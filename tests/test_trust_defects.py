@@ -430,23 +430,29 @@ def _table_yeoh_rod(base_rotation):
     )
     c10 = 316227.7660168379
     rod = softrod.Rod(
-        length, section, softrod.Yeoh(c10, 0.125 * c10, 12352.64711003273),
+        length,
+        section,
+        softrod.Yeoh(c10, 0.125 * c10, 12352.64711003273),
         rest_curvature=(0.09979250034173506, 0.0, -0.4508841804731354),
         base_pose=(np.zeros(3), np.asarray(base_rotation, dtype=float)),
     )
     tendons = [
-        softrod.Tendon((-0.0024959722673536426, 0.0014178277004398044), 1.1076066823408115,
-                       0.5 * length),
-        softrod.Tendon((1.7722662770693556e-05, 0.0021361569518273137), 1.0247749020971715,
-                       0.5 * length),
+        softrod.Tendon(
+            (-0.0024959722673536426, 0.0014178277004398044), 1.1076066823408115, 0.5 * length
+        ),
+        softrod.Tendon(
+            (1.7722662770693556e-05, 0.0021361569518273137), 1.0247749020971715, 0.5 * length
+        ),
     ]
     loads = softrod.Loads(distributed_force=(0.0, 0.34444201701569443, -0.03827133522396605))
     return rod, tendons, loads
 
 
-@xfail("found by the property suite: a converged solution carries NaN strains where the "
-       "hyperelastic section solve failed (the same robot with the base unrotated raises "
-       "'hyperelastic section solve ... residual NaN')")
+@xfail(
+    "found by the property suite: a converged solution carries NaN strains where the "
+    "hyperelastic section solve failed (the same robot with the base unrotated raises "
+    "'hyperelastic section solve ... residual NaN')"
+)
 def test_converged_solution_has_no_nan_strains():
     rod, tendons, loads = _table_yeoh_rod(np.diag([-1.0, -1.0, 1.0]))
     try:
@@ -457,14 +463,22 @@ def test_converged_solution_has_no_nan_strains():
         assert np.all(np.isfinite(np.asarray(getattr(sol, name)))), name
 
 
-@xfail("found by the fuzz: a warm start of 1e308 N returns converged=True with residual inf "
-       "and NaN forces (adaptive, throw=False)")
+@xfail(
+    "found by the fuzz: a warm start of 1e308 N returns converged=True with residual inf "
+    "and NaN forces (adaptive, throw=False)"
+)
 def test_absurd_warm_start_is_not_reported_converged():
     rod = softrod.Rod(0.3, softrod.CircularSection(0.002), softrod.LinearElastic(5e7, 0.3))
     loads = softrod.Loads(tip_force=(0.01, 0.0, 0.0))
     try:
-        sol = softrod.solve_statics(rod, [], loads, integrator="adaptive",
-                                    warm_start=[1e308, 0, 0, 0, 0.003, 0], throw=False)
+        sol = softrod.solve_statics(
+            rod,
+            [],
+            loads,
+            integrator="adaptive",
+            warm_start=[1e308, 0, 0, 0, 0.003, 0],
+            throw=False,
+        )
     except ValueError as exc:
         assert _named(exc, "warm_start")
         return
