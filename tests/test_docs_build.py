@@ -55,7 +55,13 @@ def test_mkdocs_build_strict(tmp_path):
     )
     assert r.returncode == 0, r.stderr[-3000:]
     api = (tmp_path / "site" / "api" / "index.html").read_text(encoding="utf-8")
-    for name in ("softrod.solve_statics", "softrod.Robot", "softrod.plot.plot_rod"):
+    for name in (
+        "softrod.solve_statics",
+        "softrod.Robot",
+        "softrod.plot.plot_rod",
+        "softrod.vision.extract.extract_backbone",
+        "softrod.vision.backbone.Backbone",
+    ):
         assert f'id="{name}"' in api
 
 

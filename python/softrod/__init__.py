@@ -3,11 +3,12 @@
 SI units everywhere (m, N, Pa, rad). See https://softrod docs in ``docs/`` for the models.
 
 The numerics live in the compiled core ``softrod._core``; this package re-exports it and adds
-file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`softrod.plot`)
-and the ``softrod`` command line (:mod:`softrod.cli`).
+file I/O (:mod:`softrod.io`), analyses (:mod:`softrod.analysis`), plots (:mod:`softrod.plot`),
+backbones from photographs (:mod:`softrod.vision`) and the ``softrod`` command line
+(:mod:`softrod.cli`).
 """
 
-from . import examples, pcc
+from . import examples, pcc, vision
 from ._core import (
     SILICONES,
     Chamber,
@@ -62,10 +63,13 @@ from .analysis import (
 )
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
+from .vision import Backbone, BackboneQuality
 
 __all__ = [
     "SILICONES",
+    "Backbone",
     "BackboneDistance",
+    "BackboneQuality",
     "Chamber",
     "CircularSection",
     "Compliance",
@@ -107,6 +111,7 @@ __all__ = [
     "compliance",
     "eigenscrews",
     "examples",
+    "extract_backbone",
     "fit_uniaxial",
     "load_robot",
     "pcc",
@@ -116,6 +121,7 @@ __all__ = [
     "solve_statics",
     "tangent_compliance",
     "tension_grid",
+    "vision",
     "workspace_map",
     "write_samples_csv",
 ]
@@ -141,3 +147,17 @@ def _alias_modules() -> None:
 
 
 _alias_modules()
+
+
+def __getattr__(name: str):
+    # ``extract_backbone`` loads the image-processing stack on first use (see softrod.vision).
+    if name == "extract_backbone":
+        from .vision import extract_backbone
+
+        globals()[name] = extract_backbone
+        return extract_backbone
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -1,4 +1,5 @@
-"""Comparing backbones at equal arm index (fraction of arm length), as seed 000 did."""
+"""Comparing backbones at equal arm index (fraction of arm length), as the planar cable-arm
+paper did."""
 
 from __future__ import annotations
 
@@ -39,6 +40,10 @@ class BackboneDistance:
 
 
 def _points(name: str, value: ArrayLike) -> np.ndarray:
+    if hasattr(value, "points") and hasattr(value, "arc_length"):  # a Backbone
+        value = value.points
+    elif hasattr(value, "x") and hasattr(value, "y") and hasattr(value, "tension"):
+        value = np.column_stack([value.x, value.y])  # a PlanarSolution (m)
     try:
         arr = np.ascontiguousarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -52,25 +57,37 @@ def _points(name: str, value: ArrayLike) -> np.ndarray:
     return arr
 
 
+def _check_units(a: object, b: object) -> None:
+    units = [getattr(v, "unit", "m" if hasattr(v, "tension") else None) for v in (a, b)]
+    if None not in units and units[0] != units[1]:
+        raise ParameterError(
+            f"invalid parameter `b`: backbones in different units ({units[0]} and {units[1]}); "
+            "extract the photo's backbone with `scale` (m per pixel) to compare it with a model"
+        )
+
+
 def backbone_distance(a: ArrayLike, b: ArrayLike, n_index: int | None = None) -> BackboneDistance:
     """Distance between two backbones at the same arm index, max and mean.
 
     Each backbone is a polyline of points (any number, e.g. digitised from a photo), shape
-    (n, 2) or (n, 3), in any length unit. Each is parametrised by its own normalised chord
-    length (arm index in [0, 1]) and resampled linearly; distances are taken between points
-    of equal index.
+    (n, 2) or (n, 3), in any length unit; or a :class:`softrod.Backbone` extracted from a
+    photo (its ``points``), or a :class:`softrod.PlanarSolution` (its x, y in m). Each is
+    parametrised by its own normalised chord length (arm index in [0, 1]) and resampled
+    linearly; distances are taken between points of equal index.
 
     Args:
-        a: First backbone, shape (n_a, dim).
-        b: Second backbone, shape (n_b, dim), same dim as ``a``.
+        a: First backbone, shape (n_a, dim), a Backbone or a PlanarSolution.
+        b: Second backbone, shape (n_b, dim), same dim as ``a``, or as for ``a``.
         n_index: Number of uniform arm indices compared; default ``max(n_a, n_b)``.
 
     Returns:
         The distances; unpacks as ``(max, mean)``.
 
     Raises:
-        ParameterError: Bad shapes, fewer than two points, zero length, non-finite values.
+        ParameterError: Bad shapes, fewer than two points, zero length, non-finite values,
+            or a Backbone in pixels compared with one in metres.
     """
+    _check_units(a, b)
     d = _core.backbone_distance(_points("a", a), _points("b", b), n_index)
     return BackboneDistance(
         max=d["max"],
