@@ -41,6 +41,11 @@ NAMING = pytest.mark.xfail(strict=True, reason="issue 10: errors do not name the
 CALLBACK = pytest.mark.xfail(strict=True, reason="issue 10: callback errors swallowed")
 
 
+def test_every_public_callable_and_parameter_is_fuzzed():
+    # A new public function, method or parameter needs a baseline in harness/fuzz.py.
+    assert fuzz.coverage() == []
+
+
 def test_baselines_run(sample):
     _check_baselines(sample)
 

@@ -567,6 +567,15 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("Robot(source)")(
+        lambda d: (sr.Robot, dict(rod=_niti().rod, tendons=_niti().tendons, source=_niti().source))
+    )
+    t("Robot.from_spec")(
+        lambda d: (sr.Robot.from_spec, dict(spec=_niti().spec, name="r", source="file.toml"))
+    )
+    t("Robot.to_toml")(lambda d: (_niti().to_toml, {}))
+    t("PlanarCableArm.seed_arm")(lambda d: (sr.PlanarCableArm.seed_arm, {}))
+    t("TensileCurve.initial_slope")(lambda d: (sr.TensileCurve(*_curve_data()).initial_slope, {}))
     t("Robot.from_dict")(lambda d: (sr.Robot.from_dict, dict(data=_robot_dict(), name="r")))
     t("Robot.from_toml")(lambda d: (sr.Robot.from_toml, dict(text=_TOML, name="r")))
     t("Robot.solve")(lambda d: (_niti().solve, dict(tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0])))
@@ -591,6 +600,34 @@ def _define_targets() -> None:
         )
     )
     t("ModelComparison.table")(lambda d: (sr.compare_models(_niti(), repeats=1).table, {}))
+    # backbones from photographs
+    t("extract_backbone")(
+        lambda d: (
+            sr.extract_backbone,
+            dict(
+                image=_photo(),
+                scale=1e-3,
+                base=tuple(_backbone().pixels[0]),
+                direction=tuple(_backbone().direction),
+                mask=None,
+                polarity="bright",
+                n_points=50,
+                knot_spacing=12.0,
+                min_area=30,
+            ),
+        )
+    )
+    t("extract_backbone(mask)")(
+        lambda d: (sr.extract_backbone, dict(image=_photo(), mask=_photo_mask()))
+    )
+    t("Backbone.at_arm_index")(lambda d: (_backbone().at_arm_index, dict(u=[0.0, 0.5, 1.0])))
+    t("Backbone.resample")(lambda d: (_backbone().resample, dict(n=20)))
+    t("Backbone.to_dict")(lambda d: (_backbone().to_dict, {}))
+    t("Backbone.to_csv")(
+        lambda d: (_backbone().to_csv, dict(path=str(d / "backbone-out.csv"), overwrite=True))
+    )
+    t("Backbone.read_csv")(lambda d: (sr.Backbone.read_csv, dict(path=_backbone_csv(d))))
+    t("BackboneQuality.to_dict")(lambda d: (_backbone().quality.to_dict, {}))
     # softrod.pcc
     t("pcc.Robot")(
         lambda d: (
@@ -760,6 +797,36 @@ def _define_targets() -> None:
             ),
         )
     )
+
+
+def _photo() -> str:
+    return str(_sr().examples.data_path("photos") / "cable-arm-2N.jpg")
+
+
+_CACHE: dict = {}
+
+
+def _backbone():
+    if "backbone" not in _CACHE:
+        _CACHE["backbone"] = _sr().extract_backbone(_photo(), scale=1e-3)
+    return _CACHE["backbone"]
+
+
+def _photo_mask():
+    if "mask" not in _CACHE:
+        from softrod import vision
+
+        img = np.asarray(vision.read_image(_photo()), dtype=float)
+        grey = img.mean(axis=2) if img.ndim == 3 else img
+        _CACHE["mask"] = grey > 0.5 * (grey.min() + grey.max())
+    return _CACHE["mask"]
+
+
+def _backbone_csv(d: Path) -> str:
+    path = d / "backbone-in.csv"
+    if not path.exists():
+        _backbone().to_csv(path, overwrite=True)
+    return str(path)
 
 
 def _spd():
@@ -1297,3 +1364,122 @@ def summary(outcomes: list[Outcome]) -> dict:
         "defects": [o for o in fuzzed if o.outcome in DEFECTS],
         "unnamed": [o for o in fuzzed if o.outcome == "unnamed-error"],
     }
+
+
+# ----------------------------------------------------------------------------- coverage
+
+#: Public classes users do not construct (results, exceptions) and result records: their
+#: constructors are not fuzzed (their public methods are).
+NOT_CONSTRUCTED = {
+    "Backbone",
+    "BackboneQuality",
+    "BackboneDistance",
+    "Compliance",
+    "ConvergenceError",
+    "Eigenscrews",
+    "ModelComparison",
+    "ModelResult",
+    "ParameterError",
+    "PlanarBatch",
+    "PlanarSolution",
+    "Section",
+    "Silicone",
+    "StaticsSolution",
+    "TangentCompliance",
+    "UniaxialFit",
+    "UniaxialLaw",
+    "WorkspaceMap",
+    "Solution",
+}
+
+
+def _public_callables():
+    """(owner class or None, name, callable) for every public callable of the two modules."""
+    import inspect
+
+    import softrod
+    from softrod import pcc
+
+    out = []
+    for mod in (softrod, pcc):
+        for name in mod.__all__:
+            obj = getattr(mod, name)
+            if inspect.ismodule(obj) or not callable(obj):
+                continue
+            if inspect.isclass(obj):
+                if obj.__name__ not in NOT_CONSTRUCTED and name not in NOT_CONSTRUCTED:
+                    out.append((obj, "__init__", obj))
+                for m, v in vars(obj).items():
+                    if m.startswith("_") or isinstance(v, property):
+                        continue
+                    attr = getattr(obj, m)
+                    if callable(attr) and not inspect.isclass(attr):
+                        out.append((obj, m, attr))
+            else:
+                out.append((None, obj.__qualname__, obj))
+    out.append((None, "path", softrod.examples.path))
+    return out
+
+
+def _parameters(fn) -> set[str]:
+    import inspect
+
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return set()
+    return {
+        p.name
+        for p in sig.parameters.values()
+        if p.name not in ("self", "cls") and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+    }
+
+
+def coverage() -> list[str]:
+    """Public callables, or parameters of them, that no target fuzzes."""
+    import inspect
+
+    if not TARGETS:
+        _define_targets()
+    d = Path(tempfile.gettempdir())
+    covered: dict[tuple[str, str], set[str]] = {}
+    for build in TARGETS.values():
+        fn, kwargs = build(d)
+        if inspect.isclass(fn):
+            key = (fn.__name__, "__init__")
+        else:
+            owner = getattr(fn, "__self__", None)
+            qual = fn.__qualname__
+            if "." in qual:
+                cls_name, method = qual.rsplit(".", 1)
+            else:
+                cls_name, method = "", qual
+            if inspect.isclass(owner):
+                cls_name = owner.__name__
+            elif owner is not None and not inspect.ismodule(owner):
+                cls_name = type(owner).__name__
+            key = (cls_name, method)
+        covered.setdefault(key, set()).update(kwargs)
+    missing = []
+    for owner, name, fn in _public_callables():
+        if owner is None:
+            keys = [("", name)]
+        else:
+            subclasses = {owner.__name__} | {c.__name__ for c in _all_subclasses(owner)}
+            keys = [(c, name) for c in subclasses]
+        got = [covered[k] for k in keys if k in covered]
+        label = name if owner is None else f"{owner.__name__}.{name}"
+        if not got:
+            missing.append(label)
+            continue
+        params = _parameters(fn) - set().union(*got)
+        if params:
+            missing.append(f"{label}({', '.join(sorted(params))})")
+    return missing
+
+
+def _all_subclasses(cls):
+    out = set()
+    for c in cls.__subclasses__():
+        out |= {c} | _all_subclasses(c)
+    return out
