@@ -47,7 +47,10 @@ def test_no_silent_wrong_branch(sweep, integrator):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("integrator", [pytest.param("rk4", marks=NO_LOAD_FACTOR), "adaptive"])
+@pytest.mark.parametrize(
+    "integrator",
+    [pytest.param("rk4", marks=NO_LOAD_FACTOR), pytest.param("adaptive", marks=NO_LOAD_FACTOR)],
+)
 def test_every_failure_is_a_convergence_error_with_its_fields(sweep, integrator):
     errors = [
         r for r in sweep.records if r.integrator == integrator and r.outcome == "convergence-error"

@@ -557,7 +557,7 @@ def chambers(draw, section: SectionCase, length: float, ei: float, modulus: floa
     if budget is not None:
         budget.append(c)
     pressure = min(c * ei / (area * dc * length), 0.2 * modulus)
-    start = draw(st.one_of(st.just(0.0), st.floats(0.0, 0.3)))
+    start = draw(st.one_of(st.just(0.0), st.floats(0.01, 0.3)))
     end = draw(st.one_of(st.none(), st.floats(0.6, 1.0)))
     return ChamberCase(pressure, rc, dc * math.cos(a), dc * math.sin(a), start, end)
 
