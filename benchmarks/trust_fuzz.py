@@ -50,6 +50,9 @@ def main() -> None:
     for k in ORDER:
         print(f"  {k:<28} {s['counts'].get(k, 0):>6}")
     print(f"errors naming the parameter: {100 * s['named_rate']:.1f} %")
+    type_errors = [o for o in out if o.call.parameter and o.detail.startswith("TypeError")]
+    unnamed_type = sum(o.outcome == "unnamed-error" for o in type_errors)
+    print(f"TypeErrors that do not name the parameter: {unnamed_type} of {len(type_errors)}")
     print(f"NaN/inf arguments accepted silently (finite result): {s['accepted_nonfinite']}")
     for o in s["baseline_failures"]:
         print(f"BASELINE FAILED {o.call.target}: {o.detail}")
