@@ -15,6 +15,7 @@ mod materials;
 mod model;
 mod pcc;
 mod planar;
+mod sections;
 mod statics;
 
 /// The compiled core of softrod.
@@ -33,13 +34,13 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;
     m.add_function(wrap_pyfunction!(planar::backbone_distance, m)?)?;
-    m.add_class::<model::PySection>()?;
-    m.add_class::<model::CircularSection>()?;
-    m.add_class::<model::TaperedCircularSection>()?;
-    m.add_class::<model::TubeSection>()?;
-    m.add_class::<model::TableSection>()?;
-    m.add_class::<model::FunctionSection>()?;
-    m.add_class::<model::LinearElastic>()?;
+    m.add_class::<sections::PySection>()?;
+    m.add_class::<sections::CircularSection>()?;
+    m.add_class::<sections::TaperedCircularSection>()?;
+    m.add_class::<sections::TubeSection>()?;
+    m.add_class::<sections::TableSection>()?;
+    m.add_class::<sections::FunctionSection>()?;
+    m.add_class::<sections::LinearElastic>()?;
     m.add_class::<model::Rod>()?;
     m.add_class::<model::Tendon>()?;
     m.add_class::<model::Chamber>()?;

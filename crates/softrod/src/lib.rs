@@ -49,9 +49,9 @@ pub use model::material::fit::{
     UniaxialData, UniaxialFit,
 };
 pub use model::material::hyperelastic::{
-    Hookean, Linearised, MooneyRivlin, NeoHookean, Ogden, Silicone, UniaxialLaw, UniaxialModel,
-    Yeoh,
+    Hookean, Linearised, MooneyRivlin, NeoHookean, Ogden, UniaxialLaw, UniaxialModel, Yeoh,
 };
+pub use model::material::silicone::Silicone;
 pub use model::material::{LinearElastic, Material};
 pub use model::rod::{Pose, Profile, Rod};
 pub use model::section::{Section, SectionProperties};

@@ -303,7 +303,8 @@ mod tests {
     use super::*;
     use crate::model::chamber::{Chamber, ChamberArea};
     use crate::model::loads::{Frame, Loads, PointLoad};
-    use crate::model::material::hyperelastic::{Silicone, UniaxialModel};
+    use crate::model::material::hyperelastic::UniaxialModel;
+    use crate::model::material::silicone::Silicone;
     use crate::model::rod::Rod;
     use crate::model::section::Section;
     use crate::model::tendon::Tendon;

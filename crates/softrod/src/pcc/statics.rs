@@ -64,9 +64,8 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
 use crate::math::series::arc_fns;
-use crate::pcc::kinematics::{
-    chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons,
-};
+use crate::pcc::actuation::{ElasticSegment, PccChambers, PccTendons};
+use crate::pcc::kinematics::{chain_pose, PccChain, PccSegment};
 use crate::solve::{
     continuation, newton, Armijo, ContinuationSettings, Evaluated, LineSearch, NewtonOptions,
     NewtonSettings, Problem, SolverStats,

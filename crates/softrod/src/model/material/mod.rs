@@ -43,6 +43,7 @@
 
 pub mod fit;
 pub mod hyperelastic;
+pub mod silicone;
 
 use nalgebra::{Matrix6, Vector6};
 
