@@ -23,12 +23,12 @@ def niti():
 def test_every_public_name_is_the_prefixed_core_function():
     assert softrod.pcc is pcc
     assert pcc.Robot is _core.PccRobot and pcc.Solution is _core.PccSolution
-    for name in pcc.__all__:
-        if name in ("Robot", "Solution"):
-            continue
+    assert pcc.PccRobot is _core.PccRobot and pcc.PccSolution is _core.PccSolution
+    classes = {"Robot", "Solution", "PccRobot", "PccSolution"}
+    for name in set(pcc.__all__) - classes:
         assert getattr(pcc, name) is getattr(_core, f"pcc_{name}"), name
     prefixed = {n[4:] for n in dir(_core) if n.startswith("pcc_")}
-    assert prefixed == set(pcc.__all__) - {"Robot", "Solution"}
+    assert prefixed == set(pcc.__all__) - classes
 
 
 def test_kinematics_shapes_and_consistency():

@@ -49,6 +49,7 @@ def test_solution_fields_have_documented_shapes():
     np.testing.assert_array_equal(sol.tip_rotation, sol.rotation[-1])
     assert sol.converged and sol.stats["converged"]
     assert set(sol.stats) == {
+        "load_factor",
         "iterations",
         "residual",
         "function_evaluations",

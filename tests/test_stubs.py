@@ -74,6 +74,86 @@ def test_solve_signature_matches_stub():
             assert defaults == real
 
 
+def _stub_params(fn: ast.FunctionDef):
+    """(name, kind, default) of a stub function's parameters; default `...` means "given"."""
+    a = fn.args
+    pos = a.posonlyargs + a.args
+    defaults = [None] * (len(pos) - len(a.defaults)) + list(a.defaults)
+    out = []
+    for arg, d in zip(pos, defaults, strict=True):
+        out.append((arg.arg, "positional", d))
+    if a.vararg:
+        out.append((a.vararg.arg, "var_positional", None))
+    for arg, d in zip(a.kwonlyargs, a.kw_defaults, strict=True):
+        out.append((arg.arg, "keyword_only", d))
+    if a.kwarg:
+        out.append((a.kwarg.arg, "var_keyword", None))
+    return out
+
+
+def _default(node):
+    if node is None:
+        return inspect.Parameter.empty
+    if isinstance(node, ast.Constant) and node.value is Ellipsis:
+        return Ellipsis
+    return ast.literal_eval(node)
+
+
+def _compare(stub: ast.FunctionDef, real, what: str, drop_first: bool):
+    sig = inspect.signature(real)
+    got = []
+    for p in sig.parameters.values():
+        kind = {
+            p.POSITIONAL_ONLY: "positional",
+            p.POSITIONAL_OR_KEYWORD: "positional",
+            p.KEYWORD_ONLY: "keyword_only",
+            p.VAR_POSITIONAL: "var_positional",
+            p.VAR_KEYWORD: "var_keyword",
+        }[p.kind]
+        got.append((p.name, kind, p.default))
+    want = _stub_params(stub)
+    if drop_first and want and want[0][0] in ("self", "cls"):
+        want = want[1:]
+    if got and got[0][0] in ("self", "cls", "$self", "$cls"):
+        got = got[1:]
+    assert [(n, k) for n, k, _ in got] == [(n, k) for n, k, _ in want], what
+    for (name, _, real_default), (_, _, node) in zip(got, want, strict=True):
+        d = _default(node)
+        if d is Ellipsis:
+            assert real_default is not inspect.Parameter.empty, f"{what}: {name} has a default"
+        elif d is inspect.Parameter.empty:
+            assert real_default is inspect.Parameter.empty, f"{what}: {name} has no default"
+        else:
+            assert real_default == d, f"{what}: default of {name}: {real_default!r} vs {d!r}"
+
+
+def test_every_public_signature_matches_the_stub():
+    checked = 0
+    for node in _stub_tree().body:
+        if isinstance(node, ast.FunctionDef) and not node.name.startswith("_"):
+            _compare(node, getattr(_core, node.name), node.name, drop_first=False)
+            checked += 1
+        elif isinstance(node, ast.ClassDef) and not node.name.endswith("Error"):
+            cls = getattr(_core, node.name)
+            for fn in node.body:
+                if not isinstance(fn, ast.FunctionDef):
+                    continue
+                decorators = {getattr(d, "id", getattr(d, "attr", None)) for d in fn.decorator_list}
+                if "property" in decorators or (
+                    fn.name.startswith("__")
+                    and fn.name
+                    not in (
+                        "__init__",
+                        "__new__",
+                    )
+                ):
+                    continue
+                real = cls if fn.name in ("__init__", "__new__") else getattr(cls, fn.name)
+                _compare(fn, real, f"{node.name}.{fn.name}", drop_first=True)
+                checked += 1
+    assert checked > 60, checked
+
+
 def test_package_layout_and_earlier_module_paths():
     import softrod.analysis
     import softrod.cli

@@ -141,24 +141,37 @@ class Section:
     """A rod's cross-section along its length."""
 
     def properties(self, s: float, length: float) -> dict[str, float]: ...
+    @property
+    def parameters(self) -> dict[str, object]:
+        """The constructor arguments by name, as given (what a writer needs)."""
 
 @final
 class CircularSection(Section):
     """Solid circle of constant radius (m)."""
 
     def __init__(self, radius: float) -> None: ...
+    @property
+    def radius(self) -> float: ...
 
 @final
 class TaperedCircularSection(Section):
     """Solid circle tapering linearly from base_radius to tip_radius (m)."""
 
     def __init__(self, base_radius: float, tip_radius: float) -> None: ...
+    @property
+    def base_radius(self) -> float: ...
+    @property
+    def tip_radius(self) -> float: ...
 
 @final
 class TubeSection(Section):
     """Circular tube (m)."""
 
     def __init__(self, outer_radius: float, inner_radius: float = 0.0) -> None: ...
+    @property
+    def outer_radius(self) -> float: ...
+    @property
+    def inner_radius(self) -> float: ...
 
 @final
 class TableSection(Section):
@@ -220,13 +233,30 @@ class Rod:
     @property
     def length(self) -> float: ...
     @property
+    def section(self) -> Section:
+        """The section, as given."""
+    @property
+    def material(self) -> LinearElastic | UniaxialLaw:
+        """The material, as given."""
+    @property
+    def rest_strain(self) -> _Vec3 | _VecFn | None:
+        """The rest strain as given (None: (0, 0, 1))."""
+    @property
+    def rest_curvature(self) -> _Vec3 | _VecFn | None:
+        """The rest curvature as given (None: zero)."""
+    @property
     def inextensible(self) -> bool: ...
     @property
     def density(self) -> float | None: ...
     @property
-    def shear_coefficient(self) -> float: ...
+    def shear_coefficient(self) -> float:
+        """The shear coefficient in use (the one given, or Cowper's value)."""
     @property
-    def base_pose(self) -> NDArray[np.float64]: ...
+    def shear_coefficient_given(self) -> float | None:
+        """The shear coefficient as given (None: Cowper's value)."""
+    @property
+    def base_pose(self) -> NDArray[np.float64]:
+        """Base pose, 4x4 homogeneous transform (body at s = 0 to world)."""
 
 @final
 class Tendon:
@@ -253,6 +283,12 @@ class Tendon:
     def tension(self) -> float: ...
     @property
     def end(self) -> float | None: ...
+    @property
+    def routing(self) -> Literal["constant", "function", "radius_proportional", "helical"]: ...
+    @property
+    def parameters(self) -> dict[str, object]:
+        """The routing's parameters as given (offset and derivative; ratio and angle; radius,
+        pitch and phase), with tension and end."""
 
 @final
 class PointLoad:
@@ -261,10 +297,18 @@ class PointLoad:
     def __init__(
         self,
         s: float,
-        force: _Vec3 = ...,
-        moment: _Vec3 = ...,
+        force: _Vec3 | None = None,
+        moment: _Vec3 | None = None,
         frame: Literal["world", "body"] = "world",
     ) -> None: ...
+    @property
+    def s(self) -> float: ...
+    @property
+    def force(self) -> list[float]: ...
+    @property
+    def moment(self) -> list[float]: ...
+    @property
+    def frame(self) -> Literal["world", "body"]: ...
 
 @final
 class Loads:
@@ -281,6 +325,20 @@ class Loads:
         distributed_force: _Vec3 | _VecFn | None = None,
         distributed_moment: _Vec3 | _VecFn | None = None,
     ) -> None: ...
+    @property
+    def tip_force(self) -> list[float]: ...
+    @property
+    def tip_moment(self) -> list[float]: ...
+    @property
+    def gravity(self) -> list[float]: ...
+    @property
+    def tip_frame(self) -> Literal["world", "body"]: ...
+    @property
+    def point_loads(self) -> list[PointLoad]: ...
+    @property
+    def distributed_force(self) -> _Vec3 | _VecFn | None: ...
+    @property
+    def distributed_moment(self) -> _Vec3 | _VecFn | None: ...
 
 @final
 class StaticsSolution:
@@ -311,6 +369,12 @@ class StaticsSolution:
     @property
     def base_wrench(self) -> NDArray[np.float64]: ...
     @property
+    def tensions(self) -> NDArray[np.float64]:
+        """Tendon tensions it was solved for (N), shape (n_tendons,)."""
+    @property
+    def pressures(self) -> NDArray[np.float64]:
+        """Chamber pressures it was solved for (Pa), shape (n_chambers,)."""
+    @property
     def tip_position(self) -> NDArray[np.float64]: ...
     @property
     def tip_rotation(self) -> NDArray[np.float64]: ...
@@ -325,18 +389,21 @@ def solve_statics(
     tendons: Sequence[Tendon] = ...,
     loads: Loads | None = None,
     *,
-    integrator: Literal["rk4", "adaptive"] = "rk4",
-    steps: int = 40,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
-    tolerance: float = 1e-10,
-    max_iterations: int = 30,
-    continuation: bool = True,
-    max_load_steps: int = 64,
+    integrator: Literal["rk4", "adaptive"] | None = None,
+    steps: int | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    continuation: bool | None = None,
+    max_load_steps: int | None = None,
     warm_start: StaticsSolution | Sequence[float] | None = None,
-    throw: bool = True,
+    throw: bool | None = None,
     chambers: Sequence[Chamber] = ...,
-) -> StaticsSolution: ...
+) -> StaticsSolution:
+    """Options not given keep the core's defaults: integrator "rk4" with 40 steps (rtol 1e-8,
+    atol 1e-10 for "adaptive"), tolerance 1e-10, max_iterations 30, continuation True,
+    max_load_steps 64, throw True."""
 
 # ----------------------------------------------------------------------------- materials
 
@@ -518,6 +585,9 @@ class PccRobot:
     def axial_stiffness(self) -> list[float | None]: ...
     @property
     def tendons(self) -> NDArray[np.float64]: ...
+    @property
+    def chambers(self) -> list[tuple[int, list[float], list[float], list[float]]]:
+        """Chamber groups as (segment, areas, distances, angles)."""
 
 @final
 class PccSolution:
@@ -547,6 +617,10 @@ class PccSolution:
     def converged(self) -> bool: ...
     @property
     def load_steps(self) -> int: ...
+    @property
+    def load_factor(self) -> float: ...
+    @property
+    def stats(self) -> dict[str, float | int | bool]: ...
     def frames_at(self, s: _Floats) -> NDArray[np.float64]: ...
 
 def pcc_solve(
@@ -557,15 +631,21 @@ def pcc_solve(
     tip_force: _Floats | None = None,
     tip_moment: _Floats | None = None,
     s: _Floats | None = None,
-    n_points: int = 50,
-    tolerance: float = 1e-12,
-    max_iterations: int = 50,
-    continuation: bool = True,
-    max_load_steps: int = 64,
+    n_points: int | None = None,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    continuation: bool | None = None,
+    max_load_steps: int | None = None,
     warm_start: PccSolution | _Rows | None = None,
-    throw: bool = True,
-) -> PccSolution: ...
+    throw: bool | None = None,
+) -> PccSolution:
+    """Options not given keep the core's defaults: 50 frames, tolerance 1e-12,
+    max_iterations 50, continuation True, max_load_steps 64, throw True."""
+
 def pcc_arc_pose(curvature: float, plane_angle: float, length: float) -> NDArray[np.float64]: ...
+def pcc_arc_poses(curvature: _Floats, plane_angle: _Floats, length: _Floats) -> NDArray[np.float64]:
+    """Tip poses (N, 4, 4) of N arcs in one call (a number is repeated)."""
+
 def pcc_arc_frames(
     curvature: float, plane_angle: float, length: float, s: _Floats
 ) -> NDArray[np.float64]: ...
@@ -752,13 +832,14 @@ def _workspace_map(
     tensions: NDArray[np.float64],
     loads: Loads | None = None,
     *,
-    integrator: Literal["rk4", "adaptive"] = "rk4",
-    steps: int = 40,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
-    tolerance: float = 1e-10,
+    integrator: Literal["rk4", "adaptive"] | None = None,
+    steps: int | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    tolerance: float | None = None,
     chunk: int = 64,
     tangent: Literal["tension", "length"] | None = None,
+    chambers: Sequence[Chamber] = ...,
 ) -> dict[str, NDArray[np.float64]]: ...
 
 # ----------------------------------------------------------------------------- chambers
@@ -778,6 +859,9 @@ class Chamber:
     def with_pressure(self, pressure: float) -> Chamber: ...
     @property
     def pressure(self) -> float: ...
+    @property
+    def area(self) -> float | Callable[[float], float]:
+        """The area as given."""
     def area_at(self, s: float) -> float: ...
     @property
     def offset(self) -> tuple[float, float]: ...

@@ -25,8 +25,7 @@ Example:
     array([0.0637, 0.    , 0.0637])
 """
 
-from ._core import PccRobot as Robot
-from ._core import PccSolution as Solution
+from ._core import PccRobot, PccSolution
 from ._core import pcc_arc_frames as arc_frames
 from ._core import pcc_arc_from_pressures as arc_from_pressures
 from ._core import pcc_arc_from_pressures_jacobian as arc_from_pressures_jacobian
@@ -40,6 +39,7 @@ from ._core import pcc_arc_from_tip as arc_from_tip
 from ._core import pcc_arc_from_tip_with_length as arc_from_tip_with_length
 from ._core import pcc_arc_jacobian as arc_jacobian
 from ._core import pcc_arc_pose as arc_pose
+from ._core import pcc_arc_poses as arc_poses
 from ._core import pcc_chain_frames as chain_frames
 from ._core import pcc_chain_jacobian as chain_jacobian
 from ._core import pcc_chain_pose as chain_pose
@@ -47,7 +47,13 @@ from ._core import pcc_solve as solve
 from ._core import pcc_tendon_displacement_jacobian as tendon_displacement_jacobian
 from ._core import pcc_tendon_displacements as tendon_displacements
 
+# The names of the first release, kept: ``softrod.pcc.Robot`` is ``PccRobot``.
+Robot = PccRobot
+Solution = PccSolution
+
 __all__ = [
+    "PccRobot",
+    "PccSolution",
     "Robot",
     "Solution",
     "arc_frames",
@@ -61,6 +67,7 @@ __all__ = [
     "arc_from_tip_with_length",
     "arc_jacobian",
     "arc_pose",
+    "arc_poses",
     "chain_frames",
     "chain_jacobian",
     "chain_pose",

@@ -698,6 +698,12 @@ def _define_targets() -> None:
     t("pcc.Solution.frames_at")(lambda d: (_pcc_solution().frames_at, dict(s=[0.0, 0.1, 0.3])))
     arc = dict(curvature=5.0, plane_angle=0.3, length=0.2)
     t("pcc.arc_pose")(lambda d: (pcc.arc_pose, dict(arc)))
+    t("pcc.arc_poses")(
+        lambda d: (
+            pcc.arc_poses,
+            dict(curvature=[5.0, 0.0], plane_angle=[0.3, 1.0], length=[0.2, 0.1]),
+        )
+    )
     t("pcc.arc_frames")(lambda d: (pcc.arc_frames, dict(arc, s=[0.0, 0.1, 0.2])))
     t("pcc.arc_jacobian")(
         lambda d: (pcc.arc_jacobian, dict(arc, frame="spatial", coordinates="arc"))
@@ -1390,6 +1396,7 @@ NOT_CONSTRUCTED = {
     "UniaxialLaw",
     "WorkspaceMap",
     "Solution",
+    "PccSolution",
 }
 
 

@@ -1,16 +1,19 @@
 //! Binding of the compliance module: integrated and tangent compliance of a solved rod,
 //! eigenscrews, workspace maps. Arrays only; the numerics are in `softrod::compliance`,
-//! `softrod::eigenscrew` and `softrod::workspace`.
+//! `softrod::compliance::eigenscrew` and `softrod::batch::workspace`.
 
 use numpy::ndarray::Array;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
+use softrod::math::linalg::invert_spd;
 use softrod::nalgebra::Matrix6;
 
 use crate::errors::{param_err, to_py_err};
+use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 use crate::pcc::PccSolution;
-use crate::statics::{Loads, Problem, Rod, StaticsSolution, Tendon};
+use crate::statics::{solve_options, OptionArgs, Problem, StaticsSolution};
 
 fn mat6<'py>(py: Python<'py>, m: &Matrix6<f64>) -> Bound<'py, PyArray2<f64>> {
     Array::from_shape_fn((6, 6), |(i, j)| m[(i, j)]).into_pyarray(py)
@@ -20,20 +23,15 @@ fn mats6<'py>(py: Python<'py>, v: &[Matrix6<f64>]) -> Bound<'py, PyArray3<f64>> 
     Array::from_shape_fn((v.len(), 6, 6), |(k, i, j)| v[k][(i, j)]).into_pyarray(py)
 }
 
-fn problem_of(solution: &StaticsSolution) -> PyResult<&Problem> {
-    solution.problem.as_deref().ok_or_else(|| {
-        param_err(
-            "solution",
-            "a solution without its problem",
-            "a solution returned by solve_statics",
-        )
-    })
-}
-
 /// Integrated compliance and stiffness at every node of a solution (seed 001, eqs. 6-7).
+///
+/// Compliances `C` (6x6: m/N, 1/N, rad/(N m) blocks) map a wrench [f; m] (N, N m) to a twist
+/// [translation (m); rotation (rad)], world and body frames; stiffness `K = C^-1`.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Compliance {
     inner: softrod::Compliance,
+    /// The call that produced it (for pickling: it is computed again, bit for bit).
+    call: Args,
 }
 
 #[pymethods]
@@ -94,23 +92,17 @@ impl Compliance {
     /// Tip stiffness, world frame, shape (6, 6).
     #[getter]
     fn tip_stiffness_world<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        mat6(
-            py,
-            &softrod::compliance::invert_spd(&self.inner.tip_world()).0,
-        )
+        mat6(py, &invert_spd(&self.inner.tip_world()).0)
     }
     /// Tip stiffness, body frame, shape (6, 6).
     #[getter]
     fn tip_stiffness_body<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        mat6(
-            py,
-            &softrod::compliance::invert_spd(&self.inner.tip_body()).0,
-        )
+        mat6(py, &invert_spd(&self.inner.tip_body()).0)
     }
     /// 1-norm condition number of the tip compliance.
     #[getter]
     fn tip_condition(&self) -> f64 {
-        softrod::compliance::invert_spd(&self.inner.tip_world()).1
+        invert_spd(&self.inner.tip_world()).1
     }
     fn __len__(&self) -> usize {
         self.inner.s.len()
@@ -121,6 +113,11 @@ impl Compliance {
             self.inner.s.len(),
             self.tip_condition()
         )
+    }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("compliance")?;
+        slf.get().call.reduce(py, f)
     }
 }
 
@@ -133,14 +130,37 @@ pub(crate) enum AnySolution<'py> {
 
 /// The seed's integrated compliance along a solved rod (world and body frames), Cosserat or
 /// PCC (same computation; the PCC arcs take `rod`'s section and material).
+///
+/// Returns a `Compliance`: 6x6 matrices per node (m/N, 1/N, rad/(N m) blocks) in the world
+/// and body frames, and the dimensionless `gamma_c`.
 #[pyfunction]
 #[pyo3(signature = (solution, rod=None, *, panels=None))]
-pub(crate) fn compliance(
-    py: Python<'_>,
-    solution: AnySolution<'_>,
-    rod: Option<PyRef<'_, Rod>>,
+pub(crate) fn compliance<'py>(
+    py: Python<'py>,
+    solution: &Bound<'py, PyAny>,
+    rod: Option<Bound<'py, Rod>>,
     panels: Option<i64>,
 ) -> PyResult<Compliance> {
+    let call = Args::new(
+        py,
+        &[
+            ("solution", solution.clone().unbind()),
+            (
+                "rod",
+                rod.as_ref()
+                    .map_or_else(|| py.None(), |r| r.clone().into_any().unbind()),
+            ),
+            ("panels", panels.into_pyobject(py)?.into_any().unbind()),
+        ],
+    )?;
+    let solution: AnySolution<'_> = solution.extract().map_err(|_| {
+        param_err(
+            "solution",
+            "<object>",
+            "a StaticsSolution or a softrod.pcc solution",
+        )
+    })?;
+    let rod = rod.as_ref().map(|r| r.borrow());
     let inner = match solution {
         AnySolution::Cosserat(solution) => {
             if rod.is_some() {
@@ -150,9 +170,8 @@ pub(crate) fn compliance(
                     "None for a Cosserat solution (it carries its rod)",
                 ));
             }
-            let problem = problem_of(&solution)?;
             let sol = &solution.inner;
-            py.detach(|| softrod::compliance(&problem.rod, sol))
+            py.detach(|| softrod::compliance(sol))
         }
         AnySolution::Pcc(solution) => {
             let rod = rod.ok_or_else(|| {
@@ -167,14 +186,18 @@ pub(crate) fn compliance(
         }
     }
     .map_err(to_py_err)?;
-    Ok(Compliance { inner })
+    Ok(Compliance { inner, call })
 }
 
 /// Exact tangent compliance at one node of a loaded, actuated equilibrium.
+///
+/// `world` and `body` are 6x6 (m/N, 1/N, rad/(N m) blocks); `tension_rate` in N/N and
+/// N/(N m) per tendon.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct TangentCompliance {
     inner: softrod::TangentCompliance,
     tendons: String,
+    call: Args,
 }
 
 #[pymethods]
@@ -237,21 +260,38 @@ impl TangentCompliance {
             self.inner.node, self.inner.s, self.tendons, self.inner.condition
         )
     }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("tangent_compliance")?;
+        slf.get().call.reduce(py, f)
+    }
 }
 
 /// Exact tangent compliance of the equilibrium `solution` at `node` (default: the tip), with
 /// the tendons at fixed "tension" or fixed "length" (all, or the indices `held`).
+///
+/// Any number of tendons can be held; returns a `TangentCompliance` (6x6, m/N, 1/N, rad/(N m)
+/// blocks).
 #[pyfunction]
 #[pyo3(signature = (solution, tendons="tension", *, held=None, node=None))]
-pub(crate) fn tangent_compliance(
-    py: Python<'_>,
-    solution: PyRef<'_, StaticsSolution>,
+pub(crate) fn tangent_compliance<'py>(
+    py: Python<'py>,
+    solution: &Bound<'py, StaticsSolution>,
     tendons: &str,
     held: Option<Vec<i64>>,
     node: Option<i64>,
 ) -> PyResult<TangentCompliance> {
-    let problem = problem_of(&solution)?;
-    let nt = problem.tendons.len();
+    let call = Args::new(
+        py,
+        &[
+            ("solution", solution.clone().into_any().unbind()),
+            ("tendons", tendons.into_pyobject(py)?.into_any().unbind()),
+            ("held", held.clone().into_pyobject(py)?.into_any().unbind()),
+            ("node", node.into_pyobject(py)?.into_any().unbind()),
+        ],
+    )?;
+    let solution = solution.get();
+    let nt = solution.inner.model.tendons().len();
     let held: Vec<usize> = match (tendons, held) {
         ("tension", None) => Vec::new(),
         ("tension", Some(_)) => {
@@ -278,31 +318,26 @@ pub(crate) fn tangent_compliance(
         Some(k) => return Err(param_err("node", k, "in [-N, N)")),
     };
     let sol = &solution.inner;
-    let result = py.detach(|| {
-        softrod::compliance::tangent_compliance_held(
-            &problem.rod,
-            &problem.tendons,
-            &problem.loads,
-            sol,
-            &problem.options,
-            &held,
-            node,
-        )
-    });
-    if let Some(err) = problem.callback_error() {
+    let result = py.detach(|| softrod::compliance::tangent_compliance_held(sol, &held, node));
+    if let Some(err) = solution.callback_error() {
         return Err(err);
     }
     Ok(TangentCompliance {
         inner: result.map_err(to_py_err)?,
         tendons: tendons.to_string(),
+        call,
     })
 }
 
 /// Eigenscrew decomposition of a 6x6 stiffness or compliance, with the compliance ellipsoids.
+///
+/// Values in N/m, N/rad (stiffness) or m/N, rad/(N m) (compliance); pitches in m/rad; axis
+/// points in m.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Eigenscrews {
     inner: softrod::Decomposition,
     kind: String,
+    matrix: Py<PyAny>,
 }
 
 #[pymethods]
@@ -379,13 +414,30 @@ impl Eigenscrews {
             v.join(", ")
         )
     }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("eigenscrews")?;
+        let e = slf.get();
+        let args = (e.matrix.clone_ref(py), e.kind.clone()).into_pyobject(py)?;
+        PyTuple::new(py, [f, args.into_any()])
+    }
 }
 
 /// Eigenscrews of a symmetric positive definite 6x6 `matrix` (kind "stiffness" or
 /// "compliance"; twists [translation; rotation], wrenches [force; moment]).
 #[pyfunction]
 #[pyo3(signature = (matrix, kind="stiffness"))]
-pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyResult<Eigenscrews> {
+pub(crate) fn eigenscrews(
+    py: Python<'_>,
+    matrix: PyReadonlyArray2<'_, f64>,
+    kind: &str,
+) -> PyResult<Eigenscrews> {
+    let copy = matrix
+        .as_array()
+        .to_owned()
+        .into_pyarray(py)
+        .into_any()
+        .unbind();
     let a = matrix.as_array();
     if a.shape() != [6, 6] {
         return Err(param_err(
@@ -404,6 +456,7 @@ pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyRe
     Ok(Eigenscrews {
         inner,
         kind: kind.to_string(),
+        matrix: copy,
     })
 }
 
@@ -411,22 +464,24 @@ pub(crate) fn eigenscrews(matrix: PyReadonlyArray2<'_, f64>, kind: &str) -> PyRe
 /// `tendons` (their tensions replaced by each row of `tensions`, shape (M, n_tendons)) and
 /// returns a dict of arrays.
 #[pyfunction]
-#[pyo3(signature = (rod, tendons, tensions, loads=None, *, integrator="rk4", steps=50,
-                    rtol=1e-8, atol=1e-10, tolerance=1e-10, chunk=64, tangent=None))]
+#[pyo3(signature = (rod, tendons, tensions, loads=None, *, integrator=None, steps=None,
+                    rtol=None, atol=None, tolerance=None, chunk=softrod::batch::workspace::DEFAULT_CHUNK as i64,
+                    tangent=None, chambers=Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _workspace_map<'py>(
     py: Python<'py>,
-    rod: PyRef<'_, Rod>,
-    tendons: Vec<PyRef<'_, Tendon>>,
+    rod: &Bound<'py, Rod>,
+    tendons: Vec<Bound<'py, Tendon>>,
     tensions: PyReadonlyArray2<'_, f64>,
-    loads: Option<PyRef<'_, Loads>>,
-    integrator: &str,
-    steps: i64,
-    rtol: f64,
-    atol: f64,
-    tolerance: f64,
+    loads: Option<&Bound<'py, Loads>>,
+    integrator: Option<&'py str>,
+    steps: Option<i64>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    tolerance: Option<f64>,
     chunk: i64,
     tangent: Option<&str>,
+    chambers: Vec<Bound<'py, Chamber>>,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let tangent = match tangent {
         None => None,
@@ -440,40 +495,34 @@ pub(crate) fn _workspace_map<'py>(
             ))
         }
     };
-    let problem = Problem::new(
-        &rod,
-        &tendons,
-        loads.as_deref(),
+    let options = solve_options(&OptionArgs {
         integrator,
         steps,
         rtol,
         atol,
         tolerance,
-        30,
-        true,
-        64,
-        None,
-        true,
-    )?;
+        ..Default::default()
+    })?;
+    let problem = Problem::new(rod.get(), &tendons, loads.map(Bound::get), &chambers)?;
+    let nt = problem.model.tendons().len();
     if chunk < 1 {
         return Err(param_err("chunk", chunk, ">= 1"));
     }
     let a = tensions.as_array();
-    if a.ndim() != 2 || a.shape()[1] != problem.tendons.len() {
+    if a.ndim() != 2 || a.shape()[1] != nt {
         return Err(param_err(
             "tensions",
             format!("shape {:?}", a.shape()),
-            &format!("shape (M, {})", problem.tendons.len()),
+            &format!("shape (M, {nt})"),
         ));
     }
     let flat: Vec<f64> = a.iter().copied().collect();
     let result = py.detach(|| {
         softrod::workspace_map(
-            &problem.rod,
-            &problem.tendons,
-            &problem.loads,
+            &problem.model,
+            &problem.actuation,
             &flat,
-            &problem.options,
+            &options,
             chunk as usize,
             tangent,
         )

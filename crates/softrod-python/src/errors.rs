@@ -10,13 +10,15 @@ create_exception!(
     _core,
     ParameterError,
     PyValueError,
-    "A parameter is outside its valid range; the message names it, its value and the range."
+    "A parameter is outside its valid range; the message names it, its value and the range.\n\n\
+     `parameter` is the name (e.g. `tip_force`); values are in SI units (m, N, Pa, rad)."
 );
 create_exception!(
     _core,
     ConvergenceError,
     PyRuntimeError,
-    "A solver or integrator did not converge; carries `iterations` and `residual`."
+    "A solver or integrator did not converge; carries `iterations` and `residual`.\n\n\
+     The residual is the solver's scaled (dimensionless) residual."
 );
 
 /// The one place where core errors become Python exceptions.

@@ -2,7 +2,9 @@
 //!
 //! This crate only converts arrays, maps the core's one error type to Python exceptions (in
 //! `errors::to_py_err`) and releases the GIL around solves. All numerics live in the `softrod`
-//! crate. One module per area of the API: `planar`, `statics`; conversions in `convert`.
+//! crate. It is split like the core: `model` (the robot description), `statics`,
+//! `compliance`, `pcc`, `planar`, `materials`; argument conversions in `convert`, errors in
+//! `errors`.
 
 use pyo3::prelude::*;
 
@@ -10,8 +12,10 @@ mod compliance;
 mod convert;
 mod errors;
 mod materials;
+mod model;
 mod pcc;
 mod planar;
+mod sections;
 mod statics;
 
 /// The compiled core of softrod.
@@ -30,20 +34,21 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;
     m.add_function(wrap_pyfunction!(planar::backbone_distance, m)?)?;
-    m.add_class::<statics::PySection>()?;
-    m.add_class::<statics::CircularSection>()?;
-    m.add_class::<statics::TaperedCircularSection>()?;
-    m.add_class::<statics::TubeSection>()?;
-    m.add_class::<statics::TableSection>()?;
-    m.add_class::<statics::FunctionSection>()?;
-    m.add_class::<statics::LinearElastic>()?;
-    m.add_class::<statics::Rod>()?;
-    m.add_class::<statics::Tendon>()?;
-    m.add_class::<statics::Chamber>()?;
-    m.add_class::<statics::PointLoad>()?;
-    m.add_class::<statics::Loads>()?;
+    m.add_class::<sections::PySection>()?;
+    m.add_class::<sections::CircularSection>()?;
+    m.add_class::<sections::TaperedCircularSection>()?;
+    m.add_class::<sections::TubeSection>()?;
+    m.add_class::<sections::TableSection>()?;
+    m.add_class::<sections::FunctionSection>()?;
+    m.add_class::<sections::LinearElastic>()?;
+    m.add_class::<model::Rod>()?;
+    m.add_class::<model::Tendon>()?;
+    m.add_class::<model::Chamber>()?;
+    m.add_class::<model::PointLoad>()?;
+    m.add_class::<model::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(model::_rebuild, m)?)?;
     m.add_class::<materials::PyUniaxialLaw>()?;
     m.add_class::<materials::Hookean>()?;
     m.add_class::<materials::Linearised>()?;
@@ -54,6 +59,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<materials::UniaxialFit>()?;
     m.add_class::<materials::Silicone>()?;
     m.add_function(wrap_pyfunction!(materials::fit_uniaxial, m)?)?;
+    m.add_function(wrap_pyfunction!(materials::_uniaxial_fit, m)?)?;
     m.add_function(wrap_pyfunction!(materials::silicone, m)?)?;
     m.add("SILICONES", materials::silicone_names(m.py())?)?;
     m.add_function(wrap_pyfunction!(statics::_time_solve_statics, m)?)?;
@@ -68,6 +74,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<pcc::PccSolution>()?;
     m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_arc_poses, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::_pcc_robot, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_frames, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_chain_pose, m)?)?;

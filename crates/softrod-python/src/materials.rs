@@ -12,7 +12,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use softrod::fit::{FitOptions, ModelKind, StrainMeasure, StressMeasure, UniaxialData};
+use softrod::model::material::fit::{
+    FitOptions, ModelKind, StrainMeasure, StressMeasure, UniaxialData,
+};
 use softrod::{Error, UniaxialLaw as _, UniaxialModel};
 
 use crate::errors::{param_err, to_py_err};
@@ -181,9 +183,25 @@ impl PyUniaxialLaw {
     fn __repr__(&self) -> String {
         self.inner.to_string()
     }
+    /// Pickles as the constructor of its class called with its parameters (exact).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let rebuild = py.import("softrod._core")?.getattr("_rebuild")?;
+        let inner = PyTuple::new(
+            py,
+            [
+                slf.get_type().into_any(),
+                PyTuple::empty(py).into_any(),
+                parameters(py, &slf.get().inner)?.into_any(),
+            ],
+        )?;
+        PyTuple::new(py, [rebuild, inner.into_any()])
+    }
 }
 
 /// Linear law `P = E (λ − 1)` with Young's modulus `youngs_modulus` (Pa).
+///
+/// The nominal stress `P` is in Pa, the stretch `λ` dimensionless.
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct Hookean {
     law: softrod::Hookean,
@@ -247,6 +265,8 @@ impl Linearised {
 }
 
 /// Incompressible Neo-Hookean law with initial shear modulus `mu` (Pa).
+///
+/// `W = mu/2 (I1 - 3)`; small-strain Young's modulus `3 mu` (Pa).
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct NeoHookean {
     law: softrod::NeoHookean,
@@ -270,6 +290,8 @@ impl NeoHookean {
 }
 
 /// Incompressible two-parameter Mooney–Rivlin law with `c10`, `c01` (Pa).
+///
+/// `W = c10 (I1 - 3) + c01 (I2 - 3)`; small-strain modulus `6 (c10 + c01)` (Pa).
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct MooneyRivlin {
     law: softrod::MooneyRivlin,
@@ -298,6 +320,8 @@ impl MooneyRivlin {
 }
 
 /// Incompressible Yeoh law with `c10 > 0`, `c20`, `c30` (Pa).
+///
+/// `W = sum_i ci0 (I1 - 3)^i`; small-strain modulus `6 c10` (Pa).
 #[pyclass(frozen, extends = PyUniaxialLaw, module = "softrod._core")]
 pub(crate) struct Yeoh {
     law: softrod::Yeoh,
@@ -397,6 +421,23 @@ pub(crate) struct UniaxialFit {
 
 #[pymethods]
 impl UniaxialFit {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = slf.get();
+        let func = py.import("softrod._core")?.getattr("_uniaxial_fit")?;
+        let args = (
+            f.law.clone_ref(py),
+            f.rms,
+            f.r_squared,
+            f.max_abs_residual,
+            f.points,
+            f.iterations,
+            f.stress_measure,
+            f.stretch_range,
+        )
+            .into_pyobject(py)?;
+        PyTuple::new(py, [func, args.into_any()])
+    }
     /// The fitted law (a `UniaxialLaw` subclass: `NeoHookean`, `Yeoh`, ...).
     #[getter]
     fn model(&self, py: Python<'_>) -> Py<PyAny> {
@@ -482,6 +523,9 @@ fn parse_stress_measure(name: &str) -> PyResult<(StressMeasure, &'static str)> {
 }
 
 /// Fits a law to uniaxial test data by least squares (see the docs).
+///
+/// `strain` (dimensionless) and `stress` (Pa) arrays; returns a `UniaxialFit` with the law and
+/// its errors (Pa).
 #[pyfunction]
 #[pyo3(signature = (strain, stress, model="neo-hookean", *, strain_measure="engineering",
                     stress_measure="nominal", terms=None, nonnegative=false, stretch_range=None,
@@ -548,9 +592,48 @@ pub(crate) fn fit_uniaxial(
     })
 }
 
+/// A fit from its parts (the pickled form of `UniaxialFit`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _uniaxial_fit(
+    law: &Bound<'_, PyUniaxialLaw>,
+    rms: f64,
+    r_squared: f64,
+    max_abs_residual: f64,
+    points: usize,
+    iterations: usize,
+    stress_measure: &str,
+    stretch_range: (f64, f64),
+) -> PyResult<UniaxialFit> {
+    let stress_measure = match stress_measure {
+        "nominal" => "nominal",
+        "true" => "true",
+        other => {
+            return Err(param_err(
+                "stress_measure",
+                other,
+                "\"nominal\" or \"true\"",
+            ))
+        }
+    };
+    Ok(UniaxialFit {
+        model: law.get().inner.clone(),
+        law: law.clone().into_any().unbind(),
+        rms,
+        r_squared,
+        max_abs_residual,
+        points,
+        iterations,
+        stress_measure,
+        stretch_range,
+    })
+}
+
 // ----------------------------------------------------------------------------------- library
 
 /// A named silicone of the library, with sourced parameters (see `softrod.silicone`).
+///
+/// Its laws are in Pa (Neo-Hookean, Mooney–Rivlin, Yeoh), with the source of the parameters.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Silicone {
     inner: softrod::Silicone,
@@ -594,9 +677,17 @@ impl Silicone {
     fn __repr__(&self) -> String {
         format!("Silicone({:?})", self.inner.name())
     }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("silicone")?;
+        let args = PyTuple::new(py, [slf.get().inner.name()])?;
+        PyTuple::new(py, [f, args.into_any()])
+    }
 }
 
 /// The silicone named `name` (case, spaces, `-` and `_` ignored), e.g. "Dragon Skin 10".
+///
+/// Raises `ParameterError` naming `name` for an unknown silicone; the laws are in Pa.
 #[pyfunction]
 pub(crate) fn silicone(name: &str) -> PyResult<Silicone> {
     let inner = softrod::Silicone::from_name(name).map_err(to_py_err)?;

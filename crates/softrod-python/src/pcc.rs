@@ -8,35 +8,21 @@
 use numpy::ndarray::Array;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
 use softrod::nalgebra::{Matrix4, Vector3};
+use softrod::pcc::statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
 use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegment};
-use softrod::pcc_statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
 
 use crate::errors::{param_err, to_py_err};
 
-/// Floats given as a NumPy array (any strides), any sequence, or one number.
-#[derive(FromPyObject)]
-pub(crate) enum Floats<'py> {
-    Array(numpy::PyReadonlyArray1<'py, f64>),
-    Scalar(f64),
-    Seq(Vec<f64>),
-}
+use crate::convert::Floats;
 
-impl Floats<'_> {
-    fn to_vec(&self) -> PyResult<Vec<f64>> {
-        Ok(match self {
-            Floats::Array(a) => a.as_array().to_vec(),
-            Floats::Scalar(x) => vec![*x],
-            Floats::Seq(v) => v.clone(),
-        })
-    }
-}
+/// A chamber group `(segment, areas, distances, angles)` (m², m, rad).
+type ChamberGroup = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
 
-// The Python signature spells the core's defaults as literals; keep them in step.
-const _: () = assert!(statics::DEFAULT_TOLERANCE == 1e-12);
-const _: () = assert!(statics::DEFAULT_MAX_ITERATIONS == 50);
-const _: () = assert!(statics::DEFAULT_MAX_LOAD_STEPS == 64);
+/// Frames sampled along a solution when neither `s` nor `n_points` is given.
+const DEFAULT_FRAMES: usize = 50;
 
 fn frame_from(frame: &str) -> PyResult<JacobianFrame> {
     match frame {
@@ -146,6 +132,55 @@ pub(crate) fn pcc_arc_pose(
 ) -> PyResult<Bound<'_, PyArray2<f64>>> {
     let t = pcc::arc_pose(curvature, plane_angle, length).map_err(to_py_err)?;
     Ok(pose_array(py, &t))
+}
+
+/// Tip poses (N, 4, 4) of N arcs: `curvature`, `plane_angle`, `length` are arrays of one
+/// length (a number is repeated); one call for any number of poses.
+#[pyfunction]
+pub(crate) fn pcc_arc_poses<'py>(
+    py: Python<'py>,
+    curvature: Floats<'py>,
+    plane_angle: Floats<'py>,
+    length: Floats<'py>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let (k, p, l) = (curvature.to_vec()?, plane_angle.to_vec()?, length.to_vec()?);
+    let n = k.len().max(p.len()).max(l.len());
+    for (name, v) in [("curvature", &k), ("plane_angle", &p), ("length", &l)] {
+        if v.len() != n && v.len() != 1 {
+            return Err(param_err(
+                &format!("{name}.len()"),
+                v.len(),
+                &format!("1 or the common length {n}"),
+            ));
+        }
+    }
+    let at = |v: &[f64], i: usize| if v.len() == 1 { v[0] } else { v[i] };
+    let mut out = numpy::ndarray::Array3::<f64>::zeros((n, 4, 4));
+    let result = py.detach(|| -> softrod::Result<()> {
+        for i in 0..n {
+            let seg = PccSegment::new(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| match e {
+                softrod::Error::InvalidParameter {
+                    name,
+                    value,
+                    expected,
+                } => softrod::Error::InvalidParameter {
+                    name: format!("{name}[{i}]"),
+                    value,
+                    expected,
+                },
+                other => other,
+            })?;
+            let t = seg.pose();
+            for r in 0..4 {
+                for c in 0..4 {
+                    out[[i, r, c]] = t[(r, c)];
+                }
+            }
+        }
+        Ok(())
+    });
+    result.map_err(to_py_err)?;
+    Ok(out.into_pyarray(py))
 }
 
 /// Backbone frames (N, 4, 4) of one arc at arc lengths `s`.
@@ -585,6 +620,39 @@ impl PccRobot {
         .into_pyarray(py)
     }
 
+    /// Chamber groups as `(segment, areas, distances, angles)`.
+    #[getter]
+    fn chambers(&self) -> Vec<ChamberGroup> {
+        self.inner
+            .chambers()
+            .iter()
+            .map(|(seg, c)| {
+                (
+                    *seg,
+                    c.areas().to_vec(),
+                    c.distances().to_vec(),
+                    c.angles().to_vec(),
+                )
+            })
+            .collect()
+    }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let r = &slf.get().inner;
+        let bodies: Vec<(f64, f64, Option<f64>)> = r
+            .segments()
+            .iter()
+            .map(|b| (b.rest_length(), b.bending_stiffness(), b.axial_stiffness()))
+            .collect();
+        let tendons: Vec<(f64, f64, usize)> = r
+            .tendons()
+            .iter()
+            .map(|t| (t.distance(), t.angle(), t.last_segment()))
+            .collect();
+        let f = py.import("softrod._core")?.getattr("_pcc_robot")?;
+        let args = (bodies, tendons, slf.get().chambers()).into_pyobject(py)?;
+        PyTuple::new(py, [f, args.into_any()])
+    }
     fn __repr__(&self) -> String {
         format!(
             "PccRobot(segments={}, tendons={}, chambers={})",
@@ -595,6 +663,32 @@ impl PccRobot {
     }
 }
 
+/// A PCC robot from its parts (the pickled form of `PccRobot`): segments `(rest_length,
+/// bending_stiffness, axial_stiffness)`, tendons `(distance, angle, last_segment)`, chamber
+/// groups `(segment, areas, distances, angles)`.
+#[pyfunction]
+pub(crate) fn _pcc_robot(
+    bodies: Vec<(f64, f64, Option<f64>)>,
+    tendons: Vec<(f64, f64, usize)>,
+    chambers: Vec<ChamberGroup>,
+) -> PyResult<PccRobot> {
+    let segs = bodies
+        .iter()
+        .map(|&(l, ei, ea)| ElasticSegment::new(l, ei, ea))
+        .collect::<softrod::Result<Vec<_>>>()
+        .map_err(to_py_err)?;
+    let mut robot = CoreRobot::new(segs).map_err(to_py_err)?;
+    for (d, b, last) in tendons {
+        let t = statics::RoutedTendon::new(d, b, last).map_err(to_py_err)?;
+        robot = robot.with_tendon(t).map_err(to_py_err)?;
+    }
+    for (seg, a, d, b) in chambers {
+        let c = pcc::PccChambers::new(&a, &d, &b).map_err(to_py_err)?;
+        robot = robot.with_chambers(seg, c).map_err(to_py_err)?;
+    }
+    Ok(PccRobot { inner: robot })
+}
+
 /// A solved PCC robot.
 #[pyclass(frozen, module = "softrod._core", name = "PccSolution")]
 pub(crate) struct PccSolution {
@@ -603,6 +697,8 @@ pub(crate) struct PccSolution {
     pub(crate) robot: CoreRobot,
     s: Vec<f64>,
     frames: Vec<Matrix4<f64>>,
+    /// The call that produced it (for pickling: it is solved again, bit for bit).
+    call: crate::model::Args,
 }
 
 #[pymethods]
@@ -669,6 +765,21 @@ impl PccSolution {
     fn load_steps(&self) -> usize {
         self.inner.stats.load_steps
     }
+    /// Fraction of the tip load the returned shape carries.
+    #[getter]
+    fn load_factor(&self) -> f64 {
+        self.inner.stats.load_factor
+    }
+    /// Solver statistics (the keys of `StaticsSolution.stats`).
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::statics::stats_dict(py, &self.inner.stats)
+    }
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let f = py.import("softrod._core")?.getattr("pcc_solve")?;
+        slf.get().call.reduce(py, f)
+    }
     /// Backbone frames (N, 4, 4) at other arc lengths `s` (m, deformed, along the chain).
     fn frames_at<'py>(
         &self,
@@ -724,33 +835,88 @@ pub(crate) enum PccWarm<'py> {
 ///     `frames` (N, 4, 4) at `s`, `tendon_lengths`, solver statistics.
 #[pyfunction]
 #[pyo3(signature = (robot, tensions=None, pressures=None, *, tip_force=None, tip_moment=None,
-                    s=None, n_points=50, tolerance=1e-12, max_iterations=50, continuation=true,
-                    max_load_steps=64, warm_start=None, throw=true))]
+                    s=None, n_points=None, tolerance=None, max_iterations=None, continuation=None,
+                    max_load_steps=None, warm_start=None, throw=None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn pcc_solve<'py>(
     py: Python<'py>,
-    robot: PyRef<'py, PccRobot>,
-    tensions: Option<Floats<'py>>,
-    pressures: Option<Floats<'py>>,
-    tip_force: Option<Floats<'py>>,
-    tip_moment: Option<Floats<'py>>,
-    s: Option<Floats<'py>>,
-    n_points: i64,
-    tolerance: f64,
-    max_iterations: i64,
-    continuation: bool,
-    max_load_steps: i64,
-    warm_start: Option<PccWarm<'py>>,
-    throw: bool,
+    robot: &Bound<'py, PccRobot>,
+    tensions: Option<Bound<'py, PyAny>>,
+    pressures: Option<Bound<'py, PyAny>>,
+    tip_force: Option<Bound<'py, PyAny>>,
+    tip_moment: Option<Bound<'py, PyAny>>,
+    s: Option<Bound<'py, PyAny>>,
+    n_points: Option<i64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<i64>,
+    continuation: Option<bool>,
+    max_load_steps: Option<i64>,
+    warm_start: Option<Bound<'py, PyAny>>,
+    throw: Option<bool>,
 ) -> PyResult<PccSolution> {
-    if max_iterations < 1 {
-        return Err(param_err("max_iterations", max_iterations, ">= 1"));
-    }
-    if max_load_steps < 1 {
-        return Err(param_err("max_load_steps", max_load_steps, ">= 1"));
-    }
-    if s.is_none() && n_points < 2 {
-        return Err(param_err("n_points", n_points, ">= 2"));
-    }
+    let o = |v: &Option<Bound<'py, PyAny>>| {
+        v.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind())
+    };
+    let call = crate::model::Args::new(
+        py,
+        &[
+            ("robot", robot.clone().into_any().unbind()),
+            ("tensions", o(&tensions)),
+            ("pressures", o(&pressures)),
+            ("tip_force", o(&tip_force)),
+            ("tip_moment", o(&tip_moment)),
+            ("s", o(&s)),
+            ("n_points", crate::model::obj(py, n_points)?),
+            ("tolerance", crate::model::obj(py, tolerance)?),
+            ("max_iterations", crate::model::obj(py, max_iterations)?),
+            ("continuation", crate::model::obj(py, continuation)?),
+            ("max_load_steps", crate::model::obj(py, max_load_steps)?),
+            ("warm_start", o(&warm_start)),
+            ("throw", crate::model::obj(py, throw)?),
+        ],
+    )?;
+    let floats = |v: Option<Bound<'py, PyAny>>, name: &str| -> PyResult<Option<Floats<'py>>> {
+        v.map(|b| {
+            b.extract::<Floats<'py>>().map_err(|_| {
+                param_err(
+                    name,
+                    "<object>",
+                    "floats (a number, a sequence or an array)",
+                )
+            })
+        })
+        .transpose()
+    };
+    let (tensions, pressures) = (
+        floats(tensions, "tensions")?,
+        floats(pressures, "pressures")?,
+    );
+    let (tip_force, tip_moment, s) = (
+        floats(tip_force, "tip_force")?,
+        floats(tip_moment, "tip_moment")?,
+        floats(s, "s")?,
+    );
+    let warm_start: Option<PccWarm<'py>> = warm_start
+        .map(|w| {
+            w.extract()
+                .map_err(|_| param_err("warm_start", "<object>", "a solution or (n, 3) arc rows"))
+        })
+        .transpose()?;
+    let robot = robot.borrow();
+    let d = PccSolveOptions::default();
+    let count = |name: &str, v: Option<i64>, default: usize| -> PyResult<usize> {
+        v.map_or(Ok(default), |k| crate::statics::count(name, k))
+    };
+    let max_iterations = count("max_iterations", max_iterations, d.newton.max_iterations)?;
+    let max_load_steps = count("max_load_steps", max_load_steps, d.newton.max_load_steps)?;
+    let tolerance = tolerance.unwrap_or(d.newton.tolerance);
+    let continuation = continuation.unwrap_or(d.newton.continuation);
+    let throw = throw.unwrap_or(d.newton.throw);
+    let n_points = match n_points {
+        None => DEFAULT_FRAMES as i64,
+        Some(k) if k >= 2 => k,
+        Some(k) => return Err(param_err("n_points", k, ">= 2")),
+    };
     let loads = PccLoads {
         tensions: tensions
             .map(|t| t.to_vec())
@@ -783,12 +949,14 @@ pub(crate) fn pcc_solve<'py>(
         }
     };
     let options = PccSolveOptions {
-        tolerance,
-        max_iterations: max_iterations as usize,
-        continuation,
-        max_load_steps: max_load_steps as usize,
+        newton: softrod::NewtonOptions {
+            tolerance,
+            max_iterations,
+            continuation,
+            max_load_steps,
+            throw,
+        },
         warm_start: warm,
-        throw,
     };
     let samples = match s {
         Some(s) => Some(s.to_vec()?),
@@ -813,5 +981,6 @@ pub(crate) fn pcc_solve<'py>(
         robot: model.clone(),
         s,
         frames,
+        call,
     })
 }

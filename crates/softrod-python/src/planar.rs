@@ -2,7 +2,9 @@
 
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
+
+use crate::model::{obj, Args};
 
 use softrod::AdaptiveOptions;
 
@@ -53,14 +55,68 @@ fn samples_from(length: f64, n_points: i64, s: Option<Floats<'_>>) -> PyResult<V
 }
 
 /// The seed-000 tapered cable-driven arm (immutable).
+///
+/// Length, radii (m), cable offset ratio (dimensionless), Young's modulus (Pa), cable anchor
+/// (m); `solve(tension)` with the tension in N.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct PlanarCableArm {
     inner: softrod::PlanarCableArm,
 }
 
+fn extract_floats<'py>(b: &Bound<'py, PyAny>, name: &str) -> PyResult<Floats<'py>> {
+    b.extract().map_err(|_| {
+        param_err(
+            name,
+            "<object>",
+            "floats (a number, a sequence or an array)",
+        )
+    })
+}
+
+/// The call `arm.<method>(first, n_points=..., s=..., ...)` of a solution, for pickling.
+#[allow(clippy::too_many_arguments)]
+fn call_args<'py>(
+    arm: &Bound<'py, PlanarCableArm>,
+    method_name: &'static str,
+    first: Py<PyAny>,
+    n_points: i64,
+    s: &Option<Bound<'py, PyAny>>,
+    method: &str,
+    rtol: f64,
+    atol: f64,
+    max_steps: i64,
+) -> PyResult<(Py<PyAny>, Args)> {
+    let py = arm.py();
+    let first_name = if method_name == "solve" {
+        "tension"
+    } else {
+        "tensions"
+    };
+    let args = Args::new(
+        py,
+        &[
+            (first_name, first),
+            ("n_points", obj(py, n_points)?),
+            (
+                "s",
+                s.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind()),
+            ),
+            ("method", obj(py, method)?),
+            ("rtol", obj(py, rtol)?),
+            ("atol", obj(py, atol)?),
+            ("max_steps", obj(py, max_steps)?),
+        ],
+    )?;
+    Ok((arm.getattr(method_name)?.unbind(), args))
+}
+
 /// Samples of one solved planar arm.
+///
+/// Arc length, backbone x, y (m), curvature (1/m), axial strain (dimensionless), tangent
+/// angle (rad), per sample.
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct PlanarSolution {
+    call: (Py<PyAny>, Args),
     #[pyo3(get)]
     tension: f64,
     #[pyo3(get)]
@@ -89,6 +145,10 @@ pub(crate) struct PlanarSolution {
 
 #[pymethods]
 impl PlanarSolution {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let (f, args) = &slf.get().call;
+        args.reduce(slf.py(), f.bind(slf.py()).clone())
+    }
     fn __repr__(&self) -> String {
         format!(
             "PlanarSolution(tension={} N, method={:?}, tip_angle={:.6} rad)",
@@ -98,8 +158,11 @@ impl PlanarSolution {
 }
 
 /// Many tensions solved on one set of samples; 2-D arrays are `(n_tensions, n_samples)`.
+///
+/// Tensions (N), backbone x, y (m), curvature (1/m), strain (dimensionless), angle (rad).
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct PlanarBatch {
+    call: (Py<PyAny>, Args),
     #[pyo3(get)]
     tension: Py<PyArray1<f64>>,
     #[pyo3(get)]
@@ -122,6 +185,10 @@ pub(crate) struct PlanarBatch {
 
 #[pymethods]
 impl PlanarBatch {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let (f, args) = &slf.get().call;
+        args.reduce(slf.py(), f.bind(slf.py()).clone())
+    }
     fn __repr__(&self, py: Python<'_>) -> String {
         let shape = self.x.bind(py).dims();
         format!("PlanarBatch(tensions={}, samples={})", shape[0], shape[1])
@@ -219,21 +286,52 @@ impl PlanarCableArm {
         )
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let a = &slf.get().inner;
+        let args = Args::new(
+            py,
+            &[
+                ("length", obj(py, a.length())?),
+                ("base_radius", obj(py, a.base_radius())?),
+                ("tip_radius", obj(py, a.tip_radius())?),
+                ("offset_ratio", obj(py, a.offset_ratio())?),
+                ("youngs_modulus", obj(py, a.youngs_modulus())?),
+                ("anchor", obj(py, a.anchor())?),
+            ],
+        )?;
+        args.reduce(py, slf.get_type().into_any())
+    }
+
     #[pyo3(signature = (tension, n_points=201, *, s=None, method="closed-form", rtol=1e-8, atol=1e-10, max_steps=100_000))]
-    fn solve(
-        &self,
-        py: Python<'_>,
+    #[allow(clippy::too_many_arguments)]
+    fn solve<'py>(
+        slf: &Bound<'py, Self>,
+        py: Python<'py>,
         tension: f64,
         n_points: i64,
-        s: Option<Floats<'_>>,
+        s: Option<Bound<'py, PyAny>>,
         method: &str,
         rtol: f64,
         atol: f64,
         max_steps: i64,
     ) -> PyResult<PlanarSolution> {
-        let samples = samples_from(self.inner.length(), n_points, s)?;
+        let call = call_args(
+            slf,
+            "solve",
+            obj(py, tension)?,
+            n_points,
+            &s,
+            method,
+            rtol,
+            atol,
+            max_steps,
+        )?;
+        let s = s.map(|b| extract_floats(&b, "s")).transpose()?;
+        let this = slf.get();
+        let samples = samples_from(this.inner.length(), n_points, s)?;
         let m = method_from(method, rtol, atol, max_steps)?;
-        let arm = self.inner;
+        let arm = this.inner;
         let sol = py
             .detach(move || softrod::solve_planar(&arm, tension, &samples, m))
             .map_err(to_py_err)?;
@@ -266,25 +364,40 @@ impl PlanarCableArm {
             }
             .to_string(),
             stats,
+            call,
         })
     }
 
     #[pyo3(signature = (tensions, n_points=201, *, s=None, method="closed-form", rtol=1e-8, atol=1e-10, max_steps=100_000))]
-    fn solve_many(
-        &self,
-        py: Python<'_>,
-        tensions: Floats<'_>,
+    #[allow(clippy::too_many_arguments)]
+    fn solve_many<'py>(
+        slf: &Bound<'py, Self>,
+        py: Python<'py>,
+        tensions: Bound<'py, PyAny>,
         n_points: i64,
-        s: Option<Floats<'_>>,
+        s: Option<Bound<'py, PyAny>>,
         method: &str,
         rtol: f64,
         atol: f64,
         max_steps: i64,
     ) -> PyResult<PlanarBatch> {
-        let samples = samples_from(self.inner.length(), n_points, s)?;
+        let call = call_args(
+            slf,
+            "solve_many",
+            tensions.clone().unbind(),
+            n_points,
+            &s,
+            method,
+            rtol,
+            atol,
+            max_steps,
+        )?;
+        let s = s.map(|b| extract_floats(&b, "s")).transpose()?;
+        let t = extract_floats(&tensions, "tensions")?.to_vec()?;
+        let this = slf.get();
+        let samples = samples_from(this.inner.length(), n_points, s)?;
         let m = method_from(method, rtol, atol, max_steps)?;
-        let arm = self.inner;
-        let t = tensions.to_vec()?;
+        let arm = this.inner;
         let b = py
             .detach(move || softrod::solve_planar_many(&arm, &t, &samples, m))
             .map_err(to_py_err)?;
@@ -300,6 +413,7 @@ impl PlanarCableArm {
             y: to_2d(py, b.y, nt, ns)?,
             tip: to_2d(py, tip, nt, 2)?,
             tip_angle: b.tip_angle.into_pyarray(py).unbind(),
+            call,
         })
     }
 }

@@ -4,62 +4,60 @@
 //! Run: `CARGO_TARGET_DIR=... cargo bench -p softrod --bench compliance`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+use std::sync::Arc;
+
 use criterion::{criterion_group, criterion_main, Criterion};
+use softrod::batch::workspace::{workspace_map, DEFAULT_CHUNK};
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::nalgebra::Vector3;
-use softrod::workspace::{workspace_map, DEFAULT_CHUNK};
-use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
+use softrod::{
+    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Tendon,
+};
 use std::hint::black_box;
 
-fn two_segment(tensions: &[f64; 6]) -> Vec<Tendon> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
-fn niti() -> Rod {
-    Rod::new(
+fn niti(loads: Loads) -> Arc<RobotModel> {
+    let rod = Rod::new(
         0.4,
         Section::circular(0.7e-3).unwrap(),
         LinearElastic::new(54e9, 0.3).unwrap(),
     )
-    .unwrap()
+    .unwrap();
+    let tendons = (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            let end = Some(if i < 3 { 0.2 } else { 0.4 });
+            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
 }
 
 fn bench(c: &mut Criterion) {
-    let rod = niti();
     let opts = SolveOptions::default();
-    let tendons = two_segment(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     for (name, loads) in [
         ("tendons_only", Loads::default()),
         ("tip_force", Loads::tip_force(Vector3::new(0.05, 0.0, 0.0))),
     ] {
+        let model = niti(loads);
         let mut g = c.benchmark_group(format!("compliance_niti_{name}"));
-        let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+        let sol = solve_statics(&model, &act, &opts).unwrap();
         g.bench_function("solve", |b| {
-            b.iter(|| solve_statics(&rod, black_box(&tendons), &loads, &opts).unwrap())
+            b.iter(|| solve_statics(&model, black_box(&act), &opts).unwrap())
         });
         g.bench_function("compliance_along_arm", |b| {
-            b.iter(|| compliance(&rod, black_box(&sol)).unwrap())
+            b.iter(|| compliance(black_box(&sol)).unwrap())
         });
         g.bench_function("compliance_with_stiffness_and_condition", |b| {
             b.iter(|| {
-                let c = compliance(&rod, black_box(&sol)).unwrap();
+                let c = compliance(black_box(&sol)).unwrap();
                 (c.stiffness_world(), c.stiffness_body())
             })
         });
         g.bench_function("solve_plus_compliance", |b| {
             b.iter(|| {
-                let s = solve_statics(&rod, black_box(&tendons), &loads, &opts).unwrap();
-                compliance(&rod, &s).unwrap()
+                let s = solve_statics(&model, black_box(&act), &opts).unwrap();
+                compliance(&s).unwrap()
             })
         });
         for (mode, ctl) in [
@@ -67,15 +65,12 @@ fn bench(c: &mut Criterion) {
             ("length", TendonControl::Length),
         ] {
             g.bench_function(format!("tangent_tip_{mode}"), |b| {
-                b.iter(|| {
-                    tangent_compliance(&rod, &tendons, &loads, black_box(&sol), &opts, ctl, None)
-                        .unwrap()
-                })
+                b.iter(|| tangent_compliance(black_box(&sol), ctl, None).unwrap())
             });
         }
         g.finish();
     }
-    let base = two_segment(&[0.0; 6]);
+    let model = niti(Loads::default());
     let mut tensions = Vec::with_capacity(60_000);
     for i in 0..100 {
         for j in 0..100 {
@@ -92,9 +87,8 @@ fn bench(c: &mut Criterion) {
     g.bench_function("10000_configurations", |b| {
         b.iter(|| {
             workspace_map(
-                &rod,
-                &base,
-                &Loads::default(),
+                &model,
+                &Actuation::default(),
                 black_box(&tensions),
                 &opts,
                 DEFAULT_CHUNK,

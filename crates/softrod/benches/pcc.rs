@@ -77,9 +77,9 @@ fn pcc(c: &mut Criterion) {
 }
 
 /// PCC statics (issue 6): the two-segment NiTi robot of the docs, by Newton on the
-/// equilibrium equations (`softrod::pcc_statics`).
+/// equilibrium equations (`softrod::pcc::statics`).
 fn pcc_statics(c: &mut Criterion) {
-    use softrod::pcc_statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
+    use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
     let body = ElasticSegment::solid_circle(0.2, 0.0007, 54e9, true).unwrap();
     let angles: Vec<f64> = [90.0f64, -30.0, 210.0]
         .iter()

@@ -1,63 +1,94 @@
-//! Cosserat-rod statics: the two-segment NiTi tendon robot (cold and warm-started solves) and
-//! a planar soft cantilever under a tip force.
+//! Cosserat-rod statics: the two-segment NiTi tendon robot (cold and warm-started solves,
+//! unloaded and with a 0.05 N tip force), a 1 m four-tendon robot under gravity and a planar
+//! soft cantilever under a tip force.
 //!
 //! Run: `CARGO_TARGET_DIR=... cargo bench -p softrod --bench statics`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+use std::sync::Arc;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::nalgebra::Vector3;
-use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
+use softrod::{
+    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Tendon,
+};
 use std::hint::black_box;
 
-fn two_segment(tensions: &[f64; 6]) -> Vec<Tendon> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
-fn statics(c: &mut Criterion) {
+/// The two-segment NiTi robot under `loads`.
+fn niti(loads: Loads) -> Arc<RobotModel> {
     let rod = Rod::new(
         0.4,
         Section::circular(0.7e-3).unwrap(),
         LinearElastic::new(54e9, 0.3).unwrap(),
     )
     .unwrap();
+    let tendons = (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            let end = Some(if i < 3 { 0.2 } else { 0.4 });
+            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+}
+
+/// A 1 m NiTi rod (radius 1 mm, 6450 kg/m³) with four tendons at 10 mm, 90° apart, ending at
+/// the tip, horizontal base, under gravity.
+pub fn four_tendon_gravity() -> Arc<RobotModel> {
+    let rod = Rod::new(
+        1.0,
+        Section::circular(1e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_density(6450.0)
+    .unwrap();
+    let tendons = (0..4)
+        .map(|i| {
+            let a = (90.0 * i as f64).to_radians();
+            Tendon::constant([0.01 * a.cos(), 0.01 * a.sin()], None).unwrap()
+        })
+        .collect();
+    let g = Loads {
+        gravity: Vector3::new(-9.81, 0.0, 0.0),
+        ..Default::default()
+    };
+    RobotModel::new(rod, tendons, Vec::new(), g).unwrap()
+}
+
+fn statics(c: &mut Criterion) {
     let opts = SolveOptions::default();
-    let loads = Loads::default();
-    let tendons = two_segment(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
-    let changed = two_segment(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
-    let prev = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let warm = SolveOptions {
-        warm_start: Some(prev.warm_start()),
-        ..opts
-    };
+    let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let changed = Actuation::tensions(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
     let mut g = c.benchmark_group("statics_two_segment_niti");
-    g.bench_function("cold", |b| {
-        b.iter(|| solve_statics(&rod, black_box(&tendons), &loads, &opts).unwrap())
-    });
-    g.bench_function("warm_2pct", |b| {
-        b.iter(|| solve_statics(&rod, black_box(&changed), &loads, &warm).unwrap())
-    });
-    // The same robot with a small tip force, so that Newton iterations are needed.
-    let tip = Loads::tip_force(Vector3::new(0.05, 0.0, 0.0));
-    g.bench_function("cold_with_tip_force", |b| {
-        b.iter(|| solve_statics(&rod, black_box(&tendons), &tip, &opts).unwrap())
-    });
-    let prev_tip = solve_statics(&rod, &tendons, &tip, &opts).unwrap();
-    let warm_tip = SolveOptions {
-        warm_start: Some(prev_tip.warm_start()),
-        ..opts
-    };
-    g.bench_function("warm_2pct_with_tip_force", |b| {
-        b.iter(|| solve_statics(&rod, black_box(&changed), &tip, &warm_tip).unwrap())
+    for (suffix, loads) in [
+        ("", Loads::default()),
+        // The same robot with a small tip force, so that Newton iterations are needed.
+        (
+            "_with_tip_force",
+            Loads::tip_force(Vector3::new(0.05, 0.0, 0.0)),
+        ),
+    ] {
+        let model = niti(loads);
+        let prev = solve_statics(&model, &act, &opts).unwrap();
+        let warm = SolveOptions {
+            warm_start: Some(prev.warm_start()),
+            ..opts
+        };
+        g.bench_function(format!("cold{suffix}"), |b| {
+            b.iter(|| solve_statics(&model, black_box(&act), &opts).unwrap())
+        });
+        g.bench_function(format!("warm_2pct{suffix}"), |b| {
+            b.iter(|| solve_statics(&model, black_box(&changed), &warm).unwrap())
+        });
+    }
+    g.finish();
+
+    let mut g = c.benchmark_group("statics_four_tendon_1m");
+    let model = four_tendon_gravity();
+    let act4 = Actuation::tensions(&[2.0, 0.0, 1.0, 0.0]);
+    g.bench_function("gravity_cold", |b| {
+        b.iter(|| solve_statics(&model, black_box(&act4), &opts).unwrap())
     });
     g.finish();
 
@@ -67,10 +98,11 @@ fn statics(c: &mut Criterion) {
         LinearElastic::new(110e3, 0.5).unwrap(),
     )
     .unwrap();
-    let f = Loads::tip_force(Vector3::new(0.02, 0.0, 0.0));
+    let model = RobotModel::rod_only(soft, Loads::tip_force(Vector3::new(0.02, 0.0, 0.0))).unwrap();
+    let none = Actuation::default();
     let mut g = c.benchmark_group("statics_soft_cantilever");
     g.bench_function("tip_force_0.02N", |b| {
-        b.iter(|| solve_statics(black_box(&soft), &[], &f, &opts).unwrap())
+        b.iter(|| solve_statics(black_box(&model), &none, &opts).unwrap())
     });
     g.finish();
 }

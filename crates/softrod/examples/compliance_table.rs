@@ -5,26 +5,12 @@
 //! Run: `cargo run --release -p softrod --example compliance_table`.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+#[path = "../tests/common/robot.rs"]
+mod common;
+
 use softrod::compliance::{compliance, tangent_compliance, tangent_compliance_held, TendonControl};
 use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution,
-    Tendon,
-};
-
-fn two_segment(tensions: [f64; 6]) -> Vec<Tendon> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
+use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution};
 
 fn rot(sol: &StaticsSolution) -> Matrix3<f64> {
     let r = sol.rotation.last().unwrap();
@@ -36,7 +22,7 @@ fn rot(sol: &StaticsSolution) -> Matrix3<f64> {
 /// Central difference (Richardson-extrapolated) of the tip twist w.r.t. the world tip wrench.
 fn finite_difference(
     rod: &Rod,
-    tendons: &[Tendon],
+    tendons: &[common::Tensioned],
     loads: &Loads,
     opts: &SolveOptions,
     sol: &StaticsSolution,
@@ -56,8 +42,8 @@ fn finite_difference(
             ..*opts
         };
         let (a, b) = (
-            solve_statics(rod, tendons, &m, &o).unwrap(),
-            solve_statics(rod, tendons, &p, &o).unwrap(),
+            common::solve(rod, tendons, &m, &o).unwrap(),
+            common::solve(rod, tendons, &p, &o).unwrap(),
         );
         let dp = Vector3::from(b.tip_position()) - Vector3::from(a.tip_position());
         let th = Rotation3::from_matrix_unchecked(rot(&b) * rot(&a).transpose()).scaled_axis();
@@ -108,7 +94,10 @@ fn main() {
     .unwrap();
     let opts = SolveOptions {
         integrator: Integrator::Rk4 { steps: 200 },
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     };
     println!("Two-segment NiTi robot, tensions = scale x [4, 0, 0, 0, 2, 0] N, world tip force [f_x, 0, 0] N;");
@@ -118,34 +107,14 @@ fn main() {
     for scale in [0.0, 0.5, 1.0] {
         for fx in [0.0, 0.1, 0.3] {
             let t = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0].map(|v| v * scale);
-            let tendons = two_segment(t);
+            let tendons = common::niti_tendons(&t);
             let loads = Loads::tip_force(Vector3::new(fx, 0.0, 0.0));
-            let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-            let c = compliance(&rod, &sol).unwrap().tip_world();
-            let ten = tangent_compliance(
-                &rod,
-                &tendons,
-                &loads,
-                &sol,
-                &opts,
-                TendonControl::Tension,
-                None,
-            )
-            .unwrap();
-            let len = tangent_compliance(
-                &rod,
-                &tendons,
-                &loads,
-                &sol,
-                &opts,
-                TendonControl::Length,
-                None,
-            )
-            .unwrap();
+            let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+            let c = compliance(&sol).unwrap().tip_world();
+            let ten = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
+            let len = tangent_compliance(&sol, TendonControl::Length, None).unwrap();
             let tensioned: Vec<usize> = (0..6).filter(|&i| t[i] > 0.0).collect();
-            let part =
-                tangent_compliance_held(&rod, &tendons, &loads, &sol, &opts, &tensioned, None)
-                    .unwrap();
+            let part = tangent_compliance_held(&sol, &tensioned, None).unwrap();
             let fd = finite_difference(&rod, &tendons, &loads, &opts, &sol, &ten.world);
             println!(
                 "| {scale:.1} | {fx:.1} | {:.5} | {:.5} | {:.5} | {:.2e} | {:.2e} | {:.5} | {:.3} | {:.5} | {:.3} |",

@@ -10,6 +10,7 @@
 //! "True strain" there is the logarithmic strain `ln λ`, not `λ − 1`. The fits use the
 //! engineering columns (the measured ones: crosshead strain and force / initial area), converted
 //! from MPa to Pa; the true columns are derived from them.
+#![allow(clippy::too_many_lines)]
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

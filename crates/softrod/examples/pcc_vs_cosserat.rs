@@ -8,12 +8,13 @@
 //!
 //! Run: `cargo run --release -p softrod --example pcc_vs_cosserat`.
 
+#[path = "../tests/common/robot.rs"]
+mod common;
+
 use softrod::nalgebra::Vector3;
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
 use softrod::pcc::{ElasticSegment, PccTendons};
-use softrod::pcc_statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions};
 
 fn main() -> softrod::Result<()> {
     let (e, nu, r, seg, d) = (54e9, 0.3, 0.0007, 0.2, 0.01);
@@ -34,12 +35,15 @@ fn main() -> softrod::Result<()> {
         .map(|i| {
             let b: f64 = angles[i % 3];
             let end = (i < 3).then_some(seg);
-            Tendon::constant([d * b.cos(), d * b.sin()], tensions[i], end)
+            common::tendon([d * b.cos(), d * b.sin()], tensions[i], end)
         })
         .collect::<softrod::Result<Vec<_>>>()?;
     let cosserat_options = SolveOptions {
         integrator: Integrator::Rk4 { steps: 400 },
-        tolerance: 1e-12,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-12,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     };
 
@@ -63,7 +67,7 @@ fn main() -> softrod::Result<()> {
             },
         )?;
         warm_pcc = Some(pcc.warm_start());
-        let cos = solve_statics(
+        let cos = common::solve(
             &rod,
             &tendons,
             &Loads::tip_force(force),

@@ -3,12 +3,15 @@
 //! tip of the two-segment NiTi tendon robot.
 //!
 //! Run: `cargo run --release -p softrod --example statics_tables`.
-#![allow(clippy::unwrap_used)]
+#![allow(clippy::unwrap_used, clippy::too_many_lines)]
+
+#[path = "../tests/common/robot.rs"]
+mod common;
 
 use softrod::integrate::AdaptiveOptions;
 use softrod::{
-    solve_planar, solve_statics, uniform_samples, Integrator, LinearElastic, Loads, PlanarCableArm,
-    PlanarMethod, Rod, Routing, Section, SolveOptions, Tendon,
+    solve_planar, uniform_samples, Integrator, LinearElastic, Loads, PlanarCableArm, PlanarMethod,
+    Rod, Routing, Section, SolveOptions,
 };
 
 fn tight() -> SolveOptions {
@@ -18,7 +21,10 @@ fn tight() -> SolveOptions {
             atol: 1e-15,
             max_steps: 1_000_000,
         }),
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -58,7 +64,7 @@ fn main() {
     for t in [0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0] {
         // 201 samples: the planar backbone integration refines its panels with the sampling.
         let planar = solve_planar(&arm, t, &samples, PlanarMethod::ClosedForm).unwrap();
-        let tendon = Tendon::new(
+        let tendon = common::tendon_with(
             Routing::RadiusProportional {
                 ratio: arm.offset_ratio(),
                 angle: 0.0,
@@ -70,7 +76,7 @@ fn main() {
         let defl = (planar.tip[1].powi(2) + (arm.length() - planar.tip[0]).powi(2)).sqrt();
         print!("{t:5.2} {:9.6} {:9.6}", planar.tip[0], planar.tip[1]);
         for r in [&rigid_shear, &rod] {
-            let sol = solve_statics(
+            let sol = common::solve(
                 r,
                 std::slice::from_ref(&tendon),
                 &Loads::default(),
@@ -108,10 +114,10 @@ fn main() {
     )
     .unwrap();
     let tensions = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
-    let tendons: Vec<Tendon> = (0..6)
+    let tendons: Vec<common::Tensioned> = (0..6)
         .map(|i| {
             let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
+            common::tendon(
                 [0.01 * ang.cos(), 0.01 * ang.sin()],
                 tensions[i],
                 Some(if i < 3 { 0.2 } else { 0.4 }),
@@ -120,7 +126,7 @@ fn main() {
         })
         .collect();
     println!("\nTwo-segment NiTi robot, tensions {tensions:?} N");
-    let reference = solve_statics(&rod, &tendons, &Loads::default(), &tight()).unwrap();
+    let reference = common::solve(&rod, &tendons, &Loads::default(), &tight()).unwrap();
     let r = reference.tip_position();
     println!(
         "  reference (DP5(4), rtol 1e-12): tip = [{:.9}, {:.9}, {:.9}] m",
@@ -131,7 +137,7 @@ fn main() {
             integrator: Integrator::Rk4 { steps },
             ..Default::default()
         };
-        let sol = solve_statics(&rod, &tendons, &Loads::default(), &opts).unwrap();
+        let sol = common::solve(&rod, &tendons, &Loads::default(), &opts).unwrap();
         let t = sol.tip_position();
         let e = ((t[0] - r[0]).powi(2) + (t[1] - r[1]).powi(2) + (t[2] - r[2]).powi(2)).sqrt();
         println!(

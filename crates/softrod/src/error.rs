@@ -92,25 +92,3 @@ pub fn check_finite(name: &str, value: f64) -> Result<f64> {
         Err(Error::invalid(name, value, "finite"))
     }
 }
-
-/// Checks the options shared by the Newton solvers (shooting and PCC statics): a finite
-/// `tolerance` > 0, and at least one iteration and one load step.
-///
-/// # Errors
-/// [`Error::InvalidParameter`] naming `tolerance`, `max_iterations` or `max_load_steps`.
-pub fn check_newton_options(
-    tolerance: f64,
-    max_iterations: usize,
-    max_load_steps: usize,
-) -> Result<()> {
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(Error::invalid("tolerance", tolerance, "finite and > 0"));
-    }
-    if max_iterations == 0 {
-        return Err(Error::invalid("max_iterations", max_iterations, ">= 1"));
-    }
-    if max_load_steps == 0 {
-        return Err(Error::invalid("max_load_steps", max_load_steps, ">= 1"));
-    }
-    Ok(())
-}

@@ -4,73 +4,62 @@
 //!
 //! Conventions used everywhere: SI units; arc length `s` along the undeformed backbone;
 //! the body z axis is the rod tangent; wrenches are `[force; moment]` and twists
-//! `[translation; rotation]`.
+//! `[translation; rotation]` ([`math::se3`] owns the adjoint).
 //!
-//! Modules:
-//! * [`planar`]: seed 000, the planar tapered cable-driven arm (closed form and final-value ODE);
-//! * [`compare`]: distances between backbones at equal arm index;
-//! * [`integrate`]: ODE integrators shared by every model;
-//! * [`hyperelastic`]: uniaxial material laws (linear, Neo-Hookean, Mooney–Rivlin, Yeoh, Ogden)
-//!   and a library of named silicones;
-//! * [`fit`]: least-squares fitting of those laws to uniaxial test data;
-//! * [`se3`]: the adjoint and the twist/wrench ordering (owned here, used everywhere);
-//! * [`compliance`](mod@compliance), [`eigenscrew`], [`workspace`]: seed 001,
-//!   configuration-dependent compliance and stiffness (Cosserat and PCC configurations),
-//!   eigenscrews, workspace maps;
+//! The crate is laid out as the architecture (see `docs/architecture.md`):
+//! * [`model`]: the validated, immutable [`RobotModel`] (rod, section, material, tendon
+//!   routings, chamber geometry, loads) and the [`Actuation`] input (tensions, pressures);
+//! * [`cosserat`]: the Cosserat-rod statics, [`solve_statics`]`(&model, &actuation,
+//!   &options)`, whose [`StaticsSolution`] keeps its model, actuation and options;
+//! * [`compliance`](mod@compliance): integrated and tangent compliance, eigenscrews;
+//! * [`pcc`]: piecewise-constant-curvature kinematics, actuation maps and statics;
+//! * [`planar`]: the planar tapered cable arm (closed form and final-value ODE);
+//! * [`batch`]: workspace maps and backbone distances;
+//! * [`integrate`]: the one Runge–Kutta driver (RK4, Bogacki–Shampine, Dormand–Prince
+//!   tableaus) and the march over breaks;
+//! * [`solve`]: the one nonlinear solver (Newton, Broyden, line search, continuation);
+//! * [`math`]: rotations, the adjoint, small linear algebra, the arc series;
 //! * [`error`]: the crate's one error type.
 
-pub mod chamber;
-pub mod compare;
+pub mod batch;
 pub mod compliance;
-pub mod eigenscrew;
+pub mod cosserat;
 pub mod error;
-pub mod fit;
-pub mod hyperelastic;
 pub mod integrate;
+pub mod math;
+pub mod model;
 pub mod pcc;
-pub mod pcc_statics;
 pub mod planar;
+pub mod solve;
 
-pub use chamber::{Chamber, ChamberArea};
-pub use compare::{backbone_distance, BackboneDistance};
+pub use batch::compare::{backbone_distance, BackboneDistance};
+pub use batch::workspace::{workspace_map, WorkspaceSample};
+pub use compliance::eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
 pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
-pub use eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
+pub use cosserat::statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};
 pub use error::{Error, Result};
-pub use fit::{
+pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use model::chamber::{Chamber, ChamberArea};
+pub use model::loads::{Frame, Loads, PointLoad};
+pub use model::material::fit::{
     fit_stats, fit_uniaxial, FitOptions, FitStats, ModelKind, StrainMeasure, StressMeasure,
     UniaxialData, UniaxialFit,
 };
-pub use hyperelastic::{
-    Hookean, Linearised, MooneyRivlin, NeoHookean, Ogden, Silicone, UniaxialLaw, UniaxialModel,
-    Yeoh,
+pub use model::material::hyperelastic::{
+    Hookean, Linearised, MooneyRivlin, NeoHookean, Ogden, UniaxialLaw, UniaxialModel, Yeoh,
 };
-pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use model::material::silicone::Silicone;
+pub use model::material::{LinearElastic, Material};
+pub use model::rod::{Pose, Profile, Rod};
+pub use model::section::{Section, SectionProperties};
+pub use model::tendon::{Routing, Tendon};
+pub use model::{Actuation, RobotModel, TendonInput};
+pub use nalgebra;
 pub use planar::{
     solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,
     PlanarSolution,
 };
-
-pub mod cosserat;
-pub mod loads;
-pub mod material;
-pub mod rod;
-pub mod se3;
-pub mod section;
-pub mod so3;
-pub mod statics;
-pub mod tendon;
-pub mod workspace;
-
-pub use loads::{Frame, Loads, PointLoad};
-pub use material::{LinearElastic, Material};
-pub use nalgebra;
-pub use rod::{Pose, Profile, Rod};
-pub use section::{Section, SectionProperties};
-pub use statics::{
-    solve_statics, Integrator, SolveOptions, SolverStats, StaticsSolution, WarmStart,
-};
-pub use tendon::{Routing, Tendon};
-pub use workspace::{workspace_map, WorkspaceSample};
+pub use solve::{NewtonOptions, SolverStats};

@@ -1,13 +1,15 @@
 //! Eigenscrews of stiffnesses built from known screws; the workspace map against single solves.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
+use softrod::batch::workspace::workspace_map;
+use softrod::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
-use softrod::eigenscrew::{eigenscrews, MatrixKind};
+use softrod::math::se3::{adjoint, delta};
+use softrod::math::so3::exp_so3;
 use softrod::nalgebra::{Matrix6, Vector3, Vector6};
-use softrod::se3::{adjoint, delta};
-use softrod::so3::exp_so3;
-use softrod::workspace::workspace_map;
-use softrod::{solve_statics, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon};
+use softrod::{Loads, SolveOptions};
 
 /// Unit twist about the axis through `c` along unit `a` with pitch `h`: `[c × a + h a; a]`.
 fn twist(a: Vector3<f64>, c: Vector3<f64>, h: f64) -> Vector6<f64> {
@@ -73,29 +75,10 @@ fn eigenscrews_recover_the_screws_a_stiffness_was_built_from() {
     }
 }
 
-fn two_segment(tensions: [f64; 6]) -> Vec<Tendon> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
 #[test]
 fn workspace_map_matches_single_solves() {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = two_segment([0.0; 6]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[0.0; 6]);
     let loads = Loads::default();
     let opts = SolveOptions::default();
     let mut tensions = Vec::new();
@@ -107,10 +90,10 @@ fn workspace_map_matches_single_solves() {
             tensions.extend_from_slice(&t);
         }
     }
+    let (model, base) = common::split(&rod, &tendons, &[], &loads).unwrap();
     let map = workspace_map(
-        &rod,
-        &tendons,
-        &loads,
+        &model,
+        &base,
         &tensions,
         &opts,
         7,
@@ -119,24 +102,23 @@ fn workspace_map_matches_single_solves() {
     .unwrap();
     assert_eq!(map.len(), 30);
     for (i, row) in tensions.chunks(6).enumerate() {
-        let ts: Vec<Tendon> = tendons
+        let ts: Vec<common::Tensioned> = tendons
             .iter()
             .zip(row)
             .map(|(t, &tau)| t.with_tension(tau).unwrap())
             .collect();
-        let sol = solve_statics(&rod, &ts, &loads, &opts).unwrap();
+        let sol = common::solve(&rod, &ts, &loads, &opts).unwrap();
         let tip = Vector3::from(sol.tip_position());
         assert!(map[i].converged);
         assert!((Vector3::from(map[i].tip_position) - tip).norm() < 1e-9);
-        let c = compliance(&rod, &sol).unwrap().tip_world();
+        let c = compliance(&sol).unwrap().tip_world();
         let ctt = c
             .fixed_view::<3, 3>(0, 0)
             .into_owned()
             .symmetric_eigen()
             .eigenvalues;
         assert!((map[i].max_translational_compliance - ctt.max()).abs() < 1e-8 * ctt.max());
-        let t = tangent_compliance(&rod, &ts, &loads, &sol, &opts, TendonControl::Length, None)
-            .unwrap();
+        let t = tangent_compliance(&sol, TendonControl::Length, None).unwrap();
         let b = t.world.fixed_view::<3, 3>(0, 0).into_owned();
         let e = ((b + b.transpose()) * 0.5)
             .symmetric_eigen()

@@ -10,12 +10,12 @@ use common::{assert_blocks_close, castigliano_arc};
 use std::f64::consts::PI;
 
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
+use softrod::math::se3::rotation_adjoint;
+use softrod::math::so3::exp_so3;
 use softrod::nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
-use softrod::se3::rotation_adjoint;
-use softrod::so3::exp_so3;
 use softrod::{
     solve_statics, Integrator, LinearElastic, Loads, Pose, Profile, Rod, Section, SolveOptions,
-    StaticsSolution, Tendon,
+    StaticsSolution,
 };
 
 const E: f64 = 2.0e9;
@@ -26,7 +26,10 @@ const LENGTH: f64 = 0.5;
 fn rk4(steps: usize) -> SolveOptions {
     SolveOptions {
         integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -76,8 +79,8 @@ fn straight_cantilever_matches_timoshenko_closed_form() {
     )
     .unwrap()
     .with_base_pose(base);
-    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
-    let c = compliance(&rod, &sol).unwrap();
+    let sol = common::solve(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
+    let c = compliance(&sol).unwrap();
     let (ei, gj, ea, gas) = section_constants(rod.shear_coefficient());
     let exact = timoshenko(LENGTH, ei, gj, ea, Some(gas));
     assert_blocks_close(&c.tip_body(), &exact, 1e-10, "tip body");
@@ -105,8 +108,8 @@ fn gamma_c_is_one_at_the_tip_without_shear() {
     )
     .unwrap()
     .with_inextensible(true);
-    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
-    let c = compliance(&rod, &sol).unwrap();
+    let sol = common::solve(&rod, &[], &Loads::default(), &rk4(40)).unwrap();
+    let c = compliance(&sol).unwrap();
     let g = c.gamma_c.last().unwrap();
     assert!((g[0] - 1.0).abs() < 1e-12, "{g:?}");
     assert!((g[1] - 1.0).abs() < 1e-12, "{g:?}");
@@ -138,44 +141,21 @@ fn arc_rod(angle: f64) -> Rod {
 fn stress_free_arc_matches_castigliano() {
     for angle in [PI / 2.0, PI, 1.5 * PI] {
         let rod = arc_rod(angle);
-        let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(2000)).unwrap();
-        let c = compliance(&rod, &sol).unwrap();
+        let sol = common::solve(&rod, &[], &Loads::default(), &rk4(2000)).unwrap();
+        let c = compliance(&sol).unwrap();
         let (ei, gj, ea, gas) = section_constants(rod.shear_coefficient());
         let exact = castigliano_arc(angle / LENGTH, LENGTH, [gas, gas, ea, ei, ei, gj]);
         assert_blocks_close(&c.tip_world(), &exact, 1e-8, &format!("arc {angle}"));
     }
 }
 
-fn two_segment(tensions: [f64; 6]) -> Vec<Tendon> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
-fn niti() -> Rod {
-    Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap()
-}
-
 #[test]
 fn frames_are_related_by_the_adjoint_and_k_inverts_c() {
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
-    let sol = solve_statics(&rod, &tendons, &loads, &rk4(50)).unwrap();
-    let c = compliance(&rod, &sol).unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &rk4(50)).unwrap();
+    let c = compliance(&sol).unwrap();
     let (kw, cond) = c.stiffness_world();
     let kb = c.stiffness_body();
     assert!(cond[0].is_infinite() && kw[0][(0, 0)].is_nan());
@@ -211,7 +191,7 @@ fn tip_twist(a: &StaticsSolution, b: &StaticsSolution) -> Vector6<f64> {
 /// Richardson-extrapolated over steps `h` and `h/2` (fourth order in the step).
 fn fd_tip_compliance(
     rod: &Rod,
-    tendons: &[Tendon],
+    tendons: &[common::Tensioned],
     loads: &Loads,
     opts: &SolveOptions,
     sol: &StaticsSolution,
@@ -231,8 +211,8 @@ fn fd_tip_compliance(
             warm_start: Some(sol.warm_start()),
             ..*opts
         };
-        let sp = solve_statics(rod, tendons, &plus, &o).unwrap();
-        let sm = solve_statics(rod, tendons, &minus, &o).unwrap();
+        let sp = common::solve(rod, tendons, &plus, &o).unwrap();
+        let sm = common::solve(rod, tendons, &minus, &o).unwrap();
         tip_twist(&sm, &sp) / (2.0 * eps)
     };
     let mut c = Matrix6::zeros();
@@ -256,10 +236,9 @@ fn unloaded_integrated_tangent_and_finite_difference_agree() {
         let rod = arc_rod(angle);
         let opts = rk4(400);
         let loads = Loads::default();
-        let sol = solve_statics(&rod, &[], &loads, &opts).unwrap();
-        let c = compliance(&rod, &sol).unwrap().tip_world();
-        let t = tangent_compliance(&rod, &[], &loads, &sol, &opts, TendonControl::Tension, None)
-            .unwrap();
+        let sol = common::solve(&rod, &[], &loads, &opts).unwrap();
+        let c = compliance(&sol).unwrap().tip_world();
+        let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
         let fd = fd_tip_compliance(&rod, &[], &loads, &opts, &sol, &c);
         assert_blocks_close(
             &t.world,
@@ -273,83 +252,148 @@ fn unloaded_integrated_tangent_and_finite_difference_agree() {
 
 #[test]
 fn loaded_tangent_matches_finite_difference() {
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads {
         tip_force: Vector3::new(0.3, -0.2, -0.1),
         tip_moment: Vector3::new(0.0, 0.002, 0.001),
         ..Default::default()
     };
     let opts = rk4(400);
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let t = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
     let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
     assert_blocks_close(&t.world, &fd, 1e-6, "loaded tangent vs fd");
     // The seed's integrated compliance differs under load and actuation.
-    let c = compliance(&rod, &sol).unwrap().tip_world();
+    let c = compliance(&sol).unwrap().tip_world();
     let rel = (c - t.world).amax() / t.world.amax();
     assert!(rel > 1e-3, "{rel}");
 }
 
+/// Tip pose of `model` under `tensions` plus an extra tip wrench `w` with the tendon path
+/// lengths held at `lengths`: Newton on the tensions (finite-difference Jacobian of the
+/// lengths in the tensions), each evaluation a full nonlinear solve.
+fn held_length_tip(
+    model: &std::sync::Arc<softrod::RobotModel>,
+    tensions: &[f64],
+    lengths: &[f64],
+    w: [f64; 6],
+    opts: &SolveOptions,
+) -> ([f64; 3], [[f64; 3]; 3]) {
+    let base = model.loads().clone();
+    let loaded = model
+        .with_loads(Loads {
+            tip_force: base.tip_force + Vector3::new(w[0], w[1], w[2]),
+            tip_moment: base.tip_moment + Vector3::new(w[3], w[4], w[5]),
+            ..base
+        })
+        .unwrap();
+    let n = tensions.len();
+    let solve = |t: &[f64]| solve_statics(&loaded, &softrod::Actuation::tensions(t), opts).unwrap();
+    let mut t = tensions.to_vec();
+    for _ in 0..20 {
+        let s = solve(&t);
+        let r: Vec<f64> = (0..n).map(|i| s.tendon_lengths[i] - lengths[i]).collect();
+        if r.iter().all(|v| v.abs() < 1e-15) {
+            return (s.tip_position(), s.rotation[s.s.len() - 1]);
+        }
+        let h = 1e-6;
+        let mut jac = softrod::nalgebra::DMatrix::zeros(n, n);
+        for k in 0..n {
+            let mut tp = t.clone();
+            tp[k] += h;
+            let sp = solve(&tp);
+            for i in 0..n {
+                jac[(i, k)] = (sp.tendon_lengths[i] - s.tendon_lengths[i]) / h;
+            }
+        }
+        let dt = jac
+            .lu()
+            .solve(&softrod::nalgebra::DVector::from_vec(r))
+            .unwrap();
+        for k in 0..n {
+            t[k] -= dt[k];
+        }
+    }
+    let s = solve(&t);
+    (s.tip_position(), s.rotation[s.s.len() - 1])
+}
+
+/// The fixed-length tangent compliance against its definition: central differences of the
+/// tip pose under a small tip wrench, the tendon path lengths held by re-solving the
+/// tensions (all tendons tensioned, so that none goes slack).
 #[test]
-fn fixed_length_tendons_stiffen_the_niti_robot() {
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
-    let loads = Loads::default();
-    let opts = rk4(50);
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let ten = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
-    let len = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
-        TendonControl::Length,
-        None,
-    )
-    .unwrap();
-    let tt = |c: &Matrix6<f64>| {
-        c.fixed_view::<3, 3>(0, 0)
-            .into_owned()
-            .symmetric_eigen()
-            .eigenvalues
-    };
-    let (et, el) = (tt(&ten.world), tt(&len.world));
-    println!("translational compliances (m/N): tension {et:?}, length {el:?}");
-    // Holding the lengths removes compliance: C_tension - C_length is positive semi-definite
-    // (translational block) and the largest translational compliance drops.
-    let diff = (ten.world - len.world)
-        .fixed_view::<3, 3>(0, 0)
-        .into_owned();
-    let d = ((diff + diff.transpose()) * 0.5)
-        .symmetric_eigen()
-        .eigenvalues;
-    assert!(d.min() > -1e-9 * et.max(), "{d:?}");
-    assert!(el.max() < 0.5 * et.max(), "{} vs {}", el.max(), et.max());
-    // The tension rates are reported for every tendon.
-    assert!(len
-        .tension_rate
-        .iter()
-        .any(|r| r.iter().any(|v| v.abs() > 0.0)));
+fn fixed_length_tangent_matches_the_resolved_finite_difference() {
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 1.0, 1.5, 0.5, 2.0, 0.8]);
+    let loads = Loads::tip_force(Vector3::new(0.02, -0.01, 0.0));
+    let opts = rk4(200);
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Length, None).unwrap();
+    let tensions = sol.tensions();
+    let lengths = sol.tendon_lengths.clone();
+    let mut fd = Matrix6::zeros();
+    for j in 0..6 {
+        let h = if j < 3 { 1e-4 } else { 1e-6 };
+        let mut w = [0.0; 6];
+        w[j] = h;
+        let (pp, rp) = held_length_tip(&sol.model, &tensions, &lengths, w, &opts);
+        w[j] = -h;
+        let (pm, rm) = held_length_tip(&sol.model, &tensions, &lengths, w, &opts);
+        let m = |a: [[f64; 3]; 3], b: [[f64; 3]; 3], i: usize, k: usize| {
+            (0..3).map(|q| a[i][q] * b[k][q]).sum::<f64>()
+        };
+        for i in 0..3 {
+            fd[(i, j)] = (pp[i] - pm[i]) / (2.0 * h);
+        }
+        fd[(3, j)] = 0.5 * (m(rp, rm, 2, 1) - m(rp, rm, 1, 2)) / (2.0 * h);
+        fd[(4, j)] = 0.5 * (m(rp, rm, 0, 2) - m(rp, rm, 2, 0)) / (2.0 * h);
+        fd[(5, j)] = 0.5 * (m(rp, rm, 1, 0) - m(rp, rm, 0, 1)) / (2.0 * h);
+    }
+    let err = (t.world - fd).amax() / t.world.amax();
+    println!("fixed-length tangent vs re-solved finite difference: {err:e}");
+    assert!(err < 1e-6, "relative error {err:e}");
+}
+
+/// More tendons held than the old eight-column limit: ten tendons at 36°, ending at 0.04 m
+/// intervals (each holds its own stretch of the rod).
+#[test]
+fn ten_held_tendons_match_the_resolved_finite_difference() {
+    let rod = common::niti_rod();
+    let tendons: Vec<common::Tensioned> = (0..10)
+        .map(|k| {
+            let a = (36.0 * k as f64).to_radians();
+            let end = Some(0.04 * (k + 1) as f64);
+            common::tendon([0.01 * a.cos(), 0.01 * a.sin()], 0.5 + 0.1 * k as f64, end).unwrap()
+        })
+        .collect();
+    let loads = Loads::tip_force(Vector3::new(0.02, -0.01, 0.0));
+    let opts = rk4(200);
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Length, None).unwrap();
+    let tensions = sol.tensions();
+    let lengths = sol.tendon_lengths.clone();
+    let mut fd = Matrix6::zeros();
+    for j in 0..6 {
+        let h = if j < 3 { 1e-4 } else { 1e-6 };
+        let mut w = [0.0; 6];
+        w[j] = h;
+        let (pp, rp) = held_length_tip(&sol.model, &tensions, &lengths, w, &opts);
+        w[j] = -h;
+        let (pm, rm) = held_length_tip(&sol.model, &tensions, &lengths, w, &opts);
+        let m = |a: [[f64; 3]; 3], b: [[f64; 3]; 3], i: usize, k: usize| {
+            (0..3).map(|q| a[i][q] * b[k][q]).sum::<f64>()
+        };
+        for i in 0..3 {
+            fd[(i, j)] = (pp[i] - pm[i]) / (2.0 * h);
+        }
+        fd[(3, j)] = 0.5 * (m(rp, rm, 2, 1) - m(rp, rm, 1, 2)) / (2.0 * h);
+        fd[(4, j)] = 0.5 * (m(rp, rm, 0, 2) - m(rp, rm, 2, 0)) / (2.0 * h);
+        fd[(5, j)] = 0.5 * (m(rp, rm, 1, 0) - m(rp, rm, 0, 1)) / (2.0 * h);
+    }
+    let err = (t.world - fd).amax() / t.world.amax();
+    println!("fixed-length tangent vs re-solved finite difference: {err:e}");
+    assert!(err < 1e-6, "relative error {err:e}");
 }
 
 /// Twist `[δp; δθ_world]` of the first node at arc length `s` between two solutions.
@@ -365,24 +409,15 @@ fn node_twist(a: &StaticsSolution, b: &StaticsSolution, s: f64) -> Vector6<f64> 
 #[test]
 fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
     use softrod::PointLoad;
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.1, 0.0, -0.05));
     let opts = rk4(400);
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
     // A node inside segment 2 that is a mesh node of the perturbed problems too.
     let node = 300;
     let s = sol.s[node];
-    let t = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
-        TendonControl::Tension,
-        Some(node),
-    )
-    .unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Tension, Some(node)).unwrap();
     assert_eq!(t.s, s);
     let mut fd = Matrix6::zeros();
     for j in 0..6 {
@@ -406,7 +441,7 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
                     warm_start: Some(sol.warm_start()),
                     ..opts
                 };
-                solve_statics(&rod, &tendons, &l, &o).unwrap()
+                common::solve(&rod, &tendons, &l, &o).unwrap()
             };
             node_twist(&mk(-1.0), &mk(1.0), s) / (2.0 * e)
         };
@@ -418,8 +453,8 @@ fn interior_node_tangent_matches_finite_difference_of_a_point_load() {
 #[test]
 fn adaptive_tangent_matches_finite_difference() {
     use softrod::AdaptiveOptions;
-    let rod = niti();
-    let tendons = two_segment([4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.2, 0.1, 0.0));
     let opts = SolveOptions {
         integrator: Integrator::Adaptive(AdaptiveOptions {
@@ -427,34 +462,19 @@ fn adaptive_tangent_matches_finite_difference() {
             atol: 1e-14,
             ..Default::default()
         }),
-        tolerance: 1e-12,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-12,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     };
-    let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
-    let t = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sol,
-        &opts,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
+    let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
     let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
     assert_blocks_close(&t.world, &fd, 1e-6, "adaptive tangent vs fd");
     // The same tangent as RK4 with many steps (both converge to the exact one).
     let r = rk4(800);
-    let sr = solve_statics(&rod, &tendons, &loads, &r).unwrap();
-    let tr = tangent_compliance(
-        &rod,
-        &tendons,
-        &loads,
-        &sr,
-        &r,
-        TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let sr = common::solve(&rod, &tendons, &loads, &r).unwrap();
+    let tr = tangent_compliance(&sr, TendonControl::Tension, None).unwrap();
     assert_blocks_close(&t.world, &tr.world, 1e-6, "adaptive vs rk4 tangent");
 }

@@ -9,13 +9,11 @@ use std::f64::consts::PI;
 
 use common::{assert_blocks_close, castigliano_arc};
 use softrod::compliance::{compliance, pcc_compliance, PCC_PANEL_ANGLE};
+use softrod::math::so3::exp_so3;
 use softrod::nalgebra::Vector3;
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon};
 use softrod::pcc::ElasticSegment;
-use softrod::pcc_statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon};
-use softrod::so3::exp_so3;
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Pose, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::{Integrator, LinearElastic, Loads, Pose, Rod, Section, SolveOptions};
 
 const E: f64 = 2.0e9;
 const NU: f64 = 0.3;
@@ -42,7 +40,7 @@ fn tendon_robot(extensible: bool, angle: f64) -> PccRobot {
     .unwrap()
 }
 
-fn solve(robot: &PccRobot, tension: f64) -> softrod::pcc_statics::PccStaticsSolution {
+fn solve(robot: &PccRobot, tension: f64) -> softrod::pcc::statics::PccStaticsSolution {
     let loads = PccLoads {
         tensions: vec![tension],
         ..Default::default()
@@ -101,15 +99,17 @@ fn pcc_and_cosserat_compliance_agree_on_an_unloaded_tendon_segment() {
             let pcc = solve(&robot, tension);
             let cos_rod = rod.clone().with_inextensible(!extensible);
             let tendon =
-                Tendon::constant([OFFSET * beta.cos(), OFFSET * beta.sin()], tension, None)
-                    .unwrap();
+                common::tendon([OFFSET * beta.cos(), OFFSET * beta.sin()], tension, None).unwrap();
             let options = SolveOptions {
                 integrator: Integrator::Rk4 { steps: 800 },
-                tolerance: 1e-13,
+                newton: softrod::NewtonOptions {
+                    tolerance: 1e-13,
+                    ..SolveOptions::default().newton
+                },
                 ..Default::default()
             };
-            let sol = solve_statics(&cos_rod, &[tendon], &Loads::default(), &options).unwrap();
-            let c_cos = compliance(&cos_rod, &sol).unwrap().tip_world();
+            let sol = common::solve(&cos_rod, &[tendon], &Loads::default(), &options).unwrap();
+            let c_cos = compliance(&sol).unwrap().tip_world();
             let c_pcc = pcc_compliance(&cos_rod, &robot, &pcc, None)
                 .unwrap()
                 .tip_world();

@@ -4,16 +4,17 @@
 //! the Euler–Bernoulli cantilever, the pneumatic closed form, and rotation invariance.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use std::f64::consts::PI;
 
 use softrod::nalgebra::{Matrix3, Vector3};
-use softrod::pcc::{arc_from_pressures, ElasticSegment, PccChambers, PccSegment, PccTendons};
-use softrod::pcc_statics::{
+use softrod::pcc::statics::{
     pcc_equilibrium, solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, RoutedTendon,
 };
+use softrod::pcc::{arc_from_pressures, ElasticSegment, PccChambers, PccSegment, PccTendons};
 use softrod::{
-    solve_statics, Error, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions,
-    StaticsSolution, Tendon,
+    Error, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, StaticsSolution,
 };
 
 // The two-segment NiTi robot of the issue.
@@ -28,7 +29,10 @@ const TENSIONS: [f64; 6] = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
 fn rk4(steps: usize) -> SolveOptions {
     SolveOptions {
         integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -45,7 +49,7 @@ fn niti_pcc(extensible: bool) -> PccRobot {
         .unwrap()
 }
 
-fn niti_cosserat(extensible: bool, tensions: &[f64]) -> (Rod, Vec<Tendon>) {
+fn niti_cosserat(extensible: bool, tensions: &[f64]) -> (Rod, Vec<common::Tensioned>) {
     let rod = Rod::new(
         2.0 * SEG,
         Section::circular(NITI_R).unwrap(),
@@ -57,7 +61,7 @@ fn niti_cosserat(extensible: bool, tensions: &[f64]) -> (Rod, Vec<Tendon>) {
         .map(|i| {
             let b = ANGLES_DEG[i % 3].to_radians();
             let end = if i < 3 { Some(SEG) } else { None };
-            Tendon::constant([OFFSET * b.cos(), OFFSET * b.sin()], tensions[i], end).unwrap()
+            common::tendon([OFFSET * b.cos(), OFFSET * b.sin()], tensions[i], end).unwrap()
         })
         .collect();
     (rod, tendons)
@@ -68,7 +72,7 @@ fn tip_rotation(s: &StaticsSolution) -> Matrix3<f64> {
     Matrix3::from_fn(|i, j| r[i][j])
 }
 
-fn pcc_tip(sol: &softrod::pcc_statics::PccStaticsSolution) -> (Vector3<f64>, Matrix3<f64>) {
+fn pcc_tip(sol: &softrod::pcc::statics::PccStaticsSolution) -> (Vector3<f64>, Matrix3<f64>) {
     let t = sol.tip_pose;
     (
         Vector3::new(t[(0, 3)], t[(1, 3)], t[(2, 3)]),
@@ -105,13 +109,13 @@ fn unloaded_tendon_segment_is_the_cosserat_arc_exactly() {
         )
         .unwrap()
         .with_inextensible(!extensible);
-        let ts: Vec<Tendon> = (0..3)
+        let ts: Vec<common::Tensioned> = (0..3)
             .map(|i| {
                 let (d, b) = (tendons.distances()[i], tendons.angles()[i]);
-                Tendon::constant([d * b.cos(), d * b.sin()], tensions[i], None).unwrap()
+                common::tendon([d * b.cos(), d * b.sin()], tensions[i], None).unwrap()
             })
             .collect();
-        let cos = solve_statics(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
+        let cos = common::solve(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
         let (p, rot) = pcc_tip(&pcc);
         let pc = Vector3::from(cos.tip_position());
         let dp = (p - pc).norm() / l;
@@ -146,7 +150,7 @@ fn unloaded_two_segment_niti_robot_matches_cosserat_exactly() {
         };
         let pcc = solve_pcc_statics(&robot, &loads, &PccSolveOptions::default()).unwrap();
         let (rod, ts) = niti_cosserat(extensible, &TENSIONS);
-        let cos = solve_statics(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
+        let cos = common::solve(&rod, &ts, &Loads::default(), &rk4(400)).unwrap();
         let (p, rot) = pcc_tip(&pcc);
         let dp = (p - Vector3::from(cos.tip_position())).norm() / (2.0 * SEG);
         let dr = (rot - tip_rotation(&cos)).amax();
@@ -207,8 +211,8 @@ fn tip_moment_about_the_bending_axis_is_exact() {
     )
     .unwrap()
     .with_inextensible(true);
-    let t = Tendon::constant([0.0, 0.005], tau, None).unwrap();
-    let cos = solve_statics(&rod, &[t], &Loads::tip_moment(loads.tip_moment), &rk4(400)).unwrap();
+    let t = common::tendon([0.0, 0.005], tau, None).unwrap();
+    let cos = common::solve(&rod, &[t], &Loads::tip_moment(loads.tip_moment), &rk4(400)).unwrap();
     let (p, _) = pcc_tip(&pcc);
     let dp = (p - Vector3::from(cos.tip_position())).norm() / l;
     println!("tip moment: θ {theta:.6} rad, |Δp|/L vs Cosserat {dp:.2e}");
@@ -478,7 +482,7 @@ fn pcc_and_cosserat_diverge_as_the_tip_load_grows() {
             warm_start: warm,
             ..rk4(400)
         };
-        let cos = solve_statics(&rod, &ts, &Loads::tip_force(force), &opts).unwrap();
+        let cos = common::solve(&rod, &ts, &Loads::tip_force(force), &opts).unwrap();
         warm = Some(cos.warm_start());
         let (p, _) = pcc_tip(&pcc);
         let pc = Vector3::from(cos.tip_position());
@@ -516,10 +520,14 @@ fn non_convergence_is_reported_or_returned() {
         tip_force: Vector3::new(0.0, -1.0, 0.0),
         ..Default::default()
     };
+    let d = PccSolveOptions::default();
     let opts = PccSolveOptions {
-        max_iterations: 1,
-        continuation: false,
-        ..Default::default()
+        newton: softrod::NewtonOptions {
+            max_iterations: 1,
+            continuation: false,
+            ..d.newton
+        },
+        ..d
     };
     match solve_pcc_statics(&robot, &loads, &opts) {
         Err(Error::NotConverged { iterations, .. }) => assert_eq!(iterations, 1),
@@ -529,8 +537,11 @@ fn non_convergence_is_reported_or_returned() {
         &robot,
         &loads,
         &PccSolveOptions {
-            throw: false,
-            ..opts
+            newton: softrod::NewtonOptions {
+                throw: false,
+                ..opts.newton
+            },
+            ..opts.clone()
         },
     )
     .unwrap();
@@ -615,7 +626,10 @@ fn invalid_inputs_name_the_parameter() {
         "warm_start.len()"
     );
     let opts = PccSolveOptions {
-        tolerance: 0.0,
+        newton: softrod::NewtonOptions {
+            tolerance: 0.0,
+            ..PccSolveOptions::default().newton
+        },
         ..Default::default()
     };
     assert_eq!(

@@ -4,13 +4,15 @@
 //! for a linear law, and the errors.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use std::f64::consts::PI;
 
 use softrod::nalgebra::Vector3;
 use softrod::{
-    solve_statics, Chamber, ChamberArea, Error, Hookean, Integrator, LinearElastic, Loads,
-    Material, MooneyRivlin, NeoHookean, Rod, Section, Silicone, SolveOptions, UniaxialLaw,
-    UniaxialModel, Yeoh,
+    ChamberArea, Error, Hookean, Integrator, LinearElastic, Loads, Material, MooneyRivlin,
+    NeoHookean, Rod, Section, Silicone, SolveOptions, StaticsSolution, UniaxialLaw, UniaxialModel,
+    Yeoh,
 };
 
 /// Seed-001-like arm: length, outer radius, chamber radius, chamber centroid distance (m).
@@ -22,7 +24,10 @@ const D: f64 = 0.6 * R;
 fn rk4(steps: usize) -> SolveOptions {
     SolveOptions {
         integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -52,19 +57,31 @@ fn arm_section() -> (Section, f64, f64) {
     (sec, a0, ix)
 }
 
-fn chambers(p: [f64; 6]) -> Vec<Chamber> {
+fn chambers(p: [f64; 6]) -> Vec<common::Pressurised> {
     angles()
         .iter()
         .zip(p)
-        .map(|(t, p)| Chamber::constant(p, PI * RC * RC, [D * t.cos(), D * t.sin()]).unwrap())
+        .map(|(t, p)| {
+            common::constant_chamber(p, PI * RC * RC, [D * t.cos(), D * t.sin()]).unwrap()
+        })
         .collect()
 }
 
-fn with_chambers(c: Vec<Chamber>) -> Loads {
-    Loads {
-        chambers: c,
-        ..Default::default()
+/// External loads and pressurised chambers.
+struct Loaded {
+    loads: Loads,
+    chambers: Vec<common::Pressurised>,
+}
+
+fn with_chambers(chambers: Vec<common::Pressurised>) -> Loaded {
+    Loaded {
+        loads: Loads::default(),
+        chambers,
     }
+}
+
+fn solve_p(rod: &Rod, l: &Loaded, opts: &SolveOptions) -> softrod::Result<StaticsSolution> {
+    common::solve_with_chambers(rod, &[], &l.chambers, &l.loads, opts)
 }
 
 /// Tip of a rod of length `l` with constant strains `v = (0, 0, lambda)`, `u = (ux, uy, 0)`.
@@ -94,7 +111,7 @@ fn one_chamber_bends_linear_arm_into_the_closed_form_arc() {
         let mut pr = [0.0; 6];
         pr[k] = p;
         let loads = with_chambers(chambers(pr));
-        let sol = solve_statics(&rod, &[], &loads, &rk4(400)).unwrap();
+        let sol = solve_p(&rod, &loads, &rk4(400)).unwrap();
         // Rod's own wrench: axial p A_c, moment p A_c r_c × (-e_z)... = p A_c (y, -x, 0).
         let t = angles()[k];
         let (x, y) = (D * t.cos(), D * t.sin());
@@ -121,7 +138,7 @@ fn equal_pressures_only_elongate() {
     let (sec, a0, _) = arm_section();
     let rod = Rod::new(L, sec, silicone_linear()).unwrap();
     let p = 60e3;
-    let sol = solve_statics(&rod, &[], &with_chambers(chambers([p; 6])), &rk4(100)).unwrap();
+    let sol = solve_p(&rod, &with_chambers(chambers([p; 6])), &rk4(100)).unwrap();
     let lambda = 1.0 + 6.0 * p * PI * RC * RC / (300e3 * a0);
     for u in &sol.u {
         assert!(u.iter().all(|c| c.abs() < 1e-12), "{u:?}");
@@ -142,7 +159,7 @@ fn hyperelastic_elongation_matches_the_uniaxial_solution() {
     ] {
         let rod = Rod::new(L, sec.clone(), law.clone()).unwrap();
         for p in [10e3, 30e3, 60e3] {
-            let sol = solve_statics(&rod, &[], &with_chambers(chambers([p; 6])), &rk4(50)).unwrap();
+            let sol = solve_p(&rod, &with_chambers(chambers([p; 6])), &rk4(50)).unwrap();
             let lambda = law.stretch_from_axial_force(a0, 6.0 * p * ac).unwrap();
             let tip = sol.tip_position();
             assert!(
@@ -164,14 +181,16 @@ fn linear_fibre_law_equals_the_linear_material_at_any_load() {
     let e = 300e3;
     let lin = Rod::new(L, sec.clone(), LinearElastic::new(e, 0.5).unwrap()).unwrap();
     let hyp = Rod::new(L, sec, UniaxialModel::from(Hookean::new(e).unwrap())).unwrap();
-    let loads = Loads {
-        tip_force: Vector3::new(0.3, -0.2, 0.3),
-        tip_moment: Vector3::new(0.0, 0.0, 2e-3),
+    let loads = Loaded {
+        loads: Loads {
+            tip_force: Vector3::new(0.3, -0.2, 0.3),
+            tip_moment: Vector3::new(0.0, 0.0, 2e-3),
+            ..Default::default()
+        },
         chambers: chambers([0.0, 120e3, 0.0, 0.0, 150e3, 0.0]),
-        ..Default::default()
     };
-    let a = solve_statics(&lin, &[], &loads, &rk4(200)).unwrap();
-    let b = solve_statics(&hyp, &[], &loads, &rk4(200)).unwrap();
+    let a = solve_p(&lin, &loads, &rk4(200)).unwrap();
+    let b = solve_p(&hyp, &loads, &rk4(200)).unwrap();
     let err = dist(a.tip_position(), b.tip_position());
     assert!(err < 1e-12, "{err:e}");
     let disp = dist(a.tip_position(), [0.0, 0.0, L]);
@@ -192,13 +211,15 @@ fn small_strains_equal_the_linear_rod_with_the_initial_modulus() {
         let hyp = Rod::new(L, sec.clone(), law.clone()).unwrap();
         let mut rel = Vec::new();
         for scale in [1e-4, 1e-5] {
-            let loads = Loads {
-                tip_force: Vector3::new(0.2, -0.1, 0.5) * scale,
-                chambers: vec![Chamber::constant(2e5 * scale, 2e-5, [0.0, 0.006]).unwrap()],
-                ..Default::default()
+            let loads = Loaded {
+                loads: Loads {
+                    tip_force: Vector3::new(0.2, -0.1, 0.5) * scale,
+                    ..Default::default()
+                },
+                chambers: vec![common::constant_chamber(2e5 * scale, 2e-5, [0.0, 0.006]).unwrap()],
             };
-            let a = solve_statics(&lin, &[], &loads, &rk4(100)).unwrap();
-            let b = solve_statics(&hyp, &[], &loads, &rk4(100)).unwrap();
+            let a = solve_p(&lin, &loads, &rk4(100)).unwrap();
+            let b = solve_p(&hyp, &loads, &rk4(100)).unwrap();
             let disp = dist(a.tip_position(), [0.0, 0.0, L]);
             rel.push(dist(a.tip_position(), b.tip_position()) / disp);
         }
@@ -215,8 +236,8 @@ fn a_partial_chamber_bends_only_its_extent() {
     let rod = Rod::new(L, sec, silicone_linear()).unwrap();
     let (a, b, p) = (0.04, 0.12, 50e3);
     let ac = PI * RC * RC;
-    let c = Chamber::new(p, ChamberArea::Constant(ac), [0.0, D], a, Some(b)).unwrap();
-    let sol = solve_statics(&rod, &[], &with_chambers(vec![c]), &rk4(400)).unwrap();
+    let c = common::chamber(p, ChamberArea::Constant(ac), [0.0, D], a, Some(b)).unwrap();
+    let sol = solve_p(&rod, &with_chambers(vec![c]), &rk4(400)).unwrap();
     let (ux, lambda) = (p * ac * D / (e * i0), 1.0 + p * ac / (e * a0));
     for i in 0..sol.s.len() {
         let inside = sol.s[i] > a && sol.s[i] < b;
@@ -245,7 +266,7 @@ fn a_varying_chamber_area_matches_the_local_closed_form() {
     let e = 300e3;
     let rod = Rod::new(L, sec, silicone_linear()).unwrap();
     let area = |s: f64| PI * RC * RC * (1.0 - 0.5 * s / L);
-    let c = Chamber::new(
+    let c = common::chamber(
         40e3,
         ChamberArea::Function(std::sync::Arc::new(area)),
         [0.0, D],
@@ -253,7 +274,7 @@ fn a_varying_chamber_area_matches_the_local_closed_form() {
         None,
     )
     .unwrap();
-    let sol = solve_statics(&rod, &[], &with_chambers(vec![c]), &rk4(200)).unwrap();
+    let sol = solve_p(&rod, &with_chambers(vec![c]), &rk4(200)).unwrap();
     for i in 0..sol.s.len() {
         let f = 40e3 * area(sol.s[i]);
         assert!((sol.n_body[i][2] - f).abs() < 1e-12);
@@ -279,38 +300,38 @@ fn bad_input_names_the_parameter() {
         "c10 + c01"
     );
     assert_eq!(
-        name_of(Chamber::constant(1e3, -1.0, [0.0, 0.0]).unwrap_err()),
+        name_of(common::constant_chamber(1e3, -1.0, [0.0, 0.0]).unwrap_err()),
         "area"
     );
     assert_eq!(
-        name_of(Chamber::constant(-2e5, 1e-5, [0.0, 0.0]).unwrap_err()),
+        name_of(common::constant_chamber(-2e5, 1e-5, [0.0, 0.0]).unwrap_err()),
         "pressure"
     );
     assert_eq!(
-        name_of(Chamber::constant(1e3, 1e-5, [f64::NAN, 0.0]).unwrap_err()),
+        name_of(common::constant_chamber(1e3, 1e-5, [f64::NAN, 0.0]).unwrap_err()),
         "offset[0]"
     );
     let area = ChamberArea::Constant(1e-5);
     assert_eq!(
-        name_of(Chamber::new(1e3, area.clone(), [0.0, 0.0], 0.1, Some(0.05)).unwrap_err()),
+        name_of(common::chamber(1e3, area.clone(), [0.0, 0.0], 0.1, Some(0.05)).unwrap_err()),
         "end"
     );
     assert_eq!(
-        name_of(Chamber::new(1e3, area.clone(), [0.0, 0.0], -0.1, None).unwrap_err()),
+        name_of(common::chamber(1e3, area.clone(), [0.0, 0.0], -0.1, None).unwrap_err()),
         "start"
     );
 
     let (sec, _, _) = arm_section();
     let rod = Rod::new(L, sec, silicone_linear()).unwrap();
-    let solve = |c: Chamber| solve_statics(&rod, &[], &with_chambers(vec![c]), &rk4(20));
-    let c = Chamber::new(1e3, area.clone(), [0.0, D], 0.0, Some(2.0 * L)).unwrap();
+    let solve = |c: common::Pressurised| solve_p(&rod, &with_chambers(vec![c]), &rk4(20));
+    let c = common::chamber(1e3, area.clone(), [0.0, D], 0.0, Some(2.0 * L)).unwrap();
     assert_eq!(name_of(solve(c).unwrap_err()), "chambers[0].end");
-    let c = Chamber::new(1e3, area.clone(), [0.0, D], L, None).unwrap();
+    let c = common::chamber(1e3, area.clone(), [0.0, D], L, None).unwrap();
     assert_eq!(name_of(solve(c).unwrap_err()), "chambers[0].start");
     // Offset in mm instead of m.
-    let c = Chamber::constant(1e3, 1e-5, [0.0, 7.2]).unwrap();
+    let c = common::constant_chamber(1e3, 1e-5, [0.0, 7.2]).unwrap();
     assert_eq!(name_of(solve(c).unwrap_err()), "chambers[0].offset");
-    let c = Chamber::new(
+    let c = common::chamber(
         1e3,
         ChamberArea::Function(std::sync::Arc::new(|s| if s > 0.1 { -1.0 } else { 1e-5 })),
         [0.0, D],
@@ -332,12 +353,12 @@ fn material_failures_during_the_solve_are_named() {
         .fold(0.0f64, f64::max);
     let rod = Rod::new(L, sec.clone(), UniaxialModel::from(law)).unwrap();
     let p = 1.5 * p_max * a0 / (6.0 * ac);
-    let err = solve_statics(&rod, &[], &with_chambers(chambers([p; 6])), &rk4(20)).unwrap_err();
+    let err = solve_p(&rod, &with_chambers(chambers([p; 6])), &rk4(20)).unwrap_err();
     assert_eq!(name_of(err), "Yeoh parameters");
     // A compression the law cannot carry: a fibre stretch would reach zero.
     let rod = Rod::new(L, sec, UniaxialModel::from(Hookean::new(300e3).unwrap())).unwrap();
     let loads = Loads::tip_force(Vector3::new(0.0, 0.0, -2.0 * 300e3 * a0));
-    let err = solve_statics(&rod, &[], &loads, &rk4(20)).unwrap_err();
+    let err = common::solve(&rod, &[], &loads, &rk4(20)).unwrap_err();
     assert_eq!(name_of(err), "stretch");
 }
 
@@ -358,26 +379,19 @@ fn tangent_compliance_of_a_pressurised_hyperelastic_arm_matches_finite_differenc
     let rod = Rod::new(L, sec, UniaxialModel::from(Silicone::DragonSkin10.yeoh())).unwrap();
     let loads = with_chambers(chambers([30e3, 30e3, 15e3, 15e3, 0.0, 0.0]));
     let opts = rk4(100);
-    let sol = solve_statics(&rod, &[], &loads, &opts).unwrap();
-    let t = softrod::tangent_compliance(
-        &rod,
-        &[],
-        &loads,
-        &sol,
-        &opts,
-        softrod::TendonControl::Tension,
-        None,
-    )
-    .unwrap();
+    let sol = solve_p(&rod, &loads, &opts).unwrap();
+    let t = softrod::tangent_compliance(&sol, softrod::TendonControl::Tension, None).unwrap();
     assert!(t.symmetric);
     let tip = |w: [f64; 6]| {
-        let l = Loads {
-            tip_force: Vector3::new(w[0], w[1], w[2]),
-            tip_moment: Vector3::new(w[3], w[4], w[5]),
+        let l = Loaded {
+            loads: Loads {
+                tip_force: Vector3::new(w[0], w[1], w[2]),
+                tip_moment: Vector3::new(w[3], w[4], w[5]),
+                ..Default::default()
+            },
             chambers: loads.chambers.clone(),
-            ..Default::default()
         };
-        let s = solve_statics(&rod, &[], &l, &opts).unwrap();
+        let s = solve_p(&rod, &l, &opts).unwrap();
         (s.tip_position(), s.rotation[s.s.len() - 1])
     };
     let mut worst = 0.0f64;

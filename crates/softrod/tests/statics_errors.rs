@@ -2,12 +2,14 @@
 //! panics on user input.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use std::sync::Arc;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::{
-    solve_statics, Error, Integrator, LinearElastic, Loads, PointLoad, Pose, Profile, Rod, Routing,
-    Section, SectionProperties, SolveOptions, Tendon, WarmStart,
+    Error, Integrator, LinearElastic, Loads, PointLoad, Pose, Profile, Rod, Routing, Section,
+    SectionProperties, SolveOptions, WarmStart,
 };
 
 fn name_of<T: std::fmt::Debug>(r: softrod::Result<T>) -> String {
@@ -119,26 +121,28 @@ fn bad_geometry_and_moduli_are_named() {
 
 #[test]
 fn bad_tendons_are_named() {
+    // A tension is an actuation input, checked when solving with the tendon's index.
+    for tension in [-1.0, f64::NAN] {
+        let t = common::tendon([0.001, 0.0], tension, None).unwrap();
+        assert_eq!(
+            name_of(common::solve(
+                &rod(),
+                &[t],
+                &Loads::default(),
+                &SolveOptions::default()
+            )),
+            "tensions[0]"
+        );
+    }
     assert_eq!(
-        name_of(Tendon::constant([0.001, 0.0], -1.0, None)),
-        "tension"
-    );
-    assert_eq!(
-        name_of(Tendon::constant([0.001, 0.0], f64::NAN, None)),
-        "tension"
-    );
-    assert_eq!(
-        name_of(Tendon::constant([0.001, f64::NAN], 1.0, None)),
+        name_of(common::tendon([0.001, f64::NAN], 1.0, None)),
         "offset[1]"
     );
     for end in [0.0, -0.1, f64::NAN] {
-        assert_eq!(
-            name_of(Tendon::constant([0.001, 0.0], 1.0, Some(end))),
-            "end"
-        );
+        assert_eq!(name_of(common::tendon([0.001, 0.0], 1.0, Some(end))), "end");
     }
     let helix = |pitch| {
-        Tendon::new(
+        common::tendon_with(
             Routing::Helical {
                 radius: 0.001,
                 pitch,
@@ -151,10 +155,10 @@ fn bad_tendons_are_named() {
     assert_eq!(name_of(helix(0.0)), "pitch");
     assert_eq!(name_of(helix(f64::INFINITY)), "pitch");
     // A termination beyond the tip is caught when solving, with the tendon's index.
-    let t = Tendon::constant([0.001, 0.0], 1.0, Some(0.31)).unwrap();
-    let ok = Tendon::constant([0.001, 0.0], 1.0, None).unwrap();
+    let t = common::tendon([0.001, 0.0], 1.0, Some(0.31)).unwrap();
+    let ok = common::tendon([0.001, 0.0], 1.0, None).unwrap();
     assert_eq!(
-        name_of(solve_statics(
+        name_of(common::solve(
             &rod(),
             &[ok, t],
             &Loads::default(),
@@ -163,7 +167,7 @@ fn bad_tendons_are_named() {
         "tendons[1].end"
     );
     // A user routing that returns NaN.
-    let bad = Tendon::new(
+    let bad = common::tendon_with(
         Routing::Function {
             offset: Arc::new(|s| [0.001, if s > 0.2 { f64::NAN } else { 0.0 }]),
             derivative: Arc::new(|_| [0.0, 0.0]),
@@ -172,7 +176,7 @@ fn bad_tendons_are_named() {
         None,
     )
     .unwrap();
-    assert!(name_of(solve_statics(
+    assert!(name_of(common::solve(
         &rod(),
         &[bad],
         &Loads::default(),
@@ -183,7 +187,7 @@ fn bad_tendons_are_named() {
 
 #[test]
 fn bad_loads_and_options_are_named() {
-    let solve = |loads: &Loads, opts: &SolveOptions| solve_statics(&rod(), &[], loads, opts);
+    let solve = |loads: &Loads, opts: &SolveOptions| common::solve(&rod(), &[], loads, opts);
     let d = SolveOptions::default();
     let mut l = Loads::tip_force(Vector3::new(0.0, f64::NAN, 0.0));
     assert_eq!(name_of(solve(&l, &d)), "loads.tip_force[1]");
@@ -219,18 +223,25 @@ fn bad_loads_and_options_are_named() {
     };
     assert_eq!(name_of(solve(&l, &o)), "integrator.steps");
     let o = SolveOptions {
-        tolerance: f64::NAN,
+        newton: softrod::NewtonOptions {
+            tolerance: f64::NAN,
+            ..d.newton
+        },
         ..d
     };
     assert_eq!(name_of(solve(&l, &o)), "tolerance");
     let o = SolveOptions {
-        max_iterations: 0,
+        newton: softrod::NewtonOptions {
+            max_iterations: 0,
+            ..d.newton
+        },
         ..d
     };
     assert_eq!(name_of(solve(&l, &o)), "max_iterations");
     let o = SolveOptions {
         warm_start: Some(WarmStart {
             base_wrench: [0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0],
+            jacobian: None,
         }),
         ..d
     };
@@ -258,24 +269,30 @@ fn extreme_inputs_never_panic() {
                     LinearElastic::new(e, 0.3).unwrap(),
                 )
                 .unwrap();
-                let t = Tendon::constant([0.0015, 0.0], tau, Some(0.2)).unwrap();
+                let t = common::tendon([0.0015, 0.0], tau, Some(0.2)).unwrap();
                 let loads = Loads::tip_force(Vector3::new(f, 0.0, -f));
                 let opts = SolveOptions {
                     integrator: Integrator::Rk4 { steps: 3 },
-                    max_load_steps: 4,
-                    max_iterations: 5,
+                    newton: softrod::NewtonOptions {
+                        max_load_steps: 4,
+                        max_iterations: 5,
+                        ..SolveOptions::default().newton
+                    },
                     ..Default::default()
                 };
-                let r = solve_statics(&rod, &[t], &loads, &opts);
+                let r = common::solve(&rod, &[t], &loads, &opts);
                 if let Ok(sol) = &r {
                     assert!(sol.stats.converged);
                 }
-                let r2 = solve_statics(
+                let r2 = common::solve(
                     &rod,
                     &[],
                     &loads,
                     &SolveOptions {
-                        throw: false,
+                        newton: softrod::NewtonOptions {
+                            throw: false,
+                            ..opts.newton
+                        },
                         ..opts
                     },
                 );

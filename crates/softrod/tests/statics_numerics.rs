@@ -3,19 +3,24 @@
 //! count, frames of tip loads, and inspection of non-converged results.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use std::f64::consts::PI;
 
 use softrod::integrate::AdaptiveOptions;
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::{
-    solve_statics, Error, Frame, Integrator, LinearElastic, Loads, Rod, Routing, Section,
-    SolveOptions, StaticsSolution, Tendon,
+    Error, Frame, Integrator, LinearElastic, Loads, Rod, Routing, Section, SolveOptions,
+    StaticsSolution,
 };
 
 fn rk4(steps: usize) -> SolveOptions {
     SolveOptions {
         integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -27,7 +32,10 @@ fn adaptive(rtol: f64) -> SolveOptions {
             atol: rtol * 1e-3,
             max_steps: 1_000_000,
         }),
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -37,38 +45,15 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// The two-segment NiTi robot of the benchmark.
-fn niti() -> Rod {
-    Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap()
-}
-
-fn niti_tendons(tensions: &[f64; 6]) -> Vec<Tendon> {
-    (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            Tendon::constant(
-                [0.01 * ang.cos(), 0.01 * ang.sin()],
-                tensions[i],
-                Some(if i < 3 { 0.2 } else { 0.4 }),
-            )
-            .unwrap()
-        })
-        .collect()
-}
-
 /// A 3-D test problem: tapered soft rod, helical tendon ending mid-way, tip force.
-fn helix_problem() -> (Rod, Vec<Tendon>, Loads) {
+fn helix_problem() -> (Rod, Vec<common::Tensioned>, Loads) {
     let rod = Rod::new(
         0.3,
         Section::tapered_circular(0.004, 0.0025).unwrap(),
         LinearElastic::new(2e6, 0.45).unwrap(),
     )
     .unwrap();
-    let t = Tendon::new(
+    let t = common::tendon_with(
         Routing::Helical {
             radius: 0.002,
             pitch: 0.25,
@@ -88,14 +73,14 @@ fn helix_problem() -> (Rod, Vec<Tendon>, Loads) {
 #[test]
 fn rk4_converges_with_order_four() {
     let (rod, tendons, loads) = helix_problem();
-    let reference = solve_statics(&rod, &tendons, &loads, &adaptive(1e-13)).unwrap();
+    let reference = common::solve(&rod, &tendons, &loads, &adaptive(1e-13)).unwrap();
     let r = reference.tip_position();
     // Asymptotic range (at 10 steps the tendon's helix is resolved by 8 points per turn).
     let errors: Vec<f64> = [20, 40, 80, 160]
         .iter()
         .map(|&n| {
             dist(
-                solve_statics(&rod, &tendons, &loads, &rk4(n))
+                common::solve(&rod, &tendons, &loads, &rk4(n))
                     .unwrap()
                     .tip_position(),
                 r,
@@ -108,7 +93,7 @@ fn rk4_converges_with_order_four() {
         assert!((3.7..4.3).contains(&order), "observed order {order}");
     }
     // The tendon path length converges too.
-    let lt = solve_statics(&rod, &tendons, &loads, &rk4(80))
+    let lt = common::solve(&rod, &tendons, &loads, &rk4(80))
         .unwrap()
         .tendon_lengths[0];
     assert!(
@@ -121,10 +106,10 @@ fn rk4_converges_with_order_four() {
 #[test]
 fn adaptive_integrator_meets_its_tolerance() {
     let (rod, tendons, loads) = helix_problem();
-    let reference = solve_statics(&rod, &tendons, &loads, &rk4(4000)).unwrap();
+    let reference = common::solve(&rod, &tendons, &loads, &rk4(4000)).unwrap();
     let r = reference.tip_position();
     for rtol in [1e-6, 1e-8, 1e-10] {
-        let sol = solve_statics(&rod, &tendons, &loads, &adaptive(rtol)).unwrap();
+        let sol = common::solve(&rod, &tendons, &loads, &adaptive(rtol)).unwrap();
         let e = dist(sol.tip_position(), r) / rod.length();
         println!(
             "rtol {rtol:e}: tip error {e:.2e} L, {} samples, {} evaluations",
@@ -138,10 +123,10 @@ fn adaptive_integrator_meets_its_tolerance() {
 
 #[test]
 fn two_segment_robot_default_options_are_accurate() {
-    let rod = niti();
-    let tendons = niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
-    let tight = solve_statics(&rod, &tendons, &Loads::default(), &adaptive(1e-12)).unwrap();
-    let sol = solve_statics(&rod, &tendons, &Loads::default(), &SolveOptions::default()).unwrap();
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let tight = common::solve(&rod, &tendons, &Loads::default(), &adaptive(1e-12)).unwrap();
+    let sol = common::solve(&rod, &tendons, &Loads::default(), &SolveOptions::default()).unwrap();
     let e = dist(sol.tip_position(), tight.tip_position());
     println!(
         "two-segment robot: tip {:?}, error {e:.2e} m",
@@ -162,22 +147,22 @@ fn two_segment_robot_default_options_are_accurate() {
 
 #[test]
 fn warm_start_reaches_the_cold_solution_in_fewer_iterations() {
-    let rod = niti();
+    let rod = common::niti_rod();
     let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
-    let a = solve_statics(
+    let a = common::solve(
         &rod,
-        &niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]),
+        &common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]),
         &loads,
         &rk4(40),
     )
     .unwrap();
-    let changed = niti_tendons(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
-    let cold = solve_statics(&rod, &changed, &loads, &rk4(40)).unwrap();
+    let changed = common::niti_tendons(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
+    let cold = common::solve(&rod, &changed, &loads, &rk4(40)).unwrap();
     let warm_opts = SolveOptions {
         warm_start: Some(a.warm_start()),
         ..rk4(40)
     };
-    let warm = solve_statics(&rod, &changed, &loads, &warm_opts).unwrap();
+    let warm = common::solve(&rod, &changed, &loads, &warm_opts).unwrap();
     println!(
         "iterations: cold {}, warm {}; evaluations: cold {}, warm {}",
         cold.stats.iterations,
@@ -204,7 +189,7 @@ fn body_frame_tip_load_is_the_world_load_rotated() {
         tip_moment: m,
         ..Default::default()
     };
-    let a = solve_statics(&rod, &tendons, &world, &rk4(100)).unwrap();
+    let a = common::solve(&rod, &tendons, &world, &rk4(100)).unwrap();
     let rl = rot(&a, a.s.len() - 1);
     let body = Loads {
         tip_force: rl.transpose() * f,
@@ -212,7 +197,7 @@ fn body_frame_tip_load_is_the_world_load_rotated() {
         tip_frame: Frame::Body,
         ..Default::default()
     };
-    let b = solve_statics(&rod, &tendons, &body, &rk4(100)).unwrap();
+    let b = common::solve(&rod, &tendons, &body, &rk4(100)).unwrap();
     assert!(dist(a.tip_position(), b.tip_position()) < 1e-12);
     // Quaternions are unit, scalar last, and agree with the rotation matrices.
     for i in 0..a.s.len() {
@@ -230,7 +215,7 @@ fn body_frame_tip_load_is_the_world_load_rotated() {
 #[test]
 fn internal_wrench_is_consistent_with_strains_and_frames() {
     let (rod, tendons, loads) = helix_problem();
-    let sol = solve_statics(&rod, &tendons, &loads, &rk4(60)).unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &rk4(60)).unwrap();
     let e: f64 = 2e6;
     let g = e / (2.0 * 1.45);
     let k = rod.shear_coefficient();
@@ -271,33 +256,39 @@ fn non_convergence_is_an_error_or_an_inspectable_result() {
     .with_inextensible(true);
     let loads = Loads::tip_force(Vector3::new(0.5, 0.0, 0.0)); // alpha ~ 1.4e2: hard
     let opts = SolveOptions {
-        max_iterations: 2,
-        continuation: false,
+        newton: softrod::NewtonOptions {
+            max_iterations: 2,
+            continuation: false,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     };
-    match solve_statics(&rod, &[], &loads, &opts) {
+    match common::solve(&rod, &[], &loads, &opts) {
         Err(Error::NotConverged {
             iterations,
             residual,
             ..
         }) => {
             assert!(iterations <= 2);
-            assert!(residual > opts.tolerance && residual.is_finite());
+            assert!(residual > opts.newton.tolerance && residual.is_finite());
         }
         other => panic!("expected NotConverged, got {other:?}"),
     }
-    let sol = solve_statics(
+    let sol = common::solve(
         &rod,
         &[],
         &loads,
         &SolveOptions {
-            throw: false,
+            newton: softrod::NewtonOptions {
+                throw: false,
+                ..opts.newton
+            },
             ..opts
         },
     )
     .unwrap();
     assert!(!sol.stats.converged);
-    assert!(sol.stats.residual > opts.tolerance);
+    assert!(sol.stats.residual > opts.newton.tolerance);
     assert_eq!(sol.s.len(), sol.position.len());
     assert!(!sol.s.is_empty());
 }
@@ -310,10 +301,10 @@ fn tendon_termination_applies_point_force_and_moment() {
     // jumps there, the 2 N tendon that continues has a kink in its path and adds the point
     // force tau (t+ - t-) of a tensioned string over a kink (its distributed load -tau t'
     // integrated across the jump).
-    let rod = niti();
-    let tendons = niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let loads = Loads::tip_force(Vector3::new(0.02, 0.01, 0.0));
-    let sol = solve_statics(&rod, &tendons, &loads, &rk4(40)).unwrap();
+    let sol = common::solve(&rod, &tendons, &loads, &rk4(40)).unwrap();
     let i = sol.s.iter().position(|&s| s == 0.2).unwrap();
     assert_eq!(sol.s[i + 1], 0.2);
     let r = rot(&sol, i);

@@ -3,18 +3,21 @@
 //! closed form.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use std::f64::consts::PI;
 
 use softrod::integrate::AdaptiveOptions;
 use softrod::nalgebra::{Matrix3, Vector3};
-use softrod::{
-    solve_statics, Integrator, LinearElastic, Loads, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::{Integrator, LinearElastic, Loads, Rod, Section, SolveOptions};
 
 fn rk4(steps: usize) -> SolveOptions {
     SolveOptions {
         integrator: Integrator::Rk4 { steps },
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -26,7 +29,10 @@ fn adaptive(rtol: f64) -> SolveOptions {
             atol: rtol * 1e-3,
             max_steps: 1_000_000,
         }),
-        tolerance: 1e-13,
+        newton: softrod::NewtonOptions {
+            tolerance: 1e-13,
+            ..SolveOptions::default().newton
+        },
         ..Default::default()
     }
 }
@@ -49,7 +55,7 @@ fn pure_tip_moment_gives_circular_arc() {
         )
         .unwrap()
         .with_inextensible(inextensible);
-        let sol = solve_statics(
+        let sol = common::solve(
             &rod,
             &[],
             &Loads::tip_moment(Vector3::new(mtip, 0.0, 0.0)),
@@ -229,7 +235,7 @@ fn tip_loaded_cantilever_matches_elastica() {
     println!("alpha   delta/L (ref)        x/L (ref)         tip error / L   iters  load steps");
     for alpha in [0.1, 0.3, 1.0, 2.0, 3.0, 5.0, 7.5, 10.0] {
         let p = alpha * ei / (l * l);
-        let sol = solve_statics(
+        let sol = common::solve(
             &rod,
             &[],
             &Loads::tip_force(Vector3::new(p, 0.0, 0.0)),
@@ -257,8 +263,8 @@ fn constant_offset_tendon_gives_constant_curvature_and_strain() {
     let ea = e * PI * r * r;
     let kappa = tau * d / ei;
     let eps = -tau / ea;
-    let tendon = Tendon::constant([d, 0.0], tau, None).unwrap();
-    let sol = solve_statics(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
+    let tendon = common::tendon([d, 0.0], tau, None).unwrap();
+    let sol = common::solve(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
     for (u, v) in sol.u.iter().zip(&sol.v) {
         assert!((u[1] - kappa).abs() <= 1e-10 * kappa, "u {u:?} vs {kappa}");
         assert!(u[0].abs() < 1e-10 * kappa && u[2].abs() < 1e-10 * kappa);
@@ -295,7 +301,7 @@ fn base_pose_rotation_rotates_the_solution() {
     use softrod::{Pose, Routing};
     let (l, r, e) = (0.3, 0.003, 1e7);
     let mat = LinearElastic::new(e, 0.4).unwrap();
-    let tendon = Tendon::new(
+    let tendon = common::tendon_with(
         Routing::Helical {
             radius: 0.002,
             pitch: 0.2,
@@ -305,7 +311,7 @@ fn base_pose_rotation_rotates_the_solution() {
         Some(0.25),
     )
     .unwrap();
-    let q = softrod::so3::exp_so3(&Vector3::new(0.7, -1.9, 0.4));
+    let q = softrod::math::so3::exp_so3(&Vector3::new(0.7, -1.9, 0.4));
     let t0 = Vector3::new(0.1, -0.2, 0.05);
     let f = Vector3::new(0.02, -0.05, 0.01);
     let base = Rod::new(l, Section::tapered_circular(r, 0.6 * r).unwrap(), mat).unwrap();
@@ -319,8 +325,8 @@ fn base_pose_rotation_rotates_the_solution() {
         0.1,
         q * Vector3::new(0.0, 0.03, 0.0),
     ));
-    let a = solve_statics(&base, std::slice::from_ref(&tendon), &loads, &rk4(60)).unwrap();
-    let b = solve_statics(&rotated, &[tendon], &loads_q, &rk4(60)).unwrap();
+    let a = common::solve(&base, std::slice::from_ref(&tendon), &loads, &rk4(60)).unwrap();
+    let b = common::solve(&rotated, &[tendon], &loads_q, &rk4(60)).unwrap();
     assert_eq!(a.s.len(), b.s.len());
     let mut worst: f64 = 0.0;
     for i in 0..a.s.len() {
@@ -354,7 +360,7 @@ fn helical_tendon_bends_out_of_plane_with_its_handedness() {
     let omega = 2.0 * PI / pitch;
     let tau = 1e-3 * ei / (rho * l); // small: tip rotation ~ 1e-3 rad
     let helix = |p: f64| {
-        let t = Tendon::new(
+        let t = common::tendon_with(
             Routing::Helical {
                 radius: rho,
                 pitch: p,
@@ -364,7 +370,7 @@ fn helical_tendon_bends_out_of_plane_with_its_handedness() {
             None,
         )
         .unwrap();
-        solve_statics(&rod, &[t], &Loads::default(), &rk4(200)).unwrap()
+        common::solve(&rod, &[t], &Loads::default(), &rk4(200)).unwrap()
     };
     let right = helix(pitch);
     let left = helix(-pitch);
@@ -421,7 +427,7 @@ fn seed_000_arm_agrees_to_the_order_of_its_linearisation() {
     println!(" T [N]  |tip diff| [m]  relative   bound max(|q| + d k)");
     for t in [0.05, 0.1, 0.5, 1.0, 2.0, 5.0] {
         let planar = solve_planar(&arm, t, &samples, PlanarMethod::ClosedForm).unwrap();
-        let tendon = Tendon::new(
+        let tendon = common::tendon_with(
             Routing::RadiusProportional {
                 ratio: arm.offset_ratio(),
                 angle: 0.0,
@@ -430,7 +436,7 @@ fn seed_000_arm_agrees_to_the_order_of_its_linearisation() {
             None,
         )
         .unwrap();
-        let sol = solve_statics(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
+        let sol = common::solve(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
         let tip = sol.tip_position();
         let (px, py) = (planar.tip[0], planar.tip[1]);
         let diff = ((px - tip[2]).powi(2) + (py - tip[0]).powi(2) + tip[1].powi(2)).sqrt();
@@ -466,7 +472,7 @@ fn precurved_rod_rests_in_its_rest_shape() {
     .unwrap()
     .with_rest_curvature(Profile::Constant(Vector3::new(0.0, kappa, 0.0)))
     .unwrap();
-    let sol = solve_statics(&rod, &[], &Loads::default(), &rk4(400)).unwrap();
+    let sol = common::solve(&rod, &[], &Loads::default(), &rk4(400)).unwrap();
     let exact = [
         (1.0 - (kappa * l).cos()) / kappa,
         0.0,
@@ -508,7 +514,7 @@ fn small_loads_match_euler_bernoulli_cantilever() {
         ..Default::default()
     };
     for loads in [dist_load, grav] {
-        let sol = solve_statics(&rod, &[], &loads, &rk4(200)).unwrap();
+        let sol = common::solve(&rod, &[], &loads, &rk4(200)).unwrap();
         let w = sol.tip_position()[0];
         assert!((w - w_q).abs() < 1e-6 * w_q, "{w} vs {w_q}");
         // Base reaction: the whole load.
@@ -520,7 +526,7 @@ fn small_loads_match_euler_bernoulli_cantilever() {
     loads
         .point_loads
         .push(PointLoad::force(a, Vector3::new(p, 0.0, 0.0)));
-    let sol = solve_statics(&rod, &[], &loads, &rk4(200)).unwrap();
+    let sol = common::solve(&rod, &[], &loads, &rk4(200)).unwrap();
     let w_p = p * a * a * (3.0 * l - a) / (6.0 * ei);
     assert!((sol.tip_position()[0] - w_p).abs() < 1e-6 * w_p);
     // The internal force jumps by the point force at s = a (the sample appears twice).
@@ -549,7 +555,7 @@ fn uniform_distributed_moment_bends_with_the_exact_angle() {
         distributed_moment: Some(Profile::Constant(Vector3::new(l0, 0.0, 0.0))),
         ..Default::default()
     };
-    let sol = solve_statics(&rod, &[], &loads, &rk4(400)).unwrap();
+    let sol = common::solve(&rod, &[], &loads, &rk4(400)).unwrap();
     let theta = |s: f64| l0 * (l * s - 0.5 * s * s) / ei;
     let y = quad(|s| -theta(s).sin(), 0.0, l, 100);
     let z = quad(|s| theta(s).cos(), 0.0, l, 100);
@@ -567,7 +573,7 @@ fn tabulated_and_function_sections_match_the_circle() {
     let c = SectionProperties::circle(r, 0.0);
     let table = Section::table(&[0.0, l], &[c.area; 2], &[c.ix; 2], &[c.iy; 2], &[c.j; 2]).unwrap();
     let func = Section::function(Arc::new(move |_| SectionProperties::circle(r, 0.0)));
-    let t = Tendon::constant([0.002, 0.001], 0.5, Some(0.2)).unwrap();
+    let t = common::tendon([0.002, 0.001], 0.5, Some(0.2)).unwrap();
     let loads = Loads::tip_force(Vector3::new(0.01, 0.0, 0.0));
     let tips: Vec<[f64; 3]> = [Section::circular(r).unwrap(), table, func]
         .into_iter()
@@ -576,7 +582,7 @@ fn tabulated_and_function_sections_match_the_circle() {
                 .unwrap()
                 .with_shear_coefficient(0.9)
                 .unwrap();
-            solve_statics(&rod, std::slice::from_ref(&t), &loads, &rk4(80))
+            common::solve(&rod, std::slice::from_ref(&t), &loads, &rk4(80))
                 .unwrap()
                 .tip_position()
         })
@@ -598,8 +604,8 @@ fn inextensible_rod_with_tendon_bends_without_stretch() {
     .unwrap()
     .with_inextensible(true);
     let kappa = tau * d / (e * PI * r.powi(4) / 4.0);
-    let t = Tendon::constant([0.0, d], tau, None).unwrap();
-    let sol = solve_statics(&rod, &[t], &Loads::default(), &rk4(400)).unwrap();
+    let t = common::tendon([0.0, d], tau, None).unwrap();
+    let sol = common::solve(&rod, &[t], &Loads::default(), &rk4(400)).unwrap();
     for (u, v) in sol.u.iter().zip(&sol.v) {
         assert!((u[0] + kappa).abs() <= 1e-10 * kappa && u[1].abs() < 1e-12 && u[2].abs() < 1e-12);
         assert_eq!(*v, [0.0, 0.0, 1.0]);
@@ -625,7 +631,7 @@ fn user_routing_function_matches_the_builtin_helix() {
         LinearElastic::new(5e6, 0.4).unwrap(),
     )
     .unwrap();
-    let builtin = Tendon::new(
+    let builtin = common::tendon_with(
         Routing::Helical {
             radius: rho,
             pitch,
@@ -635,7 +641,7 @@ fn user_routing_function_matches_the_builtin_helix() {
         Some(0.25),
     )
     .unwrap();
-    let user = Tendon::new(
+    let user = common::tendon_with(
         Routing::Function {
             offset: Arc::new(move |s| [rho * (phase + w * s).cos(), rho * (phase + w * s).sin()]),
             derivative: Arc::new(move |s| {
@@ -650,8 +656,8 @@ fn user_routing_function_matches_the_builtin_helix() {
     )
     .unwrap();
     let loads = Loads::tip_force(Vector3::new(0.0, 0.01, 0.0));
-    let a = solve_statics(&rod, &[builtin], &loads, &rk4(80)).unwrap();
-    let b = solve_statics(&rod, &[user], &loads, &rk4(80)).unwrap();
+    let a = common::solve(&rod, &[builtin], &loads, &rk4(80)).unwrap();
+    let b = common::solve(&rod, &[user], &loads, &rk4(80)).unwrap();
     assert!(dist(a.tip_position(), b.tip_position()) < 1e-14);
     assert!((a.tendon_lengths[0] - b.tendon_lengths[0]).abs() < 1e-15);
 }

@@ -1,12 +1,12 @@
 //! Property tests over pseudo-random rods, tendons and loads: whatever the shape, the total
 //! base wrench balances the external loads (global equilibrium, computed from the returned
 //! positions), and the rod's base wrench differs from it by exactly the tendons' pull.
-#![allow(clippy::unwrap_used, missing_docs)]
+#![allow(clippy::unwrap_used, missing_docs, clippy::too_many_lines)]
+
+mod common;
 
 use softrod::nalgebra::Vector3;
-use softrod::{
-    solve_statics, LinearElastic, Loads, PointLoad, Rod, Routing, Section, SolveOptions, Tendon,
-};
+use softrod::{LinearElastic, Loads, PointLoad, Rod, Routing, Section, SolveOptions};
 
 /// Small deterministic generator (64-bit LCG), uniform in [0, 1).
 struct Lcg(u64);
@@ -72,7 +72,9 @@ fn random_problems_satisfy_global_equilibrium() {
             } else {
                 Some(g.range(0.2, 1.0) * l)
             };
-            tendons.push(Tendon::new(routing, g.range(0.0, 2.0) * ei / (l * r0), end).unwrap());
+            tendons.push(
+                common::tendon_with(routing, g.range(0.0, 2.0) * ei / (l * r0), end).unwrap(),
+            );
         }
         let mut loads = Loads {
             tip_force: g.vec(f_ref),
@@ -91,10 +93,13 @@ fn random_problems_satisfy_global_equilibrium() {
             frame: softrod::Frame::World,
         });
         let opts = SolveOptions {
-            throw: false,
+            newton: softrod::NewtonOptions {
+                throw: false,
+                ..SolveOptions::default().newton
+            },
             ..Default::default()
         };
-        let sol = solve_statics(&rod, &tendons, &loads, &opts).unwrap();
+        let sol = common::solve(&rod, &tendons, &loads, &opts).unwrap();
         if !sol.stats.converged {
             continue;
         }

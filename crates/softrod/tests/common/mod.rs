@@ -3,6 +3,9 @@
 //! comparison of 6×6 compliances.
 #![allow(dead_code, missing_docs)]
 
+pub mod robot;
+pub use robot::*;
+
 use std::f64::consts::PI;
 
 use softrod::nalgebra::{Matrix3, Matrix6, Vector3, Vector6};

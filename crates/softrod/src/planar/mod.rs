@@ -13,7 +13,7 @@
 //!
 //! Beyond the anchor the arm is unloaded and straight. `k` is either evaluated in closed form or
 //! obtained from the published final-value ODE (with the final value's typo corrected,
-//! `R(L)^4`), integrated from the anchor to the base with [`crate::integrate::bs23`].
+//! `R(L)^4`), integrated from the anchor to the base with the adaptive driver of [`crate::integrate`] and the Bogacki–Shampine tableau.
 //!
 //! The backbone (`theta`, `x`, `y`) is integrated by Lobatto IIIA collocation on panels no
 //! longer than the output spacing: 3 stages (order 4) where the tangent turns by less than
@@ -29,7 +29,8 @@ use std::f64::consts::PI;
 use rayon::prelude::*;
 
 use crate::error::{check_positive, Error, Result};
-use crate::integrate::{bs23, AdaptiveOptions, IntegrationStats};
+use crate::integrate::driver::adaptive_dense;
+use crate::integrate::{AdaptiveOptions, FnSystem, IntegrationStats, BS3};
 
 /// Largest tangent-angle change (rad) allowed across one backbone-integration panel.
 ///
@@ -644,12 +645,14 @@ fn solve_into(
             Ok((tip, None))
         }
         PlanarMethod::Ode(options) => {
-            let sol = bs23(
-                |s, k: &[f64; 1]| [arm.curvature_rate(s, k[0], tension)],
-                anchor,
+            let mut rhs = FnSystem(|s: f64, k: &[f64; 1]| [arm.curvature_rate(s, k[0], tension)]);
+            let sol = adaptive_dense(
+                &BS3,
+                &mut rhs,
+                [anchor, 0.0],
                 [arm.final_value(tension)],
-                0.0,
-                options,
+                &options,
+                1,
             )?;
             let rates = Rates {
                 turn: sol.y.iter().fold(0.0f64, |m, k| m.max(k[0].abs())),

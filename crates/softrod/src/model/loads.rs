@@ -1,5 +1,4 @@
-//! External loads on a rod: tip wrench, point wrenches, distributed force and moment, gravity;
-//! and the pressure of pneumatic chambers.
+//! External loads on a rod: tip wrench, point wrenches, distributed force and moment, gravity.
 //!
 //! All vectors are in the world frame unless a [`Frame::Body`] is given (body components are
 //! rotated with the rod: follower loads). Forces in N, moments in N m, distributed forces in
@@ -7,9 +6,8 @@
 
 use nalgebra::Vector3;
 
-use crate::chamber::Chamber;
 use crate::error::{Error, Result};
-use crate::rod::Profile;
+use crate::model::rod::Profile;
 
 /// Frame in which a load's components are given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -66,9 +64,6 @@ pub struct Loads {
     /// Gravitational acceleration (m/s², world frame); needs the rod's density. The load is
     /// `rho A(s) g` per unit undeformed length.
     pub gravity: Vector3<f64>,
-    /// Pressurised pneumatic chambers (self-equilibrated internal loads: cap forces, wall
-    /// pressure; see [`crate::chamber`]), validated against the rod when solving.
-    pub chambers: Vec<Chamber>,
 }
 
 fn check_vec(name: &str, v: &Vector3<f64>) -> Result<()> {
@@ -131,5 +126,16 @@ impl Loads {
             ));
         }
         Ok(())
+    }
+
+    /// Whether there is no external load at all (the total base wrench is then zero for any
+    /// actuation).
+    pub fn is_unloaded(&self) -> bool {
+        self.tip_force == Vector3::zeros()
+            && self.tip_moment == Vector3::zeros()
+            && self.point_loads.is_empty()
+            && self.distributed_force.is_none()
+            && self.distributed_moment.is_none()
+            && self.gravity == Vector3::zeros()
     }
 }

@@ -62,8 +62,14 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
-use crate::error::{check_finite, check_newton_options, check_positive, Error, Result};
-use crate::pcc::{chain_pose, ElasticSegment, PccChain, PccChambers, PccSegment, PccTendons};
+use crate::error::{check_finite, check_positive, Error, Result};
+use crate::math::series::arc_fns;
+use crate::pcc::actuation::{ElasticSegment, PccChambers, PccTendons};
+use crate::pcc::kinematics::{chain_pose, PccChain, PccSegment};
+use crate::solve::{
+    continuation, newton, Armijo, ContinuationSettings, Evaluated, LineSearch, NewtonOptions,
+    NewtonSettings, Problem, SolverStats,
+};
 
 /// Default tolerance on the scaled residual (max norm): bending residual `|g_θ| ℓ0 / E I`
 /// (rad) and axial residual `|g_ℓ| / E A` (strain).
@@ -74,15 +80,6 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 50;
 pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
 /// Most step halvings of the Newton line search.
 pub const MAX_LINE_SEARCH_HALVINGS: usize = 20;
-/// Sufficient-decrease constant of the line search (Armijo, on the residual norm).
-pub const ARMIJO: f64 = 1e-4;
-/// Smallest load-factor increment of the continuation before giving up.
-pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
-/// `θ²` (rad²) below which the arc functions are summed as series (12 terms: error below
-/// `1e-20` for `θ² < 1`); above it the closed forms lose at most `~1e-14` relative.
-const SERIES_BOUND: f64 = 1.0;
-/// Number of series terms.
-const SERIES_TERMS: usize = 13;
 
 /// A tendon of a multi-segment robot: straight, at the constant body offset
 /// `distance (cos angle, sin angle)` (m, rad from body x toward body y) in every segment it
@@ -238,46 +235,27 @@ pub struct PccLoads {
 /// Options of [`solve_pcc_statics`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PccSolveOptions {
-    /// Tolerance on the scaled residual (max norm), > 0.
-    pub tolerance: f64,
-    /// Newton iterations per solve (per load step), >= 1.
-    pub max_iterations: usize,
-    /// Whether to fall back on stepping the tip load when the direct solve fails.
-    pub continuation: bool,
-    /// Load steps (attempted) under continuation, >= 1.
-    pub max_load_steps: usize,
+    /// Nonlinear solve; the tolerance is on the scaled residual (bending `|g_θ| ℓ0 / E I` in
+    /// rad, axial `|g_ℓ| / E A`); continuation steps the tip load.
+    pub newton: NewtonOptions,
     /// Initial guess, one segment per robot segment; `None` starts from the actuator-only
     /// solution (exact without a tip load).
     pub warm_start: Option<Vec<PccSegment>>,
-    /// `true`: non-convergence is [`Error::NotConverged`]; `false`: the last iterate is
-    /// returned with `stats.converged == false`.
-    pub throw: bool,
 }
 
 impl Default for PccSolveOptions {
     fn default() -> Self {
         Self {
-            tolerance: DEFAULT_TOLERANCE,
-            max_iterations: DEFAULT_MAX_ITERATIONS,
-            continuation: true,
-            max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+            newton: NewtonOptions {
+                tolerance: DEFAULT_TOLERANCE,
+                max_iterations: DEFAULT_MAX_ITERATIONS,
+                continuation: true,
+                max_load_steps: DEFAULT_MAX_LOAD_STEPS,
+                throw: true,
+            },
             warm_start: None,
-            throw: true,
         }
     }
-}
-
-/// Solver statistics of [`solve_pcc_statics`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PccSolverStats {
-    /// Newton iterations (accepted steps), over all load steps.
-    pub iterations: usize,
-    /// Final scaled residual (max norm: rad for bending, strain for stretch).
-    pub residual: f64,
-    /// Whether the residual met the tolerance.
-    pub converged: bool,
-    /// Load steps taken by the continuation (0: solved directly).
-    pub load_steps: usize,
 }
 
 /// A solved PCC robot.
@@ -290,7 +268,7 @@ pub struct PccStaticsSolution {
     /// Path length of every tendon from the base to its termination (m).
     pub tendon_lengths: Vec<f64>,
     /// Solver statistics.
-    pub stats: PccSolverStats,
+    pub stats: SolverStats,
 }
 
 impl PccStaticsSolution {
@@ -328,102 +306,6 @@ pub struct PccEquilibrium {
     pub jacobian: DMatrix<f64>,
     /// Scaled residual (max norm), as compared with [`PccSolveOptions::tolerance`].
     pub scaled_residual: f64,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Arc functions of x = θ².
-// ---------------------------------------------------------------------------------------------
-
-/// `S = sin θ/θ`, `B = (1 - cos θ)/θ²`, `C = (θ - sin θ)/θ³` and their derivatives in `x = θ²`.
-#[derive(Debug, Clone, Copy)]
-struct ArcFns {
-    s: f64,
-    s1: f64,
-    s2: f64,
-    b: f64,
-    b1: f64,
-    b2: f64,
-    c: f64,
-    c1: f64,
-}
-
-/// Coefficients `(-1)^k / (2k + n)!` of the series of `S` (`n = 1`), `B` (2) and `C` (3).
-const fn series_coefficients(n: u32) -> [f64; SERIES_TERMS] {
-    let mut c = [0.0; SERIES_TERMS];
-    let mut fact = 1.0;
-    let mut i = 2;
-    while i <= n {
-        fact *= i as f64;
-        i += 1;
-    }
-    c[0] = 1.0 / fact;
-    let mut k = 1;
-    while k < SERIES_TERMS {
-        let m = (2 * k as u32 + n) as f64;
-        c[k] = -c[k - 1] / ((m - 1.0) * m);
-        k += 1;
-    }
-    c
-}
-
-const SERIES_S: [f64; SERIES_TERMS] = series_coefficients(1);
-const SERIES_B: [f64; SERIES_TERMS] = series_coefficients(2);
-const SERIES_C: [f64; SERIES_TERMS] = series_coefficients(3);
-
-/// `Σ_k c_k x^k` and its first two derivatives, by Horner's rule.
-#[inline]
-fn series(c: &[f64; SERIES_TERMS], x: f64) -> (f64, f64, f64) {
-    let (mut f, mut f1, mut f2) = (0.0, 0.0, 0.0);
-    for k in (0..SERIES_TERMS).rev() {
-        let kf = k as f64;
-        f = f * x + c[k];
-        if k >= 1 {
-            f1 = f1 * x + kf * c[k];
-        }
-        if k >= 2 {
-            f2 = f2 * x + kf * (kf - 1.0) * c[k];
-        }
-    }
-    (f, f1, f2)
-}
-
-fn arc_fns(x: f64) -> ArcFns {
-    if x < SERIES_BOUND {
-        let (s, s1, s2) = series(&SERIES_S, x);
-        let (b, b1, b2) = series(&SERIES_B, x);
-        let (c, c1, _) = series(&SERIES_C, x);
-        return ArcFns {
-            s,
-            s1,
-            s2,
-            b,
-            b1,
-            b2,
-            c,
-            c1,
-        };
-    }
-    let th = x.sqrt();
-    let (sn, cs) = th.sin_cos();
-    let ix = 1.0 / x;
-    let s = sn / th;
-    let s1 = 0.5 * (cs - s) * ix;
-    let s2 = 0.5 * (-0.5 * s - 3.0 * s1) * ix;
-    let b = (1.0 - cs) * ix;
-    let b1 = (0.5 * s - b) * ix;
-    let b2 = (0.5 * s1 - 2.0 * b1) * ix;
-    let c = (1.0 - s) * ix;
-    let c1 = (-s1 - c) * ix;
-    ArcFns {
-        s,
-        s1,
-        s2,
-        b,
-        b1,
-        b2,
-        c,
-        c1,
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -538,34 +420,11 @@ fn check_vector(name: &str, v: &Vector3<f64>) -> Result<()> {
 }
 
 fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
-    let nt = robot.n_tendons();
-    let nc = robot.n_chambers();
-    if !(loads.tensions.is_empty() || loads.tensions.len() == nt) {
-        return Err(Error::invalid(
-            "tensions.len()",
-            loads.tensions.len(),
-            format!("the number of tendons, {nt} (or 0 for none)"),
-        ));
-    }
-    if !(loads.pressures.is_empty() || loads.pressures.len() == nc) {
-        return Err(Error::invalid(
-            "pressures.len()",
-            loads.pressures.len(),
-            format!("the number of chambers, {nc} (or 0 for none)"),
-        ));
-    }
-    for (i, &t) in loads.tensions.iter().enumerate() {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(Error::invalid(
-                format!("tensions[{i}]"),
-                t,
-                "finite and >= 0 N",
-            ));
-        }
-    }
-    for (i, &p) in loads.pressures.iter().enumerate() {
-        check_finite(&format!("pressures[{i}]"), p)?;
-    }
+    let (nt, nc) = (robot.n_tendons(), robot.n_chambers());
+    // The same inputs as the Cosserat statics, checked the same way.
+    crate::model::Actuation::tensions(&loads.tensions)
+        .with_pressures(&loads.pressures)
+        .validate(nt, nc)?;
     check_vector("tip_force", &loads.tip_force)?;
     check_vector("tip_moment", &loads.tip_moment)?;
     let mut actuation = vec![[0.0; 3]; robot.bodies.len()];
@@ -624,8 +483,6 @@ struct Work {
     blocks: Vec<Matrix3<f64>>,
     g: DVector<f64>,
     h: DMatrix<f64>,
-    /// Elimination scratch of the Newton step.
-    lu: Vec<f64>,
 }
 
 impl Work {
@@ -635,7 +492,6 @@ impl Work {
             blocks: Vec::new(),
             g: DVector::zeros(3 * n),
             h: DMatrix::zeros(0, 0),
-            lu: Vec::new(),
         }
     }
 }
@@ -724,54 +580,7 @@ fn evaluate(
         w.g[3 * i + 2] = ux * ga + uy * gb + gl;
     }
     if jacobian {
-        if w.h.nrows() != 3 * n {
-            w.blocks = vec![Matrix3::zeros(); n * n];
-            w.h = DMatrix::zeros(3 * n, 3 * n);
-        }
-        for (i, body) in robot.bodies.iter().enumerate() {
-            let l0 = body.rest_length();
-            let kb = body.bending_stiffness() / l0;
-            let ka = body.axial_stiffness().map_or(0.0, |ea| ea / l0);
-            for j in 0..n {
-                w.blocks[i * n + j] = if i == j {
-                    Matrix3::from_diagonal(&Vector3::new(kb, kb, ka))
-                } else {
-                    Matrix3::zeros()
-                };
-            }
-        }
-        if loaded {
-            load_stiffness(w, &f);
-        }
-        for i in 0..n {
-            let (uxi, uyi, li) = (q[i][0], q[i][1], q[i][2]);
-            for j in 0..n {
-                let (uxj, uyj, lj) = (q[j][0], q[j][1], q[j][2]);
-                let b = &w.blocks[i * n + j];
-                // B J: columns ℓ_j b0, ℓ_j b1, u_x b0 + u_y b1 + b2.
-                let mut bj = Matrix3::zeros();
-                for r in 0..3 {
-                    bj[(r, 0)] = lj * b[(r, 0)];
-                    bj[(r, 1)] = lj * b[(r, 1)];
-                    bj[(r, 2)] = uxj * b[(r, 0)] + uyj * b[(r, 1)] + b[(r, 2)];
-                }
-                // Jᵀ (B J): rows ℓ_i r0, ℓ_i r1, u_x r0 + u_y r1 + r2.
-                let mut blk = Matrix3::zeros();
-                for c in 0..3 {
-                    blk[(0, c)] = li * bj[(0, c)];
-                    blk[(1, c)] = li * bj[(1, c)];
-                    blk[(2, c)] = uxi * bj[(0, c)] + uyi * bj[(1, c)] + bj[(2, c)];
-                }
-                if i == j {
-                    let [ga, gb, _] = w.segs[i].g_theta;
-                    blk[(0, 2)] += ga;
-                    blk[(2, 0)] += ga;
-                    blk[(1, 2)] += gb;
-                    blk[(2, 1)] += gb;
-                }
-                w.h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&blk);
-            }
-        }
+        assemble_jacobian(robot, q, &f, loaded, w);
     }
     // Inextensible segments: the ℓ row is the constraint ℓ = ℓ0.
     for (i, body) in robot.bodies.iter().enumerate() {
@@ -788,6 +597,66 @@ fn evaluate(
         }
     }
     scaled
+}
+
+/// `∂g/∂q` in curvature-vector coordinates into `w.h`: the elastic blocks, the load stiffness
+/// of the tip wrench (force `f`, when `loaded`), mapped from `θ` coordinates.
+fn assemble_jacobian(
+    robot: &PccRobot,
+    q: &[[f64; 3]],
+    f: &Vector3<f64>,
+    loaded: bool,
+    w: &mut Work,
+) {
+    let n = q.len();
+    if w.h.nrows() != 3 * n {
+        w.blocks = vec![Matrix3::zeros(); n * n];
+        w.h = DMatrix::zeros(3 * n, 3 * n);
+    }
+    for (i, body) in robot.bodies.iter().enumerate() {
+        let l0 = body.rest_length();
+        let kb = body.bending_stiffness() / l0;
+        let ka = body.axial_stiffness().map_or(0.0, |ea| ea / l0);
+        for j in 0..n {
+            w.blocks[i * n + j] = if i == j {
+                Matrix3::from_diagonal(&Vector3::new(kb, kb, ka))
+            } else {
+                Matrix3::zeros()
+            };
+        }
+    }
+    if loaded {
+        load_stiffness(w, f);
+    }
+    for i in 0..n {
+        let (uxi, uyi, li) = (q[i][0], q[i][1], q[i][2]);
+        for j in 0..n {
+            let (uxj, uyj, lj) = (q[j][0], q[j][1], q[j][2]);
+            let b = &w.blocks[i * n + j];
+            // B J: columns ℓ_j b0, ℓ_j b1, u_x b0 + u_y b1 + b2.
+            let mut bj = Matrix3::zeros();
+            for r in 0..3 {
+                bj[(r, 0)] = lj * b[(r, 0)];
+                bj[(r, 1)] = lj * b[(r, 1)];
+                bj[(r, 2)] = uxj * b[(r, 0)] + uyj * b[(r, 1)] + b[(r, 2)];
+            }
+            // Jᵀ (B J): rows ℓ_i r0, ℓ_i r1, u_x r0 + u_y r1 + r2.
+            let mut blk = Matrix3::zeros();
+            for c in 0..3 {
+                blk[(0, c)] = li * bj[(0, c)];
+                blk[(1, c)] = li * bj[(1, c)];
+                blk[(2, c)] = uxi * bj[(0, c)] + uyi * bj[(1, c)] + bj[(2, c)];
+            }
+            if i == j {
+                let [ga, gb, _] = w.segs[i].g_theta;
+                blk[(0, 2)] += ga;
+                blk[(2, 0)] += ga;
+                blk[(1, 2)] += gb;
+                blk[(2, 1)] += gb;
+            }
+            w.h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&blk);
+        }
+    }
 }
 
 /// Adds `-∂(J_hᵀ W)/∂θ` (the load stiffness of the dead tip wrench) to `w.blocks`, from the
@@ -887,133 +756,64 @@ pub fn pcc_equilibrium(
     })
 }
 
-/// Outcome of the Newton iteration at one load factor.
-struct NewtonOut {
+/// The PCC equilibrium as a [`Problem`] in `(u_x, u_y, ℓ)` per segment (unknowns) with the
+/// tip load scaled by the load factor; its norm is the scaled residual.
+struct Equilibrium<'a> {
+    robot: &'a PccRobot,
+    prep: &'a Prepared,
+    work: Work,
     q: Vec<[f64; 3]>,
-    residual: f64,
-    converged: bool,
-    iterations: usize,
+    /// Scaled residual of the last evaluation.
+    scaled: f64,
+    evaluations: usize,
 }
 
-fn newton(
-    robot: &PccRobot,
-    prep: &Prepared,
-    q0: &[[f64; 3]],
-    factor: f64,
-    likely_exact: bool,
-    opts: &PccSolveOptions,
-    w: &mut Work,
-) -> NewtonOut {
-    let n = q0.len();
-    let mut q = q0.to_vec();
-    let mut trial = q.clone();
-    let mut dx = vec![0.0; 3 * n];
-    // Without a tip load the actuator-only start is exact: check it without the Jacobian.
-    let mut rn = evaluate(robot, prep, &q, factor, !likely_exact, w);
-    let mut out = NewtonOut {
-        q: q.clone(),
-        residual: rn,
-        converged: rn <= opts.tolerance,
-        iterations: 0,
-    };
-    if out.converged || !rn.is_finite() {
-        return out;
+impl Problem for Equilibrium<'_> {
+    fn dim(&self) -> usize {
+        3 * self.q.len()
     }
-    if likely_exact {
-        evaluate(robot, prep, &q, factor, true, w);
-    }
-    for _ in 0..opts.max_iterations {
-        if !solve_in_place(&w.h, &w.g, &mut w.lu, &mut dx) {
-            break;
-        }
-        let mut lambda = 1.0;
-        let mut accepted = false;
-        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
-            let mut ok = true;
-            for i in 0..n {
-                for c in 0..3 {
-                    trial[i][c] = q[i][c] + lambda * dx[3 * i + c];
-                }
-                ok &= trial[i][2] > 0.0;
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
+        let n = self.q.len();
+        for i in 0..n {
+            self.q[i] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
+            if self.q[i][2].is_nan() || self.q[i][2] <= 0.0 {
+                return Evaluated::Failed;
             }
-            if ok {
-                let rt = evaluate(robot, prep, &trial, factor, true, w);
-                if rt <= (1.0 - ARMIJO * lambda) * rn || rt <= opts.tolerance {
-                    q.copy_from_slice(&trial);
-                    rn = rt;
-                    accepted = true;
-                    break;
-                }
+        }
+        self.evaluations += 1;
+        let want = jacobian.is_some();
+        self.scaled = evaluate(self.robot, self.prep, &self.q, lambda, want, &mut self.work);
+        r.copy_from_slice(self.work.g.as_slice());
+        if !self.scaled.is_finite() {
+            return Evaluated::Failed;
+        }
+        match jacobian {
+            Some(j) => {
+                j.copy_from_slice(self.work.h.as_slice());
+                Evaluated::Jacobian
             }
-            lambda *= 0.5;
-        }
-        if !accepted {
-            // Restore the workspace to the last accepted iterate.
-            evaluate(robot, prep, &q, factor, true, w);
-            break;
-        }
-        out.iterations += 1;
-        if rn <= opts.tolerance {
-            out.converged = true;
-            break;
+            None => Evaluated::Residual,
         }
     }
-    out.q = q;
-    out.residual = rn;
-    out
+
+    fn norm(&self, _r: &[f64]) -> f64 {
+        self.scaled
+    }
 }
 
-/// Solves `h dx = -g` by Gaussian elimination with partial pivoting in the scratch `lu`
-/// (column-major copy of `h`; no allocation after the first call). Returns `false` if `h` is
-/// singular or the step is not finite.
-fn solve_in_place(h: &DMatrix<f64>, g: &DVector<f64>, lu: &mut Vec<f64>, dx: &mut [f64]) -> bool {
-    let n = g.len();
-    lu.clear();
-    lu.extend_from_slice(h.as_slice());
-    for (d, gv) in dx.iter_mut().zip(g.iter()) {
-        *d = -gv;
-    }
-    for k in 0..n {
-        let (mut piv, mut best) = (k, lu[k + k * n].abs());
-        for r in k + 1..n {
-            let v = lu[r + k * n].abs();
-            if v > best {
-                piv = r;
-                best = v;
-            }
-        }
-        if !(best > 0.0 && best.is_finite()) {
-            return false;
-        }
-        if piv != k {
-            for c in k..n {
-                lu.swap(k + c * n, piv + c * n);
-            }
-            dx.swap(k, piv);
-        }
-        let inv = 1.0 / lu[k + k * n];
-        for r in k + 1..n {
-            let f = lu[r + k * n] * inv;
-            if f != 0.0 {
-                for c in k + 1..n {
-                    lu[r + c * n] -= f * lu[k + c * n];
-                }
-                dx[r] -= f * dx[k];
-            }
-        }
-    }
-    for k in (0..n).rev() {
-        let mut v = dx[k];
-        for c in k + 1..n {
-            v -= lu[k + c * n] * dx[c];
-        }
-        dx[k] = v / lu[k + k * n];
-    }
-    dx.iter().all(|v| v.is_finite())
+fn flat(q: &[[f64; 3]]) -> Vec<f64> {
+    q.iter().flatten().copied().collect()
 }
 
 fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
-    check_newton_options(opts.tolerance, opts.max_iterations, opts.max_load_steps)?;
+    opts.newton.validate()?;
     if let Some(ws) = &opts.warm_start {
         if ws.len() != robot.bodies.len() {
             return Err(Error::invalid(
@@ -1092,54 +892,70 @@ pub fn solve_pcc_statics(
             .collect(),
         None => q_act.clone(),
     };
-    let mut w = Work::new(n);
-    let mut stats = PccSolverStats::default();
+    let mut p = Equilibrium {
+        robot,
+        prep: &prep,
+        work: Work::new(n),
+        q: q0.clone(),
+        scaled: f64::INFINITY,
+        evaluations: 0,
+    };
+    let opts = &options.newton;
+    let mut stats = SolverStats {
+        load_factor: 1.0,
+        ..SolverStats::default()
+    };
     let unloaded = prep.force == Vector3::zeros() && prep.moment == Vector3::zeros();
-    let likely_exact = unloaded && options.warm_start.is_none();
-    let mut result = newton(robot, &prep, &q0, 1.0, likely_exact, options, &mut w);
+    let settings = NewtonSettings {
+        line_search: LineSearch {
+            factor: 0.5,
+            max_halvings: MAX_LINE_SEARCH_HALVINGS,
+        },
+        condition: Armijo::default(),
+        first_step_limit: None,
+        // Without a tip load the actuator-only start is exact: check it without the Jacobian.
+        residual_first: unloaded && options.warm_start.is_none(),
+        broyden: false,
+        jacobian: None,
+    };
+    let mut result = newton(&mut p, &flat(&q0), 1.0, opts, &settings);
     stats.iterations = result.iterations;
-    if !result.converged && options.continuation {
-        let (mut lambda, mut dl) = (0.0f64, 0.25f64);
-        let mut q = q_act;
-        let mut steps = 0usize;
-        let mut last = None;
-        while steps < options.max_load_steps {
-            let target = (lambda + dl).min(1.0);
-            let out = newton(robot, &prep, &q, target, false, options, &mut w);
-            stats.iterations += out.iterations;
-            steps += 1;
-            if out.converged {
-                lambda = target;
-                q.clone_from(&out.q);
-                let done = lambda >= 1.0;
-                last = Some(out);
-                if done {
-                    break;
-                }
-                dl = (dl * 2.0).min(0.5);
-            } else {
-                dl *= 0.5;
-                if dl < MIN_LOAD_INCREMENT {
-                    break;
-                }
-            }
-        }
-        stats.load_steps = steps;
-        if let Some(out) = last.filter(|_| lambda >= 1.0) {
-            result = out;
+    if !result.converged && opts.continuation {
+        let x_act = flat(&q_act);
+        let start = ContinuationSettings {
+            x0: &x_act,
+            jacobian0: None,
+            first_increment: 0.25,
+            max_increment: 0.5,
+        };
+        let c = continuation(
+            &mut p,
+            &start,
+            opts,
+            &NewtonSettings {
+                residual_first: false,
+                ..settings
+            },
+        );
+        stats.iterations += c.iterations;
+        stats.load_steps = c.steps;
+        stats.load_factor = c.load_factor;
+        if c.load_factor >= 1.0 {
+            result = c.outcome;
         }
     }
     stats.residual = result.residual;
     stats.converged = result.converged;
-    if !result.converged && options.throw {
+    stats.function_evaluations = p.evaluations;
+    if !result.converged && opts.throw {
         return Err(Error::NotConverged {
             what: "PCC statics Newton".into(),
             iterations: stats.iterations,
             residual: result.residual,
         });
     }
-    let segments = result
-        .q
+    let q: Vec<[f64; 3]> = result.x.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let segments = q
         .iter()
         .map(|qi| PccSegment::from_curvature_vector(qi[0], qi[1], qi[2]))
         .collect::<Result<Vec<_>>>()?;
@@ -1147,7 +963,7 @@ pub fn solve_pcc_statics(
         .tendons
         .iter()
         .map(|t| {
-            result.q[..=t.last_segment]
+            q[..=t.last_segment]
                 .iter()
                 .map(|qi| {
                     let (a, b) = (qi[2] * qi[0], qi[2] * qi[1]);

@@ -10,9 +10,9 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::{check_positive, Error, Result};
-use crate::material::Material;
-use crate::section::{Section, SectionProperties};
-use crate::so3::orthonormality_error;
+use crate::math::so3::orthonormality_error;
+use crate::model::material::Material;
+use crate::model::section::{Section, SectionProperties};
 
 /// Tolerance on `|RᵀR - I|` and `|det R - 1|` when a user gives a rotation matrix.
 pub const ROTATION_TOLERANCE: f64 = 1e-9;

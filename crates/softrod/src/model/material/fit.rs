@@ -21,7 +21,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::{check_positive, Error, Result};
-use crate::hyperelastic::{
+use crate::model::material::hyperelastic::{
     check_stretch, ogden_term, Linearised, MooneyRivlin, NeoHookean, Ogden, UniaxialLaw,
     UniaxialModel, Yeoh,
 };
@@ -566,8 +566,7 @@ fn fit_ogden(data: &UniaxialData, terms: usize, options: &FitOptions) -> Result<
             options,
             &solve_mu,
             &unit,
-            &logs,
-            &factor,
+            (&logs, &factor),
             (c0, mu, alpha),
         ) {
             Ok((c, mu, alpha, it)) => {
@@ -607,8 +606,7 @@ fn ogden_lm(
     options: &FitOptions,
     solve_mu: &MuSolver<'_>,
     unit: &dyn Fn(f64, usize) -> f64,
-    logs: &[f64],
-    factor: &[f64],
+    (logs, factor): (&[f64], &[f64]),
     start: (f64, Vec<f64>, Vec<f64>),
 ) -> Result<(f64, Vec<f64>, Vec<f64>, usize)> {
     let n = data.len();

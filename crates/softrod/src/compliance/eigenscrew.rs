@@ -2,7 +2,7 @@
 //! ellipsoids.
 //!
 //! With twists `t = [δp; δθ]`, wrenches `w = [f; m]` and `Δ = [[0, I], [I, 0]]`
-//! ([`crate::se3::delta`]), an **eigenscrew** of a stiffness `K` is a twist `ξ` that `K` maps
+//! ([`crate::math::se3::delta`]), an **eigenscrew** of a stiffness `K` is a twist `ξ` that `K` maps
 //! to a wrench on the same screw axis: `K ξ = κ Δ ξ` (Patterson & Lipkin 1993). For a
 //! symmetric positive definite `K = L Lᵀ` these are `ξ = L⁻ᵀ η` with `η` the eigenvectors of
 //! the symmetric `L⁻¹ Δ L⁻ᵀ` (eigenvalues `1/κ`): six real eigenstiffnesses, three positive
@@ -22,7 +22,7 @@
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use crate::error::{Error, Result};
-use crate::se3::delta;
+use crate::math::se3::delta;
 
 /// Which matrix is decomposed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -8,13 +8,14 @@
 
 use rayon::prelude::*;
 
+use std::sync::Arc;
+
+use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::compliance::{tangent_compliance, tip_compliance_world, TendonControl};
-use crate::eigenscrew::{eigenscrews, MatrixKind};
+use crate::cosserat::statics::{solve_statics, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
-use crate::loads::Loads;
-use crate::rod::Rod;
-use crate::statics::{solve_statics, SolveOptions};
-use crate::tendon::Tendon;
+use crate::math::linalg::invert_spd;
+use crate::model::{Actuation, RobotModel};
 
 /// Default number of samples per warm-started chunk.
 pub const DEFAULT_CHUNK: usize = 64;
@@ -54,26 +55,24 @@ impl WorkspaceSample {
     }
 }
 
-/// Solves `rod` with `tendons` and `loads` for every row of `tensions` (row-major,
-/// `n_samples × tendons.len()`, N), replacing the tendons' tensions, and measures the tip
-/// compliance. `chunk` samples (>= 1) are solved in order per thread with warm starts.
-/// With `tangent`, the exact tangent tip compliance (tendons at fixed tension or length) is
-/// computed too (about four times the cost of a tendon-only solve).
+/// Solves `model` for every row of `tensions` (row-major, `n_samples × n_tendons`, N), with
+/// the chamber pressures of `base` (Pa) in every sample, and measures the tip compliance.
+/// `chunk` samples (>= 1) are solved in order per thread with warm starts. With `tangent`, the
+/// exact tangent tip compliance (tendons at fixed tension or length) is computed too.
 /// Non-converged samples are reported with `converged == false`.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] if `tensions.len()` is not a multiple of the number of tendons,
 /// a tension is negative or not finite, `chunk == 0`, or the problem data are invalid.
 pub fn workspace_map(
-    rod: &Rod,
-    tendons: &[Tendon],
-    loads: &Loads,
+    model: &Arc<RobotModel>,
+    base: &Actuation,
     tensions: &[f64],
     options: &SolveOptions,
     chunk: usize,
     tangent: Option<TendonControl>,
 ) -> Result<Vec<WorkspaceSample>> {
-    let nt = tendons.len();
+    let nt = model.tendons().len();
     if nt == 0 || tensions.len() % nt != 0 {
         return Err(Error::invalid(
             "tensions",
@@ -93,46 +92,29 @@ pub fn workspace_map(
             ));
         }
     }
+    let pressures = base.pressure_values(model.chambers().len());
+    let actuation = |row: &[f64]| Actuation::tensions(row).with_pressures(&pressures);
     // Validate the problem once (errors here are the user's, not a sample's).
-    let probe: Vec<Tendon> = tendons
-        .iter()
-        .zip(&tensions[..nt])
-        .map(|(t, &tau)| t.with_tension(tau))
-        .collect::<Result<_>>()?;
-    solve_statics(
-        rod,
-        &probe,
-        loads,
-        &SolveOptions {
-            throw: false,
-            ..*options
-        },
-    )?;
+    let mut quiet = *options;
+    quiet.newton.throw = false;
+    solve_statics(model, &actuation(&tensions[..nt]), &quiet)?;
     let rows: Vec<&[f64]> = tensions.chunks(nt).collect();
     let out: Vec<Vec<WorkspaceSample>> = rows
         .par_chunks(chunk)
         .map(|block| {
             let mut warm = None;
             let mut local = Vec::with_capacity(block.len());
-            let mut ts: Vec<Tendon> = tendons.to_vec();
             for row in block {
-                for (t, &tau) in ts.iter_mut().zip(row.iter()) {
-                    if let Ok(n) = t.with_tension(tau) {
-                        *t = n;
-                    }
-                }
                 let opts = SolveOptions {
                     warm_start: warm,
-                    throw: false,
-                    ..*options
+                    ..quiet
                 };
-                let sample = match solve_statics(rod, &ts, loads, &opts) {
+                let sample = match solve_statics(model, &actuation(row), &opts) {
                     Ok(sol) if sol.stats.converged => {
                         warm = Some(sol.warm_start());
-                        let mut m = measure(rod, &sol);
+                        let mut m = measure(&sol);
                         if let Some(ctl) = tangent {
-                            let t = tangent_compliance(rod, &ts, loads, &sol, &opts, ctl, None);
-                            if let Ok(t) = t {
+                            if let Ok(t) = tangent_compliance(&sol, ctl, None) {
                                 let b = t.world.fixed_view::<3, 3>(0, 0).into_owned();
                                 let b = (b + b.transpose()) * 0.5;
                                 m.tangent_max_translational_compliance =
@@ -151,12 +133,12 @@ pub fn workspace_map(
     Ok(out.into_iter().flatten().collect())
 }
 
-fn measure(rod: &Rod, sol: &crate::statics::StaticsSolution) -> WorkspaceSample {
-    let Ok(c) = tip_compliance_world(rod, sol) else {
+fn measure(sol: &StaticsSolution) -> WorkspaceSample {
+    let Ok(c) = tip_compliance_world(sol) else {
         return WorkspaceSample::failed();
     };
     let ctt = c.fixed_view::<3, 3>(0, 0).into_owned().symmetric_eigen();
-    let (kmat, condition) = crate::compliance::invert_spd(&c);
+    let (kmat, condition) = invert_spd(&c);
     let mut eig = [f64::NAN; 6];
     if let Ok(d) = eigenscrews(&kmat, MatrixKind::Stiffness) {
         for (k, s) in d.screws.iter().enumerate() {

@@ -9,7 +9,7 @@
 //!
 //! # Hyperelastic rods
 //! [`Material::Hyperelastic`] holds an incompressible uniaxial law (nominal stress `P(λ)`, see
-//! [`crate::hyperelastic`]) and integrates it over the section as a *fibre section*: with
+//! [`crate::model::material::hyperelastic`]) and integrates it over the section as a *fibre section*: with
 //! rigid cross-sections (the Cosserat kinematics that also places tendons and chambers), the
 //! material fibre at the reference offset `r = (X, Y)` has the stretch
 //! `λ_f = 1 + (v_z - v*_z) + (κ × r)_z = λ + κ_x Y - κ_y X` (`κ = u - u*`), carries the axial
@@ -41,11 +41,15 @@
 //! E. Spacone, F. C. Filippou, F. F. Taucer, "Fibre beam-column model for non-linear analysis
 //! of R/C frames", Earthq. Eng. Struct. Dyn. 25(7), 1996 (fibre sections).
 
+pub mod fit;
+pub mod hyperelastic;
+pub mod silicone;
+
 use nalgebra::{Matrix6, Vector6};
 
 use crate::error::{check_positive, Error, Result};
-use crate::hyperelastic::{UniaxialLaw, UniaxialModel};
-use crate::section::SectionProperties;
+use crate::model::material::hyperelastic::{UniaxialLaw, UniaxialModel};
+use crate::model::section::SectionProperties;
 
 /// Isotropic linear elastic material (`LinearElastic(youngs_modulus, poisson_ratio)`).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -40,7 +40,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use crate::error::{check_finite, check_non_negative, check_positive, Error, Result};
-use crate::rod::{Rod, FUNCTION_CHECKS};
+use crate::model::rod::{Rod, FUNCTION_CHECKS};
 
 /// Standard atmospheric pressure (Pa): the lowest gauge pressure a chamber can hold (vacuum).
 pub const ATMOSPHERIC_PRESSURE: f64 = 101_325.0;
@@ -66,40 +66,41 @@ impl fmt::Debug for ChamberArea {
     }
 }
 
-/// One pneumatic chamber (`Chamber(pressure, area, offset, start=0, end=None)` in Python).
+/// One pneumatic chamber: cavity geometry (`Chamber(pressure, area, offset, start=0, end=None)`
+/// in Python, where the pressure becomes the actuation input).
 #[derive(Clone, Debug)]
 pub struct Chamber {
-    pressure: f64,
     area: ChamberArea,
     offset: [f64; 2],
     start: f64,
     end: Option<f64>,
 }
 
+/// Checks a gauge pressure (Pa): finite and `>= -`[`ATMOSPHERIC_PRESSURE`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name`.
+pub fn check_pressure(name: &str, pressure: f64) -> Result<f64> {
+    check_finite(name, pressure)?;
+    if pressure < -ATMOSPHERIC_PRESSURE {
+        return Err(Error::invalid(
+            name,
+            pressure,
+            format!(">= -{ATMOSPHERIC_PRESSURE} Pa (gauge; below is more than vacuum)"),
+        ));
+    }
+    Ok(pressure)
+}
+
 impl Chamber {
-    /// A chamber at gauge `pressure` (Pa, >= -[`ATMOSPHERIC_PRESSURE`]) with cross-section
-    /// `area` (m²), centroid `offset` (m, body frame) and extent `[start, end]` (m; `end =
-    /// None` for the tip). That the extent lies in `[0, L]` and the chamber inside the section
-    /// is checked when solving.
+    /// A chamber with cross-section `area` (m²), centroid `offset` (m, body frame) and extent
+    /// `[start, end]` (m; `end = None` for the tip). That the extent lies in `[0, L]` and the
+    /// chamber inside the section is checked when the robot model is built.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `pressure`, `area`, `offset[k]`, `start` (finite,
-    /// >= 0) or `end` (finite, > start).
-    pub fn new(
-        pressure: f64,
-        area: ChamberArea,
-        offset: [f64; 2],
-        start: f64,
-        end: Option<f64>,
-    ) -> Result<Self> {
-        check_finite("pressure", pressure)?;
-        if pressure < -ATMOSPHERIC_PRESSURE {
-            return Err(Error::invalid(
-                "pressure",
-                pressure,
-                format!(">= -{ATMOSPHERIC_PRESSURE} Pa (gauge; below is more than vacuum)"),
-            ));
-        }
+    /// [`Error::InvalidParameter`] naming `area`, `offset[k]`, `start` (finite, >= 0) or `end`
+    /// (finite, > start).
+    pub fn new(area: ChamberArea, offset: [f64; 2], start: f64, end: Option<f64>) -> Result<Self> {
         if let ChamberArea::Constant(a) = area {
             check_positive("area", a, "m^2")?;
         }
@@ -117,7 +118,6 @@ impl Chamber {
             }
         }
         Ok(Self {
-            pressure,
             area,
             offset,
             start,
@@ -129,36 +129,10 @@ impl Chamber {
     ///
     /// # Errors
     /// As [`Chamber::new`].
-    pub fn constant(pressure: f64, area: f64, offset: [f64; 2]) -> Result<Self> {
-        Self::new(pressure, ChamberArea::Constant(area), offset, 0.0, None)
+    pub fn constant(area: f64, offset: [f64; 2]) -> Result<Self> {
+        Self::new(ChamberArea::Constant(area), offset, 0.0, None)
     }
 
-    /// The same chamber at another gauge pressure (Pa).
-    ///
-    /// # Errors
-    /// As [`Chamber::new`] for `pressure`.
-    pub fn with_pressure(&self, pressure: f64) -> Result<Self> {
-        Self::new(
-            pressure,
-            self.area.clone(),
-            self.offset,
-            self.start,
-            self.end,
-        )
-    }
-
-    /// The same chamber over `[start, end]` (m; `None`: the tip).
-    ///
-    /// # Errors
-    /// As [`Chamber::new`] for `start` and `end`.
-    pub fn with_extent(&self, start: f64, end: Option<f64>) -> Result<Self> {
-        Self::new(self.pressure, self.area.clone(), self.offset, start, end)
-    }
-
-    /// Gauge pressure (Pa).
-    pub fn pressure(&self) -> f64 {
-        self.pressure
-    }
     /// Cross-section area.
     pub fn area(&self) -> &ChamberArea {
         &self.area
@@ -185,17 +159,11 @@ impl Chamber {
         }
     }
 
-    /// Axial force `p A_c(s)` (N) the pressure exerts on a cap of the chamber at `s`.
-    #[inline]
-    pub fn cap_force(&self, s: f64) -> f64 {
-        self.pressure * self.area_at(s)
-    }
-
     /// Body-frame wrench `[-p A_c e_z; -p A_c r_c × e_z]` carried across the section at `s` by
-    /// the fluid, with the pressure scaled by `factor`.
+    /// the fluid at gauge `pressure` (Pa).
     #[inline]
-    pub(crate) fn fluid_wrench(&self, s: f64, factor: f64) -> [f64; 6] {
-        let f = -self.cap_force(s) * factor;
+    pub(crate) fn fluid_wrench(&self, s: f64, pressure: f64) -> [f64; 6] {
+        let f = -pressure * self.area_at(s);
         let [x, y] = self.offset;
         // r × e_z = (y, -x, 0).
         [0.0, 0.0, f, f * y, -f * x, 0.0]

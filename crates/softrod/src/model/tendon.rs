@@ -1,7 +1,7 @@
-//! Tendons: routing, tension and termination.
+//! Tendons: routing and termination (the tension is an input, see [`crate::model::actuation`]).
 //!
 //! A tendon runs through the rod at the body-frame offset `r(s) = (x(s), y(s), 0)` from the
-//! backbone (m), from the base (where it is pulled with `tension`, N) to its termination `end`
+//! backbone (m), from the base (where it is pulled, see [`crate::model::Actuation`]) to its termination `end`
 //! (m), where it is fixed to the rod. Its path is `p_i(s) = p(s) + R(s) r(s)`. It loads the
 //! rod as in Rucker & Webster (2011): a distributed force from the curvature of its path, and a
 //! point force and moment at its termination; see `cosserat.rs` for how the solver applies
@@ -16,7 +16,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use crate::error::{check_non_negative, check_positive, Error, Result};
-use crate::section::SectionProperties;
+use crate::model::section::SectionProperties;
 
 /// A user function `s (m) -> (x, y)` (m, body frame); it must be thread-safe.
 pub type OffsetFn = Arc<dyn Fn(f64) -> [f64; 2] + Send + Sync>;
@@ -101,24 +101,23 @@ impl Routing {
     }
 }
 
-/// One tendon (`Tendon(offset, tension, end=None)` in Python).
+/// One tendon: routing and termination (`Tendon(offset, tension, end=None)` in Python, where
+/// the tension becomes the actuation input).
 #[derive(Clone, Debug)]
 pub struct Tendon {
     routing: Routing,
-    tension: f64,
     end: Option<f64>,
 }
 
 impl Tendon {
-    /// A tendon with the given routing, `tension` (N, >= 0) and termination `end` (m, in
-    /// `(0, L]`; `None` for the tip). `end <= L` is checked when solving.
+    /// A tendon with the given routing and termination `end` (m, in `(0, L]`; `None` for the
+    /// tip). `end <= L` is checked when the robot model is built.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `tension` (not finite or negative), `end` (not
-    /// finite or <= 0), or the routing parameter that is invalid (`ratio`, `angle`, `radius`,
-    /// `pitch`, `phase`, `offset`: not finite; `radius`, `ratio` negative; `pitch` zero).
-    pub fn new(routing: Routing, tension: f64, end: Option<f64>) -> Result<Self> {
-        check_non_negative("tension", tension, "N")?;
+    /// [`Error::InvalidParameter`] naming `end` (not finite or <= 0), or the routing parameter
+    /// that is invalid (`ratio`, `angle`, `radius`, `pitch`, `phase`, `offset`: not finite;
+    /// `radius`, `ratio` negative; `pitch` zero).
+    pub fn new(routing: Routing, end: Option<f64>) -> Result<Self> {
         if let Some(e) = end {
             check_positive("end", e, "m")?;
         }
@@ -155,44 +154,23 @@ impl Tendon {
             }
             Routing::Function { .. } => {}
         }
-        Ok(Self {
-            routing,
-            tension,
-            end,
-        })
+        Ok(Self { routing, end })
     }
 
     /// Tendon at the constant offset `(x, y)` (m).
     ///
     /// # Errors
     /// As [`Tendon::new`].
-    pub fn constant(offset: [f64; 2], tension: f64, end: Option<f64>) -> Result<Self> {
-        Self::new(Routing::Constant(offset), tension, end)
+    pub fn constant(offset: [f64; 2], end: Option<f64>) -> Result<Self> {
+        Self::new(Routing::Constant(offset), end)
     }
 
     /// Routing.
     pub fn routing(&self) -> &Routing {
         &self.routing
     }
-    /// Tension (N).
-    pub fn tension(&self) -> f64 {
-        self.tension
-    }
     /// Termination (m), `None` for the tip.
     pub fn end(&self) -> Option<f64> {
         self.end
-    }
-
-    /// The same tendon with another tension (N).
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] naming `tension` if not finite or negative.
-    pub fn with_tension(&self, tension: f64) -> Result<Self> {
-        check_non_negative("tension", tension, "N")?;
-        Ok(Self {
-            routing: self.routing.clone(),
-            tension,
-            end: self.end,
-        })
     }
 }

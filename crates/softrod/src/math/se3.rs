@@ -20,7 +20,7 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use crate::so3::hat;
+use crate::math::so3::hat;
 
 /// Adjoint `Ad_g = [[R, p̂ R], [0, R]]` of the pose `g = (R, p)` (twists `[δp; δθ]`).
 #[inline]
@@ -93,7 +93,7 @@ pub fn delta() -> Matrix6<f64> {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
-    use crate::so3::exp_so3;
+    use crate::math::so3::exp_so3;
 
     #[test]
     fn adjoint_is_a_group_homomorphism_and_preserves_work() {

@@ -1,0 +1,471 @@
+//! Configuration-dependent compliance and stiffness along a solved rod (seed 001).
+//!
+//! Conventions ([`crate::math::se3`]): twists `[δp; δθ]`, wrenches `[f; m]`, `t = C w`, `w = K t`.
+//! At a node `s` the **world** compliance relates a wrench applied at the node's position with
+//! world components to the node's twist in world components (`δθ` with `δR = δθ̂ R`); the
+//! **body** compliance does the same in the node's body axes (`δR = R δθ̂`):
+//! `C_body = blockdiag(Rᵀ, Rᵀ) C_world blockdiag(R, R)`.
+//!
+//! * [`element_compliance`]: `c(s) = diag[1/(kGA), 1/(kGA), 1/(EA), 1/(EIx), 1/(EIy), 1/(GJ)]`
+//!   (seed eq. 1 with the torsion erratum), the material's tangent at the solved wrench.
+//! * [`compliance`]: the seed's integrated compliance (eqs. 6–7), the serial sum of the
+//!   element compliances frozen in the solved configuration,
+//!   `C_world(s) = ∫₀ˢ Ad_{h(σ)} c(σ) Ad_{h(σ)}ᵀ dσ`, `h(σ) = (R(σ), p(σ) - p(s))`.
+//!   Since `Ad_{h(σ)} = Ad_{(I, p(0) - p(s))} Ad_{(R(σ), p(σ) - p(0))}`, one cumulative
+//!   integral `Q(s) = ∫₀ˢ Ad_{(R, p - p(0))} c Ad_{(R, p - p(0))}ᵀ dσ` gives every node:
+//!   `C_world(s) = Ad_{(I, p(0) - p(s))} Q(s) Ad_{(I, p(0) - p(s))}ᵀ`. The integrand does not
+//!   feed back into the kinematics, so instead of appending it to the ODE state (which would
+//!   re-run the constitutive solves) it is integrated on the solved mesh by a fourth-order
+//!   cumulative quadrature (per panel, the cubic through the four nearest nodes of the same
+//!   interval): the same order as RK4, exact for the straight rod, and free of new solves.
+//!   [`compliance`] and [`pcc_compliance`] both build a [`Configuration`] (nodes with arc
+//!   length, pose and element compliance) and call the same integration: the PCC path samples
+//!   the arcs of a [`PccStaticsSolution`] with the rod's section and material.
+//! * [`tangent_compliance`]: the exact tangent of the loaded, actuated equilibrium, from the
+//!   linearised boundary-value problem (variational equations of the shooting method, plus
+//!   columns for the applied wrench and, with tendons held at fixed length, for the tensions
+//!   and the path lengths), after Oliver-Butler, Till & Rucker (2019).
+//! * [`gamma_c`]: the dimensionless flexural compliance.
+//!
+//! # References
+//! K. Oliver-Butler, J. Till, C. Rucker, "Continuum robot stiffness under external loads and
+//! prescribed tendon displacements", IEEE Trans. Robotics 35(2), 2019.
+
+use nalgebra::{Matrix3, Matrix6, Vector3};
+
+use crate::cosserat::statics::StaticsSolution;
+use crate::error::{Error, Result};
+use crate::math::linalg::invert_spd;
+use crate::math::so3::hat;
+use crate::model::rod::Rod;
+use crate::pcc::statics::{PccRobot, PccStaticsSolution};
+
+/// The integrated compliance and stiffness at every node of a solution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Compliance {
+    /// Undeformed arc length of each node (m), as in the solution (break nodes twice).
+    pub s: Vec<f64>,
+    /// Element compliance `c(s)` (body; 1/N for the first three, 1/(N m²) for the last three).
+    pub element: Vec<[f64; 6]>,
+    /// `C_world(s)` (m/N, 1/N, rad/(N m) blocks), twist `[δp; δθ]` = C `[f; m]`.
+    pub world: Vec<Matrix6<f64>>,
+    /// `C_body(s)`.
+    pub body: Vec<Matrix6<f64>>,
+    /// Dimensionless flexural compliance per body axis (see [`gamma_c`]).
+    pub gamma_c: Vec<[f64; 3]>,
+}
+
+impl Compliance {
+    /// Compliance at the tip, world frame.
+    pub fn tip_world(&self) -> Matrix6<f64> {
+        self.world
+            .last()
+            .copied()
+            .unwrap_or(Matrix6::repeat(f64::NAN))
+    }
+    /// Compliance at the tip, body frame.
+    pub fn tip_body(&self) -> Matrix6<f64> {
+        self.body
+            .last()
+            .copied()
+            .unwrap_or(Matrix6::repeat(f64::NAN))
+    }
+    /// `K_world = C_world⁻¹` at every node where `C_world` is positive definite, NaN
+    /// otherwise (e.g. at `s = 0`, or with shear and stretch off), with the 1-norm condition
+    /// number `‖C‖₁ ‖K‖₁` of `C_world` (SI units; infinite where not positive definite).
+    /// Computed on demand (Cholesky per node).
+    pub fn stiffness_world(&self) -> (Vec<Matrix6<f64>>, Vec<f64>) {
+        self.world.iter().map(invert_spd).unzip()
+    }
+    /// `K_body = C_body⁻¹` at every node (NaN where not positive definite); the condition
+    /// numbers are those of [`Compliance::stiffness_world`] (the frames differ by a rotation).
+    pub fn stiffness_body(&self) -> Vec<Matrix6<f64>> {
+        self.body.iter().map(|c| invert_spd(c).0).collect()
+    }
+}
+
+/// Element compliance `c(s)` at every node: the material's tangent compliance at the solved
+/// body wrench of the rod (same shear coefficient as the statics).
+pub fn element_compliance(solution: &StaticsSolution) -> Vec<[f64; 6]> {
+    let rod = solution.model.rod();
+    let k = rod.shear_coefficient();
+    solution
+        .s
+        .iter()
+        .enumerate()
+        .map(|(i, &s)| {
+            let (n, m) = (solution.n_body[i], solution.m_body[i]);
+            let wb = [n[0], n[1], n[2], m[0], m[1], m[2]];
+            rod.material()
+                .elastic_strain(&rod.section_at(s), k, rod.inextensible(), &wb)
+                .1
+        })
+        .collect()
+}
+
+/// Nodes and weights (`m` of them) of the fourth-order integral over the panel
+/// `[x_j, x_{j+1}]` of the cubic through the (up to) four nearest nodes.
+fn panel_weights(x: &[f64], j: usize) -> ([usize; 4], [f64; 4], usize) {
+    const G: [(f64, f64); 3] = [
+        (0.112_701_665_379_258_31, 5.0 / 18.0),
+        (0.5, 8.0 / 18.0),
+        (0.887_298_334_620_741_7, 5.0 / 18.0),
+    ];
+    let n = x.len();
+    let m = n.min(4);
+    let start = j.saturating_sub(1).min(n - m);
+    let mut nodes = [0usize; 4];
+    let mut weights = [0.0f64; 4];
+    for k in 0..m {
+        nodes[k] = start + k;
+    }
+    let (a, b) = (x[j], x[j + 1]);
+    for k in 0..m {
+        let i = nodes[k];
+        let mut w = 0.0;
+        for (c, g) in G {
+            let t = a + c * (b - a);
+            let mut l = 1.0;
+            for &q in &nodes[..m] {
+                if q != i {
+                    l *= (t - x[q]) / (x[i] - x[q]);
+                }
+            }
+            w += g * (b - a) * l;
+        }
+        weights[k] = w;
+    }
+    (nodes, weights, m)
+}
+
+/// `blockdiag(Rᵀ, Rᵀ) M blockdiag(R, R)` (world to body components of a 6×6 compliance or
+/// stiffness), block by block; exactly symmetric.
+fn rotate_blocks(m: &Matrix6<f64>, r: &Matrix3<f64>) -> Matrix6<f64> {
+    let rt = r.transpose();
+    let b = |i: usize, j: usize| rt * m.fixed_view::<3, 3>(i, j) * r;
+    blocks(&b(0, 0), &b(0, 3), &b(3, 3))
+}
+
+/// The symmetric matrix `[[tt, tr], [trᵀ, rr]]` (symmetrising the diagonal blocks).
+fn blocks(tt: &Matrix3<f64>, tr: &Matrix3<f64>, rr: &Matrix3<f64>) -> Matrix6<f64> {
+    let mut m = Matrix6::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&((tt + tt.transpose()) * 0.5));
+    m.fixed_view_mut::<3, 3>(0, 3).copy_from(tr);
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&tr.transpose());
+    m.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&((rr + rr.transpose()) * 0.5));
+    m
+}
+
+/// The integrated compliance at the last node only (world frame, at the tip), without the
+/// per-node inverses: the cheap path of [`crate::batch::workspace::workspace_map`].
+pub fn tip_compliance_world(solution: &StaticsSolution) -> Result<Matrix6<f64>> {
+    compliance_matrices(&Configuration::from_statics(solution)?, true).map(|(w, _)| w[w.len() - 1])
+}
+
+/// Dimensionless flexural compliance `γ_c = diag(C_body,tt) · 3 E I(0) / L³` per body axis
+/// `(x, y, z)`: the three translational diagonal entries of the body compliance scaled by the
+/// base bending stiffness `E I(0) = E min(Ix, Iy)` at `s = 0` and the total undeformed length
+/// `L`. A straight uniform Euler–Bernoulli cantilever has `γ_c = (1, 1, ·)` at its tip.
+pub fn gamma_c(rod: &Rod, body: &Matrix6<f64>) -> [f64; 3] {
+    let l = rod.length();
+    let ei = rod.material().bending_stiffness(&rod.section_at(0.0));
+    let k = 3.0 * ei / (l * l * l);
+    [body[(0, 0)] * k, body[(1, 1)] * k, body[(2, 2)] * k]
+}
+
+/// Largest bending angle per quadrature panel (rad) of the PCC path ([`pcc_compliance`]):
+/// on an arc the fourth-order quadrature converges as `0.06 (θ/n)⁴` relative (measured against
+/// Castigliano, see docs/pcc.md), so 0.005 rad per panel is below 1e-10 of each block's scale
+/// (and ~1e-9 of its smaller entries).
+pub const PCC_PANEL_ANGLE: f64 = 0.005;
+
+/// Fewest quadrature panels per PCC segment (a straight segment's integrand is a quadratic
+/// in `s`, integrated exactly by any number of panels).
+pub const PCC_MIN_PANELS: usize = 8;
+
+/// A configuration to integrate the compliance along, as nodes (the one input of the
+/// integrated compliance, provided by the Cosserat and the PCC models alike).
+///
+/// `s` is the undeformed arc length (m, non-decreasing; a repeated value starts a new
+/// interval, e.g. at a load or a segment break); at each node, the backbone position (m,
+/// world), the rotation (body → world) and the element compliance `c(s)` (body, per
+/// undeformed length).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Configuration {
+    /// Undeformed arc length of each node (m).
+    pub s: Vec<f64>,
+    /// Backbone position of each node (m, world).
+    pub position: Vec<Vector3<f64>>,
+    /// Rotation of each node (body → world).
+    pub rotation: Vec<Matrix3<f64>>,
+    /// Element compliance `c(s)` of each node (body).
+    pub element: Vec<[f64; 6]>,
+}
+
+impl Configuration {
+    /// The solved mesh of a Cosserat solution, with the material's tangent at the solved
+    /// wrench ([`element_compliance`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ
+    /// in length.
+    pub fn from_statics(solution: &StaticsSolution) -> Result<Self> {
+        let n = solution.s.len();
+        if n == 0 || solution.position.len() != n || solution.rotation.len() != n {
+            return Err(Error::invalid(
+                "solution",
+                format!("{n} nodes"),
+                "a solution with nodes",
+            ));
+        }
+        Ok(Self {
+            s: solution.s.clone(),
+            position: solution
+                .position
+                .iter()
+                .map(|p| Vector3::from(*p))
+                .collect(),
+            rotation: solution
+                .rotation
+                .iter()
+                .map(|r| {
+                    Matrix3::new(
+                        r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1],
+                        r[2][2],
+                    )
+                })
+                .collect(),
+            element: element_compliance(solution),
+        })
+    }
+
+    /// The arcs of a PCC solution of `robot`, sampled at `panels + 1` nodes per segment
+    /// (default: `max(PCC_MIN_PANELS, ⌈θ / PCC_PANEL_ANGLE⌉)` for a bending angle `θ`; the
+    /// segment's junction nodes repeated), placed at the base pose of `rod`, with the
+    /// element compliance of `rod`'s section and (linear) material.
+    ///
+    /// A segment of rest length `ℓ0` and deformed length `ℓ` is uniformly stretched, so the
+    /// node at undeformed `σ` of the segment is at deformed arc length `σ ℓ / ℓ0`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `rod` if its material is not linear or its length
+    /// differs from the robot's total rest length (relative 1e-9), `solution` if its segment
+    /// count differs from the robot's, `panels` if zero.
+    pub fn from_pcc(
+        rod: &Rod,
+        robot: &PccRobot,
+        solution: &PccStaticsSolution,
+        panels: Option<usize>,
+    ) -> Result<Self> {
+        if !rod.material().is_linear() {
+            return Err(Error::invalid(
+                "rod",
+                "a hyperelastic material",
+                "a linear elastic rod (the PCC statics is linear)",
+            ));
+        }
+        let segs = robot.segments();
+        if solution.segments.len() != segs.len() {
+            return Err(Error::invalid(
+                "solution",
+                format!("{} segments", solution.segments.len()),
+                format!("a solution of the robot ({} segments)", segs.len()),
+            ));
+        }
+        let total: f64 = segs.iter().map(|s| s.rest_length()).sum();
+        if (total - rod.length()).abs() > 1e-9 * total {
+            return Err(Error::invalid(
+                "rod",
+                format!("length {} m", rod.length()),
+                format!("the robot's total rest length, {total} m"),
+            ));
+        }
+        if panels == Some(0) {
+            return Err(Error::invalid("panels", 0, ">= 1"));
+        }
+        let base = rod.base_pose();
+        let (rb, pb) = (base.rotation(), base.position());
+        let k = rod.shear_coefficient();
+        let mut out = Self {
+            s: Vec::new(),
+            position: Vec::new(),
+            rotation: Vec::new(),
+            element: Vec::new(),
+        };
+        let (mut s0, mut frame_r, mut frame_p) = (0.0, rb, pb);
+        for (seg, body) in solution.segments.iter().zip(segs) {
+            let l0 = body.rest_length();
+            let panels = panels.unwrap_or_else(|| {
+                let n = (seg.bending_angle().abs() / PCC_PANEL_ANGLE).ceil();
+                (n as usize).max(PCC_MIN_PANELS)
+            });
+            for j in 0..=panels {
+                let f = j as f64 / panels as f64;
+                let t = seg.pose_at(f * seg.length())?;
+                let r = t.fixed_view::<3, 3>(0, 0).into_owned();
+                let p = Vector3::new(t[(0, 3)], t[(1, 3)], t[(2, 3)]);
+                let sigma = if j == panels { s0 + l0 } else { s0 + f * l0 };
+                out.s.push(sigma);
+                out.position.push(frame_p + frame_r * p);
+                out.rotation.push(frame_r * r);
+                out.element.push(rod.material().compliance(
+                    &rod.section_at(sigma.min(rod.length())),
+                    k,
+                    rod.inextensible(),
+                ));
+            }
+            s0 += l0;
+            frame_p = out.position[out.position.len() - 1];
+            frame_r = out.rotation[out.rotation.len() - 1];
+        }
+        Ok(out)
+    }
+}
+
+/// World and body compliances, node by node.
+type WorldBody = (Vec<Matrix6<f64>>, Vec<Matrix6<f64>>);
+
+/// World and body compliances (all nodes, or only the last with `tip_only`) of a
+/// configuration: the one integrated-compliance computation of both models.
+fn compliance_matrices(config: &Configuration, tip_only: bool) -> Result<WorldBody> {
+    let n = config.s.len();
+    if n == 0
+        || config.position.len() != n
+        || config.rotation.len() != n
+        || config.element.len() != n
+    {
+        return Err(Error::invalid(
+            "configuration",
+            format!("{n} nodes"),
+            "nodes with equally long arrays",
+        ));
+    }
+    let pos = |i: usize| config.position[i];
+    let rotm = |i: usize| config.rotation[i];
+    let p0 = pos(0);
+    // Integrand Ad c Adᵀ with Ad = [[R, P R], [0, R]], P = (p - p(0))^: with
+    // A = R c_v Rᵀ and B = R c_u Rᵀ it is [[A + P B Pᵀ, P B], [B Pᵀ, B]].
+    let integrand: Vec<Matrix6<f64>> = (0..n)
+        .map(|i| {
+            let r = rotm(i);
+            let e = &config.element[i];
+            let a = r * Matrix3::from_diagonal(&Vector3::new(e[0], e[1], e[2])) * r.transpose();
+            let b = r * Matrix3::from_diagonal(&Vector3::new(e[3], e[4], e[5])) * r.transpose();
+            let pb = hat(&(pos(i) - p0)) * b;
+            let mut m = Matrix6::zeros();
+            m.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(a + pb * hat(&(pos(i) - p0)).transpose()));
+            m.fixed_view_mut::<3, 3>(0, 3).copy_from(&pb);
+            m.fixed_view_mut::<3, 3>(3, 0).copy_from(&pb.transpose());
+            m.fixed_view_mut::<3, 3>(3, 3).copy_from(&b);
+            m
+        })
+        .collect();
+    // Cumulative Q over the intervals (a repeated s starts a new interval; Q is continuous).
+    let mut q = vec![Matrix6::zeros(); n];
+    let mut start = 0;
+    while start < n {
+        let mut end = start + 1;
+        while end < n && config.s[end] != config.s[end - 1] {
+            end += 1;
+        }
+        if start > 0 {
+            q[start] = q[start - 1];
+        }
+        let x = &config.s[start..end];
+        for j in 0..x.len() - 1 {
+            let (nodes, weights, m) = panel_weights(x, j);
+            let mut acc = q[start + j];
+            for k in 0..m {
+                acc += integrand[start + nodes[k]] * weights[k];
+            }
+            q[start + j + 1] = acc;
+        }
+        start = end;
+    }
+    let (mut world, mut body) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let first = if tip_only { n - 1 } else { 0 };
+    for (i, qi) in q.iter().enumerate().skip(first) {
+        // C_world = T Q Tᵀ with T = [[I, P], [0, I]], P = (p(0) - p(s))^.
+        let p = hat(&(p0 - pos(i)));
+        let qtt = qi.fixed_view::<3, 3>(0, 0).into_owned();
+        let qtr = qi.fixed_view::<3, 3>(0, 3).into_owned();
+        let qrr = qi.fixed_view::<3, 3>(3, 3).into_owned();
+        let ctr = qtr + p * qrr;
+        let ctt = qtt + p * qtr.transpose() + ctr * p.transpose();
+        let w = blocks(&ctt, &ctr, &qrr);
+        // C_body = blockdiag(Rᵀ) C_world blockdiag(R).
+        body.push(rotate_blocks(&w, &rotm(i)));
+        world.push(w);
+    }
+    Ok((world, body))
+}
+
+/// The seed's integrated compliance (eqs. 6–7) at every node of a configuration of `rod`
+/// (see the module documentation for the formula and the quadrature); `rod` scales
+/// [`Compliance::gamma_c`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `configuration` if it has no nodes or its arrays
+/// differ in length.
+pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Compliance> {
+    let (world, body) = compliance_matrices(&config, false)?;
+    let gk = gamma_c(rod, &Matrix6::identity())[0];
+    let gamma = body
+        .iter()
+        .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
+        .collect();
+    Ok(Compliance {
+        s: config.s,
+        element: config.element,
+        world,
+        body,
+        gamma_c: gamma,
+    })
+}
+
+/// The seed's integrated compliance (eqs. 6–7) at every node of `solution` (see the module
+/// documentation for the formula and the quadrature).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ in
+/// length.
+pub fn compliance(solution: &StaticsSolution) -> Result<Compliance> {
+    configuration_compliance(solution.model.rod(), Configuration::from_statics(solution)?)
+}
+
+/// The seed's integrated compliance along the arcs of a PCC solution (same computation as
+/// [`compliance`], on [`Configuration::from_pcc`] with `panels` per segment, default from
+/// [`PCC_PANEL_ANGLE`]); `rod` gives the section and material of `c(s)` and the base
+/// pose. The nodes' `s` is the undeformed arc length, junctions repeated.
+///
+/// # Errors
+/// As [`Configuration::from_pcc`].
+pub fn pcc_compliance(
+    rod: &Rod,
+    robot: &PccRobot,
+    solution: &PccStaticsSolution,
+    panels: Option<usize>,
+) -> Result<Compliance> {
+    configuration_compliance(rod, Configuration::from_pcc(rod, robot, solution, panels)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panel_weights_integrate_cubics_exactly_on_uneven_nodes() {
+        let x = [0.0, 0.1, 0.25, 0.3, 0.55, 0.6, 0.9];
+        let f = |t: f64| 2.0 - 3.0 * t + 0.5 * t * t + 4.0 * t * t * t;
+        let big_f = |t: f64| 2.0 * t - 1.5 * t * t + t.powi(3) / 6.0 + t.powi(4);
+        for j in 0..x.len() - 1 {
+            let (nodes, w, m) = panel_weights(&x, j);
+            let q: f64 = (0..m).map(|k| w[k] * f(x[nodes[k]])).sum();
+            let exact = big_f(x[j + 1]) - big_f(x[j]);
+            assert!((q - exact).abs() < 1e-14, "panel {j}: {q} vs {exact}");
+        }
+    }
+}

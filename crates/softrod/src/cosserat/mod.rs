@@ -1,0 +1,11 @@
+//! The Cosserat-rod model with tendons and chambers: the equations and their variational
+//! columns ([`equations`]), the constitutive local solve (linear and hyperelastic), the
+//! shooting problem, the statics entry point and its solution ([`statics`]).
+
+pub(crate) mod equations;
+mod hyperelastic_local;
+pub(crate) mod shooting;
+pub mod statics;
+
+pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+pub use statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};

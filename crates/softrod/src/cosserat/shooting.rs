@@ -1,0 +1,382 @@
+//! The shooting problem: unknown scaled base wrench, residual the scaled tip conditions.
+//!
+//! Unknowns `x = [N(0)/F; M(0)/(F L)]` (`F = E I(0)/L²`, world frame, total wrench of rod and
+//! tendons), residual `r = [(N(L) - F_tip)/F; (M(L) - M_tip)/(F L)]`, so the tolerance is
+//! dimensionless (a residual `ε` leaves a tip error of about `ε L / 3`). One evaluation is one
+//! march over the breaks: the state alone for a residual, the state with six variational
+//! columns for the exact Jacobian. With a zero base force and no force along the rod, `N ≡ 0`
+//! and the Jacobian is known in closed form (`δN(L) = δN(0)`,
+//! `δM(L) = δM(0) - (p(L) - p(0)) × δN(0)`), so it costs nothing. The solver sees it as a
+//! [`Problem`]; its safeguard compares shapes node by node.
+
+use nalgebra::{Matrix3, Vector3, Vector6};
+
+use super::equations::{rot, v3, Column, Equations, Evaluator, Workspace, FULL, STATE};
+use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
+use crate::error::{Error, Result};
+use crate::integrate::march::{march, Scheme};
+use crate::math::so3::hat;
+use crate::model::loads::Frame;
+use crate::solve::{Evaluated, Problem};
+
+/// A recorded mesh node.
+#[derive(Clone, Copy)]
+pub(crate) struct Node {
+    pub s: f64,
+    pub interval: usize,
+    pub y: [f64; STATE],
+}
+
+fn head<const N: usize>(y: &[f64; N]) -> [f64; STATE] {
+    let mut h = [0.0; STATE];
+    h.copy_from_slice(&y[..STATE]);
+    h
+}
+
+/// What a pass returns: the scaled residual, its derivative along each column, the chord.
+pub(crate) type PassOutput = (Vector6<f64>, Vec<Vector6<f64>>, Vector3<f64>);
+
+/// The shooting problem of one model and actuation, with its workspace and the nodes of the
+/// last pass.
+pub(crate) struct Shooting<'a> {
+    pub eq: Equations<'a>,
+    pub ws: Workspace,
+    pub integrator: Integrator,
+    pub plan: Vec<usize>,
+    /// Nodes of the last pass (a break appears twice: before and after its jump).
+    pub nodes: Vec<Node>,
+    /// Tendon path lengths of the last pass (m).
+    pub lengths: Vec<f64>,
+    /// The shape of the committed state (positions, rotations), the safeguard's reference.
+    reference: Vec<(Vector3<f64>, Matrix3<f64>)>,
+    /// Right-hand-side evaluations so far.
+    pub evaluations: usize,
+}
+
+impl<'a> Shooting<'a> {
+    pub fn new(eq: Equations<'a>, integrator: Integrator, plan: Vec<usize>) -> Self {
+        let ws = Workspace::new(eq.model.tendons().len());
+        Self {
+            eq,
+            ws,
+            integrator,
+            plan,
+            nodes: Vec::new(),
+            lengths: Vec::new(),
+            reference: Vec::new(),
+            evaluations: 0,
+        }
+    }
+
+    fn scheme<'p>(integrator: &Integrator, plan: &'p [usize]) -> Scheme<'p> {
+        match *integrator {
+            Integrator::Rk4 { .. } => Scheme::Rk4(plan),
+            Integrator::Adaptive(options) => Scheme::Adaptive {
+                options,
+                controlled: STATE,
+            },
+        }
+    }
+
+    /// One march from the base with unknowns `x` at load factor `lambda`, recording the
+    /// nodes; with `N == FULL` the six base-wrench columns are integrated too. Returns the
+    /// scaled residual, its Jacobian columns (empty without columns) and the chord
+    /// `p(L) - p(0)`.
+    pub fn pass<const N: usize>(&mut self, x: &[f64], lambda: f64) -> Result<PassOutput> {
+        self.eq.load_factor = lambda;
+        let columns: &[Column] = if N >= FULL { &[Column::Free; 6] } else { &[] };
+        self.ws.set_columns(columns, &[]);
+        // RK4 passes integrate the tendon lengths from the nodes afterwards (Simpson); the
+        // adaptive ones on the stages.
+        self.ws.track_lengths = matches!(self.integrator, Integrator::Adaptive(_));
+        self.nodes.clear();
+        let y0: [f64; N] = self.eq.initial(x);
+        let scheme = Self::scheme(&self.integrator, &self.plan);
+        let breaks = self.eq.model.breaks();
+        let eq = self.eq;
+        let mut ev = Evaluator {
+            eq,
+            ws: &mut self.ws,
+        };
+        let nodes = &mut self.nodes;
+        let result = march(&mut ev, breaks, &[], y0, scheme, |_, s, interval, y| {
+            nodes.push(Node {
+                s,
+                interval,
+                y: head(y),
+            });
+        });
+        self.evaluations += std::mem::take(&mut self.ws.evaluations);
+        let y = result?;
+        if !y[..STATE].iter().all(|v| v.is_finite()) {
+            return Err(Error::NotConverged {
+                what: "rod integration: non-finite state".into(),
+                iterations: 0,
+                residual: f64::INFINITY,
+            });
+        }
+        let nt = self.eq.model.tendons().len();
+        self.lengths.clear();
+        self.lengths.extend_from_slice(&self.ws.integral[..nt]);
+        let (r, cols) = eq.residual(&y, columns.len());
+        let chord = v3(&y, 0) - eq.model.rod().base_pose().position();
+        Ok((r, cols, chord))
+    }
+
+    /// Positions and rotations at the nodes of the last pass.
+    fn shape(&self) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
+        self.nodes
+            .iter()
+            .map(|n| (v3(&n.y, 0), rot(&n.y)))
+            .collect()
+    }
+}
+
+/// Whether two shapes differ by at most [`MAX_LOAD_STEP_TURN`] in rotation (rad) and
+/// `MAX_LOAD_STEP_TURN L / 2` in position, node by node on a common mesh (RK4), at the tip
+/// otherwise (adaptive meshes differ between passes).
+fn shape_change_is_small(
+    a: &[(Vector3<f64>, Matrix3<f64>)],
+    b: &[(Vector3<f64>, Matrix3<f64>)],
+    length: f64,
+) -> bool {
+    let close = |(p0, r0): &(Vector3<f64>, Matrix3<f64>),
+                 (p1, r1): &(Vector3<f64>, Matrix3<f64>)| {
+        let c = ((r0.tr_mul(r1).trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
+        c.acos() <= MAX_LOAD_STEP_TURN && (p1 - p0).norm() <= 0.5 * MAX_LOAD_STEP_TURN * length
+    };
+    if a.len() == b.len() {
+        a.iter().zip(b).all(|(x, y)| close(x, y))
+    } else {
+        match (a.last(), b.last()) {
+            (Some(x), Some(y)) => close(x, y),
+            _ => false,
+        }
+    }
+}
+
+impl Problem for Shooting<'_> {
+    fn dim(&self) -> usize {
+        6
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
+        // N ≡ 0 along the rod: the Jacobian in closed form from a pass without columns.
+        let analytic =
+            x[..3].iter().all(|v| *v == 0.0) && (self.eq.model.force_free() || lambda == 0.0);
+        let full = jacobian.is_some() && !analytic;
+        let pass = if full {
+            self.pass::<FULL>(x, lambda)
+        } else {
+            self.pass::<STATE>(x, lambda)
+        };
+        let Ok((res, cols, chord)) = pass else {
+            return Evaluated::Failed;
+        };
+        r.copy_from_slice(res.as_slice());
+        if !r.iter().all(|v| v.is_finite()) {
+            return Evaluated::Failed;
+        }
+        let Some(j) = jacobian else {
+            return Evaluated::Residual;
+        };
+        j.fill(0.0);
+        if full {
+            for (c, col) in cols.iter().enumerate() {
+                j[6 * c..6 * c + 6].copy_from_slice(col.as_slice());
+            }
+        } else {
+            for k in 0..6 {
+                j[7 * k] = 1.0;
+            }
+            let h = hat(&chord) / self.eq.model.length();
+            for a in 0..3 {
+                for b in 0..3 {
+                    j[(3 + a) + 6 * b] = -h[(a, b)];
+                }
+            }
+        }
+        Evaluated::Jacobian
+    }
+
+    fn tolerance(&self, x: &[f64], tolerance: f64) -> f64 {
+        match self.integrator {
+            Integrator::Rk4 { .. } => tolerance,
+            Integrator::Adaptive(a) => {
+                let amax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                tolerance.max(10.0 * a.rtol * (1.0 + amax))
+            }
+        }
+    }
+
+    fn load_derivative(&mut self, x: &[f64], lambda: f64, out: &mut [f64]) -> bool {
+        if let Some(d) = self.eq.load_derivative_force_free() {
+            out.copy_from_slice(d.as_slice());
+            return true;
+        }
+        // At the unloaded equilibrium (N ≡ 0) every external load acts on the shape of the
+        // last pass: ∂N(L)/∂λ is the total force and ∂M(L)/∂λ their moment about the tip.
+        if !(lambda == 0.0 && x.iter().all(|v| *v == 0.0) && !self.nodes.is_empty()) {
+            return false;
+        }
+        let model = self.eq.model;
+        let loads = model.loads();
+        let rod = model.rod();
+        let tip = v3(&self.nodes[self.nodes.len() - 1].y, 0);
+        let (mut fsum, mut msum) = (Vector3::zeros(), Vector3::zeros());
+        let load_at = |s: f64| -> (Vector3<f64>, Vector3<f64>) {
+            let mut f = loads
+                .distributed_force
+                .as_ref()
+                .map_or(Vector3::zeros(), |p| p.at(s));
+            if let Some(g) = model.rho_g() {
+                f += g * rod.section_at(s).area;
+            }
+            let l = loads
+                .distributed_moment
+                .as_ref()
+                .map_or(Vector3::zeros(), |p| p.at(s));
+            (f, l)
+        };
+        // Trapezoid rule over the nodes of each interval.
+        for w in self.nodes.windows(2) {
+            if w[0].interval != w[1].interval || w[1].s <= w[0].s {
+                continue;
+            }
+            let h = w[1].s - w[0].s;
+            for n in w {
+                let (f, l) = load_at(n.s);
+                let p = v3(&n.y, 0);
+                fsum += f * (0.5 * h);
+                msum += ((tip - p).cross(&f) + l) * (0.5 * h);
+            }
+        }
+        for pl in &loads.point_loads {
+            let Some(n) = self.nodes.iter().find(|n| n.s == pl.s) else {
+                return false;
+            };
+            let (f, m) = match pl.frame {
+                Frame::World => (pl.force, pl.moment),
+                Frame::Body => (rot(&n.y) * pl.force, rot(&n.y) * pl.moment),
+            };
+            fsum += f;
+            msum += (tip - v3(&n.y, 0)).cross(&f) + m;
+        }
+        let rt = rot(&self.nodes[self.nodes.len() - 1].y);
+        let (ft, mt) = match loads.tip_frame {
+            Frame::World => (loads.tip_force, loads.tip_moment),
+            Frame::Body => (rt * loads.tip_force, rt * loads.tip_moment),
+        };
+        let f_ref = model.force_scale();
+        let fm = f_ref * model.length();
+        let dn = -(fsum + ft) / f_ref;
+        let dm = -(msum + mt) / fm;
+        out.copy_from_slice(&[dn.x, dn.y, dn.z, dm.x, dm.y, dm.z]);
+        out.iter().all(|v| v.is_finite())
+    }
+
+    fn commit(&mut self) {
+        self.reference = self.shape();
+    }
+
+    fn close(&self) -> bool {
+        match self.reference.is_empty() {
+            true => false,
+            false => shape_change_is_small(&self.reference, &self.shape(), self.eq.model.length()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use std::f64::consts::PI;
+
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::model::chamber::{Chamber, ChamberArea};
+    use crate::model::loads::{Frame, Loads, PointLoad};
+    use crate::model::material::hyperelastic::UniaxialModel;
+    use crate::model::material::silicone::Silicone;
+    use crate::model::rod::Rod;
+    use crate::model::section::Section;
+    use crate::model::tendon::Tendon;
+    use crate::model::RobotModel;
+
+    /// The exact shooting Jacobian (variational columns) against central differences of the
+    /// residual, on a hyperelastic tube with a tendon, two chambers, a follower point load and
+    /// a tip wrench, away from equilibrium.
+    #[test]
+    fn shooting_jacobian_is_exact_for_a_hyperelastic_rod_with_chambers() {
+        let rod = Rod::new(
+            0.16,
+            Section::tube(0.012, 0.002).unwrap(),
+            UniaxialModel::from(Silicone::DragonSkin10.yeoh()),
+        )
+        .unwrap();
+        let ac = PI * 0.0025f64.powi(2);
+        let tendons = vec![Tendon::constant([0.008, 0.0], Some(0.12)).unwrap()];
+        let chambers = vec![
+            Chamber::new(ChamberArea::Constant(ac), [0.0, 0.0072], 0.0, None).unwrap(),
+            Chamber::new(
+                ChamberArea::Constant(ac),
+                [0.0072 * (-30f64).to_radians().cos(), -0.0036],
+                0.03,
+                Some(0.13),
+            )
+            .unwrap(),
+        ];
+        let loads = Loads {
+            tip_force: Vector3::new(0.1, -0.05, 0.2),
+            tip_moment: Vector3::new(0.0, 2e-3, 1e-3),
+            point_loads: vec![PointLoad {
+                s: 0.1,
+                force: Vector3::new(0.0, 0.1, 0.0),
+                moment: Vector3::zeros(),
+                frame: Frame::Body,
+            }],
+            ..Default::default()
+        };
+        let model = RobotModel::new(rod, tendons, chambers, loads).unwrap();
+        let (tensions, pressures) = ([2.0], [60e3, 30e3]);
+        let eq = Equations {
+            model: &model,
+            tensions: &tensions,
+            pressures: &pressures,
+            load_factor: 1.0,
+        };
+        let plan = crate::integrate::march::rk4_plan(model.breaks(), 40 * 6);
+        let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 240 }, plan);
+        let x = [0.3, -0.2, 0.5, 0.1, -0.15, 0.05];
+        let mut r = [0.0; 6];
+        let mut jac = [0.0; 36];
+        assert_eq!(
+            p.evaluate(&x, 1.0, Some(&mut jac), &mut r),
+            Evaluated::Jacobian
+        );
+        let h = 1e-6;
+        let mut err = 0.0f64;
+        let scale = jac.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for j in 0..6 {
+            let (mut xp, mut xm) = (x, x);
+            xp[j] += h;
+            xm[j] -= h;
+            let (mut rp, mut rm) = ([0.0; 6], [0.0; 6]);
+            p.evaluate(&xp, 1.0, None, &mut rp);
+            p.evaluate(&xm, 1.0, None, &mut rm);
+            for i in 0..6 {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                err = err.max((fd - jac[i + 6 * j]).abs() / scale);
+            }
+        }
+        assert!(err < 1e-6, "relative Jacobian error {err:e}");
+        assert!(p.ws.material_error.is_none());
+    }
+}

@@ -1,0 +1,95 @@
+//! The march of a piecewise system over the breaks of a rod: interval by interval, fixed RK4
+//! steps or adaptive Dormand–Prince steps, with a jump at every interior break and an
+//! observer of every node.
+//!
+//! The Cosserat shooting pass, the tangent compliance and (through the shooting) the
+//! compliance all march with this function; they differ only in their system (state and
+//! sensitivity columns) and their observer (recording nodes, seeding load columns).
+
+use super::driver::{adaptive, fixed, System};
+use super::tableau::{DP5, RK4};
+use super::AdaptiveOptions;
+use crate::error::Result;
+
+/// A system whose right-hand side changes at the breaks `b_0 < b_1 < ...`.
+pub trait Piecewise<const N: usize>: System<N> {
+    /// Called before integrating the interval `[b_k, b_{k+1}]`.
+    fn enter_interval(&mut self, k: usize);
+    /// Applies the jump of the state across the interior break `s` (e.g. a point load).
+    fn jump(&mut self, s: f64, y: &mut [f64; N]);
+}
+
+/// How each interval is integrated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scheme<'a> {
+    /// Classical RK4 with the given number of equal steps per interval.
+    Rk4(&'a [usize]),
+    /// Adaptive Dormand–Prince 5(4), error control on the first `controlled` components.
+    Adaptive {
+        /// Tolerances.
+        options: AdaptiveOptions,
+        /// Number of leading state components under error control.
+        controlled: usize,
+    },
+}
+
+/// Per-interval step counts of an RK4 plan with `steps` in total: `max(1, round(steps
+/// length / L))` each.
+pub fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
+    let l = breaks[breaks.len() - 1];
+    breaks
+        .windows(2)
+        .map(|w| ((steps as f64 * (w[1] - w[0]) / l).round() as usize).max(1))
+        .collect()
+}
+
+/// Integrates `sys` over `breaks` from `y0`, calling `node(sys, s, interval, y)` at the start
+/// of every interval and after every step (`y` may be modified there, e.g. to seed a column).
+/// With the adaptive scheme, every point of `stops` inside an interval ends a step there.
+/// Returns the state at the last break.
+///
+/// # Errors
+/// What the driver reports (non-finite state, adaptive step failures).
+pub fn march<const N: usize, Y: Piecewise<N>>(
+    sys: &mut Y,
+    breaks: &[f64],
+    stops: &[f64],
+    y0: [f64; N],
+    scheme: Scheme<'_>,
+    mut node: impl FnMut(&mut Y, f64, usize, &mut [f64; N]),
+) -> Result<[f64; N]> {
+    let mut y = y0;
+    for k in 0..breaks.len() - 1 {
+        let (a, b) = (breaks[k], breaks[k + 1]);
+        sys.enter_interval(k);
+        node(sys, a, k, &mut y);
+        match scheme {
+            Scheme::Rk4(plan) => {
+                y = fixed(&RK4, sys, a, y, b, plan[k], |sys, s, y| node(sys, s, k, y))?;
+            }
+            Scheme::Adaptive {
+                options,
+                controlled,
+            } => {
+                let mut start = a;
+                for &stop in stops.iter().filter(|&&s| s > a && s < b).chain([&b]) {
+                    let (end, _) = adaptive(
+                        &DP5,
+                        sys,
+                        [start, stop],
+                        y,
+                        &options,
+                        controlled,
+                        |sys, y, step| node(sys, step.t1, k, y),
+                    )?;
+                    y = end;
+                    start = stop;
+                }
+            }
+        }
+        if k + 2 < breaks.len() {
+            sys.jump(b, &mut y);
+        }
+    }
+    Ok(y)
+}

@@ -1,0 +1,114 @@
+//! The actuation input: what the motors and the pumps do, separate from the robot model.
+//!
+//! A [`RobotModel`](crate::model::RobotModel) describes the robot (rod, tendon routings,
+//! chambers, external loads); an [`Actuation`] says how it is driven for one solve: per tendon
+//! a [`TendonInput`] (today a tension; a held path shortening and friction join it as new
+//! variants), per chamber a gauge pressure. A sweep changes the actuation and keeps the model.
+
+use crate::error::{Error, Result};
+use crate::model::chamber::check_pressure;
+
+/// How one tendon is driven.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum TendonInput {
+    /// Pulled at the base with a given tension (N, >= 0): force control.
+    Tension(f64),
+}
+
+impl TendonInput {
+    /// The tension (N) of a tension-controlled tendon.
+    pub fn tension(&self) -> f64 {
+        match self {
+            TendonInput::Tension(t) => *t,
+        }
+    }
+}
+
+/// Tendon inputs and chamber pressures of one configuration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Actuation {
+    /// One input per tendon of the model, in the model's order.
+    pub tendons: Vec<TendonInput>,
+    /// One gauge pressure per chamber of the model (Pa), in the model's order.
+    pub pressures: Vec<f64>,
+}
+
+impl Actuation {
+    /// Tension control of every tendon (N), no pressures.
+    pub fn tensions(tensions: &[f64]) -> Self {
+        Self {
+            tendons: tensions.iter().map(|&t| TendonInput::Tension(t)).collect(),
+            pressures: Vec::new(),
+        }
+    }
+
+    /// Only chamber pressures (Pa).
+    pub fn pressures(pressures: &[f64]) -> Self {
+        Self {
+            tendons: Vec::new(),
+            pressures: pressures.to_vec(),
+        }
+    }
+
+    /// The same actuation with `pressures` (Pa).
+    pub fn with_pressures(mut self, pressures: &[f64]) -> Self {
+        self.pressures = pressures.to_vec();
+        self
+    }
+
+    /// Tension of every tendon (N), given `n_tendons` in the model (missing inputs: 0).
+    pub fn tension_values(&self, n_tendons: usize) -> Vec<f64> {
+        (0..n_tendons)
+            .map(|i| self.tendons.get(i).map_or(0.0, TendonInput::tension))
+            .collect()
+    }
+
+    /// Pressure of every chamber (Pa), given `n_chambers` in the model (missing inputs: 0).
+    pub fn pressure_values(&self, n_chambers: usize) -> Vec<f64> {
+        (0..n_chambers)
+            .map(|i| self.pressures.get(i).copied().unwrap_or(0.0))
+            .collect()
+    }
+
+    /// Checks the inputs against a model with `n_tendons` tendons and `n_chambers` chambers:
+    /// one input per actuator (or none at all: all zero), tensions finite and >= 0, pressures
+    /// finite and above vacuum.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]`, `pressures.len()` or
+    /// `pressures[i]`.
+    pub fn validate(&self, n_tendons: usize, n_chambers: usize) -> Result<()> {
+        if !(self.tendons.is_empty() || self.tendons.len() == n_tendons) {
+            return Err(Error::invalid(
+                "tensions.len()",
+                self.tendons.len(),
+                format!("the number of tendons, {n_tendons} (or 0 for none)"),
+            ));
+        }
+        if !(self.pressures.is_empty() || self.pressures.len() == n_chambers) {
+            return Err(Error::invalid(
+                "pressures.len()",
+                self.pressures.len(),
+                format!("the number of chambers, {n_chambers} (or 0 for none)"),
+            ));
+        }
+        for (i, t) in self.tendons.iter().enumerate() {
+            match t {
+                TendonInput::Tension(v) => {
+                    if !(v.is_finite() && *v >= 0.0) {
+                        return Err(Error::invalid(
+                            format!("tensions[{i}]"),
+                            v,
+                            "finite and >= 0 N",
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, &p) in self.pressures.iter().enumerate() {
+            check_pressure(&format!("pressures[{i}]"), p)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,146 @@
+//! The one nonlinear solver of softrod: damped Newton (or Broyden's update of the Jacobian)
+//! with a backtracking line search under the Armijo condition, and load continuation with a
+//! tangent or secant predictor. The Cosserat shooting and the PCC statics are [`Problem`]s;
+//! inverse statics and contact plug in the same way.
+//!
+//! The pieces are small and separate, after argmin: a [`LineSearch`] proposes step lengths
+//! and a [`Condition`] accepts them; [`newton`] runs the iteration at one load factor;
+//! [`continuation`] steps the load factor from a solved state.
+
+mod continuation;
+mod newton;
+
+pub use continuation::{continuation, ContinuationSettings, Continued};
+pub use newton::{newton, Armijo, Condition, LineSearch, NewtonOutcome, NewtonSettings};
+
+use crate::error::{Error, Result};
+
+/// Smallest load-factor increment of the continuation before giving up.
+pub const MIN_LOAD_INCREMENT: f64 = 1e-4;
+
+/// Options of the nonlinear solve (keyword arguments in Python), shared by every problem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonOptions {
+    /// Tolerance on the problem's scaled residual (max norm), > 0.
+    pub tolerance: f64,
+    /// Newton iterations per solve (per load step under continuation), >= 1.
+    pub max_iterations: usize,
+    /// Whether to step the external loads when the direct solve fails or is refused.
+    pub continuation: bool,
+    /// Load steps (attempted) under continuation, >= 1.
+    pub max_load_steps: usize,
+    /// `true`: non-convergence is [`Error::NotConverged`]; `false`: the last iterate is
+    /// returned with `stats.converged == false`.
+    pub throw: bool,
+}
+
+impl NewtonOptions {
+    /// Checks the options: a finite `tolerance` > 0, at least one iteration and one load step.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `tolerance`, `max_iterations` or `max_load_steps`.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return Err(Error::invalid(
+                "tolerance",
+                self.tolerance,
+                "finite and > 0",
+            ));
+        }
+        if self.max_iterations == 0 {
+            return Err(Error::invalid(
+                "max_iterations",
+                self.max_iterations,
+                ">= 1",
+            ));
+        }
+        if self.max_load_steps == 0 {
+            return Err(Error::invalid(
+                "max_load_steps",
+                self.max_load_steps,
+                ">= 1",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Statistics of a nonlinear solve (the same for every problem).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SolverStats {
+    /// Newton (or Broyden) iterations, over all load steps.
+    pub iterations: usize,
+    /// Final scaled residual (max norm, dimensionless).
+    pub residual: f64,
+    /// Residual evaluations (for the Cosserat shooting: right-hand-side evaluations).
+    pub function_evaluations: usize,
+    /// Whether the residual met the tolerance.
+    pub converged: bool,
+    /// Load steps taken by the continuation (0: solved directly).
+    pub load_steps: usize,
+    /// Fraction of the external loads the returned state carries: 1 when converged; for a
+    /// non-converged result under continuation, the last load factor reached.
+    pub load_factor: f64,
+}
+
+/// What an evaluation of a [`Problem`] produced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Evaluated {
+    /// The evaluation failed (non-finite state, a material failure): the point is rejected.
+    Failed,
+    /// The residual only.
+    Residual,
+    /// The residual and its Jacobian.
+    Jacobian,
+}
+
+/// A square nonlinear system `r(x, λ) = 0` in scaled unknowns, `λ` the load factor.
+pub trait Problem {
+    /// Number of unknowns (and residuals).
+    fn dim(&self) -> usize;
+    /// Residual `r(x, λ)` into `r`; with `jacobian`, also `∂r/∂x` (column-major `dim × dim`).
+    /// A problem may fill the Jacobian unasked when it is free (returning
+    /// [`Evaluated::Jacobian`]).
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated;
+    /// The norm the tolerance applies to, of the residual `r` of the last evaluation; the max
+    /// norm by default.
+    fn norm(&self, r: &[f64]) -> f64 {
+        max_norm(r)
+    }
+    /// Tolerance on the norm of the residual at `x` (the option, or the resolution of the
+    /// problem's discretisation).
+    fn tolerance(&self, x: &[f64], tolerance: f64) -> f64 {
+        let _ = x;
+        tolerance
+    }
+    /// `∂r/∂λ` at `(x, λ)` into `out`, for the tangent predictor of the continuation; `false`
+    /// when not available (a secant predictor is used).
+    fn load_derivative(&mut self, _x: &[f64], _lambda: f64, _out: &mut [f64]) -> bool {
+        false
+    }
+    /// Remembers the state of the last evaluation as the reference of [`Problem::close`].
+    fn commit(&mut self) {}
+    /// Whether the state of the last evaluation is close enough to the committed reference to
+    /// stay on the same equilibrium branch (the continuation's safeguard); `true` by default.
+    fn close(&self) -> bool {
+        true
+    }
+}
+
+/// Max norm, infinite if any entry is not finite.
+pub fn max_norm(v: &[f64]) -> f64 {
+    let mut m = 0.0f64;
+    for x in v {
+        if !x.is_finite() {
+            return f64::INFINITY;
+        }
+        m = m.max(x.abs());
+    }
+    m
+}

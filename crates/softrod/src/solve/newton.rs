@@ -1,0 +1,512 @@
+//! Damped Newton at one load factor, with Broyden updates of the Jacobian between exact
+//! evaluations.
+
+use super::{max_norm, Evaluated, NewtonOptions, Problem};
+use crate::math::linalg::DenseLu;
+
+/// Sufficient-decrease condition of a step of length `alpha`: accepts the trial residual
+/// norm `trial` against the current `current`.
+pub trait Condition {
+    /// Whether the step is accepted.
+    fn accept(&self, alpha: f64, current: f64, trial: f64) -> bool;
+}
+
+/// Armijo's condition on the residual norm: `|r(x + α dx)| <= (1 - c α) |r(x)|`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Armijo {
+    /// Sufficient-decrease constant `c` in `(0, 1)`.
+    pub c: f64,
+}
+
+impl Default for Armijo {
+    fn default() -> Self {
+        Self { c: 1e-4 }
+    }
+}
+
+impl Condition for Armijo {
+    #[inline]
+    fn accept(&self, alpha: f64, current: f64, trial: f64) -> bool {
+        trial <= (1.0 - self.c * alpha) * current
+    }
+}
+
+/// Backtracking line search: step lengths `1, f, f², ...` (`max_halvings + 1` of them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineSearch {
+    /// Reduction factor of the step length, in `(0, 1)`.
+    pub factor: f64,
+    /// Most reductions.
+    pub max_halvings: usize,
+}
+
+impl LineSearch {
+    /// The step lengths to try, longest first.
+    pub fn lengths(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..=self.max_halvings).scan(1.0, move |a, _| {
+            let out = *a;
+            *a *= self.factor;
+            Some(out)
+        })
+    }
+}
+
+/// How [`newton`] iterates (the problem's own policy; [`NewtonOptions`] are the user's).
+#[derive(Debug, Clone, Copy)]
+pub struct NewtonSettings<'a> {
+    /// Step lengths of the line search.
+    pub line_search: LineSearch,
+    /// Acceptance of a step.
+    pub condition: Armijo,
+    /// A first step longer than this (max norm) is refused and reported in
+    /// [`NewtonOutcome::first_step`] (the continuation then steps the load).
+    pub first_step_limit: Option<f64>,
+    /// Evaluate the residual alone at the initial guess first (it may already solve).
+    pub residual_first: bool,
+    /// Update the Jacobian by Broyden's formula after each full step instead of evaluating it,
+    /// as long as the residual falls fast (the exact Jacobian is evaluated again otherwise).
+    pub broyden: bool,
+    /// A Jacobian at (or near) the initial guess to start from (column-major).
+    pub jacobian: Option<&'a [f64]>,
+}
+
+/// Result of [`newton`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct NewtonOutcome {
+    /// The last accepted iterate.
+    pub x: Vec<f64>,
+    /// Its residual norm (max norm; infinite if never evaluated successfully).
+    pub residual: f64,
+    /// Whether the residual met the tolerance.
+    pub converged: bool,
+    /// Accepted steps.
+    pub iterations: usize,
+    /// Size of a first step refused by [`NewtonSettings::first_step_limit`] (0 otherwise).
+    pub first_step: f64,
+    /// The Jacobian (exact or updated) at `x`, column-major.
+    pub jacobian: Option<Vec<f64>>,
+    /// Whether the problem's last evaluation was at `x` (its recorded state belongs to `x`).
+    pub at_x: bool,
+}
+
+/// Contraction of the residual below which a Broyden step keeps the updated Jacobian.
+const BROYDEN_CONTRACTION: f64 = 0.5;
+
+/// The iterate of [`newton`]: unknowns, residual and its norm, the Jacobian (exact, or
+/// updated by Broyden's formula), and scratch.
+struct Iterate {
+    x: Vec<f64>,
+    r: Vec<f64>,
+    jac: Vec<f64>,
+    rn: f64,
+    exact: bool,
+    xt: Vec<f64>,
+    rt: Vec<f64>,
+    jt: Vec<f64>,
+}
+
+/// The first evaluations at `x0`: the residual (alone first when asked), then a Jacobian
+/// (given, or evaluated). `None` if an evaluation fails or the start already solves.
+fn start<P: Problem + ?Sized>(
+    problem: &mut P,
+    x0: &[f64],
+    lambda: f64,
+    options: &NewtonOptions,
+    settings: &NewtonSettings<'_>,
+    out: &mut NewtonOutcome,
+) -> Option<Iterate> {
+    let n = problem.dim();
+    let mut it = Iterate {
+        x: x0.to_vec(),
+        r: vec![0.0; n],
+        jac: if settings.residual_first && settings.jacobian.is_none() {
+            Vec::new()
+        } else {
+            vec![0.0; n * n]
+        },
+        rn: f64::INFINITY,
+        exact: false,
+        // Scratch of the iterations, allocated once the start does not solve.
+        xt: Vec::new(),
+        rt: Vec::new(),
+        jt: Vec::new(),
+    };
+    let want = !settings.residual_first && settings.jacobian.is_none();
+    let ev = problem.evaluate(&it.x, lambda, want.then_some(&mut it.jac[..]), &mut it.r);
+    if ev == Evaluated::Residual && settings.jacobian.is_none() {
+        // Not needed unless the start fails.
+        it.jac.clear();
+    }
+    if ev == Evaluated::Failed {
+        return None;
+    }
+    it.rn = problem.norm(&it.r);
+    out.residual = it.rn;
+    out.at_x = true;
+    let mut have_j = ev == Evaluated::Jacobian;
+    it.exact = have_j;
+    if !have_j {
+        if let Some(j) = settings.jacobian {
+            it.jac.copy_from_slice(j);
+            have_j = true;
+        }
+    }
+    if it.rn <= problem.tolerance(&it.x, options.tolerance) {
+        out.converged = true;
+        out.jacobian = have_j.then(|| it.jac.clone());
+        return None;
+    }
+    if !it.rn.is_finite() {
+        return None;
+    }
+    it.jac.resize(n * n, 0.0);
+    it.xt.resize(n, 0.0);
+    it.rt.resize(n, 0.0);
+    it.jt.resize(n * n, 0.0);
+    if !have_j {
+        if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian {
+            out.at_x = false;
+            return None;
+        }
+        it.rn = problem.norm(&it.r);
+        it.exact = true;
+    }
+    Some(it)
+}
+
+/// What a Broyden step did.
+enum Broyden {
+    /// Accepted; `true` when the residual fell slowly (evaluate the Jacobian next).
+    Accepted(bool),
+    /// Refused: the residual did not fall enough.
+    Refused,
+}
+
+/// A full step `dx` with the residual alone; on sufficient decrease, Broyden's update
+/// `J += (Δr - J Δx) Δxᵀ / (Δxᵀ Δx)`.
+fn broyden_step<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    settings: &NewtonSettings<'_>,
+    tol: f64,
+) -> Broyden {
+    let n = dx.len();
+    for k in 0..n {
+        it.xt[k] = it.x[k] + dx[k];
+    }
+    let ev = problem.evaluate(&it.xt, lambda, None, &mut it.rt);
+    let rtn = if ev == Evaluated::Failed {
+        f64::INFINITY
+    } else {
+        problem.norm(&it.rt)
+    };
+    if !(rtn <= tol || settings.condition.accept(1.0, it.rn, rtn)) {
+        return Broyden::Refused;
+    }
+    let dd: f64 = dx.iter().map(|v| v * v).sum();
+    if dd > 0.0 {
+        let mut u = vec![0.0; n];
+        for i in 0..n {
+            let mut jdx = 0.0;
+            for k in 0..n {
+                jdx += it.jac[i + k * n] * dx[k];
+            }
+            u[i] = (it.rt[i] - it.r[i] - jdx) / dd;
+        }
+        for c in 0..n {
+            for i in 0..n {
+                it.jac[i + c * n] += u[i] * dx[c];
+            }
+        }
+    }
+    let slow = rtn > BROYDEN_CONTRACTION * it.rn;
+    it.x.copy_from_slice(&it.xt);
+    it.r.copy_from_slice(&it.rt);
+    it.rn = rtn;
+    it.exact = false;
+    Broyden::Accepted(slow)
+}
+
+/// Backtracking line search along the exact Newton direction `dx`, evaluating exact
+/// Jacobians; `true` if a step was accepted.
+fn line_search<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    settings: &NewtonSettings<'_>,
+    options: &NewtonOptions,
+) -> bool {
+    for alpha in settings.line_search.lengths() {
+        for k in 0..dx.len() {
+            it.xt[k] = it.x[k] + alpha * dx[k];
+        }
+        if problem.evaluate(&it.xt, lambda, Some(&mut it.jt), &mut it.rt) != Evaluated::Jacobian {
+            continue;
+        }
+        let rtn = problem.norm(&it.rt);
+        if settings.condition.accept(alpha, it.rn, rtn)
+            || rtn <= problem.tolerance(&it.xt, options.tolerance)
+        {
+            std::mem::swap(&mut it.x, &mut it.xt);
+            std::mem::swap(&mut it.r, &mut it.rt);
+            std::mem::swap(&mut it.jac, &mut it.jt);
+            it.rn = rtn;
+            it.exact = true;
+            return true;
+        }
+    }
+    false
+}
+
+/// Under quadratic convergence the next residual is about `rn³ / r_prev²`: when that is far
+/// below the tolerance, the full step is tried with the residual alone (the last evaluation).
+/// `true` if it meets the tolerance (the iterate is then updated).
+fn last_step<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    options: &NewtonOptions,
+) -> bool {
+    for k in 0..dx.len() {
+        it.xt[k] = it.x[k] + dx[k];
+    }
+    if problem.evaluate(&it.xt, lambda, None, &mut it.rt) == Evaluated::Failed {
+        return false;
+    }
+    let rtn = problem.norm(&it.rt);
+    if rtn <= problem.tolerance(&it.xt, options.tolerance) {
+        it.x.copy_from_slice(&it.xt);
+        it.rn = rtn;
+        return true;
+    }
+    false
+}
+
+/// Damped Newton on `problem` at load factor `lambda` from `x0`.
+pub fn newton<P: Problem + ?Sized>(
+    problem: &mut P,
+    x0: &[f64],
+    lambda: f64,
+    options: &NewtonOptions,
+    settings: &NewtonSettings<'_>,
+) -> NewtonOutcome {
+    let n = problem.dim();
+    let mut out = NewtonOutcome {
+        x: x0.to_vec(),
+        residual: f64::INFINITY,
+        converged: false,
+        iterations: 0,
+        first_step: 0.0,
+        jacobian: None,
+        at_x: false,
+    };
+    let Some(mut it) = start(problem, x0, lambda, options, settings, &mut out) else {
+        return out;
+    };
+    let mut lu = DenseLu::default();
+    let mut dx = vec![0.0; n];
+    let mut r_prev = f64::INFINITY;
+    let mut refresh = false;
+    while out.iterations < options.max_iterations {
+        if refresh && !it.exact {
+            // Evaluate the exact Jacobian at the current iterate.
+            if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian
+            {
+                out.at_x = false;
+                break;
+            }
+            it.rn = problem.norm(&it.r);
+            it.exact = true;
+            out.at_x = true;
+        }
+        refresh = false;
+        if !lu.factor(n, &it.jac) {
+            break;
+        }
+        for k in 0..n {
+            dx[k] = -it.r[k];
+        }
+        if !lu.solve_in_place(&mut dx) {
+            break;
+        }
+        if let Some(limit) = settings.first_step_limit {
+            if out.iterations == 0 && max_norm(&dx) > limit {
+                out.first_step = max_norm(&dx);
+                break;
+            }
+        }
+        let tol = problem.tolerance(&it.x, options.tolerance);
+        if settings.broyden || !it.exact {
+            let was_exact = it.exact;
+            out.at_x = false;
+            match broyden_step(problem, &mut it, &dx, lambda, settings, tol) {
+                Broyden::Accepted(slow) => {
+                    refresh = slow;
+                    out.at_x = true;
+                    out.iterations += 1;
+                    if it.rn <= problem.tolerance(&it.x, options.tolerance) {
+                        out.converged = true;
+                        break;
+                    }
+                    continue;
+                }
+                Broyden::Refused if !was_exact => {
+                    // The updated Jacobian failed: evaluate the exact one and retry.
+                    refresh = true;
+                    continue;
+                }
+                Broyden::Refused => {}
+            }
+        } else if r_prev.is_finite()
+            && it.rn < 0.1 * r_prev
+            && it.rn * (it.rn / r_prev).powi(2) < 0.5 * tol
+        {
+            out.at_x = false;
+            if last_step(problem, &mut it, &dx, lambda, options) {
+                out.iterations += 1;
+                out.at_x = true;
+                out.converged = true;
+                break;
+            }
+        }
+        r_prev = it.rn;
+        out.at_x = false;
+        if !line_search(problem, &mut it, &dx, lambda, settings, options) {
+            break;
+        }
+        out.at_x = true;
+        out.iterations += 1;
+        if it.rn <= problem.tolerance(&it.x, options.tolerance) {
+            out.converged = true;
+            break;
+        }
+    }
+    out.x = it.x;
+    out.residual = it.rn;
+    out.jacobian = Some(it.jac);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::super::{Evaluated, NewtonOptions, Problem};
+    use super::*;
+
+    /// Intersection of the circle |x| = 2 with the hyperbola x y = 1, scaled by λ on the
+    /// right-hand side: r = (x² + y² - 4, x y - λ). Roots in closed form.
+    struct Circle {
+        evaluations: usize,
+    }
+
+    impl Problem for Circle {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            lambda: f64,
+            jacobian: Option<&mut [f64]>,
+            r: &mut [f64],
+        ) -> Evaluated {
+            self.evaluations += 1;
+            r[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
+            r[1] = x[0] * x[1] - lambda;
+            match jacobian {
+                Some(j) => {
+                    j.copy_from_slice(&[2.0 * x[0], x[1], 2.0 * x[1], x[0]]);
+                    Evaluated::Jacobian
+                }
+                None => Evaluated::Residual,
+            }
+        }
+    }
+
+    fn settings(broyden: bool) -> NewtonSettings<'static> {
+        NewtonSettings {
+            line_search: LineSearch {
+                factor: 0.5,
+                max_halvings: 12,
+            },
+            condition: Armijo::default(),
+            first_step_limit: None,
+            residual_first: false,
+            broyden,
+            jacobian: None,
+        }
+    }
+
+    const OPTS: NewtonOptions = NewtonOptions {
+        tolerance: 1e-13,
+        max_iterations: 40,
+        continuation: false,
+        max_load_steps: 1,
+        throw: false,
+    };
+
+    /// x = sqrt(2 + sqrt(3)), y = 1/x: the root near (2, 0.5).
+    fn exact_root() -> [f64; 2] {
+        let x = (2.0 + 3f64.sqrt()).sqrt();
+        [x, 1.0 / x]
+    }
+
+    #[test]
+    fn newton_and_broyden_find_the_closed_form_root() {
+        for broyden in [false, true] {
+            let mut p = Circle { evaluations: 0 };
+            let out = newton(&mut p, &[2.0, 0.6], 1.0, &OPTS, &settings(broyden));
+            assert!(out.converged && out.at_x, "broyden {broyden}: {out:?}");
+            let e = exact_root();
+            assert!((out.x[0] - e[0]).abs() < 1e-12 && (out.x[1] - e[1]).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn newton_converges_quadratically() {
+        // Residual norms of successive exact Newton iterates: e_{k+1} <= C e_k².
+        let mut norms = Vec::new();
+        for it in 1..=4 {
+            let mut p = Circle { evaluations: 0 };
+            let o = NewtonOptions {
+                max_iterations: it,
+                tolerance: 1e-300,
+                ..OPTS
+            };
+            norms.push(newton(&mut p, &[2.0, 0.6], 1.0, &o, &settings(false)).residual);
+        }
+        for k in 1..3 {
+            assert!(norms[k] <= 10.0 * norms[k - 1] * norms[k - 1], "{norms:?}");
+        }
+    }
+
+    #[test]
+    fn line_search_lengths_and_armijo() {
+        let ls = LineSearch {
+            factor: 0.5,
+            max_halvings: 3,
+        };
+        assert_eq!(
+            ls.lengths().collect::<Vec<_>>(),
+            vec![1.0, 0.5, 0.25, 0.125]
+        );
+        let a = Armijo { c: 0.1 };
+        assert!(a.accept(1.0, 1.0, 0.9) && !a.accept(1.0, 1.0, 0.95));
+        assert!(a.accept(0.5, 1.0, 0.95));
+    }
+
+    #[test]
+    fn a_long_first_step_is_refused() {
+        let mut p = Circle { evaluations: 0 };
+        let s = NewtonSettings {
+            first_step_limit: Some(0.1),
+            ..settings(false)
+        };
+        let out = newton(&mut p, &[3.0, 0.0], 1.0, &OPTS, &s);
+        assert!(!out.converged && out.first_step > 0.1 && out.iterations == 0);
+    }
+}

@@ -1,0 +1,135 @@
+//! Robots as the tests write them: tendons with their tensions and chambers with their
+//! pressures, split into the model and the actuation by [`solve`]; and the one fixture of the
+//! two-segment NiTi tendon robot.
+#![allow(dead_code, missing_docs)]
+
+use std::sync::Arc;
+
+use softrod::{
+    solve_statics, Actuation, Chamber, ChamberArea, LinearElastic, Loads, Result, RobotModel, Rod,
+    Routing, Section, SolveOptions, StaticsSolution, Tendon,
+};
+
+/// A tendon and the tension it is pulled with (N).
+#[derive(Clone, Debug)]
+pub struct Tensioned {
+    pub tendon: Tendon,
+    pub tension: f64,
+}
+
+impl Tensioned {
+    pub fn tension(&self) -> f64 {
+        self.tension
+    }
+    pub fn with_tension(&self, tension: f64) -> Result<Self> {
+        Ok(Self {
+            tendon: self.tendon.clone(),
+            tension,
+        })
+    }
+}
+
+/// A tendon at the constant offset `(x, y)` (m) with `tension` (N).
+pub fn tendon(offset: [f64; 2], tension: f64, end: Option<f64>) -> Result<Tensioned> {
+    tendon_with(Routing::Constant(offset), tension, end)
+}
+
+/// A tendon of any routing with `tension` (N).
+pub fn tendon_with(routing: Routing, tension: f64, end: Option<f64>) -> Result<Tensioned> {
+    Ok(Tensioned {
+        tendon: Tendon::new(routing, end)?,
+        tension,
+    })
+}
+
+/// A chamber and its gauge pressure (Pa).
+#[derive(Clone, Debug)]
+pub struct Pressurised {
+    pub chamber: Chamber,
+    pub pressure: f64,
+}
+
+pub fn chamber(
+    pressure: f64,
+    area: ChamberArea,
+    offset: [f64; 2],
+    start: f64,
+    end: Option<f64>,
+) -> Result<Pressurised> {
+    softrod::model::chamber::check_pressure("pressure", pressure)?;
+    Ok(Pressurised {
+        chamber: Chamber::new(area, offset, start, end)?,
+        pressure,
+    })
+}
+
+pub fn constant_chamber(pressure: f64, area: f64, offset: [f64; 2]) -> Result<Pressurised> {
+    chamber(pressure, ChamberArea::Constant(area), offset, 0.0, None)
+}
+
+/// The model and actuation of a rod with tensioned tendons and pressurised chambers.
+pub fn split(
+    rod: &Rod,
+    tendons: &[Tensioned],
+    chambers: &[Pressurised],
+    loads: &Loads,
+) -> Result<(Arc<RobotModel>, Actuation)> {
+    let model = RobotModel::new(
+        rod.clone(),
+        tendons.iter().map(|t| t.tendon.clone()).collect(),
+        chambers.iter().map(|c| c.chamber.clone()).collect(),
+        loads.clone(),
+    )?;
+    let t: Vec<f64> = tendons.iter().map(|t| t.tension).collect();
+    let p: Vec<f64> = chambers.iter().map(|c| c.pressure).collect();
+    Ok((model, Actuation::tensions(&t).with_pressures(&p)))
+}
+
+/// Solves a rod with tensioned tendons under loads.
+pub fn solve(
+    rod: &Rod,
+    tendons: &[Tensioned],
+    loads: &Loads,
+    options: &SolveOptions,
+) -> Result<StaticsSolution> {
+    solve_with_chambers(rod, tendons, &[], loads, options)
+}
+
+/// Solves a rod with tensioned tendons and pressurised chambers under loads.
+pub fn solve_with_chambers(
+    rod: &Rod,
+    tendons: &[Tensioned],
+    chambers: &[Pressurised],
+    loads: &Loads,
+    options: &SolveOptions,
+) -> Result<StaticsSolution> {
+    let (model, act) = split(rod, tendons, chambers, loads)?;
+    solve_statics(&model, &act, options)
+}
+
+/// The two-segment NiTi robot: a 0.4 m superelastic NiTi backbone (E = 54 GPa, nu = 0.3,
+/// radius 0.7 mm).
+pub fn niti_rod() -> Rod {
+    Rod::new(
+        0.4,
+        Section::circular(0.7e-3).expect("radius"),
+        LinearElastic::new(54e9, 0.3).expect("material"),
+    )
+    .expect("rod")
+}
+
+/// Its six tendons at 10 mm, at 90°, -30°, 210° in each segment; the first three end at
+/// 0.2 m, the others at the tip; with the given tensions (N).
+pub fn niti_tendons(tensions: &[f64; 6]) -> Vec<Tensioned> {
+    (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            tendon(
+                [0.01 * ang.cos(), 0.01 * ang.sin()],
+                tensions[i],
+                Some(if i < 3 { 0.2 } else { 0.4 }),
+            )
+            .expect("tendon")
+        })
+        .collect()
+}
