@@ -171,3 +171,25 @@ def test_robots_are_immutable(niti):
     options = niti.solver
     options["steps"] = 3
     assert niti.solver["steps"] == 50
+
+
+def test_a_robot_built_in_code_round_trips_through_toml_and_pickle():
+    rod = softrod.Rod(
+        0.3,
+        softrod.TaperedCircularSection(0.004, 0.002),
+        softrod.LinearElastic(2e6, 0.45),
+        density=1100.0,
+    )
+    tendons = [
+        softrod.Tendon((0.002, 0.0), 0.05, 0.2),
+        softrod.Tendon.helical(0.0015, 0.25, 0.02, 0.3),
+        softrod.Tendon.radius_proportional(0.5, 2.0, 0.03),
+    ]
+    chambers = [softrod.Chamber(2e3, 1e-6, (0.0, 0.0015), 0.05, 0.25)]
+    loads = softrod.Loads(tip_force=(0.001, 0.0, -0.002), gravity=(0.0, 0.0, -9.81))
+    robot = Robot(rod, tendons=tendons, chambers=chambers, loads=loads, name="coded")
+    again = Robot.from_toml(robot.to_toml())
+    assert again.name == "coded"
+    expected = robot.solve().position
+    np.testing.assert_array_equal(again.solve().position, expected)
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(robot)).solve().position, expected)

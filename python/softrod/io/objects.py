@@ -321,29 +321,27 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
     out: dict[str, Any] = {"tension": float(t.tension)}
     if t.end is not None:
         out["end"] = float(t.end)
-    routing = r.get(t, "routing")
-    if routing is None:
+    routing, p = r.get(t, "routing"), r.get(t, "parameters")
+    if routing is None or p is None:
         return None
-    if routing == "constant":
-        offset = r.get(t, "offset")
-        return None if offset is None else {**out, "offset": _floats(offset)}
+    if routing == "constant" and p.get("derivative") is None and not callable(p["offset"]):
+        return {**out, "offset": _floats(p["offset"])}
     if routing == "radius_proportional":
-        ratio, angle = r.get(t, "ratio"), r.get(t, "angle")
-        if ratio is None or angle is None:
-            return None
-        return {**out, "routing": routing, "ratio": ratio, "angle_deg": math.degrees(angle)}
-    if routing == "helical":
-        radius, pitch, phase = r.get(t, "radius"), r.get(t, "pitch"), r.get(t, "phase")
-        if radius is None or pitch is None or phase is None:
-            return None
         return {
             **out,
             "routing": routing,
-            "radius": radius,
-            "pitch": pitch,
-            "phase_deg": math.degrees(phase),
+            "ratio": p["ratio"],
+            "angle_deg": math.degrees(p["angle"]),
         }
-    r.unserialisable.append(f"tendons[{i}] (routing {routing!r})")
+    if routing == "helical":
+        return {
+            **out,
+            "routing": routing,
+            "radius": p["radius"],
+            "pitch": p["pitch"],
+            "phase_deg": math.degrees(p["phase"]),
+        }
+    r.unserialisable.append(f"tendons[{i}] (routing {routing!r} with a Python function)")
     return None
 
 
@@ -421,10 +419,10 @@ def describe(
     material = r.get(rod, "material")
     rod_table["section"] = _describe_section(section, r) if section is not None else None
     rod_table["material"] = _describe_material(material, r) if material is not None else None
-    for name in ("rest_strain", "rest_curvature"):
-        v = _vector(r.get(rod, name), f"rod.{name}", r)
+    for key in ("rest_strain", "rest_curvature"):
+        v = _vector(r.get(rod, key), f"rod.{key}", r)
         if v is not None:
-            rod_table[name] = v
+            rod_table[key] = v
     data: dict[str, Any] = {
         "name": name,
         "description": description,
