@@ -39,6 +39,10 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
+pub use cosserat::sensitivity::{
+    actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
+    Parameter, Sensitivities,
+};
 pub use cosserat::statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};

@@ -86,9 +86,9 @@ impl<'a> Shooting<'a> {
         self.eq.load_factor = lambda;
         let columns: &[Column] = if N >= FULL { &[Column::Free; 6] } else { &[] };
         self.ws.set_columns(columns, &[]);
-        // RK4 passes integrate the tendon lengths from the nodes afterwards (Simpson); the
-        // adaptive ones on the stages.
-        self.ws.track_lengths = matches!(self.integrator, Integrator::Adaptive(_));
+        // The tendon lengths ride on the stages (the quadrature the displacement constraints
+        // and their sensitivities use).
+        self.ws.track_lengths = true;
         self.nodes.clear();
         let y0: [f64; N] = self.eq.initial(x);
         let scheme = Self::scheme(&self.integrator, &self.plan);

@@ -188,8 +188,12 @@ pub struct StaticsSolution {
     pub v: Vec<[f64; 3]>,
     /// Bending/twist strain `u` (body, 1/m per undeformed length).
     pub u: Vec<[f64; 3]>,
-    /// Path length of each tendon from the base to its termination (m), `∫ |p_i'| ds`.
+    /// Path length of each tendon from the base to its termination (m), `∫ |p_i'| ds`
+    /// (quadrature on the integration stages).
     pub tendon_lengths: Vec<f64>,
+    /// Tension carried by each tendon (N): the input of a tension-controlled tendon, the
+    /// solved tension of a displacement-controlled one (0 when slack).
+    pub tendon_tensions: Vec<f64>,
     /// Total base wrench (rod + tendons), for [`SolveOptions::warm_start`].
     pub base_wrench: [f64; 6],
     /// Solver statistics.
@@ -218,9 +222,9 @@ impl StaticsSolution {
         }
     }
 
-    /// Tension of every tendon (N).
+    /// Tension of every tendon (N), as [`StaticsSolution::tendon_tensions`].
     pub fn tensions(&self) -> Vec<f64> {
-        self.actuation.tension_values(self.model.tendons().len())
+        self.tendon_tensions.clone()
     }
 
     /// Pressure of every chamber (Pa).
@@ -501,6 +505,7 @@ fn assemble(
         v: Vec::with_capacity(n),
         u: Vec::with_capacity(n),
         tendon_lengths: p.lengths.clone(),
+        tendon_tensions: p.eq.tensions.to_vec(),
         base_wrench,
         stats,
         model: Arc::clone(shared),
@@ -513,21 +518,12 @@ fn assemble(
         eq: p.eq,
         ws: &mut ws,
     };
-    let rk4 = matches!(p.integrator, Integrator::Rk4 { .. });
-    if rk4 {
-        sol.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
-    }
-    ev.ws.track_lengths = true;
-    let nt = model.tendons().len();
-    // Tendon speeds |p_i'| at the nodes of the current interval (RK4: Simpson on the nodes).
-    let mut speeds: Vec<Vec<f64>> = vec![Vec::new(); nt];
     let mut current = usize::MAX;
     let nodes: &[Node] = &p.nodes;
-    for (j, node) in nodes.iter().enumerate() {
+    for node in nodes {
         if node.interval != current {
             ev.set_interval(node.interval);
             current = node.interval;
-            speeds.iter_mut().for_each(Vec::clear);
         }
         let y = &node.y;
         let r = rot(y);
@@ -547,50 +543,6 @@ fn assemble(
         sol.m_body.push(arr(&mb));
         sol.v.push(arr(&loc.v));
         sol.u.push(arr(&loc.u));
-        if rk4 && nt > 0 {
-            let k = node.interval;
-            let b = model.breaks()[k + 1];
-            for (i, &end) in model.tendon_ends().iter().enumerate() {
-                if end >= b {
-                    speeds[i].push(ev.ws.tendon_speed[i]);
-                }
-            }
-            let last_of_interval = nodes.get(j + 1).is_none_or(|n| n.interval != k);
-            if last_of_interval {
-                let count = nodes.iter().filter(|n| n.interval == k).count();
-                let h = (b - model.breaks()[k]) / (count - 1).max(1) as f64;
-                for (i, sp) in speeds.iter().enumerate() {
-                    if !sp.is_empty() {
-                        sol.tendon_lengths[i] += uniform_quadrature(sp, h);
-                    }
-                }
-            }
-        }
     }
     sol
-}
-
-/// Fourth-order quadrature of samples `f` on a uniform grid of spacing `h`: composite Simpson,
-/// with Simpson's 3/8 rule on the last three panels when the number of panels is odd
-/// (trapezoid for a single panel).
-fn uniform_quadrature(f: &[f64], h: f64) -> f64 {
-    let panels = f.len().saturating_sub(1);
-    match panels {
-        0 => 0.0,
-        1 => 0.5 * h * (f[0] + f[1]),
-        _ => {
-            let simpson_end = if panels % 2 == 0 { panels } else { panels - 3 };
-            let mut sum = 0.0;
-            let mut i = 0;
-            while i < simpson_end {
-                sum += h / 3.0 * (f[i] + 4.0 * f[i + 1] + f[i + 2]);
-                i += 2;
-            }
-            if simpson_end < panels {
-                let k = simpson_end;
-                sum += 3.0 * h / 8.0 * (f[k] + 3.0 * f[k + 1] + 3.0 * f[k + 2] + f[k + 3]);
-            }
-            sum
-        }
-    }
 }
