@@ -4,6 +4,7 @@
 //! sensitivities of an equilibrium from the linearised boundary-value problem
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
 
+pub mod displacement;
 pub(crate) mod equations;
 mod hyperelastic_local;
 pub mod sensitivity;
@@ -11,6 +12,7 @@ pub(crate) mod shooting;
 pub mod statics;
 
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+pub use displacement::reference_lengths;
 pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
     Parameter, Sensitivities,

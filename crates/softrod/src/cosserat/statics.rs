@@ -73,7 +73,8 @@ impl Default for Integrator {
     }
 }
 
-/// A starting point for the shooting unknowns, taken from a previous solution.
+/// A starting point for the shooting unknowns, taken from a previous solution (the tensions
+/// of its displacement-controlled tendons go into [`Actuation::tension_guess`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WarmStart {
     /// Total base wrench `[N(0); M(0)]` (N, N m; world frame) including the tendons' share.
@@ -350,6 +351,9 @@ pub fn solve_statics(
     options.validate()?;
     let (nt, nc) = (model.tendons().len(), model.chambers().len());
     actuation.validate(nt, nc)?;
+    if actuation.has_held() {
+        return super::displacement::solve_held(model, actuation, options);
+    }
     let tensions = actuation.tension_values(nt);
     let pressures = actuation.pressure_values(nc);
     let plan = match options.integrator {
@@ -485,7 +489,7 @@ fn rows(r: &Matrix3<f64>) -> [[f64; 3]; 3] {
 }
 
 /// Derived quantities at the recorded nodes of the last pass (which is at the solution).
-fn assemble(
+pub(crate) fn assemble(
     p: &mut Shooting<'_>,
     shared: &Arc<RobotModel>,
     base_wrench: [f64; 6],
@@ -505,7 +509,7 @@ fn assemble(
         v: Vec::with_capacity(n),
         u: Vec::with_capacity(n),
         tendon_lengths: p.lengths.clone(),
-        tendon_tensions: p.eq.tensions.to_vec(),
+        tendon_tensions: p.tensions.clone(),
         base_wrench,
         stats,
         model: Arc::clone(shared),
@@ -515,7 +519,7 @@ fn assemble(
     };
     let mut ws = Workspace::new(model.tendons().len());
     let mut ev = Evaluator {
-        eq: p.eq,
+        eq: p.equations(),
         ws: &mut ws,
     };
     let mut current = usize::MAX;

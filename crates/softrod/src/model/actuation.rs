@@ -78,6 +78,10 @@ pub struct Actuation {
     /// displacement-controlled tendons; `None`: computed by the solve (one more solve of the
     /// model at zero actuation, a single integration without external loads).
     pub reference_lengths: Option<Vec<f64>>,
+    /// First guess of the tensions (N, one per tendon) of the displacement-controlled tendons,
+    /// e.g. a previous solution's `tendon_tensions`; `None`: taut where the tendon would be
+    /// stretched at zero tension, from zero tension.
+    pub tension_guess: Option<Vec<f64>>,
 }
 
 impl Actuation {
@@ -128,12 +132,12 @@ impl Actuation {
             .collect()
     }
 
-    /// The same actuation with zero tensions and pressures (the motors' zero).
+    /// Zero tensions and pressures (the motors' zero).
     pub fn zero(n_tendons: usize, n_chambers: usize) -> Self {
         Self {
             tendons: vec![TendonInput::Tension(0.0); n_tendons],
             pressures: vec![0.0; n_chambers],
-            reference_lengths: None,
+            ..Self::default()
         }
     }
 
@@ -209,6 +213,15 @@ impl Actuation {
                         ));
                     }
                 }
+            }
+        }
+        if let Some(g) = &self.tension_guess {
+            if g.len() != n_tendons || g.iter().any(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    "tension_guess",
+                    format!("{g:?}"),
+                    format!("{n_tendons} finite tensions (N)"),
+                ));
             }
         }
         if let Some(r) = &self.reference_lengths {
