@@ -15,6 +15,9 @@
 //! * [`pcc`]: piecewise-constant-curvature kinematics, actuation maps and statics;
 //! * [`planar`]: the planar tapered cable arm (closed form and final-value ODE);
 //! * [`batch`]: workspace maps and backbone distances;
+//! * [`inverse`]: inverse statics (minimum-norm actuation reaching a target) and trajectory
+//!   tracking, for the Cosserat and PCC models; [`cosserat::sensitivity`] gives the exact
+//!   actuation Jacobians and parameter sensitivities it uses;
 //! * [`integrate`]: the one Runge–Kutta driver (RK4, Bogacki–Shampine, Dormand–Prince
 //!   tableaus) and the march over breaks;
 //! * [`solve`]: the one nonlinear solver (Newton, Broyden, line search, continuation);
@@ -26,6 +29,7 @@ pub mod compliance;
 pub mod cosserat;
 pub mod error;
 pub mod integrate;
+pub mod inverse;
 pub mod math;
 pub mod model;
 pub mod pcc;
@@ -47,6 +51,11 @@ pub use cosserat::sensitivity::{
 pub use cosserat::statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use inverse::pcc::PccForward;
+pub use inverse::{
+    inverse_statics, inverse_statics_path, solve_inverse, CosseratForward, Evaluation, Forward,
+    InverseOptions, InverseSolution, InverseWarmStart, Target,
+};
 pub use model::chamber::{Chamber, ChamberArea};
 pub use model::loads::{Frame, Loads, PointLoad};
 pub use model::material::fit::{

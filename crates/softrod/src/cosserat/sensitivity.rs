@@ -172,6 +172,10 @@ pub(crate) struct Integrated {
     pub rotations: Vec<Matrix3<f64>>,
     /// The nodes (if recorded).
     pub nodes: Vec<Node>,
+    /// Per column, `(δp, R w)` at the tip.
+    pub tip: Vec<Vector6<f64>>,
+    /// Tip position (m) and rotation.
+    pub tip_pose: (Vector3<f64>, Matrix3<f64>),
     /// Right-hand-side evaluations.
     pub evaluations: usize,
 }
@@ -294,6 +298,14 @@ fn pass<const N: usize>(
         ));
     }
     let (residual, d_residual) = eq.residual(&y, seeds.len());
+    let r_tip = rot(&y);
+    let tip = (0..seeds.len())
+        .map(|c| {
+            let b = STATE + COLUMN * c;
+            let (dp, w) = (v3(&y, b), r_tip * v3(&y, b + 3));
+            Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
+        })
+        .collect();
     let nl = req.lengths.len();
     let d_lengths = (0..seeds.len())
         .map(|c| ws.integral[nt + c * nl..nt + (c + 1) * nl].to_vec())
@@ -306,6 +318,8 @@ fn pass<const N: usize>(
         poses,
         rotations,
         nodes,
+        tip,
+        tip_pose: (v3(&y, 0), r_tip),
         evaluations,
     })
 }
@@ -347,6 +361,7 @@ pub(crate) fn integrate(
                 for (mine, theirs) in a.poses.iter_mut().zip(p.poses) {
                     mine.extend(theirs);
                 }
+                a.tip.extend(p.tip);
                 a.evaluations += p.evaluations;
             }
         }
