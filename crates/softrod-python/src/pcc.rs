@@ -967,11 +967,11 @@ pub(crate) fn pcc_solve<'py>(
         .detach(move || -> softrod::Result<_> {
             let sol = statics::solve_pcc_statics(model, &loads, &options)?;
             let chain = sol.chain();
-            let s = samples.unwrap_or_else(|| {
-                let l = chain.length();
-                let n = n_points as usize;
-                (0..n).map(|i| l * i as f64 / (n - 1) as f64).collect()
-            });
+            let s = match samples {
+                Some(s) => s,
+                // Exactly 0 and exactly the chain's length at the ends.
+                None => softrod::uniform_samples(chain.length(), n_points as usize)?,
+            };
             let frames = chain.backbone(&s)?;
             Ok((sol, s, frames))
         })

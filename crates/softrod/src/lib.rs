@@ -19,13 +19,14 @@
 //!   tableaus) and the march over breaks;
 //! * [`solve`]: the one nonlinear solver (Newton, Broyden, line search, continuation);
 //! * [`math`]: rotations, the adjoint, small linear algebra, the arc series;
-//! * [`error`]: the crate's one error type.
+//! * [`error`]: the crate's one error type; [`limits`]: the limits on input sizes and loads.
 
 pub mod batch;
 pub mod compliance;
 pub mod cosserat;
 pub mod error;
 pub mod integrate;
+pub mod limits;
 pub mod math;
 pub mod model;
 pub mod pcc;

@@ -259,7 +259,7 @@ fn bad_loads_and_options_are_named() {
 #[test]
 fn extreme_inputs_never_panic() {
     // Enormous tensions (the tendon path folds back), loads, stiffnesses and tiny step counts:
-    // each returns a result or an error.
+    // each returns a result, a convergence error, or (beyond the load limit) a named error.
     for e in [1e-6, 1.0, 1e12, 1e300] {
         for tau in [0.0, 1e-9, 1.0, 1e6, 1e15] {
             for f in [0.0, 1e-3, 1e3, 1e12] {
@@ -296,7 +296,18 @@ fn extreme_inputs_never_panic() {
                         ..opts
                     },
                 );
-                assert!(r2.is_ok() || matches!(r2, Err(Error::NotConverged { .. })));
+                // Loads beyond softrod::limits::MAX_LOAD_NUMBER are refused by name.
+                let refused = |r: &softrod::Result<_>| {
+                    matches!(r, Err(Error::InvalidParameter { name, .. })
+                        if name.starts_with("loads.") || name.starts_with("tensions["))
+                };
+                assert!(r.is_ok() || matches!(r, Err(Error::NotConverged { .. })) || refused(&r));
+                assert!(
+                    r2.is_ok() || matches!(r2, Err(Error::NotConverged { .. })) || refused(&r2)
+                );
+                let number =
+                    f * 2f64.sqrt() * 0.09 / (e * std::f64::consts::PI * 0.002f64.powi(4) / 4.0);
+                assert_eq!(refused(&r2), number > softrod::limits::MAX_LOAD_NUMBER);
             }
         }
     }

@@ -345,7 +345,10 @@ pub fn solve_statics(
 ) -> Result<StaticsSolution> {
     options.validate()?;
     let (nt, nc) = (model.tendons().len(), model.chambers().len());
-    actuation.validate(nt, nc)?;
+    model.check_actuation(actuation)?;
+    if let Some(w) = &options.warm_start {
+        model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
+    }
     let tensions = actuation.tension_values(nt);
     let pressures = actuation.pressure_values(nc);
     let plan = match options.integrator {

@@ -30,7 +30,7 @@ impl ElasticSegment {
         bending_stiffness: f64,
         axial_stiffness: Option<f64>,
     ) -> Result<Self> {
-        check_positive("rest_length", rest_length, "m")?;
+        crate::limits::check_length("rest_length", rest_length, false)?;
         check_positive("bending_stiffness", bending_stiffness, "N m^2")?;
         if let Some(ea) = axial_stiffness {
             check_positive("axial_stiffness", ea, "N")?;
@@ -56,11 +56,23 @@ impl ElasticSegment {
         check_positive("radius", radius, "m")?;
         check_positive("youngs_modulus", youngs_modulus, "Pa")?;
         let area = std::f64::consts::PI * radius * radius;
-        Self::new(
-            rest_length,
-            youngs_modulus * area * radius * radius / 4.0,
-            extensible.then_some(youngs_modulus * area),
-        )
+        let second_moment = area * radius * radius / 4.0;
+        if !(second_moment.is_finite() && second_moment > f64::MIN_POSITIVE) {
+            return Err(Error::invalid(
+                "radius",
+                radius,
+                "finite and > 0 m, with pi r^4 / 4 a finite nonzero float",
+            ));
+        }
+        let (ei, ea) = (youngs_modulus * second_moment, youngs_modulus * area);
+        if !(ei.is_finite() && ei > f64::MIN_POSITIVE && ea.is_finite()) {
+            return Err(Error::invalid(
+                "youngs_modulus",
+                youngs_modulus,
+                "finite and > 0 Pa, with E pi r^4 / 4 and E pi r^2 finite and nonzero",
+            ));
+        }
+        Self::new(rest_length, ei, extensible.then_some(ea))
     }
 
     /// Rest length `ℓ0` (m).
