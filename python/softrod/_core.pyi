@@ -16,11 +16,17 @@ class ParameterError(ValueError):
 
     parameter: str
 
+class ParameterTypeError(ParameterError, TypeError):
+    """An argument of the wrong type or shape; ``parameter`` names it."""
+
 class ConvergenceError(RuntimeError):
     """A solver or integrator did not converge."""
 
     iterations: int
     residual: float
+
+class InternalError(RuntimeError):
+    """A defect of softrod caught at the binding (never bad input); please report it."""
 
 @final
 class PlanarSolution:

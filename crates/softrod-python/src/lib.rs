@@ -8,6 +8,7 @@
 
 use pyo3::prelude::*;
 
+mod callbacks;
 mod compliance;
 mod convert;
 mod errors;
@@ -30,6 +31,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "ConvergenceError",
         m.py().get_type::<errors::ConvergenceError>(),
     )?;
+    m.add("ParameterTypeError", errors::parameter_type_error(m.py())?)?;
+    m.add("InternalError", m.py().get_type::<errors::InternalError>())?;
     m.add_class::<planar::PlanarCableArm>()?;
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;

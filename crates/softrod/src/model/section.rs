@@ -262,6 +262,11 @@ impl Section {
         }
     }
 
+    /// Whether the section is a user function of `s`.
+    pub fn is_function(&self) -> bool {
+        matches!(self.kind, Kind::Function(_))
+    }
+
     /// Whether the properties are the same at every `s` (circles and tubes).
     pub fn is_uniform(&self) -> bool {
         matches!(self.kind, Kind::Circular { .. } | Kind::Tube { .. })
