@@ -11,6 +11,15 @@ __version__: str
 _Floats = float | Sequence[float] | NDArray[np.float64]
 _Method = Literal["closed-form", "ode"]
 
+#: Limits on input sizes and magnitudes (``softrod::limits``; see docs/conventions.md).
+MAX_SAMPLES: int
+MAX_ITERATIONS: int
+MAX_LOAD_NUMBER: float
+MAX_LENGTH: float
+MAX_MODULUS: float
+MAX_BENDING_ANGLE: float
+MAX_OFFSET_RATIO: float
+
 class ParameterError(ValueError):
     """A parameter is outside its valid range; ``parameter`` names it."""
 

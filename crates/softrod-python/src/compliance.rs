@@ -524,7 +524,7 @@ pub(crate) fn _workspace_map<'py>(
         return Err(param_err(
             "tensions",
             format!("shape {:?}", a.shape()),
-            &format!("shape (M, {nt})"),
+            &format!("shape (M, n_tendons) with n_tendons = len(tendons) = {nt}"),
         ));
     }
     let flat: Vec<f64> = a.iter().copied().collect();

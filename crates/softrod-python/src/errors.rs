@@ -135,3 +135,45 @@ pub(crate) fn describe(obj: &Bound<'_, PyAny>) -> String {
 pub(crate) fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
+
+/// A core error of a function of `params`: an error naming an intermediate (`u_x`, `curvature`
+/// of the computed arc) says which arguments it was computed from.
+pub(crate) fn blame(params: &'static [&'static str]) -> impl Fn(Error) -> PyErr {
+    move |e| match e {
+        Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        } if !params.iter().any(|p| {
+            name == *p || name.starts_with(&format!("{p}[")) || name.starts_with(&format!("{p}."))
+        }) =>
+        {
+            to_py_err(Error::InvalidParameter {
+                name,
+                value,
+                expected: format!("{expected} (computed from {})", params.join(", ")),
+            })
+        }
+        other => to_py_err(other),
+    }
+}
+
+/// `values` if every one is finite, else a `ParameterError` saying that the result of
+/// `params` overflows (the inputs are individually valid but their combination is not
+/// representable).
+pub(crate) fn finite_result<'v>(
+    values: impl IntoIterator<Item = &'v f64>,
+    params: &[&str],
+) -> PyResult<()> {
+    if values.into_iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
+    Err(param_err(
+        params.first().copied().unwrap_or("arguments"),
+        "(see the message)",
+        &format!(
+            "such that the result is finite: it overflows a double for these {}",
+            params.join(", ")
+        ),
+    ))
+}

@@ -33,6 +33,13 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("ParameterTypeError", errors::parameter_type_error(m.py())?)?;
     m.add("InternalError", m.py().get_type::<errors::InternalError>())?;
+    m.add("MAX_SAMPLES", softrod::limits::MAX_SAMPLES)?;
+    m.add("MAX_ITERATIONS", softrod::limits::MAX_ITERATIONS)?;
+    m.add("MAX_LOAD_NUMBER", softrod::limits::MAX_LOAD_NUMBER)?;
+    m.add("MAX_LENGTH", softrod::limits::MAX_LENGTH)?;
+    m.add("MAX_MODULUS", softrod::limits::MAX_MODULUS)?;
+    m.add("MAX_BENDING_ANGLE", softrod::limits::MAX_BENDING_ANGLE)?;
+    m.add("MAX_OFFSET_RATIO", softrod::limits::MAX_OFFSET_RATIO)?;
     m.add_class::<planar::PlanarCableArm>()?;
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;

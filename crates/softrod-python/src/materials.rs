@@ -270,7 +270,11 @@ impl Linearised {
     /// From one datasheet point: nominal stress (Pa) at engineering strain `strain` (e.g. the
     /// "100 % modulus" at `strain = 1`).
     #[staticmethod]
-    fn from_secant_point(py: Python<'_>, nominal_stress: f64, strain: f64) -> PyResult<Py<Self>> {
+    fn from_secant_point(
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::nominal_stress)] nominal_stress: f64,
+        #[pyo3(from_py_with = arg::strain)] strain: f64,
+    ) -> PyResult<Py<Self>> {
         let law =
             softrod::Linearised::from_secant_point(nominal_stress, strain).map_err(to_py_err)?;
         Py::new(py, Self::init(law))
@@ -589,7 +593,21 @@ pub(crate) fn fit_uniaxial(
 
     let mut data = UniaxialData::new(&strain, strain_m, &stress, stress_m).map_err(to_py_err)?;
     if let Some((lo, hi)) = stretch_range {
-        data = data.within(lo, hi).map_err(to_py_err)?;
+        data = data.within(lo, hi).map_err(|e| match e {
+            // The range is one argument here: `stretch_range[0]`, not `stretch_min`.
+            Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => to_py_err(Error::InvalidParameter {
+                name: name
+                    .replace("stretch_min", "stretch_range[0]")
+                    .replace("stretch_max", "stretch_range[1]"),
+                value,
+                expected,
+            }),
+            other => to_py_err(other),
+        })?;
     }
     let range = (data.stretch_min(), data.stretch_max());
     let fit = py

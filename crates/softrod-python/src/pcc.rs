@@ -16,7 +16,7 @@ use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegme
 
 use crate::callbacks::run;
 use crate::convert::{arg, choice, count, Arg, Floats};
-use crate::errors::{param_err, to_py_err, type_err};
+use crate::errors::{blame, finite_result, param_err, to_py_err, type_err};
 
 /// A chamber group `(segment, areas, distances, angles)` (m², m, rad).
 type ChamberGroup = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
@@ -130,7 +130,12 @@ pub(crate) fn pcc_arc_pose(
     #[pyo3(from_py_with = arg::plane_angle)] plane_angle: f64,
     #[pyo3(from_py_with = arg::length)] length: f64,
 ) -> PyResult<Bound<'_, PyArray2<f64>>> {
-    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(to_py_err)?;
+    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(blame(&[
+        "curvature",
+        "plane_angle",
+        "length",
+    ]))?;
+    finite_result(t.iter(), &["curvature", "plane_angle", "length"])?;
     Ok(pose_array(py, &t))
 }
 
@@ -150,7 +155,7 @@ pub(crate) fn pcc_arc_poses<'py>(
             return Err(param_err(
                 &format!("{name}.len()"),
                 v.len(),
-                &format!("1 or the common length {n}"),
+                &format!("1 or the common length {n} of curvature, plane_angle and length"),
             ));
         }
     }
@@ -180,7 +185,7 @@ pub(crate) fn pcc_arc_poses<'py>(
         }
         Ok(())
     });
-    result.map_err(to_py_err)?;
+    result.map_err(blame(&["curvature", "plane_angle", "length"]))?;
     Ok(out.into_pyarray(py))
 }
 
@@ -194,7 +199,16 @@ pub(crate) fn pcc_arc_frames<'py>(
     #[pyo3(from_py_with = arg::s)] s: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let s = s.to_vec()?;
-    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(to_py_err)?;
+    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(blame(&[
+        "curvature",
+        "plane_angle",
+        "length",
+        "s",
+    ]))?;
+    finite_result(
+        ts.iter().flat_map(|m| m.iter()),
+        &["curvature", "plane_angle", "length", "s"],
+    )?;
     Ok(poses_array(py, &ts))
 }
 
@@ -210,7 +224,17 @@ pub(crate) fn pcc_arc_jacobian<'py>(
     #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (f, c) = (frame_from(frame)?, coordinates_from(coordinates)?);
-    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(to_py_err)?;
+    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(blame(&[
+        "curvature",
+        "plane_angle",
+        "length",
+        "frame",
+        "coordinates",
+    ]))?;
+    finite_result(
+        j.iter(),
+        &["curvature", "plane_angle", "length", "frame", "coordinates"],
+    )?;
     Ok(matrix_array(py, &j))
 }
 
@@ -231,8 +255,11 @@ pub(crate) fn pcc_chain_frames<'py>(
     segments: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = arg::s)] s: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(to_py_err)?;
-    let ts = chain.backbone(&s.to_vec()?).map_err(to_py_err)?;
+    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(blame(&["segments", "s"]))?;
+    let ts = chain
+        .backbone(&s.to_vec()?)
+        .map_err(blame(&["segments", "s"]))?;
+    finite_result(ts.iter().flat_map(|m| m.iter()), &["segments", "s"])?;
     Ok(poses_array(py, &ts))
 }
 
@@ -257,7 +284,7 @@ pub(crate) fn pcc_arc_from_tip<'py>(
     #[pyo3(from_py_with = arg::position)] position: Floats,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let p = vector3(position, "position")?;
-    let s = pcc::arc_from_tip(&p).map_err(to_py_err)?;
+    let s = pcc::arc_from_tip(&p).map_err(blame(&["position"]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -269,19 +296,20 @@ pub(crate) fn pcc_arc_from_tip_with_length<'py>(
     #[pyo3(from_py_with = arg::length)] length: f64,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
     let p = vector3(position, "position")?;
-    let fit = pcc::arc_from_tip_with_length(&p, length).map_err(to_py_err)?;
+    let fit = pcc::arc_from_tip_with_length(&p, length).map_err(blame(&["position", "length"]))?;
     Ok((arc_array(py, &fit.segment), fit.residual))
 }
 
 // ---------------------------------------------------------------------------- actuation maps
 
 fn tendons_from(distances: Floats, angles: Floats) -> PyResult<pcc::PccTendons> {
-    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?).map_err(to_py_err)
+    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?)
+        .map_err(blame(&["position", "length"]))
 }
 
 fn chambers_from(areas: Floats, distances: Floats, angles: Floats) -> PyResult<pcc::PccChambers> {
     pcc::PccChambers::new(&areas.to_vec()?, &distances.to_vec()?, &angles.to_vec()?)
-        .map_err(to_py_err)
+        .map_err(blame(&["position", "length"]))
 }
 
 /// Tendon length changes (m) of a segment with arc parameters `arc`.
@@ -296,7 +324,13 @@ pub(crate) fn pcc_tendon_displacements<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let seg = arc3(arc, "arc")?;
     let t = tendons_from(distances, angles)?;
-    let d = pcc::tendon_displacements(&seg, &t, rest_length).map_err(to_py_err)?;
+    let d = pcc::tendon_displacements(&seg, &t, rest_length).map_err(blame(&[
+        "arc",
+        "distances",
+        "angles",
+        "rest_length",
+    ]))?;
+    finite_result(&d, &["arc", "distances", "rest_length"])?;
     Ok(d.into_pyarray(py))
 }
 
@@ -333,7 +367,13 @@ pub(crate) fn pcc_arc_from_tendon_displacements<'py>(
     let t = tendons_from(distances, angles)?;
     let s =
         pcc::arc_from_tendon_displacements(&displacements.to_vec()?, &t, rest_length, extensible)
-            .map_err(to_py_err)?;
+            .map_err(blame(&[
+            "displacements",
+            "distances",
+            "angles",
+            "rest_length",
+            "extensible",
+        ]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -358,7 +398,25 @@ pub(crate) fn pcc_arc_from_tendon_displacements_jacobian<'py>(
         extensible,
         c,
     )
-    .map_err(to_py_err)?;
+    .map_err(blame(&[
+        "displacements",
+        "distances",
+        "angles",
+        "rest_length",
+        "extensible",
+        "coordinates",
+    ]))?;
+    finite_result(
+        j.iter(),
+        &[
+            "displacements",
+            "distances",
+            "angles",
+            "rest_length",
+            "extensible",
+            "coordinates",
+        ],
+    )?;
     Ok(matrix_array(py, &j))
 }
 
@@ -367,7 +425,14 @@ fn body_from(
     bending_stiffness: f64,
     axial_stiffness: Option<f64>,
 ) -> PyResult<ElasticSegment> {
-    ElasticSegment::new(rest_length, bending_stiffness, axial_stiffness).map_err(to_py_err)
+    ElasticSegment::new(rest_length, bending_stiffness, axial_stiffness).map_err(blame(&[
+        "displacements",
+        "distances",
+        "angles",
+        "rest_length",
+        "extensible",
+        "coordinates",
+    ]))
 }
 
 /// The arc of a uniform elastic segment pulled by tendon tensions (N).
@@ -384,7 +449,14 @@ pub(crate) fn pcc_arc_from_tendon_tensions<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let t = tendons_from(distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let s = pcc::arc_from_tendon_tensions(&tensions.to_vec()?, &t, &body).map_err(to_py_err)?;
+    let s = pcc::arc_from_tendon_tensions(&tensions.to_vec()?, &t, &body).map_err(blame(&[
+        "tensions",
+        "distances",
+        "angles",
+        "rest_length",
+        "bending_stiffness",
+        "axial_stiffness",
+    ]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -404,8 +476,29 @@ pub(crate) fn pcc_arc_from_tendon_tensions_jacobian<'py>(
     let c = coordinates_from(coordinates)?;
     let t = tendons_from(distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c)
-        .map_err(to_py_err)?;
+    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c).map_err(
+        blame(&[
+            "tensions",
+            "distances",
+            "angles",
+            "rest_length",
+            "bending_stiffness",
+            "axial_stiffness",
+            "coordinates",
+        ]),
+    )?;
+    finite_result(
+        j.iter(),
+        &[
+            "tensions",
+            "distances",
+            "angles",
+            "rest_length",
+            "bending_stiffness",
+            "axial_stiffness",
+            "coordinates",
+        ],
+    )?;
     Ok(matrix_array(py, &j))
 }
 
@@ -424,7 +517,15 @@ pub(crate) fn pcc_arc_from_pressures<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let ch = chambers_from(areas, distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let s = pcc::arc_from_pressures(&pressures.to_vec()?, &ch, &body).map_err(to_py_err)?;
+    let s = pcc::arc_from_pressures(&pressures.to_vec()?, &ch, &body).map_err(blame(&[
+        "pressures",
+        "areas",
+        "distances",
+        "angles",
+        "rest_length",
+        "bending_stiffness",
+        "axial_stiffness",
+    ]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -446,7 +547,16 @@ pub(crate) fn pcc_arc_from_pressures_jacobian<'py>(
     let ch = chambers_from(areas, distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
     let j =
-        pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c).map_err(to_py_err)?;
+        pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c).map_err(blame(&[
+            "pressures",
+            "areas",
+            "distances",
+            "angles",
+            "rest_length",
+            "bending_stiffness",
+            "axial_stiffness",
+            "coordinates",
+        ]))?;
     Ok(matrix_array(py, &j))
 }
 
@@ -461,7 +571,7 @@ fn per_segment(v: Floats, n: usize, name: &str) -> PyResult<Vec<f64>> {
         k => Err(param_err(
             &format!("{name}.len()"),
             k,
-            &format!("1 or the number of segments, {n}"),
+            &format!("1 or the number of segments (the length of rest_lengths), {n}"),
         )),
     }
 }

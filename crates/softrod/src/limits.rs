@@ -14,6 +14,7 @@
 //!   nine orders of magnitude above that, so no physical load is refused, while the scaled
 //!   residual of the solvers (loads over `EI / L²` and `EI / L`), its square and its
 //!   Jacobian stay far from overflow.
+//! - Materials: [`MAX_MODULUS`].
 //! - Geometry: [`MAX_LENGTH`], [`MAX_BENDING_ANGLE`], and for tendon routings
 //!   [`MAX_OFFSET_RATIO`].
 
@@ -39,6 +40,11 @@ pub const MAX_LENGTH: f64 = 1e6;
 /// beyond it an arc's pose is no longer a meaningful function of its parameters (the square of
 /// the angle enters the arc series).
 pub const MAX_BENDING_ANGLE: f64 = 1e6;
+
+/// Largest elastic modulus or material parameter (Pa): ten times the Young's modulus of
+/// diamond. Softer materials span nine orders of magnitude below it; the stiffness of a
+/// section (a modulus times a fourth power of its radius) stays finite.
+pub const MAX_MODULUS: f64 = 1e13;
 
 /// Largest distance of a tendon from the backbone, as a fraction of the rod length.
 ///
@@ -78,6 +84,39 @@ pub fn check_length(name: &str, value: f64, allow_zero: bool) -> Result<f64> {
             name,
             value,
             format!("finite, {low} and <= {MAX_LENGTH:e} m"),
+        ))
+    }
+}
+
+/// Checks an elastic modulus (Pa): finite, > 0 and at most [`MAX_MODULUS`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn check_modulus(name: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 && value <= MAX_MODULUS {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            name,
+            value,
+            format!("finite, > 0 and <= {MAX_MODULUS:e} Pa"),
+        ))
+    }
+}
+
+/// Checks a material parameter that may have either sign (Pa): finite and of magnitude at
+/// most [`MAX_MODULUS`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name` otherwise.
+pub fn check_parameter(name: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value.abs() <= MAX_MODULUS {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            name,
+            value,
+            format!("finite and of magnitude <= {MAX_MODULUS:e} Pa"),
         ))
     }
 }

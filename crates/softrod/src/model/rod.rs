@@ -128,7 +128,7 @@ impl Pose {
             }
         }
         let err = orthonormality_error(&rotation);
-        if err.is_nan() || err > ROTATION_TOLERANCE {
+        if rotation.iter().any(|v| !v.is_finite()) || err.is_nan() || err > ROTATION_TOLERANCE {
             return Err(Error::invalid(
                 "base_pose.rotation",
                 format!("{rotation:?}"),

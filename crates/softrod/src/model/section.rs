@@ -199,7 +199,7 @@ impl Section {
                 return Err(Error::invalid(
                     format!("{name}.len()"),
                     col.len(),
-                    format!("equal to s.len() = {n}"),
+                    format!("equal to the length of `s`, {n}"),
                 ));
             }
         }

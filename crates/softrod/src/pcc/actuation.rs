@@ -54,7 +54,7 @@ impl ElasticSegment {
         extensible: bool,
     ) -> Result<Self> {
         check_positive("radius", radius, "m")?;
-        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        crate::limits::check_modulus("youngs_modulus", youngs_modulus)?;
         let area = std::f64::consts::PI * radius * radius;
         let second_moment = area * radius * radius / 4.0;
         if !(second_moment.is_finite() && second_moment > f64::MIN_POSITIVE) {
@@ -115,7 +115,7 @@ fn check_actuators(distances: &[f64], angles: &[f64]) -> Result<()> {
         ));
     }
     for (i, (&d, &b)) in distances.iter().zip(angles).enumerate() {
-        check_positive(&format!("distances[{i}]"), d, "m")?;
+        crate::limits::check_length(&format!("distances[{i}]"), d, false)?;
         check_finite(&format!("angles[{i}]"), b)?;
     }
     Ok(())
@@ -229,7 +229,14 @@ impl PccChambers {
             ));
         }
         for (i, &a) in areas.iter().enumerate() {
-            check_positive(&format!("areas[{i}]"), a, "m^2")?;
+            let max = crate::limits::MAX_LENGTH * crate::limits::MAX_LENGTH;
+            if !(a.is_finite() && a > 0.0 && a <= max) {
+                return Err(Error::invalid(
+                    format!("areas[{i}]"),
+                    a,
+                    format!("finite, > 0 and <= {max:e} m^2"),
+                ));
+            }
         }
         let (sin, cos) = angles.iter().map(|b| b.sin_cos()).unzip();
         Ok(Self {
@@ -539,7 +546,10 @@ fn elastic_arc<F: Fn(usize) -> Loading>(
         return Err(Error::invalid(
             name,
             format!("{values:?}"),
-            format!("an axial strain > -1 (net axial force {f:e} N)"),
+            format!(
+                "an axial strain > -1: net axial force {f:e} N over axial_stiffness {} N",
+                body.axial_stiffness.unwrap_or(f64::INFINITY)
+            ),
         ));
     }
     Ok((mx / ei, my / ei, l))

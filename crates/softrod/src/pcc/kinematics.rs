@@ -66,7 +66,7 @@
 
 use nalgebra::{Matrix3, Matrix4, Matrix6x3, Matrix6xX, Vector3};
 
-use crate::error::{check_finite, check_positive, Error, Result};
+use crate::error::{check_finite, Error, Result};
 use crate::limits::MAX_BENDING_ANGLE;
 use crate::math::samples::in_range;
 use crate::math::series::{arc_s1, arc_sb};
@@ -425,11 +425,14 @@ pub fn arc_jacobian(
 
 fn check_position(position: &Vector3<f64>) -> Result<()> {
     for k in 0..3 {
-        if !position[k].is_finite() {
+        if !(position[k].is_finite() && position[k].abs() <= crate::limits::MAX_LENGTH) {
             return Err(Error::invalid(
                 format!("position[{k}]"),
                 position[k],
-                "finite (m)",
+                format!(
+                    "finite and of magnitude <= {:e} m",
+                    crate::limits::MAX_LENGTH
+                ),
             ));
         }
     }
@@ -490,7 +493,7 @@ pub struct TipFit {
 /// and > 0.
 pub fn arc_from_tip_with_length(position: &Vector3<f64>, length: f64) -> Result<TipFit> {
     check_position(position)?;
-    check_positive("length", length, "m")?;
+    crate::limits::check_length("length", length, false)?;
     let (x, y, z) = (position.x, position.y, position.z);
     let r = x.hypot(y);
     let phi = if r > 0.0 { y.atan2(x) } else { 0.0 };
@@ -697,7 +700,18 @@ impl PccChain {
         s.iter()
             .enumerate()
             .map(|(i, &si)| {
-                let si = in_range(|| format!("s[{i}]"), si, total)?;
+                let si = in_range(|| format!("s[{i}]"), si, total).map_err(|e| match e {
+                    Error::InvalidParameter {
+                        name,
+                        value,
+                        expected,
+                    } => Error::InvalidParameter {
+                        name,
+                        value,
+                        expected: format!("{expected} (the total length of the segments)"),
+                    },
+                    other => other,
+                })?;
                 let k = self
                     .ends
                     .partition_point(|&e| e < si)

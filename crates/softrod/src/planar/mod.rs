@@ -140,7 +140,7 @@ impl PlanarCableArm {
         if !(offset_ratio.is_finite() && (0.0..1.0).contains(&offset_ratio)) {
             return Err(Error::invalid("offset_ratio", offset_ratio, "in [0, 1)"));
         }
-        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        crate::limits::check_modulus("youngs_modulus", youngs_modulus)?;
         // The bending stiffness E pi R^4 / 4 at both ends must be a finite nonzero float (a
         // radius of 1e-100 m or 1e100 m is positive but under- or overflows it).
         for (name, r) in [("base_radius", base_radius), ("tip_radius", tip_radius)] {
