@@ -114,7 +114,7 @@ def finite_array(value: Any, name: str, *, ndim: int | None = None) -> np.ndarra
     if bad.size:
         index = np.unravel_index(bad[0], a.shape)
         at = ", ".join(str(int(i)) for i in index)
-        raise value_error(f"{name}[{at}]", a[index], "finite")
+        raise value_error(f"{name}[{at}]" if at else name, a[index], "finite")
     return a
 
 

@@ -22,6 +22,7 @@ use pyo3::prelude::*;
 
 use crate::errors::{describe, internal_err, param_err, to_py_err};
 
+
 /// Where the first exception of a computation's callables waits until the core returns.
 #[derive(Clone, Default)]
 pub(crate) struct ErrorSlot(Arc<Mutex<Option<PyErr>>>);
@@ -61,16 +62,15 @@ fn with_slot<R>(slot: &ErrorSlot, f: impl FnOnce() -> R) -> R {
 /// A Python callable of the arc length `s`, named by the parameter it was given as.
 pub(crate) struct Callback {
     f: Py<PyAny>,
-    what: String,
+    what: &'static str,
+    label: &'static str,
 }
 
 impl Callback {
-    /// The callable `f` given as the parameter `what` (e.g. `rest_curvature`).
-    pub(crate) fn new(f: Py<PyAny>, what: impl Into<String>) -> Self {
-        Self {
-            f,
-            what: what.into(),
-        }
+    /// The callable `f` given as the parameter `what` (e.g. `rest_curvature`), described in
+    /// messages as `label` (e.g. "the rest curvature").
+    pub(crate) fn new(f: Py<PyAny>, what: &'static str, label: &'static str) -> Self {
+        Self { f, what, label }
     }
 
     /// Calls it at `s` and converts the result with `convert`; on failure reports to the
@@ -87,20 +87,24 @@ impl Callback {
                 Ok(r) => match convert(&r) {
                     Some(v) => return v,
                     None => param_err(
-                        &self.what,
-                        format!("{} at s = {s} m", describe(&r)),
-                        &format!("a function of s returning {expected}"),
+                        self.what,
+                        format!("<function> returning {} at s = {s} m", describe(&r)),
+                        &format!("a function of s returning {expected} ({})", self.label),
                     ),
                 },
                 Err(original) => {
-                    let e = param_err(
-                        &self.what,
-                        format!("<function> at s = {s} m"),
-                        &format!(
-                            "a function of s returning {expected}; it raised {}",
-                            crate::errors::one_line(&original.to_string())
-                        ),
-                    );
+                    let text = crate::errors::one_line(&format!(
+                        "invalid parameter `{}`: {} raised {} at s = {s} m",
+                        self.what,
+                        self.label,
+                        original
+                            .value(py)
+                            .repr()
+                            .map(|r| r.to_string())
+                            .unwrap_or_else(|_| original.to_string())
+                    ));
+                    let e = crate::errors::ParameterError::new_err(text);
+                    let _ = e.value(py).setattr("parameter", self.what);
                     e.set_cause(py, Some(original));
                     e
                 }

@@ -594,17 +594,15 @@ pub(crate) fn fit_uniaxial(
     let mut data = UniaxialData::new(&strain, strain_m, &stress, stress_m).map_err(to_py_err)?;
     if let Some((lo, hi)) = stretch_range {
         data = data.within(lo, hi).map_err(|e| match e {
-            // The range is one argument here: `stretch_range[0]`, not `stretch_min`.
+            // The range is one argument here: say so.
             Error::InvalidParameter {
                 name,
                 value,
                 expected,
             } => to_py_err(Error::InvalidParameter {
-                name: name
-                    .replace("stretch_min", "stretch_range[0]")
-                    .replace("stretch_max", "stretch_range[1]"),
+                name,
                 value,
-                expected,
+                expected: format!("{expected} (stretch_range = (stretch_min, stretch_max))"),
             }),
             other => to_py_err(other),
         })?;

@@ -85,9 +85,13 @@ where
 }
 
 /// A 3-vector argument (constant) or a Python function of `s`, as a core profile.
-fn profile(arg: &Bound<'_, PyAny>, what: &'static str) -> PyResult<softrod::Profile> {
+fn profile(
+    arg: &Bound<'_, PyAny>,
+    what: &'static str,
+    label: &'static str,
+) -> PyResult<softrod::Profile> {
     if arg.is_callable() {
-        let cb = Callback::new(arg.clone().unbind(), what);
+        let cb = Callback::new(arg.clone().unbind(), what, label);
         return Ok(softrod::Profile::Function(Arc::new(move |s| {
             Vector3::from(cb.floats::<3>(s))
         })));
@@ -138,9 +142,9 @@ impl Rod {
     ) -> PyResult<Self> {
         let sec = section.get().inner.clone();
         let material_core = material_of(material)?;
-        let rest_strain_p = rest_strain.map(|v| profile(v, "rest_strain")).transpose()?;
+        let rest_strain_p = rest_strain.map(|v| profile(v, "rest_strain", "the rest strain")).transpose()?;
         let rest_curvature_p = rest_curvature
-            .map(|u| profile(u, "rest_curvature"))
+            .map(|u| profile(u, "rest_curvature", "the rest curvature"))
             .transpose()?;
         let pose = match base_pose {
             Some(p) => {
@@ -272,8 +276,12 @@ pub(crate) struct Tendon {
     args: Args,
 }
 
-fn offset_fn(f: &Bound<'_, PyAny>, what: &'static str) -> softrod::model::tendon::OffsetFn {
-    let cb = Callback::new(f.clone().unbind(), what);
+fn offset_fn(
+    f: &Bound<'_, PyAny>,
+    what: &'static str,
+    label: &'static str,
+) -> softrod::model::tendon::OffsetFn {
+    let cb = Callback::new(f.clone().unbind(), what, label);
     Arc::new(move |s| cb.floats::<2>(s))
 }
 
@@ -305,8 +313,8 @@ impl Tendon {
                     return Err(type_err("derivative", df, "a function of s"));
                 }
                 softrod::Routing::Function {
-                    offset: offset_fn(offset, "offset"),
-                    derivative: offset_fn(df, "derivative"),
+                    offset: offset_fn(offset, "offset", "the tendon offset"),
+                    derivative: offset_fn(df, "derivative", "the tendon offset derivative"),
                 }
             }
             (true, None) => {
@@ -510,7 +518,7 @@ impl Chamber {
         let pressure =
             softrod::model::chamber::check_pressure("pressure", pressure).map_err(to_py_err)?;
         let a = if area.is_callable() {
-            let cb = Callback::new(area.clone().unbind(), "area");
+            let cb = Callback::new(area.clone().unbind(), "area", "the chamber area");
             softrod::ChamberArea::Function(Arc::new(move |s| cb.float(s)))
         } else {
             let v: f64 = crate::convert::Arg::from_arg(area, "area")
@@ -521,9 +529,9 @@ impl Chamber {
         let inner = run_attached("Chamber", || {
             let c = softrod::Chamber::new(a, offset_xy, start, end)?;
             if let softrod::ChamberArea::Function(_) = c.area() {
-                // Called once here (the rod, hence the chamber's extent, is not known yet).
-                let a0 = c.area_at(start);
-                softrod::error::check_positive(&format!("area({start})"), a0, "m^2")?;
+                // Called once here (the rod, hence the chamber's extent, is not known yet);
+                // its values are checked with the rod (`chambers[i].area(s)`).
+                softrod::error::check_finite(&format!("area({start})"), c.area_at(start))?;
             }
             Ok(c)
         })?;
@@ -724,10 +732,10 @@ impl Loads {
             tip_frame: frame_from("tip_frame", tip_frame)?,
             point_loads: point_loads.iter().map(|p| p.get().inner).collect(),
             distributed_force: distributed_force
-                .map(|f| profile(f, "distributed_force"))
+                .map(|f| profile(f, "distributed_force", "the distributed force"))
                 .transpose()?,
             distributed_moment: distributed_moment
-                .map(|f| profile(f, "distributed_moment"))
+                .map(|f| profile(f, "distributed_moment", "the distributed moment"))
                 .transpose()?,
             gravity: v(gravity, "gravity")?,
         };

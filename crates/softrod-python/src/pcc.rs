@@ -50,7 +50,23 @@ fn coordinates_from(coordinates: &str) -> PyResult<ArcCoordinates> {
 /// Rows of three floats: an (n, 3) array or nested sequence (one row of 3 is accepted too).
 fn rows3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
     let what = "an (n, 3) array of rows (curvature, plane_angle, length)";
-    let a = crate::convert::float_array(obj, name, what)?;
+    let a = match crate::convert::float_array(obj, name, what) {
+        Ok(a) => a,
+        Err(e) => {
+            // A ragged list: name the row that is not 3 numbers.
+            if let Ok(rows) = obj.cast::<pyo3::types::PyList>() {
+                for (i, row) in rows.iter().enumerate() {
+                    crate::convert::floats_n(
+                        &row,
+                        &format!("{name}[{i}]"),
+                        3,
+                        "a row of 3 numbers (curvature, plane_angle, length)",
+                    )?;
+                }
+            }
+            return Err(e);
+        }
+    };
     let a = match a.ndim() {
         1 => a.insert_axis(numpy::ndarray::Axis(0)),
         _ => a,

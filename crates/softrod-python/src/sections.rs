@@ -227,7 +227,7 @@ impl FunctionSection {
         if !function.bind(py).is_callable() {
             return Err(type_err("function", function.bind(py), "a function of s"));
         }
-        let cb = Callback::new(function.clone_ref(py), "function");
+        let cb = Callback::new(function.clone_ref(py), "function", "the section function");
         let inner = softrod::Section::function(Arc::new(move |s| {
             let [area, ix, iy, j] = cb.floats::<4>(s);
             softrod::model::section::SectionProperties {

@@ -134,6 +134,35 @@ impl Problem {
     }
 }
 
+/// The core's `tensions[i]` / `pressures[i]` as the Python objects that carry them:
+/// `tendons[i].tension`, `chambers[i].pressure`.
+pub(crate) fn actuator_names(e: softrod::Error) -> softrod::Error {
+    match e {
+        softrod::Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => {
+            let rename = |prefix: &str, object: &str, field: &str| -> Option<String> {
+                let index = name.strip_prefix(prefix)?.strip_suffix(']')?;
+                index
+                    .parse::<usize>()
+                    .ok()
+                    .map(|i| format!("{object}[{i}].{field}"))
+            };
+            let name = rename("tensions[", "tendons", "tension")
+                .or_else(|| rename("pressures[", "chambers", "pressure"))
+                .unwrap_or(name);
+            softrod::Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            }
+        }
+        other => other,
+    }
+}
+
 /// A solved rod, sampled at the integration mesh (SI units, world frame unless `_body`).
 ///
 /// Positions (m), rotations, internal force (N) and moment (N m), strains, tendon lengths (m),
@@ -377,7 +406,7 @@ pub(crate) fn solve_statics<'py>(
     )?;
     let (model, act) = (&problem.model, &problem.actuation);
     let result = run(py, "solve_statics", || {
-        softrod::solve_statics(model, act, &options)
+        softrod::solve_statics(model, act, &options).map_err(actuator_names)
     })?;
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(

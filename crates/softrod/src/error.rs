@@ -41,9 +41,16 @@ impl Error {
         value: impl std::fmt::Display,
         expected: impl Into<String>,
     ) -> Self {
+        let mut value = value.to_string();
+        // A huge or tiny float prints as hundreds of digits: show it in scientific notation.
+        if value.len() > 24 {
+            if let Ok(v) = value.parse::<f64>() {
+                value = format!("{v:e}");
+            }
+        }
         Error::InvalidParameter {
             name: name.into(),
-            value: value.to_string(),
+            value,
             expected: expected.into(),
         }
     }

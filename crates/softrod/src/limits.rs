@@ -46,13 +46,14 @@ pub const MAX_BENDING_ANGLE: f64 = 1e6;
 /// section (a modulus times a fourth power of its radius) stays finite.
 pub const MAX_MODULUS: f64 = 1e13;
 
-/// Largest distance of a tendon from the backbone, as a fraction of the rod length.
+/// Largest distance of a tendon (or a PCC chamber) from the backbone, as a fraction of the rod
+/// length.
 ///
 /// A tendon may run outside the section (through spacer disks, as on a thin superelastic
-/// backbone); a rod model still needs its cross-section and the guides of its tendons small
-/// against its length. Half the length (disks as wide as the rod is long) is far beyond any
-/// slender robot.
-pub const MAX_OFFSET_RATIO: f64 = 0.5;
+/// backbone: 10 mm on a 0.7 mm rod); a rod model still needs the guides of its tendons smaller
+/// than the rod is long. A tendon farther from the backbone than the whole length of the rod
+/// (0.5 m on a 0.4 m robot) describes no slender robot.
+pub const MAX_OFFSET_RATIO: f64 = 1.0;
 
 /// Checks a count: `min <= value <= max`.
 ///

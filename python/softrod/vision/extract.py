@@ -168,9 +168,7 @@ def extract_backbone(
         n_points = _args.count(n_points, "n_points", 2, _args.MAX_SAMPLES)
     knot_spacing = _positive("knot_spacing", knot_spacing)
     if knot_spacing is not None and knot_spacing < MIN_KNOT_SPACING:
-        raise parameter_error(
-            "knot_spacing", f"{knot_spacing!r} must be >= {MIN_KNOT_SPACING} px"
-        )
+        raise parameter_error("knot_spacing", f"{knot_spacing!r} must be >= {MIN_KNOT_SPACING} px")
     if min_area is not None and (
         isinstance(min_area, bool) or not isinstance(min_area, (int, np.integer)) or min_area < 1
     ):
