@@ -21,6 +21,7 @@ class ConvergenceError(RuntimeError):
 
     iterations: int
     residual: float
+    load_factor: float
 
 @final
 class PlanarSolution:

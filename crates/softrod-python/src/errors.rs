@@ -17,8 +17,10 @@ create_exception!(
     _core,
     ConvergenceError,
     PyRuntimeError,
-    "A solver or integrator did not converge; carries `iterations` and `residual`.\n\n\
-     The residual is the solver's scaled (dimensionless) residual."
+    "A solver or integrator did not converge; carries `iterations`, `residual` and \
+     `load_factor`.\n\n\
+     The residual is the solver's scaled (dimensionless) residual; `load_factor` is the \
+     fraction of the external loads the last iterate carries (1: the full problem)."
 );
 
 /// The one place where core errors become Python exceptions.
@@ -33,11 +35,13 @@ pub(crate) fn to_py_err(e: Error) -> PyErr {
         Error::NotConverged {
             iterations,
             residual,
+            load_factor,
             ..
         } => Python::attach(|py| {
             let err = ConvergenceError::new_err(msg);
             let _ = err.value(py).setattr("iterations", iterations);
             let _ = err.value(py).setattr("residual", residual);
+            let _ = err.value(py).setattr("load_factor", load_factor);
             err
         }),
     }

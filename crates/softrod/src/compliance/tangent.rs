@@ -338,11 +338,8 @@ fn solve_linearised(
     held: &[usize],
     tension_rate: &mut [[f64; 6]],
 ) -> Result<Matrix6<f64>> {
-    let fail = |what: &str| Error::NotConverged {
-        what: format!("tangent compliance: {what}"),
-        iterations: 0,
-        residual: f64::INFINITY,
-    };
+    let fail =
+        |what: &str| Error::not_converged(format!("tangent compliance: {what}"), 0, f64::INFINITY);
     let (residual, lengths, pose) = (&columns.residual, &columns.lengths, &columns.pose);
     // Linear system in z = [δx (scaled base wrench); δτ (held)], column-major.
     let dim = 6 + held.len();

@@ -109,11 +109,11 @@ impl<'a> Shooting<'a> {
         self.evaluations += std::mem::take(&mut self.ws.evaluations);
         let y = result?;
         if !y[..STATE].iter().all(|v| v.is_finite()) {
-            return Err(Error::NotConverged {
-                what: "rod integration: non-finite state".into(),
-                iterations: 0,
-                residual: f64::INFINITY,
-            });
+            return Err(Error::not_converged(
+                "rod integration: non-finite state",
+                0,
+                f64::INFINITY,
+            ));
         }
         let nt = self.eq.model.tendons().len();
         self.lengths.clear();

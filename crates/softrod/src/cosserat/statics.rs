@@ -402,11 +402,11 @@ pub fn solve_statics(
         if let Some(e) = p.ws.material_error.take() {
             return Err(e);
         }
-        return Err(Error::NotConverged {
-            what: "shooting Newton (Cosserat rod statics)".into(),
-            iterations: stats.iterations,
-            residual: result.residual,
-        });
+        return Err(Error::not_converged(
+            "shooting Newton (Cosserat rod statics)",
+            stats.iterations,
+            result.residual,
+        ));
     }
     let x = &result.x;
     let base_wrench = [

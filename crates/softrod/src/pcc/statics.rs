@@ -948,11 +948,11 @@ pub fn solve_pcc_statics(
     stats.converged = result.converged;
     stats.function_evaluations = p.evaluations;
     if !result.converged && opts.throw {
-        return Err(Error::NotConverged {
-            what: "PCC statics Newton".into(),
-            iterations: stats.iterations,
-            residual: result.residual,
-        });
+        return Err(Error::not_converged(
+            "PCC statics Newton",
+            stats.iterations,
+            result.residual,
+        ));
     }
     let q: Vec<[f64; 3]> = result.x.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     let segments = q
