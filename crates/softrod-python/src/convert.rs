@@ -99,3 +99,16 @@ pub(crate) fn frame_from(name: &str, frame: &str) -> PyResult<softrod::Frame> {
         other => Err(param_err(name, other, "\"world\" or \"body\"")),
     }
 }
+
+/// Any number of floats from a sequence or a 1-d array (`None`: empty), naming `name` on
+/// failure.
+pub(crate) fn floats_opt(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Vec<f64>> {
+    match obj {
+        None => Ok(Vec::new()),
+        Some(o) if o.is_none() => Ok(Vec::new()),
+        Some(o) => match o.extract::<Floats<'_>>() {
+            Ok(f) => f.to_vec(),
+            Err(_) => Err(param_err(name, describe(o), "a sequence of floats (m)")),
+        },
+    }
+}

@@ -1,7 +1,7 @@
 //! Python exceptions and the one place where core errors become them.
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 
 use softrod::Error;
@@ -21,6 +21,21 @@ create_exception!(
      `load_factor`.\n\n\
      The residual is the solver's scaled (dimensionless) residual; `load_factor` is the \
      fraction of the external loads the last iterate carries (1: the full problem)."
+);
+
+create_exception!(
+    _core,
+    StabilityWarning,
+    PyUserWarning,
+    "The equilibrium returned is unstable (its tip tangent stiffness is not positive \
+     definite) and no stable one was found; see `StaticsSolution.stability_margin`."
+);
+create_exception!(
+    _core,
+    StabilityError,
+    PyRuntimeError,
+    "The equilibrium reached is unstable and no stable one was found \
+     (`on_unstable=\"raise\"`); carries `stability_margin` and the unstable `solution`."
 );
 
 /// The one place where core errors become Python exceptions.

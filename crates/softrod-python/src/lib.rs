@@ -30,6 +30,14 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "ConvergenceError",
         m.py().get_type::<errors::ConvergenceError>(),
     )?;
+    m.add(
+        "StabilityWarning",
+        m.py().get_type::<errors::StabilityWarning>(),
+    )?;
+    m.add(
+        "StabilityError",
+        m.py().get_type::<errors::StabilityError>(),
+    )?;
     m.add_class::<planar::PlanarCableArm>()?;
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;

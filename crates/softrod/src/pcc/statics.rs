@@ -917,6 +917,7 @@ pub fn solve_pcc_statics(
         residual_first: unloaded && options.warm_start.is_none(),
         broyden: false,
         jacobian: None,
+        exact_at_solution: false,
     };
     let mut result = newton(&mut p, &flat(&q0), 1.0, opts, &settings);
     stats.iterations = result.iterations;
