@@ -383,7 +383,11 @@ fn on_unstable(v: Option<&str>) -> PyResult<OnUnstable> {
 
 /// Warns (`StabilityWarning`) or raises (`StabilityError`) for a converged, unstable
 /// solution, as asked.
-fn report_unstable(py: Python<'_>, sol: StaticsSolution, mode: OnUnstable) -> PyResult<StaticsSolution> {
+fn report_unstable(
+    py: Python<'_>,
+    sol: StaticsSolution,
+    mode: OnUnstable,
+) -> PyResult<StaticsSolution> {
     let inner = &sol.inner;
     if mode == OnUnstable::Ignore || inner.stable || !inner.stats.converged {
         return Ok(sol);
@@ -494,12 +498,18 @@ pub(crate) fn solve_statics<'py>(
             ("warm_start", o(warm_start.map(Bound::unbind))),
             ("throw", throw.into_pyobject(py)?.into_any().unbind()),
             ("chambers", chambers.into_pyobject(py)?.into_any().unbind()),
-            ("s_out", s_values.clone().into_pyobject(py)?.into_any().unbind()),
+            (
+                "s_out",
+                s_values.clone().into_pyobject(py)?.into_any().unbind(),
+            ),
             (
                 "seek_stable",
                 seek_stable.into_pyobject(py)?.into_any().unbind(),
             ),
-            ("on_unstable", "ignore".into_pyobject(py)?.into_any().unbind()),
+            (
+                "on_unstable",
+                "ignore".into_pyobject(py)?.into_any().unbind(),
+            ),
         ],
     )?;
     let sol = StaticsSolution {

@@ -575,9 +575,8 @@ fn seek_stable(
         ..*options
     };
     for sign in [1.0, -1.0] {
-        let w: [f64; 6] = std::array::from_fn(|i| {
-            sign * zeta[i] * if i < 3 { f } else { f * model.length() }
-        });
+        let w: [f64; 6] =
+            std::array::from_fn(|i| sign * zeta[i] * if i < 3 { f } else { f * model.length() });
         let mut loads = model.loads().clone();
         loads.point_loads.push(PointLoad {
             s: model.length(),
