@@ -33,6 +33,7 @@ class ConvergenceError(RuntimeError):
 
     iterations: int
     residual: float
+    load_factor: float
 
 class InternalError(RuntimeError):
     """A defect of softrod caught at the binding (never bad input); please report it."""

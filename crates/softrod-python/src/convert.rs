@@ -499,5 +499,15 @@ pub(crate) mod arg {
         ix,
         iy,
         j,
+        seek_stable,
     );
+}
+/// Any number of floats from a sequence or a 1-d array (`None`: empty), naming `name` on
+/// failure.
+pub(crate) fn floats_opt(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<Vec<f64>> {
+    match obj {
+        None => Ok(Vec::new()),
+        Some(o) if o.is_none() => Ok(Vec::new()),
+        Some(o) => Ok(Floats::from_arg(o, name)?.0),
+    }
 }

@@ -8,7 +8,7 @@
 //!   panic), never a user error.
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyUserWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyTuple, PyType};
@@ -26,8 +26,25 @@ create_exception!(
     _core,
     ConvergenceError,
     PyRuntimeError,
-    "A solver or integrator did not converge; carries `iterations` and `residual`.\n\n\
-     The residual is the solver's scaled (dimensionless) residual."
+    "A solver or integrator did not converge; carries `iterations`, `residual` and \
+     `load_factor`.\n\n\
+     The residual is the solver's scaled (dimensionless) residual; `load_factor` is the \
+     fraction of the external loads the last iterate carries (1: the full problem)."
+);
+
+create_exception!(
+    _core,
+    StabilityWarning,
+    PyUserWarning,
+    "The equilibrium returned is unstable (its tip tangent stiffness is not positive \
+     definite) and no stable one was found; see `StaticsSolution.stability_margin`."
+);
+create_exception!(
+    _core,
+    StabilityError,
+    PyRuntimeError,
+    "The equilibrium reached is unstable and no stable one was found \
+     (`on_unstable=\"raise\"`); carries `stability_margin` and the unstable `solution`."
 );
 create_exception!(
     _core,
@@ -78,11 +95,13 @@ pub(crate) fn to_py_err(e: Error) -> PyErr {
         Error::NotConverged {
             iterations,
             residual,
+            load_factor,
             ..
         } => Python::attach(|py| {
             let err = ConvergenceError::new_err(msg);
             let _ = err.value(py).setattr("iterations", iterations);
             let _ = err.value(py).setattr("residual", residual);
+            let _ = err.value(py).setattr("load_factor", load_factor);
             err
         }),
     }

@@ -40,6 +40,14 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_MODULUS", softrod::limits::MAX_MODULUS)?;
     m.add("MAX_BENDING_ANGLE", softrod::limits::MAX_BENDING_ANGLE)?;
     m.add("MAX_OFFSET_RATIO", softrod::limits::MAX_OFFSET_RATIO)?;
+    m.add(
+        "StabilityWarning",
+        m.py().get_type::<errors::StabilityWarning>(),
+    )?;
+    m.add(
+        "StabilityError",
+        m.py().get_type::<errors::StabilityError>(),
+    )?;
     m.add_class::<planar::PlanarCableArm>()?;
     m.add_class::<planar::PlanarSolution>()?;
     m.add_class::<planar::PlanarBatch>()?;

@@ -17,7 +17,7 @@ use softrod::{AdaptiveOptions, Integrator, SolveOptions};
 
 use crate::callbacks::{run, run_attached};
 use crate::convert::{arg, count, floats_n};
-use crate::errors::{param_err, to_py_err};
+use crate::errors::{param_err, to_py_err, StabilityError, StabilityWarning};
 use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 
 /// The user's options, each `None` when not given.
@@ -33,6 +33,7 @@ pub(crate) struct OptionArgs<'py> {
     pub max_load_steps: Option<i64>,
     pub warm_start: Option<Bound<'py, PyAny>>,
     pub throw: Option<bool>,
+    pub seek_stable: Option<bool>,
 }
 
 /// The one keyword parser of the solve options: from the core's defaults, each given option
@@ -79,6 +80,9 @@ pub(crate) fn solve_options(a: &OptionArgs<'_>) -> PyResult<SolveOptions> {
     }
     if let Some(t) = a.throw {
         o.newton.throw = t;
+    }
+    if let Some(t) = a.seek_stable {
+        o.seek_stable = t;
     }
     if let Some(w) = &a.warm_start {
         o.warm_start = Some(if let Ok(s) = w.cast::<StaticsSolution>() {
@@ -311,6 +315,20 @@ impl StaticsSolution {
     fn converged(&self) -> bool {
         self.inner.stats.converged
     }
+    /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
+    /// tension, dead loads) is positive definite; always True without external loads,
+    /// False for a result that did not converge (docs/stability.md).
+    #[getter]
+    fn stable(&self) -> bool {
+        self.inner.stable
+    }
+    /// Smallest eigenvalue of the symmetric part of the dimensionless tip tangent stiffness
+    /// D K D / (EI(0)/L), D = diag(L, L, L, 1, 1, 1): > 0 for a stable equilibrium; NaN if
+    /// not converged (docs/stability.md).
+    #[getter]
+    fn stability_margin(&self, py: Python<'_>) -> f64 {
+        py.detach(|| self.inner.stability_margin())
+    }
     /// Solver statistics: iterations, residual, function_evaluations, load_steps, load_factor,
     /// converged.
     #[getter]
@@ -356,16 +374,68 @@ pub(crate) fn stats_dict<'py>(
     Ok(d)
 }
 
+/// What to do when the equilibrium returned is unstable.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum OnUnstable {
+    Warn,
+    Raise,
+    Ignore,
+}
+
+fn on_unstable(v: Option<&str>) -> PyResult<OnUnstable> {
+    match v.unwrap_or("warn") {
+        "warn" => Ok(OnUnstable::Warn),
+        "raise" => Ok(OnUnstable::Raise),
+        "ignore" => Ok(OnUnstable::Ignore),
+        other => Err(param_err(
+            "on_unstable",
+            other,
+            "\"warn\", \"raise\" or \"ignore\"",
+        )),
+    }
+}
+
+/// Warns (`StabilityWarning`) or raises (`StabilityError`) for a converged, unstable
+/// solution, as asked.
+fn report_unstable(
+    py: Python<'_>,
+    sol: StaticsSolution,
+    mode: OnUnstable,
+) -> PyResult<StaticsSolution> {
+    let inner = &sol.inner;
+    if mode == OnUnstable::Ignore || inner.stable || !inner.stats.converged {
+        return Ok(sol);
+    }
+    let margin = inner.stability_margin();
+    let msg = format!(
+        "the equilibrium returned is unstable (stability margin {margin:.4e}: the tip \
+         tangent stiffness is not positive definite) and no stable equilibrium was found \
+         from it; see docs/stability.md"
+    );
+    if mode == OnUnstable::Warn {
+        let category = py.get_type::<StabilityWarning>();
+        PyErr::warn(py, &category, &std::ffi::CString::new(msg)?, 1)?;
+        return Ok(sol);
+    }
+    let err = StabilityError::new_err(msg);
+    let value = err.value(py);
+    value.setattr("stability_margin", margin)?;
+    value.setattr("solution", Py::new(py, sol)?)?;
+    Err(err)
+}
+
 /// Solves the statics of `rod` with `tendons`, `loads` and pneumatic `chambers` by shooting
 /// (see the docs). Options not given keep the core's defaults.
 ///
 /// Tendon tensions (N) and chamber pressures (Pa) are the actuation; returns a
-/// `StaticsSolution` (SI units) or raises `ConvergenceError` (with iterations, residual).
+/// `StaticsSolution` (SI units; at the arc lengths `s_out` (m) if given) or raises
+/// `ConvergenceError` (with iterations, residual, load_factor). An unstable equilibrium is
+/// replaced by a stable one when found (`seek_stable`), else reported (`on_unstable`).
 #[pyfunction]
 #[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator=None, steps=None,
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
                     continuation=None, max_load_steps=None, warm_start=None, throw=None,
-                    chambers=Vec::new()))]
+                    chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
     py: Python<'py>,
@@ -383,8 +453,13 @@ pub(crate) fn solve_statics<'py>(
     warm_start: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::throw)] throw: Option<bool>,
     #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
+    s_out: Option<Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
+    on_unstable: Option<&'py str>,
 ) -> PyResult<StaticsSolution> {
     let warm_start = warm_start.filter(|w| !w.is_none());
+    let unstable = self::on_unstable(on_unstable)?;
+    let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
     let args = OptionArgs {
         integrator,
         steps,
@@ -396,6 +471,7 @@ pub(crate) fn solve_statics<'py>(
         max_load_steps,
         warm_start: warm_start.clone(),
         throw,
+        seek_stable,
     };
     let options = solve_options(&args)?;
     let problem = Problem::new(
@@ -406,7 +482,7 @@ pub(crate) fn solve_statics<'py>(
     )?;
     let (model, act) = (&problem.model, &problem.actuation);
     let result = run(py, "solve_statics", || {
-        softrod::solve_statics(model, act, &options).map_err(actuator_names)
+        softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
     })?;
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(
@@ -441,13 +517,26 @@ pub(crate) fn solve_statics<'py>(
             ("warm_start", o(warm_start.map(Bound::unbind))),
             ("throw", throw.into_pyobject(py)?.into_any().unbind()),
             ("chambers", chambers.into_pyobject(py)?.into_any().unbind()),
+            (
+                "s_out",
+                s_values.clone().into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "seek_stable",
+                seek_stable.into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "on_unstable",
+                "ignore".into_pyobject(py)?.into_any().unbind(),
+            ),
         ],
     )?;
-    Ok(StaticsSolution {
+    let sol = StaticsSolution {
         inner: result,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
-    })
+    };
+    report_unstable(py, sol, unstable)
 }
 
 /// Benchmark hook: runs the same solve `repeats` times inside Rust and returns each call's

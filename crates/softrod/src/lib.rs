@@ -40,7 +40,9 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
-pub use cosserat::statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};
+pub use cosserat::statics::{
+    solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,
+};
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
 pub use model::chamber::{Chamber, ChamberArea};

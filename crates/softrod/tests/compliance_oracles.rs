@@ -207,8 +207,11 @@ fn fd_tip_compliance(
             plus.tip_moment[j - 3] += eps;
             minus.tip_moment[j - 3] -= eps;
         }
+        // The derivative along the solution's branch: no search for another equilibrium
+        // (the axial step of a straight rod compresses it past buckling).
         let o = SolveOptions {
             warm_start: Some(sol.warm_start()),
+            seek_stable: false,
             ..*opts
         };
         let sp = common::solve(rod, tendons, &plus, &o).unwrap();

@@ -15,7 +15,10 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector6};
 
-use crate::cosserat::equations::{rot, v3, Column, Equations, Evaluator, Workspace, COLUMN, STATE};
+use crate::cosserat::equations::{
+    col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, DM, DN,
+    STATE,
+};
 use crate::cosserat::statics::{Integrator, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, rk4_plan, Scheme};
@@ -116,9 +119,9 @@ fn pass<const N: usize>(
         if let Seed::Base(k) = s {
             let b = STATE + COLUMN * c;
             if *k < 3 {
-                y0[b + 6 + k] = f_ref;
+                y0[b + DN + k] = f_ref;
             } else {
-                y0[b + 9 + k - 3] = fm;
+                y0[b + DM + k - 3] = fm;
             }
         }
     }
@@ -136,14 +139,14 @@ fn pass<const N: usize>(
                 let pose = (0..seeds.len())
                     .map(|c| {
                         let b = STATE + COLUMN * c;
-                        let (dp, w) = (v3(y, b), r * v3(y, b + 3));
+                        let (dp, w) = (v3(y, b), rotation_variation(&r, &col_rot(y, b)));
                         Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
                     })
                     .collect();
                 at_node = Some((pose, r));
                 for (c, seed) in seeds.iter().enumerate() {
                     if let Seed::Load(k) = seed {
-                        let b = STATE + COLUMN * c + if *k < 3 { 6 + k } else { 9 + k - 3 };
+                        let b = STATE + COLUMN * c + if *k < 3 { DN + k } else { DM + k - 3 };
                         y[b] = -1.0;
                     }
                 }
@@ -338,11 +341,8 @@ fn solve_linearised(
     held: &[usize],
     tension_rate: &mut [[f64; 6]],
 ) -> Result<Matrix6<f64>> {
-    let fail = |what: &str| Error::NotConverged {
-        what: format!("tangent compliance: {what}"),
-        iterations: 0,
-        residual: f64::INFINITY,
-    };
+    let fail =
+        |what: &str| Error::not_converged(format!("tangent compliance: {what}"), 0, f64::INFINITY);
     let (residual, lengths, pose) = (&columns.residual, &columns.lengths, &columns.pose);
     // Linear system in z = [δx (scaled base wrench); δτ (held)], column-major.
     let dim = 6 + held.len();

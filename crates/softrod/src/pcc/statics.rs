@@ -974,6 +974,7 @@ pub fn solve_pcc_statics(
         residual_first: unloaded && options.warm_start.is_none(),
         broyden: false,
         jacobian: None,
+        exact_at_solution: false,
     };
     let mut result = newton(&mut p, &flat(&q0), 1.0, opts, &settings);
     stats.iterations = result.iterations;
@@ -1005,11 +1006,11 @@ pub fn solve_pcc_statics(
     stats.converged = result.converged;
     stats.function_evaluations = p.evaluations;
     if !result.converged && opts.throw {
-        return Err(Error::NotConverged {
-            what: "PCC statics Newton".into(),
-            iterations: stats.iterations,
-            residual: result.residual,
-        });
+        return Err(Error::not_converged(
+            "PCC statics Newton",
+            stats.iterations,
+            result.residual,
+        ));
     }
     let q: Vec<[f64; 3]> = result.x.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     let segments = q

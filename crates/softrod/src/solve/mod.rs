@@ -10,7 +10,7 @@
 mod continuation;
 mod newton;
 
-pub use continuation::{continuation, ContinuationSettings, Continued};
+pub use continuation::{continuation, ContinuationSettings, Continued, Stopped};
 pub use newton::{newton, Armijo, Condition, LineSearch, NewtonOutcome, NewtonSettings};
 
 use crate::error::{Error, Result};

@@ -383,11 +383,11 @@ fn invert_nominal_stress<L: UniaxialLaw + ?Sized>(law: &L, target: f64) -> Resul
         }
         x = next;
     }
-    Err(Error::NotConverged {
-        what: format!("{} stretch-from-stress inversion", law.model_name()),
-        iterations: INVERSE_MAX_ITERATIONS,
+    Err(Error::not_converged(
+        format!("{} stretch-from-stress inversion", law.model_name()),
+        INVERSE_MAX_ITERATIONS,
         residual,
-    })
+    ))
 }
 
 /// `λ² − 1/λ = (λ − 1)(λ² + λ + 1)/λ`, written to keep its relative accuracy near `λ = 1`.
