@@ -35,6 +35,15 @@ class ConvergenceError(RuntimeError):
     residual: float
     load_factor: float
 
+class StabilityWarning(UserWarning):
+    """The equilibrium returned is unstable and no stable one was found."""
+
+class StabilityError(RuntimeError):
+    """The equilibrium reached is unstable (``on_unstable="raise"``)."""
+
+    stability_margin: float
+    solution: StaticsSolution
+
 class InternalError(RuntimeError):
     """A defect of softrod caught at the binding (never bad input); please report it."""
 
@@ -385,6 +394,12 @@ class StaticsSolution:
     @property
     def base_wrench(self) -> NDArray[np.float64]: ...
     @property
+    def stable(self) -> bool:
+        """Whether the equilibrium is stable (tip tangent stiffness positive definite)."""
+    @property
+    def stability_margin(self) -> float:
+        """Smallest eigenvalue of the scaled tip tangent stiffness (> 0: stable)."""
+    @property
     def tensions(self) -> NDArray[np.float64]:
         """Tendon tensions it was solved for (N), shape (n_tendons,)."""
     @property
@@ -416,10 +431,14 @@ def solve_statics(
     warm_start: StaticsSolution | Sequence[float] | None = None,
     throw: bool | None = None,
     chambers: Sequence[Chamber] = ...,
+    s_out: Sequence[float] | NDArray[np.float64] | None = None,
+    seek_stable: bool | None = None,
+    on_unstable: Literal["warn", "raise", "ignore"] | None = None,
 ) -> StaticsSolution:
     """Options not given keep the core's defaults: integrator "rk4" with 40 steps (rtol 1e-8,
     atol 1e-10 for "adaptive"), tolerance 1e-10, max_iterations 30, continuation True,
-    max_load_steps 64, throw True."""
+    max_load_steps 64, throw True, seek_stable True, on_unstable "warn". ``s_out`` (m) adds
+    nodes at those arc lengths."""
 
 # ----------------------------------------------------------------------------- materials
 

@@ -487,6 +487,9 @@ def _define_targets() -> None:
                 warm_start=None,
                 throw=True,
                 chambers=[],
+                s_out=[0.05, 0.1],
+                seek_stable=True,
+                on_unstable="ignore",
             ),
         )
     )

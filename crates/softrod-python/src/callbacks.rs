@@ -22,7 +22,6 @@ use pyo3::prelude::*;
 
 use crate::errors::{describe, internal_err, param_err, to_py_err};
 
-
 /// Where the first exception of a computation's callables waits until the core returns.
 #[derive(Clone, Default)]
 pub(crate) struct ErrorSlot(Arc<Mutex<Option<PyErr>>>);

@@ -142,7 +142,9 @@ impl Rod {
     ) -> PyResult<Self> {
         let sec = section.get().inner.clone();
         let material_core = material_of(material)?;
-        let rest_strain_p = rest_strain.map(|v| profile(v, "rest_strain", "the rest strain")).transpose()?;
+        let rest_strain_p = rest_strain
+            .map(|v| profile(v, "rest_strain", "the rest strain"))
+            .transpose()?;
         let rest_curvature_p = rest_curvature
             .map(|u| profile(u, "rest_curvature", "the rest curvature"))
             .transpose()?;
