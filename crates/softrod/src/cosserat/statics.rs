@@ -514,6 +514,10 @@ fn assemble(
         ws: &mut ws,
     };
     let rk4 = matches!(p.integrator, Integrator::Rk4 { .. });
+    if sol.tendon_lengths.len() != model.tendons().len() {
+        // The last pass failed before its lengths (a non-converged result): none to report.
+        sol.tendon_lengths = vec![f64::NAN; model.tendons().len()];
+    }
     if rk4 {
         sol.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
     }
