@@ -10,6 +10,7 @@ core per task).
 
 from __future__ import annotations
 
+import re
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -191,7 +192,9 @@ def client_of(scheduler):
         raise ImportError("scheduler= needs dask[distributed]: pip install 'dask[distributed]'") from exc
     if isinstance(scheduler, Client):
         return scheduler, False
-    if isinstance(scheduler, str) or hasattr(scheduler, "scheduler_address"):
+    if isinstance(scheduler, str) and re.match(r"[a-z][a-z0-9+.-]*://\S+\Z", scheduler):
+        return Client(scheduler), True
+    if not isinstance(scheduler, str) and hasattr(scheduler, "scheduler_address"):
         return Client(scheduler), True
     exc = ParameterError(
         f"invalid parameter `scheduler` = {scheduler!r}: must be None (all cores of this "

@@ -94,6 +94,13 @@ def workspace_measures(points: np.ndarray, voxel: float) -> dict[str, float]:
     return out
 
 
+def _vector(name: str, value: Any) -> np.ndarray:
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise _bad(name, value, "3 numbers") from None
+
+
 def _largest_compliance(ds) -> Any:
     """``c_max`` per sample (m/N) at the last arc point (the tip by default), or None."""
     arc = "s" if "s" in ds.dims else "arm_index" if "arm_index" in ds.dims else None
@@ -149,12 +156,18 @@ def design_summary(
 
     if "tip_position" not in getattr(ds, "data_vars", {}):
         raise _bad("ds", "no tip_position", "a sweep with outputs including 'tip_pose'")
-    over = list(ds.attrs.get("actuation_dims", []) if over is None else over)
+    if over is None:
+        over = str(ds.attrs.get("actuation_dims", "")).split()
+    elif isinstance(over, str):
+        over = [over]
+    elif not isinstance(over, (list, tuple)) or not all(isinstance(d, str) for d in over):
+        raise _bad("over", over, "a sequence of dimension names")
+    over = list(over)
     for d in over:
         if d not in ds.dims:
             raise _bad("over", d, f"dimensions of ds ({', '.join(map(str, ds.dims))})")
-    a = np.asarray(axis, dtype=float)
-    o = np.asarray(origin, dtype=float)
+    a = _vector("axis", axis)
+    o = _vector("origin", origin)
     if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
         raise _bad("axis", axis, "a nonzero direction of 3 finite numbers")
     if o.shape != (3,) or not np.all(np.isfinite(o)):
@@ -167,6 +180,8 @@ def design_summary(
         p = p[np.all(np.isfinite(p), axis=1)]
         diag = float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) if len(p) else 0.0
         voxel = VOXEL_FRACTION * diag if diag > 0 else 1e-3
+    if isinstance(voxel, bool) or not isinstance(voxel, (int, float, np.number)):
+        raise _bad("voxel", voxel, "a number (m)")
     if not (np.isfinite(voxel) and voxel > 0):
         raise _bad("voxel", voxel, "finite and > 0 m")
     cmax = _largest_compliance(ds)
@@ -225,7 +240,17 @@ def design_summary(
     }
     coords = {d: ds[d] for d in rest if d in ds.coords}
     data = {n: (rest, out[n].reshape(shape), attrs[n]) for n in names}
-    return xr.Dataset(data, coords=coords, attrs={"voxel": voxel, "over": over})
+    return xr.Dataset(data, coords=coords, attrs={"voxel": voxel, "over": " ".join(over)})
+
+
+def _objective(name: str, value: Any) -> np.ndarray:
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise _bad(name, value, "numbers (an array or a DataArray)") from None
+    if v.ndim == 0:
+        raise _bad(name, value, "an array of objective values (at least one dimension)")
+    return v
 
 
 class Pareto:
@@ -257,16 +282,33 @@ class Pareto:
         better: Sequence[str] = ("min", "min"),
         names: Sequence[str] | None = None,
     ) -> None:
+        if (
+            isinstance(better, str)
+            or not isinstance(better, (list, tuple))
+            or len(better) != 2
+            or any(x not in ("min", "max") for x in better)
+        ):
+            raise _bad("better", better, "two of 'min' or 'max', one per objective")
         better = tuple(better)
-        if len(better) != 2 or any(x not in ("min", "max") for x in better):
-            raise _bad("better", better, "two of 'min' or 'max'")
         self._da = a if hasattr(a, "dims") and hasattr(a, "coords") else None
-        av = np.asarray(a, dtype=float)
-        bv = np.asarray(b, dtype=float)
+        av = _objective("a", a)
+        bv = _objective("b", b)
         if av.shape != bv.shape:
-            raise _bad("b", f"shape {bv.shape}", f"the shape of a, {av.shape}")
+            exc = ParameterError(
+                f"invalid parameters `a` and `b`: must have the same shape, not {av.shape} "
+                f"and {bv.shape}"
+            )
+            exc.parameter = "b"
+            raise exc
         if names is None:
             names = (getattr(a, "name", None) or "a", getattr(b, "name", None) or "b")
+        elif (
+            isinstance(names, str)
+            or not isinstance(names, (list, tuple))
+            or len(names) != 2
+            or not all(isinstance(n, str) for n in names)
+        ):
+            raise _bad("names", names, "two strings, one per objective")
         self.names = tuple(str(n) for n in names)
         self.better = better
         self._shape = av.shape

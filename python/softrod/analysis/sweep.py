@@ -115,26 +115,41 @@ def _outputs(outputs: Any) -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
+def _floats(name: str, value: Any) -> np.ndarray:
+    try:
+        return np.atleast_1d(np.asarray(value, dtype=float))
+    except (TypeError, ValueError):
+        raise _bad(name, value, "a 1-D sequence of numbers") from None
+
+
 def _arcs(robot, arc_lengths, arm_index) -> tuple[tuple[float, ...] | None, tuple[float, ...]]:
     if arc_lengths is not None and arm_index is not None:
         raise _bad("arm_index", arm_index, "None when `arc_lengths` is given (one or the other)")
     if arc_lengths is not None:
-        a = np.atleast_1d(np.asarray(arc_lengths, dtype=float))
+        a = _floats("arc_lengths", arc_lengths)
         length = robot.rod.length
         if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)):
             raise _bad("arc_lengths", arc_lengths, "a non-empty 1-D sequence of finite m")
         if np.any(a < 0) or np.any(a > length):
             raise _bad("arc_lengths", arc_lengths, f"in [0, {length}] m (the rod)")
         return tuple(float(x) for x in a), ()
-    u = np.atleast_1d(np.asarray(1.0 if arm_index is None else arm_index, dtype=float))
+    u = _floats("arm_index", 1.0 if arm_index is None else arm_index)
     if u.ndim != 1 or u.size == 0 or not np.all((u >= 0) & (u <= 1)):
         raise _bad("arm_index", arm_index, "fractions of the rod's length in [0, 1]")
     return None, tuple(float(x) for x in u)
 
 
+#: Largest ``block`` and ``chunk`` accepted (samples).
+MAX_SAMPLES_PER_TASK = 2**31 - 1
+
+
 def _positive_int(name: str, value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise _bad(name, value, "an integer >= 1")
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, np.integer))
+        or not 1 <= value <= MAX_SAMPLES_PER_TASK
+    ):
+        raise _bad(name, value, f"an integer in [1, {MAX_SAMPLES_PER_TASK}]")
     return int(value)
 
 
@@ -197,8 +212,9 @@ def sweep(
         An ``xarray.Dataset``: the output variables (units in ``attrs``), ``status`` (0
         converged, 1 not converged, 2 failed, 3 infeasible design; NaN outputs unless 0),
         ``error`` (the error class per sample, "" if none), ``design_status`` and
-        ``design_error`` (the message) per design point; ``attrs``: the robot file, the
-        softrod version, the dimensions and the warm-start rule.
+        ``design_error`` (the message) per design point; ``attrs``: the robot file
+        (``robot``), ``softrod_version``, ``design_dims`` and ``actuation_dims`` (names
+        separated by spaces), ``outputs``, ``block`` and the ``warm_start_rule``.
 
     Raises:
         ParameterError: An unknown path or output, an actuation path in the wrong place, a
@@ -212,6 +228,8 @@ def sweep(
         raise TypeError(f"invalid parameter `robot` = {robot!r}: must be a softrod.Robot")
     names = _outputs(outputs)
     block = _positive_int("block", block)
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise _bad("progress", progress, "True, False or None")
     if chunk is not None:
         chunk = _positive_int("chunk", chunk)
     act = parse_axes(actuation, "actuation", "sample")
@@ -232,7 +250,10 @@ def sweep(
     for i, p in enumerate(des.paths):
         if p in act.paths:
             raise _bad(f"design[{p!r}]", p, "a path not also swept in `actuation`")
-        robot.parameter(p)  # an unknown path is the user's error, raised here
+        try:
+            robot.parameter(p)  # an unknown path is the user's error, raised here
+        except ParameterError as exc:
+            raise _bad(f"design[{p!r}]", p, str(exc).split(": must be ", 1)[-1]) from None
         if des.kind == "grid" and not np.all(np.isfinite(des.values[i])):
             raise _bad(f"design[{p!r}]", des.values[i], "finite")
     arcs, arm = _arcs(robot, arc_lengths, arm_index)
@@ -434,9 +455,9 @@ class _Store:
             "robot_name": robot.name,
             "robot": description,
             "softrod_version": __version__,
-            "design_dims": list(des.dims),
-            "actuation_dims": list(act.dims),
-            "outputs": list(names),
+            "design_dims": " ".join(des.dims),
+            "actuation_dims": " ".join(act.dims),
+            "outputs": " ".join(names),
             "block": block,
             "warm_start_rule": WARM_START_RULE,
         }
