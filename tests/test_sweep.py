@@ -269,9 +269,12 @@ def test_killing_a_dask_worker_loses_no_sample():
         progress=False,
     )
     local = softrod.sweep(arm, **kw)
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
-    ) as c, distributed.Client(c) as client:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as c,
+        distributed.Client(c) as client,
+    ):
         result = {}
 
         def run():

@@ -189,7 +189,7 @@ def client_of(scheduler):
     try:
         from distributed import Client
     except ImportError as exc:  # pragma: no cover - dask is a dependency
-        raise ImportError("scheduler= needs dask[distributed]: pip install 'dask[distributed]'") from exc
+        raise ImportError("scheduler= needs dask: pip install 'dask[distributed]'") from exc
     if isinstance(scheduler, Client):
         return scheduler, False
     if isinstance(scheduler, str) and re.match(r"[a-z][a-z0-9+.-]*://\S+\Z", scheduler):
@@ -221,8 +221,11 @@ def run_dask(client, robot, spec, tasks, pieces_of, progress, token: str):
 
     if progress is not False:
         link = getattr(client, "dashboard_link", None)
-        print(f"softrod sweep: {len(tasks)} tasks on {client.scheduler.address}"
-              + (f"; dashboard: {link}" if link else ""), file=sys.stderr)
+        print(
+            f"softrod sweep: {len(tasks)} tasks on {client.scheduler.address}"
+            + (f"; dashboard: {link}" if link else ""),
+            file=sys.stderr,
+        )
     futures = {}
     for i, t in enumerate(tasks):
         fut = client.submit(

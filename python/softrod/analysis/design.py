@@ -192,14 +192,23 @@ def design_summary(
     shape = tuple(ds.sizes[d] for d in rest)
     n_points = int(np.prod(shape)) if shape else 1
     tip_flat = tips_t.values.reshape(n_points, -1, 3)
-    c_flat = (
-        cmax.transpose(*rest, *over).values.reshape(n_points, -1) if cmax is not None else None
-    )
-    names = ["reachable", "workspace_dimension", "hull_volume", "hull_area", "voxel_volume",
-             "voxel_area"]
+    c_flat = cmax.transpose(*rest, *over).values.reshape(n_points, -1) if cmax is not None else None
+    names = [
+        "reachable",
+        "workspace_dimension",
+        "hull_volume",
+        "hull_area",
+        "voxel_volume",
+        "voxel_area",
+    ]
     if c_flat is not None:
-        names += ["stiffness_min", "stiffness_median", "stiffness_mean", "stiffness_max",
-                  "centre_periphery_ratio"]
+        names += [
+            "stiffness_min",
+            "stiffness_median",
+            "stiffness_mean",
+            "stiffness_max",
+            "centre_periphery_ratio",
+        ]
     out = {n: np.full(n_points, np.nan) for n in names}
     for i in range(n_points):
         m = workspace_measures(tip_flat[i], voxel)
@@ -227,8 +236,10 @@ def design_summary(
         "hull_volume": {"units": "m^3", "long_name": "convex hull volume of the tips"},
         "hull_area": {"units": "m^2", "long_name": "convex hull area of planar tips"},
         "voxel_volume": {"units": "m^3", "long_name": f"occupied voxels (edge {voxel:.3g} m)"},
-        "voxel_area": {"units": "m^2", "long_name": f"occupied pixels of planar tips "
-                       f"(edge {voxel:.3g} m)"},
+        "voxel_area": {
+            "units": "m^2",
+            "long_name": f"occupied pixels of planar tips (edge {voxel:.3g} m)",
+        },
         "stiffness_min": {"units": "N/m", "long_name": "least tip stiffness 1/c_max"},
         "stiffness_median": {"units": "N/m", "long_name": "median tip stiffness 1/c_max"},
         "stiffness_mean": {"units": "N/m", "long_name": "mean tip stiffness 1/c_max"},

@@ -286,9 +286,9 @@ def sweep(
         if client is None:
             results = run.run_local(robot, spec, tasks, pieces_of, progress)
         else:
-            token = hashlib.sha1(
-                pickle.dumps((robot.source, act.rows, points, spec))
-            ).hexdigest()[:12]
+            token = hashlib.sha1(pickle.dumps((robot.source, act.rows, points, spec))).hexdigest()[
+                :12
+            ]
             results = run.run_dask(client, robot, spec, tasks, pieces_of, progress, token)
         for task, parts in results:
             for (d, a0, a1), part in zip(task, parts, strict=True):

@@ -132,10 +132,13 @@ def _cmd_sweep(args) -> int:
     infeasible = int(ds["design_status"].values.sum())
     where = "in this process" if scheduler is None else f"on {args.scheduler}"
     print(f"robot: {robot.name} ({args.robot})")
+    n_design = ds["design_status"].size
     print(
-        f"sweep: {n} samples ({ds.attrs['design_dims'] or 'no design axes'} x "
-        f"{ds.attrs['actuation_dims'] or 'no actuation axes'}) in {elapsed:.3f} s {where}"
+        f"sweep: {n} samples = {n_design} design points x {n // n_design} actuations "
+        f"in {elapsed:.3f} s {where}"
     )
+    print(f"  design: {ds.attrs['design_dims'] or '(the robot)'}")
+    print(f"  actuation: {ds.attrs['actuation_dims'] or '(the robot file)'}")
     print(
         f"status: {counts['converged']} converged, {counts['not_converged']} not converged, "
         f"{counts['failed']} failed, {counts['infeasible_design']} in {infeasible} infeasible "
