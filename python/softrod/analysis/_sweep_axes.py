@@ -10,7 +10,6 @@ samples are neighbours and warm starts help; results are stored back in grid ord
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -43,22 +42,7 @@ class SampleTable(Mapping):
     """
 
     def __init__(self, columns: Mapping[str, Any]) -> None:
-        if not isinstance(columns, Mapping) or not columns:
-            raise _bad("table", columns, "a non-empty mapping of path -> 1-D array")
-        cols = {}
-        n = None
-        for key, value in columns.items():
-            a = _float_array(value, f"table[{key!r}]")
-            if a.ndim != 1:
-                raise _bad(f"table[{key!r}]", f"shape {a.shape}", "a 1-D array")
-            if n is not None and len(a) != n:
-                raise _bad(f"table[{key!r}]", f"{len(a)} rows", f"{n} rows like the others")
-            n = len(a)
-            cols[str(key)] = a
-        if not n:
-            raise _bad("table", "0 rows", "at least one row")
-        self._columns = cols
-        self.rows = n
+        self._columns, self.rows = _check_columns(columns, "columns")
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self._columns[key]
@@ -71,6 +55,25 @@ class SampleTable(Mapping):
 
     def __repr__(self) -> str:
         return f"SampleTable(rows={self.rows}, columns={list(self._columns)})"
+
+
+def _check_columns(columns: Any, name: str) -> tuple[dict[str, np.ndarray], int]:
+    """The columns as 1-D float arrays of equal length, and that length."""
+    if not isinstance(columns, Mapping) or not columns:
+        raise _bad(name, columns, "a non-empty mapping of path -> 1-D array")
+    cols = {}
+    n = None
+    for key, value in columns.items():
+        a = _float_array(value, f"{name}[{key!r}]")
+        if a.ndim != 1:
+            raise _bad(f"{name}[{key!r}]", f"shape {a.shape}", "a 1-D array")
+        if n is not None and len(a) != n:
+            raise _bad(f"{name}[{key!r}]", f"{len(a)} rows", f"{n} rows like the others")
+        n = len(a)
+        cols[str(key)] = a
+    if not n:
+        raise _bad(name, "0 rows", "at least one row")
+    return cols, n
 
 
 def samples(table: Any) -> SampleTable:
@@ -89,7 +92,9 @@ def samples(table: Any) -> SampleTable:
     """
     if isinstance(table, SampleTable):
         return table
-    return SampleTable(_columns_of(table))
+    columns = _columns_of(table)
+    _check_columns(columns, "table")
+    return SampleTable(columns)
 
 
 def _columns_of(table: Any) -> Mapping[str, Any]:
@@ -298,10 +303,3 @@ def design_points(axes: Axes) -> list[dict[str, float]]:
         for row in axes.rows
         if axes.paths
     ] or [{}]
-
-
-def is_finite_number(x: Any) -> bool:
-    try:
-        return math.isfinite(float(x))
-    except (TypeError, ValueError):
-        return False

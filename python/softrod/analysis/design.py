@@ -182,8 +182,10 @@ def design_summary(
         voxel = VOXEL_FRACTION * diag if diag > 0 else 1e-3
     if isinstance(voxel, bool) or not isinstance(voxel, (int, float, np.number)):
         raise _bad("voxel", voxel, "a number (m)")
-    if not (np.isfinite(voxel) and voxel > 0):
-        raise _bad("voxel", voxel, "finite and > 0 m")
+    with np.errstate(over="ignore", under="ignore"):
+        cube = np.float64(voxel) ** 3
+    if not (np.isfinite(voxel) and 0.0 < cube < np.inf):
+        raise _bad("voxel", voxel, "> 0 m, with a finite, nonzero cube")
     cmax = _largest_compliance(ds)
     if cmax is not None:
         cmax = cmax.where(ok)

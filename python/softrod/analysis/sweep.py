@@ -124,7 +124,12 @@ def _floats(name: str, value: Any) -> np.ndarray:
 
 def _arcs(robot, arc_lengths, arm_index) -> tuple[tuple[float, ...] | None, tuple[float, ...]]:
     if arc_lengths is not None and arm_index is not None:
-        raise _bad("arm_index", arm_index, "None when `arc_lengths` is given (one or the other)")
+        exc = ParameterError(
+            f"invalid parameters `arc_lengths` = {arc_lengths!r} and `arm_index` = "
+            f"{arm_index!r}: give one or the other"
+        )
+        exc.parameter = "arc_lengths"
+        raise exc
     if arc_lengths is not None:
         a = _floats("arc_lengths", arc_lengths)
         length = robot.rod.length
@@ -365,7 +370,7 @@ class _Store:
             # Solve order -> C order of both grids, then the grid shape.
             out = np.empty_like(a)
             out[np.ix_(des.order, act.order)] = a
-            return out.reshape(*prefix_shape, *a.shape[2:])
+            return out.reshape(prefix_shape + a.shape[2:])
 
         coords: dict[str, Any] = {}
         for axes in (des, act):
