@@ -38,7 +38,14 @@ class SampleTable(Mapping):
 
     Build one with :func:`softrod.samples`; ``softrod.sweep`` solves its rows (one ``sample``
     dimension for an actuation table, one ``design`` dimension for a design table) instead of
-    the outer product a plain dict of grids stands for.
+    the outer product a plain dict of grids stands for. Values are in the SI units of their
+    paths (tensions in N, pressures in Pa, lengths in m).
+
+    Args:
+        columns: Path -> 1-D array, all of one length.
+
+    Attributes:
+        rows: The number of samples.
     """
 
     def __init__(self, columns: Mapping[str, Any]) -> None:

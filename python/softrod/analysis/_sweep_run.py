@@ -24,8 +24,8 @@ from .._core import ConvergenceError, ParameterError
 #: Samples per task in-process (the progress bar advances per task).
 LOCAL_CHUNK = 4096
 #: Most samples per task on a cluster, and tasks per worker thread aimed at by default.
-CLUSTER_MAX_CHUNK = 65536
-CLUSTER_TASKS_PER_THREAD = 4
+CLUSTER_MAX_CHUNK = 16384
+CLUSTER_TASKS_PER_THREAD = 16
 #: Times a failed Dask task is retried (a lost worker is handled by the scheduler).
 TASK_RETRIES = 3
 

@@ -208,7 +208,7 @@ def sweep(
             the task's samples are pickled; failed tasks are retried and a lost worker's
             tasks rescheduled).
         chunk: Samples per task (rounded up to a multiple of ``block``); default 4096 in
-            process, about four tasks per worker thread on a cluster.
+            process, about 16 tasks per worker thread on a cluster (at most 16384 samples each).
         block: Samples per warm-started block (>= 1); part of the result's definition.
         progress: Show a progress bar (tqdm) on stderr; None: only on a terminal. On a
             cluster the dashboard link is printed unless False.
