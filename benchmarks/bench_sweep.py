@@ -77,7 +77,9 @@ def main() -> None:
     print(f"results identical bit for bit: {identical}; converged {converged} of {n}")
     cores = {"in process": cores_local, "dask": args.workers}
     per_core = {}
-    print(f"{'scheduler':<12} {'cores':>5} {'median (s)':>11} {'runs (s)':<28} {'per core (1/s)':>15}")
+    print(
+        f"{'scheduler':<12} {'cores':>5} {'median (s)':>11} {'runs (s)':<28} {'per core (1/s)':>15}"
+    )
     for name, ts in times.items():
         med = statistics.median(ts)
         per_core[name] = n / (med * cores[name])

@@ -77,7 +77,8 @@ fn option<'py, T: for<'a> FromPyObject<'a, 'py>>(
             Ok(x) => Ok(Some(x)),
             Err(_) => Err(param_err(
                 &format!("jobs[{k}].options.{key}"),
-                v.repr().map_or_else(|_| "<object>".into(), |r| r.to_string()),
+                v.repr()
+                    .map_or_else(|_| "<object>".into(), |r| r.to_string()),
                 "a valid option",
             )),
         },
@@ -107,7 +108,12 @@ fn convert(job: &Bound<'_, PyDict>, k: usize) -> PyResult<Converted> {
     } else {
         Some(loads.cast::<Loads>()?.clone())
     };
-    let problem = Problem::new(rod.get(), &tendons, loads.as_ref().map(Bound::get), &chambers)?;
+    let problem = Problem::new(
+        rod.get(),
+        &tendons,
+        loads.as_ref().map(Bound::get),
+        &chambers,
+    )?;
     let opts = item(job, k, "options")?;
     let opts = opts.cast::<PyDict>()?;
     let integrator: Option<String> = option(opts, k, "integrator")?;
@@ -186,12 +192,13 @@ fn arrays<'py>(
     let col = |f: &dyn Fn(&SweepSample) -> f64| samples.iter().map(f).collect::<Vec<f64>>();
     d.set_item(
         "status",
-        samples.iter().map(status_code).collect::<Vec<_>>().into_pyarray(py),
+        samples
+            .iter()
+            .map(status_code)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
     )?;
-    d.set_item(
-        "error",
-        PyList::new(py, samples.iter().map(error_name))?,
-    )?;
+    d.set_item("error", PyList::new(py, samples.iter().map(error_name))?)?;
     d.set_item(
         "iterations",
         samples
@@ -217,7 +224,10 @@ fn arrays<'py>(
             .into_pyarray(py),
     )?;
     d.set_item("residual", col(&|s| s.stats.residual).into_pyarray(py))?;
-    d.set_item("load_factor", col(&|s| s.stats.load_factor).into_pyarray(py))?;
+    d.set_item(
+        "load_factor",
+        col(&|s| s.stats.load_factor).into_pyarray(py),
+    )?;
     if request.tip_pose {
         d.set_item(
             "tip_position",

@@ -214,11 +214,24 @@ def cluster_threads(client) -> int:
         return 1
 
 
+def worker_version() -> str:
+    """The softrod version of the process (run on each Dask worker)."""
+    return _core.__version__
+
+
 def run_dask(client, robot, spec, tasks, pieces_of, progress, token: str):
     """Submits every task (retried on failure; a lost worker's tasks are rescheduled by the
     scheduler) and yields results as they complete."""
     from distributed import as_completed
 
+    versions = client.run(worker_version)
+    other = {a: v for a, v in versions.items() if v != _core.__version__}
+    if other:
+        addr, v = next(iter(other.items()))
+        raise RuntimeError(
+            f"the Dask worker {addr} runs softrod {v}, this process {_core.__version__}: "
+            "install the same softrod on every worker (results would differ)"
+        )
     if progress is not False:
         link = getattr(client, "dashboard_link", None)
         print(

@@ -252,6 +252,16 @@ def sweep(
             ),
         )
     _check_actuation_values(act, axes)
+    if des.paths:
+        try:
+            robot.spec
+        except ParameterError as exc:
+            raise _bad(
+                "design",
+                list(des.paths),
+                "axes of a robot a robot file describes (design points are built with "
+                f"Robot.with_parameters); this one is not: {' '.join(str(exc).split())}",
+            ) from None
     for i, p in enumerate(des.paths):
         if p in act.paths:
             raise _bad(f"design[{p!r}]", p, "a path not also swept in `actuation`")
