@@ -254,7 +254,7 @@ def sweep(
     _check_actuation_values(act, axes)
     if des.paths:
         try:
-            robot.spec
+            _ = robot.spec  # design points are built from the description
         except ParameterError as exc:
             raise _bad(
                 "design",
