@@ -83,6 +83,17 @@ def test_chambers_and_pressures_are_swept_like_tendons():
     assert np.ptp(tips[:, 0]) > 1e-3
 
 
+def test_tip_loads_are_swept_like_the_file_s_loads():
+    robot = niti().with_parameters({"loads.tip_moment": [0.0, 0.0, 0.002]})
+    fy = [0.0, 0.02, 0.05]
+    ds = softrod.sweep(robot, actuation={"loads.tip_force[1]": fy}, block=1, progress=False)
+    assert ds["loads.tip_force[1]"].attrs["units"] == "N"
+    for i, f in enumerate(fy):
+        loaded = robot.with_parameters({"loads.tip_force": [0.0, f, 0.0]})
+        sol = loaded.solve()  # cold, like every sample with block=1
+        assert np.array_equal(ds["tip_position"].values[i], sol.tip_position), f
+
+
 def test_tables_give_a_sample_and_a_design_dimension():
     pd = pytest.importorskip("pandas")
     robot = niti()
