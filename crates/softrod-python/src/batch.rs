@@ -199,29 +199,17 @@ fn arrays<'py>(
             .into_pyarray(py),
     )?;
     d.set_item("error", PyList::new(py, samples.iter().map(error_name))?)?;
-    d.set_item(
-        "iterations",
+    let ints = |f: &dyn Fn(&softrod::SolverStats) -> usize| {
         samples
             .iter()
-            .map(|s| s.stats.iterations as i64)
-            .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    d.set_item(
-        "load_steps",
-        samples
-            .iter()
-            .map(|s| s.stats.load_steps as i64)
-            .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
+            .map(|s| f(&s.stats) as i64)
+            .collect::<Vec<i64>>()
+    };
+    d.set_item("iterations", ints(&|st| st.iterations).into_pyarray(py))?;
+    d.set_item("load_steps", ints(&|st| st.load_steps).into_pyarray(py))?;
     d.set_item(
         "function_evaluations",
-        samples
-            .iter()
-            .map(|s| s.stats.function_evaluations as i64)
-            .collect::<Vec<_>>()
-            .into_pyarray(py),
+        ints(&|st| st.function_evaluations).into_pyarray(py),
     )?;
     d.set_item("residual", col(&|s| s.stats.residual).into_pyarray(py))?;
     d.set_item(

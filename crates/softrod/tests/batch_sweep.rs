@@ -10,7 +10,7 @@ mod common;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use common::{assert_blocks_close, castigliano_arc};
+use common::{assert_blocks_close, castigliano_arc, timoshenko};
 use softrod::nalgebra::{Matrix6, Vector3};
 use softrod::{
     solve_statics, sweep, Actuation, ActuationTable, Error, Integrator, LinearElastic, Loads,
@@ -220,10 +220,7 @@ fn straight_rod() -> Rod {
 }
 
 fn section_constants(k: f64) -> (f64, f64, f64, f64) {
-    let g = E / (2.0 * (1.0 + NU));
-    let a = PI * RADIUS * RADIUS;
-    let i = PI * RADIUS.powi(4) / 4.0;
-    (E * i, g * 2.0 * i, E * a, k * g * a)
+    common::circular_constants(E, NU, RADIUS, k)
 }
 
 #[test]
@@ -237,17 +234,7 @@ fn compliance_between_nodes_of_a_straight_rod_is_the_timoshenko_cantilever() {
     let out = sweep(&[job(&model, rk4(4), table(1, &[]), &s)], &all(), 4, false).unwrap();
     for (arc, &l) in out[0][0].arcs.iter().zip(&s) {
         let lat = l.powi(3) / (3.0 * ei) + l / gas;
-        let mut c = Matrix6::zeros();
-        c[(0, 0)] = lat;
-        c[(1, 1)] = lat;
-        c[(2, 2)] = l / ea;
-        c[(3, 3)] = l / ei;
-        c[(4, 4)] = l / ei;
-        c[(5, 5)] = l / gj;
-        c[(0, 4)] = l * l / (2.0 * ei);
-        c[(4, 0)] = c[(0, 4)];
-        c[(1, 3)] = -l * l / (2.0 * ei);
-        c[(3, 1)] = c[(1, 3)];
+        let c = timoshenko(l, ei, gj, ea, Some(gas));
         assert_blocks_close(&arc.compliance, &c, 1e-11, &format!("C_world({l})"));
         assert!((arc.position[2] - l).abs() < 1e-15 && arc.position[0] == 0.0);
         // γ_c = (s/L)³ + shear part, laterally.
