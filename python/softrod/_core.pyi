@@ -1,7 +1,7 @@
 """Type stubs of the compiled core ``softrod._core`` (checked against the module by the tests)."""
 
 from collections.abc import Callable, Sequence
-from typing import Literal, final
+from typing import Any, Literal, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -876,6 +876,15 @@ def _workspace_map(
     tangent: Literal["tension", "length"] | None = None,
     chambers: Sequence[Chamber] = ...,
 ) -> dict[str, NDArray[np.float64]]: ...
+def _sweep(
+    jobs: Sequence[dict[str, Any]],
+    *,
+    outputs: Sequence[str],
+    block: int = 32,
+    parallel: bool = True,
+) -> list[dict[str, Any]]:
+    """Actuation sweeps of design points (used by ``softrod.sweep``): one dict of arrays per
+    job (``status``: 0 converged, 1 not converged, 2 failed; ``error`` per sample)."""
 
 # ----------------------------------------------------------------------------- chambers
 

@@ -3,11 +3,12 @@
 //! This crate only converts arrays, maps the core's one error type to Python exceptions (in
 //! `errors::to_py_err`) and releases the GIL around solves. All numerics live in the `softrod`
 //! crate. It is split like the core: `model` (the robot description), `statics`,
-//! `compliance`, `pcc`, `planar`, `materials`; argument conversions in `convert`, errors in
+//! `compliance`, `pcc`, `planar`, `materials`, `batch` (sweeps); argument conversions in `convert`, errors in
 //! `errors`.
 
 use pyo3::prelude::*;
 
+mod batch;
 mod callbacks;
 mod compliance;
 mod convert;
@@ -88,6 +89,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compliance::tangent_compliance, m)?)?;
     m.add_function(wrap_pyfunction!(compliance::eigenscrews, m)?)?;
     m.add_function(wrap_pyfunction!(compliance::_workspace_map, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::_sweep, m)?)?;
     m.add_class::<pcc::PccRobot>()?;
     m.add_class::<pcc::PccSolution>()?;
     m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;

@@ -14,7 +14,7 @@
 //! * [`compliance`](mod@compliance): integrated and tangent compliance, eigenscrews;
 //! * [`pcc`]: piecewise-constant-curvature kinematics, actuation maps and statics;
 //! * [`planar`]: the planar tapered cable arm (closed form and final-value ODE);
-//! * [`batch`]: workspace maps and backbone distances;
+//! * [`batch`]: workspace maps, actuation sweeps of design points and backbone distances;
 //! * [`integrate`]: the one Runge–Kutta driver (RK4, Bogacki–Shampine, Dormand–Prince
 //!   tableaus) and the march over breaks;
 //! * [`solve`]: the one nonlinear solver (Newton, Broyden, line search, continuation);
@@ -34,6 +34,9 @@ pub mod planar;
 pub mod solve;
 
 pub use batch::compare::{backbone_distance, BackboneDistance};
+pub use batch::sweep::{
+    sweep, ActuationTable, ArcSample, SampleStatus, SweepJob, SweepRequest, SweepSample,
+};
 pub use batch::workspace::{workspace_map, WorkspaceSample};
 pub use compliance::eigenscrew::{eigenscrews, Decomposition, Eigenscrew, Ellipsoid, MatrixKind};
 pub use compliance::{

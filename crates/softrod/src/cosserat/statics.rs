@@ -912,6 +912,10 @@ fn assemble(
         }
         keep
     });
+    if sol.tendon_lengths.len() != model.tendons().len() {
+        // The last pass failed before its lengths (a non-converged result): none to report.
+        sol.tendon_lengths = vec![f64::NAN; model.tendons().len()];
+    }
     if rk4 {
         sol.tendon_lengths.iter_mut().for_each(|l| *l = 0.0);
     }
