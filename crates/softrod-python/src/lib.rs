@@ -3,11 +3,13 @@
 //! This crate only converts arrays, maps the core's one error type to Python exceptions (in
 //! `errors::to_py_err`) and releases the GIL around solves. All numerics live in the `softrod`
 //! crate. It is split like the core: `model` (the robot description), `statics`,
-//! `compliance`, `pcc`, `planar`, `materials`; argument conversions in `convert`, errors in
+//! `compliance`, `pcc`, `planar`, `materials`, `batch` (sweeps); argument conversions in `convert`, errors in
 //! `errors`.
 
 use pyo3::prelude::*;
 
+mod batch;
+mod callbacks;
 mod compliance;
 mod convert;
 mod errors;
@@ -29,6 +31,27 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add(
         "ConvergenceError",
         m.py().get_type::<errors::ConvergenceError>(),
+    )?;
+    m.add(
+        "TargetUnreachableError",
+        m.py().get_type::<errors::TargetUnreachableError>(),
+    )?;
+    m.add("ParameterTypeError", errors::parameter_type_error(m.py())?)?;
+    m.add("InternalError", m.py().get_type::<errors::InternalError>())?;
+    m.add("MAX_SAMPLES", softrod::limits::MAX_SAMPLES)?;
+    m.add("MAX_ITERATIONS", softrod::limits::MAX_ITERATIONS)?;
+    m.add("MAX_LOAD_NUMBER", softrod::limits::MAX_LOAD_NUMBER)?;
+    m.add("MAX_LENGTH", softrod::limits::MAX_LENGTH)?;
+    m.add("MAX_MODULUS", softrod::limits::MAX_MODULUS)?;
+    m.add("MAX_BENDING_ANGLE", softrod::limits::MAX_BENDING_ANGLE)?;
+    m.add("MAX_OFFSET_RATIO", softrod::limits::MAX_OFFSET_RATIO)?;
+    m.add(
+        "StabilityWarning",
+        m.py().get_type::<errors::StabilityWarning>(),
+    )?;
+    m.add(
+        "StabilityError",
+        m.py().get_type::<errors::StabilityError>(),
     )?;
     m.add_class::<planar::PlanarCableArm>()?;
     m.add_class::<planar::PlanarSolution>()?;
@@ -70,6 +93,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compliance::tangent_compliance, m)?)?;
     m.add_function(wrap_pyfunction!(compliance::eigenscrews, m)?)?;
     m.add_function(wrap_pyfunction!(compliance::_workspace_map, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::_sweep, m)?)?;
     m.add_class::<pcc::PccRobot>()?;
     m.add_class::<pcc::PccSolution>()?;
     m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;

@@ -21,14 +21,22 @@ pub enum Error {
         expected: String,
     },
     /// An iterative solver or an adaptive integrator did not reach its tolerance.
-    #[error("{what} did not converge after {iterations} iterations (residual {residual:.3e})")]
+    #[error(
+        "{what} did not converge after {iterations} iterations (residual {residual:.3e}{})",
+        load_factor_note(*.load_factor)
+    )]
     NotConverged {
-        /// What did not converge (e.g. `"shooting Newton"`, `"ode23 step size"`).
+        /// What did not converge, and why it stopped (e.g. `"shooting Newton (Cosserat rod
+        /// statics): the load steps ran out"`).
         what: String,
         /// Iterations (or steps) taken before giving up.
         iterations: usize,
         /// Residual norm (or error estimate) at the last iterate.
         residual: f64,
+        /// Fraction of the external loads carried by the last iterate: the last load factor
+        /// reached by a load continuation, 1 where the full problem was attempted directly
+        /// (and for solvers without load steps).
+        load_factor: f64,
     },
     /// Inverse statics: the target cannot be reached within the actuation bounds; the closest
     /// reachable pose found is this far from it.
@@ -47,19 +55,45 @@ pub enum Error {
     },
 }
 
+/// The load factor in a convergence message, when it is not the full load.
+fn load_factor_note(load_factor: f64) -> String {
+    if load_factor < 1.0 {
+        format!(", load factor {load_factor:.4}")
+    } else {
+        String::new()
+    }
+}
+
 /// Result alias used throughout the crate.
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
+    /// An [`Error::NotConverged`] of a solver without load steps (load factor 1).
+    pub fn not_converged(what: impl Into<String>, iterations: usize, residual: f64) -> Self {
+        Error::NotConverged {
+            what: what.into(),
+            iterations,
+            residual,
+            load_factor: 1.0,
+        }
+    }
+
     /// Builds an [`Error::InvalidParameter`] from any displayable value.
     pub fn invalid(
         name: impl Into<String>,
         value: impl std::fmt::Display,
         expected: impl Into<String>,
     ) -> Self {
+        let mut value = value.to_string();
+        // A huge or tiny float prints as hundreds of digits: show it in scientific notation.
+        if value.len() > 24 {
+            if let Ok(v) = value.parse::<f64>() {
+                value = format!("{v:e}");
+            }
+        }
         Error::InvalidParameter {
             name: name.into(),
-            value: value.to_string(),
+            value,
             expected: expected.into(),
         }
     }

@@ -148,7 +148,10 @@ fn held_tendons_meet_the_complementarity_exactly() {
     for i in 0..6 {
         let tau = sol.tendon_tensions[i];
         let slack = (zero[i] - sol.tendon_lengths[i]) - disp[i];
-        assert!(tau >= 0.0 && slack >= -1e-12, "tendon {i}: {tau} N, slack {slack}");
+        assert!(
+            tau >= 0.0 && slack >= -1e-12,
+            "tendon {i}: {tau} N, slack {slack}"
+        );
         assert!(
             tau == 0.0 || slack.abs() <= 1e-12,
             "tendon {i}: {tau} N, slack {slack}"
@@ -177,7 +180,10 @@ fn a_compliant_tendon_stretches_by_its_tension_over_its_stiffness() {
     let sol = solve_statics(&model, &act, &o).unwrap();
     let tau = sol.tendon_tensions[0];
     let shortening = zero[0] - sol.tendon_lengths[0];
-    assert!((2e-3 - shortening - tau / k).abs() <= 1e-13, "{tau} {shortening}");
+    assert!(
+        (2e-3 - shortening - tau / k).abs() <= 1e-13,
+        "{tau} {shortening}"
+    );
     // The same shape as the tension-controlled solve at that tension.
     let mut t = [0.0; 6];
     t[0] = tau;
@@ -198,7 +204,10 @@ fn held_tangent_compliance_matches_central_differences() {
     let o = options();
     let base = niti(Loads::default(), None);
     let zero = reference_lengths(&base, &o).unwrap();
-    let mut act = Actuation::mixed(&[0.0, 0.0, 0.0, 0.0, 1.0, 0.0], &[1e-3, 0.0, 0.0, f64::NAN, f64::NAN, 2e-4]);
+    let mut act = Actuation::mixed(
+        &[0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        &[1e-3, 0.0, 0.0, f64::NAN, f64::NAN, 2e-4],
+    );
     act.tendons[5] = TendonInput::Displacement {
         displacement: 2e-4,
         stiffness: 5e3,
@@ -288,7 +297,11 @@ fn held_sensitivities_match_central_differences() {
     let sol = solve_statics(&model, &act(1e-3, 1.0), &o).unwrap();
     println!("{:?}", sol.tendon_tensions);
     assert!(sol.tendon_tensions[0] > 0.0 && sol.tendon_tensions[1] == 0.0);
-    let params = [Parameter::Displacement(0), Parameter::Tension(4), Parameter::Displacement(1)];
+    let params = [
+        Parameter::Displacement(0),
+        Parameter::Tension(4),
+        Parameter::Displacement(1),
+    ];
     let n = sol.s.len() - 1;
     let sens = sensitivities(&sol, &params, &[n], Linearisation::Actuated).unwrap();
     // A slack tendon's displacement changes nothing.

@@ -59,10 +59,7 @@ fn check_kkt(model: &Arc<RobotModel>, a: &[f64]) {
     // a_F = J_Fᵀ λ: least squares for λ.
     let jf = DMatrix::from_fn(3, free.len(), |r, k| jp[(r, free[k])]);
     let af = DVector::from_fn(free.len(), |k, _| a[free[k]]);
-    let lambda = (&jf * jf.transpose())
-        .lu()
-        .solve(&(&jf * &af))
-        .unwrap();
+    let lambda = (&jf * jf.transpose()).lu().solve(&(&jf * &af)).unwrap();
     let res = &af - jf.transpose() * &lambda;
     let scale = af.amax();
     assert!(res.amax() <= 1e-7 * scale, "stationarity {:e}", res.amax());
@@ -70,7 +67,11 @@ fn check_kkt(model: &Arc<RobotModel>, a: &[f64]) {
     let g = DVector::from_column_slice(a) - jp.transpose() * &lambda;
     for i in 0..a.len() {
         if a[i] <= 1e-12 {
-            assert!(g[i] >= -1e-7 * scale, "bound multiplier of tendon {i}: {}", g[i]);
+            assert!(
+                g[i] >= -1e-7 * scale,
+                "bound multiplier of tendon {i}: {}",
+                g[i]
+            );
         }
     }
 }
@@ -102,7 +103,10 @@ fn niti_round_trip_reaches_every_target_inside_the_bounds() {
         if inv.converged && err <= 1e-9 {
             reached += 1;
         } else {
-            println!("target {k} ({t:?}): error {err:e}, converged {}", inv.converged);
+            println!(
+                "target {k} ({t:?}): error {err:e}, converged {}",
+                inv.converged
+            );
         }
         if k < 8 {
             check_kkt(&model, inv.tensions());
@@ -169,8 +173,8 @@ fn a_target_out_of_reach_is_reported_with_its_distance() {
         throw: false,
         ..Default::default()
     };
-    let (inv, _) = inverse_statics(&model, &Target::tip(Vector3::from(tip)), &opts, &o, None)
-        .unwrap();
+    let (inv, _) =
+        inverse_statics(&model, &Target::tip(Vector3::from(tip)), &opts, &o, None).unwrap();
     assert!(!inv.converged && inv.position_error > 1e-3);
     assert!(inv.tensions().iter().all(|&t| (0.0..=1.0).contains(&t)));
 }
@@ -185,14 +189,22 @@ fn a_shape_target_is_reached_from_its_backbone_points() {
     let n = sol.s.len();
     let idx = [n / 4, n / 2, n - 1];
     let mut s: Vec<f64> = idx.iter().map(|&i| sol.s[i]).collect();
-    let mut points: Vec<Vector3<f64>> = idx.iter().map(|&i| Vector3::from(sol.position[i])).collect();
+    let mut points: Vec<Vector3<f64>> = idx
+        .iter()
+        .map(|&i| Vector3::from(sol.position[i]))
+        .collect();
     let target = Target {
         points: points.clone(),
         s: Some(s.clone()),
         rotation: None,
     };
-    let (inv, back) = inverse_statics(&model, &target, &InverseOptions::default(), &o, None).unwrap();
-    assert!(inv.converged && inv.position_error <= 1e-9, "{}", inv.position_error);
+    let (inv, back) =
+        inverse_statics(&model, &target, &InverseOptions::default(), &o, None).unwrap();
+    assert!(
+        inv.converged && inv.position_error <= 1e-9,
+        "{}",
+        inv.position_error
+    );
     for (k, &i) in idx.iter().enumerate() {
         assert!((Vector3::from(back.position[i]) - points[k]).norm() <= 1e-9);
     }
@@ -242,7 +254,14 @@ fn warm_started_tracking_takes_few_iterations() {
             .unwrap()
             .tip_position(),
     );
-    let (first, _) = inverse_statics(&model, &Target::tip(tip), &InverseOptions::default(), &o, None).unwrap();
+    let (first, _) = inverse_statics(
+        &model,
+        &Target::tip(tip),
+        &InverseOptions::default(),
+        &o,
+        None,
+    )
+    .unwrap();
     let mut warm = InverseWarmStart::from(&first);
     let mut total = 0;
     for k in 1..=10 {
@@ -294,7 +313,9 @@ fn pcc_actuation_jacobian_matches_central_differences() {
             up[k] += h;
             down[k] -= h;
             let pu = solve_pcc_statics(&robot, &loads(&up), &o).unwrap().tip_pose;
-            let pd = solve_pcc_statics(&robot, &loads(&down), &o).unwrap().tip_pose;
+            let pd = solve_pcc_statics(&robot, &loads(&down), &o)
+                .unwrap()
+                .tip_pose;
             let dp = (pu.fixed_view::<3, 1>(0, 3) - pd.fixed_view::<3, 1>(0, 3)) / (2.0 * h);
             let dr = pu.fixed_view::<3, 3>(0, 0) * pd.fixed_view::<3, 3>(0, 0).transpose();
             let dw = softrod::math::so3::log_so3(&dr.into_owned()) / (2.0 * h);

@@ -171,7 +171,10 @@ fn check(build: &Build, params: &[Parameter], what: &str) {
         for i in 0..nt {
             let fd = (up.tendon_lengths[i] - down.tendon_lengths[i]) / (2.0 * h);
             let err = (fd - sens.tendon_lengths[(i, j)]).abs() / lscale;
-            assert!(err < 1e-6, "{what}: {p:?} length of tendon {i}: rel {err:e}");
+            assert!(
+                err < 1e-6,
+                "{what}: {p:?} length of tendon {i}: rel {err:e}"
+            );
         }
         println!("{what}: {p:?} ok");
     }
@@ -186,7 +189,10 @@ fn niti(tensions: [f64; 6], loads: Loads, density: Option<f64>) -> Build {
         tendons: (0..6)
             .map(|i| {
                 let a = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-                ([0.01 * a.cos(), 0.01 * a.sin()], if i < 3 { 0.2 } else { 0.4 })
+                (
+                    [0.01 * a.cos(), 0.01 * a.sin()],
+                    if i < 3 { 0.2 } else { 0.4 },
+                )
             })
             .collect(),
         tensions: tensions.to_vec(),

@@ -16,8 +16,8 @@
 
 use nalgebra::Matrix6;
 
-use crate::cosserat::sensitivity::{held_rows, linearise, HeldRow, Seed};
 pub use crate::cosserat::sensitivity::COLUMNS_PER_PASS;
+use crate::cosserat::sensitivity::{held_rows, linearise, HeldRow, Seed};
 use crate::cosserat::statics::StaticsSolution;
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_general;

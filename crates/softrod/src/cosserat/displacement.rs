@@ -26,7 +26,7 @@ use std::sync::Arc;
 use super::sensitivity::slack_scale;
 use super::shooting::{Held, Shooting};
 use super::statics::{
-    assemble, Integrator, SolveOptions, StaticsSolution, DIRECT_STEP_LIMIT,
+    assemble, Integrator, SolveOptions, StaticsSolution, WarmStart, DIRECT_STEP_LIMIT,
     MAX_LINE_SEARCH_HALVINGS,
 };
 use crate::error::{Error, Result};
@@ -93,6 +93,7 @@ fn settings(broyden: bool) -> NewtonSettings<'static> {
         residual_first: false,
         broyden,
         jacobian: None,
+        exact_at_solution: false,
     }
 }
 
@@ -164,6 +165,57 @@ fn smooth(
 /// As [`super::statics::solve_statics`]; [`Error::NotConverged`] naming the active set if it
 /// does not settle.
 pub(crate) fn solve_held(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    s_out: &[f64],
+) -> Result<StaticsSolution> {
+    let mut sol = solve_held_on_mesh(model, actuation, options)?;
+    let loaded = !model.loads().is_unloaded();
+    sol.stable = !loaded && sol.stats.converged;
+    if (loaded || !s_out.is_empty()) && sol.stats.converged {
+        // The same equilibrium under tension control at the solved tensions (a warm-started
+        // direct solve): its nodes at `s_out`, and its stability, which is sufficient for the
+        // held tendons (holding a tendon only adds a constraint).
+        let act = Actuation {
+            tendons: sol
+                .tendon_tensions
+                .iter()
+                .map(|&t| TendonInput::Tension(t))
+                .collect(),
+            pressures: actuation.pressures.clone(),
+            reference_lengths: None,
+            tension_guess: None,
+        };
+        let opts = SolveOptions {
+            warm_start: Some(WarmStart::wrench(sol.base_wrench)),
+            ..*options
+        };
+        let fixed = super::statics::solve_statics_at(model, &act, &opts, s_out)?;
+        if s_out.is_empty() {
+            sol.stable = fixed.stable;
+            if let Some(m) = fixed.margin.get() {
+                let _ = sol.margin.set(*m);
+            }
+        } else {
+            let (actuation, stats, lengths, tensions) = (
+                sol.actuation.clone(),
+                sol.stats,
+                sol.tendon_lengths.clone(),
+                sol.tendon_tensions.clone(),
+            );
+            sol = fixed;
+            sol.actuation = actuation;
+            sol.stats = stats;
+            sol.tendon_lengths = lengths;
+            sol.tendon_tensions = tensions;
+        }
+    }
+    Ok(sol)
+}
+
+/// [`solve_held`] on the integration mesh.
+fn solve_held_on_mesh(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
     options: &SolveOptions,
@@ -311,6 +363,7 @@ pub(crate) fn solve_held(
                     what,
                     iterations: stats.iterations,
                     residual: out.residual,
+                    load_factor: 1.0,
                 });
             }
             p.tensions.clone_from(&tensions);
@@ -322,7 +375,7 @@ pub(crate) fn solve_held(
                 x0[4] * fm,
                 x0[5] * fm,
             ];
-            let mut sol = assemble(&mut p, model, base_wrench, stats);
+            let mut sol = assemble(&mut p, model, base_wrench, stats, &[]);
             let mut act = actuation.clone();
             act.reference_lengths = Some(reference);
             sol.actuation = act;

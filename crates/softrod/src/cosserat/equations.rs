@@ -36,13 +36,21 @@
 //! applied exactly.
 //!
 //! The shooting Jacobian is propagated with the state: for each of the six unknowns of the
-//! base wrench, a variation `(δp, w, δN, δM)` with `δR = R ŵ` (body-frame rotation variation)
-//! obeys the variational equations
+//! base wrench, a variation `(δp, δR, δN, δM)` in the same coordinates as the state obeys the
+//! variational equations
 //!
 //! ```text
-//! δp' = R (w × v + δv),   w' = w × u + δu,   δN' = 0,   δM' = -(δp' × N + p' × δN),
-//! (δv, δu) = (I + C D)⁻¹ C (N_b × w + Rᵀ δN, M_b × w + Rᵀ δM).
+//! δp' = δR v + R δv,   δR' = δR û + R δû,   δN' = 0,   δM' = -(δp' × N + p' × δN),
+//! (δv, δu) = (I + C D)⁻¹ C (δRᵀ N + Rᵀ δN, δRᵀ M + Rᵀ δM).
 //! ```
+//!
+//! Runge–Kutta methods commute with linearisation when the variation is written in the
+//! coordinates of the state: the integrated columns, with the derivative of the
+//! re-orthonormalisation applied after every step, are then the exact derivative of the
+//! discrete march (not only an approximation of the continuous variation to the order of the
+//! method), so the tangent compliance is the derivative of the solve it comes from. (A
+//! 3-vector `w` with `δR = R ŵ` would differ from it by the method's truncation error, large
+//! where the rod is strongly curved per step, e.g. the thin end of a taper.)
 //!
 //! # References
 //! D. C. Rucker, R. J. Webster III, IEEE Trans. Robotics 27(6), 2011, eqs. (1)–(18).
@@ -67,8 +75,16 @@ use crate::model::RobotModel;
 
 /// Length of the state `(p, R, N, M)`: 3 + 9 + 3 + 3.
 pub(crate) const STATE: usize = 18;
-/// Length of one sensitivity column `(δp, w, δN, δM)`.
-pub(crate) const COLUMN: usize = 12;
+/// Length of one sensitivity column `(δp, δR, δN, δM)`, laid out as the state: the
+/// derivative of the state along one unknown, so that the integrator's linear combinations
+/// (and the projection's derivative) make it the exact derivative of the discrete march.
+pub(crate) const COLUMN: usize = STATE;
+/// Offset of `δR` (9, column-major) in a column.
+pub(crate) const DR: usize = 3;
+/// Offset of `δN` in a column.
+pub(crate) const DN: usize = 12;
+/// Offset of `δM` in a column.
+pub(crate) const DM: usize = 15;
 /// Length of the state with the six shooting columns appended.
 pub(crate) const FULL: usize = STATE + 6 * COLUMN;
 
@@ -94,11 +110,41 @@ pub(crate) fn rot(y: &[f64]) -> Matrix3<f64> {
     Matrix3::from_column_slice(&y[3..12])
 }
 
-/// Re-orthonormalises the rotation part of a state.
+/// `δR` of the column starting at `b`.
+#[inline]
+pub(crate) fn col_rot(y: &[f64], b: usize) -> Matrix3<f64> {
+    Matrix3::from_column_slice(&y[b + DR..b + DR + 9])
+}
+
+/// The rotation variation `δθ` (world, rad) of `δR` at `R`: the axial vector of the skew
+/// part of `δR Rᵀ` (`δR = δθ̂ R` on the rotation group).
+#[inline]
+pub(crate) fn rotation_variation(r: &Matrix3<f64>, dr: &Matrix3<f64>) -> Vector3<f64> {
+    let a = dr * r.transpose();
+    Vector3::new(
+        0.5 * (a[(2, 1)] - a[(1, 2)]),
+        0.5 * (a[(0, 2)] - a[(2, 0)]),
+        0.5 * (a[(1, 0)] - a[(0, 1)]),
+    )
+}
+
+/// Re-orthonormalises the rotation part of a state, and maps each column's `δR` by the
+/// derivative of the same step, `δR (3I - RᵀR)/2 - R (δRᵀR + RᵀδR)/2` (at the unprojected
+/// `R`).
 #[inline]
 pub(crate) fn project<const N: usize>(y: &mut [f64; N]) {
-    let r = reorthonormalise(&rot(y));
+    let raw = rot(y);
+    let r = reorthonormalise(&raw);
     y[3..12].copy_from_slice(r.as_slice());
+    let rtr = raw.tr_mul(&raw);
+    let half = Matrix3::identity() * 1.5 - rtr * 0.5;
+    for c in 0..(N - STATE) / COLUMN {
+        let b = STATE + COLUMN * c;
+        let dr = col_rot(y, b);
+        let sym = dr.tr_mul(&raw);
+        let d = dr * half - raw * (sym + sym.transpose()) * 0.5;
+        y[b + DR..b + DR + 9].copy_from_slice(d.as_slice());
+    }
 }
 
 /// The tangent `d(v, u)/d(n_b, m_b)` of one constitutive solve: `(I + C D)⁻¹ C` with active
@@ -345,8 +391,8 @@ impl<'e> Equations<'e> {
         }
         if N >= FULL {
             for k in 0..3 {
-                y[STATE + COLUMN * k + 6 + k] = f_ref;
-                y[STATE + COLUMN * (k + 3) + 9 + k] = fm;
+                y[STATE + COLUMN * k + DN + k] = f_ref;
+                y[STATE + COLUMN * (k + 3) + DM + k] = fm;
             }
         }
         y
@@ -370,9 +416,9 @@ impl<'e> Equations<'e> {
             Frame::Body => {
                 let r = rot(y);
                 for (k, dk) in d.iter_mut().enumerate().take(ncol) {
-                    let w = v3(y, STATE + COLUMN * k + 3);
-                    dk[0] += r * w.cross(&f);
-                    dk[1] += r * w.cross(&m);
+                    let dr = col_rot(y, STATE + COLUMN * k);
+                    dk[0] += dr * f;
+                    dk[1] += dr * m;
                 }
                 (r * f, r * m)
             }
@@ -392,9 +438,9 @@ impl<'e> Equations<'e> {
             put3(y, 15, &m1);
             for (k, dk) in d.iter().enumerate() {
                 let b = STATE + COLUMN * k;
-                let (dn1, dm1) = (v3(y, b + 6) - dk[0], v3(y, b + 9) - dk[1]);
-                put3(y, b + 6, &dn1);
-                put3(y, b + 9, &dm1);
+                let (dn1, dm1) = (v3(y, b + DN) - dk[0], v3(y, b + DM) - dk[1]);
+                put3(y, b + DN, &dn1);
+                put3(y, b + DM, &dm1);
             }
         }
     }
@@ -424,8 +470,8 @@ impl<'e> Equations<'e> {
         let cols = (0..ncol)
             .map(|k| {
                 let b = STATE + COLUMN * k;
-                let jf = (v3(y, b + 6) - d[k][0]) / f_ref;
-                let jm = (v3(y, b + 9) - d[k][1]) / fm;
+                let jf = (v3(y, b + DN) - d[k][0]) / f_ref;
+                let jm = (v3(y, b + DM) - d[k][1]) / fm;
                 Vector6::new(jf.x, jf.y, jf.z, jm.x, jm.y, jm.z)
             })
             .collect();
@@ -837,10 +883,7 @@ impl Evaluator<'_, '_> {
         let b_end = eq.model.breaks()[self.ws.interval + 1];
         let ends = eq.model.tendon_ends();
         let nl = self.ws.length_tendons.len();
-        let needs_dirs = nl > 0
-            || self.ws.columns[..ncol]
-                .iter()
-                .any(Column::needs_directions);
+        let needs_dirs = nl > 0 || self.ws.columns[..ncol].iter().any(Column::needs_directions);
         if needs_dirs {
             for i in 0..ends.len() {
                 self.ws.dirs[i] =
@@ -858,11 +901,11 @@ impl Evaluator<'_, '_> {
         );
         for c in 0..ncol {
             let b = STATE + COLUMN * c;
-            let w = v3(y, b + 3);
-            let dn = v3(y, b + 6);
-            let dm = v3(y, b + 9);
-            let dnb = nb.cross(&w) + r.tr_mul(&dn);
-            let dmb = mb.cross(&w) + r.tr_mul(&dm);
+            let dr = col_rot(y, b);
+            let dn = v3(y, b + DN);
+            let dm = v3(y, b + DM);
+            let dnb = dr.tr_mul(&nw) + r.tr_mul(&dn);
+            let dmb = dr.tr_mul(&mw) + r.tr_mul(&dm);
             let mut e = [dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z];
             let column = self.ws.columns[c];
             // d|p_i'| of the tendon whose offset the column changes, at fixed strains.
@@ -879,13 +922,13 @@ impl Evaluator<'_, '_> {
                 Vector3::new(d[0], d[1], d[2]),
                 Vector3::new(d[3], d[4], d[5]),
             );
-            let dpd = r * (w.cross(&v) + dv);
-            let wd = w.cross(&u) + du;
+            let dpd = dr * v + r * dv;
+            let drd = dr * hat(&u) + r * hat(&du);
             let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
             put3(out, b, &dpd);
-            put3(out, b + 3, &wd);
-            put3(out, b + 6, &Vector3::zeros());
-            put3(out, b + 9, &dmd);
+            out[b + DR..b + DR + 9].copy_from_slice(drd.as_slice());
+            put3(out, b + DN, &Vector3::zeros());
+            put3(out, b + DM, &dmd);
             for h in 0..nl {
                 let i = self.ws.length_tendons[h];
                 let mut g = match &self.ws.dirs[i] {

@@ -86,11 +86,7 @@ impl Evaluator<'_, '_> {
             Some((g, h))
         };
         let fail = |ev: &mut Self, what: String| {
-            ev.material_error(Error::NotConverged {
-                what,
-                iterations: LOCAL_MAX_ITERATIONS,
-                residual: f64::NAN,
-            });
+            ev.material_error(Error::not_converged(what, LOCAL_MAX_ITERATIONS, f64::NAN));
             ev.ws.guess = None;
             Local::nan()
         };
@@ -175,11 +171,11 @@ fn check_fibres(
             ),
         ));
     }
-    Err(Error::NotConverged {
-        what: format!("hyperelastic section solve at s = {s} m (body wrench {wb:?})"),
-        iterations: LOCAL_MAX_ITERATIONS,
-        residual: f64::NAN,
-    })
+    Err(Error::not_converged(
+        format!("hyperelastic section solve at s = {s} m (body wrench {wb:?})"),
+        LOCAL_MAX_ITERATIONS,
+        f64::NAN,
+    ))
 }
 
 /// Newton's method on the local residual `eval(x) = (g, ∂g/∂x)` from `x` (with `g`, `h` at

@@ -9,12 +9,16 @@ pub(crate) mod equations;
 mod hyperelastic_local;
 pub mod sensitivity;
 pub(crate) mod shooting;
+mod stability;
 pub mod statics;
 
-pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 pub use displacement::reference_lengths;
+pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
     Parameter, Sensitivities,
 };
-pub use statics::{solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart};
+pub use stability::{CONSTRAINT_COMPLIANCE, NEUTRAL_MARGIN};
+pub use statics::{
+    solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,
+};

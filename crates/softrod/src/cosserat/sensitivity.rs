@@ -45,12 +45,16 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
 
-use super::equations::{rot, v3, Column, Equations, Evaluator, Workspace, COLUMN, STATE};
+use super::equations::{
+    col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, DM, DN,
+    DR, STATE,
+};
 use super::shooting::Node;
 use super::statics::{Integrator, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, rk4_plan, Scheme};
 use crate::math::linalg::DenseLu;
+use crate::math::so3::hat;
 use crate::model::section::SectionProperties;
 use crate::model::{RobotModel, TendonInput};
 
@@ -227,12 +231,13 @@ fn pass<const N: usize>(
     for (c, s) in seeds.iter().enumerate() {
         let b = STATE + COLUMN * c;
         match *s {
-            Seed::Base(k) if k < 3 => y0[b + 6 + k] = f_ref,
-            Seed::Base(k) => y0[b + 9 + k - 3] = fm,
+            Seed::Base(k) if k < 3 => y0[b + DN + k] = f_ref,
+            Seed::Base(k) => y0[b + DM + k - 3] = fm,
             Seed::BaseTranslation(k) => y0[b + k] = 1.0,
             Seed::BaseRotation(k) => {
-                let w = r0.transpose() * Vector3::ith(k, 1.0);
-                y0[b + 3..b + 6].copy_from_slice(w.as_slice());
+                // δR(0) = δθ̂ R(0) for a world rotation δθ = e_k.
+                let dr = hat(&Vector3::ith(k, 1.0)) * r0;
+                y0[b + DR..b + DR + 9].copy_from_slice(dr.as_slice());
             }
             Seed::Load(_) | Seed::Forced(_) => {}
         }
@@ -261,7 +266,7 @@ fn pass<const N: usize>(
                     (0..seeds.len())
                         .map(|c| {
                             let b = STATE + COLUMN * c;
-                            let (dp, w) = (v3(y, b), r * v3(y, b + 3));
+                            let (dp, w) = (v3(y, b), rotation_variation(&r, &col_rot(y, b)));
                             Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
                         })
                         .collect(),
@@ -274,7 +279,7 @@ fn pass<const N: usize>(
             if req.load_node == Some(index) {
                 for (c, seed) in seeds.iter().enumerate() {
                     if let Seed::Load(k) = seed {
-                        let b = STATE + COLUMN * c + if *k < 3 { 6 + k } else { 9 + k - 3 };
+                        let b = STATE + COLUMN * c + if *k < 3 { DN + k } else { DM + k - 3 };
                         y[b] = -1.0;
                     }
                 }
@@ -288,6 +293,7 @@ fn pass<const N: usize>(
             what: "rod integration: non-finite state".into(),
             iterations: 0,
             residual: f64::INFINITY,
+            load_factor: 1.0,
         });
     }
     if next < req.observe.len() {
@@ -302,7 +308,7 @@ fn pass<const N: usize>(
     let tip = (0..seeds.len())
         .map(|c| {
             let b = STATE + COLUMN * c;
-            let (dp, w) = (v3(&y, b), r_tip * v3(&y, b + 3));
+            let (dp, w) = (v3(&y, b), rotation_variation(&r_tip, &col_rot(&y, b)));
             Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
         })
         .collect();
@@ -418,7 +424,9 @@ impl Evaluator<'_, '_> {
                 let r = Vector3::new(r[0], r[1], 0.0);
                 let rp = Vector3::new(rp[0], rp[1], 0.0);
                 let (dr, drp) = match column {
-                    Column::TendonOffsetShift(_, d) => (Vector3::new(d[0], d[1], 0.0), Vector3::zeros()),
+                    Column::TendonOffsetShift(_, d) => {
+                        (Vector3::new(d[0], d[1], 0.0), Vector3::zeros())
+                    }
                     _ => (r, rp),
                 };
                 let w = v + u.cross(&r) + rp;
@@ -592,6 +600,7 @@ pub(crate) fn linearise(
             what: "linearised equilibrium: singular problem".into(),
             iterations: 0,
             residual: f64::INFINITY,
+            load_factor: 1.0,
         });
     }
     let nrhs = seeds.len() + displaced.len();
@@ -623,6 +632,7 @@ pub(crate) fn linearise(
                 what: "linearised equilibrium: singular problem".into(),
                 iterations: 0,
                 residual: f64::INFINITY,
+                load_factor: 1.0,
             });
         }
         let combine = |get: &dyn Fn(usize) -> Vector6<f64>| -> Vector6<f64> {
@@ -641,7 +651,8 @@ pub(crate) fn linearise(
         let mut base = [0.0; 6];
         base[..nb.min(6)].copy_from_slice(&z[..nb]);
         out.base.push(base);
-        out.tensions.push(z[nb..].iter().map(|v| v * f_ref).collect());
+        out.tensions
+            .push(z[nb..].iter().map(|v| v * f_ref).collect());
         out.lengths.push(
             (0..nl)
                 .map(|h| {
@@ -703,16 +714,14 @@ fn check_parameter(model: &RobotModel, solution: &StaticsSolution, p: &Parameter
             bad("tendon", i, nt)
         }
         Parameter::Displacement(i) if i >= nt => bad("tendon", i, nt),
-        Parameter::Displacement(i) if !solution.actuation.tendons[i].is_held() => Err(
-            Error::invalid(
+        Parameter::Displacement(i) if !solution.actuation.tendons[i].is_held() => {
+            Err(Error::invalid(
                 format!("parameters: {p:?}"),
                 i,
                 "a displacement-controlled tendon",
-            ),
-        ),
-        Parameter::Pressure(j) | Parameter::ChamberAreaScale(j) if j >= nc => {
-            bad("chamber", j, nc)
+            ))
         }
+        Parameter::Pressure(j) | Parameter::ChamberAreaScale(j) if j >= nc => bad("chamber", j, nc),
         Parameter::BaseTranslation(k) | Parameter::BaseRotation(k) if k >= 3 => {
             bad("world axis", k, 3)
         }
@@ -833,7 +842,15 @@ pub fn sensitivities(
     let nt = model.tendons().len();
     let all_tendons: Vec<usize> = (0..nt).collect();
     let held = held_for(solution, lin);
-    let linear = linearise(solution, &held, &seeds, &displaced, &observe, &all_tendons, None)?;
+    let linear = linearise(
+        solution,
+        &held,
+        &seeds,
+        &displaced,
+        &observe,
+        &all_tendons,
+        None,
+    )?;
     let np = parameters.len();
     let f_ref = model.force_scale();
     let fm = f_ref * model.length();

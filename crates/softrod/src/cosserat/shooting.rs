@@ -16,10 +16,14 @@
 //! Which held tendons are taut is decided outside, by the active set of
 //! `cosserat/displacement.rs`; the tendons that are slack carry zero tension here.
 
-use nalgebra::{Matrix3, Vector3, Vector6};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3, Vector6};
 
-use super::equations::{rot, v3, Column, Equations, Evaluator, Workspace, FULL, STATE};
+use super::equations::{
+    col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, FULL,
+    STATE,
+};
 use super::sensitivity::{integrate, scheme_of, Request, Seed};
+use super::stability::tip_stability;
 use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Scheme};
@@ -60,6 +64,8 @@ pub(crate) struct Held {
     /// Slack per scaled unit of the residual (m).
     pub scale: f64,
 }
+/// A shape: arc length, position and rotation at the nodes of a pass.
+type Shape = Vec<(f64, Vector3<f64>, Matrix3<f64>)>;
 
 /// The shooting problem of one model and actuation, with its workspace and the nodes of the
 /// last pass.
@@ -73,12 +79,22 @@ pub(crate) struct Shooting<'a> {
     pub ws: Workspace,
     pub integrator: Integrator,
     pub plan: Vec<usize>,
+    /// Arc lengths (sorted, inside the rod) where every pass puts a node (`s_out`).
+    pub stops: Vec<f64>,
     /// Nodes of the last pass (a break appears twice: before and after its jump).
     pub nodes: Vec<Node>,
+    /// Tip twist `[δp; δθ]` (m, rad; world) along each base-wrench column of the last pass,
+    /// if it integrated the columns (`None` after a pass without them).
+    pub tip_twist: Option<[Vector6<f64>; 6]>,
+    /// The residual's derivative columns (column-major 6×6) of the last pass with columns.
+    pub columns: Option<[f64; 36]>,
+    /// Whether the continuation's safeguard also refuses an unstable state (judged from the
+    /// tip columns of its pass, when it has them; see [`super::stability`]).
+    pub require_stable: bool,
     /// Tendon path lengths of the last pass (m).
     pub lengths: Vec<f64>,
-    /// The shape of the committed state (positions, rotations), the safeguard's reference.
-    reference: Vec<(Vector3<f64>, Matrix3<f64>)>,
+    /// The shape of the committed state, the safeguard's reference.
+    reference: Shape,
     /// Right-hand-side evaluations so far.
     pub evaluations: usize,
 }
@@ -93,7 +109,11 @@ impl<'a> Shooting<'a> {
             ws,
             integrator,
             plan,
+            stops: Vec::new(),
             nodes: Vec::new(),
+            tip_twist: None,
+            columns: None,
+            require_stable: false,
             lengths: Vec::new(),
             reference: Vec::new(),
             evaluations: 0,
@@ -146,26 +166,48 @@ impl<'a> Shooting<'a> {
             ws: &mut self.ws,
         };
         let nodes = &mut self.nodes;
-        let result = march(&mut ev, breaks, &[], y0, scheme, |_, s, interval, y| {
-            nodes.push(Node {
-                s,
-                interval,
-                y: head(y),
-            });
-        });
+        let result = march(
+            &mut ev,
+            breaks,
+            &self.stops,
+            y0,
+            scheme,
+            |_, s, interval, y| {
+                nodes.push(Node {
+                    s,
+                    interval,
+                    y: head(y),
+                });
+            },
+        );
         self.evaluations += std::mem::take(&mut self.ws.evaluations);
+        self.tip_twist = None;
         let y = result?;
         if !y[..STATE].iter().all(|v| v.is_finite()) {
-            return Err(Error::NotConverged {
-                what: "rod integration: non-finite state".into(),
-                iterations: 0,
-                residual: f64::INFINITY,
-            });
+            return Err(Error::not_converged(
+                "rod integration: non-finite state",
+                0,
+                f64::INFINITY,
+            ));
         }
         let nt = self.eq.model.tendons().len();
         self.lengths.clear();
         self.lengths.extend_from_slice(&self.ws.integral[..nt]);
         let (r, cols) = eq.residual(&y, columns.len());
+        self.columns = None;
+        if N >= FULL {
+            let mut j = [0.0; 36];
+            for (c, col) in cols.iter().enumerate() {
+                j[6 * c..6 * c + 6].copy_from_slice(col.as_slice());
+            }
+            self.columns = Some(j);
+            let rt = rot(&y);
+            self.tip_twist = Some(std::array::from_fn(|k| {
+                let b = STATE + COLUMN * k;
+                let (dp, w) = (v3(&y, b), rotation_variation(&rt, &col_rot(&y, b)));
+                Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
+            }));
+        }
         let chord = v3(&y, 0) - eq.model.rod().base_pose().position();
         Ok((r, cols, chord))
     }
@@ -191,7 +233,8 @@ impl<'a> Shooting<'a> {
             };
             r[..6].copy_from_slice(res.as_slice());
             for (h, held) in self.held.iter().enumerate() {
-                let g = held.target - self.lengths[held.tendon] + held.compliance * z[6 + h] * f_ref;
+                let g =
+                    held.target - self.lengths[held.tendon] + held.compliance * z[6 + h] * f_ref;
                 r[6 + h] = g / held.scale;
             }
             return if r.iter().all(|v| v.is_finite()) {
@@ -203,7 +246,11 @@ impl<'a> Shooting<'a> {
         self.eq.load_factor = lambda;
         let seeds: Vec<Seed> = (0..6)
             .map(Seed::Base)
-            .chain(self.held.iter().map(|h| Seed::Forced(Column::Tension(h.tendon))))
+            .chain(
+                self.held
+                    .iter()
+                    .map(|h| Seed::Forced(Column::Tension(h.tendon))),
+            )
             .collect();
         let lengths: Vec<usize> = self.held.iter().map(|h| h.tendon).collect();
         let mut plan = Vec::new();
@@ -253,35 +300,45 @@ impl<'a> Shooting<'a> {
         }
     }
 
-    /// Positions and rotations at the nodes of the last pass.
-    fn shape(&self) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
+    /// Arc lengths, positions and rotations at the nodes of the last pass.
+    fn shape(&self) -> Shape {
         self.nodes
             .iter()
-            .map(|n| (v3(&n.y, 0), rot(&n.y)))
+            .map(|n| (n.s, v3(&n.y, 0), rot(&n.y)))
             .collect()
     }
 }
 
+/// The pose of `shape` at `s`: linear in position, normalised linear in the quaternion of
+/// the rotation between the two nodes around `s` (the node itself if `s` is one).
+fn pose_at(shape: &Shape, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
+    let j = shape.partition_point(|n| n.0 < s).min(shape.len() - 1);
+    if j == 0 || shape[j].0 == s {
+        return (shape[j].1, shape[j].2);
+    }
+    let (a, b) = (&shape[j - 1], &shape[j]);
+    let t = ((s - a.0) / (b.0 - a.0)).clamp(0.0, 1.0);
+    let qa = UnitQuaternion::from_matrix(&a.2);
+    let qb = UnitQuaternion::from_matrix(&b.2);
+    let q = qa.nlerp(&qb, t);
+    (a.1 + (b.1 - a.1) * t, *q.to_rotation_matrix().matrix())
+}
+
 /// Whether two shapes differ by at most [`MAX_LOAD_STEP_TURN`] in rotation (rad) and
-/// `MAX_LOAD_STEP_TURN L / 2` in position, node by node on a common mesh (RK4), at the tip
-/// otherwise (adaptive meshes differ between passes).
-fn shape_change_is_small(
-    a: &[(Vector3<f64>, Matrix3<f64>)],
-    b: &[(Vector3<f64>, Matrix3<f64>)],
-    length: f64,
-) -> bool {
-    let close = |(p0, r0): &(Vector3<f64>, Matrix3<f64>),
-                 (p1, r1): &(Vector3<f64>, Matrix3<f64>)| {
-        let c = ((r0.tr_mul(r1).trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
+/// `MAX_LOAD_STEP_TURN L / 2` in position at every node: node by node on a common mesh (RK4),
+/// else at the nodes of `b`, `a` interpolated there (adaptive meshes differ between passes).
+fn shape_change_is_small(a: &Shape, b: &Shape, length: f64) -> bool {
+    let close = |(p0, r0): (Vector3<f64>, Matrix3<f64>), (p1, r1): (Vector3<f64>, Matrix3<f64>)| {
+        let c = ((r0.tr_mul(&r1).trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
         c.acos() <= MAX_LOAD_STEP_TURN && (p1 - p0).norm() <= 0.5 * MAX_LOAD_STEP_TURN * length
     };
-    if a.len() == b.len() {
-        a.iter().zip(b).all(|(x, y)| close(x, y))
+    if a.is_empty() || b.is_empty() {
+        return false;
+    }
+    if a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.0 == y.0) {
+        a.iter().zip(b).all(|(x, y)| close((x.1, x.2), (y.1, y.2)))
     } else {
-        match (a.last(), b.last()) {
-            (Some(x), Some(y)) => close(x, y),
-            _ => false,
-        }
+        b.iter().all(|y| close(pose_at(a, y.0), (y.1, y.2)))
     }
 }
 
@@ -427,9 +484,15 @@ impl Problem for Shooting<'_> {
     }
 
     fn close(&self) -> bool {
-        match self.reference.is_empty() {
-            true => false,
-            false => shape_change_is_small(&self.reference, &self.shape(), self.eq.model.length()),
+        let length = self.eq.model.length();
+        if self.reference.is_empty()
+            || !shape_change_is_small(&self.reference, &self.shape(), length)
+        {
+            return false;
+        }
+        match (self.require_stable, &self.columns, &self.tip_twist) {
+            (true, Some(j), Some(tw)) => tip_stability(j, tw, length).is_some_and(|s| s.stable),
+            _ => true,
         }
     }
 }
@@ -519,5 +582,53 @@ mod tests {
         }
         assert!(err < 1e-6, "relative Jacobian error {err:e}");
         assert!(p.ws.material_error.is_none());
+    }
+}
+
+#[cfg(test)]
+mod taper_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::model::loads::Loads;
+    use crate::model::material::LinearElastic;
+    use crate::model::rod::Rod;
+    use crate::model::section::Section;
+    use crate::model::tendon::Tendon;
+    use crate::model::RobotModel;
+
+    /// On a soft tapered rod bent by two tendons (27 times the base curvature at the thin
+    /// end), the integrated columns are the derivative of the discrete march: central
+    /// differences of the residual agree to round-off at 40 RK4 steps (a rotation variation
+    /// `w` with `δR = R ŵ` differs from it by 5e-6, the truncation error of RK4).
+    #[test]
+    fn columns_are_the_derivative_of_the_discrete_march_on_a_taper() {
+        let sec = Section::tapered_circular(0.015625, 0.0068359375).unwrap();
+        let rod = Rod::new(0.5, sec, LinearElastic::new(51614.7, 0.49).unwrap()).unwrap();
+        let tendons = vec![Tendon::constant([0.00341796875, 0.0], None).unwrap(); 2];
+        let model = RobotModel::new(rod, tendons, vec![], Loads::default()).unwrap();
+        let tensions = [0.7069281979685804; 2];
+        let eq = Equations {
+            model: &model,
+            tensions: &tensions,
+            pressures: &[],
+            load_factor: 1.0,
+        };
+        let plan = crate::integrate::march::rk4_plan(model.breaks(), 40);
+        let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 40 }, plan);
+        let x = [0.01, -0.02, 0.03, 0.01, -0.015, 0.005];
+        let (_, cols, _) = p.pass::<FULL>(&x, 1.0).unwrap();
+        let h = 1e-6;
+        let mut err = 0.0f64;
+        for j in 0..6 {
+            let (mut xp, mut xm) = (x, x);
+            xp[j] += h;
+            xm[j] -= h;
+            let (rp, _, _) = p.pass::<STATE>(&xp, 1.0).unwrap();
+            let (rm, _, _) = p.pass::<STATE>(&xm, 1.0).unwrap();
+            for i in 0..6 {
+                err = err.max(((rp[i] - rm[i]) / (2.0 * h) - cols[j][i]).abs());
+            }
+        }
+        assert!(err < 1e-9, "Jacobian error {err:e}");
     }
 }

@@ -14,20 +14,22 @@
 //! chamber ends and point loads with fixed-step RK4 (the seed's method) or the adaptive
 //! Dormand–Prince 5(4) pair; rotation matrices are re-orthonormalised after every step.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
-use super::equations::{rot, v3, Equations, Evaluator, Workspace};
+use super::equations::{rot, v3, Equations, Evaluator, Workspace, FULL};
 use super::shooting::{Node, Shooting};
+use super::stability::{tip_stability, Stability};
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
 use crate::integrate::AdaptiveOptions;
 use crate::math::so3::quaternion_xyzw;
+use crate::model::loads::{Frame, PointLoad};
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{
     continuation, max_norm, newton, Armijo, ContinuationSettings, Evaluated, LineSearch,
-    NewtonOptions, NewtonOutcome, NewtonSettings, Problem, SolverStats,
+    NewtonOptions, NewtonOutcome, NewtonSettings, Problem, SolverStats, Stopped,
 };
 
 /// Default number of RK4 steps over the whole rod (split among the intervals in proportion
@@ -104,6 +106,9 @@ pub struct SolveOptions {
     pub newton: NewtonOptions,
     /// Initial guess of the base wrench; `None` starts from the unloaded rod.
     pub warm_start: Option<WarmStart>,
+    /// When the equilibrium reached is unstable, search for a stable one (smaller load steps
+    /// from the unloaded rod, then along the unstable mode) and return it if found.
+    pub seek_stable: bool,
 }
 
 impl Default for SolveOptions {
@@ -118,6 +123,7 @@ impl Default for SolveOptions {
                 throw: true,
             },
             warm_start: None,
+            seek_stable: true,
         }
     }
 }
@@ -207,6 +213,15 @@ pub struct StaticsSolution {
     pub options: SolveOptions,
     /// The (exact or updated) shooting Jacobian at the solution, in scaled unknowns.
     pub jacobian: Option<Matrix6<f64>>,
+    /// The arc lengths the solution was asked at (m; empty: the integration mesh).
+    pub s_out: Vec<f64>,
+    /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
+    /// tension, dead loads) is positive definite (see [`StaticsSolution::stability_margin`]
+    /// and `docs/stability.md`). Always true without external loads; false for a result
+    /// that did not converge.
+    pub stable: bool,
+    /// The stability margin, once computed.
+    pub(crate) margin: OnceLock<f64>,
 }
 
 impl StaticsSolution {
@@ -232,12 +247,59 @@ impl StaticsSolution {
     pub fn pressures(&self) -> Vec<f64> {
         self.actuation.pressure_values(self.model.chambers().len())
     }
+
+    /// The smallest eigenvalue of the symmetric part of the dimensionless tip tangent
+    /// stiffness `D K D / (E I(0) / L)`, `K` the inverse of the tip tangent compliance
+    /// (tendons at fixed tension, dead loads), `D = diag(L, L, L, 1, 1, 1)`: positive for a
+    /// stable equilibrium (see `docs/stability.md`). Computed during a loaded solve; for an
+    /// unloaded one (always stable) on first call, by one march with the six base-wrench
+    /// columns. NaN for a result that did not converge.
+    pub fn stability_margin(&self) -> f64 {
+        *self.margin.get_or_init(|| {
+            if !self.stats.converged {
+                return f64::NAN;
+            }
+            margin_of(self).unwrap_or(f64::NAN)
+        })
+    }
+}
+
+/// The stability margin of a solution, from one march with the base-wrench columns.
+fn margin_of(sol: &StaticsSolution) -> Option<f64> {
+    let model = &*sol.model;
+    let tensions = sol.tensions();
+    let pressures = sol.pressures();
+    let eq = Equations {
+        model,
+        tensions: &tensions,
+        pressures: &pressures,
+        load_factor: 1.0,
+    };
+    let plan = match sol.options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let mut p = Shooting::new(eq, sol.options.integrator, plan);
+    p.stops = interior(&sol.s_out, model.length());
+    let x = scaled(model, &sol.base_wrench);
+    stability_at(&mut p, &x, None, false).map(|(s, _)| s.margin)
+}
+
+/// The points of `s_out` strictly inside `(0, length)`.
+fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
+    s_out
+        .iter()
+        .copied()
+        .filter(|&s| s > 0.0 && s < length)
+        .collect()
 }
 
 /// Newton settings of the shooting. Broyden's update of the Jacobian is used with the fixed
 /// RK4 mesh (the residual is then a smooth function of the unknowns); with the adaptive
 /// integrator the residual carries the integration error and exact Jacobians are evaluated.
-fn settings(broyden: bool, jacobian: Option<&[f64]>) -> NewtonSettings<'_> {
+/// A loaded solve ends on an exact Jacobian at the solution (the stability test needs its
+/// columns).
+fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
     NewtonSettings {
         line_search: LineSearch {
             factor: 0.5,
@@ -248,27 +310,53 @@ fn settings(broyden: bool, jacobian: Option<&[f64]>) -> NewtonSettings<'_> {
         residual_first: false,
         broyden,
         jacobian,
+        exact_at_solution: exact,
+    }
+}
+
+/// What a solve reached: the Newton outcome (on failure, the last accepted state with its
+/// residual at `load_factor`), its load factor and effort, and why a continuation stopped.
+struct Reached {
+    outcome: NewtonOutcome,
+    load_factor: f64,
+    iterations: usize,
+    load_steps: usize,
+    stopped: Option<Stopped>,
+}
+
+impl Reached {
+    fn direct(outcome: NewtonOutcome) -> Self {
+        Self {
+            load_factor: 1.0,
+            iterations: outcome.iterations,
+            load_steps: 0,
+            stopped: None,
+            outcome,
+        }
     }
 }
 
 /// The direct solve at full load: from the warm start, or from the tangent predictor at the
 /// unloaded rod. Returns the outcome and, for a cold start, the unloaded Jacobian and the
-/// size of a predictor step refused by the step limit.
+/// size of a predictor step refused by the step limit. A cold solution that moved the shape
+/// by more than [`MAX_LOAD_STEP_TURN`] from the unloaded rod (the safeguard of one load step
+/// of size 1) is refused, so that continuation follows the branch instead.
 fn direct(
     p: &mut Shooting<'_>,
     options: &SolveOptions,
     x0: &[f64; 6],
+    exact: bool,
 ) -> (NewtonOutcome, Option<Vec<f64>>, f64) {
     let opts = &options.newton;
     let limit = opts.continuation.then_some(DIRECT_STEP_LIMIT);
     let broyden = matches!(options.integrator, Integrator::Rk4 { .. });
-    let settings = |_: bool, j| settings(broyden, j);
+    let settings = |j| settings(broyden, j, exact);
     if let Some(w) = &options.warm_start {
         let j = w.jacobian.map(|m| m.as_slice().to_vec());
         let s = NewtonSettings {
             first_step_limit: limit,
             residual_first: true,
-            ..settings(true, j.as_deref())
+            ..settings(j.as_deref())
         };
         return (newton(p, x0, 1.0, opts, &s), None, 0.0);
     }
@@ -276,7 +364,7 @@ fn direct(
         // Nothing to apply: x = 0 solves the actuated rod exactly.
         let s = NewtonSettings {
             residual_first: true,
-            ..settings(true, None)
+            ..settings(None)
         };
         return (newton(p, x0, 1.0, opts, &s), None, 0.0);
     }
@@ -284,12 +372,9 @@ fn direct(
     let mut r = [0.0; 6];
     let mut j0 = vec![0.0; 36];
     if p.evaluate(x0, 0.0, Some(&mut j0), &mut r) != Evaluated::Jacobian {
-        let s = NewtonSettings {
-            residual_first: true,
-            ..settings(true, None)
-        };
-        return (newton(p, x0, 1.0, opts, &s), None, 0.0);
+        return (refused(x0, f64::INFINITY, 0.0), None, 0.0);
     }
+    p.commit();
     let mut drdl = [0.0; 6];
     let mut guess = *x0;
     if p.load_derivative(x0, 0.0, &mut drdl) {
@@ -298,16 +383,7 @@ fn direct(
         if lu.factor(6, &j0) && lu.solve_in_place(&mut t) {
             let step = max_norm(&t);
             if limit.is_some_and(|l| step > l) {
-                let refused = NewtonOutcome {
-                    x: x0.to_vec(),
-                    residual: f64::INFINITY,
-                    converged: false,
-                    iterations: 0,
-                    first_step: step,
-                    jacobian: None,
-                    at_x: false,
-                };
-                return (refused, Some(j0), step);
+                return (refused(x0, f64::INFINITY, step), Some(j0), step);
             }
             for k in 0..6 {
                 guess[k] += t[k];
@@ -318,41 +394,346 @@ fn direct(
     // predicted point.
     let s = NewtonSettings {
         first_step_limit: if guess == *x0 { limit } else { None },
-        ..settings(true, None)
+        ..settings(None)
     };
     let mut out = newton(p, &guess, 1.0, opts, &s);
     if !out.converged && !out.residual.is_finite() && guess != *x0 {
         // The predictor left the domain of the equations: Newton from the unloaded rod.
         let s = NewtonSettings {
             first_step_limit: limit,
-            ..settings(true, Some(&j0))
+            ..settings(Some(&j0))
         };
         out = newton(p, x0, 1.0, opts, &s);
+    }
+    if out.converged && opts.continuation && !(out.at_x && p.close()) {
+        // Too far from the unloaded rod for one step: maybe another branch.
+        return (refused(x0, out.residual, 0.0), Some(j0), 0.0);
     }
     let first = out.first_step;
     (out, Some(j0), first)
 }
 
+/// A refused direct solve (continuation takes over).
+fn refused(x0: &[f64; 6], residual: f64, first_step: f64) -> NewtonOutcome {
+    NewtonOutcome {
+        x: x0.to_vec(),
+        residual,
+        converged: false,
+        iterations: 0,
+        first_step,
+        jacobian: None,
+        at_x: false,
+        exact: false,
+    }
+}
+
+/// Steps the external loads from the unloaded rod (x = 0 is exact at λ = 0) by continuation,
+/// from the refused predictor step `first_step` (0: none), with load increments of at most
+/// `max_increment`.
+fn step_loads(
+    p: &mut Shooting<'_>,
+    options: &SolveOptions,
+    j0: Option<Vec<f64>>,
+    first_step: f64,
+    max_increment: f64,
+    exact: bool,
+) -> Reached {
+    let zero = [0.0; 6];
+    let j0 = match j0 {
+        Some(j) => Some(j),
+        None => {
+            let mut j = vec![0.0; 36];
+            let mut r = [0.0; 6];
+            (p.evaluate(&zero, 0.0, Some(&mut j), &mut r) == Evaluated::Jacobian).then_some(j)
+        }
+    };
+    let first = if first_step > 0.0 {
+        (0.8 * DIRECT_STEP_LIMIT / first_step).clamp(crate::solve::MIN_LOAD_INCREMENT, 0.5)
+    } else {
+        0.25
+    }
+    .min(max_increment);
+    let start = ContinuationSettings {
+        x0: &zero,
+        jacobian0: j0.as_deref(),
+        first_increment: first,
+        max_increment,
+    };
+    let s = NewtonSettings {
+        first_step_limit: Some(DIRECT_STEP_LIMIT),
+        ..settings(
+            matches!(options.integrator, Integrator::Rk4 { .. }),
+            None,
+            exact,
+        )
+    };
+    let c = continuation(p, &start, &options.newton, &s);
+    Reached {
+        outcome: c.outcome,
+        load_factor: c.load_factor,
+        iterations: c.iterations,
+        load_steps: c.steps,
+        stopped: Some(c.stopped),
+    }
+}
+
+/// The direct solve, then continuation if it fails or is refused.
+fn attempt(p: &mut Shooting<'_>, options: &SolveOptions, x0: &[f64; 6], exact: bool) -> Reached {
+    let (result, j0, first_step) = direct(p, options, x0, exact);
+    if result.converged || !options.newton.continuation {
+        return Reached::direct(result);
+    }
+    let iterations = result.iterations;
+    let mut c = step_loads(p, options, j0, first_step, 0.5, exact);
+    c.iterations += iterations;
+    c
+}
+
+/// Scaled unknowns of a base wrench (N, N m).
+fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
+    let f = model.force_scale();
+    let fm = f * model.length();
+    [
+        b[0] / f,
+        b[1] / f,
+        b[2] / f,
+        b[3] / fm,
+        b[4] / fm,
+        b[5] / fm,
+    ]
+}
+
+/// The stability of the converged state `x` of `p`, with the Jacobian there: from the tip
+/// columns of its last pass if that pass was at `x` with them (`fresh`, `jacobian`), else
+/// from a pass with the columns at `x`.
+fn stability_at(
+    p: &mut Shooting<'_>,
+    x: &[f64],
+    jacobian: Option<&[f64]>,
+    fresh: bool,
+) -> Option<(Stability, Vec<f64>)> {
+    let length = p.eq.model.length();
+    if let (true, Some(j), Some(tw)) = (fresh, jacobian, p.tip_twist) {
+        return tip_stability(j, &tw, length).map(|s| (s, j.to_vec()));
+    }
+    let (_, cols, _) = p.pass::<FULL>(x, 1.0).ok()?;
+    let mut j = vec![0.0; 36];
+    for (c, col) in cols.iter().enumerate() {
+        j[6 * c..6 * c + 6].copy_from_slice(col.as_slice());
+    }
+    let tw = p.tip_twist?;
+    tip_stability(&j, &tw, length).map(|s| (s, j))
+}
+
+/// Size of the imperfection of [`seek_stable`]: a dead tip wrench of `IMPERFECTION` times the
+/// force scale `E I(0) / L²` (and `E I(0) / L` for its moment) along the unstable mode.
+pub const IMPERFECTION: f64 = 1e-1;
+
+/// A stable equilibrium instead of the unstable one at `x` (see [`SolveOptions::seek_stable`]):
+/// first continuation from the unloaded rod in load steps of at most 1/8, refusing unstable
+/// states (the stable branch connected to the unloaded rod); then, for a symmetric problem whose
+/// continuation stays on the unstable branch (a column past its critical load), the same
+/// rod with a small dead tip wrench along the unstable mode ([`IMPERFECTION`], either sign)
+/// solved by continuation, and the perfect rod solved again from there by Newton. Returns
+/// the unknowns and the stability of the first converged, stable equilibrium found, and the
+/// Newton iterations spent.
+fn seek_stable(
+    p: &mut Shooting<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    (x, stability): (&[f64], &Stability),
+) -> (Option<(Vec<f64>, Stability, Vec<f64>)>, usize) {
+    let mut iterations = 0;
+    if options.newton.continuation {
+        p.require_stable = true;
+        let c = step_loads(p, options, None, 0.0, 0.125, true);
+        p.require_stable = false;
+        iterations += c.iterations;
+        if c.outcome.converged && c.load_factor >= 1.0 {
+            let o = &c.outcome;
+            if let Some((s, j)) = stability_at(p, &o.x, o.jacobian.as_deref(), o.exact) {
+                if s.stable {
+                    return (Some((o.x.clone(), s, j)), iterations);
+                }
+            }
+        }
+    }
+    let Some(mode) = stability.mode else {
+        return (None, iterations);
+    };
+    // The mode's unit dimensionless tip wrench ζ = Y δx, in SI.
+    let mut j = [0.0; 36];
+    let mut r = [0.0; 6];
+    if p.evaluate(x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
+        return (None, iterations);
+    }
+    let zeta: [f64; 6] = std::array::from_fn(|i| (0..6).map(|k| j[i + 6 * k] * mode[k]).sum());
+    let f = model.force_scale() * IMPERFECTION;
+    let quiet = SolveOptions {
+        seek_stable: false,
+        warm_start: None,
+        newton: NewtonOptions {
+            throw: false,
+            ..options.newton
+        },
+        ..*options
+    };
+    for sign in [1.0, -1.0] {
+        let w: [f64; 6] =
+            std::array::from_fn(|i| sign * zeta[i] * if i < 3 { f } else { f * model.length() });
+        let mut loads = model.loads().clone();
+        loads.point_loads.push(PointLoad {
+            s: model.length(),
+            force: Vector3::new(w[0], w[1], w[2]),
+            moment: Vector3::new(w[3], w[4], w[5]),
+            frame: Frame::World,
+        });
+        let Ok(imperfect) = RobotModel::new(
+            model.rod().clone(),
+            model.tendons().to_vec(),
+            model.chambers().to_vec(),
+            loads,
+        ) else {
+            return (None, iterations);
+        };
+        let Ok(bent) = solve_with(&imperfect, actuation, &quiet, &[], true) else {
+            continue;
+        };
+        iterations += bent.stats.iterations;
+        if !bent.stats.converged {
+            continue;
+        }
+        let x1 = scaled(model, &bent.base_wrench);
+        let broyden = matches!(options.integrator, Integrator::Rk4 { .. });
+        let jac = bent.jacobian.map(|m| m.as_slice().to_vec());
+        let s = NewtonSettings {
+            residual_first: true,
+            ..settings(broyden, jac.as_deref(), true)
+        };
+        let out = newton(p, &x1, 1.0, &options.newton, &s);
+        iterations += out.iterations;
+        let moved = (0..6).map(|k| (out.x[k] - x[k]).abs()).fold(0.0, f64::max);
+        if !out.converged || moved <= 1e-6 * (1.0 + max_norm(x)) {
+            continue;
+        }
+        if let Some((s, j)) = stability_at(p, &out.x, out.jacobian.as_deref(), out.exact) {
+            if s.stable {
+                return (Some((out.x, s, j)), iterations);
+            }
+        }
+    }
+    (None, iterations)
+}
+
+/// The message of a solve that did not converge: why it stopped.
+fn failure(reached: &Reached, max_load_steps: usize) -> String {
+    let what = "shooting Newton (Cosserat rod statics)";
+    match reached.stopped {
+        Some(Stopped::StepsExhausted) => format!(
+            "{what}: the load steps ran out at load factor {:.4} ({max_load_steps} steps; \
+             raise max_load_steps)",
+            reached.load_factor
+        ),
+        Some(Stopped::IncrementUnderflow) => format!(
+            "{what}: no load step beyond load factor {:.4} converged on the branch from the \
+             unloaded rod (load increment below {:e})",
+            reached.load_factor,
+            crate::solve::MIN_LOAD_INCREMENT
+        ),
+        Some(Stopped::StartFailed) => format!(
+            "{what}: the actuated rod without external loads could not be integrated \
+             (non-finite state or a failed constitutive solve: the actuation is beyond what \
+             the integration resolves)"
+        ),
+        _ => what.to_string(),
+    }
+}
+
 /// Solves the statics of `model` under `actuation` (`solve_statics(rod, tendons=(),
-/// loads=None, ...)` in Python, which builds both).
+/// loads=None, ...)` in Python, which builds both), reporting the solution at the
+/// integration mesh.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] naming the offending input (`tensions[i]`, `pressures[i]`,
-/// their counts, options); [`Error::NotConverged`] with the iterations and final scaled
-/// residual if the shooting does not converge and `options.newton.throw` is true, unless a
-/// hyperelastic material failed on the way: then [`Error::InvalidParameter`] naming `stretch`
-/// (a fibre compressed to zero length) or the law's parameters (a law that is not monotonic at
-/// the stretches reached).
+/// As [`solve_statics_at`].
 pub fn solve_statics(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
     options: &SolveOptions,
 ) -> Result<StaticsSolution> {
+    solve_statics_at(model, actuation, options, &[])
+}
+
+/// Checks `s_out`: finite, in `[0, L]`, strictly increasing.
+fn check_s_out(s_out: &[f64], length: f64) -> Result<()> {
+    for (i, &s) in s_out.iter().enumerate() {
+        if !(s.is_finite() && (0.0..=length).contains(&s)) {
+            return Err(Error::invalid(
+                format!("s_out[{i}]"),
+                s,
+                format!("in [0, length] = [0, {length}] m"),
+            ));
+        }
+        if i > 0 && s <= s_out[i - 1] {
+            return Err(Error::invalid(
+                format!("s_out[{i}]"),
+                s,
+                format!(
+                    "> s_out[{}] = {} m (strictly increasing)",
+                    i - 1,
+                    s_out[i - 1]
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// [`solve_statics`] with the solution reported at the arc lengths `s_out` (m, strictly
+/// increasing in `[0, L]`; empty: at the integration mesh). Every `s_out` is a node of every
+/// pass (an RK4 interval is split there, an adaptive step ends there), not interpolated; at a
+/// break (a tendon termination, a point load) the values just after the jump are reported.
+///
+/// A loaded solution reports its stability ([`StaticsSolution::stable`]); when the
+/// equilibrium reached is unstable and [`SolveOptions::seek_stable`] is set, a stable one is
+/// searched (smaller load steps from the unloaded rod, then along the unstable mode) and
+/// returned if found.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the offending input (`tensions[i]`, `pressures[i]`,
+/// their counts, options, `s_out[i]`); [`Error::NotConverged`] with the iterations, the
+/// residual of the last accepted state and its load factor if the shooting does not converge
+/// and `options.newton.throw` is true (its message says why: the load steps ran out, no load
+/// step converged, the actuated rod could not be integrated), unless a hyperelastic material
+/// failed on the way: then [`Error::InvalidParameter`] naming `stretch` (a fibre compressed
+/// to zero length) or the law's parameters (a law that is not monotonic at the stretches
+/// reached).
+pub fn solve_statics_at(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    s_out: &[f64],
+) -> Result<StaticsSolution> {
+    solve_with(model, actuation, options, s_out, false)
+}
+
+/// [`solve_statics_at`], the continuation refusing unstable states if `require_stable`.
+fn solve_with(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    s_out: &[f64],
+    require_stable: bool,
+) -> Result<StaticsSolution> {
     options.validate()?;
+    check_s_out(s_out, model.length())?;
     let (nt, nc) = (model.tendons().len(), model.chambers().len());
-    actuation.validate(nt, nc)?;
+    model.check_actuation(actuation)?;
+    if let Some(w) = &options.warm_start {
+        model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
+    }
     if actuation.has_held() {
-        return super::displacement::solve_held(model, actuation, options);
+        return super::displacement::solve_held(model, actuation, options, s_out);
     }
     let tensions = actuation.tension_values(nt);
     let pressures = actuation.pressure_values(nc);
@@ -367,113 +748,110 @@ pub fn solve_statics(
         load_factor: 1.0,
     };
     let mut p = Shooting::new(eq, options.integrator, plan);
-    let f_ref = model.force_scale();
-    let fm = f_ref * model.length();
+    p.stops = interior(s_out, model.length());
+    p.require_stable = require_stable;
     let x0 = match &options.warm_start {
-        Some(w) => {
-            let b = &w.base_wrench;
-            [
-                b[0] / f_ref,
-                b[1] / f_ref,
-                b[2] / f_ref,
-                b[3] / fm,
-                b[4] / fm,
-                b[5] / fm,
-            ]
-        }
+        Some(w) => scaled(model, &w.base_wrench),
         None => [0.0; 6],
     };
     let opts = &options.newton;
-    let mut stats = SolverStats {
-        load_factor: 1.0,
-        ..SolverStats::default()
-    };
-    let (mut result, j0, first_step) = direct(&mut p, options, &x0);
-    stats.iterations = result.iterations;
-    if !result.converged && opts.continuation {
-        result = step_loads(&mut p, options, j0, first_step, &mut stats);
+    // Without external loads the equilibrium is unique (x = 0) and stable (docs/stability.md).
+    let loaded = !model.loads().is_unloaded();
+    let mut reached = attempt(&mut p, options, &x0, loaded);
+    let mut stability = None;
+    if reached.outcome.converged && loaded {
+        let o = &reached.outcome;
+        stability = stability_at(&mut p, &o.x, o.jacobian.as_deref(), o.exact).map(|(s, _)| s);
+        if let Some(s) = stability.filter(|s| !s.stable && options.seek_stable) {
+            let x = reached.outcome.x.clone();
+            let (found, its) = seek_stable(&mut p, model, actuation, options, (&x, &s));
+            reached.iterations += its;
+            if let Some((x, s, j)) = found {
+                reached.outcome.x = x;
+                reached.outcome.jacobian = Some(j);
+                reached.outcome.at_x = false;
+                stability = Some(s);
+            }
+        }
     }
+    let result = &mut reached.outcome;
     // The recorded pass must be the one at the returned unknowns (and their load factor).
     if !result.at_x {
         let mut r = [0.0; 6];
-        if p.evaluate(&result.x, stats.load_factor, None, &mut r) != Evaluated::Failed
-            && !result.converged
-            && stats.load_factor >= 1.0
-        {
+        if p.evaluate(&result.x, reached.load_factor, None, &mut r) != Evaluated::Failed {
             result.residual = max_norm(&r);
+        } else {
+            result.residual = f64::INFINITY;
         }
+        result.converged =
+            result.converged && result.residual <= p.tolerance(&result.x, opts.tolerance);
     }
-    stats.residual = result.residual;
-    stats.converged = result.converged;
-    stats.function_evaluations = p.evaluations;
-    if !result.converged && opts.throw {
-        if let Some(e) = p.ws.material_error.take() {
-            return Err(e);
-        }
-        return Err(Error::NotConverged {
-            what: "shooting Newton (Cosserat rod statics)".into(),
-            iterations: stats.iterations,
-            residual: result.residual,
-        });
-    }
-    let x = &result.x;
-    let base_wrench = [
-        x[0] * f_ref,
-        x[1] * f_ref,
-        x[2] * f_ref,
-        x[3] * fm,
-        x[4] * fm,
-        x[5] * fm,
-    ];
+    let finite = p.nodes.iter().all(|n| n.y.iter().all(|v| v.is_finite()));
+    let mut stats = SolverStats {
+        iterations: reached.iterations,
+        residual: result.residual,
+        function_evaluations: 0,
+        converged: result.converged && finite && result.residual.is_finite(),
+        load_steps: reached.load_steps,
+        load_factor: reached.load_factor,
+    };
+    let x = result.x.clone();
     let jacobian = result
         .jacobian
         .as_ref()
         .map(|j| Matrix6::from_column_slice(j));
-    let mut sol = assemble(&mut p, model, base_wrench, stats);
+    let mut sol = assemble(&mut p, model, scaled_back(model, &x), stats, s_out);
+    let strains_finite = sol
+        .v
+        .iter()
+        .chain(&sol.u)
+        .all(|v| v.iter().all(|c| c.is_finite()));
+    if !strains_finite {
+        stats.converged = false;
+        sol.stats.converged = false;
+    }
+    sol.stats.function_evaluations = p.evaluations;
+    if !stats.converged && opts.throw {
+        if let Some(e) = p.ws.material_error.take() {
+            return Err(e);
+        }
+        let mut what = failure(&reached, opts.max_load_steps);
+        if !finite || !strains_finite {
+            what.push_str(": non-finite values along the rod");
+        }
+        return Err(Error::NotConverged {
+            what,
+            iterations: stats.iterations,
+            residual: stats.residual,
+            load_factor: stats.load_factor,
+        });
+    }
     sol.actuation = actuation.clone();
     sol.options = *options;
+    sol.s_out = s_out.to_vec();
     sol.jacobian = jacobian;
+    match stability {
+        Some(s) => {
+            sol.stable = s.stable;
+            let _ = sol.margin.set(s.margin);
+        }
+        None => sol.stable = !loaded && sol.stats.converged,
+    }
     Ok(sol)
 }
 
-/// Steps the external loads from the unloaded rod (x = 0 is exact at λ = 0) by continuation,
-/// from the refused predictor step `first_step` (0: none); the steps taken go into `stats`.
-fn step_loads(
-    p: &mut Shooting<'_>,
-    options: &SolveOptions,
-    j0: Option<Vec<f64>>,
-    first_step: f64,
-    stats: &mut SolverStats,
-) -> NewtonOutcome {
-    let zero = [0.0; 6];
-    let j0 = match j0 {
-        Some(j) => Some(j),
-        None => {
-            let mut j = vec![0.0; 36];
-            let mut r = [0.0; 6];
-            (p.evaluate(&zero, 0.0, Some(&mut j), &mut r) == Evaluated::Jacobian).then_some(j)
-        }
-    };
-    let first = if first_step > 0.0 {
-        (0.8 * DIRECT_STEP_LIMIT / first_step).clamp(crate::solve::MIN_LOAD_INCREMENT, 0.5)
-    } else {
-        0.25
-    };
-    let start = ContinuationSettings {
-        x0: &zero,
-        jacobian0: j0.as_deref(),
-        first_increment: first,
-        max_increment: 0.5,
-    };
-    let s = NewtonSettings {
-        first_step_limit: Some(DIRECT_STEP_LIMIT),
-        ..settings(matches!(options.integrator, Integrator::Rk4 { .. }), None)
-    };
-    let c = continuation(p, &start, &options.newton, &s);
-    stats.iterations += c.iterations;
-    stats.load_steps = c.steps;
-    stats.load_factor = c.load_factor;
-    c.outcome
+/// The base wrench (N, N m) of scaled unknowns.
+fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
+    let f = model.force_scale();
+    let fm = f * model.length();
+    [
+        x[0] * f,
+        x[1] * f,
+        x[2] * f,
+        x[3] * fm,
+        x[4] * fm,
+        x[5] * fm,
+    ]
 }
 
 fn arr(v: &Vector3<f64>) -> [f64; 3] {
@@ -494,6 +872,7 @@ pub(crate) fn assemble(
     shared: &Arc<RobotModel>,
     base_wrench: [f64; 6],
     stats: SolverStats,
+    s_out: &[f64],
 ) -> StaticsSolution {
     let n = p.nodes.len();
     let model = p.eq.model;
@@ -508,7 +887,11 @@ pub(crate) fn assemble(
         m_body: Vec::with_capacity(n),
         v: Vec::with_capacity(n),
         u: Vec::with_capacity(n),
-        tendon_lengths: p.lengths.clone(),
+        tendon_lengths: if p.lengths.len() == p.eq.model.tendons().len() {
+            p.lengths.clone()
+        } else {
+            vec![f64::NAN; p.eq.model.tendons().len()]
+        },
         tendon_tensions: p.tensions.clone(),
         base_wrench,
         stats,
@@ -516,15 +899,28 @@ pub(crate) fn assemble(
         actuation: Actuation::default(),
         options: SolveOptions::default(),
         jacobian: None,
+        s_out: Vec::new(),
+        stable: false,
+        margin: OnceLock::new(),
     };
     let mut ws = Workspace::new(model.tendons().len());
     let mut ev = Evaluator {
         eq: p.equations(),
         ws: &mut ws,
     };
+    // With `s_out`, only the nodes there (the last copy of a break).
+    let keep: Option<Vec<bool>> = (!s_out.is_empty()).then(|| {
+        let mut keep = vec![false; n];
+        for &s in s_out {
+            if let Some(j) = p.nodes.iter().rposition(|node| node.s == s) {
+                keep[j] = true;
+            }
+        }
+        keep
+    });
     let mut current = usize::MAX;
     let nodes: &[Node] = &p.nodes;
-    for node in nodes {
+    for (j, node) in nodes.iter().enumerate() {
         if node.interval != current {
             ev.set_interval(node.interval);
             current = node.interval;
@@ -535,6 +931,9 @@ pub(crate) fn assemble(
         let mb_tot = r.tr_mul(&v3(y, 15));
         let props = model.rod().section_at(node.s);
         let loc = ev.local(node.s, &props, &nb_tot, &mb_tot, false);
+        if keep.as_ref().is_some_and(|k| !k[j]) {
+            continue;
+        }
         let nb = nb_tot - loc.tendon_force;
         let mb = mb_tot - loc.tendon_moment;
         sol.s.push(node.s);

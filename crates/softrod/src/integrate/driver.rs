@@ -177,11 +177,11 @@ pub fn fixed<const N: usize, const S: usize, Y: System<N>>(
         sys.step_accepted(&weights(tab, h), false);
         sys.project(&mut y);
         if !y.iter().all(|v| v.is_finite()) {
-            return Err(Error::NotConverged {
-                what: format!("{} integration: non-finite state", tab.name),
-                iterations: i + 1,
-                residual: f64::INFINITY,
-            });
+            return Err(Error::not_converged(
+                format!("{} integration: non-finite state", tab.name),
+                i + 1,
+                f64::INFINITY,
+            ));
         }
         on_step(sys, t_end, &mut y);
     }
@@ -189,11 +189,11 @@ pub fn fixed<const N: usize, const S: usize, Y: System<N>>(
 }
 
 fn not_converged(method: &str, detail: &str, iterations: usize, residual: f64) -> Error {
-    Error::NotConverged {
-        what: format!("{method} integration{detail}"),
+    Error::not_converged(
+        format!("{method} integration{detail}"),
         iterations,
         residual,
-    }
+    )
 }
 
 /// Factor of the next step after a scaled error `err` for an error estimate of order `order`

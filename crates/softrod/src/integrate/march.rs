@@ -45,7 +45,9 @@ pub fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
 
 /// Integrates `sys` over `breaks` from `y0`, calling `node(sys, s, interval, y)` at the start
 /// of every interval and after every step (`y` may be modified there, e.g. to seed a column).
-/// With the adaptive scheme, every point of `stops` inside an interval ends a step there.
+/// Every point of `stops` (sorted) inside an interval ends a step there: an adaptive step is
+/// cut short; with RK4 the interval is split there and its steps shared among the parts in
+/// proportion to their lengths (at least one each), so a stop is a node of the mesh.
 /// Returns the state at the last break.
 ///
 /// # Errors
@@ -65,7 +67,17 @@ pub fn march<const N: usize, Y: Piecewise<N>>(
         node(sys, a, k, &mut y);
         match scheme {
             Scheme::Rk4(plan) => {
-                y = fixed(&RK4, sys, a, y, b, plan[k], |sys, s, y| node(sys, s, k, y))?;
+                // Stops split the interval; its steps are shared in proportion to length.
+                let mut start = a;
+                for &stop in stops.iter().filter(|&&s| s > a && s < b).chain([&b]) {
+                    let n = if stop == b && start == a {
+                        plan[k]
+                    } else {
+                        ((plan[k] as f64 * (stop - start) / (b - a)).round() as usize).max(1)
+                    };
+                    y = fixed(&RK4, sys, start, y, stop, n, |sys, s, y| node(sys, s, k, y))?;
+                    start = stop;
+                }
             }
             Scheme::Adaptive {
                 options,

@@ -366,9 +366,7 @@ fn check_target(target: &Target) -> Result<()> {
         }
     }
     if let Some(r) = &target.rotation {
-        if !r.iter().all(|v| v.is_finite())
-            || crate::math::so3::orthonormality_error(r) > 1e-6
-        {
+        if !r.iter().all(|v| v.is_finite()) || crate::math::so3::orthonormality_error(r) > 1e-6 {
             return Err(Error::invalid(
                 "target_rotation",
                 format!("{r:?}"),
@@ -399,7 +397,8 @@ fn error_rows(
     if let Some(rt) = &target.rotation {
         let w = log_so3(&(rt * ev.rotation.transpose()));
         rot = w.norm();
-        e.fixed_rows_mut::<3>(3 * np).copy_from(&(w * rotation_weight));
+        e.fixed_rows_mut::<3>(3 * np)
+            .copy_from(&(w * rotation_weight));
     }
     let jac = ev.jacobian.as_ref().map(|js| {
         let n = js[0].ncols();
@@ -520,12 +519,16 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 what: "inverse statics: no Jacobian".into(),
                 iterations,
                 residual: dist,
+                load_factor: 1.0,
             });
         };
         // The quadratic program in y = a + Δ: min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ, J y = b, bounds.
         let av = DVector::from_column_slice(&a);
         let b = &e + &jac * &av;
-        let tol_qp = 1e-3 * options.tolerance.min(options.rotation_tolerance * rotation_weight);
+        let tol_qp = 1e-3
+            * options
+                .tolerance
+                .min(options.rotation_tolerance * rotation_weight);
         let mut least_squares = shape;
         let mut multipliers = None;
         let feasible = if shape {
@@ -539,9 +542,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 y_w
             }
             Some((y_w, l_w)) => {
-                let wd = DVector::from_fn(n, |i, _| {
-                    bounds.weights[i] * (a[i] - bounds.centre[i])
-                });
+                let wd = DVector::from_fn(n, |i, _| bounds.weights[i] * (a[i] - bounds.centre[i]));
                 let q = wd - &hess * &av;
                 match qp::active_set_qp(&hess, &q, &jac, &bounds, &y_w) {
                     Some((y, l)) => {
@@ -556,7 +557,11 @@ pub fn solve_inverse<F: Forward + ?Sized>(
             }
             None => {
                 least_squares = true;
-                let scale = jac.iter().fold(0.0f64, |m, v| m.max(v.abs())).powi(2).max(1e-300);
+                let scale = jac
+                    .iter()
+                    .fold(0.0f64, |m, v| m.max(v.abs()))
+                    .powi(2)
+                    .max(1e-300);
                 let wmax = bounds.weights.iter().fold(0.0f64, |m, v| m.max(*v));
                 qp::bounded_least_squares(
                     &jac,
@@ -602,6 +607,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                     what: "inverse statics (SQP)".into(),
                     iterations,
                     residual: dist.max(rot * rotation_weight),
+                    load_factor: 1.0,
                 });
             }
             return Ok(out);
@@ -630,7 +636,8 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 if let (Some(lambda), Some(jn)) =
                     (&multipliers, error_rows(target, &t, rotation_weight).1)
                 {
-                    curved |= bfgs_update(&mut hess, &bounds.weights, &a, &trial, &jac, &jn, lambda);
+                    curved |=
+                        bfgs_update(&mut hess, &bounds.weights, &a, &trial, &jac, &jn, lambda);
                 }
                 a = trial;
                 ev = t;
@@ -825,9 +832,8 @@ impl Forward for CosseratForward {
                     record_nodes: self.nodes.is_some(),
                 },
             )?;
-            let to_matrix = |c: &[nalgebra::Vector6<f64>]| {
-                DMatrix::from_fn(6, nt + nc, |r, k| c[k][r])
-            };
+            let to_matrix =
+                |c: &[nalgebra::Vector6<f64>]| DMatrix::from_fn(6, nt + nc, |r, k| c[k][r]);
             return Ok(match &self.nodes {
                 None => Evaluation {
                     positions: vec![cols.tip_pose.0],
@@ -844,7 +850,12 @@ impl Forward for CosseratForward {
                     Evaluation {
                         positions,
                         rotation: cols.rotations[at(last)],
-                        jacobian: Some(nodes.iter().map(|&i| to_matrix(&cols.poses[at(i)])).collect()),
+                        jacobian: Some(
+                            nodes
+                                .iter()
+                                .map(|&i| to_matrix(&cols.poses[at(i)]))
+                                .collect(),
+                        ),
                     }
                 }
             });
@@ -859,7 +870,10 @@ impl Forward for CosseratForward {
                 r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
             )
         };
-        let positions = nodes.iter().map(|&i| Vector3::from(sol.position[i])).collect();
+        let positions = nodes
+            .iter()
+            .map(|&i| Vector3::from(sol.position[i]))
+            .collect();
         let last = *nodes.last().unwrap_or(&(n - 1));
         let jac = if jacobian {
             let mut sorted = nodes.clone();

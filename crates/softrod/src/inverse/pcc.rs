@@ -7,7 +7,9 @@ use nalgebra::{Matrix3, Vector3};
 use super::{Evaluation, Forward};
 use crate::error::Result;
 use crate::pcc::sensitivity::pcc_actuation_jacobian;
-use crate::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, PccStaticsSolution};
+use crate::pcc::statics::{
+    solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions, PccStaticsSolution,
+};
 
 /// A PCC robot under a tip wrench as a forward model, warm-started from its last solve.
 pub struct PccForward<'r> {

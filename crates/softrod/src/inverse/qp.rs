@@ -92,7 +92,11 @@ pub fn min_norm(
             1e-14 * trace
         } else {
             // Nothing free: a gradient step on the dual.
-            a.iter().fold(0.0f64, |m, v| m.max(v * v)) / inv_w.iter().fold(f64::INFINITY, |m, v| m.min(1.0 / v)).max(1e-300)
+            a.iter().fold(0.0f64, |m, v| m.max(v * v))
+                / inv_w
+                    .iter()
+                    .fold(f64::INFINITY, |m, v| m.min(1.0 / v))
+                    .max(1e-300)
         };
         for k in 0..m {
             h[(k, k)] += reg.max(1e-300);
@@ -137,7 +141,9 @@ pub fn active_set_qp(
 ) -> Option<(DVector<f64>, DVector<f64>)> {
     let (m, n) = a.shape();
     let mut y = y0.clone();
-    let mut fixed: Vec<bool> = (0..n).map(|i| y[i] <= bx.lo[i] || y[i] >= bx.hi[i]).collect();
+    let mut fixed: Vec<bool> = (0..n)
+        .map(|i| y[i] <= bx.lo[i] || y[i] >= bx.hi[i])
+        .collect();
     for _ in 0..MAX_ACTIVE_SET_CHANGES * (n + 1) {
         let free: Vec<usize> = (0..n).filter(|&i| !fixed[i]).collect();
         let k = free.len();
@@ -309,7 +315,10 @@ mod tests {
     struct Lcg(u64);
     impl Lcg {
         fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((self.0 >> 11) as f64) / ((1u64 << 53) as f64)
         }
     }
@@ -388,9 +397,13 @@ mod tests {
         let b = &a * &y0;
         let bx = Bounds {
             lo: vec![0.0; n],
-            hi: (0..n).map(|_| if g.next() < 0.3 { 1.5 } else { f64::INFINITY }).collect(),
+            hi: (0..n)
+                .map(|_| if g.next() < 0.3 { 1.5 } else { f64::INFINITY })
+                .collect(),
             weights: (0..n).map(|_| 0.5 + g.next()).collect(),
-            centre: (0..n).map(|_| if g.next() < 0.5 { 0.0 } else { g.next() }).collect(),
+            centre: (0..n)
+                .map(|_| if g.next() < 0.5 { 0.0 } else { g.next() })
+                .collect(),
         };
         (a, b, bx)
     }
@@ -406,7 +419,10 @@ mod tests {
             let fast = min_norm(&a, &b, &bx, 1e-12).map(|(y, _)| y);
             match (brute, fast) {
                 (Some(x), Some(y)) => {
-                    assert!((&x - &y).amax() <= 1e-9 * (1.0 + x.amax()), "{trial}: {x} vs {y}");
+                    assert!(
+                        (&x - &y).amax() <= 1e-9 * (1.0 + x.amax()),
+                        "{trial}: {x} vs {y}"
+                    );
                     solved += 1;
                 }
                 (None, None) => {}
@@ -432,7 +448,10 @@ mod tests {
             let y0 = brute_min_norm(&a, &b, &bx).unwrap();
             let (z, mu) = active_set_qp(&w, &q, &a, &bx, &y0).unwrap();
             assert!((&z - &y).amax() <= 1e-9 * (1.0 + y.amax()), "{trial}");
-            assert!((&mu - &lambda).amax() <= 1e-6 * (1.0 + lambda.amax()), "{trial}: {mu} {lambda}");
+            assert!(
+                (&mu - &lambda).amax() <= 1e-6 * (1.0 + lambda.amax()),
+                "{trial}: {mu} {lambda}"
+            );
             // A general SPD Hessian: the result is feasible and no worse than y.
             let r = DMatrix::from_fn(n, n, |_, _| g.next() - 0.5);
             let h = &w + &r * r.transpose();
@@ -463,7 +482,11 @@ mod tests {
         let n = a.ncols();
         let f = |y: &DVector<f64>| {
             0.5 * (a * y - b).norm_squared()
-                + 0.5 * mu * (0..n).map(|i| bx.weights[i] * (y[i] - bx.centre[i]).powi(2)).sum::<f64>()
+                + 0.5
+                    * mu
+                    * (0..n)
+                        .map(|i| bx.weights[i] * (y[i] - bx.centre[i]).powi(2))
+                        .sum::<f64>()
         };
         let mut best: Option<(f64, DVector<f64>)> = None;
         for code in 0..3usize.pow(n as u32) {

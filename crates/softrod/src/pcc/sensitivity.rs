@@ -65,11 +65,16 @@ pub fn pcc_actuation_jacobian(
     let q = solution.coordinates();
     let eq = pcc_equilibrium(robot, loads, &q)?;
     let g = actuation_columns(robot, &q);
-    let dq = eq.jacobian.lu().solve(&(-g)).ok_or_else(|| Error::NotConverged {
-        what: "PCC actuation Jacobian: singular equilibrium Jacobian".into(),
-        iterations: 0,
-        residual: f64::INFINITY,
-    })?;
+    let dq = eq
+        .jacobian
+        .lu()
+        .solve(&(-g))
+        .ok_or_else(|| Error::NotConverged {
+            what: "PCC actuation Jacobian: singular equilibrium Jacobian".into(),
+            iterations: 0,
+            residual: f64::INFINITY,
+            load_factor: 1.0,
+        })?;
     let chain = solution.chain();
     let j = chain.jacobian(JacobianFrame::Hybrid, ArcCoordinates::CurvatureVector);
     let out = j * dq;

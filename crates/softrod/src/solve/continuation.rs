@@ -5,7 +5,7 @@
 //! (the problem's [`Problem::close`] safeguard), doubling it after a success.
 
 use super::newton::{newton, NewtonOutcome, NewtonSettings};
-use super::{NewtonOptions, Problem, MIN_LOAD_INCREMENT};
+use super::{Evaluated, NewtonOptions, Problem, MIN_LOAD_INCREMENT};
 use crate::math::linalg::DenseLu;
 
 /// Where the continuation starts and how it steps.
@@ -21,11 +21,25 @@ pub struct ContinuationSettings<'a> {
     pub max_increment: f64,
 }
 
+/// Why [`continuation`] stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stopped {
+    /// The full load (load factor 1) was reached.
+    Converged,
+    /// The load steps ([`NewtonOptions::max_load_steps`]) ran out.
+    StepsExhausted,
+    /// The load increment fell below [`MIN_LOAD_INCREMENT`].
+    IncrementUnderflow,
+    /// The evaluation of the start state failed.
+    StartFailed,
+}
+
 /// Result of [`continuation`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Continued {
-    /// The Newton outcome of the last attempted step (converged at `load_factor` = 1 on
-    /// success); on failure `x` is the last accepted state.
+    /// The Newton outcome of the last accepted step (converged at `load_factor` = 1 on
+    /// success); on failure its `x` is the last accepted state and `residual` that state's
+    /// residual at `load_factor` (`converged` false).
     pub outcome: NewtonOutcome,
     /// The load factor of the last accepted state.
     pub load_factor: f64,
@@ -33,6 +47,8 @@ pub struct Continued {
     pub steps: usize,
     /// Newton iterations over all steps.
     pub iterations: usize,
+    /// Why it stopped.
+    pub stopped: Stopped,
 }
 
 /// `-J⁻¹ v` (column-major `J`), `None` if singular.
@@ -57,7 +73,10 @@ pub fn continuation<P: Problem + ?Sized>(
     let mut x = start.x0.to_vec();
     let mut r = vec![0.0; n];
     // The reference state of the safeguard: the solution at load factor 0.
-    let _ = problem.evaluate(&x, 0.0, None, &mut r);
+    let start_failed = problem.evaluate(&x, 0.0, None, &mut r) == Evaluated::Failed;
+    if start_failed {
+        r.fill(f64::INFINITY);
+    }
     problem.commit();
     let mut lambda = 0.0f64;
     let mut dl = start
@@ -70,20 +89,27 @@ pub fn continuation<P: Problem + ?Sized>(
     };
     let mut prev: Option<(Vec<f64>, f64)> = None;
     let mut jac: Option<Vec<f64>> = start.jacobian0.map(<[f64]>::to_vec);
+    let mut accepted = NewtonOutcome {
+        x: x.clone(),
+        residual: problem.norm(&r),
+        converged: false,
+        iterations: 0,
+        first_step: 0.0,
+        jacobian: jac.clone(),
+        at_x: true,
+        exact: false,
+    };
     let mut out = Continued {
-        outcome: NewtonOutcome {
-            x: x.clone(),
-            residual: problem.norm(&r),
-            converged: false,
-            iterations: 0,
-            first_step: 0.0,
-            jacobian: None,
-            at_x: true,
-        },
+        outcome: accepted.clone(),
         load_factor: 0.0,
         steps: 0,
         iterations: 0,
+        stopped: Stopped::StepsExhausted,
     };
+    if start_failed {
+        out.stopped = Stopped::StartFailed;
+        return out;
+    }
     while out.steps < options.max_load_steps {
         let target = (lambda + dl).min(1.0);
         let h = target - lambda;
@@ -110,21 +136,25 @@ pub fn continuation<P: Problem + ?Sized>(
                 Some(j) if problem.load_derivative(&x, lambda, &mut drdl) => tangent(j, &drdl),
                 _ => None,
             };
+            accepted = step.clone();
             out.outcome = step;
             out.load_factor = lambda;
             if lambda >= 1.0 {
+                out.stopped = Stopped::Converged;
                 break;
             }
             dl = (dl * 2.0).min(start.max_increment);
         } else {
+            // Back to the last accepted state (the problem's last evaluation is elsewhere).
             out.outcome = NewtonOutcome {
                 converged: false,
-                x: x.clone(),
                 at_x: false,
-                ..step
+                exact: false,
+                ..accepted.clone()
             };
             dl *= 0.5;
             if dl < MIN_LOAD_INCREMENT {
+                out.stopped = Stopped::IncrementUnderflow;
                 break;
             }
         }

@@ -68,6 +68,11 @@ pub struct NewtonSettings<'a> {
     pub broyden: bool,
     /// A Jacobian at (or near) the initial guess to start from (column-major).
     pub jacobian: Option<&'a [f64]>,
+    /// End on an exact Jacobian evaluated at the converged iterate (the problem's last
+    /// evaluation then carries it, e.g. for a stability test): a Broyden step predicted to
+    /// converge is taken with the Jacobian, and a converged iterate without one is evaluated
+    /// once more.
+    pub exact_at_solution: bool,
 }
 
 /// Result of [`newton`].
@@ -87,6 +92,8 @@ pub struct NewtonOutcome {
     pub jacobian: Option<Vec<f64>>,
     /// Whether the problem's last evaluation was at `x` (its recorded state belongs to `x`).
     pub at_x: bool,
+    /// Whether `jacobian` is exact at `x` and came with the problem's last evaluation (at `x`).
+    pub exact: bool,
 }
 
 /// Contraction of the residual below which a Broyden step keeps the updated Jacobian.
@@ -153,6 +160,18 @@ fn start<P: Problem + ?Sized>(
     }
     if it.rn <= problem.tolerance(&it.x, options.tolerance) {
         out.converged = true;
+        out.exact = ev == Evaluated::Jacobian;
+        if settings.exact_at_solution && !out.exact {
+            let mut j = vec![0.0; n * n];
+            if problem.evaluate(&it.x, lambda, Some(&mut j), &mut it.r) == Evaluated::Jacobian {
+                out.residual = problem.norm(&it.r);
+                out.converged = out.residual <= problem.tolerance(&it.x, options.tolerance);
+                out.exact = true;
+                out.jacobian = Some(j);
+                return None;
+            }
+            out.at_x = false;
+        }
         out.jacobian = have_j.then(|| it.jac.clone());
         return None;
     }
@@ -303,6 +322,7 @@ pub fn newton<P: Problem + ?Sized>(
         first_step: 0.0,
         jacobian: None,
         at_x: false,
+        exact: false,
     };
     let Some(mut it) = start(problem, x0, lambda, options, settings, &mut out) else {
         return out;
@@ -311,6 +331,7 @@ pub fn newton<P: Problem + ?Sized>(
     let mut dx = vec![0.0; n];
     let mut r_prev = f64::INFINITY;
     let mut refresh = false;
+    let mut single_failed = false;
     while out.iterations < options.max_iterations {
         if refresh && !it.exact {
             // Evaluate the exact Jacobian at the current iterate.
@@ -340,11 +361,46 @@ pub fn newton<P: Problem + ?Sized>(
             }
         }
         let tol = problem.tolerance(&it.x, options.tolerance);
+        // Under superlinear convergence the next residual is about rn² / r_prev: a step
+        // predicted to converge is taken with the Jacobian when the solve must end on one.
+        let rn = it.rn;
+        if settings.exact_at_solution
+            && !single_failed
+            && r_prev.is_finite()
+            && rn * (rn / r_prev) <= 10.0 * tol
+        {
+            out.at_x = false;
+            let single = NewtonSettings {
+                line_search: LineSearch {
+                    max_halvings: 0,
+                    ..settings.line_search
+                },
+                ..*settings
+            };
+            if line_search(problem, &mut it, &dx, lambda, &single, options) {
+                r_prev = rn;
+                out.at_x = true;
+                out.iterations += 1;
+                if it.rn <= problem.tolerance(&it.x, options.tolerance) {
+                    out.converged = true;
+                    break;
+                }
+                continue;
+            }
+            // The full step failed: search along the exact Newton direction of the iterate.
+            single_failed = true;
+            if !it.exact {
+                refresh = true;
+                continue;
+            }
+        }
+        single_failed = false;
         if settings.broyden || !it.exact {
             let was_exact = it.exact;
             out.at_x = false;
             match broyden_step(problem, &mut it, &dx, lambda, settings, tol) {
                 Broyden::Accepted(slow) => {
+                    r_prev = rn;
                     refresh = slow;
                     out.at_x = true;
                     out.iterations += 1;
@@ -361,7 +417,8 @@ pub fn newton<P: Problem + ?Sized>(
                 }
                 Broyden::Refused => {}
             }
-        } else if r_prev.is_finite()
+        } else if !settings.exact_at_solution
+            && r_prev.is_finite()
             && it.rn < 0.1 * r_prev
             && it.rn * (it.rn / r_prev).powi(2) < 0.5 * tol
         {
@@ -385,6 +442,17 @@ pub fn newton<P: Problem + ?Sized>(
             break;
         }
     }
+    if out.converged && settings.exact_at_solution && !(it.exact && out.at_x) {
+        // Converged on a residual-only evaluation: the Jacobian at the solution.
+        out.at_x = false;
+        if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) == Evaluated::Jacobian {
+            it.rn = problem.norm(&it.r);
+            it.exact = true;
+            out.at_x = true;
+            out.converged = it.rn <= problem.tolerance(&it.x, options.tolerance);
+        }
+    }
+    out.exact = it.exact && out.at_x;
     out.x = it.x;
     out.residual = it.rn;
     out.jacobian = Some(it.jac);
@@ -438,6 +506,7 @@ mod tests {
             residual_first: false,
             broyden,
             jacobian: None,
+            exact_at_solution: false,
         }
     }
 

@@ -88,8 +88,25 @@ impl UniaxialData {
                     format!("finite, giving a stretch > 0 ({strain_measure:?} measure)"),
                 ));
             }
-            if !s.is_finite() {
-                return Err(Error::invalid(format!("stress[{i}]"), s, "finite (Pa)"));
+            if !(s.is_finite() && s.abs() <= crate::limits::MAX_MODULUS) {
+                return Err(Error::invalid(
+                    format!("stress[{i}]"),
+                    s,
+                    format!(
+                        "finite and of magnitude <= {:e} Pa",
+                        crate::limits::MAX_MODULUS
+                    ),
+                ));
+            }
+            if !(l <= crate::model::material::hyperelastic::INVERSE_STRETCH_MAX) {
+                return Err(Error::invalid(
+                    format!("strain[{i}]"),
+                    e,
+                    format!(
+                        "giving a stretch <= {:e} ({strain_measure:?} measure)",
+                        crate::model::material::hyperelastic::INVERSE_STRETCH_MAX
+                    ),
+                ));
             }
             stretch.push(l);
         }
@@ -452,21 +469,17 @@ fn solve_columns(a: &DMatrix<f64>, b: &DVector<f64>, cols: &[usize], k: usize) -
     let sub = DMatrix::from_fn(n, cols.len(), |i, j| a[(i, cols[j])] / scales[j]);
     if !sub.iter().chain(b.iter()).all(|v| v.is_finite()) {
         // E.g. an Ogden exponent so large that λ^α overflows; the SVD must not see it.
-        return Err(Error::NotConverged {
-            what: "least-squares solve (non-finite design matrix)".into(),
-            iterations: 0,
-            residual: f64::NAN,
-        });
+        return Err(Error::not_converged(
+            "least-squares solve (non-finite design matrix)",
+            0,
+            f64::NAN,
+        ));
     }
     let svd = sub.svd(true, true);
     let max_sv = svd.singular_values.max();
     let x = svd
         .solve(b, SVD_RCOND * max_sv)
-        .map_err(|msg| Error::NotConverged {
-            what: format!("least-squares solve ({msg})"),
-            iterations: 0,
-            residual: f64::NAN,
-        })?;
+        .map_err(|msg| Error::not_converged(format!("least-squares solve ({msg})"), 0, f64::NAN))?;
     let mut c = vec![0.0; k];
     for (j, &col) in cols.iter().enumerate() {
         c[col] = x[j] / scales[j];
@@ -527,11 +540,7 @@ fn fit_ogden(data: &UniaxialData, terms: usize, options: &FitOptions) -> Result<
         }
     }
     if starts.is_empty() {
-        return Err(Error::NotConverged {
-            what: "Ogden grid start".into(),
-            iterations: 0,
-            residual: f64::NAN,
-        });
+        return Err(Error::not_converged("Ogden grid start", 0, f64::NAN));
     }
     starts.sort_by(|a, b| a.0.total_cmp(&b.0));
     // The best few, plus the best of each sign pattern (number of negative exponents): the
@@ -580,11 +589,7 @@ fn fit_ogden(data: &UniaxialData, terms: usize, options: &FitOptions) -> Result<
     match (best, last_error) {
         (Some((_, mu, alpha, it)), _) => Ok((Ogden::new(&mu, &alpha)?, it)),
         (None, Some(e)) => Err(e),
-        (None, None) => Err(Error::NotConverged {
-            what: "Ogden fit".into(),
-            iterations: 0,
-            residual: f64::NAN,
-        }),
+        (None, None) => Err(Error::not_converged("Ogden fit", 0, f64::NAN)),
     }
 }
 
@@ -707,11 +712,11 @@ fn ogden_lm(
         }
     }
     if !converged {
-        return Err(Error::NotConverged {
-            what: format!("Ogden ({terms} terms) Levenberg-Marquardt fit"),
+        return Err(Error::not_converged(
+            format!("Ogden ({terms} terms) Levenberg-Marquardt fit"),
             iterations,
-            residual: (c0 / n as f64).sqrt(),
-        });
+            (c0 / n as f64).sqrt(),
+        ));
     }
     Ok((c0, mu, alpha, iterations))
 }

@@ -1,0 +1,163 @@
+//! Stability of a Cosserat-rod equilibrium from the tip columns of the shooting problem.
+//!
+//! The rod is clamped at its base and free at its tip. Its equilibria are the stationary
+//! points of the potential energy (elastic energy, `τ ℓ_i` for a tendon held at tension `τ`,
+//! the work of dead external loads); an equilibrium is stable when the second variation `H`
+//! of the energy is positive definite. Write `C` for the 6×6 tangent compliance at the tip
+//! (tip twist per extra dead tip wrench, tendons at fixed tension) and `H_c` for the second
+//! variation of the same rod with its tip clamped too. The inertia of a Schur complement
+//! (Haynsworth) gives
+//!
+//! ```text
+//! n₋(H) = n₋(H_c) + n₋(C),
+//! ```
+//!
+//! `n₋` the number of negative eigenvalues. The first term counts the conjugate points of the
+//! doubly clamped problem along the rod (Jacobi's condition; Till & Rucker's test on the
+//! determinant of the pose block of the shooting Jacobian); it vanishes unless the rod, with
+//! its tip clamped in the solved pose, would buckle on its own. The second is what a user
+//! feels at the tip: a direction in which the tip moves against an extra push. softrod
+//! reports the tip condition, which is exact whenever `H_c` is positive definite:
+//!
+//! * `stability_margin` = the smallest eigenvalue of the symmetric part of the dimensionless
+//!   tip stiffness `K̂ = D C⁻¹ D / (E I(0)/L)`, `D = diag(L, L, L, 1, 1, 1)`; computed as
+//!   `min 1/μ` over the eigenvalues `μ` of the symmetric part of `Ĉ = K̂⁻¹ = D⁻¹ X Y⁻¹`,
+//!   where `Y` is the shooting Jacobian (scaled tip residual per scaled base wrench) and `X`
+//!   the tip twist per scaled base wrench, both from the six base-wrench columns of one
+//!   march at the solution. Directions of zero compliance (the axis of a straight
+//!   inextensible, unshearable rod: constraints, not degrees of freedom) are left out.
+//! * `stable` = `stability_margin > -1e-8` ([`NEUTRAL_MARGIN`]: a neutral mode, such as the
+//!   rotation of a buckled round column about its load axis, counts as stable).
+//!
+//! Follower (body-frame) loads are not conservative: the margin is then that of the
+//! symmetric part of the tangent stiffness (loss of it is divergence; flutter is not
+//! detected). See `docs/stability.md`.
+//!
+//! # References
+//! J. Till, D. C. Rucker, "Elastic stability of Cosserat rods and parallel continuum robots",
+//! IEEE Trans. Robotics 33(3), 2017. E. V. Haynsworth, "Determination of the inertia of a
+//! partitioned Hermitian matrix", Linear Algebra Appl. 1(1), 1968.
+
+use nalgebra::{Matrix6, SymmetricEigen, Vector6};
+
+use crate::math::linalg::Lu6;
+
+/// Margin within which an equilibrium counts as neutral and is reported stable: a rod with
+/// a symmetry about its load (a round column under its own weight) has a zero-stiffness mode
+/// in its buckled states, the rotation of the shape about the load axis.
+pub const NEUTRAL_MARGIN: f64 = 1e-8;
+
+/// Relative size of a tip-compliance eigenvalue below which its direction counts as a
+/// constraint (zero compliance to round-off), not as a degree of freedom.
+pub const CONSTRAINT_COMPLIANCE: f64 = 1e-9;
+
+/// The stability of one equilibrium (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stability {
+    /// Whether the tip tangent stiffness is positive definite (`margin > -NEUTRAL_MARGIN`).
+    pub stable: bool,
+    /// Smallest eigenvalue of the symmetric part of the dimensionless tip stiffness.
+    pub margin: f64,
+    /// For an unstable equilibrium, the change of the scaled base wrench that moves the rod
+    /// along its softest unstable mode (unit dimensionless tip wrench).
+    pub(crate) mode: Option<[f64; 6]>,
+}
+
+/// The stability from the scaled shooting Jacobian `y` (column-major 6×6) and the tip twist
+/// of each base-wrench column `x` (m, rad per scaled unit), for a rod of length `length`.
+/// `None` if the Jacobian is not finite.
+pub(crate) fn tip_stability(y: &[f64], x: &[Vector6<f64>; 6], length: f64) -> Option<Stability> {
+    let ym = Matrix6::from_column_slice(y);
+    if !ym.iter().all(|v| v.is_finite()) || !x.iter().all(|c| c.iter().all(|v| v.is_finite())) {
+        return None;
+    }
+    let Some(lu_t) = Lu6::new(&ym.transpose()) else {
+        // Singular: the equilibrium is critical (a zero tip stiffness).
+        return Some(Stability {
+            stable: false,
+            margin: 0.0,
+            mode: None,
+        });
+    };
+    // Ĉ = D⁻¹ X Y⁻¹, row by row: Yᵀ ĉ_i = (row i of D⁻¹ X).
+    let mut c = Matrix6::zeros();
+    for i in 0..6 {
+        let scale = if i < 3 { 1.0 / length } else { 1.0 };
+        let row: [f64; 6] = std::array::from_fn(|k| x[k][i] * scale);
+        let sol = lu_t.solve(&row);
+        for k in 0..6 {
+            c[(i, k)] = sol[k];
+        }
+    }
+    let sym = (c + c.transpose()) * 0.5;
+    let eig = SymmetricEigen::new(sym);
+    let big = eig.eigenvalues.amax();
+    let mut margin = f64::INFINITY;
+    let mut softest = None;
+    for (k, &mu) in eig.eigenvalues.iter().enumerate() {
+        if mu.abs() <= CONSTRAINT_COMPLIANCE * big {
+            continue;
+        }
+        let stiffness = 1.0 / mu;
+        if stiffness < margin {
+            margin = stiffness;
+            softest = Some(k);
+        }
+    }
+    if !margin.is_finite() {
+        return None;
+    }
+    let stable = margin > -NEUTRAL_MARGIN;
+    let mode = match softest {
+        Some(k) if !stable => {
+            // The base-wrench change of the unit tip wrench ζ: Y δx = ζ.
+            let z = eig.eigenvectors.column(k);
+            let lu = Lu6::new(&ym)?;
+            Some(lu.solve(&[z[0], z[1], z[2], z[3], z[4], z[5]]))
+        }
+        _ => None,
+    };
+    Some(Stability {
+        stable,
+        margin,
+        mode,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// A straight uniform Euler–Bernoulli cantilever (length 1, EI = 1) in scaled unknowns:
+    /// Y = I, X the tip compliance in SI; its dimensionless tip stiffness is D C⁻¹ D, whose
+    /// symmetric part has the closed-form smallest eigenvalue of the 2×2 bending block
+    /// [[12, -6], [-6, 4]]: 8 - 2 sqrt(13).
+    #[test]
+    fn straight_cantilever_margin_is_the_closed_form() {
+        let y: Vec<f64> = Matrix6::<f64>::identity().as_slice().to_vec();
+        let mut x = [Vector6::zeros(); 6];
+        // Bending in the x-z plane: force x -> (δx = 1/3, δθy = 1/2); moment y -> (1/2, 1).
+        x[0][0] = 1.0 / 3.0;
+        x[0][4] = 0.5;
+        x[4][0] = 0.5;
+        x[4][4] = 1.0;
+        x[1][1] = 1.0 / 3.0;
+        x[1][3] = -0.5;
+        x[3][1] = -0.5;
+        x[3][3] = 1.0;
+        x[2][2] = 1e-3;
+        x[5][5] = 1.0;
+        let s = tip_stability(&y, &x, 1.0).unwrap();
+        let exact = 8.0 - 2.0 * 13f64.sqrt();
+        assert!(s.stable && (s.margin - exact).abs() < 1e-12, "{s:?}");
+        // The same with the axis constrained (zero axial compliance).
+        x[2][2] = 0.0;
+        let s = tip_stability(&y, &x, 1.0).unwrap();
+        assert!(s.stable && (s.margin - exact).abs() < 1e-12, "{s:?}");
+        // A negative bending compliance: unstable, with a mode.
+        x[0][0] = -1.0;
+        let s = tip_stability(&y, &x, 1.0).unwrap();
+        assert!(!s.stable && s.margin < 0.0 && s.mode.is_some(), "{s:?}");
+    }
+}
