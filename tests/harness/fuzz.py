@@ -517,6 +517,22 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("solve_statics(displacements)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=_rod(),
+                tendons=_tendons(),
+                loads=_loads(),
+                displacements=[0.0005, None],
+                tendon_stiffness=[1e4, 1e4],
+            ),
+        )
+    )
+    t("actuation_jacobian")(lambda d: (sr.actuation_jacobian, dict(solution=_solution(), node=10)))
+    t("actuation_jacobian(pcc)")(
+        lambda d: (sr.actuation_jacobian, dict(solution=_pcc_solution(), node=-1))
+    )
     t("solve_statics(chambers)")(
         lambda d: (
             sr.solve_statics,
@@ -643,6 +659,16 @@ def _define_targets() -> None:
     t("Robot.from_toml")(lambda d: (sr.Robot.from_toml, dict(text=_TOML, name="r")))
     t("Robot.solve")(lambda d: (_niti().solve, dict(tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0])))
     t("Robot.solve(pressures)")(lambda d: (_chambered().solve, dict(pressures=[3e3])))
+    t("Robot.solve(displacements)")(
+        lambda d: (
+            _niti().solve,
+            dict(
+                tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                displacements=[None, 0.0, None, None, None, -0.001],
+                tendon_stiffness=1e5,
+            ),
+        )
+    )
     t("Robot.with_tensions")(
         lambda d: (_niti().with_tensions, dict(tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]))
     )

@@ -156,7 +156,7 @@ impl<'a, 'py> Arg<'a, 'py> for Vec<i64> {
 }
 
 /// The items of a list, tuple or other sequence (not text, not a mapping, not a number).
-fn sequence<'py>(
+pub(crate) fn sequence<'py>(
     obj: &Bound<'py, PyAny>,
     name: &str,
     what: &str,

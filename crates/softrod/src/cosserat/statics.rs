@@ -286,7 +286,7 @@ fn margin_of(sol: &StaticsSolution) -> Option<f64> {
 }
 
 /// The points of `s_out` strictly inside `(0, length)`.
-fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
+pub(crate) fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
     s_out
         .iter()
         .copied()

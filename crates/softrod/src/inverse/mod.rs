@@ -830,6 +830,7 @@ impl Forward for CosseratForward {
                     observe: &sorted,
                     load_node: None,
                     record_nodes: self.nodes.is_some(),
+                    stops: &[],
                 },
             )?;
             let to_matrix =
