@@ -1481,6 +1481,7 @@ NOT_CONSTRUCTED = {
     "Silicone",
     "StaticsSolution",
     "TangentCompliance",
+    "TargetUnreachableError",
     "UniaxialFit",
     "UniaxialLaw",
     "WorkspaceMap",
