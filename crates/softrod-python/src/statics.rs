@@ -209,7 +209,7 @@ pub(crate) fn apply_displacements(
                     ),
                 ));
             }
-            if !(ki > 0.0) {
+            if ki.is_nan() || ki <= 0.0 {
                 return Err(param_err(
                     &format!("tendon_stiffness[{i}]"),
                     ki,

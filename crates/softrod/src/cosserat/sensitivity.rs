@@ -205,6 +205,7 @@ pub(crate) fn scheme_of<'p>(
     }
 }
 
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 fn pass<const N: usize>(
     eq: Equations<'_>,
     scheme: Scheme<'_>,
@@ -522,6 +523,7 @@ pub(crate) struct Linear {
 /// tendons' displacements, the unit right-hand sides in `displaced`: indices into `held`),
 /// observing the nodes `observe` (increasing) and the path lengths of `lengths`.
 /// Right-hand sides are ordered: `seeds`, then `displaced`.
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub(crate) fn linearise(
     solution: &StaticsSolution,
     held: &[HeldRow],
