@@ -123,10 +123,12 @@ fn niti_round_trip_reaches_every_target_inside_the_bounds() {
 }
 
 #[test]
-#[ignore = "under gravity and a tip load the SQP does not reach the targets: inverse statics is not finished"]
+#[ignore = "under gravity and a tip load the SQP reaches the targets but its steps oscillate near the minimum-norm actuation (damped BFGS without a merit function): inverse statics is not finished"]
 fn niti_under_gravity_and_tip_load_reaches_targets() {
+    // A lateral tip load (an axial 0.2 N would exceed the rod's Euler load, 0.16 N: several
+    // equilibria per actuation).
     let loads = Loads {
-        tip_force: Vector3::new(0.0, 0.0, -0.2),
+        tip_force: Vector3::new(0.02, 0.0, -0.01),
         gravity: Vector3::new(0.0, -9.81, 0.0),
         ..Default::default()
     };
