@@ -215,3 +215,92 @@ def test_displacement_arguments_are_named():
         robot.solve(displacements=[0.0] * 6, tendon_stiffness=-1.0)
     with pytest.raises(softrod.ParameterError, match="tendon_stiffness"):
         robot.solve(tendon_stiffness=1e4)
+
+
+# ----------------------------------------------------------------------------- inverse statics
+
+
+def _admissible(rng):
+    """Random tensions: each segment pulled by at most two of its tendons (N)."""
+    t = np.zeros(6)
+    for seg in range(2):
+        o = rng.integers(3)
+        t[3 * seg + o] = rng.random() * 3.0
+        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
+    return t
+
+
+def _round_trip(count, seed):
+    robot = _niti()
+    rng = np.random.default_rng(seed)
+    misses = []
+    for k in range(count):
+        target = robot.solve(_admissible(rng)).tip_position
+        inv = softrod.inverse_statics(robot, target, throw=False)
+        reached = np.linalg.norm(inv.solution.tip_position - target) <= 1e-9
+        inside = np.all(inv.tensions >= 0.0)
+        if not (inv.converged and reached and inside):
+            misses.append((k, inv.position_error, inv.converged))
+    return misses
+
+
+def test_round_trip_reaches_the_targets_inside_the_bounds():
+    misses = _round_trip(40, 1)
+    assert len(misses) <= 0.01 * 40, misses
+
+
+@pytest.mark.slow
+def test_round_trip_of_a_thousand_targets():
+    misses = _round_trip(1000, 2)
+    assert len(misses) <= 10, misses
+
+
+def test_the_actuation_is_the_minimum_norm_one_of_an_independent_qp():
+    """One segment, three tendons at 120 degrees: at most two taut, and the tensions solve the
+    minimum-norm program of the linearised target (scipy's SLSQP) to 1e-8."""
+    scipy_optimize = pytest.importorskip("scipy.optimize")
+    rod = softrod.Rod(0.2, softrod.CircularSection(0.7e-3), softrod.LinearElastic(54e9, 0.3))
+    tendons = [
+        softrod.Tendon((0.01 * np.cos(a), 0.01 * np.sin(a)), 0.0)
+        for a in (np.pi / 2, -np.pi / 6, 7 * np.pi / 6)
+    ]
+    robot = softrod.Robot(rod, tendons)
+    target = robot.solve([2.0, 0.7, 0.0]).tip_position
+    inv = softrod.inverse_statics(robot, target)
+    assert inv.converged and np.sum(inv.tensions > 1e-12) <= 2
+    j = softrod.actuation_jacobian(inv.solution)[:3]
+    b = j @ inv.tensions
+    qp = scipy_optimize.minimize(
+        lambda t: 0.5 * t @ t,
+        np.ones(3),
+        jac=lambda t: t,
+        constraints=[{"type": "eq", "fun": lambda t: j @ t - b, "jac": lambda t: j}],
+        bounds=[(0.0, None)] * 3,
+        method="SLSQP",
+        options={"ftol": 1e-16, "maxiter": 500},
+    )
+    assert qp.success
+    np.testing.assert_allclose(inv.tensions, qp.x, rtol=0, atol=1e-8)
+
+
+def test_a_target_out_of_reach_is_named_with_its_distance():
+    robot = _niti()
+    with pytest.raises(softrod.TargetUnreachableError) as e:
+        softrod.inverse_statics(robot, [0.3, 0.3, 0.0])
+    assert e.value.distance > 0.05
+    inv = softrod.inverse_statics(robot, [0.3, 0.3, 0.0], throw=False)
+    assert not inv.converged and inv.position_error == pytest.approx(e.value.distance, rel=1e-6)
+
+
+def test_warm_started_tracking_and_named_arguments():
+    robot = _niti()
+    target = robot.solve(_admissible(np.random.default_rng(1))).tip_position
+    first = softrod.inverse_statics(robot, target)
+    moved = softrod.inverse_statics(robot, target + np.array([1e-3, 0, 0]), warm_start=first)
+    assert moved.converged and moved.iterations <= first.iterations
+    with pytest.raises(softrod.ParameterError, match="target_position"):
+        softrod.inverse_statics(robot, [0.0, 0.0])
+    with pytest.raises(softrod.ParameterError, match="tension_bounds"):
+        softrod.inverse_statics(robot, target, tension_bounds=(-1.0, None))
+    with pytest.raises(softrod.ParameterError, match="robot"):
+        softrod.inverse_statics("robot.toml", target)

@@ -68,6 +68,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
+from .inverse import InverseSolution, inverse_statics
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
 from .vision import Backbone, BackboneQuality
@@ -84,6 +85,7 @@ __all__ = [
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
+    "InverseSolution",
     "LinearElastic",
     "Linearised",
     "Loads",
@@ -125,6 +127,7 @@ __all__ = [
     "examples",
     "extract_backbone",
     "fit_uniaxial",
+    "inverse_statics",
     "load_robot",
     "pcc",
     "read_backbone_csv",

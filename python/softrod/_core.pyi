@@ -453,6 +453,28 @@ def solve_statics(
     nodes at those arc lengths. ``displacements`` (m, one per tendon, None: tension control)
     holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness."""
 
+def _inverse_statics(
+    rod: Rod,
+    tendons: Sequence[Tendon],
+    loads: Loads | None,
+    chambers: Sequence[Chamber],
+    target_position: _Vec3,
+    *,
+    target_rotation: Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
+    weights: Sequence[float] | NDArray[np.float64] | None = None,
+    tension_bounds: tuple[float, float | None] | None = None,
+    pressure_bounds: tuple[float, float | None] | None = None,
+    warm_start: Sequence[float] | NDArray[np.float64] | None = None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    integrator: Literal["rk4", "adaptive"] | None = None,
+    steps: int | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+) -> dict[str, Any]:
+    """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
+
 def actuation_jacobian(
     solution: StaticsSolution | PccSolution,
     node: int = ...,

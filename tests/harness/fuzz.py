@@ -533,6 +533,23 @@ def _define_targets() -> None:
     t("actuation_jacobian(pcc)")(
         lambda d: (sr.actuation_jacobian, dict(solution=_pcc_solution(), node=-1))
     )
+    t("inverse_statics")(
+        lambda d: (
+            sr.inverse_statics,
+            dict(
+                robot=_niti(),
+                target_position=[0.03388176, 0.03906025, 0.3958294],
+                target_rotation=None,
+                weights=[1.0] * 6,
+                tension_bounds=(0.0, 10.0),
+                pressure_bounds=(0.0, None),
+                warm_start=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                throw=False,
+                tolerance=1e-9,
+                max_iterations=60,
+            ),
+        )
+    )
     t("solve_statics(chambers)")(
         lambda d: (
             sr.solve_statics,
@@ -1472,6 +1489,7 @@ NOT_CONSTRUCTED = {
     "Compliance",
     "ConvergenceError",
     "Eigenscrews",
+    "InverseSolution",
     "ModelComparison",
     "ModelResult",
     "ParameterError",
