@@ -50,17 +50,17 @@ def main() -> None:
         rows["forward"].append(_time(lambda: robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0]))[0])
         rows["jacobian"].append(_time(lambda: softrod.actuation_jacobian(sol))[0])
     for target in targets:
-        dt, cold = _time(lambda: softrod.inverse_statics(robot, target, throw=False))
+        dt, cold = _time(lambda t=target: softrod.inverse_statics(robot, t, throw=False))
         rows["cold"].append(dt)
         misses["cold"] += not cold.converged
         moved = target + np.array([1e-3, 0.0, 0.0])
         dt, warm = _time(
-            lambda: softrod.inverse_statics(robot, moved, warm_start=cold, throw=False)
+            lambda m=moved, c=cold: softrod.inverse_statics(robot, m, warm_start=c, throw=False)
         )
         rows["warm"].append(dt)
         misses["warm"] += not warm.converged
 
-        def residual(t):
+        def residual(t, target=target):
             return robot.solve(t).tip_position - target
 
         dt, ls = _time(
