@@ -152,6 +152,7 @@ class PlanarCableArm:
         atol: float = 1e-10,
         max_steps: int = 100000,
     ) -> PlanarBatch: ...
+    def sensitivities(self, tension: float, s: _Floats) -> dict[str, Any]: ...
 
 def backbone_distance(
     a: NDArray[np.float64], b: NDArray[np.float64], n_index: int | None = None

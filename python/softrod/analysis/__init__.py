@@ -1,4 +1,5 @@
-"""Analyses built on the solvers: backbone comparison at equal arm index, calibration of model parameters to measured shapes, models side by side,
+"""Analyses built on the solvers: backbone comparison at equal arm index, calibration of model
+parameters to measured shapes, models side by side,
 workspace maps, tensile curves and material fits, the compliance study of soft arms, and design
 sweeps with their summaries."""
 
@@ -14,8 +15,8 @@ from .workspace import WorkspaceMap, tension_grid, workspace_map
 __all__ = [
     "BackboneDistance",
     "Calibration",
-    "ModelComparison",
     "IdentifiabilityWarning",
+    "ModelComparison",
     "ModelResult",
     "Pareto",
     "SampleTable",

@@ -34,7 +34,7 @@ import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -184,9 +184,13 @@ def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
     try:
         arr = np.array(obs, dtype=np.float64)
     except (TypeError, ValueError):
-        raise _args.type_error(where, obs, "an array of points (n, dim), a tip or a Backbone")
-    if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"invalid parameter `{where}`: non-finite values")
+        raise _args.type_error(
+            where, obs, "an array of points (n, dim), a tip or a Backbone"
+        ) from None
+    if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > 1e9):
+        raise ParameterError(
+            f"invalid parameter `{where}`: values must be finite coordinates below 1e9 m"
+        )
     if arr.ndim == 2 and arr.shape == (4, 4) and dim == 3:
         return "tip", arr
     if arr.ndim == 1 and (arr.shape[0] == dim or (dim == 2 and arr.shape[0] == 3)):
@@ -195,12 +199,13 @@ def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
         return "shape", arr
     raise ParameterError(
         f"invalid parameter `{where}` with shape {arr.shape}: must be points (n >= 2, {dim}), "
-        f"a tip position ({dim},)"
-        + (", a tip (x, y, angle)" if dim == 2 else ", a 4x4 tip pose")
+        f"a tip position ({dim},)" + (", a tip (x, y, angle)" if dim == 2 else ", a 4x4 tip pose")
     )
 
 
-def _measurements(measurements: Any, actuations: Any, dim: int) -> list[_Measurement]:
+def _measurements(
+    measurements: Any, actuations: Any, dim: int, check=lambda a, where: a
+) -> list[_Measurement]:
     if isinstance(measurements, (str, bytes)) or not isinstance(measurements, Sequence):
         raise _args.type_error(
             "measurements", measurements, "a list of (actuation, points or tip) pairs"
@@ -208,6 +213,10 @@ def _measurements(measurements: Any, actuations: Any, dim: int) -> list[_Measure
     if len(measurements) == 0:
         raise ParameterError("invalid parameter `measurements` = []: at least one measurement")
     if actuations is not None:
+        if isinstance(actuations, (str, bytes)) or not isinstance(
+            actuations, (Sequence, np.ndarray)
+        ):
+            raise _args.type_error("actuations", actuations, "a list, one per measurement")
         actuations = list(actuations)
         if len(actuations) != len(measurements):
             raise ParameterError(
@@ -218,16 +227,17 @@ def _measurements(measurements: Any, actuations: Any, dim: int) -> list[_Measure
     for i, m in enumerate(measurements):
         where = f"measurements[{i}]"
         if actuations is not None:
-            act, obs = actuations[i], m
-        elif isinstance(m, tuple) and len(m) == 2:
+            act, obs, act_where = actuations[i], m, f"actuations[{i}]"
+        elif isinstance(m, (tuple, list)) and len(m) == 2:
             act, obs = m
+            act_where = f"measurements[{i}][0]"
         else:
             raise _args.type_error(
                 where, m, "an (actuation, observation) pair (or give `actuations`)"
             )
         kind, data = _observation(obs, dim, where)
         index = _arm_index(data) if kind == "shape" else None
-        out.append(_Measurement(act, kind, data, index))
+        out.append(_Measurement(check(act, act_where), kind, data, index))
     return out
 
 
@@ -246,7 +256,7 @@ class _PlanarModel:
     """The seed-000 planar arm: core columns (E, a, T, R0, RL) of ``sensitivities``."""
 
     dim = 2
-    PARAMETERS = {
+    PARAMETERS: ClassVar[dict[str, str]] = {
         "youngs_modulus": "Young's modulus E (Pa)",
         "offset_ratio": "cable offset ratio a",
         "tension_scale": "factor on every measured tension",
@@ -255,18 +265,25 @@ class _PlanarModel:
         "tip_radius": "tip radius RL (m)",
         "base_angle": "rotation of the arm's base about the origin (rad)",
     }
-    ALIASES = {"E": "youngs_modulus", "a": "offset_ratio"}
-    CORE = {"youngs_modulus": 0, "offset_ratio": 1, "base_radius": 3, "tip_radius": 4}
+    ALIASES: ClassVar[dict[str, str]] = {"E": "youngs_modulus", "a": "offset_ratio"}
+    CORE: ClassVar[dict[str, int]] = {
+        "youngs_modulus": 0,
+        "offset_ratio": 1,
+        "base_radius": 3,
+        "tip_radius": 4,
+    }
 
     def __init__(self, arm: PlanarCableArm):
         self.arm = arm
         self.length = arm.length
 
-    def canonical(self, name: str) -> str:
+    def canonical(self, name: str, where: str = "parameters") -> str:
+        if not isinstance(name, str):
+            raise _args.type_error(where, name, "parameter names (str)")
         name = self.ALIASES.get(name, name)
         if name not in self.PARAMETERS:
             raise ParameterError(
-                f"invalid parameter `parameters`: {name!r} is not a parameter of the planar "
+                f"invalid parameter `{where}`: {name!r} is not a parameter of the planar "
                 f"arm (known: {', '.join(self.PARAMETERS)}; aliases E, a)"
             )
         return name
@@ -307,8 +324,16 @@ class _PlanarModel:
             a.anchor,
         )
 
+    def check_actuation(self, actuation: Any, where: str) -> float:
+        t = _args.number(actuation, where)
+        if not 0.0 <= t < self.arm.max_tension:
+            raise _args.value_error(
+                where, t, f"a cable tension in [0, {self.arm.max_tension:.6g}) N"
+            )
+        return t
+
     def _tension(self, m: _Measurement, values: Mapping[str, float]) -> tuple[float, float]:
-        t0 = _args.number(m.actuation, "tension")
+        t0 = m.actuation
         return values.get("tension_scale", 1.0) * t0 + values.get("pretension", 0.0), t0
 
     def _columns(self, core: np.ndarray, t0: float, names: Sequence[str]) -> np.ndarray:
@@ -366,7 +391,7 @@ class _PlanarModel:
 
     def _arm_index(self, arm, t, t0, rot, phi, names, m):
         sigma = m.index
-        s, d = self._at_index(arm, t, sigma)
+        _, d = self._at_index(arm, t, sigma)
         pts = np.column_stack([d["x"], d["y"]])
         # dr(s*)/dp = r_p + r' ds*/dp with l(s*) = sigma l(L): r' ds*/dp is the unit
         # tangent times sigma l_p(L) - l_p(s*).
@@ -445,7 +470,7 @@ def _bounds(bounds: Any, names: Sequence[str], model, p0: np.ndarray):
     if bounds is not None:
         if not isinstance(bounds, Mapping):
             raise _args.type_error("bounds", bounds, "a dict: parameter -> (low, high)")
-        given = {model.canonical(k): v for k, v in bounds.items()}
+        given = {model.canonical(k, "bounds"): v for k, v in bounds.items()}
         unknown = set(given) - set(names)
         if unknown:
             raise ParameterError(
@@ -458,7 +483,7 @@ def _bounds(bounds: Any, names: Sequence[str], model, p0: np.ndarray):
             try:
                 a, c = (float(v) for v in b)
             except (TypeError, ValueError):
-                raise _args.type_error(f"bounds[{n!r}]", b, "a pair (low, high)")
+                raise _args.type_error(f"bounds[{n!r}]", b, "a pair (low, high)") from None
         else:
             a, c = model.default_bounds(n, p0[j])
         if not (a < c) or math.isnan(a) or math.isnan(c):
@@ -489,7 +514,7 @@ def _residual_variance(r, parts, meas, infos, dim, metric) -> tuple[float, int]:
     one to one: at equal arm index only the components normal to the model's tangent (the
     tangential one is absorbed by the measured index moving with the point)."""
     total, count, start = 0.0, 0, 0
-    for m, k, info in zip(meas, parts, infos, strict=True):
+    for _m, k, info in zip(meas, parts, infos, strict=True):
         chunk = r[start : start + k]
         start += k
         if info is not None and metric == "arm-index":
@@ -612,9 +637,13 @@ def calibrate(
         raise _args.value_error("condition_limit", condition_limit, "> 1")
     if loss not in ("linear", "soft_l1", "huber", "cauchy", "arctan"):
         raise _args.value_error("loss", loss, "linear, soft_l1, huber, cauchy or arctan")
-    meas = _measurements(measurements, actuations, model.dim)
-    init = dict(initial or {})
-    init = {model.canonical(k): _args.number(v, f"initial[{k!r}]") for k, v in init.items()}
+    meas = _measurements(measurements, actuations, model.dim, model.check_actuation)
+    if initial is not None and not isinstance(initial, Mapping):
+        raise _args.type_error("initial", initial, "a dict: parameter -> starting value")
+    init = {
+        model.canonical(k, "initial"): _args.number(v, f"initial[{k!r}]")
+        for k, v in (initial or {}).items()
+    }
     p0 = np.array([init.get(n, model.initial(n)) for n in names], dtype=float)
     lo, hi = _bounds(bounds, names, model, p0)
     scale = np.array([model.typical(n, v) for n, v in zip(names, p0, strict=True)])
