@@ -545,6 +545,7 @@ def _errors_in_variables(jac, pinv, parts, meas, infos, metric) -> np.ndarray:
             dim = p.shape[1]
             blk = w[start : start + k].reshape(len(p), dim, -1)  # (N, dim, n)
             t, ell = info["tangent"], info["length"]
+            ell = np.asarray(ell, dtype=float).reshape(-1, 1)  # scalar or per point
             c = ell * np.einsum("ia,ian->in", t, blk)  # (N, n)
             chord = np.diff(p, axis=0)
             seg = np.linalg.norm(chord, axis=1)
