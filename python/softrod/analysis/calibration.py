@@ -73,7 +73,8 @@ class Calibration:
         standard_errors: Standard error of each parameter (same unit); ``inf`` for a parameter
             in a combination the data cannot determine.
         covariance: Covariance of the estimates, (n, n).
-        correlation: Correlation of the estimates, (n, n).
+        correlation: Correlation of the estimates, (n, n); NaN for parameters in an
+            undetermined combination.
         residuals: Residuals of each measurement at the optimum (model minus measured, m):
             (n_i, dim) per point for "arm-index", (n_i,) for "nearest", (k,) for a tip.
         residual_std: Estimated standard deviation of one residual, ``sigma`` (m).
@@ -729,6 +730,9 @@ def calibrate(
         dd = np.sqrt(np.maximum(np.diag(cov), 0.0))
         corr = cov / np.outer(dd, dd)
     corr[np.diag_indices(n)] = 1.0
+    for j, name in enumerate(names):
+        if name in weak:  # no meaningful correlation along an undetermined combination
+            corr[j, :] = corr[:, j] = math.nan
     residuals = []
     start = 0
     for meas_i, k in zip(meas, parts, strict=True):
