@@ -35,6 +35,12 @@ class ConvergenceError(RuntimeError):
     residual: float
     load_factor: float
 
+class TargetUnreachableError(ConvergenceError):
+    """Inverse statics: the target is out of reach within the actuation bounds."""
+
+    distance: float
+    rotation: float
+
 class StabilityWarning(UserWarning):
     """The equilibrium returned is unstable and no stable one was found."""
 
