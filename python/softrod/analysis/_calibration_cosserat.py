@@ -18,6 +18,7 @@ current parameters, rescaled to the parameter's unit:
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -72,11 +73,13 @@ class CosseratModel:
             )
         self.length = float(robot.parameter("rod.length"))
         self.material = robot.parameter("rod.material")
-        self.tendons = list(robot.parameter("tendons"))
-        self.chambers = list(robot.parameter("chambers"))
+        spec = robot.spec
+        self.tendons = [robot.parameter(f"tendons[{i}]") for i in range(len(spec.tendons))]
+        self.chambers = [robot.parameter(f"chambers[{j}]") for j in range(len(spec.chambers))]
         self.base = robot.parameter("rod.base_pose") if self._has_base() else None
         self._cache: dict[Any, Any] = {}
         self._warm: dict[int, Any] = {}
+        self._interp: dict[Any, Any] = {}
 
     def _has_base(self) -> bool:
         try:
@@ -272,12 +275,12 @@ class CosseratModel:
         scale = values.get("tension_scale", 1.0)
         act = m.actuation
         tensions = scale * act["tensions"]
-        if m.kind == "shape":
-            s_all = np.clip(m.index, 0.0, 1.0) * self.length
-            s_out, inverse = np.unique(s_all, return_inverse=True)
-        else:
-            s_out, inverse = np.array([0.0, self.length]), np.array([1])
-        options: dict[str, Any] = {"s_out": s_out}
+        if m.kind == "markers" and m.index[-1] > self.length * (1.0 + 1e-12):
+            raise ParameterError(
+                f"invalid parameter `measurements`: marker arc length {m.index[-1]} m beyond "
+                f"the robot's length {self.length} m"
+            )
+        options: dict[str, Any] = {}
         warm = self._warm.get(id(m))
         if warm is not None:
             options["warm_start"] = warm
@@ -288,9 +291,19 @@ class CosseratModel:
         )
         self._warm[id(m)] = sol
         core, plan = self._core(names)
-        sens = sol.sensitivities(core, nodes=np.arange(len(s_out)))
+        nodes = np.asarray(sol.s)
+        want = None
+        if m.kind in ("shape", "markers"):
+            want = (
+                np.clip(m.index, 0.0, 1.0) * self.length
+                if m.kind == "shape"
+                else np.minimum(m.index, self.length)
+            )
+        # The sensitivities live on the solution's mesh nodes; points between nodes are
+        # interpolated by cubic splines through the nodes (between breaks), the same linear
+        # map for the positions and their derivatives, so the Jacobian stays exact.
+        sens = sol.sensitivities(core)
         pose = np.asarray(sens["pose"])  # (nodes, 6, n_core)
-        # Per unit of each fitted parameter.
         cols = np.zeros((pose.shape[0], 6, len(names)))
         for j, (n, pairs) in enumerate(zip(names, plan, strict=True)):
             for c, w in pairs:
@@ -298,14 +311,18 @@ class CosseratModel:
             if n.startswith(("rod.material.", "tendons[", "chambers[")) or n.endswith("_scale"):
                 cols[:, :, j] /= values[n]
         pos = np.asarray(sol.position)
-        if m.kind == "shape":
-            model = pos[inverse]
-            jac = cols[inverse, :3, :]
-            rot = np.asarray(sol.rotation)[inverse]
-            v = np.asarray(sol.v)[inverse]
-            tangent = np.einsum("nij,nj->ni", rot, v)
-            speed = np.linalg.norm(tangent, axis=1)
-            info = {"tangent": tangent / speed[:, None], "length": self.length * speed}
+        if want is not None:
+            key = (id(m), nodes.tobytes())
+            if key not in self._interp:
+                self._interp[key] = _interpolation(nodes, want)
+            w, dw = self._interp[key]
+            model = w @ pos
+            jac = np.einsum("qn,nik->qik", w, cols[:, :3, :])
+            info = None
+            if m.kind == "shape":
+                tangent = dw @ pos
+                speed = np.linalg.norm(tangent, axis=1)
+                info = {"tangent": tangent / speed[:, None], "length": self.length * speed}
             return (model - m.data).ravel(), jac.reshape(-1, len(names)), info
         tip = pos[-1]
         if m.data.shape == (4, 4):
@@ -340,3 +357,33 @@ def _left_jacobian_inverse(phi: np.ndarray) -> np.ndarray:
         return np.eye(3) - 0.5 * k + k @ k / 12.0
     coef = 1.0 / theta**2 - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
     return np.eye(3) - 0.5 * k + coef * (k @ k)
+
+
+def _interpolation(nodes: np.ndarray, query: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Matrices ``W``, ``W'`` (n_query, n_nodes) of cubic-spline interpolation through the
+    nodes and its derivative, one spline per run of nodes between repeated nodes (breaks)."""
+    from scipy.interpolate import CubicSpline
+
+    n = len(nodes)
+    w = np.zeros((len(query), n))
+    dw = np.zeros((len(query), n))
+    cuts = [0, *(np.flatnonzero(np.diff(nodes) <= 0.0) + 1).tolist(), n]
+    done = np.zeros(len(query), dtype=bool)
+    for a, b in itertools.pairwise(cuts):
+        seg = nodes[a:b]
+        if len(seg) < 2:
+            continue
+        inside = (~done) & (query >= seg[0]) & (query <= seg[-1])
+        if not np.any(inside):
+            continue
+        k = len(seg)
+        if k >= 4:
+            spline = CubicSpline(seg, np.eye(k), axis=0)
+            w[inside, a:b] = spline(query[inside])
+            dw[inside, a:b] = spline(query[inside], 1)
+        else:
+            t = (query[inside] - seg[0]) / (seg[-1] - seg[0])
+            w[inside, a], w[inside, b - 1] = 1.0 - t, t
+            dw[inside, a], dw[inside, b - 1] = -1 / (seg[-1] - seg[0]), 1 / (seg[-1] - seg[0])
+        done |= inside
+    return w, dw

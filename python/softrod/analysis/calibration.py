@@ -146,7 +146,7 @@ class Calibration:
 @dataclass(frozen=True)
 class _Measurement:
     actuation: Any
-    kind: str  # "shape" or "tip"
+    kind: str  # "shape", "markers" (points at known arc lengths) or "tip"
     data: np.ndarray  # (n, dim) points, or the tip vector / 4x4 pose
     index: np.ndarray | None  # arm index of each point in [0, 1]
 
@@ -229,9 +229,25 @@ def _measurements(
         where = f"measurements[{i}]"
         if actuations is not None:
             act, obs, act_where = actuations[i], m, f"actuations[{i}]"
-        elif isinstance(m, (tuple, list)) and len(m) == 2:
-            act, obs = m
+        elif isinstance(m, (tuple, list)) and len(m) in (2, 3):
+            act, obs = m[0], m[1]
             act_where = f"measurements[{i}][0]"
+            if len(m) == 3:
+                s = _args.finite_array(m[2], f"measurements[{i}][2]", ndim=1)
+                kind, data = _observation(obs, dim, where)
+                if kind != "shape" or len(s) != len(data):
+                    raise ParameterError(
+                        f"invalid parameter `measurements[{i}]`: an (actuation, points, s) "
+                        f"triple needs one arc length per point ({len(s)} for "
+                        f"{len(data) if data.ndim == 2 else 0} points)"
+                    )
+                if np.any(s < 0.0) or np.any(np.diff(s) < 0.0):
+                    raise ParameterError(
+                        f"invalid parameter `measurements[{i}][2]`: arc lengths must be >= 0 "
+                        "and non-decreasing (m)"
+                    )
+                out.append(_Measurement(check(act, act_where), "markers", data, s))
+                continue
         else:
             raise _args.type_error(
                 where, m, "an (actuation, observation) pair (or give `actuations`)"
@@ -372,6 +388,19 @@ class _PlanarModel:
                 r.append([L * (tip[2] + phi - m.data[2])])
                 rows.append(ja)
             return np.concatenate(r), np.vstack(rows)
+        if m.kind == "markers":
+            if m.index[-1] > L * (1.0 + 1e-12):
+                raise ParameterError(
+                    f"invalid parameter `measurements`: marker arc length {m.index[-1]} m "
+                    f"beyond the arm's length {L} m"
+                )
+            d = arm.sensitivities(t, np.minimum(m.index, L))
+            core = np.stack([d["d_x"], d["d_y"]], axis=1)
+            jac = np.einsum("ij,njk->nik", rot, self._columns(core, t0, names))
+            model = np.column_stack([d["x"], d["y"]]) @ rot.T
+            if "base_angle" in names:
+                jac[:, :, names.index("base_angle")] = model @ _ROT90.T
+            return (model - m.data).ravel(), jac.reshape(-1, len(names)), None
         if metric == "arm-index":
             return self._arm_index(arm, t, t0, rot, phi, names, m)
         return self._nearest(arm, t, t0, rot, phi, names, m)
@@ -669,9 +698,9 @@ def calibrate(
         jac=lambda z: evaluate(z)["j"],
         bounds=(zlo, zhi),
         method="trf",
-        ftol=1e-14,
-        xtol=1e-14,
-        gtol=1e-14,
+        ftol=1e-10,
+        xtol=1e-10,
+        gtol=1e-10,
         x_scale=1.0,
         loss=loss,
         max_nfev=max_evaluations,
@@ -738,7 +767,7 @@ def calibrate(
     for meas_i, k in zip(meas, parts, strict=True):
         chunk = r[start : start + k]
         start += k
-        if meas_i.kind == "shape" and metric == "arm-index":
+        if meas_i.kind == "markers" or (meas_i.kind == "shape" and metric == "arm-index"):
             chunk = chunk.reshape(-1, model.dim)
         residuals.append(chunk.copy())
     return Calibration(
