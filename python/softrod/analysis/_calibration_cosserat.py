@@ -104,7 +104,7 @@ class CosseratModel:
         if name == "tendon_offset_scale" and self.tendons:
             return name
         if name == "chamber_area_scale" and self.chambers:
-            if all("area" in c for c in self.chambers):
+            if all("area" in c or "radius" in c for c in self.chambers):
                 return name
         if name.startswith("rod.material."):
             field = name.split(".", 2)[2]
@@ -210,8 +210,11 @@ class CosseratModel:
         c = values.get("chamber_area_scale")
         if c is not None:
             for j, cm in enumerate(self.chambers):
-                key = f"chambers[{j}].area"
-                ch[key] = c * ch.get(key, cm["area"])
+                if "area" in cm:
+                    key = f"chambers[{j}].area"
+                    ch[key] = c * ch.get(key, cm["area"])
+                else:  # a circular chamber: the area scales with the radius squared
+                    ch[f"chambers[{j}].radius"] = math.sqrt(c) * cm["radius"]
         if any(k in values for k in _AXES):
             rot = np.eye(3)
             for k, axis in _AXES.items():

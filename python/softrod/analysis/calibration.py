@@ -151,12 +151,12 @@ class _Measurement:
     index: np.ndarray | None  # arm index of each point in [0, 1]
 
 
-def _arm_index(points: np.ndarray) -> np.ndarray:
+def _arm_index(points: np.ndarray, where: str = "measurements") -> np.ndarray:
     """Normalised arc length of a cubic spline through the points (chord parametrisation)."""
     chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
     u = np.concatenate([[0.0], np.cumsum(chord)])
     if u[-1] <= 0.0:
-        raise ParameterError("invalid parameter `measurements`: a backbone of zero length")
+        raise ParameterError(f"invalid parameter `{where}`: a backbone of zero length")
     if len(points) < 4 or np.any(chord <= 0.0):
         return u / u[-1]
     from scipy.interpolate import CubicSpline
@@ -253,7 +253,7 @@ def _measurements(
                 where, m, "an (actuation, observation) pair (or give `actuations`)"
             )
         kind, data = _observation(obs, dim, where)
-        index = _arm_index(data) if kind == "shape" else None
+        index = _arm_index(data, where) if kind == "shape" else None
         out.append(_Measurement(check(act, act_where), kind, data, index))
     return out
 
