@@ -675,6 +675,12 @@ def _define_targets() -> None:
     )
     t("ModelComparison.table")(lambda d: (sr.compare_models(_niti(), repeats=1).table, {}))
     # calibration
+    t("StaticsSolution.sensitivities")(
+        lambda d: (
+            _niti().solve().sensitivities,
+            dict(parameters=["stiffness_scale", "tension[0]"], nodes=[0, 10]),
+        )
+    )
     t("PlanarCableArm.sensitivities")(
         lambda d: (sr.PlanarCableArm.seed_arm().sensitivities, dict(tension=1.0, s=[0.0, 0.1]))
     )
@@ -1490,6 +1496,7 @@ def summary(outcomes: list[Outcome]) -> dict:
 #: Public classes users do not construct (results, exceptions) and result records: their
 #: constructors are not fuzzed (their public methods are).
 NOT_CONSTRUCTED = {
+    "TargetUnreachableError",
     "Backbone",
     "Calibration",
     "IdentifiabilityWarning",

@@ -17,7 +17,7 @@ use softrod::{AdaptiveOptions, Integrator, SolveOptions};
 
 use crate::callbacks::{run, run_attached};
 use crate::convert::{arg, count, floats_n};
-use crate::errors::{param_err, to_py_err, StabilityError, StabilityWarning};
+use crate::errors::{param_err, to_py_err, type_err, StabilityError, StabilityWarning};
 use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 
 /// The user's options, each `None` when not given.
@@ -349,9 +349,33 @@ impl StaticsSolution {
     fn sensitivities<'py>(
         &self,
         py: Python<'py>,
-        parameters: Vec<String>,
-        nodes: Option<Vec<i64>>,
+        parameters: Bound<'py, PyAny>,
+        nodes: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let parameters: Vec<String> = items(&parameters, "parameters", "a list of names")?
+            .iter()
+            .enumerate()
+            .map(|(k, item)| {
+                item.extract::<String>()
+                    .map_err(|_| type_err(&format!("parameters[{k}]"), item, "a name (str)"))
+            })
+            .collect::<PyResult<_>>()?;
+        let nodes: Option<Vec<i64>> = nodes
+            .filter(|b| !b.is_none())
+            .map(|b| {
+                items(&b, "nodes", "a list of node indices")?
+                    .iter()
+                    .enumerate()
+                    .map(|(k, item)| {
+                        if item.is_instance_of::<pyo3::types::PyBool>() {
+                            return Err(type_err(&format!("nodes[{k}]"), item, "an integer"));
+                        }
+                        item.extract::<i64>()
+                            .map_err(|_| type_err(&format!("nodes[{k}]"), item, "an integer"))
+                    })
+                    .collect::<PyResult<Vec<_>>>()
+            })
+            .transpose()?;
         let params = parameters
             .iter()
             .enumerate()
@@ -667,4 +691,18 @@ fn parse_parameter(k: usize, name: &str) -> PyResult<softrod::Parameter> {
         "base_rotation" if index < 3 => P::BaseRotation(index),
         _ => return Err(bad()),
     })
+}
+
+/// The items of a list-like argument (not a string), or a type error naming it.
+fn items<'py>(
+    b: &Bound<'py, PyAny>,
+    name: &str,
+    expected: &str,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    if b.is_instance_of::<pyo3::types::PyString>() || b.is_none() {
+        return Err(type_err(name, b, expected));
+    }
+    let it = b.try_iter().map_err(|_| type_err(name, b, expected))?;
+    it.collect::<PyResult<Vec<_>>>()
+        .map_err(|_| type_err(name, b, expected))
 }
