@@ -5,7 +5,8 @@ Run: ``python benchmarks/calibrate.py`` (after ``pip install .``). Cases:
 * the planar cable arm (the planar cable-arm paper's model): E and a from three noise-free
   backbones of 100 points, started 30 % off;
 * the two-segment NiTi tendon robot (``examples/robots/niti_two_segment.toml``): Young's modulus
-  and tendon 0's distance from five noise-free backbones of 30 points each, started 10 % off.
+  and tendon 0's distance from five noise-free backbones of 30 points each at known arc lengths
+  (markers), started 10 % and 9 % off.
 
 Side by side, the same fits with SciPy's finite-difference Jacobian (``jac="2-point"`` on the
 same residuals), the baseline the exact sensitivities replace.
@@ -49,7 +50,7 @@ def niti_case():
         {"rod.material.youngs_modulus": 50e9, "tendons[0].distance": 0.011}
     )
     s = np.linspace(0.0, 0.4, 30)
-    data = [(t, np.asarray(truth.solve(t, s_out=s).position)) for t in NITI_TENSIONS]
+    data = [(t, np.asarray(truth.solve(t, s_out=s).position), s) for t in NITI_TENSIONS]
     start = robot.with_parameters(
         {"rod.material.youngs_modulus": 55e9, "tendons[0].distance": 0.01}
     )
