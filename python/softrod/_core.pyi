@@ -108,7 +108,7 @@ class PlanarBatch:
 
 @final
 class PlanarCableArm:
-    """The seed-000 tapered cable-driven arm (immutable, validated)."""
+    """The planar cable-arm paper's tapered cable-driven arm (immutable, validated)."""
 
     def __init__(
         self,
