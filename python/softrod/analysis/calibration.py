@@ -685,8 +685,9 @@ def calibrate(
         key = z.tobytes()
         if cache.get("key") != key:
             values = dict(zip(names, (z * scale).tolist(), strict=True))
-            r, j, parts = _stack(model, values, names, meas, metric)
-            cache.update(key=key, r=r, j=j * scale[None, :], parts=parts)
+            infos: list[Any] = []
+            r, j, parts = _stack(model, values, names, meas, metric, infos)
+            cache.update(key=key, r=r, j=j * scale[None, :], parts=parts, infos=infos)
         return cache
 
     z0 = p0 / scale
@@ -712,8 +713,7 @@ def calibrate(
     values = dict(zip(names, p.tolist(), strict=True))
     jac = jz / scale[None, :]
     m, n = jac.shape
-    infos: list[Any] = []
-    _stack(model, values, names, meas, metric, infos)
+    infos = final["infos"]
     sigma2, m_eff = _residual_variance(r, parts, meas, infos, model.dim, metric)
     dof = m_eff - n
     sigma2 = sigma2 / dof if dof > 0 else math.nan
