@@ -43,6 +43,7 @@ from ._core import (
     UniaxialLaw,
     Yeoh,
     __version__,
+    actuation_jacobian,
     compliance,
     eigenscrews,
     fit_uniaxial,
@@ -70,6 +71,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
+from .inverse import InverseSolution, inverse_statics
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
 from .vision import Backbone, BackboneQuality
@@ -88,6 +90,7 @@ __all__ = [
     "FunctionSection",
     "Hookean",
     "IdentifiabilityWarning",
+    "InverseSolution",
     "LinearElastic",
     "Linearised",
     "Loads",
@@ -120,6 +123,7 @@ __all__ = [
     "WorkspaceMap",
     "Yeoh",
     "__version__",
+    "actuation_jacobian",
     "backbone_distance",
     "calibrate",
     "compare_models",
@@ -129,6 +133,7 @@ __all__ = [
     "examples",
     "extract_backbone",
     "fit_uniaxial",
+    "inverse_statics",
     "load_robot",
     "pcc",
     "read_backbone_csv",
