@@ -60,13 +60,14 @@ fn check(arm: &PlanarCableArm, t: f64) {
         };
         let (plus, minus) = (eval(h), eval(-h));
         let n = s.len();
-        let fields: [(&[f64], &[f64], &[f64], &[f64]); 4] = [
-            (&sens.d_x, &plus.x, &minus.x, &sens.x),
-            (&sens.d_y, &plus.y, &minus.y, &sens.y),
-            (&sens.d_angle, &plus.angle, &minus.angle, &sens.angle),
-            (&sens.d_arc, &plus.arc, &minus.arc, &sens.arc),
+        type Field<'a> = (&'a [f64], &'a [f64], &'a [f64]);
+        let fields: [Field<'_>; 4] = [
+            (&sens.d_x, &plus.x, &minus.x),
+            (&sens.d_y, &plus.y, &minus.y),
+            (&sens.d_angle, &plus.angle, &minus.angle),
+            (&sens.d_arc, &plus.arc, &minus.arc),
         ];
-        for (field, (d, pl, mi, _)) in fields.iter().enumerate() {
+        for (field, (d, pl, mi)) in fields.iter().enumerate() {
             // Relative to the largest column entry (the shape's scale of that sensitivity).
             let scale = (0..n).map(|i| d[i * 5 + j].abs()).fold(0.0, f64::max);
             if scale == 0.0 {
