@@ -1539,7 +1539,6 @@ def summary(outcomes: list[Outcome]) -> dict:
 #: Public classes users do not construct (results, exceptions) and result records: their
 #: constructors are not fuzzed (their public methods are).
 NOT_CONSTRUCTED = {
-    "TargetUnreachableError",
     "Backbone",
     "Calibration",
     "IdentifiabilityWarning",
