@@ -5,14 +5,7 @@ set so that L = 0.9 l_c or 1.1 l_c with ``l_c = 1.9863 (EI/q)^(1/3)`` (the const
 first zero of J_{-1/3}, ``harness/oracles.py``). Figure: ``python benchmarks/trust_greenhill.py``.
 """
 
-import pytest
 from harness import greenhill
-
-NO_STABILITY = pytest.mark.xfail(
-    strict=True,
-    reason="issue 10: the straight column past its critical length comes back "
-    "converged with no `stable` flag",
-)
 
 
 def test_tangent_compliance_changes_sign_at_greenhills_length():
@@ -25,13 +18,11 @@ def test_tangent_compliance_changes_sign_at_greenhills_length():
     assert above["straight"] and above["lateral"] < 0
 
 
-@NO_STABILITY
 def test_reported_straight_and_stable_below_the_critical_length():
     m = greenhill.measure(0.9)
     assert m["converged"] and m["straight"] and m["stable"] is True
 
 
-@NO_STABILITY
 def test_not_straight_and_stable_above_the_critical_length():
     m = greenhill.measure(1.1)
     assert m["stable"] is not None, "solution.stable is missing"

@@ -55,7 +55,6 @@ def test_oracles_agree_on_the_issue_example():
     assert rec.margin == pytest.approx(rec.margin_fd, rel=1e-4)
 
 
-@NO_STABILITY
 def test_issue_example_is_flagged_or_replaced_by_the_stable_equilibrium():
     # Tensions [0.8178, ...] N, tip force (0.0109, 0.249, -0.153) N, steps = 50: the tip sits
     # at -y while the force pulls toward +y, an unstable equilibrium.

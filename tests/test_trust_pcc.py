@@ -11,21 +11,13 @@ from harness import pcc_random
 
 from softrod import pcc
 
-SPURIOUS = pytest.mark.xfail(
-    strict=True,
-    reason="issue 10: PCC rejects valid solves by round-off "
-    "(`s[49]` = total length + 1 ulp: must be in [0, length])",
-)
-
 
 @pytest.mark.slow
-@SPURIOUS
 def test_ten_thousand_random_configurations_have_no_spurious_error():
     run = pcc_random.run(10_000)
     assert run.counts["ok"] == 10_000, run.counts
 
 
-@SPURIOUS
 def test_sample_has_no_spurious_error():
     run = pcc_random.run(500, seed=5)
     assert run.counts["ok"] == 500, run.counts
@@ -36,7 +28,6 @@ def test_answers_that_solve_match_their_own_arcs():
     assert run.counts["tip-mismatch"] == 0 and run.counts["other-error"] == 0
 
 
-@SPURIOUS
 def test_issue_example_of_a_round_off_rejection():
     angles = np.radians([90.0, -30.0, 210.0])
     robot = (

@@ -1,7 +1,7 @@
 """Type stubs of the compiled core ``softrod._core`` (checked against the module by the tests)."""
 
 from collections.abc import Callable, Sequence
-from typing import Literal, final
+from typing import Any, Literal, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -11,10 +11,22 @@ __version__: str
 _Floats = float | Sequence[float] | NDArray[np.float64]
 _Method = Literal["closed-form", "ode"]
 
+#: Limits on input sizes and magnitudes (``softrod::limits``; see docs/conventions.md).
+MAX_SAMPLES: int
+MAX_ITERATIONS: int
+MAX_LOAD_NUMBER: float
+MAX_LENGTH: float
+MAX_MODULUS: float
+MAX_BENDING_ANGLE: float
+MAX_OFFSET_RATIO: float
+
 class ParameterError(ValueError):
     """A parameter is outside its valid range; ``parameter`` names it."""
 
     parameter: str
+
+class ParameterTypeError(ParameterError, TypeError):
+    """An argument of the wrong type or shape; ``parameter`` names it."""
 
 class ConvergenceError(RuntimeError):
     """A solver or integrator did not converge."""
@@ -22,6 +34,24 @@ class ConvergenceError(RuntimeError):
     iterations: int
     residual: float
     load_factor: float
+
+class TargetUnreachableError(ConvergenceError):
+    """Inverse statics: the target is out of reach within the actuation bounds."""
+
+    distance: float
+    rotation: float
+
+class StabilityWarning(UserWarning):
+    """The equilibrium returned is unstable and no stable one was found."""
+
+class StabilityError(RuntimeError):
+    """The equilibrium reached is unstable (``on_unstable="raise"``)."""
+
+    stability_margin: float
+    solution: StaticsSolution
+
+class InternalError(RuntimeError):
+    """A defect of softrod caught at the binding (never bad input); please report it."""
 
 @final
 class PlanarSolution:
@@ -78,7 +108,7 @@ class PlanarBatch:
 
 @final
 class PlanarCableArm:
-    """The seed-000 tapered cable-driven arm (immutable, validated)."""
+    """The planar cable-arm paper's tapered cable-driven arm (immutable, validated)."""
 
     def __init__(
         self,
@@ -370,6 +400,12 @@ class StaticsSolution:
     @property
     def base_wrench(self) -> NDArray[np.float64]: ...
     @property
+    def stable(self) -> bool:
+        """Whether the equilibrium is stable (tip tangent stiffness positive definite)."""
+    @property
+    def stability_margin(self) -> float:
+        """Smallest eigenvalue of the scaled tip tangent stiffness (> 0: stable)."""
+    @property
     def tensions(self) -> NDArray[np.float64]:
         """Tendon tensions it was solved for (N), shape (n_tendons,)."""
     @property
@@ -401,10 +437,14 @@ def solve_statics(
     warm_start: StaticsSolution | Sequence[float] | None = None,
     throw: bool | None = None,
     chambers: Sequence[Chamber] = ...,
+    s_out: Sequence[float] | NDArray[np.float64] | None = None,
+    seek_stable: bool | None = None,
+    on_unstable: Literal["warn", "raise", "ignore"] | None = None,
 ) -> StaticsSolution:
     """Options not given keep the core's defaults: integrator "rk4" with 40 steps (rtol 1e-8,
     atol 1e-10 for "adaptive"), tolerance 1e-10, max_iterations 30, continuation True,
-    max_load_steps 64, throw True."""
+    max_load_steps 64, throw True, seek_stable True, on_unstable "warn". ``s_out`` (m) adds
+    nodes at those arc lengths."""
 
 # ----------------------------------------------------------------------------- materials
 
@@ -842,6 +882,15 @@ def _workspace_map(
     tangent: Literal["tension", "length"] | None = None,
     chambers: Sequence[Chamber] = ...,
 ) -> dict[str, NDArray[np.float64]]: ...
+def _sweep(
+    jobs: Sequence[dict[str, Any]],
+    *,
+    outputs: Sequence[str],
+    block: int = 32,
+    parallel: bool = True,
+) -> list[dict[str, Any]]:
+    """Actuation sweeps of design points (used by ``softrod.sweep``): one dict of arrays per
+    job (``status``: 0 converged, 1 not converged, 2 failed; ``error`` per sample)."""
 
 # ----------------------------------------------------------------------------- chambers
 

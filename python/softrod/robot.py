@@ -17,10 +17,12 @@ import os
 import pickle
 import re
 from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
 
+from . import _args
 from ._core import (
     Chamber,
     Loads,
@@ -37,6 +39,18 @@ from .io.robot_file import FieldError, RobotFile
 __all__ = ["Robot", "load_robot"]
 
 _PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)\Z")
+
+
+@contextmanager
+def _argument(name: str):
+    """Prefixes the errors of a description given as the argument ``name`` with its name
+    (their ``parameter`` and ``errors`` keep the locations inside it)."""
+    try:
+        yield
+    except ParameterError as exc:
+        if exc.args and not str(exc.args[0]).startswith(f"`{name}`"):
+            exc.args = (f"`{name}`: {exc.args[0]}", *exc.args[1:])
+        raise
 
 
 def _parse_path(path: str) -> list[str | int]:
@@ -154,8 +168,14 @@ class Robot:
             raise TypeError(f"invalid parameter `rod` = {rod!r}: must be a softrod.Rod")
         if loads is not None and not isinstance(loads, Loads):
             raise TypeError(f"invalid parameter `loads` = {loads!r}: must be a softrod.Loads")
-        if not isinstance(name, str) or not isinstance(description, str):
-            raise TypeError("invalid parameter `name` or `description`: must be a string")
+        if not isinstance(name, str):
+            raise _args.type_error("name", name, "a string")
+        if not isinstance(description, str):
+            raise _args.type_error("description", description, "a string")
+        if solver is not None and not isinstance(solver, Mapping):
+            raise _args.type_error("solver", solver, "a dict of solver options")
+        if source is not None and not isinstance(source, Mapping):
+            raise _args.type_error("source", source, "a dict (a robot file's tables)")
         options = _plain(dict(solver or {}))
         if options:
             _rf.validate_robot_dict({"rod": _MINIMAL_ROD, "solver": options})
@@ -171,7 +191,8 @@ class Robot:
             None,
         )
         if source:
-            spec = _rf.validate_robot_dict(_plain(dict(source)))
+            with _argument("source"):
+                spec = _rf.validate_robot_dict(_plain(dict(source)))
             object.__setattr__(self, "_spec", spec.model_copy(update={"name": name}))
 
     def _set(self, name, description, rod, tendons, chambers, loads, given, solver, spec):
@@ -200,6 +221,10 @@ class Robot:
         Raises:
             ParameterError: Every constructor error, located in the file (``errors``).
         """
+        if not isinstance(spec, RobotFile):
+            raise _args.type_error("spec", spec, "a RobotFile (softrod.io.robot_file)")
+        if not isinstance(name, str):
+            raise _args.type_error("name", name, "a string")
         if spec.name is None:
             spec = spec.model_copy(update={"name": name})
         parts = _objects.build(spec, source)
@@ -224,16 +249,24 @@ class Robot:
         Raises:
             ParameterError: Every error of the description (``errors``, each located).
         """
-        return cls.from_spec(_rf.validate_robot_dict(_plain(data)), name=name)
+        if not isinstance(data, Mapping):
+            raise _args.type_error("data", data, "a dict (a robot file's tables)")
+        with _argument("data"):
+            spec = _rf.validate_robot_dict(_plain(data))
+        return cls.from_spec(spec, name=name)
 
     @classmethod
     def from_toml(cls, text: str, name: str = "robot") -> Robot:
         """Builds a robot from the text of a robot file."""
-        try:
-            data = _rf.tomllib.loads(text)
-        except _rf.tomllib.TOMLDecodeError as exc:
-            _rf.raise_errors([FieldError("", f"not valid TOML: {exc}", kind="type")])
-        return cls.from_dict(data, name=name)
+        if not isinstance(text, str):
+            raise _args.type_error("text", text, "the text of a robot file (a string)")
+        with _argument("text"):
+            try:
+                data = _rf.tomllib.loads(text)
+            except _rf.tomllib.TOMLDecodeError as exc:
+                _rf.raise_errors([FieldError("", f"not valid TOML: {exc}", kind="type")])
+            spec = _rf.validate_robot_dict(_plain(data))
+        return cls.from_spec(spec, name=name)
 
     # ------------------------------------------------------------------ attributes
 
@@ -393,6 +426,8 @@ class Robot:
             ParameterError: Any invalid value, unknown key (with a suggestion) or index out
                 of range, all reported at once at their paths.
         """
+        if not isinstance(values, Mapping):
+            raise _args.type_error("values", values, "a dict: parameter path -> value")
         data = self.spec.model_dump(mode="python", exclude_unset=True, exclude_none=True)
         errors: list[FieldError] = []
         for path, value in values.items():
@@ -400,12 +435,13 @@ class Robot:
                 _set_path(data, _parse_path(path), _plain(value))
             except ParameterError as exc:
                 errors.append(FieldError(str(path), str(exc), None, "unknown_key"))
-        try:
-            spec = _rf.validate_robot_dict(data)
-        except ParameterError as exc:
-            _rf.raise_errors([*errors, *exc.errors])
-        if errors:
-            _rf.raise_errors(errors)
+        with _argument("values"):
+            try:
+                spec = _rf.validate_robot_dict(data)
+            except ParameterError as exc:
+                _rf.raise_errors([*errors, *exc.errors])
+            if errors:
+                _rf.raise_errors(errors)
         return Robot.from_spec(spec, name=self._name)
 
     # ------------------------------------------------------------------ files
@@ -429,6 +465,8 @@ class Robot:
             FileExistsError: ``path`` exists and ``overwrite`` is false.
             ParameterError: The robot cannot be described (see :meth:`to_toml`).
         """
+        path = _args.path(path)
+        overwrite = _args.flag(overwrite, "overwrite")
         text = self.to_toml()
         with open(path, "w" if overwrite else "x", encoding="utf-8") as fh:
             fh.write(text)
@@ -554,7 +592,7 @@ def load_robot(path: str | os.PathLike[str]) -> Robot:
         ParameterError: A file that is not UTF-8 TOML, or every missing, unknown or invalid
             field of it, located (``errors`` lists them, ``parameter`` is the first).
     """
-    name = os.fspath(path)
+    name = os.fspath(_args.path(path))
     data = _rf.read_robot_toml(path)
     stem = os.path.splitext(os.path.basename(name))[0]
     spec = _rf.validate_robot_dict(data, source=name)

@@ -109,6 +109,17 @@ def _chambered():
     return sr.Robot(rod, chambers=[sr.Chamber(2e3, 1e-5, (0.004, 0.0))])
 
 
+def _sweep_ds():
+    import numpy as np
+
+    return _sr().sweep(
+        _niti(),
+        actuation={"tendons[0].tension": np.linspace(0.0, 2.0, 5), "tendons[1].tension": [0, 1]},
+        outputs=("tip_pose", "translational_compliance"),
+        progress=False,
+    )
+
+
 def _law(kind: str):
     sr = _sr()
     return {
@@ -487,6 +498,9 @@ def _define_targets() -> None:
                 warm_start=None,
                 throw=True,
                 chambers=[],
+                s_out=[0.05, 0.1],
+                seek_stable=True,
+                on_unstable="ignore",
             ),
         )
     )
@@ -553,6 +567,55 @@ def _define_targets() -> None:
             dict(n_tendons=3, axes={0: np.array([0.0, 1.0, 2.0]), 2: np.array([0.0, 1.0])}),
         )
     )
+    # design sweeps
+    t("sweep")(
+        lambda d: (
+            sr.sweep,
+            dict(
+                robot=_niti(),
+                actuation={"tendons[0].tension": [0.0, 1.0]},
+                design={"rod.section.radius": [7e-4, 8e-4]},
+                outputs=["tip_pose", "translational_compliance"],
+                arc_lengths=None,
+                arm_index=[1.0],
+                scheduler=None,
+                chunk=8,
+                block=4,
+                progress=False,
+            ),
+        )
+    )
+    t("sweep(arc_lengths)")(
+        lambda d: (
+            sr.sweep,
+            dict(
+                robot=_chambered(),
+                actuation=sr.samples({"chambers[0].pressure": [0.0, 2e3, 4e3]}),
+                outputs=["backbone", "gamma_c"],
+                arc_lengths=[0.1, 0.2],
+            ),
+        )
+    )
+    t("samples")(lambda d: (sr.samples, dict(table={"tendons[0].tension": [0.0, 1.0]})))
+    t("SampleTable")(lambda d: (sr.SampleTable, dict(columns={"rod.length": [0.2, 0.3]})))
+    t("design_summary")(
+        lambda d: (
+            sr.design_summary,
+            dict(ds=_sweep_ds(), over=None, voxel=0.01, axis=(0.0, 0.0, 1.0), origin=(0, 0, 0)),
+        )
+    )
+    t("Pareto")(
+        lambda d: (
+            sr.Pareto,
+            dict(
+                a=np.array([1.0, 2.0, 3.0]),
+                b=np.array([3.0, 1.0, 2.0]),
+                better=("min", "max"),
+                names=("x", "y"),
+            ),
+        )
+    )
+    t("Pareto.table")(lambda d: (sr.Pareto(np.array([1.0, 2.0]), np.array([2.0, 1.0])).table, {}))
     t("Robot")(
         lambda d: (
             sr.Robot,

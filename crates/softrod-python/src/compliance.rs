@@ -3,14 +3,16 @@
 //! `softrod::compliance::eigenscrew` and `softrod::batch::workspace`.
 
 use numpy::ndarray::Array;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 use softrod::math::linalg::invert_spd;
 use softrod::nalgebra::Matrix6;
 
-use crate::errors::{param_err, to_py_err};
+use crate::callbacks::{run, run_parallel};
+use crate::convert::{arg, count, Matrix};
+use crate::errors::{param_err, to_py_err, type_err};
 use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 use crate::pcc::PccSolution;
 use crate::statics::{solve_options, OptionArgs, Problem, StaticsSolution};
@@ -138,8 +140,8 @@ pub(crate) enum AnySolution<'py> {
 pub(crate) fn compliance<'py>(
     py: Python<'py>,
     solution: &Bound<'py, PyAny>,
-    rod: Option<Bound<'py, Rod>>,
-    panels: Option<i64>,
+    #[pyo3(from_py_with = arg::rod)] rod: Option<Bound<'py, Rod>>,
+    #[pyo3(from_py_with = arg::panels)] panels: Option<i64>,
 ) -> PyResult<Compliance> {
     let call = Args::new(
         py,
@@ -154,12 +156,15 @@ pub(crate) fn compliance<'py>(
         ],
     )?;
     let solution: AnySolution<'_> = solution.extract().map_err(|_| {
-        param_err(
+        type_err(
             "solution",
-            "<object>",
-            "a StaticsSolution or a softrod.pcc solution",
+            solution,
+            "a StaticsSolution or a softrod.pcc Solution",
         )
     })?;
+    let panels = panels
+        .map(|p| count("panels", p, 1, softrod::limits::MAX_SAMPLES))
+        .transpose()?;
     let rod = rod.as_ref().map(|r| r.borrow());
     let inner = match solution {
         AnySolution::Cosserat(solution) => {
@@ -171,21 +176,18 @@ pub(crate) fn compliance<'py>(
                 ));
             }
             let sol = &solution.inner;
-            py.detach(|| softrod::compliance(sol))
+            run(py, "compliance", || softrod::compliance(sol))
         }
         AnySolution::Pcc(solution) => {
             let rod = rod.ok_or_else(|| {
                 param_err("rod", "None", "the Rod giving the section and material")
             })?;
-            let panels = match panels {
-                Some(p) if p < 1 => return Err(param_err("panels", p, ">= 1")),
-                p => p.map(|p| p as usize),
-            };
             let (r, robot, sol) = (&rod.inner, &solution.robot, &solution.inner);
-            py.detach(|| softrod::pcc_compliance(r, robot, sol, panels))
+            run(py, "compliance", || {
+                softrod::pcc_compliance(r, robot, sol, panels)
+            })
         }
-    }
-    .map_err(to_py_err)?;
+    }?;
     Ok(Compliance { inner, call })
 }
 
@@ -276,10 +278,10 @@ impl TangentCompliance {
 #[pyo3(signature = (solution, tendons="tension", *, held=None, node=None))]
 pub(crate) fn tangent_compliance<'py>(
     py: Python<'py>,
-    solution: &Bound<'py, StaticsSolution>,
-    tendons: &str,
-    held: Option<Vec<i64>>,
-    node: Option<i64>,
+    #[pyo3(from_py_with = arg::solution)] solution: Bound<'py, StaticsSolution>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: &str,
+    #[pyo3(from_py_with = arg::held)] held: Option<Vec<i64>>,
+    #[pyo3(from_py_with = arg::node)] node: Option<i64>,
 ) -> PyResult<TangentCompliance> {
     let call = Args::new(
         py,
@@ -308,7 +310,13 @@ pub(crate) fn tangent_compliance<'py>(
             }
             out
         }
-        (other, _) => return Err(param_err("tendons", other, "\"tension\" or \"length\"")),
+        (other, _) => {
+            return Err(param_err(
+                "tendons",
+                format!("{other:?}"),
+                "\"tension\" or \"length\"",
+            ))
+        }
     };
     let n = solution.inner.s.len() as i64;
     let node = match node {
@@ -318,12 +326,11 @@ pub(crate) fn tangent_compliance<'py>(
         Some(k) => return Err(param_err("node", k, "in [-N, N)")),
     };
     let sol = &solution.inner;
-    let result = py.detach(|| softrod::compliance::tangent_compliance_held(sol, &held, node));
-    if let Some(err) = solution.callback_error() {
-        return Err(err);
-    }
+    let result = run(py, "tangent_compliance", || {
+        softrod::compliance::tangent_compliance_held(sol, &held, node)
+    })?;
     Ok(TangentCompliance {
-        inner: result.map_err(to_py_err)?,
+        inner: result,
         tendons: tendons.to_string(),
         call,
     })
@@ -429,16 +436,11 @@ impl Eigenscrews {
 #[pyo3(signature = (matrix, kind="stiffness"))]
 pub(crate) fn eigenscrews(
     py: Python<'_>,
-    matrix: PyReadonlyArray2<'_, f64>,
-    kind: &str,
+    #[pyo3(from_py_with = arg::matrix)] matrix: Matrix,
+    #[pyo3(from_py_with = arg::kind)] kind: &str,
 ) -> PyResult<Eigenscrews> {
-    let copy = matrix
-        .as_array()
-        .to_owned()
-        .into_pyarray(py)
-        .into_any()
-        .unbind();
-    let a = matrix.as_array();
+    let copy = matrix.0.clone().into_pyarray(py).into_any().unbind();
+    let a = matrix.0.view();
     if a.shape() != [6, 6] {
         return Err(param_err(
             "matrix",
@@ -450,7 +452,13 @@ pub(crate) fn eigenscrews(
     let k = match kind {
         "stiffness" => softrod::MatrixKind::Stiffness,
         "compliance" => softrod::MatrixKind::Compliance,
-        other => return Err(param_err("kind", other, "\"stiffness\" or \"compliance\"")),
+        other => {
+            return Err(param_err(
+                "kind",
+                format!("{other:?}"),
+                "\"stiffness\" or \"compliance\"",
+            ))
+        }
     };
     let inner = softrod::eigenscrews(&m, k).map_err(to_py_err)?;
     Ok(Eigenscrews {
@@ -470,18 +478,18 @@ pub(crate) fn eigenscrews(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _workspace_map<'py>(
     py: Python<'py>,
-    rod: &Bound<'py, Rod>,
-    tendons: Vec<Bound<'py, Tendon>>,
-    tensions: PyReadonlyArray2<'_, f64>,
-    loads: Option<&Bound<'py, Loads>>,
-    integrator: Option<&'py str>,
-    steps: Option<i64>,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    tolerance: Option<f64>,
-    chunk: i64,
-    tangent: Option<&str>,
-    chambers: Vec<Bound<'py, Chamber>>,
+    #[pyo3(from_py_with = arg::rod)] rod: Bound<'py, Rod>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: Vec<Bound<'py, Tendon>>,
+    #[pyo3(from_py_with = arg::tensions)] tensions: Matrix,
+    #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'py, Loads>>,
+    #[pyo3(from_py_with = arg::integrator)] integrator: Option<&'py str>,
+    #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::chunk)] chunk: i64,
+    #[pyo3(from_py_with = arg::tangent)] tangent: Option<&str>,
+    #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let tangent = match tangent {
         None => None,
@@ -490,7 +498,7 @@ pub(crate) fn _workspace_map<'py>(
         Some(other) => {
             return Err(param_err(
                 "tangent",
-                other,
+                format!("{other:?}"),
                 "None, \"tension\" or \"length\"",
             ))
         }
@@ -503,34 +511,33 @@ pub(crate) fn _workspace_map<'py>(
         tolerance,
         ..Default::default()
     })?;
-    let problem = Problem::new(rod.get(), &tendons, loads.map(Bound::get), &chambers)?;
+    let problem = Problem::new(
+        rod.get(),
+        &tendons,
+        loads.as_ref().map(Bound::get),
+        &chambers,
+    )?;
     let nt = problem.model.tendons().len();
-    if chunk < 1 {
-        return Err(param_err("chunk", chunk, ">= 1"));
-    }
-    let a = tensions.as_array();
+    let chunk = count("chunk", chunk, 1, usize::MAX >> 1)?;
+    let a = tensions.0.view();
     if a.ndim() != 2 || a.shape()[1] != nt {
         return Err(param_err(
             "tensions",
             format!("shape {:?}", a.shape()),
-            &format!("shape (M, {nt})"),
+            &format!("shape (M, n_tendons) with n_tendons = len(tendons) = {nt}"),
         ));
     }
     let flat: Vec<f64> = a.iter().copied().collect();
-    let result = py.detach(|| {
+    let samples = run_parallel(py, "workspace_map", problem.has_callables, || {
         softrod::workspace_map(
             &problem.model,
             &problem.actuation,
             &flat,
             &options,
-            chunk as usize,
+            chunk,
             tangent,
         )
-    });
-    if let Some(err) = problem.callback_error() {
-        return Err(err);
-    }
-    let samples = result.map_err(to_py_err)?;
+    })?;
     let m = samples.len();
     let d = pyo3::types::PyDict::new(py);
     d.set_item(

@@ -3,11 +3,13 @@
 //! This crate only converts arrays, maps the core's one error type to Python exceptions (in
 //! `errors::to_py_err`) and releases the GIL around solves. All numerics live in the `softrod`
 //! crate. It is split like the core: `model` (the robot description), `statics`,
-//! `compliance`, `pcc`, `planar`, `materials`; argument conversions in `convert`, errors in
+//! `compliance`, `pcc`, `planar`, `materials`, `batch` (sweeps); argument conversions in `convert`, errors in
 //! `errors`.
 
 use pyo3::prelude::*;
 
+mod batch;
+mod callbacks;
 mod compliance;
 mod convert;
 mod errors;
@@ -30,6 +32,19 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "ConvergenceError",
         m.py().get_type::<errors::ConvergenceError>(),
     )?;
+    m.add(
+        "TargetUnreachableError",
+        m.py().get_type::<errors::TargetUnreachableError>(),
+    )?;
+    m.add("ParameterTypeError", errors::parameter_type_error(m.py())?)?;
+    m.add("InternalError", m.py().get_type::<errors::InternalError>())?;
+    m.add("MAX_SAMPLES", softrod::limits::MAX_SAMPLES)?;
+    m.add("MAX_ITERATIONS", softrod::limits::MAX_ITERATIONS)?;
+    m.add("MAX_LOAD_NUMBER", softrod::limits::MAX_LOAD_NUMBER)?;
+    m.add("MAX_LENGTH", softrod::limits::MAX_LENGTH)?;
+    m.add("MAX_MODULUS", softrod::limits::MAX_MODULUS)?;
+    m.add("MAX_BENDING_ANGLE", softrod::limits::MAX_BENDING_ANGLE)?;
+    m.add("MAX_OFFSET_RATIO", softrod::limits::MAX_OFFSET_RATIO)?;
     m.add(
         "StabilityWarning",
         m.py().get_type::<errors::StabilityWarning>(),
@@ -78,6 +93,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compliance::tangent_compliance, m)?)?;
     m.add_function(wrap_pyfunction!(compliance::eigenscrews, m)?)?;
     m.add_function(wrap_pyfunction!(compliance::_workspace_map, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::_sweep, m)?)?;
     m.add_class::<pcc::PccRobot>()?;
     m.add_class::<pcc::PccSolution>()?;
     m.add_function(wrap_pyfunction!(pcc::pcc_solve, m)?)?;

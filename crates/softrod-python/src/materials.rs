@@ -7,7 +7,7 @@
 //! `ParameterError` naming the argument and its index, e.g. `stretch[2]`.
 
 use numpy::ndarray::{ArrayD, Dimension};
-use numpy::{AllowTypeChange, IntoPyArray, PyArrayLike1, PyArrayLikeDyn};
+use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -17,15 +17,13 @@ use softrod::model::material::fit::{
 };
 use softrod::{Error, UniaxialLaw as _, UniaxialModel};
 
+use crate::convert::{arg, count, Floats, Values};
 use crate::errors::{param_err, to_py_err};
 
 /// Yeoh terms fitted when `terms` is not given.
 const DEFAULT_YEOH_TERMS: usize = 3;
 /// Ogden terms fitted when `terms` is not given.
 const DEFAULT_OGDEN_TERMS: usize = 2;
-
-/// Numbers in: a float, anything `numpy.asarray(x, dtype=float)` accepts.
-type Values<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
 /// Appends the element index to the parameter name of an `InvalidParameter` error.
 fn at_index(e: Error, index: &[usize]) -> Error {
@@ -49,10 +47,10 @@ fn at_index(e: Error, index: &[usize]) -> Error {
 /// Applies `f` to every element: a 0-d input gives a float, an array an array of its shape.
 fn map_values(
     py: Python<'_>,
-    values: &Values<'_>,
+    values: &Values,
     f: impl Fn(f64) -> softrod::Result<f64>,
 ) -> PyResult<Py<PyAny>> {
-    let view = values.as_array();
+    let view = values.0.view();
     if view.ndim() == 0 {
         let x = view.iter().next().copied().unwrap_or(f64::NAN);
         let y = f(x).map_err(to_py_err)?;
@@ -133,19 +131,35 @@ pub(crate) struct PyUniaxialLaw {
 impl PyUniaxialLaw {
     /// Nominal (engineering) stress `P(λ)`, force per undeformed area (Pa); same shape as
     /// `stretch`.
-    fn nominal_stress(&self, py: Python<'_>, stretch: Values<'_>) -> PyResult<Py<PyAny>> {
+    fn nominal_stress(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::stretch)] stretch: Values,
+    ) -> PyResult<Py<PyAny>> {
         map_values(py, &stretch, |x| self.inner.nominal_stress(x))
     }
     /// True (Cauchy) stress `σ(λ) = λ P(λ)`, force per deformed area (Pa).
-    fn true_stress(&self, py: Python<'_>, stretch: Values<'_>) -> PyResult<Py<PyAny>> {
+    fn true_stress(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::stretch)] stretch: Values,
+    ) -> PyResult<Py<PyAny>> {
         map_values(py, &stretch, |x| self.inner.true_stress(x))
     }
     /// Tangent modulus `dσ/dε` at engineering strain `ε = λ − 1` (Pa).
-    fn tangent_modulus(&self, py: Python<'_>, strain: Values<'_>) -> PyResult<Py<PyAny>> {
+    fn tangent_modulus(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::strain)] strain: Values,
+    ) -> PyResult<Py<PyAny>> {
         map_values(py, &strain, |x| self.inner.tangent_modulus(x))
     }
     /// Slope `dP/dλ` of the nominal stress (Pa).
-    fn nominal_tangent(&self, py: Python<'_>, stretch: Values<'_>) -> PyResult<Py<PyAny>> {
+    fn nominal_tangent(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::stretch)] stretch: Values,
+    ) -> PyResult<Py<PyAny>> {
         map_values(py, &stretch, |x| self.inner.nominal_tangent(x))
     }
     /// Stretch at which the nominal stress equals `nominal_stress` (Pa): the inverse of
@@ -153,14 +167,18 @@ impl PyUniaxialLaw {
     fn stretch_from_nominal_stress(
         &self,
         py: Python<'_>,
-        nominal_stress: Values<'_>,
+        #[pyo3(from_py_with = arg::nominal_stress)] nominal_stress: Values,
     ) -> PyResult<Py<PyAny>> {
         map_values(py, &nominal_stress, |x| {
             self.inner.stretch_from_nominal_stress(x)
         })
     }
     /// Raises `ParameterError` unless `dP/dλ > 0` on `[stretch_min, stretch_max]`.
-    fn check_stable(&self, stretch_min: f64, stretch_max: f64) -> PyResult<()> {
+    fn check_stable(
+        &self,
+        #[pyo3(from_py_with = arg::stretch_min)] stretch_min: f64,
+        #[pyo3(from_py_with = arg::stretch_max)] stretch_max: f64,
+    ) -> PyResult<()> {
         self.inner
             .check_stable(stretch_min, stretch_max)
             .map_err(to_py_err)
@@ -210,7 +228,9 @@ pub(crate) struct Hookean {
 #[pymethods]
 impl Hookean {
     #[new]
-    fn new(youngs_modulus: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        #[pyo3(from_py_with = arg::youngs_modulus)] youngs_modulus: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let law = softrod::Hookean::new(youngs_modulus).map_err(to_py_err)?;
         Ok(
             PyClassInitializer::from(PyUniaxialLaw { inner: law.into() })
@@ -240,14 +260,21 @@ impl Linearised {
 #[pymethods]
 impl Linearised {
     #[new]
-    fn new(secant_modulus: f64, reference_strain: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        #[pyo3(from_py_with = arg::secant_modulus)] secant_modulus: f64,
+        #[pyo3(from_py_with = arg::reference_strain)] reference_strain: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let law = softrod::Linearised::new(secant_modulus, reference_strain).map_err(to_py_err)?;
         Ok(Self::init(law))
     }
     /// From one datasheet point: nominal stress (Pa) at engineering strain `strain` (e.g. the
     /// "100 % modulus" at `strain = 1`).
     #[staticmethod]
-    fn from_secant_point(py: Python<'_>, nominal_stress: f64, strain: f64) -> PyResult<Py<Self>> {
+    fn from_secant_point(
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::nominal_stress)] nominal_stress: f64,
+        #[pyo3(from_py_with = arg::strain)] strain: f64,
+    ) -> PyResult<Py<Self>> {
         let law =
             softrod::Linearised::from_secant_point(nominal_stress, strain).map_err(to_py_err)?;
         Py::new(py, Self::init(law))
@@ -275,7 +302,7 @@ pub(crate) struct NeoHookean {
 #[pymethods]
 impl NeoHookean {
     #[new]
-    fn new(mu: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(#[pyo3(from_py_with = arg::mu)] mu: f64) -> PyResult<PyClassInitializer<Self>> {
         let law = softrod::NeoHookean::new(mu).map_err(to_py_err)?;
         Ok(
             PyClassInitializer::from(PyUniaxialLaw { inner: law.into() })
@@ -300,7 +327,10 @@ pub(crate) struct MooneyRivlin {
 #[pymethods]
 impl MooneyRivlin {
     #[new]
-    fn new(c10: f64, c01: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        #[pyo3(from_py_with = arg::c10)] c10: f64,
+        #[pyo3(from_py_with = arg::c01)] c01: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let law = softrod::MooneyRivlin::new(c10, c01).map_err(to_py_err)?;
         Ok(
             PyClassInitializer::from(PyUniaxialLaw { inner: law.into() })
@@ -331,7 +361,11 @@ pub(crate) struct Yeoh {
 impl Yeoh {
     #[new]
     #[pyo3(signature = (c10, c20=0.0, c30=0.0))]
-    fn new(c10: f64, c20: f64, c30: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        #[pyo3(from_py_with = arg::c10)] c10: f64,
+        #[pyo3(from_py_with = arg::c20)] c20: f64,
+        #[pyo3(from_py_with = arg::c30)] c30: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let law = softrod::Yeoh::new(c10, c20, c30).map_err(to_py_err)?;
         Ok(
             PyClassInitializer::from(PyUniaxialLaw { inner: law.into() })
@@ -366,10 +400,10 @@ pub(crate) struct Ogden {
 impl Ogden {
     #[new]
     fn new(
-        mu: PyArrayLike1<'_, f64, AllowTypeChange>,
-        alpha: PyArrayLike1<'_, f64, AllowTypeChange>,
+        #[pyo3(from_py_with = arg::mu)] mu: Floats,
+        #[pyo3(from_py_with = arg::alpha)] alpha: Floats,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let (mu, alpha) = (mu.as_array().to_vec(), alpha.as_array().to_vec());
+        let (mu, alpha) = (mu.0, alpha.0);
         let law = softrod::Ogden::new(&mu, &alpha).map_err(to_py_err)?;
         Ok(PyClassInitializer::from(PyUniaxialLaw {
             inner: law.clone().into(),
@@ -533,35 +567,45 @@ fn parse_stress_measure(name: &str) -> PyResult<(StressMeasure, &'static str)> {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_uniaxial(
     py: Python<'_>,
-    strain: PyArrayLike1<'_, f64, AllowTypeChange>,
-    stress: PyArrayLike1<'_, f64, AllowTypeChange>,
-    model: &str,
-    strain_measure: &str,
-    stress_measure: &str,
-    terms: Option<i64>,
-    nonnegative: bool,
-    stretch_range: Option<(f64, f64)>,
-    max_iterations: Option<i64>,
-    tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::strain)] strain: Vec<f64>,
+    #[pyo3(from_py_with = arg::stress)] stress: Vec<f64>,
+    #[pyo3(from_py_with = arg::model)] model: &str,
+    #[pyo3(from_py_with = arg::strain_measure)] strain_measure: &str,
+    #[pyo3(from_py_with = arg::stress_measure)] stress_measure: &str,
+    #[pyo3(from_py_with = arg::terms)] terms: Option<i64>,
+    #[pyo3(from_py_with = arg::nonnegative)] nonnegative: bool,
+    #[pyo3(from_py_with = arg::stretch_range)] stretch_range: Option<(f64, f64)>,
+    #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
 ) -> PyResult<UniaxialFit> {
     let kind = model_kind(model, terms)?;
     let strain_m = parse_strain_measure(strain_measure)?;
     let (stress_m, stress_name) = parse_stress_measure(stress_measure)?;
     let defaults = FitOptions::default();
-    let max_iterations = match max_iterations {
-        None => defaults.max_iterations,
-        Some(n) if n >= 1 => n as usize,
-        Some(n) => return Err(param_err("max_iterations", n, ">= 1")),
-    };
+    let max_iterations = max_iterations.map_or(Ok(defaults.max_iterations), |n| {
+        count("max_iterations", n, 1, softrod::limits::MAX_ITERATIONS)
+    })?;
     let options = FitOptions {
         nonnegative,
         max_iterations,
         tolerance: tolerance.unwrap_or(defaults.tolerance),
     };
-    let (strain, stress) = (strain.as_array().to_vec(), stress.as_array().to_vec());
+
     let mut data = UniaxialData::new(&strain, strain_m, &stress, stress_m).map_err(to_py_err)?;
     if let Some((lo, hi)) = stretch_range {
-        data = data.within(lo, hi).map_err(to_py_err)?;
+        data = data.within(lo, hi).map_err(|e| match e {
+            // The range is one argument here: say so.
+            Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => to_py_err(Error::InvalidParameter {
+                name,
+                value,
+                expected: format!("{expected} (stretch_range = (stretch_min, stretch_max))"),
+            }),
+            other => to_py_err(other),
+        })?;
     }
     let range = (data.stretch_min(), data.stretch_max());
     let fit = py
@@ -597,13 +641,13 @@ pub(crate) fn fit_uniaxial(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _uniaxial_fit(
     law: &Bound<'_, PyUniaxialLaw>,
-    rms: f64,
-    r_squared: f64,
-    max_abs_residual: f64,
-    points: usize,
-    iterations: usize,
-    stress_measure: &str,
-    stretch_range: (f64, f64),
+    #[pyo3(from_py_with = arg::rms)] rms: f64,
+    #[pyo3(from_py_with = arg::r_squared)] r_squared: f64,
+    #[pyo3(from_py_with = arg::max_abs_residual)] max_abs_residual: f64,
+    #[pyo3(from_py_with = arg::points)] points: usize,
+    #[pyo3(from_py_with = arg::iterations)] iterations: usize,
+    #[pyo3(from_py_with = arg::stress_measure)] stress_measure: &str,
+    #[pyo3(from_py_with = arg::stretch_range)] stretch_range: (f64, f64),
 ) -> PyResult<UniaxialFit> {
     let stress_measure = match stress_measure {
         "nominal" => "nominal",
@@ -689,7 +733,7 @@ impl Silicone {
 ///
 /// Raises `ParameterError` naming `name` for an unknown silicone; the laws are in Pa.
 #[pyfunction]
-pub(crate) fn silicone(name: &str) -> PyResult<Silicone> {
+pub(crate) fn silicone(#[pyo3(from_py_with = arg::name)] name: &str) -> PyResult<Silicone> {
     let inner = softrod::Silicone::from_name(name).map_err(to_py_err)?;
     Ok(Silicone { inner })
 }

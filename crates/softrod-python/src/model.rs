@@ -7,9 +7,10 @@
 //! built by the same validated constructor and solves bit for bit identically. Python
 //! callables (rest strains, offsets, section functions, areas, distributed loads) pickle when
 //! they do (module-level functions). They are called from the solver with the GIL
-//! re-acquired; an exception they raise is kept and re-raised once the solve returns.
+//! re-acquired; an exception they raise reaches the caller of the computation that called
+//! them (see `callbacks.rs`). Every argument is converted by `convert.rs`, naming it.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use numpy::ndarray::Array;
 use numpy::{IntoPyArray, PyArray2};
@@ -19,49 +20,10 @@ use pyo3::IntoPyObjectExt;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 
-use crate::convert::{frame_from, pair, pose, vec3};
-use crate::errors::{param_err, to_py_err};
+use crate::callbacks::{run_attached, Callback};
+use crate::convert::{arg, frame_from, pair, pose, vec3};
+use crate::errors::{param_err, to_py_err, type_err};
 use crate::sections::{material_of, PySection};
-
-/// Where an exception raised by a Python callable waits until the solve returns.
-#[derive(Clone, Default)]
-pub(crate) struct ErrorSlot(Arc<Mutex<Option<PyErr>>>);
-
-impl ErrorSlot {
-    fn keep(&self, err: PyErr) {
-        if let Ok(mut slot) = self.0.lock() {
-            if slot.is_none() {
-                *slot = Some(err);
-            }
-        }
-    }
-    pub(crate) fn take(&self) -> Option<PyErr> {
-        self.0.lock().ok().and_then(|mut s| s.take())
-    }
-}
-
-/// Calls `f(s)` and extracts `T`; on failure keeps the error and returns `fallback`.
-pub(crate) fn call_py<T: for<'a, 'py> FromPyObjectOwned<'py>>(
-    f: &Py<PyAny>,
-    slot: &ErrorSlot,
-    s: f64,
-    what: &'static str,
-    fallback: T,
-) -> T {
-    Python::attach(|py| {
-        match f
-            .call1(py, (s,))
-            .and_then(|r| r.extract::<T>(py).map_err(Into::into))
-        {
-            Ok(v) => v,
-            Err(e) => {
-                let msg = format!("{what} raised or returned a bad value at s = {s}: {e}");
-                slot.keep(pyo3::exceptions::PyValueError::new_err(msg));
-                fallback
-            }
-        }
-    })
-}
 
 /// The constructor arguments of an object, for its properties and for pickling.
 pub(crate) struct Args(Py<PyDict>);
@@ -125,17 +87,26 @@ where
 /// A 3-vector argument (constant) or a Python function of `s`, as a core profile.
 fn profile(
     arg: &Bound<'_, PyAny>,
-    slot: &ErrorSlot,
     what: &'static str,
+    label: &'static str,
 ) -> PyResult<softrod::Profile> {
     if arg.is_callable() {
-        let f = arg.clone().unbind();
-        let slot = slot.clone();
+        let cb = Callback::new(arg.clone().unbind(), what, label);
         return Ok(softrod::Profile::Function(Arc::new(move |s| {
-            Vector3::from(call_py::<[f64; 3]>(&f, &slot, s, what, [f64::NAN; 3]))
+            Vector3::from(cb.floats::<3>(s))
         })));
     }
     Ok(softrod::Profile::Constant(vec3(arg, what)?))
+}
+
+/// Checks a function profile once at `s = 0` (a function of the loads, whose rod is not known
+/// yet); a constant was checked on conversion.
+fn check_at_zero(name: &str, p: &softrod::Profile) -> softrod::Result<()> {
+    let v = p.at(0.0);
+    for k in 0..3 {
+        softrod::error::check_finite(&format!("{name}(0)[{k}]"), v[k])?;
+    }
+    Ok(())
 }
 
 // ----------------------------------------------------------------------------------- rod
@@ -148,7 +119,6 @@ fn profile(
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Rod {
     pub(crate) inner: softrod::Rod,
-    pub(crate) slots: Vec<ErrorSlot>,
     args: Args,
 }
 
@@ -160,43 +130,53 @@ impl Rod {
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
-        length: f64,
-        section: &Bound<'_, PySection>,
+        #[pyo3(from_py_with = arg::length)] length: f64,
+        #[pyo3(from_py_with = arg::section)] section: Bound<'_, PySection>,
         material: &Bound<'_, PyAny>,
         rest_strain: Option<&Bound<'_, PyAny>>,
         rest_curvature: Option<&Bound<'_, PyAny>>,
-        inextensible: bool,
-        density: Option<f64>,
+        #[pyo3(from_py_with = arg::inextensible)] inextensible: bool,
+        #[pyo3(from_py_with = arg::density)] density: Option<f64>,
         base_pose: Option<&Bound<'_, PyAny>>,
-        shear_coefficient: Option<f64>,
+        #[pyo3(from_py_with = arg::shear_coefficient)] shear_coefficient: Option<f64>,
     ) -> PyResult<Self> {
-        let slot = ErrorSlot::default();
-        let sec = section.get();
-        let mut rod = softrod::Rod::new(length, sec.inner.clone(), material_of(material)?)
-            .map_err(to_py_err)?;
-        if let Some(v) = rest_strain {
-            rod = rod
-                .with_rest_strain(profile(v, &slot, "rest_strain")?)
-                .map_err(to_py_err)?;
-        }
-        if let Some(u) = rest_curvature {
-            rod = rod
-                .with_rest_curvature(profile(u, &slot, "rest_curvature")?)
-                .map_err(to_py_err)?;
-        }
-        rod = rod.with_inextensible(inextensible);
-        if let Some(rho) = density {
-            rod = rod.with_density(rho).map_err(to_py_err)?;
-        }
-        if let Some(k) = shear_coefficient {
-            rod = rod.with_shear_coefficient(k).map_err(to_py_err)?;
-        }
-        if let Some(p) = base_pose {
-            let (p, r) = pose(p, "base_pose")?;
-            let rot = Matrix3::from_fn(|i, j| r[i][j]);
-            let pose = softrod::Pose::new(Vector3::from(p), rot).map_err(to_py_err)?;
-            rod = rod.with_base_pose(pose);
-        }
+        let sec = section.get().inner.clone();
+        let material_core = material_of(material)?;
+        let rest_strain_p = rest_strain
+            .map(|v| profile(v, "rest_strain", "the rest strain"))
+            .transpose()?;
+        let rest_curvature_p = rest_curvature
+            .map(|u| profile(u, "rest_curvature", "the rest curvature"))
+            .transpose()?;
+        let pose = match base_pose {
+            Some(p) => {
+                let (p, r) = pose(p, "base_pose")?;
+                let rot = Matrix3::from_fn(|i, j| r[i][j]);
+                Some(softrod::Pose::new(Vector3::from(p), rot).map_err(to_py_err)?)
+            }
+            None => None,
+        };
+        // The profiles' functions are called here (checked on the rod's length).
+        let rod = run_attached("Rod", || {
+            let mut rod = softrod::Rod::new(length, sec, material_core)?;
+            if let Some(v) = rest_strain_p {
+                rod = rod.with_rest_strain(v)?;
+            }
+            if let Some(u) = rest_curvature_p {
+                rod = rod.with_rest_curvature(u)?;
+            }
+            rod = rod.with_inextensible(inextensible);
+            if let Some(rho) = density {
+                rod = rod.with_density(rho)?;
+            }
+            if let Some(k) = shear_coefficient {
+                rod = rod.with_shear_coefficient(k)?;
+            }
+            if let Some(pose) = pose {
+                rod = rod.with_base_pose(pose);
+            }
+            Ok(rod)
+        })?;
         let none = || py.None();
         let opt = |v: Option<&Bound<'_, PyAny>>| v.map_or_else(none, |b| b.clone().unbind());
         let args = Args::new(
@@ -213,11 +193,7 @@ impl Rod {
                 ("shear_coefficient", obj(py, shear_coefficient)?),
             ],
         )?;
-        Ok(Self {
-            inner: rod,
-            slots: vec![slot, sec.slot.clone()],
-            args,
-        })
+        Ok(Self { inner: rod, args })
     }
 
     /// Length (m).
@@ -297,19 +273,18 @@ impl Rod {
 pub(crate) struct Tendon {
     pub(crate) inner: softrod::Tendon,
     pub(crate) tension: f64,
-    pub(crate) slot: ErrorSlot,
     /// How to rebuild it: the constructor (the class or a static factory) and its arguments.
     factory: &'static str,
     args: Args,
 }
 
 fn offset_fn(
-    f: Py<PyAny>,
-    slot: &ErrorSlot,
+    f: &Bound<'_, PyAny>,
     what: &'static str,
+    label: &'static str,
 ) -> softrod::model::tendon::OffsetFn {
-    let slot = slot.clone();
-    Arc::new(move |s| call_py::<[f64; 2]>(&f, &slot, s, what, [f64::NAN; 2]))
+    let cb = Callback::new(f.clone().unbind(), what, label);
+    Arc::new(move |s| cb.floats::<2>(s))
 }
 
 fn check_tension(tension: f64) -> PyResult<f64> {
@@ -325,27 +300,23 @@ impl Tendon {
     fn new(
         py: Python<'_>,
         offset: &Bound<'_, PyAny>,
-        tension: f64,
-        end: Option<f64>,
+        #[pyo3(from_py_with = arg::tension)] tension: f64,
+        #[pyo3(from_py_with = arg::end)] end: Option<f64>,
         derivative: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let slot = ErrorSlot::default();
+        let derivative = derivative.filter(|d| !d.is_none());
         let routing = match (offset.is_callable(), derivative) {
             (false, None) => softrod::Routing::Constant(pair(offset, "offset")?),
-            (false, Some(_)) => {
-                return Err(param_err(
-                    "derivative",
-                    "<function>",
-                    "None for a constant offset",
-                ))
+            (false, Some(d)) => {
+                return Err(type_err("derivative", d, "None for a constant offset"))
             }
             (true, Some(df)) => {
                 if !df.is_callable() {
-                    return Err(param_err("derivative", "<object>", "a function of s"));
+                    return Err(type_err("derivative", df, "a function of s"));
                 }
                 softrod::Routing::Function {
-                    offset: offset_fn(offset.clone().unbind(), &slot, "tendon offset"),
-                    derivative: offset_fn(df.clone().unbind(), &slot, "tendon offset derivative"),
+                    offset: offset_fn(offset, "offset", "the tendon offset"),
+                    derivative: offset_fn(df, "derivative", "the tendon offset derivative"),
                 }
             }
             (true, None) => {
@@ -356,8 +327,18 @@ impl Tendon {
                 ))
             }
         };
-        let inner = softrod::Tendon::new(routing, end).map_err(to_py_err)?;
         let tension = check_tension(tension)?;
+        let inner = run_attached("Tendon", || {
+            if let softrod::Routing::Function { offset, derivative } = &routing {
+                // Called once here (the rod, hence the range of s, is not known yet).
+                for (name, f) in [("offset", offset), ("derivative", derivative)] {
+                    for (k, v) in f(0.0).iter().enumerate() {
+                        softrod::error::check_finite(&format!("{name}(0)[{k}]"), *v)?;
+                    }
+                }
+            }
+            softrod::Tendon::new(routing, end)
+        })?;
         let args = Args::new(
             py,
             &[
@@ -373,7 +354,6 @@ impl Tendon {
         Ok(Self {
             inner,
             tension,
-            slot,
             factory: "",
             args,
         })
@@ -385,10 +365,10 @@ impl Tendon {
     #[pyo3(signature = (ratio, angle, tension, end=None))]
     fn radius_proportional(
         py: Python<'_>,
-        ratio: f64,
-        angle: f64,
-        tension: f64,
-        end: Option<f64>,
+        #[pyo3(from_py_with = arg::ratio)] ratio: f64,
+        #[pyo3(from_py_with = arg::angle)] angle: f64,
+        #[pyo3(from_py_with = arg::tension)] tension: f64,
+        #[pyo3(from_py_with = arg::end)] end: Option<f64>,
     ) -> PyResult<Self> {
         let inner =
             softrod::Tendon::new(softrod::Routing::RadiusProportional { ratio, angle }, end)
@@ -406,7 +386,6 @@ impl Tendon {
         Ok(Self {
             inner,
             tension,
-            slot: ErrorSlot::default(),
             factory: "radius_proportional",
             args,
         })
@@ -418,11 +397,11 @@ impl Tendon {
     #[pyo3(signature = (radius, pitch, tension, phase=0.0, end=None))]
     fn helical(
         py: Python<'_>,
-        radius: f64,
-        pitch: f64,
-        tension: f64,
-        phase: f64,
-        end: Option<f64>,
+        #[pyo3(from_py_with = arg::radius)] radius: f64,
+        #[pyo3(from_py_with = arg::pitch)] pitch: f64,
+        #[pyo3(from_py_with = arg::tension)] tension: f64,
+        #[pyo3(from_py_with = arg::phase)] phase: f64,
+        #[pyo3(from_py_with = arg::end)] end: Option<f64>,
     ) -> PyResult<Self> {
         let inner = softrod::Tendon::new(
             softrod::Routing::Helical {
@@ -447,21 +426,23 @@ impl Tendon {
         Ok(Self {
             inner,
             tension,
-            slot: ErrorSlot::default(),
             factory: "helical",
             args,
         })
     }
 
     /// The same tendon with another tension (N).
-    fn with_tension(&self, py: Python<'_>, tension: f64) -> PyResult<Self> {
+    fn with_tension(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::tension)] tension: f64,
+    ) -> PyResult<Self> {
         let tension = check_tension(tension)?;
         let args = Args(self.args.0.bind(py).copy()?.unbind());
         args.0.bind(py).set_item("tension", tension)?;
         Ok(Self {
             inner: self.inner.clone(),
             tension,
-            slot: self.slot.clone(),
             factory: self.factory,
             args,
         })
@@ -521,7 +502,6 @@ impl Tendon {
 pub(crate) struct Chamber {
     pub(crate) inner: softrod::Chamber,
     pub(crate) pressure: f64,
-    pub(crate) slot: ErrorSlot,
     args: Args,
 }
 
@@ -531,29 +511,32 @@ impl Chamber {
     #[pyo3(signature = (pressure, area, offset, start=0.0, end=None))]
     fn new(
         py: Python<'_>,
-        pressure: f64,
+        #[pyo3(from_py_with = arg::pressure)] pressure: f64,
         area: &Bound<'_, PyAny>,
         offset: &Bound<'_, PyAny>,
-        start: f64,
-        end: Option<f64>,
+        #[pyo3(from_py_with = arg::start)] start: f64,
+        #[pyo3(from_py_with = arg::end)] end: Option<f64>,
     ) -> PyResult<Self> {
-        let slot = ErrorSlot::default();
         let pressure =
             softrod::model::chamber::check_pressure("pressure", pressure).map_err(to_py_err)?;
         let a = if area.is_callable() {
-            let f = area.clone().unbind();
-            let slot = slot.clone();
-            softrod::ChamberArea::Function(Arc::new(move |s| {
-                call_py::<f64>(&f, &slot, s, "chamber area", f64::NAN)
-            }))
+            let cb = Callback::new(area.clone().unbind(), "area", "the chamber area");
+            softrod::ChamberArea::Function(Arc::new(move |s| cb.float(s)))
         } else {
-            let v: f64 = area
-                .extract()
-                .map_err(|_| param_err("area", "<object>", "a number (m^2) or a function of s"))?;
+            let v: f64 = crate::convert::Arg::from_arg(area, "area")
+                .map_err(|_| type_err("area", area, "a number (m^2) or a function of s"))?;
             softrod::ChamberArea::Constant(v)
         };
-        let inner =
-            softrod::Chamber::new(a, pair(offset, "offset")?, start, end).map_err(to_py_err)?;
+        let offset_xy = pair(offset, "offset")?;
+        let inner = run_attached("Chamber", || {
+            let c = softrod::Chamber::new(a, offset_xy, start, end)?;
+            if let softrod::ChamberArea::Function(_) = c.area() {
+                // Called once here (the rod, hence the chamber's extent, is not known yet);
+                // its values are checked with the rod (`chambers[i].area(s)`).
+                softrod::error::check_finite(&format!("area({start})"), c.area_at(start))?;
+            }
+            Ok(c)
+        })?;
         let args = Args::new(
             py,
             &[
@@ -567,13 +550,16 @@ impl Chamber {
         Ok(Self {
             inner,
             pressure,
-            slot,
             args,
         })
     }
 
     /// The same chamber at another gauge pressure (Pa).
-    fn with_pressure(&self, py: Python<'_>, pressure: f64) -> PyResult<Self> {
+    fn with_pressure(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::pressure)] pressure: f64,
+    ) -> PyResult<Self> {
         let pressure =
             softrod::model::chamber::check_pressure("pressure", pressure).map_err(to_py_err)?;
         let args = Args(self.args.0.bind(py).copy()?.unbind());
@@ -581,7 +567,6 @@ impl Chamber {
         Ok(Self {
             inner: self.inner.clone(),
             pressure,
-            slot: self.slot.clone(),
             args,
         })
     }
@@ -596,8 +581,22 @@ impl Chamber {
         self.args.get(py, "area")
     }
     /// Cross-section area at arc length `s` (m^2).
-    fn area_at(&self, s: f64) -> f64 {
-        self.inner.area_at(s)
+    ///
+    /// Raises `ParameterError` naming `s` outside `[start, end]`, or `area(s)` if the area is
+    /// not finite and > 0 there.
+    fn area_at(&self, #[pyo3(from_py_with = arg::s)] s: f64) -> PyResult<f64> {
+        let c = &self.inner;
+        run_attached("Chamber.area_at", || {
+            let end = c.end().unwrap_or(f64::INFINITY);
+            if !(s.is_finite() && s >= c.start() && s <= end) {
+                return Err(softrod::Error::invalid(
+                    "s",
+                    s,
+                    format!("finite and in [start, end] = [{}, {end}] m", c.start()),
+                ));
+            }
+            softrod::error::check_positive(&format!("area({s})"), c.area_at(s), "m^2")
+        })
     }
     /// Centroid offset (x, y) (m, body frame).
     #[getter]
@@ -646,20 +645,20 @@ impl PointLoad {
     #[new]
     #[pyo3(signature = (s, force=None, moment=None, frame="world"))]
     fn new(
-        s: f64,
+        #[pyo3(from_py_with = arg::s)] s: f64,
         force: Option<&Bound<'_, PyAny>>,
         moment: Option<&Bound<'_, PyAny>>,
-        frame: &str,
+        #[pyo3(from_py_with = arg::frame)] frame: &str,
     ) -> PyResult<Self> {
         let v = |a: Option<&Bound<'_, PyAny>>, n| a.map_or(Ok(Vector3::zeros()), |a| vec3(a, n));
-        Ok(Self {
-            inner: softrod::PointLoad {
-                s,
-                force: v(force, "force")?,
-                moment: v(moment, "moment")?,
-                frame: frame_from("frame", frame)?,
-            },
-        })
+        let inner = softrod::PointLoad::new(
+            s,
+            v(force, "force")?,
+            v(moment, "moment")?,
+            frame_from("frame", frame)?,
+        )
+        .map_err(to_py_err)?;
+        Ok(Self { inner })
     }
     /// Arc length (m).
     #[getter]
@@ -709,7 +708,6 @@ impl PointLoad {
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct Loads {
     pub(crate) inner: softrod::Loads,
-    pub(crate) slot: ErrorSlot,
     args: Args,
 }
 
@@ -724,12 +722,11 @@ impl Loads {
         tip_force: Option<&Bound<'_, PyAny>>,
         tip_moment: Option<&Bound<'_, PyAny>>,
         gravity: Option<&Bound<'_, PyAny>>,
-        tip_frame: &str,
-        point_loads: Vec<Bound<'_, PointLoad>>,
+        #[pyo3(from_py_with = arg::tip_frame)] tip_frame: &str,
+        #[pyo3(from_py_with = arg::point_loads)] point_loads: Vec<Bound<'_, PointLoad>>,
         distributed_force: Option<&Bound<'_, PyAny>>,
         distributed_moment: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let slot = ErrorSlot::default();
         let v = |a: Option<&Bound<'_, PyAny>>, n| a.map_or(Ok(Vector3::zeros()), |a| vec3(a, n));
         let inner = softrod::Loads {
             tip_force: v(tip_force, "tip_force")?,
@@ -737,13 +734,25 @@ impl Loads {
             tip_frame: frame_from("tip_frame", tip_frame)?,
             point_loads: point_loads.iter().map(|p| p.get().inner).collect(),
             distributed_force: distributed_force
-                .map(|f| profile(f, &slot, "distributed_force"))
+                .map(|f| profile(f, "distributed_force", "the distributed force"))
                 .transpose()?,
             distributed_moment: distributed_moment
-                .map(|f| profile(f, &slot, "distributed_moment"))
+                .map(|f| profile(f, "distributed_moment", "the distributed moment"))
                 .transpose()?,
             gravity: v(gravity, "gravity")?,
         };
+        run_attached("Loads", || {
+            inner.check_values()?;
+            for (name, f) in [
+                ("distributed_force", &inner.distributed_force),
+                ("distributed_moment", &inner.distributed_moment),
+            ] {
+                if let Some(p) = f {
+                    check_at_zero(name, p)?;
+                }
+            }
+            Ok(())
+        })?;
         let opt =
             |a: Option<&Bound<'_, PyAny>>| a.map_or_else(|| py.None(), |b| b.clone().unbind());
         let args = Args::new(
@@ -758,7 +767,7 @@ impl Loads {
                 ("distributed_moment", opt(distributed_moment)),
             ],
         )?;
-        Ok(Self { inner, slot, args })
+        Ok(Self { inner, args })
     }
     /// Tip force (N).
     #[getter]
@@ -803,5 +812,40 @@ impl Loads {
     }
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         slf.get().args.reduce(slf.py(), slf.get_type().into_any())
+    }
+}
+
+fn is_function(p: &softrod::Profile) -> bool {
+    matches!(p, softrod::Profile::Function(_))
+}
+
+impl Rod {
+    /// Whether a Python callable is part of the rod (section, rest strain or curvature).
+    pub(crate) fn has_callables(&self) -> bool {
+        let r = &self.inner;
+        r.section().is_function() || is_function(r.rest_strain()) || is_function(r.rest_curvature())
+    }
+}
+
+impl Tendon {
+    /// Whether the routing is a Python callable.
+    pub(crate) fn has_callables(&self) -> bool {
+        matches!(self.inner.routing(), softrod::Routing::Function { .. })
+    }
+}
+
+impl Chamber {
+    /// Whether the area is a Python callable.
+    pub(crate) fn has_callables(&self) -> bool {
+        matches!(self.inner.area(), softrod::ChamberArea::Function(_))
+    }
+}
+
+impl Loads {
+    /// Whether a distributed load is a Python callable.
+    pub(crate) fn has_callables(&self) -> bool {
+        let l = &self.inner;
+        l.distributed_force.as_ref().is_some_and(is_function)
+            || l.distributed_moment.as_ref().is_some_and(is_function)
     }
 }

@@ -6,7 +6,7 @@
 //! `[translation; rotation]`.
 
 use numpy::ndarray::Array;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -14,9 +14,9 @@ use softrod::nalgebra::{Matrix4, Vector3};
 use softrod::pcc::statics::{self as statics, PccLoads, PccRobot as CoreRobot, PccSolveOptions};
 use softrod::pcc::{self, ArcCoordinates, ElasticSegment, JacobianFrame, PccSegment};
 
-use crate::errors::{param_err, to_py_err};
-
-use crate::convert::Floats;
+use crate::callbacks::run;
+use crate::convert::{arg, choice, count, Arg, Floats};
+use crate::errors::{blame, finite_result, param_err, to_py_err, type_err};
 
 /// A chamber group `(segment, areas, distances, angles)` (m², m, rad).
 type ChamberGroup = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
@@ -25,60 +25,75 @@ type ChamberGroup = (usize, Vec<f64>, Vec<f64>, Vec<f64>);
 const DEFAULT_FRAMES: usize = 50;
 
 fn frame_from(frame: &str) -> PyResult<JacobianFrame> {
-    match frame {
-        "spatial" => Ok(JacobianFrame::Spatial),
-        "body" => Ok(JacobianFrame::Body),
-        "hybrid" => Ok(JacobianFrame::Hybrid),
-        other => Err(param_err(
-            "frame",
-            other,
-            "\"spatial\", \"body\" or \"hybrid\"",
-        )),
-    }
+    Ok(
+        match choice("frame", frame, &["spatial", "body", "hybrid"])? {
+            "spatial" => JacobianFrame::Spatial,
+            "body" => JacobianFrame::Body,
+            _ => JacobianFrame::Hybrid,
+        },
+    )
 }
 
 fn coordinates_from(coordinates: &str) -> PyResult<ArcCoordinates> {
-    match coordinates {
-        "arc" => Ok(ArcCoordinates::Arc),
-        "curvature_vector" | "curvature-vector" => Ok(ArcCoordinates::CurvatureVector),
-        other => Err(param_err(
-            "coordinates",
-            other,
-            "\"arc\" or \"curvature_vector\"",
-        )),
-    }
+    let c = choice(
+        "coordinates",
+        coordinates,
+        &["arc", "curvature_vector", "curvature-vector"],
+    )?;
+    Ok(if c == "arc" {
+        ArcCoordinates::Arc
+    } else {
+        ArcCoordinates::CurvatureVector
+    })
 }
 
 /// Rows of three floats: an (n, 3) array or nested sequence (one row of 3 is accepted too).
 fn rows3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
-    let rows: Vec<Vec<f64>> = if let Ok(a) = obj.extract::<PyReadonlyArray2<'_, f64>>() {
-        a.as_array()
-            .rows()
-            .into_iter()
-            .map(|r| r.to_vec())
-            .collect()
-    } else if let Ok(v) = obj.extract::<Vec<Vec<f64>>>() {
-        v
-    } else if let Ok(v) = obj.extract::<Vec<f64>>() {
-        vec![v]
-    } else {
-        return Err(param_err(name, "<object>", "an (n, 3) array of floats"));
+    let what = "an (n, 3) array of rows (curvature, plane_angle, length)";
+    let a = match crate::convert::float_array(obj, name, what) {
+        Ok(a) => a,
+        Err(e) => {
+            // A ragged list: name the row that is not 3 numbers.
+            if let Ok(rows) = obj.cast::<pyo3::types::PyList>() {
+                for (i, row) in rows.iter().enumerate() {
+                    crate::convert::floats_n(
+                        &row,
+                        &format!("{name}[{i}]"),
+                        3,
+                        "a row of 3 numbers (curvature, plane_angle, length)",
+                    )?;
+                }
+            }
+            return Err(e);
+        }
     };
-    rows.iter()
-        .enumerate()
-        .map(|(i, r)| {
-            <[f64; 3]>::try_from(r.as_slice()).map_err(|_| {
-                param_err(
-                    &format!("{name}[{i}]"),
-                    format!("{r:?}"),
-                    "a row of 3 floats (curvature, plane_angle, length)",
-                )
-            })
-        })
-        .collect()
+    let a = match a.ndim() {
+        1 => a.insert_axis(numpy::ndarray::Axis(0)),
+        _ => a,
+    };
+    if a.ndim() != 2 || a.shape()[1] != 3 || a.shape()[0] == 0 {
+        return Err(type_err(name, obj, what));
+    }
+    Ok(a.outer_iter().map(|r| [r[0], r[1], r[2]]).collect())
 }
 
-fn vector3(v: Floats<'_>, name: &str) -> PyResult<Vector3<f64>> {
+/// The name of a core error prefixed: `segments[0].curvature` as `warm_start[0].curvature`.
+fn renamed(e: softrod::Error, from: &str, to: &str) -> softrod::Error {
+    match e {
+        softrod::Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => softrod::Error::InvalidParameter {
+            name: name.replacen(from, to, 1),
+            value,
+            expected,
+        },
+        other => other,
+    }
+}
+
+fn vector3(v: Floats, name: &str) -> PyResult<Vector3<f64>> {
     let v = v.to_vec()?;
     if v.len() != 3 {
         return Err(param_err(&format!("{name}.len()"), v.len(), "3 (x, y, z)"));
@@ -86,9 +101,10 @@ fn vector3(v: Floats<'_>, name: &str) -> PyResult<Vector3<f64>> {
     Ok(Vector3::new(v[0], v[1], v[2]))
 }
 
-fn arc3(arc: Floats<'_>, name: &str) -> PyResult<PccSegment> {
+fn arc3(arc: Floats, name: &str) -> PyResult<PccSegment> {
     let a = vector3(arc, name)?;
-    PccSegment::new(a[0], a[1], a[2]).map_err(to_py_err)
+    PccSegment::checked(a[0], a[1], a[2])
+        .map_err(|e| to_py_err(renamed(e, "", &format!("{name}."))))
 }
 
 fn segments_from(obj: &Bound<'_, PyAny>) -> PyResult<Vec<PccSegment>> {
@@ -126,11 +142,16 @@ fn arc_array<'py>(py: Python<'py>, s: &PccSegment) -> Bound<'py, PyArray1<f64>> 
 #[pyfunction]
 pub(crate) fn pcc_arc_pose(
     py: Python<'_>,
-    curvature: f64,
-    plane_angle: f64,
-    length: f64,
+    #[pyo3(from_py_with = arg::curvature)] curvature: f64,
+    #[pyo3(from_py_with = arg::plane_angle)] plane_angle: f64,
+    #[pyo3(from_py_with = arg::length)] length: f64,
 ) -> PyResult<Bound<'_, PyArray2<f64>>> {
-    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(to_py_err)?;
+    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(blame(&[
+        "curvature",
+        "plane_angle",
+        "length",
+    ]))?;
+    finite_result(t.iter(), &["curvature", "plane_angle", "length"])?;
     Ok(pose_array(py, &t))
 }
 
@@ -139,9 +160,9 @@ pub(crate) fn pcc_arc_pose(
 #[pyfunction]
 pub(crate) fn pcc_arc_poses<'py>(
     py: Python<'py>,
-    curvature: Floats<'py>,
-    plane_angle: Floats<'py>,
-    length: Floats<'py>,
+    #[pyo3(from_py_with = arg::curvature)] curvature: Floats,
+    #[pyo3(from_py_with = arg::plane_angle)] plane_angle: Floats,
+    #[pyo3(from_py_with = arg::length)] length: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let (k, p, l) = (curvature.to_vec()?, plane_angle.to_vec()?, length.to_vec()?);
     let n = k.len().max(p.len()).max(l.len());
@@ -150,7 +171,7 @@ pub(crate) fn pcc_arc_poses<'py>(
             return Err(param_err(
                 &format!("{name}.len()"),
                 v.len(),
-                &format!("1 or the common length {n}"),
+                &format!("1 or the common length {n} of curvature, plane_angle and length"),
             ));
         }
     }
@@ -158,18 +179,19 @@ pub(crate) fn pcc_arc_poses<'py>(
     let mut out = numpy::ndarray::Array3::<f64>::zeros((n, 4, 4));
     let result = py.detach(|| -> softrod::Result<()> {
         for i in 0..n {
-            let seg = PccSegment::new(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| match e {
-                softrod::Error::InvalidParameter {
-                    name,
-                    value,
-                    expected,
-                } => softrod::Error::InvalidParameter {
-                    name: format!("{name}[{i}]"),
-                    value,
-                    expected,
-                },
-                other => other,
-            })?;
+            let seg =
+                PccSegment::checked(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| match e {
+                    softrod::Error::InvalidParameter {
+                        name,
+                        value,
+                        expected,
+                    } => softrod::Error::InvalidParameter {
+                        name: format!("{name}[{i}]"),
+                        value,
+                        expected,
+                    },
+                    other => other,
+                })?;
             let t = seg.pose();
             for r in 0..4 {
                 for c in 0..4 {
@@ -179,7 +201,7 @@ pub(crate) fn pcc_arc_poses<'py>(
         }
         Ok(())
     });
-    result.map_err(to_py_err)?;
+    result.map_err(blame(&["curvature", "plane_angle", "length"]))?;
     Ok(out.into_pyarray(py))
 }
 
@@ -187,13 +209,22 @@ pub(crate) fn pcc_arc_poses<'py>(
 #[pyfunction]
 pub(crate) fn pcc_arc_frames<'py>(
     py: Python<'py>,
-    curvature: f64,
-    plane_angle: f64,
-    length: f64,
-    s: Floats<'py>,
+    #[pyo3(from_py_with = arg::curvature)] curvature: f64,
+    #[pyo3(from_py_with = arg::plane_angle)] plane_angle: f64,
+    #[pyo3(from_py_with = arg::length)] length: f64,
+    #[pyo3(from_py_with = arg::s)] s: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let s = s.to_vec()?;
-    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(to_py_err)?;
+    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(blame(&[
+        "curvature",
+        "plane_angle",
+        "length",
+        "s",
+    ]))?;
+    finite_result(
+        ts.iter().flat_map(|m| m.iter()),
+        &["curvature", "plane_angle", "length", "s"],
+    )?;
     Ok(poses_array(py, &ts))
 }
 
@@ -202,14 +233,24 @@ pub(crate) fn pcc_arc_frames<'py>(
 #[pyo3(signature = (curvature, plane_angle, length, *, frame="spatial", coordinates="arc"))]
 pub(crate) fn pcc_arc_jacobian<'py>(
     py: Python<'py>,
-    curvature: f64,
-    plane_angle: f64,
-    length: f64,
-    frame: &str,
-    coordinates: &str,
+    #[pyo3(from_py_with = arg::curvature)] curvature: f64,
+    #[pyo3(from_py_with = arg::plane_angle)] plane_angle: f64,
+    #[pyo3(from_py_with = arg::length)] length: f64,
+    #[pyo3(from_py_with = arg::frame)] frame: &str,
+    #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (f, c) = (frame_from(frame)?, coordinates_from(coordinates)?);
-    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(to_py_err)?;
+    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(blame(&[
+        "curvature",
+        "plane_angle",
+        "length",
+        "frame",
+        "coordinates",
+    ]))?;
+    finite_result(
+        j.iter(),
+        &["curvature", "plane_angle", "length", "frame", "coordinates"],
+    )?;
     Ok(matrix_array(py, &j))
 }
 
@@ -228,10 +269,13 @@ pub(crate) fn pcc_chain_pose<'py>(
 pub(crate) fn pcc_chain_frames<'py>(
     py: Python<'py>,
     segments: &Bound<'py, PyAny>,
-    s: Floats<'py>,
+    #[pyo3(from_py_with = arg::s)] s: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(to_py_err)?;
-    let ts = chain.backbone(&s.to_vec()?).map_err(to_py_err)?;
+    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(blame(&["segments", "s"]))?;
+    let ts = chain
+        .backbone(&s.to_vec()?)
+        .map_err(blame(&["segments", "s"]))?;
+    finite_result(ts.iter().flat_map(|m| m.iter()), &["segments", "s"])?;
     Ok(poses_array(py, &ts))
 }
 
@@ -241,8 +285,8 @@ pub(crate) fn pcc_chain_frames<'py>(
 pub(crate) fn pcc_chain_jacobian<'py>(
     py: Python<'py>,
     segments: &Bound<'py, PyAny>,
-    frame: &str,
-    coordinates: &str,
+    #[pyo3(from_py_with = arg::frame)] frame: &str,
+    #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (f, c) = (frame_from(frame)?, coordinates_from(coordinates)?);
     let segs = segments_from(segments)?;
@@ -253,10 +297,10 @@ pub(crate) fn pcc_chain_jacobian<'py>(
 #[pyfunction]
 pub(crate) fn pcc_arc_from_tip<'py>(
     py: Python<'py>,
-    position: Floats<'py>,
+    #[pyo3(from_py_with = arg::position)] position: Floats,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let p = vector3(position, "position")?;
-    let s = pcc::arc_from_tip(&p).map_err(to_py_err)?;
+    let s = pcc::arc_from_tip(&p).map_err(blame(&["position"]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -264,27 +308,24 @@ pub(crate) fn pcc_arc_from_tip<'py>(
 #[pyfunction]
 pub(crate) fn pcc_arc_from_tip_with_length<'py>(
     py: Python<'py>,
-    position: Floats<'py>,
-    length: f64,
+    #[pyo3(from_py_with = arg::position)] position: Floats,
+    #[pyo3(from_py_with = arg::length)] length: f64,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
     let p = vector3(position, "position")?;
-    let fit = pcc::arc_from_tip_with_length(&p, length).map_err(to_py_err)?;
+    let fit = pcc::arc_from_tip_with_length(&p, length).map_err(blame(&["position", "length"]))?;
     Ok((arc_array(py, &fit.segment), fit.residual))
 }
 
 // ---------------------------------------------------------------------------- actuation maps
 
-fn tendons_from(distances: Floats<'_>, angles: Floats<'_>) -> PyResult<pcc::PccTendons> {
-    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?).map_err(to_py_err)
+fn tendons_from(distances: Floats, angles: Floats) -> PyResult<pcc::PccTendons> {
+    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?)
+        .map_err(blame(&["position", "length"]))
 }
 
-fn chambers_from(
-    areas: Floats<'_>,
-    distances: Floats<'_>,
-    angles: Floats<'_>,
-) -> PyResult<pcc::PccChambers> {
+fn chambers_from(areas: Floats, distances: Floats, angles: Floats) -> PyResult<pcc::PccChambers> {
     pcc::PccChambers::new(&areas.to_vec()?, &distances.to_vec()?, &angles.to_vec()?)
-        .map_err(to_py_err)
+        .map_err(blame(&["position", "length"]))
 }
 
 /// Tendon length changes (m) of a segment with arc parameters `arc`.
@@ -292,14 +333,20 @@ fn chambers_from(
 #[pyo3(signature = (arc, distances, angles, rest_length=None))]
 pub(crate) fn pcc_tendon_displacements<'py>(
     py: Python<'py>,
-    arc: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: Option<f64>,
+    #[pyo3(from_py_with = arg::arc)] arc: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let seg = arc3(arc, "arc")?;
     let t = tendons_from(distances, angles)?;
-    let d = pcc::tendon_displacements(&seg, &t, rest_length).map_err(to_py_err)?;
+    let d = pcc::tendon_displacements(&seg, &t, rest_length).map_err(blame(&[
+        "arc",
+        "distances",
+        "angles",
+        "rest_length",
+    ]))?;
+    finite_result(&d, &["arc", "distances", "rest_length"])?;
     Ok(d.into_pyarray(py))
 }
 
@@ -308,10 +355,10 @@ pub(crate) fn pcc_tendon_displacements<'py>(
 #[pyo3(signature = (arc, distances, angles, *, coordinates="arc"))]
 pub(crate) fn pcc_tendon_displacement_jacobian<'py>(
     py: Python<'py>,
-    arc: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    coordinates: &str,
+    #[pyo3(from_py_with = arg::arc)] arc: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let c = coordinates_from(coordinates)?;
     let seg = arc3(arc, "arc")?;
@@ -327,16 +374,22 @@ pub(crate) fn pcc_tendon_displacement_jacobian<'py>(
 #[pyo3(signature = (displacements, distances, angles, rest_length, *, extensible=true))]
 pub(crate) fn pcc_arc_from_tendon_displacements<'py>(
     py: Python<'py>,
-    displacements: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: f64,
-    extensible: bool,
+    #[pyo3(from_py_with = arg::displacements)] displacements: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::extensible)] extensible: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let t = tendons_from(distances, angles)?;
     let s =
         pcc::arc_from_tendon_displacements(&displacements.to_vec()?, &t, rest_length, extensible)
-            .map_err(to_py_err)?;
+            .map_err(blame(&[
+            "displacements",
+            "distances",
+            "angles",
+            "rest_length",
+            "extensible",
+        ]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -345,12 +398,12 @@ pub(crate) fn pcc_arc_from_tendon_displacements<'py>(
 #[pyo3(signature = (displacements, distances, angles, rest_length, *, extensible=true, coordinates="arc"))]
 pub(crate) fn pcc_arc_from_tendon_displacements_jacobian<'py>(
     py: Python<'py>,
-    displacements: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: f64,
-    extensible: bool,
-    coordinates: &str,
+    #[pyo3(from_py_with = arg::displacements)] displacements: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::extensible)] extensible: bool,
+    #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let c = coordinates_from(coordinates)?;
     let t = tendons_from(distances, angles)?;
@@ -361,7 +414,25 @@ pub(crate) fn pcc_arc_from_tendon_displacements_jacobian<'py>(
         extensible,
         c,
     )
-    .map_err(to_py_err)?;
+    .map_err(blame(&[
+        "displacements",
+        "distances",
+        "angles",
+        "rest_length",
+        "extensible",
+        "coordinates",
+    ]))?;
+    finite_result(
+        j.iter(),
+        &[
+            "displacements",
+            "distances",
+            "angles",
+            "rest_length",
+            "extensible",
+            "coordinates",
+        ],
+    )?;
     Ok(matrix_array(py, &j))
 }
 
@@ -370,7 +441,14 @@ fn body_from(
     bending_stiffness: f64,
     axial_stiffness: Option<f64>,
 ) -> PyResult<ElasticSegment> {
-    ElasticSegment::new(rest_length, bending_stiffness, axial_stiffness).map_err(to_py_err)
+    ElasticSegment::new(rest_length, bending_stiffness, axial_stiffness).map_err(blame(&[
+        "displacements",
+        "distances",
+        "angles",
+        "rest_length",
+        "extensible",
+        "coordinates",
+    ]))
 }
 
 /// The arc of a uniform elastic segment pulled by tendon tensions (N).
@@ -378,16 +456,23 @@ fn body_from(
 #[pyo3(signature = (tensions, distances, angles, rest_length, bending_stiffness, axial_stiffness=None))]
 pub(crate) fn pcc_arc_from_tendon_tensions<'py>(
     py: Python<'py>,
-    tensions: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: f64,
-    bending_stiffness: f64,
-    axial_stiffness: Option<f64>,
+    #[pyo3(from_py_with = arg::tensions)] tensions: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::bending_stiffness)] bending_stiffness: f64,
+    #[pyo3(from_py_with = arg::axial_stiffness)] axial_stiffness: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let t = tendons_from(distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let s = pcc::arc_from_tendon_tensions(&tensions.to_vec()?, &t, &body).map_err(to_py_err)?;
+    let s = pcc::arc_from_tendon_tensions(&tensions.to_vec()?, &t, &body).map_err(blame(&[
+        "tensions",
+        "distances",
+        "angles",
+        "rest_length",
+        "bending_stiffness",
+        "axial_stiffness",
+    ]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -396,19 +481,40 @@ pub(crate) fn pcc_arc_from_tendon_tensions<'py>(
 #[pyo3(signature = (tensions, distances, angles, rest_length, bending_stiffness, axial_stiffness=None, *, coordinates="arc"))]
 pub(crate) fn pcc_arc_from_tendon_tensions_jacobian<'py>(
     py: Python<'py>,
-    tensions: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: f64,
-    bending_stiffness: f64,
-    axial_stiffness: Option<f64>,
-    coordinates: &str,
+    #[pyo3(from_py_with = arg::tensions)] tensions: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::bending_stiffness)] bending_stiffness: f64,
+    #[pyo3(from_py_with = arg::axial_stiffness)] axial_stiffness: Option<f64>,
+    #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let c = coordinates_from(coordinates)?;
     let t = tendons_from(distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c)
-        .map_err(to_py_err)?;
+    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c).map_err(
+        blame(&[
+            "tensions",
+            "distances",
+            "angles",
+            "rest_length",
+            "bending_stiffness",
+            "axial_stiffness",
+            "coordinates",
+        ]),
+    )?;
+    finite_result(
+        j.iter(),
+        &[
+            "tensions",
+            "distances",
+            "angles",
+            "rest_length",
+            "bending_stiffness",
+            "axial_stiffness",
+            "coordinates",
+        ],
+    )?;
     Ok(matrix_array(py, &j))
 }
 
@@ -417,17 +523,25 @@ pub(crate) fn pcc_arc_from_tendon_tensions_jacobian<'py>(
 #[pyo3(signature = (pressures, areas, distances, angles, rest_length, bending_stiffness, axial_stiffness=None))]
 pub(crate) fn pcc_arc_from_pressures<'py>(
     py: Python<'py>,
-    pressures: Floats<'py>,
-    areas: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: f64,
-    bending_stiffness: f64,
-    axial_stiffness: Option<f64>,
+    #[pyo3(from_py_with = arg::pressures)] pressures: Floats,
+    #[pyo3(from_py_with = arg::areas)] areas: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::bending_stiffness)] bending_stiffness: f64,
+    #[pyo3(from_py_with = arg::axial_stiffness)] axial_stiffness: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let ch = chambers_from(areas, distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let s = pcc::arc_from_pressures(&pressures.to_vec()?, &ch, &body).map_err(to_py_err)?;
+    let s = pcc::arc_from_pressures(&pressures.to_vec()?, &ch, &body).map_err(blame(&[
+        "pressures",
+        "areas",
+        "distances",
+        "angles",
+        "rest_length",
+        "bending_stiffness",
+        "axial_stiffness",
+    ]))?;
     Ok(arc_array(py, &s))
 }
 
@@ -436,27 +550,36 @@ pub(crate) fn pcc_arc_from_pressures<'py>(
 #[pyo3(signature = (pressures, areas, distances, angles, rest_length, bending_stiffness, axial_stiffness=None, *, coordinates="arc"))]
 pub(crate) fn pcc_arc_from_pressures_jacobian<'py>(
     py: Python<'py>,
-    pressures: Floats<'py>,
-    areas: Floats<'py>,
-    distances: Floats<'py>,
-    angles: Floats<'py>,
-    rest_length: f64,
-    bending_stiffness: f64,
-    axial_stiffness: Option<f64>,
-    coordinates: &str,
+    #[pyo3(from_py_with = arg::pressures)] pressures: Floats,
+    #[pyo3(from_py_with = arg::areas)] areas: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::bending_stiffness)] bending_stiffness: f64,
+    #[pyo3(from_py_with = arg::axial_stiffness)] axial_stiffness: Option<f64>,
+    #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let c = coordinates_from(coordinates)?;
     let ch = chambers_from(areas, distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
     let j =
-        pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c).map_err(to_py_err)?;
+        pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c).map_err(blame(&[
+            "pressures",
+            "areas",
+            "distances",
+            "angles",
+            "rest_length",
+            "bending_stiffness",
+            "axial_stiffness",
+            "coordinates",
+        ]))?;
     Ok(matrix_array(py, &j))
 }
 
 // ---------------------------------------------------------------------------------- statics
 
 /// One value per segment from a scalar or a sequence of `n`.
-fn per_segment(v: Floats<'_>, n: usize, name: &str) -> PyResult<Vec<f64>> {
+fn per_segment(v: Floats, n: usize, name: &str) -> PyResult<Vec<f64>> {
     let v = v.to_vec()?;
     match v.len() {
         1 => Ok(vec![v[0]; n]),
@@ -464,7 +587,7 @@ fn per_segment(v: Floats<'_>, n: usize, name: &str) -> PyResult<Vec<f64>> {
         k => Err(param_err(
             &format!("{name}.len()"),
             k,
-            &format!("1 or the number of segments, {n}"),
+            &format!("1 or the number of segments (the length of rest_lengths), {n}"),
         )),
     }
 }
@@ -480,9 +603,9 @@ impl PccRobot {
     #[new]
     #[pyo3(signature = (rest_lengths, bending_stiffness, axial_stiffness=None))]
     fn new(
-        rest_lengths: Floats<'_>,
-        bending_stiffness: Floats<'_>,
-        axial_stiffness: Option<Floats<'_>>,
+        #[pyo3(from_py_with = arg::rest_lengths)] rest_lengths: Floats,
+        #[pyo3(from_py_with = arg::bending_stiffness)] bending_stiffness: Floats,
+        #[pyo3(from_py_with = arg::axial_stiffness)] axial_stiffness: Option<Floats>,
     ) -> PyResult<Self> {
         let l0 = rest_lengths.to_vec()?;
         let n = l0.len();
@@ -517,10 +640,10 @@ impl PccRobot {
     #[staticmethod]
     #[pyo3(signature = (rest_lengths, radius, youngs_modulus, *, extensible=true))]
     fn solid_circle(
-        rest_lengths: Floats<'_>,
-        radius: f64,
-        youngs_modulus: f64,
-        extensible: bool,
+        #[pyo3(from_py_with = arg::rest_lengths)] rest_lengths: Floats,
+        #[pyo3(from_py_with = arg::radius)] radius: f64,
+        #[pyo3(from_py_with = arg::youngs_modulus)] youngs_modulus: f64,
+        #[pyo3(from_py_with = arg::extensible)] extensible: bool,
     ) -> PyResult<Self> {
         let l0 = rest_lengths.to_vec()?;
         let bodies = l0
@@ -537,9 +660,9 @@ impl PccRobot {
     /// segments before it at the same body offsets).
     fn with_tendons(
         &self,
-        segment: usize,
-        distances: Floats<'_>,
-        angles: Floats<'_>,
+        #[pyo3(from_py_with = arg::segment)] segment: usize,
+        #[pyo3(from_py_with = arg::distances)] distances: Floats,
+        #[pyo3(from_py_with = arg::angles)] angles: Floats,
     ) -> PyResult<Self> {
         let t = tendons_from(distances, angles)?;
         let inner = self
@@ -553,10 +676,10 @@ impl PccRobot {
     /// A new robot with pneumatic chambers in `segment`.
     fn with_chambers(
         &self,
-        segment: usize,
-        areas: Floats<'_>,
-        distances: Floats<'_>,
-        angles: Floats<'_>,
+        #[pyo3(from_py_with = arg::segment)] segment: usize,
+        #[pyo3(from_py_with = arg::areas)] areas: Floats,
+        #[pyo3(from_py_with = arg::distances)] distances: Floats,
+        #[pyo3(from_py_with = arg::angles)] angles: Floats,
     ) -> PyResult<Self> {
         let ch = chambers_from(areas, distances, angles)?;
         let inner = self
@@ -784,7 +907,7 @@ impl PccSolution {
     fn frames_at<'py>(
         &self,
         py: Python<'py>,
-        s: Floats<'py>,
+        #[pyo3(from_py_with = arg::s)] s: Floats,
     ) -> PyResult<Bound<'py, PyArray3<f64>>> {
         let ts = self
             .inner
@@ -801,13 +924,6 @@ impl PccSolution {
             self.inner.stats.iterations
         )
     }
-}
-
-/// A warm start: a previous solution or arc rows (curvature, plane_angle, length).
-#[derive(FromPyObject)]
-pub(crate) enum PccWarm<'py> {
-    Solution(PyRef<'py, PccSolution>),
-    Arcs(Bound<'py, PyAny>),
 }
 
 /// Statics of a PCC robot under tensions, pressures and a world-frame tip wrench.
@@ -840,19 +956,19 @@ pub(crate) enum PccWarm<'py> {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn pcc_solve<'py>(
     py: Python<'py>,
-    robot: &Bound<'py, PccRobot>,
+    #[pyo3(from_py_with = arg::robot)] robot: Bound<'py, PccRobot>,
     tensions: Option<Bound<'py, PyAny>>,
     pressures: Option<Bound<'py, PyAny>>,
     tip_force: Option<Bound<'py, PyAny>>,
     tip_moment: Option<Bound<'py, PyAny>>,
     s: Option<Bound<'py, PyAny>>,
-    n_points: Option<i64>,
-    tolerance: Option<f64>,
-    max_iterations: Option<i64>,
-    continuation: Option<bool>,
-    max_load_steps: Option<i64>,
+    #[pyo3(from_py_with = arg::n_points)] n_points: Option<i64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+    #[pyo3(from_py_with = arg::continuation)] continuation: Option<bool>,
+    #[pyo3(from_py_with = arg::max_load_steps)] max_load_steps: Option<i64>,
     warm_start: Option<Bound<'py, PyAny>>,
-    throw: Option<bool>,
+    #[pyo3(from_py_with = arg::throw)] throw: Option<bool>,
 ) -> PyResult<PccSolution> {
     let o = |v: &Option<Bound<'py, PyAny>>| {
         v.as_ref().map_or_else(|| py.None(), |b| b.clone().unbind())
@@ -875,17 +991,10 @@ pub(crate) fn pcc_solve<'py>(
             ("throw", crate::model::obj(py, throw)?),
         ],
     )?;
-    let floats = |v: Option<Bound<'py, PyAny>>, name: &str| -> PyResult<Option<Floats<'py>>> {
-        v.map(|b| {
-            b.extract::<Floats<'py>>().map_err(|_| {
-                param_err(
-                    name,
-                    "<object>",
-                    "floats (a number, a sequence or an array)",
-                )
-            })
-        })
-        .transpose()
+    let floats = |v: Option<Bound<'py, PyAny>>, name: &str| -> PyResult<Option<Floats>> {
+        v.filter(|b| !b.is_none())
+            .map(|b| Floats::from_arg(&b, name))
+            .transpose()
     };
     let (tensions, pressures) = (
         floats(tensions, "tensions")?,
@@ -896,27 +1005,22 @@ pub(crate) fn pcc_solve<'py>(
         floats(tip_moment, "tip_moment")?,
         floats(s, "s")?,
     );
-    let warm_start: Option<PccWarm<'py>> = warm_start
-        .map(|w| {
-            w.extract()
-                .map_err(|_| param_err("warm_start", "<object>", "a solution or (n, 3) arc rows"))
-        })
-        .transpose()?;
     let robot = robot.borrow();
     let d = PccSolveOptions::default();
-    let count = |name: &str, v: Option<i64>, default: usize| -> PyResult<usize> {
-        v.map_or(Ok(default), |k| crate::statics::count(name, k))
-    };
-    let max_iterations = count("max_iterations", max_iterations, d.newton.max_iterations)?;
-    let max_load_steps = count("max_load_steps", max_load_steps, d.newton.max_load_steps)?;
+    let max = softrod::limits::MAX_ITERATIONS;
+    let max_iterations = max_iterations.map_or(Ok(d.newton.max_iterations), |k| {
+        count("max_iterations", k, 1, max)
+    })?;
+    let max_load_steps = max_load_steps.map_or(Ok(d.newton.max_load_steps), |k| {
+        count("max_load_steps", k, 1, max)
+    })?;
     let tolerance = tolerance.unwrap_or(d.newton.tolerance);
     let continuation = continuation.unwrap_or(d.newton.continuation);
     let throw = throw.unwrap_or(d.newton.throw);
-    let n_points = match n_points {
-        None => DEFAULT_FRAMES as i64,
-        Some(k) if k >= 2 => k,
-        Some(k) => return Err(param_err("n_points", k, ">= 2")),
-    };
+    // Checked before anything is solved or allocated.
+    let n_points = n_points.map_or(Ok(DEFAULT_FRAMES), |k| {
+        count("n_points", k, 2, softrod::limits::MAX_SAMPLES)
+    })?;
     let loads = PccLoads {
         tensions: tensions
             .map(|t| t.to_vec())
@@ -935,18 +1039,20 @@ pub(crate) fn pcc_solve<'py>(
             .transpose()?
             .unwrap_or_else(Vector3::zeros),
     };
-    let warm = match warm_start {
+    let warm = match warm_start.filter(|w| !w.is_none()) {
         None => None,
-        Some(PccWarm::Solution(sol)) => Some(sol.inner.warm_start()),
-        Some(PccWarm::Arcs(a)) => {
-            let rows = rows3(&a, "warm_start")?;
-            Some(
-                pcc::PccChain::from_parameters(&rows)
-                    .map_err(to_py_err)?
-                    .segments()
-                    .to_vec(),
-            )
-        }
+        Some(w) => match w.cast::<PccSolution>() {
+            Ok(sol) => Some(sol.get().inner.warm_start()),
+            Err(_) => {
+                let rows = rows3(&w, "warm_start")?;
+                Some(
+                    pcc::PccChain::from_parameters(&rows)
+                        .map_err(|e| to_py_err(renamed(e, "segments", "warm_start")))?
+                        .segments()
+                        .to_vec(),
+                )
+            }
+        },
     };
     let options = PccSolveOptions {
         newton: softrod::NewtonOptions {
@@ -963,19 +1069,17 @@ pub(crate) fn pcc_solve<'py>(
         None => None,
     };
     let model = &robot.inner;
-    let (inner, s, frames) = py
-        .detach(move || -> softrod::Result<_> {
-            let sol = statics::solve_pcc_statics(model, &loads, &options)?;
-            let chain = sol.chain();
-            let s = samples.unwrap_or_else(|| {
-                let l = chain.length();
-                let n = n_points as usize;
-                (0..n).map(|i| l * i as f64 / (n - 1) as f64).collect()
-            });
-            let frames = chain.backbone(&s)?;
-            Ok((sol, s, frames))
-        })
-        .map_err(to_py_err)?;
+    let (inner, s, frames) = run(py, "pcc.solve", move || {
+        let sol = statics::solve_pcc_statics(model, &loads, &options)?;
+        let chain = sol.chain();
+        let s = match samples {
+            Some(s) => s,
+            // Exactly 0 and exactly the chain's length at the ends.
+            None => softrod::uniform_samples(chain.length(), n_points)?,
+        };
+        let frames = chain.backbone(&s)?;
+        Ok((sol, s, frames))
+    })?;
     Ok(PccSolution {
         inner,
         robot: model.clone(),

@@ -1,6 +1,6 @@
 //! Binding of the seed-000 planar cable arm and the backbone distance.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
@@ -8,7 +8,8 @@ use crate::model::{obj, Args};
 
 use softrod::AdaptiveOptions;
 
-use crate::convert::Floats;
+use crate::callbacks::run;
+use crate::convert::{arg, choice, count, Arg, Floats, Matrix};
 use crate::errors::{param_err, to_py_err};
 
 // The Python signatures spell the core's default tolerances as literals (so that
@@ -23,33 +24,27 @@ fn method_from(
     atol: f64,
     max_steps: i64,
 ) -> PyResult<softrod::PlanarMethod> {
-    if max_steps < 1 {
-        return Err(param_err("max_steps", max_steps, ">= 1"));
+    let max_steps = count("max_steps", max_steps, 1, softrod::limits::MAX_ITERATIONS)?;
+    // The tolerances are checked whichever method uses them.
+    let opts = AdaptiveOptions {
+        rtol,
+        atol,
+        max_steps,
     }
-    match method {
-        "closed-form" | "closed_form" => Ok(softrod::PlanarMethod::ClosedForm),
-        "ode" => {
-            let opts = AdaptiveOptions {
-                rtol,
-                atol,
-                max_steps: max_steps as usize,
-            }
-            .validated()
-            .map_err(to_py_err)?;
-            Ok(softrod::PlanarMethod::Ode(opts))
-        }
-        other => Err(param_err("method", other, "\"closed-form\" or \"ode\"")),
+    .validated()
+    .map_err(to_py_err)?;
+    match choice("method", method, &["closed-form", "closed_form", "ode"])? {
+        "ode" => Ok(softrod::PlanarMethod::Ode(opts)),
+        _ => Ok(softrod::PlanarMethod::ClosedForm),
     }
 }
 
-fn samples_from(length: f64, n_points: i64, s: Option<Floats<'_>>) -> PyResult<Vec<f64>> {
+fn samples_from(length: f64, n_points: i64, s: Option<Floats>) -> PyResult<Vec<f64>> {
     match s {
         Some(s) => s.to_vec(),
         None => {
-            if n_points < 2 {
-                return Err(param_err("n_points", n_points, ">= 2"));
-            }
-            softrod::uniform_samples(length, n_points as usize).map_err(to_py_err)
+            let n = count("n_points", n_points, 2, softrod::limits::MAX_SAMPLES)?;
+            softrod::uniform_samples(length, n).map_err(to_py_err)
         }
     }
 }
@@ -63,14 +58,8 @@ pub(crate) struct PlanarCableArm {
     inner: softrod::PlanarCableArm,
 }
 
-fn extract_floats<'py>(b: &Bound<'py, PyAny>, name: &str) -> PyResult<Floats<'py>> {
-    b.extract().map_err(|_| {
-        param_err(
-            name,
-            "<object>",
-            "floats (a number, a sequence or an array)",
-        )
-    })
+fn extract_floats(b: &Bound<'_, PyAny>, name: &str) -> PyResult<Floats> {
+    Floats::from_arg(b, name)
 }
 
 /// The call `arm.<method>(first, n_points=..., s=..., ...)` of a solution, for pickling.
@@ -207,12 +196,12 @@ impl PlanarCableArm {
     #[new]
     #[pyo3(signature = (length, base_radius, tip_radius, offset_ratio, youngs_modulus, anchor=None))]
     fn new(
-        length: f64,
-        base_radius: f64,
-        tip_radius: f64,
-        offset_ratio: f64,
-        youngs_modulus: f64,
-        anchor: Option<f64>,
+        #[pyo3(from_py_with = arg::length)] length: f64,
+        #[pyo3(from_py_with = arg::base_radius)] base_radius: f64,
+        #[pyo3(from_py_with = arg::tip_radius)] tip_radius: f64,
+        #[pyo3(from_py_with = arg::offset_ratio)] offset_ratio: f64,
+        #[pyo3(from_py_with = arg::youngs_modulus)] youngs_modulus: f64,
+        #[pyo3(from_py_with = arg::anchor)] anchor: Option<f64>,
     ) -> PyResult<Self> {
         softrod::PlanarCableArm::new(
             length,
@@ -264,12 +253,22 @@ impl PlanarCableArm {
     }
 
     /// Section radius R(s) (m) at arc lengths `s` (m).
-    fn radius<'py>(&self, py: Python<'py>, s: Floats<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    ///
+    /// Raises `ParameterError` naming `s[i]` for an arc length outside `[0, length]` (the taper
+    /// is not extrapolated).
+    fn radius<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = arg::s)] s: Floats,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let s = s.to_vec()?;
-        Ok(s.iter()
-            .map(|&si| self.inner.radius(si))
-            .collect::<Vec<_>>()
-            .into_pyarray(py))
+        let r = s
+            .iter()
+            .enumerate()
+            .map(|(i, &si)| self.inner.radius_at(|| format!("s[{i}]"), si))
+            .collect::<softrod::Result<Vec<_>>>()
+            .map_err(to_py_err)?;
+        Ok(r.into_pyarray(py))
     }
 
     fn __repr__(&self) -> String {
@@ -308,13 +307,13 @@ impl PlanarCableArm {
     fn solve<'py>(
         slf: &Bound<'py, Self>,
         py: Python<'py>,
-        tension: f64,
-        n_points: i64,
+        #[pyo3(from_py_with = arg::tension)] tension: f64,
+        #[pyo3(from_py_with = arg::n_points)] n_points: i64,
         s: Option<Bound<'py, PyAny>>,
-        method: &str,
-        rtol: f64,
-        atol: f64,
-        max_steps: i64,
+        #[pyo3(from_py_with = arg::method)] method: &str,
+        #[pyo3(from_py_with = arg::rtol)] rtol: f64,
+        #[pyo3(from_py_with = arg::atol)] atol: f64,
+        #[pyo3(from_py_with = arg::max_steps)] max_steps: i64,
     ) -> PyResult<PlanarSolution> {
         let call = call_args(
             slf,
@@ -332,9 +331,9 @@ impl PlanarCableArm {
         let samples = samples_from(this.inner.length(), n_points, s)?;
         let m = method_from(method, rtol, atol, max_steps)?;
         let arm = this.inner;
-        let sol = py
-            .detach(move || softrod::solve_planar(&arm, tension, &samples, m))
-            .map_err(to_py_err)?;
+        let sol = run(py, "PlanarCableArm.solve", move || {
+            softrod::solve_planar(&arm, tension, &samples, m)
+        })?;
         let stats = match sol.ode_stats {
             Some(st) => {
                 let d = PyDict::new(py);
@@ -374,12 +373,12 @@ impl PlanarCableArm {
         slf: &Bound<'py, Self>,
         py: Python<'py>,
         tensions: Bound<'py, PyAny>,
-        n_points: i64,
+        #[pyo3(from_py_with = arg::n_points)] n_points: i64,
         s: Option<Bound<'py, PyAny>>,
-        method: &str,
-        rtol: f64,
-        atol: f64,
-        max_steps: i64,
+        #[pyo3(from_py_with = arg::method)] method: &str,
+        #[pyo3(from_py_with = arg::rtol)] rtol: f64,
+        #[pyo3(from_py_with = arg::atol)] atol: f64,
+        #[pyo3(from_py_with = arg::max_steps)] max_steps: i64,
     ) -> PyResult<PlanarBatch> {
         let call = call_args(
             slf,
@@ -398,9 +397,9 @@ impl PlanarCableArm {
         let samples = samples_from(this.inner.length(), n_points, s)?;
         let m = method_from(method, rtol, atol, max_steps)?;
         let arm = this.inner;
-        let b = py
-            .detach(move || softrod::solve_planar_many(&arm, &t, &samples, m))
-            .map_err(to_py_err)?;
+        let b = run(py, "PlanarCableArm.solve_many", move || {
+            softrod::solve_planar_many(&arm, &t, &samples, m)
+        })?;
         let (nt, ns) = (b.tensions.len(), b.s.len());
         let tip: Vec<f64> = b.tip.iter().flatten().copied().collect();
         Ok(PlanarBatch {
@@ -423,11 +422,12 @@ impl PlanarCableArm {
 #[pyo3(signature = (a, b, n_index=None))]
 pub(crate) fn backbone_distance<'py>(
     py: Python<'py>,
-    a: PyReadonlyArray2<'py, f64>,
-    b: PyReadonlyArray2<'py, f64>,
-    n_index: Option<i64>,
+    #[pyo3(from_py_with = arg::a)] a: Matrix,
+    #[pyo3(from_py_with = arg::b)] b: Matrix,
+    #[pyo3(from_py_with = arg::n_index)] n_index: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (da, db) = (a.as_array().ncols(), b.as_array().ncols());
+    let (a, b) = (a.0, b.0);
+    let (da, db) = (a.ncols(), b.ncols());
     if da != db {
         return Err(param_err(
             "b.shape[1]",
@@ -435,14 +435,14 @@ pub(crate) fn backbone_distance<'py>(
             &format!("equal to a.shape[1] = {da}"),
         ));
     }
-    let n_index = match n_index {
-        Some(n) if n < 2 => return Err(param_err("n_index", n, ">= 2")),
-        Some(n) => Some(n as usize),
-        None => None,
-    };
-    let av = a.as_array().iter().copied().collect::<Vec<_>>();
-    let bv = b.as_array().iter().copied().collect::<Vec<_>>();
-    let d = softrod::backbone_distance(&av, &bv, da, n_index).map_err(to_py_err)?;
+    let n_index = n_index
+        .map(|n| count("n_index", n, 2, softrod::limits::MAX_SAMPLES))
+        .transpose()?;
+    let av = a.iter().copied().collect::<Vec<_>>();
+    let bv = b.iter().copied().collect::<Vec<_>>();
+    let d = run(py, "backbone_distance", || {
+        softrod::backbone_distance(&av, &bv, da, n_index)
+    })?;
     let out = PyDict::new(py);
     out.set_item("max", d.max)?;
     out.set_item("mean", d.mean)?;

@@ -7,8 +7,10 @@ use std::sync::Arc;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::errors::{param_err, to_py_err};
-use crate::model::{call_py, obj, Args, ErrorSlot};
+use crate::callbacks::{run_attached, Callback};
+use crate::convert::arg;
+use crate::errors::{param_err, to_py_err, type_err};
+use crate::model::{obj, Args};
 
 // ----------------------------------------------------------------------------------- sections
 
@@ -19,7 +21,6 @@ use crate::model::{call_py, obj, Args, ErrorSlot};
 #[pyclass(frozen, module = "softrod._core", name = "Section", subclass)]
 pub(crate) struct PySection {
     pub(crate) inner: softrod::Section,
-    pub(crate) slot: ErrorSlot,
     args: Args,
 }
 
@@ -27,12 +28,10 @@ impl PySection {
     fn init(
         py: Python<'_>,
         inner: softrod::Section,
-        slot: ErrorSlot,
         items: &[(&str, Py<PyAny>)],
     ) -> PyResult<PyClassInitializer<Self>> {
         Ok(PyClassInitializer::from(Self {
             inner,
-            slot,
             args: Args::new(py, items)?,
         }))
     }
@@ -45,13 +44,23 @@ impl PySection {
     }
     /// Section properties at arc length `s` (m) of a rod of `length` (m): dict of area (m^2),
     /// ix, iy, j (m^4), radius (m).
+    ///
+    /// Raises `ParameterError` naming `length` (finite, > 0), `s` (in `[0, length]`) or the
+    /// property that is not finite and > 0 there.
     fn properties<'py>(
         &self,
         py: Python<'py>,
-        s: f64,
-        length: f64,
+        #[pyo3(from_py_with = arg::s)] s: f64,
+        #[pyo3(from_py_with = arg::length)] length: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let p = self.inner.properties(s, length);
+        let section = &self.inner;
+        let p = run_attached("Section.properties", || {
+            softrod::limits::check_length("length", length, false)?;
+            let s = softrod::math::samples::in_range(|| "s".into(), s, length)?;
+            section
+                .properties(s, length)
+                .validated(&format!("section({s})"))
+        })?;
         let d = PyDict::new(py);
         d.set_item("area", p.area)?;
         d.set_item("ix", p.ix)?;
@@ -81,10 +90,13 @@ pub(crate) struct CircularSection {
 #[pymethods]
 impl CircularSection {
     #[new]
-    fn new(py: Python<'_>, radius: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        py: Python<'_>,
+        #[pyo3(from_py_with = arg::radius)] radius: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let inner = softrod::Section::circular(radius).map_err(to_py_err)?;
         let items = [("radius", obj(py, radius)?)];
-        Ok(PySection::init(py, inner, ErrorSlot::default(), &items)?.add_subclass(Self { radius }))
+        Ok(PySection::init(py, inner, &items)?.add_subclass(Self { radius }))
     }
     /// Radius (m).
     #[getter]
@@ -107,8 +119,8 @@ impl TaperedCircularSection {
     #[new]
     fn new(
         py: Python<'_>,
-        base_radius: f64,
-        tip_radius: f64,
+        #[pyo3(from_py_with = arg::base_radius)] base_radius: f64,
+        #[pyo3(from_py_with = arg::tip_radius)] tip_radius: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
         let inner =
             softrod::Section::tapered_circular(base_radius, tip_radius).map_err(to_py_err)?;
@@ -116,12 +128,10 @@ impl TaperedCircularSection {
             ("base_radius", obj(py, base_radius)?),
             ("tip_radius", obj(py, tip_radius)?),
         ];
-        Ok(
-            PySection::init(py, inner, ErrorSlot::default(), &items)?.add_subclass(Self {
-                base_radius,
-                tip_radius,
-            }),
-        )
+        Ok(PySection::init(py, inner, &items)?.add_subclass(Self {
+            base_radius,
+            tip_radius,
+        }))
     }
     /// Radius at the base (m).
     #[getter]
@@ -150,20 +160,18 @@ impl TubeSection {
     #[pyo3(signature = (outer_radius, inner_radius=0.0))]
     fn new(
         py: Python<'_>,
-        outer_radius: f64,
-        inner_radius: f64,
+        #[pyo3(from_py_with = arg::outer_radius)] outer_radius: f64,
+        #[pyo3(from_py_with = arg::inner_radius)] inner_radius: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
         let inner = softrod::Section::tube(outer_radius, inner_radius).map_err(to_py_err)?;
         let items = [
             ("outer_radius", obj(py, outer_radius)?),
             ("inner_radius", obj(py, inner_radius)?),
         ];
-        Ok(
-            PySection::init(py, inner, ErrorSlot::default(), &items)?.add_subclass(Self {
-                outer_radius,
-                inner_radius,
-            }),
-        )
+        Ok(PySection::init(py, inner, &items)?.add_subclass(Self {
+            outer_radius,
+            inner_radius,
+        }))
     }
     /// Outer radius (m).
     #[getter]
@@ -187,11 +195,11 @@ impl TableSection {
     #[new]
     fn new(
         py: Python<'_>,
-        s: Vec<f64>,
-        area: Vec<f64>,
-        ix: Vec<f64>,
-        iy: Vec<f64>,
-        j: Vec<f64>,
+        #[pyo3(from_py_with = arg::s)] s: Vec<f64>,
+        #[pyo3(from_py_with = arg::area)] area: Vec<f64>,
+        #[pyo3(from_py_with = arg::ix)] ix: Vec<f64>,
+        #[pyo3(from_py_with = arg::iy)] iy: Vec<f64>,
+        #[pyo3(from_py_with = arg::j)] j: Vec<f64>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let inner = softrod::Section::table(&s, &area, &ix, &iy, &j).map_err(to_py_err)?;
         let items = [
@@ -201,7 +209,7 @@ impl TableSection {
             ("iy", obj(py, iy)?),
             ("j", obj(py, j)?),
         ];
-        Ok(PySection::init(py, inner, ErrorSlot::default(), &items)?.add_subclass(Self))
+        Ok(PySection::init(py, inner, &items)?.add_subclass(Self))
     }
 }
 
@@ -217,14 +225,11 @@ impl FunctionSection {
     #[new]
     fn new(py: Python<'_>, function: Py<PyAny>) -> PyResult<PyClassInitializer<Self>> {
         if !function.bind(py).is_callable() {
-            return Err(param_err("function", "<object>", "a function of s"));
+            return Err(type_err("function", function.bind(py), "a function of s"));
         }
-        let slot = ErrorSlot::default();
-        let s2 = slot.clone();
-        let f = function.clone_ref(py);
+        let cb = Callback::new(function.clone_ref(py), "function", "the section function");
         let inner = softrod::Section::function(Arc::new(move |s| {
-            let [area, ix, iy, j] =
-                call_py::<[f64; 4]>(&f, &s2, s, "section function", [f64::NAN; 4]);
+            let [area, ix, iy, j] = cb.floats::<4>(s);
             softrod::model::section::SectionProperties {
                 area,
                 ix,
@@ -234,8 +239,13 @@ impl FunctionSection {
                 radius_rate: 0.0,
             }
         }));
+        // Called once here at s = 0 (the rod's length is not known yet).
+        run_attached("FunctionSection", || {
+            inner.properties(0.0, 1.0).validated("function(0)")?;
+            Ok(())
+        })?;
         let items = [("function", function)];
-        Ok(PySection::init(py, inner, slot, &items)?.add_subclass(Self))
+        Ok(PySection::init(py, inner, &items)?.add_subclass(Self))
     }
 }
 
@@ -256,9 +266,9 @@ impl LinearElastic {
     #[new]
     #[pyo3(signature = (youngs_modulus, poisson_ratio=None, *, shear_modulus=None))]
     fn new(
-        youngs_modulus: f64,
-        poisson_ratio: Option<f64>,
-        shear_modulus: Option<f64>,
+        #[pyo3(from_py_with = arg::youngs_modulus)] youngs_modulus: f64,
+        #[pyo3(from_py_with = arg::poisson_ratio)] poisson_ratio: Option<f64>,
+        #[pyo3(from_py_with = arg::shear_modulus)] shear_modulus: Option<f64>,
     ) -> PyResult<Self> {
         let inner = match (poisson_ratio, shear_modulus) {
             (Some(nu), None) => softrod::LinearElastic::new(youngs_modulus, nu),
@@ -324,9 +334,9 @@ pub(crate) fn material_of(arg: &Bound<'_, PyAny>) -> PyResult<softrod::Material>
     if let Ok(l) = arg.cast::<crate::materials::PyUniaxialLaw>() {
         return Ok(l.get().inner.clone().into());
     }
-    Err(param_err(
+    Err(type_err(
         "material",
-        arg.get_type().name().map_or("?".into(), |n| n.to_string()),
+        arg,
         "a LinearElastic or a UniaxialLaw (NeoHookean, MooneyRivlin, Yeoh, ...)",
     ))
 }

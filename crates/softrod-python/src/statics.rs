@@ -15,8 +15,10 @@ use pyo3::types::{PyDict, PyTuple};
 
 use softrod::{AdaptiveOptions, Integrator, SolveOptions};
 
+use crate::callbacks::{run, run_attached};
+use crate::convert::{arg, count, floats_n};
 use crate::errors::{param_err, to_py_err, StabilityError, StabilityWarning};
-use crate::model::{Args, Chamber, ErrorSlot, Loads, Rod, Tendon};
+use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 
 /// The user's options, each `None` when not given.
 #[derive(Default)]
@@ -34,44 +36,47 @@ pub(crate) struct OptionArgs<'py> {
     pub seek_stable: Option<bool>,
 }
 
-/// A count option (>= 1), naming it.
-pub(crate) fn count(name: &str, v: i64) -> PyResult<usize> {
-    if v < 1 {
-        return Err(param_err(name, v, ">= 1"));
-    }
-    Ok(v as usize)
-}
-
 /// The one keyword parser of the solve options: from the core's defaults, each given option
 /// replaced (and checked, naming the keyword).
 pub(crate) fn solve_options(a: &OptionArgs<'_>) -> PyResult<SolveOptions> {
+    use softrod::limits::MAX_ITERATIONS;
     let mut o = SolveOptions::default();
-    let adaptive_defaults = AdaptiveOptions::default();
+    let defaults = AdaptiveOptions::default();
+    // Tolerances are checked when given, whichever integrator uses them.
+    let adaptive = AdaptiveOptions {
+        rtol: a.rtol.unwrap_or(defaults.rtol),
+        atol: a.atol.unwrap_or(defaults.atol),
+        ..defaults
+    }
+    .validated()
+    .map_err(to_py_err)?;
     o.integrator = match a.integrator.unwrap_or("rk4") {
         "rk4" => match (a.steps, o.integrator) {
             (Some(s), _) => Integrator::Rk4 {
-                steps: count("steps", s)?,
+                steps: count("steps", s, 1, softrod::cosserat::statics::MAX_RK4_STEPS)?,
             },
             (None, i) => i,
         },
-        "adaptive" => Integrator::Adaptive(AdaptiveOptions {
-            rtol: a.rtol.unwrap_or(adaptive_defaults.rtol),
-            atol: a.atol.unwrap_or(adaptive_defaults.atol),
-            ..adaptive_defaults
-        }),
-        other => return Err(param_err("integrator", other, "\"rk4\" or \"adaptive\"")),
+        "adaptive" => Integrator::Adaptive(adaptive),
+        other => {
+            return Err(param_err(
+                "integrator",
+                format!("{other:?}"),
+                "\"rk4\" or \"adaptive\"",
+            ))
+        }
     };
     if let Some(t) = a.tolerance {
         o.newton.tolerance = t;
     }
     if let Some(m) = a.max_iterations {
-        o.newton.max_iterations = count("max_iterations", m)?;
+        o.newton.max_iterations = count("max_iterations", m, 1, MAX_ITERATIONS)?;
     }
     if let Some(c) = a.continuation {
         o.newton.continuation = c;
     }
     if let Some(m) = a.max_load_steps {
-        o.newton.max_load_steps = count("max_load_steps", m)?;
+        o.newton.max_load_steps = count("max_load_steps", m, 1, MAX_ITERATIONS)?;
     }
     if let Some(t) = a.throw {
         o.newton.throw = t;
@@ -82,25 +87,26 @@ pub(crate) fn solve_options(a: &OptionArgs<'_>) -> PyResult<SolveOptions> {
     if let Some(w) = &a.warm_start {
         o.warm_start = Some(if let Ok(s) = w.cast::<StaticsSolution>() {
             s.get().inner.warm_start()
-        } else if let Ok(b) = w.extract::<[f64; 6]>() {
-            softrod::WarmStart::wrench(b)
         } else {
-            return Err(param_err(
+            let b = floats_n(
+                w,
                 "warm_start",
-                "<object>",
-                "a StaticsSolution or a base wrench [force; moment] of 6 floats",
-            ));
+                6,
+                "a StaticsSolution or a base wrench [force; moment] of 6 numbers (N, N m)",
+            )?;
+            softrod::WarmStart::wrench([b[0], b[1], b[2], b[3], b[4], b[5]])
         });
     }
+    o.validate().map_err(to_py_err)?;
     Ok(o)
 }
 
-/// The core model and actuation of the user's objects, with the error slots of their
-/// callables.
+/// The core model and actuation of the user's objects.
 pub(crate) struct Problem {
     pub(crate) model: Arc<softrod::RobotModel>,
     pub(crate) actuation: softrod::Actuation,
-    pub(crate) slots: Vec<ErrorSlot>,
+    /// Whether a Python callable is part of the model (parallel work needs its own pool).
+    pub(crate) has_callables: bool,
 }
 
 impl Problem {
@@ -110,24 +116,16 @@ impl Problem {
         loads: Option<&Loads>,
         chambers: &[Bound<'_, Chamber>],
     ) -> PyResult<Self> {
-        let mut slots: Vec<ErrorSlot> = rod.slots.clone();
-        slots.extend(tendons.iter().map(|t| t.get().slot.clone()));
-        slots.extend(chambers.iter().map(|c| c.get().slot.clone()));
-        if let Some(l) = loads {
-            slots.push(l.slot.clone());
-        }
-        let model = softrod::RobotModel::new(
-            rod.inner.clone(),
-            tendons.iter().map(|t| t.get().inner.clone()).collect(),
-            chambers.iter().map(|c| c.get().inner.clone()).collect(),
-            loads.map(|l| l.inner.clone()).unwrap_or_default(),
-        )
-        .map_err(|e| {
-            // A callable that raised during validation is the cause: report its exception.
-            slots
-                .iter()
-                .find_map(ErrorSlot::take)
-                .unwrap_or_else(|| to_py_err(e))
+        let (r, l) = (rod.inner.clone(), loads.map(|l| l.inner.clone()));
+        let ts: Vec<softrod::Tendon> = tendons.iter().map(|t| t.get().inner.clone()).collect();
+        let cs: Vec<softrod::Chamber> = chambers.iter().map(|c| c.get().inner.clone()).collect();
+        let has_callables = rod.has_callables()
+            || tendons.iter().any(|t| t.get().has_callables())
+            || chambers.iter().any(|c| c.get().has_callables())
+            || loads.is_some_and(Loads::has_callables);
+        // Validation calls the callables on the rod's check points.
+        let model = run_attached("RobotModel", || {
+            softrod::RobotModel::new(r, ts, cs, l.unwrap_or_default())
         })?;
         let tensions: Vec<f64> = tendons.iter().map(|t| t.get().tension).collect();
         let pressures: Vec<f64> = chambers.iter().map(|c| c.get().pressure).collect();
@@ -135,13 +133,37 @@ impl Problem {
         Ok(Self {
             model,
             actuation,
-            slots,
+            has_callables,
         })
     }
+}
 
-    /// The first exception raised by a Python callable during a computation, if any.
-    pub(crate) fn callback_error(&self) -> Option<PyErr> {
-        self.slots.iter().find_map(ErrorSlot::take)
+/// The core's `tensions[i]` / `pressures[i]` as the Python objects that carry them:
+/// `tendons[i].tension`, `chambers[i].pressure`.
+pub(crate) fn actuator_names(e: softrod::Error) -> softrod::Error {
+    match e {
+        softrod::Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => {
+            let rename = |prefix: &str, object: &str, field: &str| -> Option<String> {
+                let index = name.strip_prefix(prefix)?.strip_suffix(']')?;
+                index
+                    .parse::<usize>()
+                    .ok()
+                    .map(|i| format!("{object}[{i}].{field}"))
+            };
+            let name = rename("tensions[", "tendons", "tension")
+                .or_else(|| rename("pressures[", "chambers", "pressure"))
+                .unwrap_or(name);
+            softrod::Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            }
+        }
+        other => other,
     }
 }
 
@@ -153,16 +175,8 @@ impl Problem {
 pub(crate) struct StaticsSolution {
     pub(crate) inner: softrod::StaticsSolution,
     cache: [PyOnceLock<Py<PyAny>>; 12],
-    /// Error slots of the callables of the problem it solves.
-    pub(crate) slots: Vec<ErrorSlot>,
     /// The call that produced it (for pickling: it is solved again, bit for bit).
     call: Args,
-}
-
-impl StaticsSolution {
-    pub(crate) fn callback_error(&self) -> Option<PyErr> {
-        self.slots.iter().find_map(ErrorSlot::take)
-    }
 }
 
 fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
@@ -425,24 +439,25 @@ fn report_unstable(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
     py: Python<'py>,
-    rod: &Bound<'py, Rod>,
-    tendons: Vec<Bound<'py, Tendon>>,
-    loads: Option<&Bound<'py, Loads>>,
-    integrator: Option<&'py str>,
-    steps: Option<i64>,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    tolerance: Option<f64>,
-    max_iterations: Option<i64>,
-    continuation: Option<bool>,
-    max_load_steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rod)] rod: Bound<'py, Rod>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: Vec<Bound<'py, Tendon>>,
+    #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'py, Loads>>,
+    #[pyo3(from_py_with = arg::integrator)] integrator: Option<&'py str>,
+    #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+    #[pyo3(from_py_with = arg::continuation)] continuation: Option<bool>,
+    #[pyo3(from_py_with = arg::max_load_steps)] max_load_steps: Option<i64>,
     warm_start: Option<Bound<'py, PyAny>>,
-    throw: Option<bool>,
-    chambers: Vec<Bound<'py, Chamber>>,
+    #[pyo3(from_py_with = arg::throw)] throw: Option<bool>,
+    #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
     s_out: Option<Bound<'py, PyAny>>,
-    seek_stable: Option<bool>,
+    #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
     on_unstable: Option<&'py str>,
 ) -> PyResult<StaticsSolution> {
+    let warm_start = warm_start.filter(|w| !w.is_none());
     let unstable = self::on_unstable(on_unstable)?;
     let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
     let args = OptionArgs {
@@ -459,12 +474,16 @@ pub(crate) fn solve_statics<'py>(
         seek_stable,
     };
     let options = solve_options(&args)?;
-    let problem = Problem::new(rod.get(), &tendons, loads.map(Bound::get), &chambers)?;
+    let problem = Problem::new(
+        rod.get(),
+        &tendons,
+        loads.as_ref().map(Bound::get),
+        &chambers,
+    )?;
     let (model, act) = (&problem.model, &problem.actuation);
-    let result = py.detach(|| softrod::solve_statics_at(model, act, &options, &s_values));
-    if let Some(err) = problem.callback_error() {
-        return Err(err);
-    }
+    let result = run(py, "solve_statics", || {
+        softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
+    })?;
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(
         py,
@@ -513,9 +532,8 @@ pub(crate) fn solve_statics<'py>(
         ],
     )?;
     let sol = StaticsSolution {
-        inner: result.map_err(to_py_err)?,
+        inner: result,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
-        slots: problem.slots,
         call,
     };
     report_unstable(py, sol, unstable)
@@ -529,45 +547,36 @@ pub(crate) fn solve_statics<'py>(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _time_solve_statics<'py>(
     py: Python<'py>,
-    rod: &Bound<'py, Rod>,
-    tendons: Vec<Bound<'py, Tendon>>,
-    loads: Option<&Bound<'py, Loads>>,
-    repeats: i64,
-    integrator: Option<&'py str>,
-    steps: Option<i64>,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::rod)] rod: Bound<'py, Rod>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: Vec<Bound<'py, Tendon>>,
+    #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'py, Loads>>,
+    #[pyo3(from_py_with = arg::repeats)] repeats: i64,
+    #[pyo3(from_py_with = arg::integrator)] integrator: Option<&'py str>,
+    #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
     warm_start: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Vec<f64>> {
-    let repeats = count("repeats", repeats)?;
+    let repeats = count("repeats", repeats, 1, softrod::limits::MAX_SAMPLES)?;
     let options = solve_options(&OptionArgs {
         integrator,
         steps,
         rtol,
         atol,
         tolerance,
-        warm_start,
+        warm_start: warm_start.filter(|w| !w.is_none()),
         ..Default::default()
     })?;
-    let problem = Problem::new(rod.get(), &tendons, loads.map(Bound::get), &[])?;
+    let problem = Problem::new(rod.get(), &tendons, loads.as_ref().map(Bound::get), &[])?;
     let (model, act) = (&problem.model, &problem.actuation);
-    let times = py.detach(|| {
-        (0..repeats)
-            .map(|_| {
-                let t0 = std::time::Instant::now();
-                let r = softrod::solve_statics(model, act, &options);
-                (t0.elapsed().as_secs_f64(), r.is_ok())
-            })
-            .collect::<Vec<_>>()
-    });
-    if let Some(err) = problem.callback_error() {
-        return Err(err);
-    }
-    if times.iter().any(|(_, ok)| !ok) {
-        if let Err(e) = softrod::solve_statics(model, act, &options) {
-            return Err(to_py_err(e));
+    run(py, "_time_solve_statics", || {
+        let mut times = Vec::with_capacity(repeats);
+        for _ in 0..repeats {
+            let t0 = std::time::Instant::now();
+            softrod::solve_statics(model, act, &options)?;
+            times.push(t0.elapsed().as_secs_f64());
         }
-    }
-    Ok(times.into_iter().map(|(t, _)| t).collect())
+        Ok(times)
+    })
 }

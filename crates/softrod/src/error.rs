@@ -2,7 +2,8 @@
 //!
 //! Every fallible public function returns [`Result<T>`]. The binding maps
 //! [`Error::InvalidParameter`] to a `ValueError` subclass and
-//! [`Error::NotConverged`] to a `RuntimeError` subclass, in one place.
+//! [`Error::NotConverged`] to a `RuntimeError` subclass (and [`Error::TargetUnreachable`] to a
+//! subclass of that), in one place.
 
 use thiserror::Error;
 
@@ -37,6 +38,21 @@ pub enum Error {
         /// (and for solvers without load steps).
         load_factor: f64,
     },
+    /// Inverse statics: the target cannot be reached within the actuation bounds; the closest
+    /// reachable pose found is this far from it.
+    #[error(
+        "target out of reach: the closest pose found is {distance:.3e} m (and {rotation:.3e} rad) \
+         from it after {iterations} iterations"
+    )]
+    TargetUnreachable {
+        /// Remaining distance to the target position (m; the largest over the points of a
+        /// shape target).
+        distance: f64,
+        /// Remaining rotation to the target orientation (rad; 0 without one).
+        rotation: f64,
+        /// Iterations taken.
+        iterations: usize,
+    },
 }
 
 /// The load factor in a convergence message, when it is not the full load.
@@ -68,9 +84,16 @@ impl Error {
         value: impl std::fmt::Display,
         expected: impl Into<String>,
     ) -> Self {
+        let mut value = value.to_string();
+        // A huge or tiny float prints as hundreds of digits: show it in scientific notation.
+        if value.len() > 24 {
+            if let Ok(v) = value.parse::<f64>() {
+                value = format!("{v:e}");
+            }
+        }
         Error::InvalidParameter {
             name: name.into(),
-            value: value.to_string(),
+            value,
             expected: expected.into(),
         }
     }

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{assert_blocks_close, castigliano_arc};
+use common::{assert_blocks_close, castigliano_arc, timoshenko};
 
 use std::f64::consts::PI;
 
@@ -41,28 +41,8 @@ fn rot_of(sol: &StaticsSolution, i: usize) -> Matrix3<f64> {
     )
 }
 
-fn timoshenko(l: f64, ei: f64, gj: f64, ea: f64, gas: Option<f64>) -> Matrix6<f64> {
-    let lat = l.powi(3) / (3.0 * ei) + gas.map_or(0.0, |g| l / g);
-    let mut c = Matrix6::zeros();
-    c[(0, 0)] = lat;
-    c[(1, 1)] = lat;
-    c[(2, 2)] = if gas.is_some() { l / ea } else { 0.0 };
-    c[(3, 3)] = l / ei;
-    c[(4, 4)] = l / ei;
-    c[(5, 5)] = l / gj;
-    // Convention of se3.rs: a tip moment m_y moves the tip along +x, m_x along -y.
-    c[(0, 4)] = l * l / (2.0 * ei);
-    c[(4, 0)] = c[(0, 4)];
-    c[(1, 3)] = -l * l / (2.0 * ei);
-    c[(3, 1)] = c[(1, 3)];
-    c
-}
-
 fn section_constants(k: f64) -> (f64, f64, f64, f64) {
-    let g = E / (2.0 * (1.0 + NU));
-    let a = PI * RADIUS * RADIUS;
-    let i = PI * RADIUS.powi(4) / 4.0;
-    (E * i, g * 2.0 * i, E * a, k * g * a)
+    common::circular_constants(E, NU, RADIUS, k)
 }
 
 #[test]

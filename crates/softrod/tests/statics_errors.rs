@@ -259,16 +259,20 @@ fn bad_loads_and_options_are_named() {
 #[test]
 fn extreme_inputs_never_panic() {
     // Enormous tensions (the tendon path folds back), loads, stiffnesses and tiny step counts:
-    // each returns a result or an error.
+    // each returns a result, a convergence error, or (beyond the load limit) a named error.
     for e in [1e-6, 1.0, 1e12, 1e300] {
         for tau in [0.0, 1e-9, 1.0, 1e6, 1e15] {
             for f in [0.0, 1e-3, 1e3, 1e12] {
-                let rod = Rod::new(
-                    0.3,
-                    Section::circular(0.002).unwrap(),
-                    LinearElastic::new(e, 0.3).unwrap(),
-                )
-                .unwrap();
+                let material = match LinearElastic::new(e, 0.3) {
+                    Ok(m) => m,
+                    Err(err) => {
+                        // Beyond softrod::limits::MAX_MODULUS: a named error, not a solve.
+                        assert_eq!(name_of::<()>(Err(err)), "youngs_modulus");
+                        assert!(e > softrod::limits::MAX_MODULUS);
+                        continue;
+                    }
+                };
+                let rod = Rod::new(0.3, Section::circular(0.002).unwrap(), material).unwrap();
                 let t = common::tendon([0.0015, 0.0], tau, Some(0.2)).unwrap();
                 let loads = Loads::tip_force(Vector3::new(f, 0.0, -f));
                 let opts = SolveOptions {
@@ -296,7 +300,18 @@ fn extreme_inputs_never_panic() {
                         ..opts
                     },
                 );
-                assert!(r2.is_ok() || matches!(r2, Err(Error::NotConverged { .. })));
+                // Loads beyond softrod::limits::MAX_LOAD_NUMBER are refused by name.
+                let refused = |r: &softrod::Result<_>| {
+                    matches!(r, Err(Error::InvalidParameter { name, .. })
+                        if name.starts_with("loads.") || name.starts_with("tensions["))
+                };
+                assert!(r.is_ok() || matches!(r, Err(Error::NotConverged { .. })) || refused(&r));
+                assert!(
+                    r2.is_ok() || matches!(r2, Err(Error::NotConverged { .. })) || refused(&r2)
+                );
+                let number =
+                    f * 2f64.sqrt() * 0.09 / (e * std::f64::consts::PI * 0.002f64.powi(4) / 4.0);
+                assert_eq!(refused(&r2), number > softrod::limits::MAX_LOAD_NUMBER);
             }
         }
     }

@@ -1,22 +1,30 @@
 """Analyses built on the solvers: backbone comparison at equal arm index, models side by side,
-workspace maps, tensile curves and material fits, and the compliance study of soft arms."""
+workspace maps, tensile curves and material fits, the compliance study of soft arms, and design
+sweeps with their summaries."""
 
 from .compare import BackboneDistance, backbone_distance
+from .design import Pareto, design_summary
 from .materials import TensileCurve, read_tensile_csv
 from .models import ModelComparison, ModelResult, compare_models
 from .study import seed001_study
+from .sweep import SampleTable, samples, sweep
 from .workspace import WorkspaceMap, tension_grid, workspace_map
 
 __all__ = [
     "BackboneDistance",
     "ModelComparison",
     "ModelResult",
+    "Pareto",
+    "SampleTable",
     "TensileCurve",
     "WorkspaceMap",
     "backbone_distance",
     "compare_models",
+    "design_summary",
     "read_tensile_csv",
+    "samples",
     "seed001_study",
+    "sweep",
     "tension_grid",
     "workspace_map",
 ]

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _args
 from .._core import ParameterError, UniaxialFit, fit_uniaxial
 
 __all__ = ["FitCheck", "TensileCurve", "check_fit", "read_tensile_csv"]
@@ -80,6 +81,27 @@ class TensileCurve:
     stress_measure: str = "nominal"
     name: str = ""
     metadata: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        # Data are checked on construction: finite 1-d columns of one length.
+        strain = _args.finite_array(self.strain, "strain", ndim=1)
+        stress = _args.finite_array(self.stress, "stress", ndim=1)
+        if strain.size == 0 or stress.shape != strain.shape:
+            raise _bad(
+                "stress",
+                f"{stress.size} values (strain has {strain.size})",
+                "as many values as strain, at least one",
+            )
+        if self.strain_measure not in _STRAIN_MEASURES:
+            raise _bad("strain_measure", repr(self.strain_measure), " or ".join(_STRAIN_MEASURES))
+        if self.stress_measure not in _STRESS_MEASURES:
+            raise _bad("stress_measure", repr(self.stress_measure), " or ".join(_STRESS_MEASURES))
+        if not isinstance(self.name, str):
+            raise _args.type_error("name", self.name, "a string")
+        if not isinstance(self.metadata, dict):
+            raise _args.type_error("metadata", self.metadata, "a dict of strings")
+        object.__setattr__(self, "strain", strain)
+        object.__setattr__(self, "stress", stress)
 
     @property
     def stretch(self) -> np.ndarray:
@@ -241,7 +263,7 @@ def read_tensile_csv(
         ParameterError: If the content or an option is not valid; the message names it (for a
             bad line, ``file:line``).
     """
-    path = Path(path)
+    path = _args.path(path)
     text = path.read_text(encoding="utf-8-sig", errors="replace")
     lines = text.splitlines()
     header_at = next(

@@ -2,8 +2,8 @@
 
 Models, from the most general: ``cosserat`` (the reference, :meth:`Robot.solve`), ``pcc``
 (:func:`softrod.pcc.solve`, one segment per distinct tendon end or chamber boundary) and
-``planar`` (the seed-000 closed-form arm, :class:`softrod.PlanarCableArm`). A model that does
-not apply is listed with the reason.
+``planar`` (the planar cable-arm paper's closed-form arm, :class:`softrod.PlanarCableArm`).
+A model that does not apply is listed with the reason.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import pcc
+from .. import _args, pcc
 from .._core import ParameterError, PlanarCableArm
 from ..io import robot_file as rf
 from ..io.robot_file import RobotFile
@@ -29,6 +29,8 @@ __all__ = ["ModelComparison", "ModelResult", "compare_models"]
 
 #: Default number of timed solves per model (the reported time is their median).
 DEFAULT_REPEATS = 5
+#: Most timed solves per model.
+MAX_REPEATS = 10_000
 #: Relative tolerance on segment breaks (m/m): closer tendon ends or chamber bounds merge.
 _END_TOLERANCE = 1e-12
 _NO_SOURCE = "the robot's section, material and routings cannot be read back to map it"
@@ -333,17 +335,17 @@ def compare_models(
 
     The Cosserat model (:meth:`Robot.solve`) is the reference. PCC applies to a uniform
     circular, linear-elastic rod with constant-offset tendons, chambers and a world-frame tip
-    wrench (one segment per distinct tendon end or chamber boundary). The seed-000 planar
-    model applies to a single radius-proportional tendon (anchored where it ends) on a circular
-    or tapered section without external loads (its plane holds the rod's axis and the
-    tendon's direction). The PCC and planar backbones are sampled at the material points of
-    the Cosserat mesh nodes (undeformed arc length), so that the backbone distance at equal
-    arm index compares like with like.
+    wrench (one segment per distinct tendon end or chamber boundary). The planar model of the
+    planar cable-arm paper applies to a single radius-proportional tendon (anchored where it
+    ends) on a circular or tapered section without external loads (its plane holds the rod's
+    axis and the tendon's direction). The PCC and planar backbones are sampled at the material
+    points of the Cosserat mesh nodes (undeformed arc length), so that the backbone distance
+    at equal arm index compares like with like.
 
     Args:
         robot: A :class:`Robot` or the path of its description file (TOML).
         tensions: Tendon tensions (N), one per tendon, instead of the file's.
-        repeats: Timed solves per model (the median is reported), >= 1.
+        repeats: Timed solves per model (the median is reported), in [1, MAX_REPEATS].
 
     Returns:
         The results, Cosserat first, then PCC and planar (applicable or not).
@@ -352,10 +354,11 @@ def compare_models(
         ParameterError: A bad robot file, tensions, ``repeats`` or ``n_points``.
         ConvergenceError: A model's solve fails.
     """
-    if int(repeats) < 1:
-        raise ParameterError(f"invalid parameter `repeats` = {repeats}: must be >= 1")
+    repeats = _args.count(repeats, "repeats", 1, MAX_REPEATS)
     if not isinstance(robot, Robot):
-        robot = load_robot(robot)
+        if not isinstance(robot, (str, os.PathLike)):
+            raise _args.type_error("robot", robot, "a Robot or the path of a robot file")
+        robot = load_robot(_args.path(robot, "robot"))
     if tensions is not None:
         robot = robot.with_tensions(tensions)
     sol, dt = _median_time(robot.solve, int(repeats))

@@ -1,4 +1,6 @@
-"""Workspace maps (seed 001, Fig. 1d): tendon-tension sweeps with tip stiffness measures.
+"""Workspace maps (the compliance-methodology paper, Fig. 1d).
+
+Tendon-tension sweeps with tip stiffness measures.
 
 The compliance itself is computed in the compiled core: :func:`softrod.compliance`,
 :func:`softrod.tangent_compliance`, :func:`softrod.eigenscrews`. This module sweeps tendon
@@ -13,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _args
 from .._core import Loads, ParameterError, Rod, Tendon, _workspace_map
 
 
@@ -55,11 +58,23 @@ def tension_grid(n_tendons: int, axes: dict[int, np.ndarray]) -> np.ndarray:
     Returns:
         Tensions, shape (product of the axis lengths, n_tendons).
     """
+    n_tendons = _args.count(n_tendons, "n_tendons", 1, _args.MAX_SAMPLES)
+    if not isinstance(axes, dict):
+        raise _args.type_error("axes", axes, "a dict: tendon index -> 1-d array of tensions")
     keys = list(axes)
     if not 1 <= len(keys) <= 2:
         raise ParameterError("invalid parameter `axes`: must name one or two tendons")
-    a = np.asarray(axes[keys[0]], dtype=float)
-    b = np.asarray(axes[keys[1]], dtype=float) if len(keys) == 2 else np.zeros(1)
+    for k in keys:
+        _args.count(k, "axes", 0, n_tendons - 1)
+    a, b = (
+        _args.finite_array(axes[k], f"axes[{k}]", ndim=1) if k is not None else np.zeros(1)
+        for k in (keys[0], keys[1] if len(keys) == 2 else None)
+    )
+    if a.size * b.size * n_tendons > 100 * _args.MAX_SAMPLES:
+        raise ParameterError(
+            f"invalid parameter `axes`: {a.size * b.size} rows of {n_tendons} tensions: must be "
+            f"at most {100 * _args.MAX_SAMPLES} values"
+        )
     rows = []
     for i, ta in enumerate(a):
         for tb in b if i % 2 == 0 else b[::-1]:
@@ -105,12 +120,15 @@ def workspace_map(
     """
     from tqdm.auto import tqdm
 
+    if isinstance(tendons, (str, bytes)) or not hasattr(tendons, "__iter__"):
+        raise _args.type_error("tendons", tendons, "a sequence of Tendon")
     tendons: list[Tendon] = list(tendons)
-    t = np.ascontiguousarray(np.atleast_2d(np.asarray(tensions, dtype=float)))
+    t = np.ascontiguousarray(np.atleast_2d(_args.finite_array(tensions, "tensions")))
     parts = []
     total = len(t)
-    if int(block) < 1:
-        raise ParameterError(f"invalid parameter `block` = {block}: must be >= 1")
+    block = _args.count(block, "block", 1, 2**62)
+    if progress is not None:
+        progress = _args.flag(progress, "progress")
     bar = tqdm(
         total=total,
         desc="workspace",

@@ -39,9 +39,17 @@ def bad(option: str, value: object, expected: str) -> ParameterError:
     return exc
 
 
-def files(parser: argparse.ArgumentParser, *, inputs=(), outputs=(), figures=()) -> None:
-    """Declares which destinations of ``parser`` are input and output files."""
-    parser.set_defaults(_inputs=tuple(inputs), _outputs=tuple(outputs), _figures=tuple(figures))
+def files(
+    parser: argparse.ArgumentParser, *, inputs=(), outputs=(), figures=(), folders=("out",)
+) -> None:
+    """Declares which destinations of ``parser`` are input and output files (``folders``:
+    the outputs that are folders, by default ``out``)."""
+    parser.set_defaults(
+        _inputs=tuple(inputs),
+        _outputs=tuple(outputs),
+        _figures=tuple(figures),
+        _folders=tuple(folders),
+    )
 
 
 def option_name(dest: str) -> str:
@@ -96,6 +104,7 @@ def check_files(args: argparse.Namespace) -> None:
         (d, getattr(args, d)) for d in getattr(args, "_outputs", ()) if getattr(args, d, None)
     ]
     figures = set(getattr(args, "_figures", ()))
+    folders = set(getattr(args, "_folders", ("out",)))
     seen: list[tuple[str, str]] = []
     for dest, path in outputs:
         name = option_name(dest)
@@ -108,9 +117,9 @@ def check_files(args: argparse.Namespace) -> None:
         for other, other_path in seen:
             if _same(path, other_path):
                 raise bad(name, path, f"is also the output of {option_name(other)}")
-        if os.path.isdir(path) and dest != "out":
+        if os.path.isdir(path) and dest not in folders:
             raise bad(name, path, "is a folder (give a file name)")
-        if dest == "out":
+        if dest in folders:
             if os.path.exists(path) and not os.path.isdir(path):
                 raise bad(name, path, "is a file (give a folder)")
         else:

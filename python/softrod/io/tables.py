@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _args
 from .._core import ParameterError, PlanarSolution, StaticsSolution
 
 __all__ = [
@@ -46,9 +47,12 @@ def read_backbone_csv(
     Raises:
         ParameterError: Unreadable numbers, fewer than two points, or a bad ``scale``.
     """
-    if not (np.isfinite(scale) and scale > 0):
-        raise ParameterError(f"invalid parameter `scale` = {scale}: must be finite and > 0")
-    with open(path, newline="", encoding="utf-8") as fh:
+    scale = _args.number(scale, "scale", positive=True)
+    if columns is not None:
+        if isinstance(columns, (str, bytes)) or not hasattr(columns, "__iter__"):
+            raise _args.type_error("columns", columns, "a sequence of 2 or 3 column indices")
+        columns = [_args.count(c, f"columns[{i}]", 0, 2**31) for i, c in enumerate(columns)]
+    with open(_args.path(path), newline="", encoding="utf-8") as fh:
         text = fh.read()
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
@@ -113,7 +117,13 @@ def write_samples_csv(path: str | os.PathLike[str], solutions: Sequence[PlanarSo
 
     Columns: ``tension, s, curvature, strain, angle, x, y`` (SI units), one row per sample.
     """
-    with open(path, "w", newline="", encoding="utf-8") as fh:
+    if isinstance(solutions, (str, bytes)) or not hasattr(solutions, "__iter__"):
+        raise _args.type_error("solutions", solutions, "a sequence of PlanarSolution")
+    solutions = list(solutions)
+    for i, sol in enumerate(solutions):
+        if not isinstance(sol, PlanarSolution):
+            raise _args.type_error(f"solutions[{i}]", sol, "a PlanarSolution")
+    with open(_args.path(path), "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(("tension", *SAMPLE_FIELDS))
         for sol in solutions:

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import _args
 from .._core import ParameterError
 
 __all__ = ["Backbone", "BackboneQuality"]
@@ -154,7 +155,7 @@ class Backbone:
         Raises:
             ParameterError: ``u`` outside [0, 1] or not finite.
         """
-        ua = np.asarray(u, dtype=np.float64)
+        ua = _args.finite_array(u, "u")
         if not np.all(np.isfinite(ua)) or np.any(ua < 0) or np.any(ua > 1):
             raise parameter_error("u", f"arm index {u!r} must be finite and in [0, 1]")
         t = self.arm_index
@@ -166,10 +167,9 @@ class Backbone:
         """The same backbone at ``n`` points uniform in arc length (linear interpolation).
 
         Raises:
-            ParameterError: ``n`` < 2.
+            ParameterError: ``n`` not in ``[2, MAX_SAMPLES]``.
         """
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-            raise parameter_error("n", f"{n!r} must be an integer >= 2")
+        n = _args.count(n, "n", 2, _args.MAX_SAMPLES)
         s = np.linspace(0.0, self.length, int(n))
         s[-1] = self.arc_length[-1]
 
@@ -214,7 +214,8 @@ class Backbone:
         Raises:
             FileExistsError: ``path`` exists and ``overwrite`` is False.
         """
-        mode = "w" if overwrite else "x"
+        path = _args.path(path)
+        mode = "w" if _args.flag(overwrite, "overwrite") else "x"
         frame = {k: v for k, v in self.to_dict().items() if k in _FRAME_KEYS}
         with open(path, mode, newline="", encoding="utf-8") as fh:
             fh.write(
@@ -235,6 +236,7 @@ class Backbone:
             ParameterError: Not a backbone file (missing frame or columns).
         """
         meta: dict[str, Any] = {}
+        path = _args.path(path)
         with open(path, encoding="utf-8") as fh:
             for line in fh:
                 if not line.startswith("#"):

@@ -9,6 +9,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
+from .. import _args
+from .._core import MAX_LENGTH
 from .backbone import Backbone, BackboneQuality, parameter_error
 from .centreline import fit_centreline
 from .segment import mask_segmentation, read_image, segment, to_grey
@@ -20,6 +22,8 @@ POINT_SPACING = 1.0
 #: A given base within max(this (px), a quarter half-width) of the visible end, along the
 #: arm's axis, is taken as the end itself (no extrapolation, no trimming).
 BASE_TOLERANCE = 1.0
+#: Smallest knot spacing of the centreline spline (px): closer knots fit pixel noise.
+MIN_KNOT_SPACING = 1.0
 #: Ends whose half-widths differ by less than this ratio cannot tell base from tip.
 WIDTH_RATIO_MIN = 1.05
 
@@ -152,17 +156,19 @@ def extract_backbone(
     arr = read_image(image)
     grey = to_grey(arr)
     scale = _positive("scale", scale)
+    if scale is not None and scale > MAX_LENGTH:
+        raise parameter_error("scale", f"{scale!r} must be <= {MAX_LENGTH:g} m per pixel")
     base_px = _pair("base", base)
     dir_px = _pair("direction", direction)
     if dir_px is not None and np.hypot(*dir_px) == 0:
         raise parameter_error("direction", f"{direction!r} must be non-zero")
     if polarity not in (None, "bright", "dark"):
         raise parameter_error("polarity", f"{polarity!r} must be 'bright', 'dark' or None")
-    if n_points is not None and (
-        isinstance(n_points, bool) or not isinstance(n_points, (int, np.integer)) or n_points < 2
-    ):
-        raise parameter_error("n_points", f"{n_points!r} must be an integer >= 2")
+    if n_points is not None:
+        n_points = _args.count(n_points, "n_points", 2, _args.MAX_SAMPLES)
     knot_spacing = _positive("knot_spacing", knot_spacing)
+    if knot_spacing is not None and knot_spacing < MIN_KNOT_SPACING:
+        raise parameter_error("knot_spacing", f"{knot_spacing!r} must be >= {MIN_KNOT_SPACING} px")
     if min_area is not None and (
         isinstance(min_area, bool) or not isinstance(min_area, (int, np.integer)) or min_area < 1
     ):

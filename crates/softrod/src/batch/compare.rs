@@ -28,11 +28,15 @@ fn arm_index(points: &[f64], dim: usize, name: &str) -> Result<Vec<f64>> {
     if n < 2 {
         return Err(Error::invalid(format!("{name}.shape[0]"), n, ">= 2 points"));
     }
-    if let Some(i) = points.iter().position(|v| !v.is_finite()) {
+    let max = crate::limits::MAX_LENGTH;
+    if let Some(i) = points
+        .iter()
+        .position(|v| !(v.is_finite() && v.abs() <= max))
+    {
         return Err(Error::invalid(
             format!("{name}[{}, {}]", i / dim, i % dim),
             points[i],
-            "finite",
+            format!("finite and of magnitude <= {max:e} m"),
         ));
     }
     let mut u = Vec::with_capacity(n);

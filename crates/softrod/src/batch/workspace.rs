@@ -83,6 +83,9 @@ pub fn workspace_map(
     if chunk == 0 {
         return Err(Error::invalid("chunk", chunk, ">= 1"));
     }
+    if tensions.is_empty() {
+        return Ok(Vec::new());
+    }
     for (i, t) in tensions.iter().enumerate() {
         if !(t.is_finite() && *t >= 0.0) {
             return Err(Error::invalid(

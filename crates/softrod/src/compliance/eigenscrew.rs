@@ -100,7 +100,8 @@ fn axis(a: &Vector3<f64>, b: &Vector3<f64>) -> ([f64; 3], [f64; 3], f64) {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `matrix` if it is not finite, not symmetric (to 1e-9
-/// relative) or not positive definite.
+/// relative), not positive definite, or so large or ill-conditioned that its decomposition
+/// overflows.
 pub fn eigenscrews(m: &Matrix6<f64>, kind: MatrixKind) -> Result<Decomposition> {
     if !m.iter().all(|v| v.is_finite()) {
         return Err(Error::invalid("matrix", "non-finite entries", "finite"));
@@ -158,9 +159,33 @@ pub fn eigenscrews(m: &Matrix6<f64>, kind: MatrixKind) -> Result<Decomposition> 
     };
     let ctt = c.fixed_view::<3, 3>(0, 0).into_owned();
     let crr = c.fixed_view::<3, 3>(3, 3).into_owned();
-    Ok(Decomposition {
+    let d = Decomposition {
         screws,
         translational: ellipsoid(&ctt),
         rotational: ellipsoid(&crr),
-    })
+    };
+    // Entries near the float range overflow the decomposition (squares, inverses).
+    let finite = d.screws.iter().all(|s| {
+        s.value.is_finite()
+            && s.pitch.is_finite()
+            && s.vector
+                .iter()
+                .chain(&s.direction)
+                .chain(&s.point)
+                .all(|v| v.is_finite())
+    }) && [d.translational, d.rotational].iter().all(|e| {
+        e.semi_axes
+            .iter()
+            .chain(e.directions.iter().flatten())
+            .all(|v| v.is_finite())
+    });
+    if !finite {
+        return Err(Error::invalid(
+            "matrix",
+            format!("entries up to {:.3e}", m.amax()),
+            "a matrix whose decomposition is representable (its entries, their squares and its \
+             inverse finite)",
+        ));
+    }
+    Ok(d)
 }

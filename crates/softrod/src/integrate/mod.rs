@@ -71,9 +71,12 @@ impl AdaptiveOptions {
         if !(self.atol.is_finite() && self.atol > 0.0) {
             return Err(Error::invalid("atol", self.atol, "finite and > 0"));
         }
-        if self.max_steps == 0 {
-            return Err(Error::invalid("max_steps", self.max_steps, ">= 1"));
-        }
+        crate::limits::check_count(
+            "max_steps",
+            self.max_steps,
+            1,
+            crate::limits::MAX_ITERATIONS,
+        )?;
         Ok(self)
     }
 }

@@ -33,6 +33,34 @@ pub struct PointLoad {
 }
 
 impl PointLoad {
+    /// A validated point load: `s` (m) finite and > 0 (`<= L` is checked with the rod),
+    /// `force` (N) and `moment` (N m) finite.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `s`, `force[k]` or `moment[k]`.
+    pub fn new(s: f64, force: Vector3<f64>, moment: Vector3<f64>, frame: Frame) -> Result<Self> {
+        let p = Self {
+            s,
+            force,
+            moment,
+            frame,
+        };
+        p.check_values("")?;
+        Ok(p)
+    }
+
+    fn check_values(&self, prefix: &str) -> Result<()> {
+        if !(self.s.is_finite() && self.s > 0.0) {
+            return Err(Error::invalid(
+                format!("{prefix}s"),
+                self.s,
+                "finite and > 0 m (in (0, length])",
+            ));
+        }
+        check_vec(&format!("{prefix}force"), &self.force)?;
+        check_vec(&format!("{prefix}moment"), &self.moment)
+    }
+
     /// A world-frame force (N) at `s` (m).
     pub fn force(s: f64, force: Vector3<f64>) -> Self {
         Self {
@@ -90,6 +118,30 @@ impl Loads {
             tip_moment: moment,
             ..Self::default()
         }
+    }
+
+    /// Checks the values that do not depend on the rod: the tip and point wrenches and gravity
+    /// finite, point loads at `s > 0`, constant distributed loads finite (functions are
+    /// checked with the rod, on its length).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the field (`tip_force[1]`, `point_loads[2].s`, ...).
+    pub fn check_values(&self) -> Result<()> {
+        check_vec("tip_force", &self.tip_force)?;
+        check_vec("tip_moment", &self.tip_moment)?;
+        check_vec("gravity", &self.gravity)?;
+        for (i, p) in self.point_loads.iter().enumerate() {
+            p.check_values(&format!("point_loads[{i}]."))?;
+        }
+        for (name, f) in [
+            ("distributed_force", &self.distributed_force),
+            ("distributed_moment", &self.distributed_moment),
+        ] {
+            if let Some(Profile::Constant(v)) = f {
+                check_vec(name, v)?;
+            }
+        }
+        Ok(())
     }
 
     /// Checks every value for a rod of `length` (m) with optional `density`.

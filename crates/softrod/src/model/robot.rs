@@ -12,6 +12,8 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 use crate::error::{Error, Result};
+use crate::limits::{check_load, MAX_OFFSET_RATIO};
+use crate::model::actuation::{Actuation, TendonInput};
 use crate::model::chamber::{self, Chamber};
 use crate::model::loads::{Frame, Loads};
 use crate::model::material::TangentCompliance;
@@ -28,6 +30,10 @@ pub struct RobotModel {
     loads: Loads,
     /// Termination of every tendon (m).
     tendon_ends: Vec<f64>,
+    /// Largest distance of every tendon from the backbone (m), over its check points.
+    tendon_reach: Vec<f64>,
+    /// Largest cross-section area of every chamber (m²), over its check points.
+    chamber_area_max: Vec<f64>,
     /// Extent `(start, end)` of every chamber (m).
     chamber_extents: Vec<(f64, f64)>,
     /// Interval end points `0 = b_0 < b_1 < ... = L`.
@@ -85,6 +91,7 @@ impl RobotModel {
         loads.validate(l, rod.density())?;
         let mut breaks = vec![0.0, l];
         let mut tendon_ends = Vec::with_capacity(tendons.len());
+        let mut tendon_reach = Vec::with_capacity(tendons.len());
         for (i, t) in tendons.iter().enumerate() {
             let end = t.end().unwrap_or(l);
             if !(end.is_finite() && end > 0.0 && end <= l) {
@@ -94,17 +101,7 @@ impl RobotModel {
                     format!("in (0, length] = (0, {l}] m"),
                 ));
             }
-            for k in 0..=FUNCTION_CHECKS {
-                let s = end * k as f64 / FUNCTION_CHECKS as f64;
-                let (r, rp) = t.routing().offset(s, &rod.section_at(s));
-                if !(r.iter().chain(rp.iter()).all(|v| v.is_finite())) {
-                    return Err(Error::invalid(
-                        format!("tendons[{i}].offset({s})"),
-                        format!("{r:?}, {rp:?}"),
-                        "finite",
-                    ));
-                }
-            }
+            tendon_reach.push(check_routing(i, t, &rod, end)?);
             breaks.push(end);
             tendon_ends.push(end);
         }
@@ -126,6 +123,16 @@ impl RobotModel {
                 "positive and finite",
             ));
         }
+        check_load_limits(&loads, &rod, force_scale)?;
+        let chamber_area_max = chambers
+            .iter()
+            .zip(&chamber_extents)
+            .map(|(c, &(a, b))| {
+                (0..=FUNCTION_CHECKS)
+                    .map(|k| c.area_at(a + (b - a) * k as f64 / FUNCTION_CHECKS as f64))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
         let rho_g = rod
             .density()
             .filter(|_| loads.gravity != Vector3::zeros())
@@ -149,7 +156,9 @@ impl RobotModel {
             chambers,
             loads,
             tendon_ends,
+            tendon_reach,
             chamber_extents,
+            chamber_area_max,
             breaks,
             force_scale,
             rho_g,
@@ -204,8 +213,158 @@ impl RobotModel {
     pub fn force_free(&self) -> bool {
         self.force_free
     }
+    /// Checks an actuation for this model: one input per actuator (or none), tensions finite
+    /// and >= 0, pressures finite and above vacuum (see [`Actuation::validate`]), and every
+    /// input within [`MAX_LOAD_NUMBER`](crate::limits::MAX_LOAD_NUMBER): a tension `T` by `T (1 + d / L) L² / EI` with `d` the
+    /// tendon's largest offset (its force and its moment `T d`), a pressure `p` by
+    /// `p A (1 + |r| / L) L² / EI` with `A` the chamber's largest area and `r` its offset.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `tensions[i]`, `pressures[i]` or their counts.
+    pub fn check_actuation(&self, actuation: &Actuation) -> Result<()> {
+        actuation.validate(self.tendons.len(), self.chambers.len())?;
+        let l = self.length();
+        for (i, input) in actuation.tendons.iter().enumerate() {
+            match input {
+                TendonInput::Tension(t) => {
+                    let scale = self.force_scale / (1.0 + self.tendon_reach[i] / l);
+                    check_load(&format!("tensions[{i}]"), *t, t.abs(), scale, "N")?;
+                }
+                TendonInput::Displacement { .. } => {}
+            }
+        }
+        for (i, &p) in actuation.pressures.iter().enumerate() {
+            let [x, y] = self.chambers[i].offset();
+            let arm = 1.0 + x.hypot(y) / l;
+            let scale = self.force_scale / (self.chamber_area_max[i] * arm);
+            check_load(&format!("pressures[{i}]"), p, p.abs(), scale, "Pa")?;
+        }
+        Ok(())
+    }
+
+    /// Checks a base wrench `[force; moment]` (N, N m) given by the user (a warm start)
+    /// against [`MAX_LOAD_NUMBER`](crate::limits::MAX_LOAD_NUMBER).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `name[k]` for the first component that is not finite
+    /// or too large.
+    pub fn check_wrench(&self, name: &str, wrench: &[f64; 6]) -> Result<()> {
+        for (k, &w) in wrench.iter().enumerate() {
+            let (scale, unit) = if k < 3 {
+                (self.force_scale, "N")
+            } else {
+                (self.force_scale * self.length(), "N m")
+            };
+            check_load(&format!("{name}[{k}]"), w, w.abs(), scale, unit)?;
+        }
+        Ok(())
+    }
+
     /// The section compliance if it is the same at every `s`.
     pub fn uniform_compliance(&self) -> Option<&TangentCompliance> {
         self.uniform_compliance.as_ref()
     }
+}
+
+/// Checks tendon `i`'s routing on `[0, end]` at the check points: offset and derivative
+/// finite, the distance from the backbone at most [`MAX_OFFSET_RATIO`] of the length (inside the
+/// section, or through spacer disks outside it), and the tendon's path running forward in the
+/// rest shape (`v*_z + u*_x y - u*_y x > 0`: on a precurved rod, a tendon beyond the centre of
+/// the rest curvature would run backwards). Returns the largest distance (m).
+fn check_routing(i: usize, tendon: &Tendon, rod: &Rod, end: f64) -> Result<f64> {
+    let l = rod.length();
+    let max_offset = MAX_OFFSET_RATIO * l;
+    let mut reach: f64 = 0.0;
+    for k in 0..=FUNCTION_CHECKS {
+        let s = end * k as f64 / FUNCTION_CHECKS as f64;
+        let (r, rp) = tendon.routing().offset(s, &rod.section_at(s));
+        if !(r.iter().chain(rp.iter()).all(|v| v.is_finite())) {
+            return Err(Error::invalid(
+                format!("tendons[{i}].offset({s})"),
+                format!("{r:?}, {rp:?}"),
+                "finite",
+            ));
+        }
+        let d = r[0].hypot(r[1]);
+        if d > max_offset {
+            return Err(Error::invalid(
+                format!("tendons[{i}].offset({s})"),
+                format!("{r:?}"),
+                format!(
+                    "at most {MAX_OFFSET_RATIO} x length = {max_offset} m from the backbone \
+                     (distance {d:.6e} m; the section radius there is {:.6e} m)",
+                    rod.section_at(s).radius
+                ),
+            ));
+        }
+        let (v, u) = (rod.rest_strain().at(s), rod.rest_curvature().at(s));
+        let forward = v[2] + u[0] * r[1] - u[1] * r[0];
+        if !(forward > 0.0) {
+            return Err(Error::invalid(
+                format!("tendons[{i}].offset({s})"),
+                format!("{r:?}"),
+                format!(
+                    "on the inner side of the rest curvature closer to the backbone than its \
+                     centre (v*_z + u*_x y - u*_y x = {forward:.3e} must be > 0)"
+                ),
+            ));
+        }
+        reach = reach.max(d);
+    }
+    Ok(reach)
+}
+
+/// Checks every external load against [`MAX_LOAD_NUMBER`](crate::limits::MAX_LOAD_NUMBER) with the force scale `EI / L²`.
+fn check_load_limits(loads: &Loads, rod: &Rod, force_scale: f64) -> Result<()> {
+    let l = rod.length();
+    let (f0, m0) = (force_scale, force_scale * l);
+    let norm = |v: &Vector3<f64>| v.norm();
+    check_load(
+        "loads.tip_force",
+        norm(&loads.tip_force),
+        norm(&loads.tip_force),
+        f0,
+        "N",
+    )?;
+    check_load(
+        "loads.tip_moment",
+        norm(&loads.tip_moment),
+        norm(&loads.tip_moment),
+        m0,
+        "N m",
+    )?;
+    for (i, p) in loads.point_loads.iter().enumerate() {
+        let (f, m) = (norm(&p.force), norm(&p.moment));
+        check_load(&format!("loads.point_loads[{i}].force"), f, f, f0, "N")?;
+        check_load(&format!("loads.point_loads[{i}].moment"), m, m, m0, "N m")?;
+    }
+    for (name, profile, scale, unit) in [
+        (
+            "loads.distributed_force",
+            &loads.distributed_force,
+            f0 / l,
+            "N/m",
+        ),
+        (
+            "loads.distributed_moment",
+            &loads.distributed_moment,
+            f0,
+            "N m/m",
+        ),
+    ] {
+        if let Some(p) = profile {
+            for (at, v) in p.check_points(l) {
+                check_load(&format!("{name}{at}"), v.norm(), v.norm(), scale, unit)?;
+            }
+        }
+    }
+    if let (Some(rho), true) = (rod.density(), loads.gravity != Vector3::zeros()) {
+        let area = (0..=FUNCTION_CHECKS)
+            .map(|k| rod.section_at(l * k as f64 / FUNCTION_CHECKS as f64).area)
+            .fold(0.0, f64::max);
+        let g = norm(&loads.gravity);
+        // The weight per length rho A g against f0 / L.
+        check_load("loads.gravity", g, g, f0 / (l * rho * area), "m/s^2")?;
+    }
+    Ok(())
 }

@@ -56,27 +56,36 @@ impl Profile {
         matches!(self, Profile::Constant(v) if *v == Vector3::zeros())
     }
 
-    /// Checks finiteness (constants) or finiteness on a grid over `[0, length]` (functions).
-    pub(crate) fn check(&self, name: &str, length: f64) -> Result<()> {
-        let check_vec = |v: Vector3<f64>, at: String| -> Result<()> {
-            for k in 0..3 {
-                if !v[k].is_finite() {
-                    return Err(Error::invalid(format!("{name}{at}[{k}]"), v[k], "finite"));
-                }
-            }
-            Ok(())
-        };
+    /// The values checked: the constant (labelled `""`), or the function at the
+    /// [`FUNCTION_CHECKS`] + 1 uniform points of `[0, length]` (labelled `"(s)"`).
+    pub(crate) fn check_points(&self, length: f64) -> Vec<(String, Vector3<f64>)> {
         match self {
-            Profile::Constant(v) => check_vec(*v, String::new()),
-            Profile::Function(f) => {
-                for i in 0..=FUNCTION_CHECKS {
+            Profile::Constant(v) => vec![(String::new(), *v)],
+            Profile::Function(f) => (0..=FUNCTION_CHECKS)
+                .map(|i| {
                     let s = length * i as f64 / FUNCTION_CHECKS as f64;
-                    check_vec(f(s), format!("({s})"))?;
-                }
-                Ok(())
-            }
+                    (format!("({s})"), f(s))
+                })
+                .collect(),
         }
     }
+
+    /// Checks finiteness (constants) or finiteness on a grid over `[0, length]` (functions).
+    pub(crate) fn check(&self, name: &str, length: f64) -> Result<()> {
+        for (at, v) in self.check_points(length) {
+            check_finite_vec(name, &at, &v)?;
+        }
+        Ok(())
+    }
+}
+
+fn check_finite_vec(name: &str, at: &str, v: &Vector3<f64>) -> Result<()> {
+    for k in 0..3 {
+        if !v[k].is_finite() {
+            return Err(Error::invalid(format!("{name}{at}[{k}]"), v[k], "finite"));
+        }
+    }
+    Ok(())
 }
 
 /// A rigid pose: position (m, world frame) and rotation (body → world).
@@ -119,7 +128,7 @@ impl Pose {
             }
         }
         let err = orthonormality_error(&rotation);
-        if err.is_nan() || err > ROTATION_TOLERANCE {
+        if rotation.iter().any(|v| !v.is_finite()) || err.is_nan() || err > ROTATION_TOLERANCE {
             return Err(Error::invalid(
                 "base_pose.rotation",
                 format!("{rotation:?}"),
@@ -164,11 +173,12 @@ impl Rod {
     /// at the world origin with the tangent along world +z, Cowper's shear coefficient.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `length` unless finite and > 0, or naming the
+    /// [`Error::InvalidParameter`] naming `length` unless finite, > 0 and at most
+    /// [`MAX_LENGTH`](crate::limits::MAX_LENGTH), or naming the
     /// section property that is invalid on `[0, length]` (a table not covering it, a function
     /// returning non-positive values).
     pub fn new(length: f64, section: Section, material: impl Into<Material>) -> Result<Self> {
-        check_positive("length", length, "m")?;
+        crate::limits::check_length("length", length, false)?;
         section.check_on(length, FUNCTION_CHECKS)?;
         Ok(Self {
             length,
@@ -187,9 +197,21 @@ impl Rod {
     /// unstretched is `(0, 0, 1)`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `rest_strain` if not finite.
+    /// [`Error::InvalidParameter`] naming `rest_strain` (`rest_strain(s)[k]` for a function) if
+    /// not finite, or if the rest stretch along the tangent `v*_z` is not > 0 at every check
+    /// point: `v*_z <= 0` is a rod folded onto itself or turned backwards in its rest shape.
     pub fn with_rest_strain(mut self, rest_strain: Profile) -> Result<Self> {
-        rest_strain.check("rest_strain", self.length)?;
+        for (at, v) in rest_strain.check_points(self.length) {
+            check_finite_vec("rest_strain", &at, &v)?;
+            if !(v[2] > 0.0) {
+                return Err(Error::invalid(
+                    format!("rest_strain{at}[2]"),
+                    v[2],
+                    "> 0: the rest stretch along the tangent ((0, 0, 1) is straight and \
+                     unstretched)",
+                ));
+            }
+        }
         self.rest_strain = rest_strain;
         Ok(self)
     }

@@ -199,7 +199,7 @@ impl Section {
                 return Err(Error::invalid(
                     format!("{name}.len()"),
                     col.len(),
-                    format!("equal to s.len() = {n}"),
+                    format!("equal to the length of `s`, {n}"),
                 ));
             }
         }
@@ -260,6 +260,11 @@ impl Section {
             Kind::Table { s: ts, props } => table_lookup(ts, props, s),
             Kind::Function(f) => f(s),
         }
+    }
+
+    /// Whether the section is a user function of `s`.
+    pub fn is_function(&self) -> bool {
+        matches!(self.kind, Kind::Function(_))
     }
 
     /// Whether the properties are the same at every `s` (circles and tubes).

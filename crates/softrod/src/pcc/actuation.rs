@@ -30,7 +30,7 @@ impl ElasticSegment {
         bending_stiffness: f64,
         axial_stiffness: Option<f64>,
     ) -> Result<Self> {
-        check_positive("rest_length", rest_length, "m")?;
+        crate::limits::check_length("rest_length", rest_length, false)?;
         check_positive("bending_stiffness", bending_stiffness, "N m^2")?;
         if let Some(ea) = axial_stiffness {
             check_positive("axial_stiffness", ea, "N")?;
@@ -54,13 +54,25 @@ impl ElasticSegment {
         extensible: bool,
     ) -> Result<Self> {
         check_positive("radius", radius, "m")?;
-        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        crate::limits::check_modulus("youngs_modulus", youngs_modulus)?;
         let area = std::f64::consts::PI * radius * radius;
-        Self::new(
-            rest_length,
-            youngs_modulus * area * radius * radius / 4.0,
-            extensible.then_some(youngs_modulus * area),
-        )
+        let second_moment = area * radius * radius / 4.0;
+        if !(second_moment.is_finite() && second_moment > f64::MIN_POSITIVE) {
+            return Err(Error::invalid(
+                "radius",
+                radius,
+                "finite and > 0 m, with pi r^4 / 4 a finite nonzero float",
+            ));
+        }
+        let (ei, ea) = (youngs_modulus * second_moment, youngs_modulus * area);
+        if !(ei.is_finite() && ei > f64::MIN_POSITIVE && ea.is_finite()) {
+            return Err(Error::invalid(
+                "youngs_modulus",
+                youngs_modulus,
+                "finite and > 0 Pa, with E pi r^4 / 4 and E pi r^2 finite and nonzero",
+            ));
+        }
+        Self::new(rest_length, ei, extensible.then_some(ea))
     }
 
     /// Rest length `ℓ0` (m).
@@ -103,7 +115,7 @@ fn check_actuators(distances: &[f64], angles: &[f64]) -> Result<()> {
         ));
     }
     for (i, (&d, &b)) in distances.iter().zip(angles).enumerate() {
-        check_positive(&format!("distances[{i}]"), d, "m")?;
+        crate::limits::check_length(&format!("distances[{i}]"), d, false)?;
         check_finite(&format!("angles[{i}]"), b)?;
     }
     Ok(())
@@ -217,7 +229,14 @@ impl PccChambers {
             ));
         }
         for (i, &a) in areas.iter().enumerate() {
-            check_positive(&format!("areas[{i}]"), a, "m^2")?;
+            let max = crate::limits::MAX_LENGTH * crate::limits::MAX_LENGTH;
+            if !(a.is_finite() && a > 0.0 && a <= max) {
+                return Err(Error::invalid(
+                    format!("areas[{i}]"),
+                    a,
+                    format!("finite, > 0 and <= {max:e} m^2"),
+                ));
+            }
         }
         let (sin, cos) = angles.iter().map(|b| b.sin_cos()).unzip();
         Ok(Self {
@@ -527,7 +546,10 @@ fn elastic_arc<F: Fn(usize) -> Loading>(
         return Err(Error::invalid(
             name,
             format!("{values:?}"),
-            format!("an axial strain > -1 (net axial force {f:e} N)"),
+            format!(
+                "an axial strain > -1: net axial force {f:e} N over axial_stiffness {} N",
+                body.axial_stiffness.unwrap_or(f64::INFINITY)
+            ),
         ));
     }
     Ok((mx / ei, my / ei, l))

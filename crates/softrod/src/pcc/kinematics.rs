@@ -66,7 +66,9 @@
 
 use nalgebra::{Matrix3, Matrix4, Matrix6x3, Matrix6xX, Vector3};
 
-use crate::error::{check_finite, check_positive, Error, Result};
+use crate::error::{check_finite, Error, Result};
+use crate::limits::MAX_BENDING_ANGLE;
+use crate::math::samples::in_range;
 use crate::math::series::{arc_s1, arc_sb};
 
 /// Samples of the bending angle over `[0, 2π]` that bracket the closest arc in
@@ -205,6 +207,29 @@ impl PccSegment {
         })
     }
 
+    /// A segment from arc parameters given by a user, as [`PccSegment::new`] with the limits
+    /// of [`crate::limits`]: `length <= MAX_LENGTH` and `|κ| ℓ <= MAX_BENDING_ANGLE`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `curvature`, `plane_angle` or `length`.
+    pub fn checked(curvature: f64, plane_angle: f64, length: f64) -> Result<Self> {
+        check_finite("curvature", curvature)?;
+        check_finite("plane_angle", plane_angle)?;
+        crate::limits::check_length("length", length, true)?;
+        let theta = (curvature * length).abs();
+        if theta > MAX_BENDING_ANGLE {
+            return Err(Error::invalid(
+                "curvature",
+                curvature,
+                format!(
+                    "such that |curvature| x length <= {MAX_BENDING_ANGLE:e} rad (length = \
+                     {length} m)"
+                ),
+            ));
+        }
+        Self::new(curvature, plane_angle, length)
+    }
+
     /// A straight segment of `length` (m) (`κ = 0`, `φ = 0`).
     ///
     /// # Errors
@@ -289,18 +314,13 @@ impl PccSegment {
         self.rigid_at(self.length).p
     }
 
-    /// Backbone frame at arc length `s` (m) in `[0, ℓ]`, as a 4×4 transform to the base frame.
+    /// Backbone frame at arc length `s` (m) in `[0, ℓ]`, as a 4×4 transform to the base frame
+    /// (round-off at the ends clamped, see [`in_range`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `s` unless finite and in `[0, ℓ]`.
     pub fn pose_at(&self, s: f64) -> Result<Matrix4<f64>> {
-        if !(s.is_finite() && (0.0..=self.length).contains(&s)) {
-            return Err(Error::invalid(
-                "s",
-                s,
-                format!("in [0, length] = [0, {}] m", self.length),
-            ));
-        }
+        let s = in_range(|| "s".into(), s, self.length)?;
         Ok(self.rigid_at(s).to_matrix())
     }
 
@@ -312,13 +332,8 @@ impl PccSegment {
         s.iter()
             .enumerate()
             .map(|(i, &si)| {
-                self.pose_at(si).map_err(|_| {
-                    Error::invalid(
-                        format!("s[{i}]"),
-                        si,
-                        format!("in [0, length] = [0, {}] m", self.length),
-                    )
-                })
+                let si = in_range(|| format!("s[{i}]"), si, self.length)?;
+                Ok(self.rigid_at(si).to_matrix())
             })
             .collect()
     }
@@ -378,7 +393,7 @@ impl PccSegment {
 /// # Errors
 /// [`Error::InvalidParameter`] naming the invalid arc parameter.
 pub fn arc_pose(curvature: f64, plane_angle: f64, length: f64) -> Result<Matrix4<f64>> {
-    Ok(PccSegment::new(curvature, plane_angle, length)?.pose())
+    Ok(PccSegment::checked(curvature, plane_angle, length)?.pose())
 }
 
 /// Backbone frames of one arc at the arc lengths `s` (m); see [`PccSegment::backbone`].
@@ -391,7 +406,7 @@ pub fn arc_frames(
     length: f64,
     s: &[f64],
 ) -> Result<Vec<Matrix4<f64>>> {
-    PccSegment::new(curvature, plane_angle, length)?.backbone(s)
+    PccSegment::checked(curvature, plane_angle, length)?.backbone(s)
 }
 
 /// 6×3 Jacobian of one arc's tip pose; see [`PccSegment::jacobian`].
@@ -405,16 +420,19 @@ pub fn arc_jacobian(
     frame: JacobianFrame,
     coordinates: ArcCoordinates,
 ) -> Result<Matrix6x3<f64>> {
-    Ok(PccSegment::new(curvature, plane_angle, length)?.jacobian(frame, coordinates))
+    Ok(PccSegment::checked(curvature, plane_angle, length)?.jacobian(frame, coordinates))
 }
 
 fn check_position(position: &Vector3<f64>) -> Result<()> {
     for k in 0..3 {
-        if !position[k].is_finite() {
+        if !(position[k].is_finite() && position[k].abs() <= crate::limits::MAX_LENGTH) {
             return Err(Error::invalid(
                 format!("position[{k}]"),
                 position[k],
-                "finite (m)",
+                format!(
+                    "finite and of magnitude <= {:e} m",
+                    crate::limits::MAX_LENGTH
+                ),
             ));
         }
     }
@@ -475,7 +493,7 @@ pub struct TipFit {
 /// and > 0.
 pub fn arc_from_tip_with_length(position: &Vector3<f64>, length: f64) -> Result<TipFit> {
     check_position(position)?;
-    check_positive("length", length, "m")?;
+    crate::limits::check_length("length", length, false)?;
     let (x, y, z) = (position.x, position.y, position.z);
     let r = x.hypot(y);
     let phi = if r > 0.0 { y.atan2(x) } else { 0.0 };
@@ -604,7 +622,7 @@ impl PccChain {
             .iter()
             .enumerate()
             .map(|(i, q)| {
-                PccSegment::new(q[0], q[1], q[2]).map_err(|e| match e {
+                PccSegment::checked(q[0], q[1], q[2]).map_err(|e| match e {
                     Error::InvalidParameter {
                         name,
                         value,
@@ -667,7 +685,7 @@ impl PccChain {
     }
 
     /// Backbone frames at the chain's arc lengths `s` (m, each in `[0, total length]`, any
-    /// order).
+    /// order; round-off at the ends clamped, see [`in_range`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `s[i]` for the first arc length out of range.
@@ -682,13 +700,18 @@ impl PccChain {
         s.iter()
             .enumerate()
             .map(|(i, &si)| {
-                if !(si.is_finite() && (0.0..=total).contains(&si)) {
-                    return Err(Error::invalid(
-                        format!("s[{i}]"),
-                        si,
-                        format!("in [0, length] = [0, {total}] m"),
-                    ));
-                }
+                let si = in_range(|| format!("s[{i}]"), si, total).map_err(|e| match e {
+                    Error::InvalidParameter {
+                        name,
+                        value,
+                        expected,
+                    } => Error::InvalidParameter {
+                        name,
+                        value,
+                        expected: format!("{expected} (the total length of the segments)"),
+                    },
+                    other => other,
+                })?;
                 let k = self
                     .ends
                     .partition_point(|&e| e < si)

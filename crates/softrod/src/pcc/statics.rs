@@ -63,6 +63,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
+use crate::limits::check_load;
 use crate::math::series::arc_fns;
 use crate::pcc::actuation::{ElasticSegment, PccChambers, PccTendons};
 use crate::pcc::kinematics::{chain_pose, PccChain, PccSegment};
@@ -157,6 +158,7 @@ impl PccRobot {
     /// [`Error::InvalidParameter`] naming `last_segment` if it is not a segment of the robot.
     pub fn with_tendon(mut self, tendon: RoutedTendon) -> Result<Self> {
         self.check_segment("last_segment", tendon.last_segment)?;
+        self.check_offsets(&[tendon.distance])?;
         self.tendons.push(tendon);
         Ok(self)
     }
@@ -168,6 +170,7 @@ impl PccRobot {
     /// [`Error::InvalidParameter`] naming `segment` if it is not a segment of the robot.
     pub fn with_segment_tendons(mut self, segment: usize, tendons: &PccTendons) -> Result<Self> {
         self.check_segment("segment", segment)?;
+        self.check_offsets(tendons.distances())?;
         for (&d, &b) in tendons.distances().iter().zip(tendons.angles()) {
             self.tendons.push(RoutedTendon::new(d, b, segment)?);
         }
@@ -178,11 +181,33 @@ impl PccRobot {
     /// added before).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `segment` if it is not a segment of the robot.
+    /// [`Error::InvalidParameter`] naming `segment` if it is not a segment of the robot, or
+    /// `distances[i]` beyond [`MAX_OFFSET_RATIO`](crate::limits::MAX_OFFSET_RATIO) of its length.
     pub fn with_chambers(mut self, segment: usize, chambers: PccChambers) -> Result<Self> {
         self.check_segment("segment", segment)?;
+        self.check_offsets(chambers.distances())?;
         self.chambers.push((segment, chambers));
         Ok(self)
+    }
+
+    /// Distances from the backbone within [`MAX_OFFSET_RATIO`](crate::limits::MAX_OFFSET_RATIO)
+    /// of the robot's total rest length (as for the Cosserat rod's tendons).
+    fn check_offsets(&self, distances: &[f64]) -> Result<()> {
+        let l: f64 = self.bodies.iter().map(ElasticSegment::rest_length).sum();
+        let max = crate::limits::MAX_OFFSET_RATIO * l;
+        for (i, &d) in distances.iter().enumerate() {
+            if !(d <= max) {
+                return Err(Error::invalid(
+                    format!("distances[{i}]"),
+                    d,
+                    format!(
+                        "at most {} x the rest length = {max} m",
+                        crate::limits::MAX_OFFSET_RATIO
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn check_segment(&self, name: &str, segment: usize) -> Result<()> {
@@ -419,6 +444,37 @@ fn check_vector(name: &str, v: &Vector3<f64>) -> Result<()> {
     Ok(())
 }
 
+/// The loads within [`MAX_LOAD_NUMBER`](crate::limits::MAX_LOAD_NUMBER), with the robot's
+/// total rest length `L` and smallest bending stiffness `EI` (as for the Cosserat rod: a
+/// tension `T` at distance `d` by `T (1 + d / L) L² / EI`, a chamber force `p A` likewise, a
+/// tip force by `F L² / EI`, a tip moment by `M L / EI`).
+fn check_load_limits(robot: &PccRobot, loads: &PccLoads) -> Result<()> {
+    let l: f64 = robot.bodies.iter().map(ElasticSegment::rest_length).sum();
+    let ei = robot
+        .bodies
+        .iter()
+        .map(ElasticSegment::bending_stiffness)
+        .fold(f64::INFINITY, f64::min);
+    let f0 = ei / (l * l);
+    for (i, (t, &tau)) in robot.tendons.iter().zip(&loads.tensions).enumerate() {
+        let scale = f0 / (1.0 + t.distance / l);
+        check_load(&format!("tensions[{i}]"), tau, tau.abs(), scale, "N")?;
+    }
+    let mut k = 0;
+    for (_, ch) in &robot.chambers {
+        for i in 0..ch.len() {
+            if let Some(&p) = loads.pressures.get(k) {
+                let scale = f0 / (ch.areas()[i] * (1.0 + ch.distances()[i] / l));
+                check_load(&format!("pressures[{k}]"), p, p.abs(), scale, "Pa")?;
+            }
+            k += 1;
+        }
+    }
+    let (f, m) = (loads.tip_force.norm(), loads.tip_moment.norm());
+    check_load("tip_force", f, f, f0, "N")?;
+    check_load("tip_moment", m, m, f0 * l, "N m")
+}
+
 fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
     let (nt, nc) = (robot.n_tendons(), robot.n_chambers());
     // The same inputs as the Cosserat statics, checked the same way.
@@ -427,6 +483,7 @@ fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
         .validate(nt, nc)?;
     check_vector("tip_force", &loads.tip_force)?;
     check_vector("tip_moment", &loads.tip_moment)?;
+    check_load_limits(robot, loads)?;
     let mut actuation = vec![[0.0; 3]; robot.bodies.len()];
     for (t, &tau) in robot.tendons.iter().zip(&loads.tensions) {
         // -τ ∂L/∂(θ_x, θ_y, ℓ) = τ (-d sin β, d cos β, -1) on every segment passed.

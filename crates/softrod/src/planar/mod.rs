@@ -31,6 +31,7 @@ use rayon::prelude::*;
 use crate::error::{check_positive, Error, Result};
 use crate::integrate::driver::adaptive_dense;
 use crate::integrate::{AdaptiveOptions, FnSystem, IntegrationStats, BS3};
+use crate::math::samples::in_range;
 
 /// Largest tangent-angle change (rad) allowed across one backbone-integration panel.
 ///
@@ -133,13 +134,33 @@ impl PlanarCableArm {
         youngs_modulus: f64,
         anchor: Option<f64>,
     ) -> Result<Self> {
-        check_positive("length", length, "m")?;
+        crate::limits::check_length("length", length, false)?;
         check_positive("base_radius", base_radius, "m")?;
         check_positive("tip_radius", tip_radius, "m")?;
         if !(offset_ratio.is_finite() && (0.0..1.0).contains(&offset_ratio)) {
             return Err(Error::invalid("offset_ratio", offset_ratio, "in [0, 1)"));
         }
-        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        crate::limits::check_modulus("youngs_modulus", youngs_modulus)?;
+        // The bending stiffness E pi R^4 / 4 at both ends must be a finite nonzero float (a
+        // radius of 1e-100 m or 1e100 m is positive but under- or overflows it).
+        for (name, r) in [("base_radius", base_radius), ("tip_radius", tip_radius)] {
+            let i = PI * r.powi(4) / 4.0;
+            if !(i.is_finite() && i > f64::MIN_POSITIVE) {
+                return Err(Error::invalid(
+                    name,
+                    r,
+                    "finite and > 0 m, with pi R^4 / 4 a finite nonzero float",
+                ));
+            }
+            let ei = youngs_modulus * i;
+            if !(ei.is_finite() && ei > f64::MIN_POSITIVE) {
+                return Err(Error::invalid(
+                    "youngs_modulus",
+                    youngs_modulus,
+                    format!("finite and > 0 Pa, with E pi R^4 / 4 finite and nonzero at {name}"),
+                ));
+            }
+        }
         let anchor = anchor.unwrap_or(length);
         if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
             return Err(Error::invalid(
@@ -202,6 +223,15 @@ impl PlanarCableArm {
     #[inline]
     pub fn radius(&self, s: f64) -> f64 {
         self.base_radius + self.taper * s
+    }
+
+    /// Section radius `R(s)` (m) at an arc length `s` checked to lie in `[0, L]` (round-off
+    /// at the ends clamped): the taper is not extrapolated beyond the arm.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `name` if `s` is not finite or outside `[0, L]`.
+    pub fn radius_at(&self, name: impl FnOnce() -> String, s: f64) -> Result<f64> {
+        Ok(self.radius(in_range(name, s, self.length)?))
     }
 
     /// Taper rate `dR/ds` (dimensionless).
@@ -285,42 +315,29 @@ impl PlanarCableArm {
     }
 }
 
-/// `n_points` uniformly spaced arc lengths over `[0, length]` (m).
-///
-/// # Errors
-/// [`Error::InvalidParameter`] if `n_points < 2`.
-pub fn uniform_samples(length: f64, n_points: usize) -> Result<Vec<f64>> {
-    if n_points < 2 {
-        return Err(Error::invalid("n_points", n_points, ">= 2"));
-    }
-    let last = (n_points - 1) as f64;
-    Ok((0..n_points)
-        .map(|i| {
-            if i + 1 == n_points {
-                length
-            } else {
-                length * i as f64 / last
-            }
-        })
-        .collect())
-}
+pub use crate::math::samples::uniform_samples;
 
-fn check_samples(samples: &[f64], length: f64) -> Result<()> {
+/// Checks user-given arc lengths: non-decreasing, in `[0, length]` (round-off at the ends
+/// clamped, see [`crate::math::samples::in_range`]).
+fn check_samples(samples: &[f64], length: f64) -> Result<Vec<f64>> {
     if samples.is_empty() {
         return Err(Error::invalid("s", "[]", "at least one arc length"));
     }
     let mut prev = 0.0;
+    let mut out = Vec::with_capacity(samples.len());
     for (i, &s) in samples.iter().enumerate() {
-        if !(s.is_finite() && (0.0..=length).contains(&s) && s >= prev) {
+        let s = in_range(|| format!("s[{i}]"), s, length)?;
+        if s < prev {
             return Err(Error::invalid(
                 format!("s[{i}]"),
                 s,
                 format!("non-decreasing and in [0, length] = [0, {length}] m"),
             ));
         }
+        out.push(s);
         prev = s;
     }
-    Ok(())
+    Ok(out)
 }
 
 /// `max(1, ceil(x))` for `x >= 0` without libm (baseline x86-64 has no rounding instruction).
@@ -682,7 +699,7 @@ pub fn solve_planar(
     samples: &[f64],
     method: PlanarMethod,
 ) -> Result<PlanarSolution> {
-    check_samples(samples, arm.length)?;
+    let samples = &check_samples(samples, arm.length)?[..];
     let n = samples.len();
     let (mut k, mut q, mut th, mut x, mut y) = (
         vec![0.0; n],
@@ -729,7 +746,7 @@ pub fn solve_planar_many(
     samples: &[f64],
     method: PlanarMethod,
 ) -> Result<PlanarBatch> {
-    check_samples(samples, arm.length)?;
+    let samples = &check_samples(samples, arm.length)?[..];
     for (i, &t) in tensions.iter().enumerate() {
         arm.check_tension(t).map_err(|e| match e {
             Error::InvalidParameter {

@@ -35,32 +35,24 @@ pub struct NewtonOptions {
 }
 
 impl NewtonOptions {
-    /// Checks the options: a finite `tolerance` > 0, at least one iteration and one load step.
+    /// Checks the options: a finite `tolerance` >= the machine epsilon, at least one iteration
+    /// and one load step, caps at most [`crate::limits::MAX_ITERATIONS`].
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `tolerance`, `max_iterations` or `max_load_steps`.
     pub fn validate(&self) -> Result<()> {
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+        // The scaled residual is O(1) at the scale of the loads: below the machine epsilon a
+        // tolerance asks for digits a double does not have.
+        if !(self.tolerance.is_finite() && self.tolerance >= f64::EPSILON) {
             return Err(Error::invalid(
                 "tolerance",
                 self.tolerance,
-                "finite and > 0",
+                format!("finite and >= {:e} (the machine epsilon)", f64::EPSILON),
             ));
         }
-        if self.max_iterations == 0 {
-            return Err(Error::invalid(
-                "max_iterations",
-                self.max_iterations,
-                ">= 1",
-            ));
-        }
-        if self.max_load_steps == 0 {
-            return Err(Error::invalid(
-                "max_load_steps",
-                self.max_load_steps,
-                ">= 1",
-            ));
-        }
+        use crate::limits::{check_count, MAX_ITERATIONS};
+        check_count("max_iterations", self.max_iterations, 1, MAX_ITERATIONS)?;
+        check_count("max_load_steps", self.max_load_steps, 1, MAX_ITERATIONS)?;
         Ok(())
     }
 }

@@ -101,3 +101,32 @@ pub fn castigliano_arc(kappa: f64, l: f64, stiff: [f64; 6]) -> Matrix6<f64> {
     }
     c
 }
+
+/// Closed-form tip compliance of a straight uniform cantilever of length `l` along body z
+/// (world axes): Euler–Bernoulli bending, axial, torsion, and Timoshenko shear when `gas`
+/// (the shear stiffness `k G A`) is given.
+pub fn timoshenko(l: f64, ei: f64, gj: f64, ea: f64, gas: Option<f64>) -> Matrix6<f64> {
+    let lat = l.powi(3) / (3.0 * ei) + gas.map_or(0.0, |g| l / g);
+    let mut c = Matrix6::zeros();
+    c[(0, 0)] = lat;
+    c[(1, 1)] = lat;
+    c[(2, 2)] = if gas.is_some() { l / ea } else { 0.0 };
+    c[(3, 3)] = l / ei;
+    c[(4, 4)] = l / ei;
+    c[(5, 5)] = l / gj;
+    // Convention of se3.rs: a tip moment m_y moves the tip along +x, m_x along -y.
+    c[(0, 4)] = l * l / (2.0 * ei);
+    c[(4, 0)] = c[(0, 4)];
+    c[(1, 3)] = -l * l / (2.0 * ei);
+    c[(3, 1)] = c[(1, 3)];
+    c
+}
+
+/// `(E I, G J, E A, k G A)` of a solid circular section of `radius` (m) of a linear material
+/// (`E` Pa, Poisson's ratio `nu`) with shear coefficient `k`.
+pub fn circular_constants(e: f64, nu: f64, radius: f64, k: f64) -> (f64, f64, f64, f64) {
+    let g = e / (2.0 * (1.0 + nu));
+    let a = PI * radius * radius;
+    let i = PI * radius.powi(4) / 4.0;
+    (e * i, g * 2.0 * i, e * a, k * g * a)
+}

@@ -88,8 +88,25 @@ impl UniaxialData {
                     format!("finite, giving a stretch > 0 ({strain_measure:?} measure)"),
                 ));
             }
-            if !s.is_finite() {
-                return Err(Error::invalid(format!("stress[{i}]"), s, "finite (Pa)"));
+            if !(s.is_finite() && s.abs() <= crate::limits::MAX_MODULUS) {
+                return Err(Error::invalid(
+                    format!("stress[{i}]"),
+                    s,
+                    format!(
+                        "finite and of magnitude <= {:e} Pa",
+                        crate::limits::MAX_MODULUS
+                    ),
+                ));
+            }
+            if !(l <= crate::model::material::hyperelastic::INVERSE_STRETCH_MAX) {
+                return Err(Error::invalid(
+                    format!("strain[{i}]"),
+                    e,
+                    format!(
+                        "giving a stretch <= {:e} ({strain_measure:?} measure)",
+                        crate::model::material::hyperelastic::INVERSE_STRETCH_MAX
+                    ),
+                ));
             }
             stretch.push(l);
         }

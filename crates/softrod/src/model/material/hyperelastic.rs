@@ -34,6 +34,7 @@
 use std::fmt;
 
 use crate::error::{check_finite, check_positive, Error, Result};
+use crate::limits::{check_modulus, check_parameter};
 
 /// Number of stretches (geometrically spaced, end points included) at which
 /// [`UniaxialLaw::check_stable`] evaluates `dP/dλ`.
@@ -114,10 +115,16 @@ pub trait UniaxialLaw: fmt::Debug + fmt::Display + Send + Sync {
     /// Nominal (engineering) stress `P(λ)`: axial force per undeformed area (Pa).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0`.
+    /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0` and the
+    /// stress there is a finite float (so for every evaluation below).
     fn nominal_stress(&self, stretch: f64) -> Result<f64> {
         let stretch = check_stretch("stretch", stretch)?;
-        Ok(self.nominal_stress_unchecked(stretch))
+        finite_at(
+            self,
+            "stretch",
+            stretch,
+            self.nominal_stress_unchecked(stretch),
+        )
     }
 
     /// True (Cauchy) stress `σ(λ) = λ P(λ)`: axial force per deformed area (Pa).
@@ -126,7 +133,12 @@ pub trait UniaxialLaw: fmt::Debug + fmt::Display + Send + Sync {
     /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0`.
     fn true_stress(&self, stretch: f64) -> Result<f64> {
         let stretch = check_stretch("stretch", stretch)?;
-        Ok(self.true_stress_unchecked(stretch))
+        finite_at(
+            self,
+            "stretch",
+            stretch,
+            self.true_stress_unchecked(stretch),
+        )
     }
 
     /// Tangent modulus `E(ε) = dσ/dε` of the true stress at engineering strain `ε = λ − 1` (Pa).
@@ -137,7 +149,7 @@ pub trait UniaxialLaw: fmt::Debug + fmt::Display + Send + Sync {
     /// [`Error::InvalidParameter`] (`strain`) unless `strain` is finite and `> −1`.
     fn tangent_modulus(&self, strain: f64) -> Result<f64> {
         let stretch = check_strain("strain", strain)?;
-        Ok(self.true_slope_unchecked(stretch))
+        finite_at(self, "strain", strain, self.true_slope_unchecked(stretch))
     }
 
     /// Slope `dP/dλ` of the nominal stress (Pa): the axial stiffness per rest area.
@@ -146,7 +158,12 @@ pub trait UniaxialLaw: fmt::Debug + fmt::Display + Send + Sync {
     /// [`Error::InvalidParameter`] (`stretch`) unless `stretch` is finite and `> 0`.
     fn nominal_tangent(&self, stretch: f64) -> Result<f64> {
         let stretch = check_stretch("stretch", stretch)?;
-        Ok(self.nominal_slope_unchecked(stretch))
+        finite_at(
+            self,
+            "stretch",
+            stretch,
+            self.nominal_slope_unchecked(stretch),
+        )
     }
 
     /// Secant modulus `P(1 + ε) / ε` at engineering strain `ε` (Pa), e.g. the "100 % modulus"
@@ -257,13 +274,30 @@ pub trait UniaxialLaw: fmt::Debug + fmt::Display + Send + Sync {
                     format!("{} parameters", self.model_name()),
                     self,
                     format!(
-                        "a stable law on stretch [{lo}, {hi}] (dP/dstretch > 0); \
-                         dP/dstretch = {slope:.4e} Pa at stretch {stretch:.6}"
+                        "a stable law on [stretch_min, stretch_max] = [{lo}, {hi}] \
+                         (dP/dstretch > 0); dP/dstretch = {slope:.4e} Pa at stretch {stretch:.6}"
                     ),
                 ));
             }
         }
         Ok(())
+    }
+}
+
+/// `value` if finite, else an [`Error::InvalidParameter`] naming the input `name` = `input`
+/// at which `law` overflows.
+fn finite_at<L: UniaxialLaw + ?Sized>(law: &L, name: &str, input: f64, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            name,
+            input,
+            format!(
+                "a value at which {law} gives a finite stress (it is {value} there: the law \
+                 overflows a double)"
+            ),
+        ))
     }
 }
 
@@ -387,7 +421,7 @@ impl Hookean {
     /// [`Error::InvalidParameter`] (`youngs_modulus`) unless finite and `> 0`.
     pub fn new(youngs_modulus: f64) -> Result<Self> {
         Ok(Self {
-            youngs_modulus: check_positive("youngs_modulus", youngs_modulus, "Pa")?,
+            youngs_modulus: check_modulus("youngs_modulus", youngs_modulus)?,
         })
     }
 
@@ -437,7 +471,7 @@ impl Linearised {
     /// [`Error::InvalidParameter`] naming `secant_modulus` (finite, `> 0`) or
     /// `reference_strain` (finite, `> −1`, `≠ 0`).
     pub fn new(secant_modulus: f64, reference_strain: f64) -> Result<Self> {
-        let secant_modulus = check_positive("secant_modulus", secant_modulus, "Pa")?;
+        let secant_modulus = check_modulus("secant_modulus", secant_modulus)?;
         check_strain("reference_strain", reference_strain)?;
         if reference_strain == 0.0 {
             return Err(Error::invalid(
@@ -465,7 +499,7 @@ impl Linearised {
             return Err(Error::invalid("strain", strain, "non-zero"));
         }
         let modulus = nominal_stress / strain;
-        if !(modulus.is_finite() && modulus > 0.0) {
+        if !(modulus.is_finite() && modulus > 0.0 && modulus <= crate::limits::MAX_MODULUS) {
             return Err(Error::invalid(
                 "nominal_stress",
                 nominal_stress,
@@ -549,7 +583,7 @@ impl NeoHookean {
     /// [`Error::InvalidParameter`] (`mu`) unless finite and `> 0`.
     pub fn new(mu: f64) -> Result<Self> {
         Ok(Self {
-            mu: check_positive("mu", mu, "Pa")?,
+            mu: check_modulus("mu", mu)?,
         })
     }
 
@@ -602,8 +636,8 @@ impl MooneyRivlin {
     /// # Errors
     /// [`Error::InvalidParameter`] naming `c10` or `c01` if not finite, or `c10 + c01` if `<= 0`.
     pub fn new(c10: f64, c01: f64) -> Result<Self> {
-        let c10 = check_finite("c10", c10)?;
-        let c01 = check_finite("c01", c01)?;
+        let c10 = check_parameter("c10", c10)?;
+        let c01 = check_parameter("c01", c01)?;
         if c10 + c01 <= 0.0 {
             return Err(Error::invalid(
                 "c10 + c01",
@@ -680,9 +714,9 @@ impl Yeoh {
     /// [`Error::InvalidParameter`] naming `c10` (finite, `> 0`), `c20` or `c30` (finite).
     pub fn new(c10: f64, c20: f64, c30: f64) -> Result<Self> {
         Ok(Self {
-            c10: check_positive("c10", c10, "Pa")?,
-            c20: check_finite("c20", c20)?,
-            c30: check_finite("c30", c30)?,
+            c10: check_modulus("c10", c10)?,
+            c20: check_parameter("c20", c20)?,
+            c30: check_parameter("c30", c30)?,
         })
     }
 
@@ -812,7 +846,7 @@ impl Ogden {
             ));
         }
         for (i, (&m, &a)) in mu.iter().zip(alpha).enumerate() {
-            check_finite(&format!("mu[{i}]"), m)?;
+            check_parameter(&format!("mu[{i}]"), m)?;
             if !(a.is_finite() && a != 0.0) {
                 return Err(Error::invalid(
                     format!("alpha[{i}]"),

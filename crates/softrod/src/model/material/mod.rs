@@ -47,7 +47,7 @@ pub mod silicone;
 
 use nalgebra::{Matrix6, Vector6};
 
-use crate::error::{check_positive, Error, Result};
+use crate::error::{Error, Result};
 use crate::model::material::hyperelastic::{UniaxialLaw, UniaxialModel};
 use crate::model::section::SectionProperties;
 
@@ -65,7 +65,7 @@ impl LinearElastic {
     /// [`Error::InvalidParameter`] naming `youngs_modulus` unless finite and > 0, or
     /// `poisson_ratio` unless in `(-1, 0.5]`.
     pub fn new(youngs_modulus: f64, poisson_ratio: f64) -> Result<Self> {
-        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
+        crate::limits::check_modulus("youngs_modulus", youngs_modulus)?;
         if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio <= 0.5) {
             return Err(Error::invalid(
                 "poisson_ratio",
@@ -85,15 +85,16 @@ impl LinearElastic {
     /// # Errors
     /// [`Error::InvalidParameter`] naming `youngs_modulus` or `shear_modulus`.
     pub fn with_shear_modulus(youngs_modulus: f64, shear_modulus: f64) -> Result<Self> {
-        check_positive("youngs_modulus", youngs_modulus, "Pa")?;
-        check_positive("shear_modulus", shear_modulus, "Pa")?;
+        crate::limits::check_modulus("youngs_modulus", youngs_modulus)?;
+        crate::limits::check_modulus("shear_modulus", shear_modulus)?;
         let nu = youngs_modulus / (2.0 * shear_modulus) - 1.0;
         if !(nu > -1.0 && nu <= 0.5 + 1e-12) {
             return Err(Error::invalid(
                 "shear_modulus",
                 shear_modulus,
                 format!(
-                    "in [E/3, inf) = [{}, inf) Pa (Poisson's ratio in (-1, 0.5])",
+                    "in [E/3, inf) = [{}, inf) Pa with E = youngs_modulus (Poisson's ratio in \
+                     (-1, 0.5])",
                     youngs_modulus / 3.0
                 ),
             ));
