@@ -786,6 +786,10 @@ fn solve_with(
         result.converged =
             result.converged && result.residual <= p.tolerance(&result.x, opts.tolerance);
     }
+    if result.converged {
+        // Material failures of rejected trial iterates are not the returned state's.
+        p.ws.material_error = None;
+    }
     let finite = p.nodes.iter().all(|n| n.y.iter().all(|v| v.is_finite()));
     let mut stats = SolverStats {
         iterations: reached.iterations,
@@ -946,6 +950,9 @@ pub(crate) fn assemble(
         sol.m_body.push(arr(&mb));
         sol.v.push(arr(&loc.v));
         sol.u.push(arr(&loc.u));
+    }
+    if let Some(e) = ws.material_error.take() {
+        p.ws.material_error.get_or_insert(e);
     }
     sol
 }
