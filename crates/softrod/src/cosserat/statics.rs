@@ -529,6 +529,9 @@ fn stability_at(
 /// force scale `E I(0) / L²` (and `E I(0) / L` for its moment) along the unstable mode.
 pub const IMPERFECTION: f64 = 1e-1;
 
+/// A stable equilibrium found: its unknowns, stability and shooting Jacobian (column-major).
+type Found = (Vec<f64>, Stability, Vec<f64>);
+
 /// A stable equilibrium instead of the unstable one at `x` (see [`SolveOptions::seek_stable`]):
 /// first continuation from the unloaded rod in load steps of at most 1/8, refusing unstable
 /// states (the stable branch connected to the unloaded rod); then, for a symmetric problem whose
@@ -543,7 +546,7 @@ fn seek_stable(
     actuation: &Actuation,
     options: &SolveOptions,
     (x, stability): (&[f64], &Stability),
-) -> (Option<(Vec<f64>, Stability, Vec<f64>)>, usize) {
+) -> (Option<Found>, usize) {
     let mut iterations = 0;
     if options.newton.continuation {
         p.require_stable = true;
@@ -717,6 +720,31 @@ pub fn solve_statics_at(
     solve_with(model, actuation, options, s_out, false)
 }
 
+/// The stability of the converged `reached`, replaced by a stable equilibrium when one is
+/// sought and found ([`seek_stable`]).
+fn stable_outcome(
+    p: &mut Shooting<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    reached: &mut Reached,
+) -> Option<Stability> {
+    let o = &reached.outcome;
+    let stability = stability_at(p, &o.x, o.jacobian.as_deref(), o.exact).map(|(s, _)| s);
+    if let Some(s) = stability.filter(|s| !s.stable && options.seek_stable) {
+        let x = reached.outcome.x.clone();
+        let (found, its) = seek_stable(p, model, actuation, options, (&x, &s));
+        reached.iterations += its;
+        if let Some((x, s, j)) = found {
+            reached.outcome.x = x;
+            reached.outcome.jacobian = Some(j);
+            reached.outcome.at_x = false;
+            return Some(s);
+        }
+    }
+    stability
+}
+
 /// [`solve_statics_at`], the continuation refusing unstable states if `require_stable`.
 fn solve_with(
     model: &Arc<RobotModel>,
@@ -758,22 +786,11 @@ fn solve_with(
     // Without external loads the equilibrium is unique (x = 0) and stable (docs/stability.md).
     let loaded = !model.loads().is_unloaded();
     let mut reached = attempt(&mut p, options, &x0, loaded);
-    let mut stability = None;
-    if reached.outcome.converged && loaded {
-        let o = &reached.outcome;
-        stability = stability_at(&mut p, &o.x, o.jacobian.as_deref(), o.exact).map(|(s, _)| s);
-        if let Some(s) = stability.filter(|s| !s.stable && options.seek_stable) {
-            let x = reached.outcome.x.clone();
-            let (found, its) = seek_stable(&mut p, model, actuation, options, (&x, &s));
-            reached.iterations += its;
-            if let Some((x, s, j)) = found {
-                reached.outcome.x = x;
-                reached.outcome.jacobian = Some(j);
-                reached.outcome.at_x = false;
-                stability = Some(s);
-            }
-        }
-    }
+    let stability = if reached.outcome.converged && loaded {
+        stable_outcome(&mut p, model, actuation, options, &mut reached)
+    } else {
+        None
+    };
     let result = &mut reached.outcome;
     // The recorded pass must be the one at the returned unknowns (and their load factor).
     if !result.at_x {

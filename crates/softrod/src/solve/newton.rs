@@ -305,6 +305,50 @@ fn last_step<P: Problem + ?Sized>(
     false
 }
 
+/// The full Newton step `dx` without line search (a step predicted to converge); whether it
+/// was accepted (counted as an iteration).
+fn full_step<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    settings: &NewtonSettings<'_>,
+    options: &NewtonOptions,
+    out: &mut NewtonOutcome,
+) -> bool {
+    out.at_x = false;
+    let single = NewtonSettings {
+        line_search: LineSearch {
+            max_halvings: 0,
+            ..settings.line_search
+        },
+        ..*settings
+    };
+    if !line_search(problem, it, dx, lambda, &single, options) {
+        return false;
+    }
+    out.at_x = true;
+    out.iterations += 1;
+    true
+}
+
+/// After convergence on a residual-only evaluation: the exact Jacobian at the solution.
+fn jacobian_at_solution<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    lambda: f64,
+    options: &NewtonOptions,
+    out: &mut NewtonOutcome,
+) {
+    out.at_x = false;
+    if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) == Evaluated::Jacobian {
+        it.rn = problem.norm(&it.r);
+        it.exact = true;
+        out.at_x = true;
+        out.converged = it.rn <= problem.tolerance(&it.x, options.tolerance);
+    }
+}
+
 /// Damped Newton on `problem` at load factor `lambda` from `x0`.
 pub fn newton<P: Problem + ?Sized>(
     problem: &mut P,
@@ -340,17 +384,13 @@ pub fn newton<P: Problem + ?Sized>(
                 out.at_x = false;
                 break;
             }
-            it.rn = problem.norm(&it.r);
-            it.exact = true;
-            out.at_x = true;
+            (it.rn, it.exact, out.at_x) = (problem.norm(&it.r), true, true);
         }
         refresh = false;
         if !lu.factor(n, &it.jac) {
             break;
         }
-        for k in 0..n {
-            dx[k] = -it.r[k];
-        }
+        dx.iter_mut().zip(&it.r).for_each(|(d, r)| *d = -r);
         if !lu.solve_in_place(&mut dx) {
             break;
         }
@@ -369,18 +409,8 @@ pub fn newton<P: Problem + ?Sized>(
             && r_prev.is_finite()
             && rn * (rn / r_prev) <= 10.0 * tol
         {
-            out.at_x = false;
-            let single = NewtonSettings {
-                line_search: LineSearch {
-                    max_halvings: 0,
-                    ..settings.line_search
-                },
-                ..*settings
-            };
-            if line_search(problem, &mut it, &dx, lambda, &single, options) {
+            if full_step(problem, &mut it, &dx, lambda, settings, options, &mut out) {
                 r_prev = rn;
-                out.at_x = true;
-                out.iterations += 1;
                 if it.rn <= problem.tolerance(&it.x, options.tolerance) {
                     out.converged = true;
                     break;
@@ -443,14 +473,7 @@ pub fn newton<P: Problem + ?Sized>(
         }
     }
     if out.converged && settings.exact_at_solution && !(it.exact && out.at_x) {
-        // Converged on a residual-only evaluation: the Jacobian at the solution.
-        out.at_x = false;
-        if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) == Evaluated::Jacobian {
-            it.rn = problem.norm(&it.r);
-            it.exact = true;
-            out.at_x = true;
-            out.converged = it.rn <= problem.tolerance(&it.x, options.tolerance);
-        }
+        jacobian_at_solution(problem, &mut it, lambda, options, &mut out);
     }
     out.exact = it.exact && out.at_x;
     out.x = it.x;
