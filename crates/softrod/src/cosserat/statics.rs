@@ -745,6 +745,22 @@ fn stable_outcome(
     stability
 }
 
+/// The options, output arc lengths, actuation and warm start of a solve of `model`.
+fn check_inputs(
+    model: &RobotModel,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    s_out: &[f64],
+) -> Result<()> {
+    options.validate()?;
+    check_s_out(s_out, model.length())?;
+    model.check_actuation(actuation)?;
+    if let Some(w) = &options.warm_start {
+        model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
+    }
+    Ok(())
+}
+
 /// [`solve_statics_at`], the continuation refusing unstable states if `require_stable`.
 fn solve_with(
     model: &Arc<RobotModel>,
@@ -753,13 +769,8 @@ fn solve_with(
     s_out: &[f64],
     require_stable: bool,
 ) -> Result<StaticsSolution> {
-    options.validate()?;
-    check_s_out(s_out, model.length())?;
+    check_inputs(model, actuation, options, s_out)?;
     let (nt, nc) = (model.tendons().len(), model.chambers().len());
-    model.check_actuation(actuation)?;
-    if let Some(w) = &options.warm_start {
-        model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
-    }
     if actuation.has_held() {
         return super::displacement::solve_held(model, actuation, options, s_out);
     }

@@ -332,6 +332,21 @@ fn full_step<P: Problem + ?Sized>(
     true
 }
 
+/// The exact Jacobian at the current iterate; false if the evaluation fails.
+fn exact_jacobian<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    lambda: f64,
+    out: &mut NewtonOutcome,
+) -> bool {
+    if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian {
+        out.at_x = false;
+        return false;
+    }
+    (it.rn, it.exact, out.at_x) = (problem.norm(&it.r), true, true);
+    true
+}
+
 /// After convergence on a residual-only evaluation: the exact Jacobian at the solution.
 fn jacobian_at_solution<P: Problem + ?Sized>(
     problem: &mut P,
@@ -358,16 +373,7 @@ pub fn newton<P: Problem + ?Sized>(
     settings: &NewtonSettings<'_>,
 ) -> NewtonOutcome {
     let n = problem.dim();
-    let mut out = NewtonOutcome {
-        x: x0.to_vec(),
-        residual: f64::INFINITY,
-        converged: false,
-        iterations: 0,
-        first_step: 0.0,
-        jacobian: None,
-        at_x: false,
-        exact: false,
-    };
+    let mut out = NewtonOutcome::unsolved(x0);
     let Some(mut it) = start(problem, x0, lambda, options, settings, &mut out) else {
         return out;
     };
@@ -377,14 +383,8 @@ pub fn newton<P: Problem + ?Sized>(
     let mut refresh = false;
     let mut single_failed = false;
     while out.iterations < options.max_iterations {
-        if refresh && !it.exact {
-            // Evaluate the exact Jacobian at the current iterate.
-            if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian
-            {
-                out.at_x = false;
-                break;
-            }
-            (it.rn, it.exact, out.at_x) = (problem.norm(&it.r), true, true);
+        if refresh && !it.exact && !exact_jacobian(problem, &mut it, lambda, &mut out) {
+            break;
         }
         refresh = false;
         if !lu.factor(n, &it.jac) {
@@ -475,11 +475,32 @@ pub fn newton<P: Problem + ?Sized>(
     if out.converged && settings.exact_at_solution && !(it.exact && out.at_x) {
         jacobian_at_solution(problem, &mut it, lambda, options, &mut out);
     }
-    out.exact = it.exact && out.at_x;
-    out.x = it.x;
-    out.residual = it.rn;
-    out.jacobian = Some(it.jac);
-    out
+    out.finish(it)
+}
+
+impl NewtonOutcome {
+    /// No iteration yet from `x0`.
+    fn unsolved(x0: &[f64]) -> Self {
+        Self {
+            x: x0.to_vec(),
+            residual: f64::INFINITY,
+            converged: false,
+            iterations: 0,
+            first_step: 0.0,
+            jacobian: None,
+            at_x: false,
+            exact: false,
+        }
+    }
+
+    /// The outcome at the last iterate `it`.
+    fn finish(mut self, it: Iterate) -> Self {
+        self.exact = it.exact && self.at_x;
+        self.x = it.x;
+        self.residual = it.rn;
+        self.jacobian = Some(it.jac);
+        self
+    }
 }
 
 #[cfg(test)]
