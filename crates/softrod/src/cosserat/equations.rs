@@ -850,9 +850,10 @@ impl Evaluator<'_, '_> {
     }
 
     /// The right-hand side of the state and of the active columns (`N >= STATE + COLUMN
-    /// ncol`), and the stage integrands (tendon speeds, path-length sensitivities).
+    /// ncol`), and the stage integrands (tendon speeds, path-length sensitivities); returns
+    /// the local solution (strains, actuator sums) at `s`.
     #[inline]
-    pub fn rhs_into<const N: usize>(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) {
+    pub fn rhs_into<const N: usize>(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) -> Local {
         self.ws.evaluations += 1;
         let eq = self.eq;
         let props = eq.model.rod().section_at(s);
@@ -875,7 +876,7 @@ impl Evaluator<'_, '_> {
         let nt = self.ws.tendon_speed.len();
         self.ws.integrand[..nt].copy_from_slice(&self.ws.tendon_speed);
         if ncol == 0 {
-            return;
+            return loc;
         }
         if !loc.v.x.is_finite() {
             self.ws.tangent.diag = [f64::NAN; 6];
@@ -946,13 +947,14 @@ impl Evaluator<'_, '_> {
         for k in STATE + COLUMN * ncol..N {
             out[k] = 0.0;
         }
+        loc
     }
 }
 
 impl<const N: usize> System<N> for Evaluator<'_, '_> {
     #[inline]
     fn rhs(&mut self, t: f64, y: &[f64; N], dy: &mut [f64; N]) {
-        self.rhs_into(t, y, dy);
+        let _ = self.rhs_into(t, y, dy);
     }
     #[inline]
     fn stage_evaluated(&mut self, stage: usize) {
