@@ -540,9 +540,6 @@ type Found = (Vec<f64>, Stability, Vec<f64>);
 /// solved by continuation, and the perfect rod solved again from there by Newton. Returns
 /// the unknowns and the stability of the first converged, stable equilibrium found, and the
 /// Newton iterations spent.
-/// A stable equilibrium found: its scaled unknowns, stability and Jacobian.
-type Found = (Vec<f64>, Stability, Vec<f64>);
-
 fn seek_stable(
     p: &mut Shooting<'_>,
     model: &Arc<RobotModel>,
