@@ -43,11 +43,15 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
+pub use cosserat::friction::{
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+};
 pub use cosserat::statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,
 };
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use model::actuation::TensionProfile;
 pub use model::chamber::{Chamber, ChamberArea};
 pub use model::loads::{Frame, Loads, PointLoad};
 pub use model::material::fit::{

@@ -242,6 +242,7 @@ pub fn tangent_compliance_held(
         tensions: &tensions,
         pressures: &pressures,
         load_factor: solution.stats.load_factor,
+        profile: solution.actuation.profile.as_deref(),
     };
     let f_ref = model.force_scale();
     let fm = f_ref * model.length();

@@ -3,12 +3,16 @@
 //! shooting problem, the statics entry point and its solution ([`statics`]).
 
 pub(crate) mod equations;
+pub mod friction;
 mod hyperelastic_local;
 pub(crate) mod shooting;
 mod stability;
 pub mod statics;
 
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+pub use friction::{
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+};
 pub use stability::{CONSTRAINT_COMPLIANCE, NEUTRAL_MARGIN};
 pub use statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,

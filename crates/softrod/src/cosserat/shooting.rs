@@ -411,6 +411,7 @@ mod tests {
             tensions: &tensions,
             pressures: &pressures,
             load_factor: 1.0,
+            profile: None,
         };
         let plan = crate::integrate::march::rk4_plan(model.breaks(), 40 * 6);
         let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 240 }, plan);
@@ -468,6 +469,7 @@ mod taper_tests {
             tensions: &tensions,
             pressures: &[],
             load_factor: 1.0,
+            profile: None,
         };
         let plan = crate::integrate::march::rk4_plan(model.breaks(), 40);
         let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 40 }, plan);

@@ -5,6 +5,8 @@
 //! a [`TendonInput`] (today a tension; a held path shortening and friction join it as new
 //! variants), per chamber a gauge pressure. A sweep changes the actuation and keeps the model.
 
+use std::sync::Arc;
+
 use crate::error::{Error, Result};
 use crate::model::chamber::check_pressure;
 
@@ -32,6 +34,43 @@ pub struct Actuation {
     pub tendons: Vec<TendonInput>,
     /// One gauge pressure per chamber of the model (Pa), in the model's order.
     pub pressures: Vec<f64>,
+    /// The tension along the tendons when it varies (friction): `None`, every tendon carries
+    /// its base tension over its whole length. Set by the frictional solve
+    /// (`cosserat::friction`), which finds it with the shape.
+    pub profile: Option<Arc<TensionProfile>>,
+}
+
+/// The tension along each tendon (N) at the nodes of an arc-length mesh (m), interpolated
+/// geometrically between them (`ln τ` linear in `s`: exact for the capstan law on an arc).
+/// A tendon without a profile carries its base tension.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TensionProfile {
+    /// Per tendon: the nodes `s` (m, increasing) and the tensions there (N, >= 0), or `None`.
+    pub tendons: Vec<Option<(Vec<f64>, Vec<f64>)>>,
+}
+
+impl TensionProfile {
+    /// Tension (N) of tendon `i` at `s` (m): `None` if the tendon has no profile.
+    #[inline]
+    pub fn at(&self, i: usize, s: f64) -> Option<f64> {
+        let (nodes, tau) = self.tendons.get(i)?.as_ref()?;
+        let n = nodes.len();
+        if n == 1 || s <= nodes[0] {
+            return Some(tau[0]);
+        }
+        if s >= nodes[n - 1] {
+            return Some(tau[n - 1]);
+        }
+        let k = nodes.partition_point(|&x| x <= s).clamp(1, n - 1);
+        let (a, b) = (nodes[k - 1], nodes[k]);
+        let w = (s - a) / (b - a);
+        let (ta, tb) = (tau[k - 1], tau[k]);
+        Some(if ta > 0.0 && tb > 0.0 {
+            ta * (tb / ta).powf(w)
+        } else {
+            ta + (tb - ta) * w
+        })
+    }
 }
 
 impl Actuation {
@@ -40,6 +79,7 @@ impl Actuation {
         Self {
             tendons: tensions.iter().map(|&t| TendonInput::Tension(t)).collect(),
             pressures: Vec::new(),
+            profile: None,
         }
     }
 
@@ -48,6 +88,7 @@ impl Actuation {
         Self {
             tendons: Vec::new(),
             pressures: pressures.to_vec(),
+            profile: None,
         }
     }
 
