@@ -67,7 +67,7 @@ from .analysis import (
     workspace_map,
 )
 from .io import read_backbone_csv, write_samples_csv
-from .robot import Robot, load_robot
+from .robot import Robot, load_robot, solve_path
 from .vision import Backbone, BackboneQuality
 
 __all__ = [
@@ -127,6 +127,7 @@ __all__ = [
     "read_tensile_csv",
     "samples",
     "silicone",
+    "solve_path",
     "solve_statics",
     "sweep",
     "tangent_compliance",

@@ -23,6 +23,7 @@ fn options(steps: usize) -> FrictionOptions {
     let mut o = FrictionOptions::default();
     o.statics.integrator = Integrator::Rk4 { steps };
     o.statics.newton.tolerance = 1e-13;
+    o.tolerance = 1e-12;
     o
 }
 

@@ -35,7 +35,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use crate::cosserat::statics::{solve_statics_at, Integrator, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
@@ -43,7 +43,7 @@ use crate::model::actuation::TensionProfile;
 use crate::model::{Actuation, RobotModel};
 
 /// Default relative tolerance of the fixed point on the tension profile.
-pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-12;
+pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-10;
 /// Default cap on the fixed-point iterations.
 pub const DEFAULT_FRICTION_ITERATIONS: usize = 200;
 /// Mesh nodes per interval between breaks with the adaptive integrator.
@@ -335,13 +335,29 @@ pub fn solve_frictional(
             let dirs = tangents(model, &p.statics);
             profile_on(model, &p.statics, &dirs, &base, prev).0
         }
-        None => vec![base.clone(); mesh.len()],
+        None => {
+            let (ends, l) = (model.tendon_ends(), model.length());
+            mesh.iter()
+                .map(|&s| {
+                    (0..nt)
+                        .map(|i| {
+                            if s < ends[i] || (ends[i] == l && s == l) {
+                                base[i]
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect()
+                })
+                .collect()
+        }
     };
     let mut statics_options = options.statics;
     if let Some(p) = previous {
         statics_options.warm_start = Some(p.statics.warm_start());
     }
     let mut iterations = 0;
+    let mut anderson = Anderson::new();
     loop {
         let mut act = actuation.clone();
         act.profile = Some(Arc::new(to_profile(model, &mesh, &tau)));
@@ -391,7 +407,77 @@ pub fn solve_frictional(
             });
         }
         statics_options.warm_start = Some(sol.warm_start());
-        tau = next;
+        tau = anderson.update(&tau, next);
+    }
+}
+
+/// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of the fixed point `x = g(x)` on
+/// the tension profile: the next iterate combines the last images so as to minimise the
+/// linearised residual `g(x) - x` (Walker & Ni, SIAM J. Numer. Anal. 49(4), 2011). The rule
+/// is applied to the rod's shape at every iterate, so the accepted profile always satisfies
+/// the capstan bounds; the acceleration only chooses where the rod is solved next.
+struct Anderson {
+    /// Past residuals `f = g(x) - x` and images `g(x)` (flattened profiles).
+    f: Vec<Vec<f64>>,
+    g: Vec<Vec<f64>>,
+}
+
+/// Depth of the Anderson acceleration.
+const ANDERSON_DEPTH: usize = 3;
+
+impl Anderson {
+    fn new() -> Self {
+        Self {
+            f: Vec::new(),
+            g: Vec::new(),
+        }
+    }
+
+    /// The next iterate from the current `x` and its image `gx`.
+    fn update(&mut self, x: &[Vec<f64>], gx: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let flat_g: Vec<f64> = gx.iter().flatten().copied().collect();
+        let flat_f: Vec<f64> = flat_g
+            .iter()
+            .zip(x.iter().flatten())
+            .map(|(g, x)| g - x)
+            .collect();
+        self.f.push(flat_f);
+        self.g.push(flat_g);
+        if self.f.len() > ANDERSON_DEPTH + 1 {
+            self.f.remove(0);
+            self.g.remove(0);
+        }
+        let m = self.f.len() - 1;
+        if m == 0 {
+            return gx;
+        }
+        let n = self.f[0].len();
+        let last = &self.f[m];
+        // Differences of consecutive residuals and images.
+        let df = DMatrix::from_fn(n, m, |r, c| self.f[c + 1][r] - self.f[c][r]);
+        let dg = DMatrix::from_fn(n, m, |r, c| self.g[c + 1][r] - self.g[c][r]);
+        let rhs = DVector::from_column_slice(last);
+        let Ok(gamma) = df.clone().svd(true, true).solve(&rhs, 1e-12) else {
+            return gx;
+        };
+        let next = DVector::from_column_slice(&self.g[m]) - dg * gamma;
+        if !next.iter().all(|v| v.is_finite()) {
+            self.f.clear();
+            self.g.clear();
+            return gx;
+        }
+        let cols = gx.first().map_or(0, Vec::len);
+        next.as_slice()
+            .chunks(cols.max(1))
+            .zip(&gx)
+            .map(|(row, g)| {
+                row.iter()
+                    .zip(g)
+                    // A tendon absent at a node stays absent; tensions stay >= 0.
+                    .map(|(v, g)| if *g == 0.0 { 0.0 } else { v.max(0.0) })
+                    .collect()
+            })
+            .collect()
     }
 }
 
