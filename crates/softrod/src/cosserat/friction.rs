@@ -43,7 +43,7 @@ use crate::model::actuation::TensionProfile;
 use crate::model::{Actuation, RobotModel};
 
 /// Default relative tolerance of the fixed point on the tension profile.
-pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-10;
+pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-9;
 /// Default cap on the fixed-point iterations.
 pub const DEFAULT_FRICTION_ITERATIONS: usize = 200;
 /// Mesh nodes per interval between breaks with the adaptive integrator.
@@ -250,8 +250,8 @@ fn to_profile(model: &RobotModel, s: &[f64], tau: &[Vec<f64>]) -> TensionProfile
     let nt = model.tendons().len();
     let ends = model.tendon_ends();
     let l = model.length();
-    TensionProfile {
-        tendons: (0..nt)
+    TensionProfile::new(
+        (0..nt)
             .map(|i| {
                 (model.tendons()[i].friction() > 0.0).then(|| {
                     let (mut nodes, mut vals) = (Vec::new(), Vec::new());
@@ -265,7 +265,7 @@ fn to_profile(model: &RobotModel, s: &[f64], tau: &[Vec<f64>]) -> TensionProfile
                 })
             })
             .collect(),
-    }
+    )
 }
 
 /// The relative change between two profiles.

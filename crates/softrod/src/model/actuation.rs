@@ -45,15 +45,45 @@ pub struct Actuation {
 /// A tendon without a profile carries its base tension.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TensionProfile {
-    /// Per tendon: the nodes `s` (m, increasing) and the tensions there (N, >= 0), or `None`.
-    pub tendons: Vec<Option<(Vec<f64>, Vec<f64>)>>,
+    tendons: Vec<Option<Track>>,
+}
+
+/// The profile of one tendon: nodes (m), tensions (N) and their logarithms.
+#[derive(Debug, Clone, PartialEq)]
+struct Track {
+    s: Vec<f64>,
+    tau: Vec<f64>,
+    log: Vec<f64>,
 }
 
 impl TensionProfile {
+    /// Per tendon: the nodes `s` (m, increasing) and the tensions there (N, >= 0), or `None`
+    /// for a tendon that carries its base tension.
+    pub fn new(tendons: Vec<Option<(Vec<f64>, Vec<f64>)>>) -> Self {
+        Self {
+            tendons: tendons
+                .into_iter()
+                .map(|t| {
+                    t.map(|(s, tau)| {
+                        let log = tau.iter().map(|t| t.ln()).collect();
+                        Track { s, tau, log }
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// The nodes (m) and tensions (N) of tendon `i`, if it has a profile.
+    pub fn tendon(&self, i: usize) -> Option<(&[f64], &[f64])> {
+        let t = self.tendons.get(i)?.as_ref()?;
+        Some((&t.s, &t.tau))
+    }
+
     /// Tension (N) of tendon `i` at `s` (m): `None` if the tendon has no profile.
     #[inline]
     pub fn at(&self, i: usize, s: f64) -> Option<f64> {
-        let (nodes, tau) = self.tendons.get(i)?.as_ref()?;
+        let t = self.tendons.get(i)?.as_ref()?;
+        let (nodes, tau) = (&t.s, &t.tau);
         let n = nodes.len();
         if n == 1 || s <= nodes[0] {
             return Some(tau[0]);
@@ -66,7 +96,7 @@ impl TensionProfile {
         let w = (s - a) / (b - a);
         let (ta, tb) = (tau[k - 1], tau[k]);
         Some(if ta > 0.0 && tb > 0.0 {
-            ta * (tb / ta).powf(w)
+            (t.log[k - 1] + (t.log[k] - t.log[k - 1]) * w).exp()
         } else {
             ta + (tb - ta) * w
         })
