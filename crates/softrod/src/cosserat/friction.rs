@@ -353,7 +353,9 @@ pub fn solve_frictional(
         }
     };
     let mut statics_options = options.statics;
-    if let Some(p) = previous {
+    // Without external loads the zero base wrench is exact (docs/statics.md): no warm start.
+    let loaded = !model.loads().is_unloaded();
+    if let Some(p) = previous.filter(|_| loaded) {
         statics_options.warm_start = Some(p.statics.warm_start());
     }
     let mut iterations = 0;
@@ -406,7 +408,9 @@ pub fn solve_frictional(
                 load_factor: sol.stats.load_factor,
             });
         }
-        statics_options.warm_start = Some(sol.warm_start());
+        if loaded {
+            statics_options.warm_start = Some(sol.warm_start());
+        }
         tau = anderson.update(&tau, next);
     }
 }
