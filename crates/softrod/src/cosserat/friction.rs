@@ -305,6 +305,13 @@ pub fn solve_frictional(
         return Err(Error::invalid("friction.max_iterations", 0, ">= 1"));
     }
     model.check_actuation(actuation)?;
+    if let Some(i) = actuation.held().first() {
+        return Err(Error::invalid(
+            format!("tendons[{i}]"),
+            "displacement-controlled",
+            "tension-controlled (friction with displacement control is not modelled)",
+        ));
+    }
     let nt = model.tendons().len();
     let base = actuation.tension_values(nt);
     let mesh = friction_mesh(model, &options.statics.integrator);
