@@ -278,22 +278,12 @@ fn change(a: &[Vec<f64>], b: &[Vec<f64>], scale: f64) -> f64 {
         / scale
 }
 
-/// Solves the statics of `model` under `actuation` with capstan friction along the tendons
-/// (see the module documentation), from the state `previous` (a solution of the same model
-/// and options: the history of stick and slip) or from rest (`None`: every element slides
-/// toward the base).
-///
-/// # Errors
-/// What [`solve_statics_at`] reports; [`Error::InvalidParameter`] naming `previous` if it is
-/// on another mesh, or `friction.tolerance` / `friction.max_iterations`;
-/// [`Error::NotConverged`] if the fixed point does not converge (`what` says so, `iterations`
-/// are the rod solves, `residual` the last relative change of the profile).
-pub fn solve_frictional(
-    model: &Arc<RobotModel>,
+/// Checks the options and the actuation of a frictional solve.
+fn check_inputs(
+    model: &RobotModel,
     actuation: &Actuation,
     options: &FrictionOptions,
-    previous: Option<&FrictionalSolution>,
-) -> Result<FrictionalSolution> {
+) -> Result<()> {
     if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
         return Err(Error::invalid(
             "friction.tolerance",
@@ -312,6 +302,44 @@ pub fn solve_frictional(
             "tension-controlled (friction with displacement control is not modelled)",
         ));
     }
+    Ok(())
+}
+
+/// Every tendon at its base tension over its length, 0 beyond (per node and tendon).
+fn base_profile(model: &RobotModel, mesh: &[f64], base: &[f64]) -> Vec<Vec<f64>> {
+    let (ends, l) = (model.tendon_ends(), model.length());
+    mesh.iter()
+        .map(|&s| {
+            (0..base.len())
+                .map(|i| {
+                    if s < ends[i] || (ends[i] == l && s == l) {
+                        base[i]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Solves the statics of `model` under `actuation` with capstan friction along the tendons
+/// (see the module documentation), from the state `previous` (a solution of the same model
+/// and options: the history of stick and slip) or from rest (`None`: every element slides
+/// toward the base).
+///
+/// # Errors
+/// What [`solve_statics_at`] reports; [`Error::InvalidParameter`] naming `previous` if it is
+/// on another mesh, or `friction.tolerance` / `friction.max_iterations`;
+/// [`Error::NotConverged`] if the fixed point does not converge (`what` says so, `iterations`
+/// are the rod solves, `residual` the last relative change of the profile).
+pub fn solve_frictional(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &FrictionOptions,
+    previous: Option<&FrictionalSolution>,
+) -> Result<FrictionalSolution> {
+    check_inputs(model, actuation, options)?;
     let nt = model.tendons().len();
     let base = actuation.tension_values(nt);
     let mesh = friction_mesh(model, &options.statics.integrator);
@@ -342,22 +370,7 @@ pub fn solve_frictional(
             let dirs = tangents(model, &p.statics);
             profile_on(model, &p.statics, &dirs, &base, prev).0
         }
-        None => {
-            let (ends, l) = (model.tendon_ends(), model.length());
-            mesh.iter()
-                .map(|&s| {
-                    (0..nt)
-                        .map(|i| {
-                            if s < ends[i] || (ends[i] == l && s == l) {
-                                base[i]
-                            } else {
-                                0.0
-                            }
-                        })
-                        .collect()
-                })
-                .collect()
-        }
+        None => base_profile(model, &mesh, &base),
     };
     let mut statics_options = options.statics;
     // Without external loads the zero base wrench is exact (docs/statics.md): no warm start.
