@@ -43,6 +43,7 @@ from ._core import (
     UniaxialLaw,
     Yeoh,
     __version__,
+    actuation_jacobian,
     compliance,
     eigenscrews,
     fit_uniaxial,
@@ -67,6 +68,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
+from .inverse import InverseSolution, inverse_statics
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot, solve_path
 from .vision import Backbone, BackboneQuality
@@ -83,6 +85,7 @@ __all__ = [
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
+    "InverseSolution",
     "LinearElastic",
     "Linearised",
     "Loads",
@@ -115,6 +118,7 @@ __all__ = [
     "WorkspaceMap",
     "Yeoh",
     "__version__",
+    "actuation_jacobian",
     "backbone_distance",
     "compare_models",
     "compliance",
@@ -123,6 +127,7 @@ __all__ = [
     "examples",
     "extract_backbone",
     "fit_uniaxial",
+    "inverse_statics",
     "load_robot",
     "pcc",
     "read_backbone_csv",

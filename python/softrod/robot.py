@@ -310,6 +310,9 @@ class Robot:
         self,
         tensions: Sequence[float] | np.ndarray | None = None,
         pressures: Sequence[float] | np.ndarray | None = None,
+        *,
+        displacements: Sequence[float | None] | np.ndarray | None = None,
+        tendon_stiffness: float | Sequence[float] | np.ndarray | None = None,
         **options: Any,
     ) -> StaticsSolution:
         """Solves the statics under an actuation.
@@ -317,6 +320,13 @@ class Robot:
         Args:
             tensions: Tendon tensions (N), one per tendon; default the robot's.
             pressures: Chamber pressures (Pa, gauge), one per chamber; default the robot's.
+            displacements: Tendon displacement control: one entry per tendon, a number (m)
+                holds the tendon's base end at that shortening of its path relative to the
+                robot at zero actuation (negative: paid out), ``None`` (or NaN) keeps it
+                tension-controlled at ``tensions``. A held tendon that would be compressed goes
+                slack (tension 0); the solved tensions are ``solution.tendon_tensions``.
+            tendon_stiffness: Axial stiffness of the held tendons (N/m; one number or one per
+                tendon; default inextensible).
             **options: Options of :func:`softrod.solve_statics` overriding the robot's
                 (``steps``, ``warm_start``, ``throw``, ...); ``previous``: the frictional
                 solution this actuation follows (stick and slip depend on it; see
@@ -334,6 +344,10 @@ class Robot:
         merged = {**self._solver, **options}
         if chambers:
             merged.setdefault("chambers", chambers)
+        if displacements is not None:
+            merged["displacements"] = displacements
+        if tendon_stiffness is not None:
+            merged["tendon_stiffness"] = tendon_stiffness
         return solve_statics(self._rod, tendons, self._loads, **merged)
 
     def _tensioned(self, tensions: Any) -> tuple[Tendon, ...]:

@@ -13,6 +13,7 @@ mod callbacks;
 mod compliance;
 mod convert;
 mod errors;
+mod inverse;
 mod materials;
 mod model;
 mod pcc;
@@ -71,6 +72,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::actuation_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::_inverse_statics, m)?)?;
     m.add_function(wrap_pyfunction!(model::_rebuild, m)?)?;
     m.add_class::<materials::PyUniaxialLaw>()?;
     m.add_class::<materials::Hookean>()?;
