@@ -98,6 +98,17 @@ def _pcc_solution():
     return pcc.solve(_pcc_robot(), [1.0, 0.0, 0.0, 0.0, 0.5, 0.0])
 
 
+def _planar_shapes():
+    import numpy as np
+
+    arm = _sr().PlanarCableArm(0.27, 0.015, 0.0074, 0.3, 1.3e5)
+    out = []
+    for t in (0.5, 1.0):
+        sol = arm.solve(t, 15)
+        out.append((t, np.column_stack([sol.x, sol.y])))
+    return out
+
+
 def _niti():
     sr = _sr()
     return sr.load_robot(sr.examples.path("niti_two_segment"))
@@ -753,6 +764,51 @@ def _define_targets() -> None:
         )
     )
     t("ModelComparison.table")(lambda d: (sr.compare_models(_niti(), repeats=1).table, {}))
+    # calibration
+    t("StaticsSolution.sensitivities")(
+        lambda d: (
+            _niti().solve().sensitivities,
+            dict(parameters=["stiffness_scale", "tension[0]"], nodes=[0, 10]),
+        )
+    )
+    t("PlanarCableArm.sensitivities")(
+        lambda d: (sr.PlanarCableArm.seed_arm().sensitivities, dict(tension=1.0, s=[0.0, 0.1]))
+    )
+    t("calibrate")(
+        lambda d: (
+            sr.calibrate,
+            dict(
+                robot=sr.PlanarCableArm.seed_arm(),
+                measurements=_planar_shapes(),
+                parameters=["youngs_modulus", "offset_ratio"],
+                bounds={"youngs_modulus": (1e4, 1e6)},
+                metric="arm-index",
+                actuations=None,
+                initial={"youngs_modulus": 1e5},
+                loss="linear",
+                max_evaluations=50,
+                condition_limit=1e8,
+            ),
+        )
+    )
+    t("calibrate(nearest)")(
+        lambda d: (
+            sr.calibrate,
+            dict(
+                robot=sr.PlanarCableArm.seed_arm(),
+                measurements=[p for _, p in _planar_shapes()],
+                parameters=["E"],
+                metric="nearest",
+                actuations=[0.5, 1.0],
+            ),
+        )
+    )
+    t("Calibration.interval")(
+        lambda d: (
+            sr.calibrate(sr.PlanarCableArm.seed_arm(), _planar_shapes(), ["E", "a"]).interval,
+            dict(level=0.9),
+        )
+    )
     # backbones from photographs
     t("extract_backbone")(
         lambda d: (
@@ -1531,6 +1587,8 @@ def summary(outcomes: list[Outcome]) -> dict:
 #: constructors are not fuzzed (their public methods are).
 NOT_CONSTRUCTED = {
     "Backbone",
+    "Calibration",
+    "IdentifiabilityWarning",
     "BackboneQuality",
     "BackboneDistance",
     "Compliance",

@@ -518,6 +518,86 @@ impl StaticsSolution {
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         stats_dict(py, &self.inner.stats)
     }
+    /// Exact derivatives of this equilibrium with respect to named inputs and parameters (the
+    /// linearised boundary-value problem on the solution's own mesh; no finite differences).
+    ///
+    /// `parameters`: names `tension[i]` (per N), `pressure[j]` (per Pa), `tension_scale`,
+    /// `stiffness_scale`, `tendon_offset_scale[i]`, `chamber_area_scale[j]` (per unit factor at
+    /// 1), `base_translation[k]` (per m), `base_rotation[k]` (per rad, world axis k). `nodes`:
+    /// sample indices (default all). Returns a dict: `parameters`, `nodes`, `s` (m), `pose`
+    /// (n_nodes, 6, n_parameters: position in m and rotation in rad, world frame, per unit of
+    /// each parameter), `base_wrench` (6, n_parameters; N, N m) and `tendon_lengths`
+    /// (n_tendons, n_parameters; m).
+    #[pyo3(signature = (parameters, nodes=None))]
+    fn sensitivities<'py>(
+        &self,
+        py: Python<'py>,
+        parameters: Bound<'py, PyAny>,
+        nodes: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let parameters: Vec<String> = items(&parameters, "parameters", "a list of names")?
+            .iter()
+            .enumerate()
+            .map(|(k, item)| {
+                item.extract::<String>()
+                    .map_err(|_| type_err(&format!("parameters[{k}]"), item, "a name (str)"))
+            })
+            .collect::<PyResult<_>>()?;
+        let nodes: Option<Vec<i64>> = nodes
+            .filter(|b| !b.is_none())
+            .map(|b| {
+                items(&b, "nodes", "a list of node indices")?
+                    .iter()
+                    .enumerate()
+                    .map(|(k, item)| {
+                        if item.is_instance_of::<pyo3::types::PyBool>() {
+                            return Err(type_err(&format!("nodes[{k}]"), item, "an integer"));
+                        }
+                        item.extract::<i64>()
+                            .map_err(|_| type_err(&format!("nodes[{k}]"), item, "an integer"))
+                    })
+                    .collect::<PyResult<Vec<_>>>()
+            })
+            .transpose()?;
+        let params = parameters
+            .iter()
+            .enumerate()
+            .map(|(k, name)| parse_parameter(k, name))
+            .collect::<PyResult<Vec<_>>>()?;
+        let n = self.inner.s.len();
+        let nodes: Vec<usize> = match nodes {
+            None => (0..n).collect(),
+            Some(v) => v
+                .iter()
+                .enumerate()
+                .map(|(k, &i)| {
+                    usize::try_from(i).ok().filter(|&i| i < n).ok_or_else(|| {
+                        param_err(&format!("nodes[{k}]"), i, &format!("in [0, {n})"))
+                    })
+                })
+                .collect::<PyResult<_>>()?,
+        };
+        let sol = &self.inner;
+        let sens = py
+            .detach(|| {
+                softrod::sensitivities(sol, &params, &nodes, softrod::Linearisation::Actuated)
+            })
+            .map_err(to_py_err)?;
+        let np = params.len();
+        let nn = sens.nodes.len();
+        let pose = Array::from_shape_fn((nn, 6, np), |(i, r, c)| sens.pose[i][(r, c)]);
+        let bw = Array::from_shape_fn((6, np), |(r, c)| sens.base_wrench[(r, c)]);
+        let nt = sens.tendon_lengths.nrows();
+        let tl = Array::from_shape_fn((nt, np), |(r, c)| sens.tendon_lengths[(r, c)]);
+        let d = PyDict::new(py);
+        d.set_item("parameters", parameters)?;
+        d.set_item("nodes", sens.nodes.clone())?;
+        d.set_item("s", sens.s.clone().into_pyarray(py))?;
+        d.set_item("pose", pose.into_pyarray(py))?;
+        d.set_item("base_wrench", bw.into_pyarray(py))?;
+        d.set_item("tendon_lengths", tl.into_pyarray(py))?;
+        Ok(d)
+    }
     fn __len__(&self) -> usize {
         self.inner.s.len()
     }
@@ -884,4 +964,50 @@ pub(crate) fn _time_solve_statics<'py>(
         }
         Ok(times)
     })
+}
+
+/// A sensitivity parameter from its name (`tension[2]`, `stiffness_scale`, ...).
+fn parse_parameter(k: usize, name: &str) -> PyResult<softrod::Parameter> {
+    use softrod::Parameter as P;
+    let bad = || {
+        param_err(
+            &format!("parameters[{k}]"),
+            format!("{name:?}"),
+            "one of tension[i], pressure[j], tension_scale, stiffness_scale, \
+             tendon_offset_scale[i], chamber_area_scale[j], base_translation[k], base_rotation[k]",
+        )
+    };
+    match name {
+        "tension_scale" => return Ok(P::TensionScale),
+        "stiffness_scale" => return Ok(P::StiffnessScale),
+        _ => {}
+    }
+    let (head, rest) = name.split_once('[').ok_or_else(bad)?;
+    let index: usize = rest
+        .strip_suffix(']')
+        .and_then(|i| i.parse().ok())
+        .ok_or_else(bad)?;
+    Ok(match head {
+        "tension" => P::Tension(index),
+        "pressure" => P::Pressure(index),
+        "tendon_offset_scale" => P::TendonOffsetScale(index),
+        "chamber_area_scale" => P::ChamberAreaScale(index),
+        "base_translation" if index < 3 => P::BaseTranslation(index),
+        "base_rotation" if index < 3 => P::BaseRotation(index),
+        _ => return Err(bad()),
+    })
+}
+
+/// The items of a list-like argument (not a string), or a type error naming it.
+fn items<'py>(
+    b: &Bound<'py, PyAny>,
+    name: &str,
+    expected: &str,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    if b.is_instance_of::<pyo3::types::PyString>() || b.is_none() {
+        return Err(type_err(name, b, expected));
+    }
+    let it = b.try_iter().map_err(|_| type_err(name, b, expected))?;
+    it.collect::<PyResult<Vec<_>>>()
+        .map_err(|_| type_err(name, b, expected))
 }

@@ -83,7 +83,7 @@ pub use model::tendon::{Routing, Tendon};
 pub use model::{Actuation, RobotModel, TendonInput};
 pub use nalgebra;
 pub use planar::{
-    solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,
-    PlanarSolution,
+    planar_sensitivities, solve_planar, solve_planar_many, uniform_samples, PlanarBatch,
+    PlanarCableArm, PlanarMethod, PlanarParameter, PlanarSensitivities, PlanarSolution,
 };
 pub use solve::{NewtonOptions, SolverStats};
