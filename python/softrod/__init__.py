@@ -73,7 +73,7 @@ from .analysis import (
 )
 from .inverse import InverseSolution, inverse_statics
 from .io import read_backbone_csv, write_samples_csv
-from .robot import Robot, load_robot
+from .robot import Robot, load_robot, solve_path
 from .vision import Backbone, BackboneQuality
 
 __all__ = [
@@ -140,6 +140,7 @@ __all__ = [
     "read_tensile_csv",
     "samples",
     "silicone",
+    "solve_path",
     "solve_statics",
     "sweep",
     "tangent_compliance",

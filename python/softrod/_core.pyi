@@ -301,20 +301,35 @@ class Tendon:
         end: float | None = None,
         *,
         derivative: Callable[[float], Sequence[float]] | None = None,
+        friction: float = 0.0,
     ) -> None: ...
     @staticmethod
     def radius_proportional(
-        ratio: float, angle: float, tension: float, end: float | None = None
+        ratio: float,
+        angle: float,
+        tension: float,
+        end: float | None = None,
+        *,
+        friction: float = 0.0,
     ) -> Tendon: ...
     @staticmethod
     def helical(
-        radius: float, pitch: float, tension: float, phase: float = 0.0, end: float | None = None
+        radius: float,
+        pitch: float,
+        tension: float,
+        phase: float = 0.0,
+        end: float | None = None,
+        *,
+        friction: float = 0.0,
     ) -> Tendon: ...
     def with_tension(self, tension: float) -> Tendon: ...
     @property
     def tension(self) -> float: ...
     @property
     def end(self) -> float | None: ...
+    @property
+    def friction(self) -> float:
+        """Friction coefficient between the tendon and its channel (>= 0)."""
     @property
     def routing(self) -> Literal["constant", "function", "radius_proportional", "helical"]: ...
     @property
@@ -399,6 +414,19 @@ class StaticsSolution:
     @property
     def tendon_lengths(self) -> NDArray[np.float64]: ...
     @property
+    def tendon_tension(self) -> NDArray[np.float64]:
+        """Tension (N) along each tendon at every sample, shape (N, n_tendons)."""
+    @property
+    def friction_force(self) -> NDArray[np.float64]:
+        """Friction force on the rod (N/m, world), shape (N, n_tendons, 3)."""
+    @property
+    def slip(self) -> NDArray[np.int8]:
+        """+1 sliding toward the base, -1 toward the tip, 0 sticking; (N, n_tendons)."""
+    @property
+    def frictional(self) -> bool: ...
+    @property
+    def friction_iterations(self) -> int: ...
+    @property
     def tendon_tensions(self) -> NDArray[np.float64]: ...
     @property
     def tendon_displacements(self) -> NDArray[np.float64]: ...
@@ -449,6 +477,7 @@ def solve_statics(
     s_out: Sequence[float] | NDArray[np.float64] | None = None,
     seek_stable: bool | None = None,
     on_unstable: Literal["warn", "raise", "ignore"] | None = None,
+    previous: StaticsSolution | None = None,
     displacements: Sequence[float | None] | NDArray[np.float64] | None = None,
     tendon_stiffness: float | Sequence[float] | NDArray[np.float64] | None = None,
 ) -> StaticsSolution:

@@ -36,7 +36,7 @@ from .io import objects as _objects
 from .io import robot_file as _rf
 from .io.robot_file import FieldError, RobotFile
 
-__all__ = ["Robot", "load_robot"]
+__all__ = ["Robot", "load_robot", "solve_path"]
 
 _PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)\Z")
 
@@ -328,7 +328,9 @@ class Robot:
             tendon_stiffness: Axial stiffness of the held tendons (N/m; one number or one per
                 tendon; default inextensible).
             **options: Options of :func:`softrod.solve_statics` overriding the robot's
-                (``steps``, ``warm_start``, ``throw``, ...).
+                (``steps``, ``warm_start``, ``throw``, ...); ``previous``: the frictional
+                solution this actuation follows (stick and slip depend on it; see
+                :func:`solve_path`).
 
         Returns:
             The solution.
@@ -611,3 +613,64 @@ def load_robot(path: str | os.PathLike[str]) -> Robot:
     stem = os.path.splitext(os.path.basename(name))[0]
     spec = _rf.validate_robot_dict(data, source=name)
     return Robot.from_spec(spec, name=stem, source=name)
+
+
+def solve_path(
+    robot: Robot,
+    actuations: Sequence[Sequence[float]] | np.ndarray,
+    pressures: Sequence[Sequence[float]] | np.ndarray | None = None,
+    **options: Any,
+) -> list[StaticsSolution]:
+    """Solves a quasi-static actuation path: each step from the equilibrium of the one before.
+
+    With tendon friction (a tendon with ``friction > 0``) the tension along each tendon
+    depends on the history: every tendon element slides toward the base, toward the tip, or
+    sticks, according to the change of its tension from the previous step
+    (``docs/friction.md``). The first step starts from rest (every element sliding toward
+    the base). Without friction every step is the frictionless equilibrium.
+
+    Args:
+        robot: The robot.
+        actuations: Tendon tensions (N), shape (n_steps, n_tendons).
+        pressures: Chamber pressures (Pa), shape (n_steps, n_chambers); default the robot's.
+        **options: Options of :meth:`Robot.solve` (not ``previous``).
+
+    Returns:
+        One solution per step.
+
+    Raises:
+        ParameterError: Bad actuations (shape, values) or options.
+        ConvergenceError: A step did not converge (unless ``throw=False``).
+    """
+    if not isinstance(robot, Robot):
+        raise ParameterError(f"robot = {robot!r}: expected a softrod.Robot")
+    if "previous" in options:
+        raise ParameterError("previous: not an option of solve_path (each step follows the last)")
+    try:
+        table = np.asarray(actuations, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"actuations = {actuations!r}: expected tensions (N), shape (n_steps, n_tendons)"
+        ) from None
+    nt = len(robot.tendons)
+    if table.ndim != 2 or table.shape[1] != nt:
+        raise ParameterError(
+            f"actuations.shape = {table.shape}: expected (n_steps, {nt}) tensions (N)"
+        )
+    if pressures is not None:
+        try:
+            ptable = np.asarray(pressures, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"pressures = {pressures!r}: expected pressures (Pa), shape (n_steps, n_chambers)"
+            ) from None
+        if ptable.ndim != 2 or ptable.shape[0] != table.shape[0]:
+            raise ParameterError(
+                f"pressures.shape = {ptable.shape}: expected ({table.shape[0]}, n_chambers)"
+            )
+    out: list[StaticsSolution] = []
+    for k, row in enumerate(table):
+        p = None if pressures is None else ptable[k]
+        previous = out[-1] if out and out[-1].frictional else None
+        out.append(robot.solve(row, p, previous=previous, **options))
+    return out

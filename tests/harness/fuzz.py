@@ -114,6 +114,14 @@ def _niti():
     return sr.load_robot(sr.examples.path("niti_two_segment"))
 
 
+def _niti_friction():
+    robot = _niti()
+    spec = robot.spec.model_dump(mode="python", exclude_none=True)
+    for t in spec["tendons"]:
+        t["friction"] = 0.2
+    return _sr().Robot.from_dict(spec)
+
+
 def _chambered():
     sr = _sr()
     rod = sr.Rod(0.2, sr.CircularSection(0.01), sr.LinearElastic(1e6, 0.45))
@@ -457,6 +465,45 @@ def _define_targets() -> None:
         lambda d: (
             sr.Tendon.helical,
             dict(radius=0.001, pitch=0.2, tension=0.5, phase=0.0, end=0.25),
+        )
+    )
+    t("Tendon(friction)")(
+        lambda d: (sr.Tendon, dict(offset=(0.001, 0.0), tension=0.5, end=0.2, friction=0.2))
+    )
+    t("Tendon.radius_proportional(friction)")(
+        lambda d: (
+            sr.Tendon.radius_proportional,
+            dict(ratio=1 / 3, angle=0.0, tension=1.0, friction=0.2),
+        )
+    )
+    t("Tendon.helical(friction)")(
+        lambda d: (
+            sr.Tendon.helical,
+            dict(radius=0.001, pitch=0.2, tension=0.5, friction=0.2),
+        )
+    )
+    t("solve_statics(friction, previous)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=_rod(),
+                tendons=[sr.Tendon((0.001, 0.0), 0.3, friction=0.2)],
+                loads=_loads(),
+                previous=sr.solve_statics(
+                    _rod(), [sr.Tendon((0.001, 0.0), 0.5, friction=0.2)], _loads()
+                ),
+            ),
+        )
+    )
+    t("solve_path")(
+        lambda d: (
+            sr.solve_path,
+            dict(
+                robot=_niti_friction(),
+                actuations=[[1.0, 0, 0, 0, 0.5, 0], [2.0, 0, 0, 0, 0.5, 0], [1.0, 0, 0, 0, 0.5, 0]],
+                pressures=None,
+                steps=30,
+            ),
         )
     )
     t("Tendon.with_tension")(

@@ -261,6 +261,8 @@ pub(crate) fn actuator_names(e: softrod::Error) -> softrod::Error {
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct StaticsSolution {
     pub(crate) inner: softrod::StaticsSolution,
+    /// The friction state of a frictional solve (tension along the tendons, slip).
+    pub(crate) friction: Option<Arc<softrod::FrictionalSolution>>,
     cache: [PyOnceLock<Py<PyAny>>; 12],
     /// The call that produced it (for pickling: it is solved again, bit for bit).
     call: Args,
@@ -358,6 +360,73 @@ impl StaticsSolution {
                 .into_any()
                 .unbind()
         })
+    }
+    /// Tension (N) along each tendon at every sample, shape (N, n_tendons): the base tension
+    /// for a frictionless tendon, the capstan profile with friction; 0 beyond a termination.
+    #[getter]
+    fn tendon_tension<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let sol = &self.inner;
+        let model = &sol.model;
+        let nt = model.tendons().len();
+        let a = match &self.friction {
+            Some(f) => Array::from_shape_fn((f.tension.len(), nt), |(j, i)| f.tension[j][i]),
+            None => {
+                let base = sol.tensions();
+                let (ends, l) = (model.tendon_ends(), model.length());
+                Array::from_shape_fn((sol.s.len(), nt), |(j, i)| {
+                    let s = sol.s[j];
+                    if s < ends[i] || (ends[i] == l && s == l) {
+                        base[i]
+                    } else {
+                        0.0
+                    }
+                })
+            }
+        };
+        a.into_pyarray(py)
+    }
+    /// Friction force on the rod per unit length (N/m, world), `dτ/ds` times the tendon's
+    /// path tangent, shape (N, n_tendons, 3); zero without friction.
+    #[getter]
+    fn friction_force<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let n = self.inner.s.len();
+        let nt = self.inner.model.tendons().len();
+        let a = match &self.friction {
+            Some(f) => Array::from_shape_fn((n, nt, 3), |(j, i, k)| f.friction_force[j][i][k]),
+            None => Array::zeros((n, nt, 3)),
+        };
+        a.into_pyarray(py)
+    }
+    /// Slip state of every tendon element, shape (N, n_tendons): +1 sliding toward the base
+    /// (loading), -1 sliding toward the tip (unloading), 0 sticking or beyond the
+    /// termination; +1 for a frictionless solve's tendons within their length.
+    #[getter]
+    fn slip<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i8>> {
+        let sol = &self.inner;
+        let model = &sol.model;
+        let nt = model.tendons().len();
+        let a = match &self.friction {
+            Some(f) => Array::from_shape_fn((f.slip.len(), nt), |(j, i)| f.slip[j][i].sign()),
+            None => {
+                let (ends, l) = (model.tendon_ends(), model.length());
+                Array::from_shape_fn((sol.s.len(), nt), |(j, i)| {
+                    let s = sol.s[j];
+                    i8::from(s < ends[i] || (ends[i] == l && s == l))
+                })
+            }
+        };
+        a.into_pyarray(py)
+    }
+    /// Whether the solve modelled tendon friction (a tendon with `friction > 0` or a
+    /// `previous` state).
+    #[getter]
+    fn frictional(&self) -> bool {
+        self.friction.is_some()
+    }
+    /// Rod solves of the friction fixed point (0 without friction).
+    #[getter]
+    fn friction_iterations(&self) -> usize {
+        self.friction.as_ref().map_or(0, |f| f.iterations)
     }
     /// Tension carried by each tendon (N), shape (n_tendons,): the input of a
     /// tension-controlled tendon, the solved tension of a displacement-controlled one (0 when
@@ -630,7 +699,7 @@ fn report_unstable(
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
                     continuation=None, max_load_steps=None, warm_start=None, throw=None,
                     chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None,
-                    displacements=None, tendon_stiffness=None))]
+                    previous=None, displacements=None, tendon_stiffness=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
     py: Python<'py>,
@@ -651,9 +720,29 @@ pub(crate) fn solve_statics<'py>(
     s_out: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
     on_unstable: Option<&'py str>,
+    previous: Option<Bound<'py, PyAny>>,
     displacements: Option<Bound<'py, PyAny>>,
     tendon_stiffness: Option<Bound<'py, PyAny>>,
 ) -> PyResult<StaticsSolution> {
+    let previous = previous.filter(|p| !p.is_none());
+    let prev_state: Option<Arc<softrod::FrictionalSolution>> = match &previous {
+        None => None,
+        Some(p) => {
+            let Ok(p) = p.cast::<StaticsSolution>() else {
+                return Err(type_err("previous", p, "a StaticsSolution (or None)"));
+            };
+            match &p.get().friction {
+                Some(f) => Some(Arc::clone(f)),
+                None => {
+                    return Err(param_err(
+                        "previous",
+                        "a frictionless solution",
+                        "a solution of a solve with friction (a tendon with friction > 0)",
+                    ))
+                }
+            }
+        }
+    };
     let warm_start = warm_start.filter(|w| !w.is_none());
     let unstable = self::on_unstable(on_unstable)?;
     let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
@@ -698,9 +787,30 @@ pub(crate) fn solve_statics<'py>(
         }
     }
     let (model, act) = (&problem.model, &actuation);
-    let result = run(py, "solve_statics", || {
-        softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
-    })?;
+    let frictional = prev_state.is_some() || model.tendons().iter().any(|t| t.friction() > 0.0);
+    if frictional && !s_values.is_empty() {
+        return Err(param_err(
+            "s_out",
+            format!("{} arc lengths", s_values.len()),
+            "None with friction (the solution is reported at the friction mesh)",
+        ));
+    }
+    let (result, friction) = if frictional {
+        let fo = softrod::FrictionOptions {
+            statics: options,
+            ..Default::default()
+        };
+        let f = run(py, "solve_statics", || {
+            softrod::solve_frictional(model, act, &fo, prev_state.as_deref())
+                .map_err(actuator_names)
+        })?;
+        (f.statics.clone(), Some(Arc::new(f)))
+    } else {
+        let r = run(py, "solve_statics", || {
+            softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
+        })?;
+        (r, None)
+    };
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(
         py,
@@ -746,12 +856,14 @@ pub(crate) fn solve_statics<'py>(
                 "on_unstable",
                 "ignore".into_pyobject(py)?.into_any().unbind(),
             ),
+            ("previous", o(previous.map(Bound::unbind))),
             ("displacements", o(displacements.map(Bound::unbind))),
             ("tendon_stiffness", o(tendon_stiffness.map(Bound::unbind))),
         ],
     )?;
     let sol = StaticsSolution {
         inner: result,
+        friction,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
     };

@@ -48,6 +48,9 @@ pub use compliance::{
     TendonControl,
 };
 pub use cosserat::displacement::reference_lengths;
+pub use cosserat::friction::{
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+};
 pub use cosserat::sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
     Parameter, Sensitivities,
@@ -62,6 +65,7 @@ pub use inverse::{
     inverse_statics, inverse_statics_path, solve_inverse, CosseratForward, Evaluation, Forward,
     InverseOptions, InverseSolution, InverseWarmStart, Target,
 };
+pub use model::actuation::TensionProfile;
 pub use model::chamber::{Chamber, ChamberArea};
 pub use model::loads::{Frame, Loads, PointLoad};
 pub use model::material::fit::{

@@ -137,10 +137,14 @@ def build_material(m: Any, errors: list[FieldError]) -> Any:
 def _tendon(t: Any) -> Tendon:
     if isinstance(t, rf.ConstantTendonSpec):
         offset = t.offset if t.offset is not None else _polar(t.distance, t.angle_deg)
-        return Tendon(offset, t.tension, t.end)
+        return Tendon(offset, t.tension, t.end, friction=t.friction)
     if isinstance(t, rf.RadiusProportionalTendonSpec):
-        return Tendon.radius_proportional(t.ratio, math.radians(t.angle_deg), t.tension, t.end)
-    return Tendon.helical(t.radius, t.pitch, t.tension, math.radians(t.phase_deg), t.end)
+        return Tendon.radius_proportional(
+            t.ratio, math.radians(t.angle_deg), t.tension, t.end, friction=t.friction
+        )
+    return Tendon.helical(
+        t.radius, t.pitch, t.tension, math.radians(t.phase_deg), t.end, friction=t.friction
+    )
 
 
 def _chamber(c: rf.ChamberSpec) -> Chamber:
@@ -321,6 +325,8 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
     out: dict[str, Any] = {"tension": float(t.tension)}
     if t.end is not None:
         out["end"] = float(t.end)
+    if t.friction:
+        out["friction"] = float(t.friction)
     routing, p = r.get(t, "routing"), r.get(t, "parameters")
     if routing is None or p is None:
         return None

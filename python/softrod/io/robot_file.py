@@ -275,6 +275,7 @@ def _union(key: str, default: str, members: dict[str, type], by_key=None) -> Any
 class _TendonBase(_Table):
     tension: _num("tension (N)", ge=0) = 0.0
     end: _num("arc length where the tendon ends (m); default the tip", gt=0) | None = None
+    friction: _num("friction coefficient between tendon and channel (capstan law)", ge=0) = 0.0
 
 
 class ConstantTendonSpec(_TendonBase):

@@ -69,6 +69,7 @@ use crate::integrate::march::Piecewise;
 use crate::integrate::System;
 use crate::math::linalg::Lu6;
 use crate::math::so3::{hat, reorthonormalise};
+use crate::model::actuation::TensionProfile;
 use crate::model::loads::Frame;
 use crate::model::section::SectionProperties;
 use crate::model::RobotModel;
@@ -218,6 +219,9 @@ pub(crate) struct Equations<'a> {
     pub tensions: &'a [f64],
     pub pressures: &'a [f64],
     pub load_factor: f64,
+    /// The tension along the tendons when it varies (friction, `cosserat::friction`);
+    /// `None`: `tensions` over each tendon's whole length.
+    pub profile: Option<&'a TensionProfile>,
 }
 
 /// What a sensitivity column is a derivative with respect to: its forcing along the rod
@@ -567,10 +571,15 @@ impl Evaluator<'_, '_> {
         self.ws.offsets.clear();
         for &i in &self.ws.active {
             let (r, rp) = tendons[i].routing().offset(s, props);
+            let tau = self
+                .eq
+                .profile
+                .and_then(|p| p.at(i, s))
+                .unwrap_or(self.eq.tensions[i]);
             self.ws.offsets.push((
                 Vector3::new(r[0], r[1], 0.0),
                 Vector3::new(rp[0], rp[1], 0.0),
-                self.eq.tensions[i],
+                tau,
             ));
         }
     }

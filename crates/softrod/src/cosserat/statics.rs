@@ -274,6 +274,7 @@ fn margin_of(sol: &StaticsSolution) -> Option<f64> {
         tensions: &tensions,
         pressures: &pressures,
         load_factor: 1.0,
+        profile: sol.actuation.profile.as_deref(),
     };
     let plan = match sol.options.integrator {
         Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
@@ -786,6 +787,7 @@ fn solve_with(
         tensions: &tensions,
         pressures: &pressures,
         load_factor: 1.0,
+        profile: actuation.profile.as_deref(),
     };
     let mut p = Shooting::new(eq, options.integrator, plan);
     p.stops = interior(s_out, model.length());
