@@ -181,6 +181,7 @@ pub(crate) fn march_compliance(
         tensions: &tensions,
         pressures: &pressures,
         load_factor: solution.stats.load_factor,
+        profile: solution.actuation.profile.as_deref(),
     };
     let f = model.force_scale();
     let fm = f * length;
