@@ -9,6 +9,8 @@
 //! The crate is laid out as the architecture (see `docs/architecture.md`):
 //! * [`model`]: the validated, immutable [`RobotModel`] (rod, section, material, tendon
 //!   routings, chamber geometry, loads) and the [`Actuation`] input (tensions, pressures);
+//! * [`contact`]: end constraints and unilateral contact with obstacles through the
+//!   shooting problem, [`solve_constrained`];
 //! * [`cosserat`]: the Cosserat-rod statics, [`solve_statics`]`(&model, &actuation,
 //!   &options)`, whose [`StaticsSolution`] keeps its model, actuation and options;
 //! * [`compliance`](mod@compliance): integrated and tangent compliance, eigenscrews;
@@ -23,6 +25,7 @@
 
 pub mod batch;
 pub mod compliance;
+pub mod contact;
 pub mod cosserat;
 pub mod error;
 pub mod integrate;
@@ -43,6 +46,7 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
+pub use contact::{solve_constrained, Contact, ContactSolution, Obstacle, TipConstraint};
 pub use cosserat::statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,
 };

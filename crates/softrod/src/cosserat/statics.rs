@@ -281,7 +281,7 @@ fn margin_of(sol: &StaticsSolution) -> Option<f64> {
 }
 
 /// The points of `s_out` strictly inside `(0, length)`.
-fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
+pub(crate) fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
     s_out
         .iter()
         .copied()
@@ -294,7 +294,7 @@ fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
 /// integrator the residual carries the integration error and exact Jacobians are evaluated.
 /// A loaded solve ends on an exact Jacobian at the solution (the stability test needs its
 /// columns).
-fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
+pub(crate) fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
     NewtonSettings {
         line_search: LineSearch {
             factor: 0.5,
@@ -485,7 +485,7 @@ fn attempt(p: &mut Shooting<'_>, options: &SolveOptions, x0: &[f64; 6], exact: b
 }
 
 /// Scaled unknowns of a base wrench (N, N m).
-fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
+pub(crate) fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();
     [
@@ -833,7 +833,7 @@ fn solve_with(
 }
 
 /// The base wrench (N, N m) of scaled unknowns.
-fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
+pub(crate) fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();
     [
@@ -859,7 +859,7 @@ fn rows(r: &Matrix3<f64>) -> [[f64; 3]; 3] {
 }
 
 /// Derived quantities at the recorded nodes of the last pass (which is at the solution).
-fn assemble(
+pub(crate) fn assemble(
     p: &mut Shooting<'_>,
     shared: &Arc<RobotModel>,
     base_wrench: [f64; 6],
