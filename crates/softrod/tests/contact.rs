@@ -1,0 +1,112 @@
+//! Unilateral frictionless contact with obstacles, against beam theory: a cantilever pushed
+//! onto a parallel plane at its tip; every contact solution checked for penetration, the sign
+//! and direction of the forces and global balance.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+mod common;
+
+use softrod::nalgebra::Vector3;
+use softrod::{
+    solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, Obstacle,
+    RobotModel, Rod, Section, SolveOptions,
+};
+
+const E: f64 = 2e9;
+const NU: f64 = 0.3;
+const L: f64 = 1.0;
+
+fn rod(radius: f64) -> Rod {
+    Rod::new(L, Section::circular(radius).unwrap(), LinearElastic::new(E, NU).unwrap()).unwrap()
+}
+
+fn options(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        ..SolveOptions::default()
+    }
+}
+
+/// The checks of every contact solution: no penetration beyond 1e-9 m at any node,
+/// non-negative normal forces along the obstacle normal, and the base wrench equal to the
+/// applied tip force and the contact forces (about the base) to 1e-10 of `scale`.
+fn assert_contact_solution(
+    sol: &ContactSolution,
+    obstacles: &[Obstacle],
+    radius: f64,
+    applied: &[(Vector3<f64>, Vector3<f64>)],
+    scale: f64,
+) {
+    for p in &sol.solution.position {
+        for o in obstacles {
+            let g = o.distance(&Vector3::from(*p)).0 - radius;
+            assert!(g >= -1e-9, "penetration {g:e} at {p:?}");
+        }
+    }
+    let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
+    for c in &sol.contacts {
+        assert!(c.normal_force >= 0.0, "pulling contact {c:?}");
+        assert!(c.tangential_force.iter().all(|t| *t == 0.0));
+        let (_, n) = obstacles[c.obstacle].distance(&Vector3::from(c.point));
+        assert!((n - Vector3::from(c.normal)).norm() < 1e-9);
+    }
+    let total: Vector3<f64> = sol
+        .contact_force
+        .iter()
+        .map(|v| Vector3::from(*v))
+        .sum();
+    let by_contact: Vector3<f64> = sol
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.normal) * c.normal_force)
+        .sum();
+    assert!((total - by_contact).norm() <= 1e-12 * scale);
+    for (j, cf) in sol.contact_force.iter().enumerate() {
+        let cf = Vector3::from(*cf);
+        f += cf;
+        m += Vector3::from(sol.solution.position[j]).cross(&cf);
+    }
+    for (p, force) in applied {
+        f += force;
+        m += p.cross(force);
+    }
+    let b = sol.solution.base_wrench;
+    for k in 0..3 {
+        assert!((b[k] - f[k]).abs() <= 1e-10 * scale, "force {k}: {} vs {}", b[k], f[k]);
+        assert!((b[3 + k] - m[k]).abs() <= 1e-10 * scale * L, "moment {k}: {} vs {}", b[3 + k], m[k]);
+    }
+}
+
+/// A cantilever along z pushed by a tip force toward the plane x = -(R + δ) (normal +x):
+/// no contact below the force 3 E I δ / L³ that closes the gap, and beyond it a tip reaction
+/// R = F - 3 E I δ / L³ (slender rod: shear below 1e-5 of it).
+#[test]
+fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let closing = 3.0 * ei * delta / L.powi(3);
+    let plane = Obstacle::plane([-(radius + delta), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    let obstacles = [plane];
+    for factor in [0.5, 0.99, 1.5, 2.0, 4.0] {
+        let force = Vector3::new(-factor * closing, 0.0, 0.0);
+        let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+        let sol = solve_constrained(&model, &Actuation::default(), &options(100), None, &obstacles)
+            .unwrap();
+        assert!(sol.solution.stats.converged);
+        let tip = Vector3::from(sol.solution.tip_position());
+        assert_contact_solution(&sol, &obstacles, radius, &[(tip, force)], closing);
+        if factor < 1.0 {
+            assert!(sol.contacts.is_empty(), "contact at F = {factor} F_c");
+            let gap = plane.distance(&tip).0 - radius;
+            assert!(gap > 0.0);
+            continue;
+        }
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        let c = sol.contacts[0];
+        assert_eq!(c.s, L);
+        let exact = (factor - 1.0) * closing;
+        let err = (c.normal_force / exact - 1.0).abs();
+        assert!(err < 1e-4, "F = {factor} F_c: R = {:e} vs {exact:e} ({err:e})", c.normal_force);
+        println!("tip contact F = {factor} F_c: R = {:e}, closed form {exact:e}, rel. error {err:e}", c.normal_force);
+    }
+}
