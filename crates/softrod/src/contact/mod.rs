@@ -38,8 +38,12 @@ pub(crate) fn obstacle_normal_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<
 pub struct Contact {
     /// Index of the obstacle in the list solved with.
     pub obstacle: usize,
-    /// Arc length of the contact (m).
+    /// Arc length of the contact (m): of the point, or where a contact interval starts.
     pub s: f64,
+    /// Length of a contact interval (m; 0 for a point contact): the segment `[s, s + length]`
+    /// lies on a plane under a distributed reaction, whose resultant is `normal_force` and
+    /// whose `point` is the tip end of the segment.
+    pub length: f64,
     /// Contact point on the rod's surface (m, world).
     pub point: [f64; 3],
     /// Outward unit normal of the obstacle at the contact (world): the direction of the

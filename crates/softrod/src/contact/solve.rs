@@ -38,6 +38,10 @@ enum Site {
     Tip,
     /// Inside the rod at an unknown arc length where the gap is least (unknowns: `s`, force).
     Interior,
+    /// On a plane, from an unknown arc length `a` to the tip: a concentrated force at `a`
+    /// (unknowns: `a`, force) and, on `(a, L]`, the distributed reaction that cancels the
+    /// normal component of the distributed loads (the segment lies flat on the plane).
+    Interval,
 }
 
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
@@ -54,7 +58,7 @@ impl Active {
     fn size(&self) -> usize {
         match self.site {
             Site::Tip => 3,
-            Site::Interior => 4,
+            Site::Interior | Site::Interval => 4,
         }
     }
 }
@@ -227,13 +231,45 @@ impl<'m> Constrained<'m> {
         for (a, o) in self.active.iter().zip(self.offsets()) {
             let (s, k) = match a.site {
                 Site::Tip => (l, o),
-                Site::Interior => (x[o] * l, o + 1),
+                Site::Interior | Site::Interval => (x[o] * l, o + 1),
             };
             if !(s > 0.0 && s <= l) {
                 return None;
             }
             let force = Vector3::new(x[k], x[k + 1], x[k + 2]) * f;
             loads.point_loads.push(PointLoad::force(s, force));
+            if a.site == Site::Interval {
+                if s >= l {
+                    return None;
+                }
+                let Obstacle::Plane { normal, .. } = self.obstacles[a.obstacle] else {
+                    return None;
+                };
+                // The reaction starts just after the break at `s` (its own break), so that
+                // no Runge-Kutta stage of the interval before sees it.
+                let after = f64::from_bits(s.to_bits() + 1);
+                loads
+                    .point_loads
+                    .push(PointLoad::force(after, Vector3::zeros()));
+                let base = loads.distributed_force.clone();
+                let rho_g = self.model.rod().density().map(|d| loads.gravity * d);
+                let rod = self.model.rod().clone();
+                loads.distributed_force = Some(Profile::Function(Arc::new(move |t| {
+                    let mut f = base.as_ref().map_or(Vector3::zeros(), |p| p.at(t));
+                    if t < after {
+                        return f;
+                    }
+                    let mut applied = f;
+                    if let Some(g) = rho_g {
+                        applied += g * rod.section_at(t).area;
+                    }
+                    let push = normal.dot(&applied);
+                    if push < 0.0 {
+                        f -= normal * push;
+                    }
+                    f
+                })));
+            }
         }
         self.model.with_loads(loads).ok()
     }
@@ -278,7 +314,7 @@ impl<'m> Constrained<'m> {
             let ob = &self.obstacles[a.obstacle];
             let (s, k) = match a.site {
                 Site::Tip => (l, o),
-                Site::Interior => (x[o] * l, o + 1),
+                Site::Interior | Site::Interval => (x[o] * l, o + 1),
             };
             let props = model.rod().section_at(s);
             let first = sh.nodes.iter().position(|n| n.s == s)?;
@@ -287,9 +323,17 @@ impl<'m> Constrained<'m> {
             let (d, n) = ob.distance(&pc);
             let g = d - props.radius;
             rows.push((g - (1.0 - mu) * a.g0) / l);
-            if a.site == Site::Interior {
+            if a.site != Site::Tip {
+                // A point contact sits at the kink of the gap (the shear jumps with the
+                // force): the mean slope of its two sides vanishes; the segment of an
+                // interval lies flat from just after its edge.
+                let sides: &[usize] = if a.site == Site::Interval {
+                    &[last, last]
+                } else {
+                    &[first, last]
+                };
                 let mut slope = 0.0;
-                for j in [first, last] {
+                for &j in sides {
                     let node = sh.nodes[j];
                     let mut ev = Evaluator {
                         eq: sh.eq,
@@ -350,7 +394,7 @@ impl<'m> Constrained<'m> {
             .map(|(a, o)| {
                 let (s, k) = match a.site {
                     Site::Tip => (l, o),
-                    Site::Interior => (x[o] * l, o + 1),
+                    Site::Interior | Site::Interval => (x[o] * l, o + 1),
                 };
                 let node = pass
                     .nodes
@@ -512,10 +556,68 @@ fn active_set(
                     .iter()
                     .zip(&p.active)
                     .any(|(f, a)| a.obstacle == o && (f.2 - s).abs() <= 1e-12 * l);
-                if minimum && !taken {
+                let inside = p
+                    .active
+                    .iter()
+                    .zip(&forces)
+                    .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
+                if minimum && !taken && !inside {
                     added.push((o, if at_tip { Site::Tip } else { Site::Interior }, s));
                 }
             }
+        }
+        // A plane touched twice (or an interval touched before its edge): one interval from
+        // the first contact to the tip.
+        let mut merged = false;
+        for &(o, _, s) in &added {
+            if !matches!(p.obstacles[o], Obstacle::Plane { .. }) {
+                continue;
+            }
+            let offsets = p.offsets();
+            let on: Vec<usize> = (0..p.active.len())
+                .filter(|i| p.active[*i].obstacle == o)
+                .collect();
+            if on.is_empty() {
+                continue;
+            }
+            let mut a = s;
+            for &i in &on {
+                a = a.min(forces[i].2);
+            }
+            if a >= l {
+                continue;
+            }
+            for &i in on.iter().rev() {
+                let size = p.active[i].size();
+                p.active.remove(i);
+                x.drain(offsets[i]..offsets[i] + size);
+            }
+            p.active.push(Active {
+                obstacle: o,
+                site: Site::Interval,
+                g0: 0.0,
+                dg0: 0.0,
+            });
+            x.push(a / l);
+            x.extend([0.0; 3]);
+            merged = true;
+            break;
+        }
+        if merged {
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        // An interval whose segment lifts off the plane is only its edge contact.
+        let lifted = p.active.iter().enumerate().position(|(i, a)| {
+            a.site == Site::Interval
+                && p.gaps(a.obstacle)
+                    .iter()
+                    .any(|g| g.1 > forces[i].2 && g.2 > penetration)
+        });
+        if let Some(i) = lifted {
+            p.active[i].site = Site::Interior;
+            x = correct(p, &x, opts, effort)?;
+            continue;
         }
         if added.is_empty() {
             return Some(x);
@@ -531,7 +633,7 @@ fn active_set(
                 g0: 0.0,
                 dg0: 0.0,
             });
-            if site == Site::Interior {
+            if site != Site::Tip {
                 x.push(s / l);
             }
             x.extend([0.0; 3]);
@@ -545,7 +647,7 @@ fn active_set(
         let offsets = p.offsets();
         for (a, o) in p.active.iter_mut().zip(offsets) {
             a.g0 = r[o] * l;
-            if a.site == Site::Interior {
+            if a.site != Site::Tip {
                 a.dg0 = r[o + 1];
             }
         }
@@ -790,6 +892,7 @@ fn finish(
         contacts.push(Contact {
             obstacle: a.obstacle,
             s: *s,
+            length: 0.0,
             point: [point.x, point.y, point.z],
             normal: [n.x, n.y, n.z],
             normal_force: *fnorm,
@@ -799,6 +902,55 @@ fn finish(
             for k in 0..3 {
                 contact_force[j][k] += fnorm * n[k];
             }
+        }
+        if a.site == Site::Interval {
+            // The distributed reaction on (a, L], lumped at the samples by the trapezoid rule.
+            let after = f64::from_bits(s.to_bits() + 1);
+            let density = |t: f64| {
+                let mut f = cm
+                    .loads()
+                    .distributed_force
+                    .as_ref()
+                    .map_or(Vector3::zeros(), |p| p.at(t));
+                // The model's distributed force already carries the reaction: take it alone.
+                if let Some(g) = cm.rho_g() {
+                    f += g * cm.rod().section_at(t).area;
+                }
+                f
+            };
+            let base = model.loads().distributed_force.as_ref();
+            let mut total = 0.0;
+            let idx: Vec<usize> = (0..sol.s.len()).filter(|j| sol.s[*j] >= after).collect();
+            for w in idx.windows(2) {
+                let (j0, j1) = (w[0], w[1]);
+                let h = sol.s[j1] - sol.s[j0];
+                if h <= 0.0 {
+                    continue;
+                }
+                for j in [j0, j1] {
+                    let t = sol.s[j];
+                    let applied = base.map_or(Vector3::zeros(), |p| p.at(t));
+                    let reaction = density(t)
+                        - applied
+                        - cm.rho_g()
+                            .map_or(Vector3::zeros(), |g| g * cm.rod().section_at(t).area);
+                    let lump = reaction * (0.5 * h);
+                    total += lump.dot(n);
+                    for k in 0..3 {
+                        contact_force[j][k] += lump[k];
+                    }
+                }
+            }
+            let tip = Vector3::from(sol.tip_position()) - n * radius;
+            contacts.push(Contact {
+                obstacle: a.obstacle,
+                s: after,
+                length: l - after,
+                point: [tip.x, tip.y, tip.z],
+                normal: [n.x, n.y, n.z],
+                normal_force: total,
+                tangential_force: [0.0; 3],
+            });
         }
     }
     let tip_reaction = p.tip.as_ref().map(|_| {
