@@ -202,3 +202,45 @@ fn distributed_contact_with_a_floor_is_the_beam_closed_form() {
         assert!(fx.abs() <= 1e-10 * q * L, "force balance {fx:e}");
     }
 }
+
+/// A cantilever pushed at its tip onto a sphere beside its middle: one interior contact at
+/// the point of least gap, whose force is the propped-cantilever reaction
+/// `R = (F c² (3L - c) / (6 E I) - δ) 3 E I / c³` (c the height of the sphere's centre, δ the
+/// surface gap there).
+#[test]
+fn interior_contact_with_a_sphere_is_the_propped_cantilever() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let (c, rs) = (0.6 * L, 0.05 * L);
+    let sphere = Obstacle::sphere([-(radius + delta + rs), 0.0, c], rs).unwrap();
+    let obstacles = [sphere];
+    let closing = delta * 6.0 * ei / (c * c * (3.0 * L - c));
+    for factor in [0.8, 1.5, 3.0] {
+        let force = Vector3::new(-factor * closing, 0.0, 0.0);
+        let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+        let sol = solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(200),
+            None,
+            &obstacles,
+        )
+        .unwrap();
+        assert!(sol.solution.stats.converged);
+        let tip = Vector3::from(sol.solution.tip_position());
+        assert_contact_solution(&sol, &obstacles, radius, &[(tip, force)], closing);
+        if factor < 1.0 {
+            assert!(sol.contacts.is_empty());
+            continue;
+        }
+        assert_eq!(sol.contacts.len(), 1);
+        let k = sol.contacts[0];
+        assert!((k.s - c).abs() < 1e-2 * L, "contact at {}", k.s);
+        let f = factor * closing;
+        let exact = (f * c * c * (3.0 * L - c) / (6.0 * ei) - delta) * 3.0 * ei / c.powi(3);
+        let err = (k.normal_force / exact - 1.0).abs();
+        println!("sphere contact F = {factor} F_c at s = {:.6}: R = {:e}, propped cantilever {exact:e}, rel. error {err:e}", k.s, k.normal_force);
+        assert!(err < 1e-3, "R = {:e} vs {exact:e}", k.normal_force);
+    }
+}
