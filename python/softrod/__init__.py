@@ -66,6 +66,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
+from .contact import Capsule, Clamp, Cylinder, Pin, Plane, Slide, Sphere
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
 from .vision import Backbone, BackboneQuality
@@ -75,10 +76,13 @@ __all__ = [
     "Backbone",
     "BackboneDistance",
     "BackboneQuality",
+    "Capsule",
     "Chamber",
     "CircularSection",
+    "Clamp",
     "Compliance",
     "ConvergenceError",
+    "Cylinder",
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
@@ -92,15 +96,19 @@ __all__ = [
     "Ogden",
     "ParameterError",
     "Pareto",
+    "Pin",
     "PlanarBatch",
     "PlanarCableArm",
     "PlanarSolution",
+    "Plane",
     "PointLoad",
     "Robot",
     "Rod",
     "SampleTable",
     "Section",
     "Silicone",
+    "Slide",
+    "Sphere",
     "StaticsSolution",
     "TableSection",
     "TangentCompliance",

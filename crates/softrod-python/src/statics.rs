@@ -177,6 +177,8 @@ pub(crate) struct StaticsSolution {
     cache: [PyOnceLock<Py<PyAny>>; 12],
     /// The call that produced it (for pickling: it is solved again, bit for bit).
     call: Args,
+    /// Contacts, contact forces and the tip reaction (with obstacles or a tip constraint).
+    contact: crate::contact::ContactData,
 }
 
 fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
@@ -271,6 +273,31 @@ impl StaticsSolution {
                 .into_any()
                 .unbind()
         })
+    }
+    /// The active contacts, one dict each: `obstacle` (index), `s` (m), `length` (m, 0 for a
+    /// point contact; a contact interval on a plane otherwise), `point` (m, world, on the
+    /// rod's surface), `normal` (the obstacle's outward unit normal), `normal_force` (N,
+    /// >= 0), `tangential_force` (N, world; zero without friction). Empty without obstacles.
+    #[getter]
+    fn contacts(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.contact.contacts_py(py)
+    }
+    /// Contact force on the rod at every sample (N, world), shape (N, 3); zeros without
+    /// obstacles.
+    #[getter]
+    fn contact_force(&self, py: Python<'_>) -> Py<PyAny> {
+        match &self.contact.contact_force {
+            Some(f) => rows3(py, f),
+            None => rows3(py, &vec![[0.0; 3]; self.inner.s.len()]),
+        }
+    }
+    /// Reaction wrench [force; moment] of the tip constraint on the rod (N, N m; world),
+    /// shape (6,), or None without a tip constraint.
+    #[getter]
+    fn tip_reaction(&self, py: Python<'_>) -> Option<Py<PyAny>> {
+        self.contact
+            .tip_reaction
+            .map(|r| r.to_vec().into_pyarray(py).into_any().unbind())
     }
     /// Total base wrench [force; moment] (N, N m; world), shape (6,).
     #[getter]
@@ -435,7 +462,8 @@ fn report_unstable(
 #[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator=None, steps=None,
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
                     continuation=None, max_load_steps=None, warm_start=None, throw=None,
-                    chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None))]
+                    chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None,
+                    obstacles=None, tip_constraint=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
     py: Python<'py>,
@@ -456,10 +484,22 @@ pub(crate) fn solve_statics<'py>(
     s_out: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
     on_unstable: Option<&'py str>,
+    obstacles: Option<Bound<'py, PyAny>>,
+    tip_constraint: Option<Bound<'py, PyAny>>,
 ) -> PyResult<StaticsSolution> {
+    let obstacle_list = crate::contact::obstacles(py, obstacles.as_ref())?;
+    let tip = crate::contact::tip_constraint(tip_constraint.as_ref())?;
+    let constrained = tip.is_some() || !obstacle_list.is_empty();
     let warm_start = warm_start.filter(|w| !w.is_none());
     let unstable = self::on_unstable(on_unstable)?;
     let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
+    if constrained && !s_values.is_empty() {
+        return Err(crate::errors::param_err(
+            "s_out",
+            format!("{s_values:?}"),
+            "None with obstacles or a tip constraint (the solution is at the integration mesh)",
+        ));
+    }
     let args = OptionArgs {
         integrator,
         steps,
@@ -481,8 +521,17 @@ pub(crate) fn solve_statics<'py>(
         &chambers,
     )?;
     let (model, act) = (&problem.model, &problem.actuation);
-    let result = run(py, "solve_statics", || {
-        softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
+    let (result, contact) = run(py, "solve_statics", || {
+        if constrained {
+            let c = softrod::solve_constrained(model, act, &options, tip.as_ref(), &obstacle_list)
+                .map_err(actuator_names)?;
+            let data = crate::contact::ContactData::from_solution(&c);
+            Ok((c.solution, data))
+        } else {
+            softrod::solve_statics_at(model, act, &options, &s_values)
+                .map_err(actuator_names)
+                .map(|r| (r, crate::contact::ContactData::default()))
+        }
     })?;
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(
@@ -529,12 +578,15 @@ pub(crate) fn solve_statics<'py>(
                 "on_unstable",
                 "ignore".into_pyobject(py)?.into_any().unbind(),
             ),
+            ("obstacles", o(obstacles.map(Bound::unbind))),
+            ("tip_constraint", o(tip_constraint.map(Bound::unbind))),
         ],
     )?;
     let sol = StaticsSolution {
         inner: result,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
+        contact,
     };
     report_unstable(py, sol, unstable)
 }
