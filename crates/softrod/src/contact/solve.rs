@@ -28,8 +28,8 @@ use crate::solve::{
 
 /// Most rounds of the active-set loop (contacts added or released) per load step.
 pub const MAX_ACTIVE_SET_ROUNDS: usize = 40;
-/// Relative step of the central differences of the contact unknowns' Jacobian columns.
-const DIFFERENCE_STEP: f64 = 1e-6;
+/// Relative step of the forward differences of the Jacobian columns with contacts.
+const DIFFERENCE_STEP: f64 = 1e-7;
 
 /// Where a contact acts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,6 +102,7 @@ struct Pass {
 /// [`Problem::evaluate`] relaxes the gap targets of newly added contacts.
 pub(crate) struct Constrained<'m> {
     model: &'m RobotModel,
+    shared: &'m Arc<RobotModel>,
     tensions: Vec<f64>,
     pressures: Vec<f64>,
     integrator: Integrator,
@@ -225,6 +226,9 @@ impl<'m> Constrained<'m> {
     /// The model with the loads at the current load factor and the contact forces of `x` as
     /// world point loads; `None` if an arc length left the rod.
     fn contact_model(&self, x: &[f64]) -> Option<Arc<RobotModel>> {
+        if self.active.is_empty() && (self.load == 1.0 || self.model.loads().is_unloaded()) {
+            return Some(Arc::clone(self.shared));
+        }
         let l = self.model.length();
         let f = self.model.force_scale();
         let mut loads = scaled_loads(self.model.loads(), self.load);
@@ -437,22 +441,20 @@ impl Problem for Constrained<'_> {
             }
             return Evaluated::Jacobian;
         }
-        // Central differences over every unknown (the contact forces move the breaks).
+        // Forward differences over every unknown (the contact forces move the breaks).
         let saved = self.last.take();
         let mut xp = x.to_vec();
         for c in 0..n {
             let h = DIFFERENCE_STEP * (1.0 + x[c].abs());
             xp[c] = x[c] + h;
             let plus = self.run(&xp, lambda, false);
-            xp[c] = x[c] - h;
-            let minus = self.run(&xp, lambda, false);
             xp[c] = x[c];
-            let (Some((a, _)), Some((b, _))) = (plus, minus) else {
+            let Some((a, _)) = plus else {
                 self.last = saved;
                 return Evaluated::Failed;
             };
             for i in 0..n {
-                j[i + n * c] = (a[i] - b[i]) / (2.0 * h);
+                j[i + n * c] = (a[i] - rows[i]) / h;
             }
         }
         self.last = saved;
@@ -498,7 +500,10 @@ fn correct(
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    let s = settings(false, None, false);
+    let s = crate::solve::NewtonSettings {
+        residual_first: true,
+        ..settings(true, None, false)
+    };
     let out = newton(p, x, 1.0, opts, &s);
     effort.iterations += out.iterations;
     if !out.converged {
@@ -657,7 +662,7 @@ fn active_set(
             first_increment: 1.0,
             max_increment: 1.0,
         };
-        let s = settings(false, None, false);
+        let s = settings(true, None, false);
         let c = continuation(p, &start, opts, &s);
         effort.iterations += c.iterations;
         if !(c.outcome.converged && c.load_factor >= 1.0) {
@@ -714,6 +719,7 @@ pub fn solve_constrained(
     let pressures = actuation.pressure_values(model.chambers().len());
     let mut p = Constrained {
         model,
+        shared: model,
         tensions,
         pressures,
         integrator: options.integrator,
@@ -768,6 +774,10 @@ pub fn solve_constrained(
         }
         p.commit();
         let mut dl: f64 = 1.0;
+        if model.loads().is_unloaded() && p.tip.is_none() {
+            // Nothing is stepped: load factor 0 is the problem.
+            lambda = 1.0;
+        }
         while lambda < 1.0 {
             if effort.load_steps >= opts.max_load_steps {
                 return fail(&p, &opts, &effort, lambda, "the load steps ran out");
@@ -840,7 +850,25 @@ fn finish(
     x: &[f64],
     effort: &Effort,
 ) -> Result<ContactSolution> {
+    // Polish: exact Newton steps (fresh Jacobians) toward round-off, so that the balance of
+    // the reactions holds to the digits of the loads, not only of the tolerance.
+    let polish = NewtonOptions {
+        tolerance: (options.newton.tolerance * 1e-4).max(f64::EPSILON),
+        max_iterations: 2,
+        ..options.newton
+    };
     let mut r = vec![0.0; p.dim()];
+    let before = if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
+        f64::INFINITY
+    } else {
+        max_norm(&r)
+    };
+    let polished = newton(p, x, 1.0, &polish, &settings(false, None, false));
+    let x: &[f64] = if polished.residual < before && polished.residual.is_finite() {
+        &polished.x
+    } else {
+        x
+    };
     if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
         return fail(
             p,
