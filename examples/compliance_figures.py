@@ -57,7 +57,8 @@ fig = plot_workspace_map(
 )
 fig.savefig("docs/figures/compliance_workspace_tangent.png", dpi=110)
 
-# Seed 001's Fig. 1e in kind: the pneumatic arm with pairs 1 and 2 pressurised together.
+# The compliance-methodology paper's Fig. 1e in kind: the pneumatic arm with pairs 1 and 2
+# pressurised together.
 arm = softrod.examples.load("seed001_pneumatic_arm")
 pressures = [0, 10, 20, 30, 40]
 comps = []
@@ -70,6 +71,6 @@ for p in pressures:
 fig = plot_gamma_c(
     comps,
     labels=[f"P1 = P2 = {p} kPa" for p in pressures],
-    title="seed-001 pneumatic arm: dimensionless flexural compliance along the arm",
+    title="compliance-methodology pneumatic arm: dimensionless flexural compliance along the arm",
 )
 fig.savefig("docs/figures/compliance_gamma_c_pneumatic.png", dpi=110)

@@ -124,8 +124,4 @@ def test_compiled_public_names_have_docstrings_with_units():
         doc = inspect.getdoc(obj) or ""
         if len(doc.strip().splitlines()) < 2 or not any(u in doc for u in UNITS):
             gaps.append(name)
-    if gaps:
-        pytest.xfail(
-            f"compiled docstrings still one line or without units (the binding's docstrings "
-            f"are expanded in the core rework): {', '.join(gaps)}"
-        )
+    assert not gaps, f"compiled docstrings of one line or without units: {', '.join(gaps)}"

@@ -35,6 +35,12 @@ class ConvergenceError(RuntimeError):
     residual: float
     load_factor: float
 
+class TargetUnreachableError(ConvergenceError):
+    """Inverse statics: the target is out of reach within the actuation bounds."""
+
+    distance: float
+    rotation: float
+
 class StabilityWarning(UserWarning):
     """The equilibrium returned is unstable and no stable one was found."""
 
@@ -102,7 +108,7 @@ class PlanarBatch:
 
 @final
 class PlanarCableArm:
-    """The seed-000 tapered cable-driven arm (immutable, validated)."""
+    """The planar cable-arm paper's tapered cable-driven arm (immutable, validated)."""
 
     def __init__(
         self,

@@ -167,6 +167,7 @@ fn error_name(s: &SweepSample) -> String {
     match &s.error {
         None => String::new(),
         Some(softrod::Error::NotConverged { .. }) => "ConvergenceError".into(),
+        Some(softrod::Error::TargetUnreachable { .. }) => "TargetUnreachableError".into(),
         Some(softrod::Error::InvalidParameter { name, .. }) => format!("ParameterError: {name}"),
     }
 }

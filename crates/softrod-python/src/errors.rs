@@ -4,6 +4,7 @@
 //! - `ParameterTypeError` (a `ParameterError` and a `TypeError`): an argument of the wrong type
 //!   or shape; `.parameter` names it.
 //! - `ConvergenceError` (a `RuntimeError`): `.iterations`, `.residual`.
+//! - `TargetUnreachableError` (a `ConvergenceError`): `.distance`, `.rotation`, `.iterations`.
 //! - `InternalError` (a `RuntimeError`): a defect of softrod caught at the binding (a Rust
 //!   panic), never a user error.
 
@@ -30,6 +31,15 @@ create_exception!(
      `load_factor`.\n\n\
      The residual is the solver's scaled (dimensionless) residual; `load_factor` is the \
      fraction of the external loads the last iterate carries (1: the full problem)."
+);
+
+create_exception!(
+    _core,
+    TargetUnreachableError,
+    ConvergenceError,
+    "Inverse statics: the target is out of reach within the actuation bounds; carries \
+     `distance` (m, to the closest pose found), `rotation` (rad) and `iterations`.\n\n\
+     Pass `throw=False` to get the closest reachable pose with `converged=False` instead."
 );
 
 create_exception!(
@@ -102,6 +112,20 @@ pub(crate) fn to_py_err(e: Error) -> PyErr {
             let _ = err.value(py).setattr("iterations", iterations);
             let _ = err.value(py).setattr("residual", residual);
             let _ = err.value(py).setattr("load_factor", load_factor);
+            err
+        }),
+        Error::TargetUnreachable {
+            distance,
+            rotation,
+            iterations,
+        } => Python::attach(|py| {
+            let err = TargetUnreachableError::new_err(msg);
+            let v = err.value(py);
+            let _ = v.setattr("distance", distance);
+            let _ = v.setattr("rotation", rotation);
+            let _ = v.setattr("iterations", iterations);
+            let _ = v.setattr("residual", distance);
+            let _ = v.setattr("load_factor", 1.0);
             err
         }),
     }

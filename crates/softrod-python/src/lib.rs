@@ -33,6 +33,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "ConvergenceError",
         m.py().get_type::<errors::ConvergenceError>(),
     )?;
+    m.add(
+        "TargetUnreachableError",
+        m.py().get_type::<errors::TargetUnreachableError>(),
+    )?;
     m.add("ParameterTypeError", errors::parameter_type_error(m.py())?)?;
     m.add("InternalError", m.py().get_type::<errors::InternalError>())?;
     m.add("MAX_SAMPLES", softrod::limits::MAX_SAMPLES)?;

@@ -2,7 +2,8 @@
 //!
 //! Every fallible public function returns [`Result<T>`]. The binding maps
 //! [`Error::InvalidParameter`] to a `ValueError` subclass and
-//! [`Error::NotConverged`] to a `RuntimeError` subclass, in one place.
+//! [`Error::NotConverged`] to a `RuntimeError` subclass (and [`Error::TargetUnreachable`] to a
+//! subclass of that), in one place.
 
 use thiserror::Error;
 
@@ -36,6 +37,21 @@ pub enum Error {
         /// reached by a load continuation, 1 where the full problem was attempted directly
         /// (and for solvers without load steps).
         load_factor: f64,
+    },
+    /// Inverse statics: the target cannot be reached within the actuation bounds; the closest
+    /// reachable pose found is this far from it.
+    #[error(
+        "target out of reach: the closest pose found is {distance:.3e} m (and {rotation:.3e} rad) \
+         from it after {iterations} iterations"
+    )]
+    TargetUnreachable {
+        /// Remaining distance to the target position (m; the largest over the points of a
+        /// shape target).
+        distance: f64,
+        /// Remaining rotation to the target orientation (rad; 0 without one).
+        rotation: f64,
+        /// Iterations taken.
+        iterations: usize,
     },
 }
 

@@ -17,6 +17,9 @@
 //! * [`pcc`]: piecewise-constant-curvature kinematics, actuation maps and statics;
 //! * [`planar`]: the planar tapered cable arm (closed form and final-value ODE);
 //! * [`batch`]: workspace maps, actuation sweeps of design points and backbone distances;
+//! * [`inverse`]: inverse statics (minimum-norm actuation reaching a target) and trajectory
+//!   tracking, for the Cosserat and PCC models; [`cosserat::sensitivity`] gives the exact
+//!   actuation Jacobians and parameter sensitivities it uses;
 //! * [`integrate`]: the one Runge–Kutta driver (RK4, Bogacki–Shampine, Dormand–Prince
 //!   tableaus) and the march over breaks;
 //! * [`solve`]: the one nonlinear solver (Newton, Broyden, line search, continuation);
@@ -29,6 +32,7 @@ pub mod contact;
 pub mod cosserat;
 pub mod error;
 pub mod integrate;
+pub mod inverse;
 pub mod limits;
 pub mod math;
 pub mod model;
@@ -47,11 +51,21 @@ pub use compliance::{
     TendonControl,
 };
 pub use contact::{solve_constrained, Contact, ContactSolution, Obstacle, TipConstraint};
+pub use cosserat::displacement::reference_lengths;
+pub use cosserat::sensitivity::{
+    actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
+    Parameter, Sensitivities,
+};
 pub use cosserat::statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,
 };
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
+pub use inverse::pcc::PccForward;
+pub use inverse::{
+    inverse_statics, inverse_statics_path, solve_inverse, CosseratForward, Evaluation, Forward,
+    InverseOptions, InverseSolution, InverseWarmStart, Target,
+};
 pub use model::chamber::{Chamber, ChamberArea};
 pub use model::loads::{Frame, Loads, PointLoad};
 pub use model::material::fit::{

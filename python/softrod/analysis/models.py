@@ -2,8 +2,8 @@
 
 Models, from the most general: ``cosserat`` (the reference, :meth:`Robot.solve`), ``pcc``
 (:func:`softrod.pcc.solve`, one segment per distinct tendon end or chamber boundary) and
-``planar`` (the seed-000 closed-form arm, :class:`softrod.PlanarCableArm`). A model that does
-not apply is listed with the reason.
+``planar`` (the planar cable-arm paper's closed-form arm, :class:`softrod.PlanarCableArm`).
+A model that does not apply is listed with the reason.
 """
 
 from __future__ import annotations
@@ -335,12 +335,12 @@ def compare_models(
 
     The Cosserat model (:meth:`Robot.solve`) is the reference. PCC applies to a uniform
     circular, linear-elastic rod with constant-offset tendons, chambers and a world-frame tip
-    wrench (one segment per distinct tendon end or chamber boundary). The seed-000 planar
-    model applies to a single radius-proportional tendon (anchored where it ends) on a circular
-    or tapered section without external loads (its plane holds the rod's axis and the
-    tendon's direction). The PCC and planar backbones are sampled at the material points of
-    the Cosserat mesh nodes (undeformed arc length), so that the backbone distance at equal
-    arm index compares like with like.
+    wrench (one segment per distinct tendon end or chamber boundary). The planar model of the
+    planar cable-arm paper applies to a single radius-proportional tendon (anchored where it
+    ends) on a circular or tapered section without external loads (its plane holds the rod's
+    axis and the tendon's direction). The PCC and planar backbones are sampled at the material
+    points of the Cosserat mesh nodes (undeformed arc length), so that the backbone distance
+    at equal arm index compares like with like.
 
     Args:
         robot: A :class:`Robot` or the path of its description file (TOML).

@@ -1,4 +1,6 @@
-"""Seed 001's study of a pneumatic arm: stiffness over the workspace and ``gamma_c`` vs pressure.
+"""The compliance-methodology paper's study of a pneumatic arm.
+
+Stiffness over the workspace and ``gamma_c`` vs pressure.
 
 For a robot with three chamber pairs (pressures P1, P2, P3 on chambers 0-1, 2-3, 4-5), solved
 twice — with its hyperelastic material and with the linear material of the same small-strain
@@ -131,7 +133,9 @@ def seed001_study(
     log: TextIO | Literal["stdout"] | None = "stdout",
     progress: bool | None = False,
 ) -> dict[str, StudyResult]:
-    """Runs seed 001's study on a three-chamber-pair robot, hyperelastic and linear.
+    """Runs the compliance-methodology paper's study (hyperelastic and linear).
+
+    The robot has three chamber pairs.
 
     Args:
         robot_path: A robot, or its description file, with six chambers (pairs 0-1, 2-3, 4-5) and a

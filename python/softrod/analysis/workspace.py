@@ -1,4 +1,6 @@
-"""Workspace maps (seed 001, Fig. 1d): tendon-tension sweeps with tip stiffness measures.
+"""Workspace maps (the compliance-methodology paper, Fig. 1d).
+
+Tendon-tension sweeps with tip stiffness measures.
 
 The compliance itself is computed in the compiled core: :func:`softrod.compliance`,
 :func:`softrod.tangent_compliance`, :func:`softrod.eigenscrews`. This module sweeps tendon

@@ -220,13 +220,39 @@ pub(crate) struct Equations<'a> {
     pub load_factor: f64,
 }
 
-/// What a sensitivity column is a derivative with respect to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What a sensitivity column is a derivative with respect to: its forcing along the rod
+/// (see `cosserat/sensitivity.rs`, where the parameters are documented).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Column {
     /// A component of the base wrench or of an applied wrench: no forcing term.
     Free,
-    /// The tension of tendon `i`.
+    /// The tension of tendon `i` (per N).
     Tension(usize),
+    /// The pressure of chamber `j` (per Pa).
+    Pressure(usize),
+    /// A common factor of every tension (per unit factor, at 1).
+    TensionScale,
+    /// A common factor of the section stiffness (per unit factor, at 1).
+    StiffnessScale,
+    /// A factor of the offset `r_i(s)` of tendon `i` (per unit factor, at 1).
+    TendonOffsetScale(usize),
+    /// A shift of the offset of tendon `i` along the body-frame direction (per m).
+    TendonOffsetShift(usize, [f64; 2]),
+    /// A factor of the area of chamber `j` (per unit factor, at 1).
+    ChamberAreaScale(usize),
+}
+
+impl Column {
+    /// Whether the column's forcing needs the directions of the tendons.
+    fn needs_directions(&self) -> bool {
+        matches!(
+            self,
+            Column::Tension(_)
+                | Column::TensionScale
+                | Column::TendonOffsetScale(_)
+                | Column::TendonOffsetShift(..)
+        )
+    }
 }
 
 /// Scratch of the evaluations of one solve (the workspace): per-interval tendon and chamber
@@ -267,6 +293,9 @@ pub(crate) struct Workspace {
     /// Tangent of the last local solve asked for it (read by the variational columns of the
     /// same evaluation).
     pub tangent: Tangent,
+    /// `(t_i, r_i × t_i)` (body) of the tendons through the current interval at the current
+    /// evaluation, for the columns (`None`: not through it or not computed).
+    pub dirs: Vec<Option<Vector6<f64>>>,
     /// First material failure met by a local solve, reported if the solve fails.
     pub material_error: Option<Error>,
 }
@@ -293,6 +322,7 @@ impl Workspace {
                 diag: [f64::NAN; 6],
                 lu: None,
             },
+            dirs: vec![None; n_tendons],
             material_error: None,
         }
     }
@@ -499,7 +529,7 @@ impl Evaluator<'_, '_> {
         for (i, &end) in model.tendon_ends().iter().enumerate() {
             ws.tendon_speed[i] = 0.0;
             if end >= b {
-                if self.eq.tensions[i] > 0.0 {
+                if self.eq.tensions[i] != 0.0 {
                     ws.active.push(i);
                 } else {
                     ws.passive.push(i);
@@ -853,24 +883,22 @@ impl Evaluator<'_, '_> {
         let b_end = eq.model.breaks()[self.ws.interval + 1];
         let ends = eq.model.tendon_ends();
         let nl = self.ws.length_tendons.len();
-        let needs_dirs = nl > 0
-            || self
-                .ws
-                .columns
-                .iter()
-                .any(|c| matches!(c, Column::Tension(_)));
-        let dir = |this: &Self, i: usize| -> Option<Vector6<f64>> {
-            (ends[i] >= b_end).then(|| this.tendon_direction(i, s, &props, &v, &u))
-        };
-        let length_dirs: Vec<Option<Vector6<f64>>> = if needs_dirs {
-            self.ws
-                .length_tendons
-                .iter()
-                .map(|&i| dir(self, i))
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let needs_dirs = nl > 0 || self.ws.columns[..ncol].iter().any(Column::needs_directions);
+        if needs_dirs {
+            for i in 0..ends.len() {
+                self.ws.dirs[i] =
+                    (ends[i] >= b_end).then(|| self.tendon_direction(i, s, &props, &v, &u));
+            }
+        }
+        // The rod's own (elastic) body wrench, for the stiffness columns.
+        let n_el = Vector6::new(
+            nb.x - loc.tendon_force.x,
+            nb.y - loc.tendon_force.y,
+            nb.z - loc.tendon_force.z,
+            mb.x - loc.tendon_moment.x,
+            mb.y - loc.tendon_moment.y,
+            mb.z - loc.tendon_moment.z,
+        );
         for c in 0..ncol {
             let b = STATE + COLUMN * c;
             let dr = col_rot(y, b);
@@ -879,12 +907,15 @@ impl Evaluator<'_, '_> {
             let dnb = dr.tr_mul(&nw) + r.tr_mul(&dn);
             let dmb = dr.tr_mul(&mw) + r.tr_mul(&dm);
             let mut e = [dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z];
-            if let Column::Tension(i) = self.ws.columns[c] {
-                if let Some(t) = dir(self, i) {
-                    for k in 0..6 {
-                        e[k] -= t[k];
-                    }
+            let column = self.ws.columns[c];
+            // d|p_i'| of the tendon whose offset the column changes, at fixed strains.
+            let mut offset_rate = None;
+            if column != Column::Free {
+                let (f, rate) = self.forcing(column, s, &props, &v, &u, &n_el);
+                for k in 0..6 {
+                    e[k] -= f[k];
                 }
+                offset_rate = rate;
             }
             let d = self.ws.tangent.apply(&e);
             let (dv, du) = (
@@ -898,11 +929,18 @@ impl Evaluator<'_, '_> {
             out[b + DR..b + DR + 9].copy_from_slice(drd.as_slice());
             put3(out, b + DN, &Vector3::zeros());
             put3(out, b + DM, &dmd);
-            for (h, t) in length_dirs.iter().enumerate() {
-                self.ws.integrand[nt + c * nl + h] = match t {
+            for h in 0..nl {
+                let i = self.ws.length_tendons[h];
+                let mut g = match &self.ws.dirs[i] {
                     Some(t) => t.dot(&Vector6::from(d)),
                     None => 0.0,
                 };
+                if let Some((k, rate)) = offset_rate {
+                    if k == i {
+                        g += rate;
+                    }
+                }
+                self.ws.integrand[nt + c * nl + h] = g;
             }
         }
         for k in STATE + COLUMN * ncol..N {

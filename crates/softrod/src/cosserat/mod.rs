@@ -1,14 +1,23 @@
 //! The Cosserat-rod model with tendons and chambers: the equations and their variational
 //! columns ([`equations`]), the constitutive local solve (linear and hyperelastic), the
-//! shooting problem, the statics entry point and its solution ([`statics`]).
+//! shooting problem, the statics entry point and its solution ([`statics`]), and the exact
+//! sensitivities of an equilibrium from the linearised boundary-value problem
+//! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
 
+pub mod displacement;
 pub(crate) mod equations;
 mod hyperelastic_local;
+pub mod sensitivity;
 pub(crate) mod shooting;
 mod stability;
 pub mod statics;
 
+pub use displacement::reference_lengths;
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+pub use sensitivity::{
+    actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
+    Parameter, Sensitivities,
+};
 pub use stability::{CONSTRAINT_COMPLIANCE, NEUTRAL_MARGIN};
 pub use statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,

@@ -8,6 +8,13 @@
 //! and the Jacobian is known in closed form (`δN(L) = δN(0)`,
 //! `δM(L) = δM(0) - (p(L) - p(0)) × δN(0)`), so it costs nothing. The solver sees it as a
 //! [`Problem`]; its safeguard compares shapes node by node.
+//!
+//! Displacement-controlled tendons held taut add their tensions to the unknowns (scaled by
+//! `F`) and their slack to the residual: `g_h = ℓ_ref,h - δ_h - ℓ_h + τ_h / k_h`, scaled by the
+//! slack a tension `F` causes ([`slack_scale`]); the Jacobian comes from the tension columns
+//! and the path-length sensitivities of the linearised problem (`cosserat/sensitivity.rs`).
+//! Which held tendons are taut is decided outside, by the active set of
+//! `cosserat/displacement.rs`; the tendons that are slack carry zero tension here.
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3, Vector6};
 
@@ -15,6 +22,7 @@ use super::equations::{
     col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, FULL,
     STATE,
 };
+use super::sensitivity::{integrate, scheme_of, Request, Seed};
 use super::stability::tip_stability;
 use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
 use crate::error::{Error, Result};
@@ -40,6 +48,22 @@ fn head<const N: usize>(y: &[f64; N]) -> [f64; STATE] {
 /// What a pass returns: the scaled residual, its derivative along each column, the chord.
 pub(crate) type PassOutput = (Vector6<f64>, Vec<Vector6<f64>>, Vector3<f64>);
 
+/// Round-off of a tendon path length, in units of `ε ℓ` (the floor of a held row's residual).
+const HELD_ROUND_OFF: f64 = 16.0;
+
+/// A displacement-controlled tendon held taut: an unknown (its tension) and a residual row
+/// (its slack).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Held {
+    /// The tendon.
+    pub tendon: usize,
+    /// `ℓ_ref - δ` (m): the path length at which it is just taut at zero tension.
+    pub target: f64,
+    /// `1 / k` (m/N).
+    pub compliance: f64,
+    /// Slack per scaled unit of the residual (m).
+    pub scale: f64,
+}
 /// A shape: arc length, position and rotation at the nodes of a pass.
 type Shape = Vec<(f64, Vector3<f64>, Matrix3<f64>)>;
 
@@ -47,6 +71,11 @@ type Shape = Vec<(f64, Vector3<f64>, Matrix3<f64>)>;
 /// last pass.
 pub(crate) struct Shooting<'a> {
     pub eq: Equations<'a>,
+    /// The tendons held taut (unknowns `x[6..]`, residual rows `r[6..]`).
+    pub held: Vec<Held>,
+    /// Tension of every tendon at the last evaluation (N): `eq.tensions` with the held
+    /// tendons' unknowns.
+    pub tensions: Vec<f64>,
     pub ws: Workspace,
     pub integrator: Integrator,
     pub plan: Vec<usize>,
@@ -75,6 +104,8 @@ impl<'a> Shooting<'a> {
         let ws = Workspace::new(eq.model.tendons().len());
         Self {
             eq,
+            held: Vec::new(),
+            tensions: eq.tensions.to_vec(),
             ws,
             integrator,
             plan,
@@ -86,6 +117,16 @@ impl<'a> Shooting<'a> {
             lengths: Vec::new(),
             reference: Vec::new(),
             evaluations: 0,
+        }
+    }
+
+    /// The equations with the tensions of the last evaluation.
+    pub fn equations(&self) -> Equations<'_> {
+        Equations {
+            model: self.eq.model,
+            tensions: &self.tensions,
+            pressures: self.eq.pressures,
+            load_factor: self.eq.load_factor,
         }
     }
 
@@ -107,15 +148,19 @@ impl<'a> Shooting<'a> {
         self.eq.load_factor = lambda;
         let columns: &[Column] = if N >= FULL { &[Column::Free; 6] } else { &[] };
         self.ws.set_columns(columns, &[]);
-        // RK4 passes on a uniform mesh per interval integrate the tendon lengths from the
-        // nodes afterwards (Simpson); the others on the stages.
-        self.ws.track_lengths =
-            matches!(self.integrator, Integrator::Adaptive(_)) || !self.stops.is_empty();
+        // The tendon lengths ride on the stages (the quadrature the displacement constraints
+        // and their sensitivities use).
+        self.ws.track_lengths = true;
         self.nodes.clear();
         let y0: [f64; N] = self.eq.initial(x);
         let scheme = Self::scheme(&self.integrator, &self.plan);
         let breaks = self.eq.model.breaks();
-        let eq = self.eq;
+        let eq = Equations {
+            model: self.eq.model,
+            tensions: &self.tensions,
+            pressures: self.eq.pressures,
+            load_factor: lambda,
+        };
         let mut ev = Evaluator {
             eq,
             ws: &mut self.ws,
@@ -167,6 +212,94 @@ impl<'a> Shooting<'a> {
         Ok((r, cols, chord))
     }
 
+    /// [`Problem::evaluate`] with held tendons: unknowns `[x (6); τ_h / F]`, residual
+    /// `[tip (6); g_h / scale_h]`.
+    fn evaluate_held(
+        &mut self,
+        z: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
+        let f_ref = self.eq.model.force_scale();
+        let nh = self.held.len();
+        for (h, held) in self.held.iter().enumerate() {
+            self.tensions[held.tendon] = z[6 + h] * f_ref;
+        }
+        let x = [z[0], z[1], z[2], z[3], z[4], z[5]];
+        let Some(j) = jacobian else {
+            let Ok((res, _, _)) = self.pass::<STATE>(&x, lambda) else {
+                return Evaluated::Failed;
+            };
+            r[..6].copy_from_slice(res.as_slice());
+            for (h, held) in self.held.iter().enumerate() {
+                let g =
+                    held.target - self.lengths[held.tendon] + held.compliance * z[6 + h] * f_ref;
+                r[6 + h] = g / held.scale;
+            }
+            return if r.iter().all(|v| v.is_finite()) {
+                Evaluated::Residual
+            } else {
+                Evaluated::Failed
+            };
+        };
+        self.eq.load_factor = lambda;
+        let seeds: Vec<Seed> = (0..6)
+            .map(Seed::Base)
+            .chain(
+                self.held
+                    .iter()
+                    .map(|h| Seed::Forced(Column::Tension(h.tendon))),
+            )
+            .collect();
+        let lengths: Vec<usize> = self.held.iter().map(|h| h.tendon).collect();
+        let mut plan = Vec::new();
+        let scheme = scheme_of(&self.integrator, self.eq.model, &mut plan);
+        let eq = Equations {
+            model: self.eq.model,
+            tensions: &self.tensions,
+            pressures: self.eq.pressures,
+            load_factor: lambda,
+        };
+        let req = Request {
+            seeds: &seeds,
+            lengths: &lengths,
+            observe: &[],
+            load_node: None,
+            record_nodes: true,
+        };
+        let Ok(cols) = integrate(eq, scheme, &x, &req) else {
+            return Evaluated::Failed;
+        };
+        self.evaluations += cols.evaluations;
+        self.nodes = cols.nodes;
+        self.lengths = cols.lengths;
+        r[..6].copy_from_slice(cols.residual.as_slice());
+        let dim = 6 + nh;
+        for (h, held) in self.held.iter().enumerate() {
+            let g = held.target - self.lengths[held.tendon] + held.compliance * z[6 + h] * f_ref;
+            r[6 + h] = g / held.scale;
+        }
+        for c in 0..dim {
+            let unit = if c < 6 { 1.0 } else { f_ref };
+            for row in 0..6 {
+                j[c * dim + row] = cols.d_residual[c][row] * unit;
+            }
+            for (h, held) in self.held.iter().enumerate() {
+                let mut d = -cols.d_lengths[c][h];
+                if c == 6 + h {
+                    d += held.compliance;
+                }
+                j[c * dim + 6 + h] = d * unit / held.scale;
+            }
+        }
+        if r.iter().chain(j.iter()).all(|v| v.is_finite()) {
+            Evaluated::Jacobian
+        } else {
+            Evaluated::Failed
+        }
+    }
+
     /// Arc lengths, positions and rotations at the nodes of the last pass.
     fn shape(&self) -> Shape {
         self.nodes
@@ -211,7 +344,7 @@ fn shape_change_is_small(a: &Shape, b: &Shape, length: f64) -> bool {
 
 impl Problem for Shooting<'_> {
     fn dim(&self) -> usize {
-        6
+        6 + self.held.len()
     }
 
     fn evaluate(
@@ -221,6 +354,9 @@ impl Problem for Shooting<'_> {
         jacobian: Option<&mut [f64]>,
         r: &mut [f64],
     ) -> Evaluated {
+        if !self.held.is_empty() {
+            return self.evaluate_held(x, lambda, jacobian, r);
+        }
         // N ≡ 0 along the rod: the Jacobian in closed form from a pass without columns.
         let analytic =
             x[..3].iter().all(|v| *v == 0.0) && (self.eq.model.force_free() || lambda == 0.0);
@@ -260,6 +396,10 @@ impl Problem for Shooting<'_> {
     }
 
     fn tolerance(&self, x: &[f64], tolerance: f64) -> f64 {
+        // A held row resolves its slack to the round-off of the path length.
+        let tolerance = self.held.iter().fold(tolerance, |t, h| {
+            t.max(HELD_ROUND_OFF * f64::EPSILON * h.target.abs() / h.scale)
+        });
         match self.integrator {
             Integrator::Rk4 { .. } => tolerance,
             Integrator::Adaptive(a) => {
@@ -270,6 +410,10 @@ impl Problem for Shooting<'_> {
     }
 
     fn load_derivative(&mut self, x: &[f64], lambda: f64, out: &mut [f64]) -> bool {
+        if !self.held.is_empty() {
+            // The held rows change with the shape: a secant predictor.
+            return false;
+        }
         if let Some(d) = self.eq.load_derivative_force_free() {
             out.copy_from_slice(d.as_slice());
             return true;

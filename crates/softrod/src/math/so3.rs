@@ -82,6 +82,38 @@ pub fn exp_so3(theta: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() + k * sa + k * k * ca
 }
 
+/// Rotation vector `θ` of a rotation matrix (`exp_so3(θ) = r`, `|θ| <= π`), accurate to
+/// round-off near the identity (the angle from `atan2`, not `acos`).
+pub fn log_so3(r: &Matrix3<f64>) -> Vector3<f64> {
+    let v = 0.5
+        * Vector3::new(
+            r[(2, 1)] - r[(1, 2)],
+            r[(0, 2)] - r[(2, 0)],
+            r[(1, 0)] - r[(0, 1)],
+        );
+    let s = v.norm();
+    let c = 0.5 * (r.trace() - 1.0);
+    let angle = s.atan2(c);
+    if s > 1e-6 * angle.max(1e-300) && angle < 3.0 {
+        return v * (angle / s);
+    }
+    if angle < 3.0 {
+        // Near the identity: θ / sin θ = 1 + θ²/6 + ...
+        return v * (1.0 + s * s / 6.0);
+    }
+    // Near π: the axis from the symmetric part, R + Rᵀ = 2 c I + 2 (1 - c) a aᵀ.
+    let b = (r + r.transpose()) * 0.5 - Matrix3::identity() * c;
+    let k = (0..3)
+        .max_by(|&i, &j| b[(i, i)].total_cmp(&b[(j, j)]))
+        .unwrap_or(0);
+    let mut a = b.column(k).into_owned();
+    a /= a.norm().max(1e-300);
+    if a.dot(&v) < 0.0 {
+        a = -a;
+    }
+    a * angle
+}
+
 /// Largest entry of `|RᵀR - I|` and `|det R - 1|`: how far `r` is from a rotation.
 pub fn orthonormality_error(r: &Matrix3<f64>) -> f64 {
     let e = (r.tr_mul(r) - Matrix3::identity()).amax();
@@ -92,6 +124,22 @@ pub fn orthonormality_error(r: &Matrix3<f64>) -> f64 {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    #[test]
+    fn log_inverts_exp() {
+        for theta in [
+            Vector3::new(1e-9, -2e-9, 3e-10),
+            Vector3::new(0.3, -1.2, 0.5),
+            Vector3::new(0.0, 0.0, 3.1),
+            Vector3::new(1.0, 1.0, 1.0).normalize() * 3.14159,
+        ] {
+            let back = log_so3(&exp_so3(&theta));
+            assert!(
+                (back - theta).amax() <= 1e-12 * theta.norm().max(1e-9),
+                "{theta:?} -> {back:?}"
+            );
+        }
+    }
 
     #[test]
     fn hat_is_cross_product() {

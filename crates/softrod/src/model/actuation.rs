@@ -2,8 +2,25 @@
 //!
 //! A [`RobotModel`](crate::model::RobotModel) describes the robot (rod, tendon routings,
 //! chambers, external loads); an [`Actuation`] says how it is driven for one solve: per tendon
-//! a [`TendonInput`] (today a tension; a held path shortening and friction join it as new
-//! variants), per chamber a gauge pressure. A sweep changes the actuation and keeps the model.
+//! a [`TendonInput`] (a tension, or a held displacement of its base end; friction joins as a
+//! new variant), per chamber a gauge pressure. A sweep changes the actuation and keeps the
+//! model.
+//!
+//! # Displacement control
+//! A displacement-controlled tendon is held by its motor: its base end has been pulled in by
+//! the displacement `δ` (m) from the motor's zero, the configuration at zero actuation (every
+//! tension and pressure zero, the model's external loads applied), where the tendon is just
+//! taut. With `ℓ_ref` its path length at zero actuation and `ℓ` the current one, the path
+//! shortening is `d = ℓ_ref - ℓ`, and the tendon (of axial stiffness `k`, N/m; rigid when
+//! infinite) carries the tension `τ` with
+//!
+//! ```text
+//! τ >= 0,   g = d - δ + τ / k >= 0,   τ g = 0,
+//! ```
+//!
+//! `g` (m) being the slack: a taut tendon (`g = 0`) stretches by `δ - d = τ / k`; a slack one
+//! (`τ = 0`) has more length than its path needs. The statics solve this complementarity
+//! exactly (see `cosserat/shooting.rs`).
 
 use crate::error::{Error, Result};
 use crate::model::chamber::check_pressure;
@@ -14,14 +31,39 @@ use crate::model::chamber::check_pressure;
 pub enum TendonInput {
     /// Pulled at the base with a given tension (N, >= 0): force control.
     Tension(f64),
+    /// Held by its motor at a displacement of its base end (displacement control; see the
+    /// module documentation): the tension is an unknown of the solve, zero if the tendon goes
+    /// slack.
+    Displacement {
+        /// Pull-in `δ` of the base end from the motor's zero (m; negative: paid out).
+        displacement: f64,
+        /// Axial stiffness `k` of the tendon from the base to its termination (N/m, > 0;
+        /// `f64::INFINITY` for an inextensible tendon).
+        stiffness: f64,
+    },
 }
 
 impl TendonInput {
-    /// The tension (N) of a tension-controlled tendon.
+    /// The tension (N) of a tension-controlled tendon; 0 for a displacement-controlled one
+    /// (its tension is an output: [`crate::StaticsSolution::tendon_tensions`]).
     pub fn tension(&self) -> f64 {
         match self {
             TendonInput::Tension(t) => *t,
+            TendonInput::Displacement { .. } => 0.0,
         }
+    }
+
+    /// An inextensible tendon held at the displacement `displacement` (m).
+    pub fn displacement(displacement: f64) -> Self {
+        TendonInput::Displacement {
+            displacement,
+            stiffness: f64::INFINITY,
+        }
+    }
+
+    /// Whether the tendon is displacement-controlled.
+    pub fn is_held(&self) -> bool {
+        matches!(self, TendonInput::Displacement { .. })
     }
 }
 
@@ -32,6 +74,14 @@ pub struct Actuation {
     pub tendons: Vec<TendonInput>,
     /// One gauge pressure per chamber of the model (Pa), in the model's order.
     pub pressures: Vec<f64>,
+    /// Path lengths `ℓ_ref` (m) of the tendons at zero actuation, the zero of the
+    /// displacement-controlled tendons; `None`: computed by the solve (one more solve of the
+    /// model at zero actuation, a single integration without external loads).
+    pub reference_lengths: Option<Vec<f64>>,
+    /// First guess of the tensions (N, one per tendon) of the displacement-controlled tendons,
+    /// e.g. a previous solution's `tendon_tensions`; `None`: taut where the tendon would be
+    /// stretched at zero tension, from zero tension.
+    pub tension_guess: Option<Vec<f64>>,
 }
 
 impl Actuation {
@@ -39,15 +89,55 @@ impl Actuation {
     pub fn tensions(tensions: &[f64]) -> Self {
         Self {
             tendons: tensions.iter().map(|&t| TendonInput::Tension(t)).collect(),
-            pressures: Vec::new(),
+            ..Self::default()
         }
     }
 
     /// Only chamber pressures (Pa).
     pub fn pressures(pressures: &[f64]) -> Self {
         Self {
-            tendons: Vec::new(),
             pressures: pressures.to_vec(),
+            ..Self::default()
+        }
+    }
+
+    /// Mixed tendon control: `displacements[i]` (m) holds tendon `i` at that displacement
+    /// (inextensible), `NaN` leaves it tension-controlled at `tensions[i]` (N).
+    pub fn mixed(tensions: &[f64], displacements: &[f64]) -> Self {
+        Self {
+            tendons: tensions
+                .iter()
+                .zip(displacements)
+                .map(|(&t, &d)| {
+                    if d.is_nan() {
+                        TendonInput::Tension(t)
+                    } else {
+                        TendonInput::displacement(d)
+                    }
+                })
+                .collect(),
+            ..Self::default()
+        }
+    }
+
+    /// Whether any tendon is displacement-controlled.
+    pub fn has_held(&self) -> bool {
+        self.tendons.iter().any(TendonInput::is_held)
+    }
+
+    /// Indices of the displacement-controlled tendons.
+    pub fn held(&self) -> Vec<usize> {
+        (0..self.tendons.len())
+            .filter(|&i| self.tendons[i].is_held())
+            .collect()
+    }
+
+    /// Zero tensions and pressures (the motors' zero).
+    pub fn zero(n_tendons: usize, n_chambers: usize) -> Self {
+        Self {
+            tendons: vec![TendonInput::Tension(0.0); n_tendons],
+            pressures: vec![0.0; n_chambers],
+            ..Self::default()
         }
     }
 
@@ -72,12 +162,12 @@ impl Actuation {
     }
 
     /// Checks the inputs against a model with `n_tendons` tendons and `n_chambers` chambers:
-    /// one input per actuator (or none at all: all zero), tensions finite and >= 0, pressures
-    /// finite and above vacuum.
+    /// one input per actuator (or none at all: all zero), tensions finite and >= 0,
+    /// displacements finite with a stiffness > 0, pressures finite and above vacuum.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]`, `pressures.len()` or
-    /// `pressures[i]`.
+    /// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]`, `displacements[i]`,
+    /// `tendon_stiffness[i]`, `reference_lengths[i]`, `pressures.len()` or `pressures[i]`.
     pub fn validate(&self, n_tendons: usize, n_chambers: usize) -> Result<()> {
         if !(self.tendons.is_empty() || self.tendons.len() == n_tendons) {
             return Err(Error::invalid(
@@ -103,6 +193,52 @@ impl Actuation {
                             "finite and >= 0 N",
                         ));
                     }
+                }
+                TendonInput::Displacement {
+                    displacement,
+                    stiffness,
+                } => {
+                    if !displacement.is_finite() {
+                        return Err(Error::invalid(
+                            format!("displacements[{i}]"),
+                            displacement,
+                            "finite (m)",
+                        ));
+                    }
+                    if !(*stiffness > 0.0) {
+                        return Err(Error::invalid(
+                            format!("tendon_stiffness[{i}]"),
+                            stiffness,
+                            "> 0 N/m (inf: inextensible)",
+                        ));
+                    }
+                }
+            }
+        }
+        if let Some(g) = &self.tension_guess {
+            if g.len() != n_tendons || g.iter().any(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    "tension_guess",
+                    format!("{g:?}"),
+                    format!("{n_tendons} finite tensions (N)"),
+                ));
+            }
+        }
+        if let Some(r) = &self.reference_lengths {
+            if r.len() != n_tendons {
+                return Err(Error::invalid(
+                    "reference_lengths.len()",
+                    r.len(),
+                    format!("the number of tendons, {n_tendons}"),
+                ));
+            }
+            for (i, v) in r.iter().enumerate() {
+                if !(v.is_finite() && *v > 0.0) {
+                    return Err(Error::invalid(
+                        format!("reference_lengths[{i}]"),
+                        v,
+                        "finite and > 0 m",
+                    ));
                 }
             }
         }

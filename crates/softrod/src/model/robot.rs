@@ -230,6 +230,7 @@ impl RobotModel {
                     let scale = self.force_scale / (1.0 + self.tendon_reach[i] / l);
                     check_load(&format!("tensions[{i}]"), *t, t.abs(), scale, "N")?;
                 }
+                TendonInput::Displacement { .. } => {}
             }
         }
         for (i, &p) in actuation.pressures.iter().enumerate() {

@@ -1,0 +1,387 @@
+//! Tendon displacement control: the complementarity of the held tendons, solved exactly by an
+//! active set over the shooting problem.
+//!
+//! Each displacement-controlled tendon `h` (see [`crate::model::actuation`]) satisfies
+//! `τ_h >= 0`, `g_h = ℓ_ref,h - ℓ_h - δ_h + τ_h / k_h >= 0`, `τ_h g_h = 0`. For a guess of which
+//! held tendons are taut (`g_h = 0`, tension unknown) and which are slack (`τ_h = 0`), the
+//! equilibrium is a smooth shooting problem with the taut tensions as extra unknowns and
+//! their slack as extra residual rows (`cosserat/shooting.rs`), solved by the same Newton and
+//! load continuation as every statics solve. Then the guess is checked: a taut tendon whose
+//! tension came out negative is released, a slack tendon whose slack came out negative
+//! (stretched) is taken up, and the problem is solved again from the last state, until no
+//! tendon changes (the primal-dual active-set strategy; it stops because each tendon's status
+//! is decided by the sign of a smooth function of the others). The result satisfies the
+//! complementarity exactly: slack tendons carry exactly zero tension, taut ones meet their
+//! displacement to the shooting tolerance.
+//!
+//! The first guess: the tendons a previous solution held taut ([`Actuation::tension_guess`]),
+//! or those that would be stretched if every held tendon carried no tension (one march of the
+//! actuated, unloaded rod).
+//!
+//! The zero of the displacements, `ℓ_ref`, is the tendons' path lengths at zero actuation under
+//! the model's external loads ([`reference_lengths`]), unless the actuation gives it.
+
+use std::sync::Arc;
+
+use super::sensitivity::slack_scale;
+use super::shooting::{Held, Shooting};
+use super::statics::{
+    assemble, Integrator, SolveOptions, StaticsSolution, WarmStart, DIRECT_STEP_LIMIT,
+    MAX_LINE_SEARCH_HALVINGS,
+};
+use crate::error::{Error, Result};
+use crate::integrate::march::rk4_plan;
+use crate::model::{Actuation, RobotModel, TendonInput};
+use crate::solve::{
+    continuation, max_norm, newton, Armijo, ContinuationSettings, Evaluated, LineSearch,
+    NewtonOutcome, NewtonSettings, Problem, SolverStats,
+};
+
+/// Most rounds of the active set (changes of the taut set) per held tendon, plus a few.
+pub const MAX_ACTIVE_SET_ROUNDS_PER_TENDON: usize = 3;
+
+/// Path length of every tendon at zero actuation (all tensions and pressures zero) under the
+/// model's external loads, with `options`' integrator (m): the zero of the displacements.
+///
+/// # Errors
+/// As [`super::statics::solve_statics`] for the zero-actuation solve.
+pub fn reference_lengths(model: &Arc<RobotModel>, options: &SolveOptions) -> Result<Vec<f64>> {
+    let zero = Actuation::zero(model.tendons().len(), model.chambers().len());
+    let opts = SolveOptions {
+        warm_start: None,
+        newton: crate::solve::NewtonOptions {
+            throw: true,
+            ..options.newton
+        },
+        ..*options
+    };
+    Ok(super::statics::solve_statics(model, &zero, &opts)?.tendon_lengths)
+}
+
+/// One held tendon: its index, `ℓ_ref - δ` (m), compliance (m/N), slack scale (m).
+fn held_of(model: &RobotModel, actuation: &Actuation, reference: &[f64]) -> Vec<Held> {
+    actuation
+        .tendons
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| match *t {
+            TendonInput::Displacement {
+                displacement,
+                stiffness,
+            } => {
+                let compliance = 1.0 / stiffness;
+                Some(Held {
+                    tendon: i,
+                    target: reference[i] - displacement,
+                    compliance,
+                    scale: slack_scale(model, i, compliance),
+                })
+            }
+            TendonInput::Tension(_) => None,
+        })
+        .collect()
+}
+
+fn settings(broyden: bool) -> NewtonSettings<'static> {
+    NewtonSettings {
+        line_search: LineSearch {
+            factor: 0.5,
+            max_halvings: MAX_LINE_SEARCH_HALVINGS,
+        },
+        condition: Armijo::default(),
+        first_step_limit: None,
+        residual_first: false,
+        broyden,
+        jacobian: None,
+        exact_at_solution: false,
+    }
+}
+
+/// Solves the smooth problem of the current taut set from `z0`: directly at full load when
+/// `warm`, else at zero load (where the base wrench is zero) and then at full load, directly
+/// or by continuation.
+fn smooth(
+    p: &mut Shooting<'_>,
+    z0: &[f64],
+    options: &SolveOptions,
+    warm: bool,
+    stats: &mut SolverStats,
+) -> NewtonOutcome {
+    let opts = &options.newton;
+    let broyden = matches!(options.integrator, Integrator::Rk4 { .. });
+    let limit = opts.continuation.then_some(DIRECT_STEP_LIMIT);
+    let unloaded = p.eq.model.loads().is_unloaded();
+    stats.load_factor = 1.0;
+    if warm || unloaded {
+        let s = NewtonSettings {
+            first_step_limit: if unloaded { None } else { limit },
+            ..settings(broyden)
+        };
+        let out = newton(p, z0, 1.0, opts, &s);
+        stats.iterations += out.iterations;
+        if out.converged || unloaded {
+            return out;
+        }
+    }
+    let mut z = z0.to_vec();
+    z[..6].fill(0.0);
+    let out0 = newton(p, &z, 0.0, opts, &settings(broyden));
+    stats.iterations += out0.iterations;
+    if !out0.converged {
+        stats.load_factor = 0.0;
+        return out0;
+    }
+    let s = NewtonSettings {
+        first_step_limit: limit,
+        jacobian: out0.jacobian.as_deref(),
+        ..settings(broyden)
+    };
+    let out1 = newton(p, &out0.x, 1.0, opts, &s);
+    stats.iterations += out1.iterations;
+    if out1.converged || !opts.continuation {
+        return out1;
+    }
+    let start = ContinuationSettings {
+        x0: &out0.x,
+        jacobian0: out0.jacobian.as_deref(),
+        first_increment: 0.25,
+        max_increment: 0.5,
+    };
+    let s = NewtonSettings {
+        first_step_limit: Some(DIRECT_STEP_LIMIT),
+        ..settings(broyden)
+    };
+    let c = continuation(p, &start, opts, &s);
+    stats.iterations += c.iterations;
+    stats.load_steps += c.steps;
+    stats.load_factor = c.load_factor;
+    c.outcome
+}
+
+/// The statics of `model` under an actuation with displacement-controlled tendons (see the
+/// module documentation).
+///
+/// # Errors
+/// As [`super::statics::solve_statics`]; [`Error::NotConverged`] naming the active set if it
+/// does not settle.
+pub(crate) fn solve_held(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    s_out: &[f64],
+) -> Result<StaticsSolution> {
+    let mut sol = solve_held_on_mesh(model, actuation, options)?;
+    let loaded = !model.loads().is_unloaded();
+    sol.stable = !loaded && sol.stats.converged;
+    if (loaded || !s_out.is_empty()) && sol.stats.converged {
+        // The same equilibrium under tension control at the solved tensions (a warm-started
+        // direct solve): its nodes at `s_out`, and its stability, which is sufficient for the
+        // held tendons (holding a tendon only adds a constraint).
+        let act = Actuation {
+            tendons: sol
+                .tendon_tensions
+                .iter()
+                .map(|&t| TendonInput::Tension(t))
+                .collect(),
+            pressures: actuation.pressures.clone(),
+            reference_lengths: None,
+            tension_guess: None,
+        };
+        let opts = SolveOptions {
+            warm_start: Some(WarmStart::wrench(sol.base_wrench)),
+            ..*options
+        };
+        let fixed = super::statics::solve_statics_at(model, &act, &opts, s_out)?;
+        if s_out.is_empty() {
+            sol.stable = fixed.stable;
+            if let Some(m) = fixed.margin.get() {
+                let _ = sol.margin.set(*m);
+            }
+        } else {
+            let (actuation, stats, lengths, tensions) = (
+                sol.actuation.clone(),
+                sol.stats,
+                sol.tendon_lengths.clone(),
+                sol.tendon_tensions.clone(),
+            );
+            sol = fixed;
+            sol.actuation = actuation;
+            sol.stats = stats;
+            sol.tendon_lengths = lengths;
+            sol.tendon_tensions = tensions;
+        }
+    }
+    Ok(sol)
+}
+
+/// [`solve_held`] on the integration mesh.
+fn solve_held_on_mesh(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+) -> Result<StaticsSolution> {
+    let (nt, nc) = (model.tendons().len(), model.chambers().len());
+    let reference = match &actuation.reference_lengths {
+        Some(r) => r.clone(),
+        None => reference_lengths(model, options)?,
+    };
+    let all_held = held_of(model, actuation, &reference);
+    let mut tensions = actuation.tension_values(nt);
+    let pressures = actuation.pressure_values(nc);
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let f_ref = model.force_scale();
+    let fm = f_ref * model.length();
+    let mut x0 = match &options.warm_start {
+        Some(w) => {
+            let b = &w.base_wrench;
+            [
+                b[0] / f_ref,
+                b[1] / f_ref,
+                b[2] / f_ref,
+                b[3] / fm,
+                b[4] / fm,
+                b[5] / fm,
+            ]
+        }
+        None => [0.0; 6],
+    };
+    let mut warm = options.warm_start.is_some();
+    // The first taut set.
+    let mut taut: Vec<bool> = match &actuation.tension_guess {
+        Some(g) => all_held
+            .iter()
+            .map(|h| {
+                tensions[h.tendon] = g[h.tendon].max(0.0);
+                g[h.tendon] > 0.0
+            })
+            .collect(),
+        None => {
+            let eq = super::equations::Equations {
+                model,
+                tensions: &tensions,
+                pressures: &pressures,
+                load_factor: 0.0,
+            };
+            let mut p = Shooting::new(eq, options.integrator, plan.clone());
+            let mut r = [0.0; 6];
+            if p.evaluate(&[0.0; 6], 0.0, None, &mut r) == Evaluated::Failed {
+                vec![true; all_held.len()]
+            } else {
+                all_held
+                    .iter()
+                    .map(|h| h.target - p.lengths[h.tendon] < 0.0)
+                    .collect()
+            }
+        }
+    };
+    let mut stats = SolverStats::default();
+    let rounds = MAX_ACTIVE_SET_ROUNDS_PER_TENDON * all_held.len() + 4;
+    let inputs = actuation.tension_values(nt);
+    let eq = super::equations::Equations {
+        model,
+        tensions: &inputs,
+        pressures: &pressures,
+        load_factor: 1.0,
+    };
+    let mut p = Shooting::new(eq, options.integrator, plan);
+    // A tension or slack counts as negative beyond the shooting tolerance.
+    let eps = 10.0 * options.newton.tolerance;
+    let mut round = 0;
+    loop {
+        p.held = all_held
+            .iter()
+            .zip(&taut)
+            .filter(|(_, t)| **t)
+            .map(|(h, _)| *h)
+            .collect();
+        for (h, t) in all_held.iter().zip(&taut) {
+            if !t {
+                tensions[h.tendon] = 0.0;
+            }
+        }
+        p.tensions.clone_from(&tensions);
+        let mut z0 = x0.to_vec();
+        z0.extend(p.held.iter().map(|h| tensions[h.tendon] / f_ref));
+        let mut round_stats = SolverStats::default();
+        let mut out = smooth(&mut p, &z0, options, warm, &mut round_stats);
+        stats.iterations += round_stats.iterations;
+        stats.load_steps += round_stats.load_steps;
+        stats.load_factor = round_stats.load_factor;
+        if !out.at_x {
+            let mut r = vec![0.0; p.dim()];
+            if p.evaluate(&out.x, stats.load_factor, None, &mut r) != Evaluated::Failed
+                && !out.converged
+                && stats.load_factor >= 1.0
+            {
+                out.residual = max_norm(&r);
+            }
+        }
+        for (h, held) in p.held.iter().enumerate() {
+            tensions[held.tendon] = out.x[6 + h] * f_ref;
+        }
+        x0.copy_from_slice(&out.x[..6]);
+        warm = true;
+        let mut changed = false;
+        if out.converged {
+            for (k, h) in all_held.iter().enumerate() {
+                let tau = tensions[h.tendon];
+                let slack = h.target - p.lengths[h.tendon] + h.compliance * tau;
+                if taut[k] && tau < -eps * f_ref {
+                    taut[k] = false;
+                    tensions[h.tendon] = 0.0;
+                    changed = true;
+                } else if !taut[k] && slack < -eps * h.scale {
+                    taut[k] = true;
+                    changed = true;
+                }
+            }
+        }
+        let settled = out.converged && !changed;
+        for h in &all_held {
+            tensions[h.tendon] = tensions[h.tendon].max(0.0);
+        }
+        if settled || !out.converged || round + 1 >= rounds {
+            stats.residual = out.residual;
+            stats.converged = settled;
+            stats.function_evaluations = p.evaluations;
+            if !settled && options.newton.throw {
+                if let Some(e) = p.ws.material_error.take() {
+                    return Err(e);
+                }
+                let what = if out.converged {
+                    format!(
+                        "active set of the displacement-controlled tendons ({} rounds)",
+                        round + 1
+                    )
+                } else {
+                    "shooting Newton (Cosserat rod statics, displacement control)".into()
+                };
+                return Err(Error::NotConverged {
+                    what,
+                    iterations: stats.iterations,
+                    residual: out.residual,
+                    load_factor: 1.0,
+                });
+            }
+            p.tensions.clone_from(&tensions);
+            let base_wrench = [
+                x0[0] * f_ref,
+                x0[1] * f_ref,
+                x0[2] * f_ref,
+                x0[3] * fm,
+                x0[4] * fm,
+                x0[5] * fm,
+            ];
+            let mut sol = assemble(&mut p, model, base_wrench, stats, &[]);
+            let mut act = actuation.clone();
+            act.reference_lengths = Some(reference);
+            sol.actuation = act;
+            sol.options = *options;
+            return Ok(sol);
+        }
+        round += 1;
+    }
+}

@@ -1,0 +1,349 @@
+//! Inverse statics: round trips through the forward solve, the optimality (KKT) conditions of
+//! the minimum-norm program checked with the exact Jacobian, out-of-reach targets, shape
+//! targets, loads, and the PCC version (its actuation Jacobian against central differences).
+
+mod common;
+
+use std::sync::Arc;
+
+use common::{niti_rod, niti_tendons};
+use softrod::nalgebra::{DMatrix, DVector, Vector3};
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
+use softrod::pcc::{pcc_actuation_jacobian, ElasticSegment, PccTendons};
+use softrod::{
+    actuation_jacobian, inverse_statics, solve_inverse, solve_statics, Actuation, Error,
+    InverseOptions, InverseWarmStart, Loads, PccForward, RobotModel, SolveOptions, Target,
+};
+
+fn niti(loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
+    let mut rod = niti_rod();
+    if let Some(d) = density {
+        rod = rod.with_density(d).unwrap();
+    }
+    let tendons = niti_tendons(&[0.0; 6])
+        .into_iter()
+        .map(|t| t.tendon)
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+}
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64) / ((1u64 << 53) as f64)
+    }
+}
+
+/// Random admissible tensions: each segment pulled by at most two of its tendons (N).
+fn random_tensions(g: &mut Lcg, max: f64) -> [f64; 6] {
+    let mut t = [0.0; 6];
+    for seg in 0..2 {
+        let off = (g.next() * 3.0) as usize % 3;
+        t[3 * seg + off] = g.next() * max;
+        t[3 * seg + (off + 1) % 3] = g.next() * max;
+    }
+    t
+}
+
+/// The KKT conditions of `min ½|a|²` s.t. `J_p a = p`, `a >= 0` at the solution: the
+/// multipliers from the free tensions, and the gradient sign at the bounds.
+fn check_kkt(model: &Arc<RobotModel>, a: &[f64]) {
+    let sol = solve_statics(model, &Actuation::tensions(a), &SolveOptions::default()).unwrap();
+    let j = actuation_jacobian(&sol, None).unwrap();
+    let jp = j.rows(0, 3).into_owned();
+    let free: Vec<usize> = (0..a.len()).filter(|&i| a[i] > 1e-12).collect();
+    // a_F = J_Fᵀ λ: least squares for λ.
+    let jf = DMatrix::from_fn(3, free.len(), |r, k| jp[(r, free[k])]);
+    let af = DVector::from_fn(free.len(), |k, _| a[free[k]]);
+    let lambda = (&jf * jf.transpose()).lu().solve(&(&jf * &af)).unwrap();
+    let res = &af - jf.transpose() * &lambda;
+    let scale = af.amax();
+    assert!(res.amax() <= 1e-7 * scale, "stationarity {:e}", res.amax());
+    // At a zero tension the gradient of the objective minus Jᵀλ must be >= 0.
+    let g = DVector::from_column_slice(a) - jp.transpose() * &lambda;
+    for i in 0..a.len() {
+        if a[i] <= 1e-12 {
+            assert!(
+                g[i] >= -1e-7 * scale,
+                "bound multiplier of tendon {i}: {}",
+                g[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn niti_round_trip_reaches_every_target_inside_the_bounds() {
+    let model = niti(Loads::default(), None);
+    let o = SolveOptions::default();
+    let mut g = Lcg(3);
+    let n = 40;
+    let mut reached = 0;
+    let mut worst = 0.0f64;
+    let mut iterations = 0;
+    for k in 0..n {
+        let t = random_tensions(&mut g, 4.0);
+        let tip = solve_statics(&model, &Actuation::tensions(&t), &o)
+            .unwrap()
+            .tip_position();
+        let target = Target::tip(Vector3::from(tip));
+        let opts = InverseOptions {
+            throw: false,
+            ..Default::default()
+        };
+        let (inv, sol) = inverse_statics(&model, &target, &opts, &o, None).unwrap();
+        let err = (Vector3::from(sol.tip_position()) - target.points[0]).norm();
+        assert!(inv.tensions().iter().all(|&x| x >= 0.0));
+        worst = worst.max(err);
+        iterations += inv.iterations;
+        if inv.converged && err <= 1e-9 {
+            reached += 1;
+        } else {
+            println!(
+                "target {k} ({t:?}): error {err:e}, converged {}",
+                inv.converged
+            );
+        }
+        if k < 8 {
+            check_kkt(&model, inv.tensions());
+        }
+    }
+    println!(
+        "{reached}/{n} reached, worst {worst:e} m, mean iterations {:.1}",
+        iterations as f64 / n as f64
+    );
+    assert_eq!(reached, n);
+}
+
+#[test]
+fn niti_under_gravity_and_tip_load_reaches_targets() {
+    let loads = Loads {
+        tip_force: Vector3::new(0.0, 0.0, -0.2),
+        gravity: Vector3::new(0.0, -9.81, 0.0),
+        ..Default::default()
+    };
+    let model = niti(loads, Some(6450.0));
+    let o = SolveOptions::default();
+    let mut g = Lcg(5);
+    for _ in 0..6 {
+        let t = random_tensions(&mut g, 3.0);
+        let tip = solve_statics(&model, &Actuation::tensions(&t), &o)
+            .unwrap()
+            .tip_position();
+        let target = Target::tip(Vector3::from(tip));
+        let (inv, sol) =
+            inverse_statics(&model, &target, &InverseOptions::default(), &o, None).unwrap();
+        let err = (Vector3::from(sol.tip_position()) - target.points[0]).norm();
+        assert!(inv.converged && err <= 1e-9, "{err:e}");
+        check_kkt(&model, inv.tensions());
+    }
+}
+
+#[test]
+fn a_target_out_of_reach_is_reported_with_its_distance() {
+    let model = niti(Loads::default(), None);
+    let o = SolveOptions::default();
+    // Straight ahead, 0.1 m beyond the tip of the straight rod.
+    let target = Target::tip(Vector3::new(0.0, 0.0, 0.5));
+    match inverse_statics(&model, &target, &InverseOptions::default(), &o, None) {
+        Err(Error::TargetUnreachable { distance, .. }) => {
+            assert!((distance - 0.1).abs() < 1e-6, "{distance}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let opts = InverseOptions {
+        throw: false,
+        ..Default::default()
+    };
+    let (inv, _) = inverse_statics(&model, &target, &opts, &o, None).unwrap();
+    assert!(!inv.converged && !inv.reached);
+    assert!((inv.position_error - 0.1).abs() < 1e-6);
+    assert!(inv.tensions().iter().all(|&t| t == 0.0));
+    // Bounded tensions make a reachable target unreachable.
+    let t = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
+    let tip = solve_statics(&model, &Actuation::tensions(&t), &o)
+        .unwrap()
+        .tip_position();
+    let opts = InverseOptions {
+        tension_bounds: (0.0, 1.0),
+        throw: false,
+        ..Default::default()
+    };
+    let (inv, _) =
+        inverse_statics(&model, &Target::tip(Vector3::from(tip)), &opts, &o, None).unwrap();
+    assert!(!inv.converged && inv.position_error > 1e-3);
+    assert!(inv.tensions().iter().all(|&t| (0.0..=1.0).contains(&t)));
+}
+
+#[test]
+fn a_shape_target_is_reached_from_its_backbone_points() {
+    let model = niti(Loads::default(), None);
+    let o = SolveOptions::default();
+    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+    let sol = solve_statics(&model, &Actuation::tensions(&t), &o).unwrap();
+    // Points at mesh nodes and between them.
+    let n = sol.s.len();
+    let idx = [n / 4, n / 2, n - 1];
+    let mut s: Vec<f64> = idx.iter().map(|&i| sol.s[i]).collect();
+    let mut points: Vec<Vector3<f64>> = idx
+        .iter()
+        .map(|&i| Vector3::from(sol.position[i]))
+        .collect();
+    let target = Target {
+        points: points.clone(),
+        s: Some(s.clone()),
+        rotation: None,
+    };
+    let (inv, back) =
+        inverse_statics(&model, &target, &InverseOptions::default(), &o, None).unwrap();
+    assert!(
+        inv.converged && inv.position_error <= 1e-9,
+        "{}",
+        inv.position_error
+    );
+    for (k, &i) in idx.iter().enumerate() {
+        assert!((Vector3::from(back.position[i]) - points[k]).norm() <= 1e-9);
+    }
+    // Off-mesh arc lengths: the model gets breaks there; a least-squares fit, converged.
+    s[0] += 0.0031;
+    points[0] += Vector3::new(1e-3, 0.0, 0.0);
+    let target = Target {
+        points,
+        s: Some(s),
+        rotation: None,
+    };
+    let (inv, _) = inverse_statics(&model, &target, &InverseOptions::default(), &o, None).unwrap();
+    assert!(inv.converged && inv.position_error > 1e-5);
+}
+
+#[test]
+fn a_rotation_target_is_reached() {
+    let model = niti(Loads::default(), None);
+    let o = SolveOptions::default();
+    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+    let sol = solve_statics(&model, &Actuation::tensions(&t), &o).unwrap();
+    let r = sol.rotation[sol.s.len() - 1];
+    let rot = softrod::nalgebra::Matrix3::new(
+        r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
+    );
+    let target = Target {
+        points: vec![Vector3::from(sol.tip_position())],
+        s: None,
+        rotation: Some(rot),
+    };
+    let (inv, _) = inverse_statics(&model, &target, &InverseOptions::default(), &o, None).unwrap();
+    assert!(inv.converged, "{inv:?}");
+    assert!(inv.position_error <= 1e-9 && inv.rotation_error <= 1e-8);
+    // Six targets, six tendons: the same tensions.
+    for (a, b) in inv.tensions().iter().zip(&t) {
+        assert!((a - b).abs() <= 1e-6 * 3.0, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn warm_started_tracking_takes_few_iterations() {
+    let model = niti(Loads::default(), None);
+    let o = SolveOptions::default();
+    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+    let tip = Vector3::from(
+        solve_statics(&model, &Actuation::tensions(&t), &o)
+            .unwrap()
+            .tip_position(),
+    );
+    let (first, _) = inverse_statics(
+        &model,
+        &Target::tip(tip),
+        &InverseOptions::default(),
+        &o,
+        None,
+    )
+    .unwrap();
+    let mut warm = InverseWarmStart::from(&first);
+    let mut total = 0;
+    for k in 1..=10 {
+        let p = tip + Vector3::new(1e-3 * k as f64, 0.0, 0.0);
+        let (inv, sol) = inverse_statics(
+            &model,
+            &Target::tip(p),
+            &InverseOptions::default(),
+            &o,
+            Some(&warm),
+        )
+        .unwrap();
+        assert!((Vector3::from(sol.tip_position()) - p).norm() <= 1e-9);
+        total += inv.evaluations;
+        warm = InverseWarmStart::from(&inv);
+    }
+    println!("evaluations per 1 mm step: {:.1}", total as f64 / 10.0);
+    assert!(total <= 40, "{total}");
+}
+
+fn pcc_niti() -> PccRobot {
+    let ang = [90.0f64, -30.0, 210.0].map(f64::to_radians);
+    let tendons = PccTendons::new(&[0.01; 3], &ang).unwrap();
+    let seg = || ElasticSegment::solid_circle(0.2, 0.7e-3, 54e9, true).unwrap();
+    PccRobot::new(vec![seg(), seg()])
+        .unwrap()
+        .with_segment_tendons(0, &tendons)
+        .unwrap()
+        .with_segment_tendons(1, &tendons)
+        .unwrap()
+}
+
+#[test]
+fn pcc_actuation_jacobian_matches_central_differences() {
+    let robot = pcc_niti();
+    for tip_force in [Vector3::zeros(), Vector3::new(0.2, -0.1, 0.3)] {
+        let loads = |t: &[f64]| PccLoads {
+            tensions: t.to_vec(),
+            tip_force,
+            ..Default::default()
+        };
+        let t = [3.0, 0.2, 1.0, 0.1, 2.0, 0.5];
+        let o = PccSolveOptions::default();
+        let sol = solve_pcc_statics(&robot, &loads(&t), &o).unwrap();
+        let j = pcc_actuation_jacobian(&robot, &loads(&t), &sol).unwrap();
+        let h = 1e-5;
+        for k in 0..6 {
+            let (mut up, mut down) = (t, t);
+            up[k] += h;
+            down[k] -= h;
+            let pu = solve_pcc_statics(&robot, &loads(&up), &o).unwrap().tip_pose;
+            let pd = solve_pcc_statics(&robot, &loads(&down), &o)
+                .unwrap()
+                .tip_pose;
+            let dp = (pu.fixed_view::<3, 1>(0, 3) - pd.fixed_view::<3, 1>(0, 3)) / (2.0 * h);
+            let dr = pu.fixed_view::<3, 3>(0, 0) * pd.fixed_view::<3, 3>(0, 0).transpose();
+            let dw = softrod::math::so3::log_so3(&dr.into_owned()) / (2.0 * h);
+            let col = j.column(k);
+            let scale = col.amax();
+            for r in 0..3 {
+                assert!((dp[r] - col[r]).abs() <= 1e-6 * scale, "{k} {r}");
+                assert!((dw[r] - col[r + 3]).abs() <= 1e-6 * scale, "{k} {r}");
+            }
+        }
+    }
+}
+
+#[test]
+fn pcc_inverse_round_trip() {
+    let robot = pcc_niti();
+    let o = PccSolveOptions::default();
+    let mut g = Lcg(9);
+    for _ in 0..20 {
+        let t = random_tensions(&mut g, 4.0);
+        let loads = PccLoads {
+            tensions: t.to_vec(),
+            ..Default::default()
+        };
+        let tip = solve_pcc_statics(&robot, &loads, &o).unwrap().tip_pose;
+        let target = Target::tip(Vector3::new(tip[(0, 3)], tip[(1, 3)], tip[(2, 3)]));
+        let mut fwd = PccForward::new(&robot, &PccLoads::default(), &o);
+        let inv = solve_inverse(&mut fwd, &target, &InverseOptions::default(), None).unwrap();
+        assert!(inv.converged && inv.position_error <= 1e-9);
+    }
+}
