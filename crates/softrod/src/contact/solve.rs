@@ -98,6 +98,10 @@ struct Pass {
     residual: Vector6<f64>,
 }
 
+/// The residual rows of one evaluation and, when asked, the exact Jacobian columns of the tip
+/// rows along the base wrench.
+type Rows = (Vec<f64>, Option<[[f64; 6]; 6]>);
+
 /// The constrained shooting problem at load factor `load`; the parameter of
 /// [`Problem::evaluate`] relaxes the gap targets of newly added contacts.
 pub(crate) struct Constrained<'m> {
@@ -280,7 +284,7 @@ impl<'m> Constrained<'m> {
 
     /// One march at `x`; with `full`, the six base-wrench columns too. Returns the residual
     /// rows, and with `full` the exact Jacobian of the tip rows along the base wrench.
-    fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<(Vec<f64>, Option<[[f64; 6]; 6]>)> {
+    fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<Rows> {
         let model = self.contact_model(x)?;
         let plan = match self.integrator {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
@@ -386,7 +390,7 @@ impl<'m> Constrained<'m> {
     }
 
     /// The normal force (N, signed) and normal of each active contact at `x` (last pass).
-    fn normal_forces(&self, x: &[f64]) -> Vec<(f64, Vector3<f64>, f64, Vector3<f64>)> {
+    fn normal_forces(&self, x: &[f64]) -> Forces {
         let Some(pass) = &self.last else {
             return Vec::new();
         };
@@ -518,6 +522,138 @@ fn correct(
     Some(out.x)
 }
 
+/// Normal forces, normal, arc length and point of each active contact at `x`.
+type Forces = Vec<(f64, Vector3<f64>, f64, Vector3<f64>)>;
+
+/// New contacts at the local minima of the gaps below `-penetration` (not at an existing
+/// contact, not inside an interval).
+fn candidates(p: &Constrained<'_>, forces: &Forces, penetration: f64) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let mut added = Vec::new();
+    for o in 0..p.obstacles.len() {
+        let g = p.gaps(o);
+        for i in 1..g.len() {
+            let (_, s, gi, _) = g[i];
+            let at_tip = i + 1 == g.len();
+            let minimum = gi < -penetration && gi <= g[i - 1].2 && (at_tip || gi <= g[i + 1].2);
+            let taken = forces
+                .iter()
+                .zip(&p.active)
+                .any(|(f, a)| a.obstacle == o && (f.2 - s).abs() <= 1e-12 * l);
+            let inside = p
+                .active
+                .iter()
+                .zip(forces)
+                .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
+            if minimum && !taken && !inside {
+                added.push((o, if at_tip { Site::Tip } else { Site::Interior }, s));
+            }
+        }
+    }
+    added
+}
+
+/// A plane touched twice (or an interval touched before its edge) becomes one interval from
+/// the first contact to the tip; `true` if a merge was made.
+fn merge_plane(
+    p: &mut Constrained<'_>,
+    x: &mut Vec<f64>,
+    forces: &Forces,
+    added: &[(usize, Site, f64)],
+) -> bool {
+    let l = p.model.length();
+    for &(o, _, s) in added {
+        if !matches!(p.obstacles[o], Obstacle::Plane { .. }) {
+            continue;
+        }
+        let offsets = p.offsets();
+        let on: Vec<usize> = (0..p.active.len())
+            .filter(|i| p.active[*i].obstacle == o)
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        let mut a = s;
+        for &i in &on {
+            a = a.min(forces[i].2);
+        }
+        if a >= l {
+            continue;
+        }
+        for &i in on.iter().rev() {
+            let size = p.active[i].size();
+            p.active.remove(i);
+            x.drain(offsets[i]..offsets[i] + size);
+        }
+        p.active.push(Active {
+            obstacle: o,
+            site: Site::Interval,
+            g0: 0.0,
+            dg0: 0.0,
+        });
+        x.push(a / l);
+        x.extend([0.0; 3]);
+        return true;
+    }
+    false
+}
+
+/// Adds the contacts `added` at zero force and relaxes their gaps from the values found to
+/// zero by continuation; the state at full contact targets.
+fn add_contacts(
+    p: &mut Constrained<'_>,
+    mut x: Vec<f64>,
+    added: Vec<(usize, Site, f64)>,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+    }
+    for (o, site, s) in added {
+        p.active.push(Active {
+            obstacle: o,
+            site,
+            g0: 0.0,
+            dg0: 0.0,
+        });
+        if site != Site::Tip {
+            x.push(s / l);
+        }
+        x.extend([0.0; 3]);
+    }
+    // The gap targets of the new contacts: their rows at zero force.
+    let mut r = vec![0.0; p.dim()];
+    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
+        return None;
+    }
+    let offsets = p.offsets();
+    for (a, o) in p.active.iter_mut().zip(offsets) {
+        a.g0 = r[o] * l;
+        if a.site != Site::Tip {
+            a.dg0 = r[o + 1];
+        }
+    }
+    let start = ContinuationSettings {
+        x0: &x,
+        jacobian0: None,
+        first_increment: 1.0,
+        max_increment: 1.0,
+    };
+    let c = continuation(p, &start, opts, &settings(true, None, false));
+    effort.iterations += c.iterations;
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+    }
+    if !(c.outcome.converged && c.load_factor >= 1.0) {
+        return None;
+    }
+    correct(p, &c.outcome.x, opts, effort)
+}
+
 /// The active-set loop at the current load factor from the state `x` (converged at the
 /// previous load factor): Newton; release the contact pulling hardest; add one contact at
 /// each local minimum of a gap below `-penetration`, reached by relaxing its gap from the
@@ -549,66 +685,8 @@ fn active_set(
             x = correct(p, &x, opts, effort)?;
             continue;
         }
-        // New contacts at the local minima of the gaps.
-        let mut added = Vec::new();
-        for o in 0..p.obstacles.len() {
-            let g = p.gaps(o);
-            for i in 1..g.len() {
-                let (_, s, gi, _) = g[i];
-                let at_tip = i + 1 == g.len();
-                let minimum = gi < -penetration && gi <= g[i - 1].2 && (at_tip || gi <= g[i + 1].2);
-                let taken = forces
-                    .iter()
-                    .zip(&p.active)
-                    .any(|(f, a)| a.obstacle == o && (f.2 - s).abs() <= 1e-12 * l);
-                let inside = p
-                    .active
-                    .iter()
-                    .zip(&forces)
-                    .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
-                if minimum && !taken && !inside {
-                    added.push((o, if at_tip { Site::Tip } else { Site::Interior }, s));
-                }
-            }
-        }
-        // A plane touched twice (or an interval touched before its edge): one interval from
-        // the first contact to the tip.
-        let mut merged = false;
-        for &(o, _, s) in &added {
-            if !matches!(p.obstacles[o], Obstacle::Plane { .. }) {
-                continue;
-            }
-            let offsets = p.offsets();
-            let on: Vec<usize> = (0..p.active.len())
-                .filter(|i| p.active[*i].obstacle == o)
-                .collect();
-            if on.is_empty() {
-                continue;
-            }
-            let mut a = s;
-            for &i in &on {
-                a = a.min(forces[i].2);
-            }
-            if a >= l {
-                continue;
-            }
-            for &i in on.iter().rev() {
-                let size = p.active[i].size();
-                p.active.remove(i);
-                x.drain(offsets[i]..offsets[i] + size);
-            }
-            p.active.push(Active {
-                obstacle: o,
-                site: Site::Interval,
-                g0: 0.0,
-                dg0: 0.0,
-            });
-            x.push(a / l);
-            x.extend([0.0; 3]);
-            merged = true;
-            break;
-        }
-        if merged {
+        let added = candidates(p, &forces, penetration);
+        if merge_plane(p, &mut x, &forces, &added) {
             x = correct(p, &x, opts, effort)?;
             continue;
         }
@@ -627,54 +705,51 @@ fn active_set(
         if added.is_empty() {
             return Some(x);
         }
-        for a in &mut p.active {
-            a.g0 = 0.0;
-            a.dg0 = 0.0;
-        }
-        for (o, site, s) in added {
-            p.active.push(Active {
-                obstacle: o,
-                site,
-                g0: 0.0,
-                dg0: 0.0,
-            });
-            if site != Site::Tip {
-                x.push(s / l);
-            }
-            x.extend([0.0; 3]);
-        }
-        // The gap targets of the new contacts: their rows at zero force.
-        let n = p.dim();
-        let mut r = vec![0.0; n];
-        if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
-            return None;
-        }
-        let offsets = p.offsets();
-        for (a, o) in p.active.iter_mut().zip(offsets) {
-            a.g0 = r[o] * l;
-            if a.site != Site::Tip {
-                a.dg0 = r[o + 1];
-            }
-        }
-        let start = ContinuationSettings {
-            x0: &x,
-            jacobian0: None,
-            first_increment: 1.0,
-            max_increment: 1.0,
-        };
-        let s = settings(true, None, false);
-        let c = continuation(p, &start, opts, &s);
-        effort.iterations += c.iterations;
-        if !(c.outcome.converged && c.load_factor >= 1.0) {
-            return None;
-        }
-        for a in &mut p.active {
-            a.g0 = 0.0;
-            a.dg0 = 0.0;
-        }
-        x = correct(p, &c.outcome.x, opts, effort)?;
+        x = add_contacts(p, x, added, opts, effort)?;
     }
     None
+}
+
+/// Steps the load factor (external loads and tip target) from 0 to 1 from the state `x`
+/// at load factor 0, halving a step whose active-set loop fails or moves the shape too far;
+/// on failure, the load factor reached and why.
+fn step_loads(
+    p: &mut Constrained<'_>,
+    mut x: Vec<f64>,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> std::result::Result<Vec<f64>, (f64, &'static str)> {
+    let mut lambda = 0.0;
+    let mut dl: f64 = 1.0;
+    while lambda < 1.0 {
+        if effort.load_steps >= opts.max_load_steps {
+            return Err((lambda, "the load steps ran out"));
+        }
+        let target = (lambda + dl).min(1.0);
+        let saved = (x.clone(), p.active.clone());
+        p.load = target;
+        effort.load_steps += 1;
+        match active_set(p, &x, opts, effort) {
+            Some(xs) if p.close() || !opts.continuation => {
+                x = xs;
+                lambda = target;
+                p.commit();
+                dl = (dl * 2.0).min(1.0);
+            }
+            _ => {
+                (x, p.active) = saved;
+                p.load = lambda;
+                if !opts.continuation {
+                    return Err((lambda, "the direct solve failed"));
+                }
+                dl *= 0.5;
+                if dl < MIN_LOAD_INCREMENT {
+                    return Err((lambda, "no load step converged (load increment underflow)"));
+                }
+            }
+        }
+    }
+    Ok(x)
 }
 
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
@@ -765,7 +840,6 @@ pub fn solve_constrained(
             p.load = 0.0;
         }
     }
-    let mut lambda = 0.0;
     if reached.is_none() {
         // Load factor 0 (contacts of the actuated rod), then the loads and the target.
         match active_set(&mut p, &x, &opts, &mut effort) {
@@ -773,45 +847,12 @@ pub fn solve_constrained(
             None => return fail(&p, &opts, &effort, 0.0, "no contact set at load factor 0"),
         }
         p.commit();
-        let mut dl: f64 = 1.0;
-        if model.loads().is_unloaded() && p.tip.is_none() {
-            // Nothing is stepped: load factor 0 is the problem.
-            lambda = 1.0;
-        }
-        while lambda < 1.0 {
-            if effort.load_steps >= opts.max_load_steps {
-                return fail(&p, &opts, &effort, lambda, "the load steps ran out");
-            }
-            let target = (lambda + dl).min(1.0);
-            let saved = (x.clone(), p.active.clone());
-            p.load = target;
-            effort.load_steps += 1;
-            let step = active_set(&mut p, &x, &opts, &mut effort);
-            match step {
-                Some(xs) if p.close() || !opts.continuation => {
-                    x = xs;
-                    lambda = target;
-                    p.commit();
-                    dl = (dl * 2.0).min(1.0);
-                }
-                _ => {
-                    (x, p.active) = saved;
-                    p.load = lambda;
-                    if !opts.continuation {
-                        return fail(&p, &opts, &effort, lambda, "the direct solve failed");
-                    }
-                    dl *= 0.5;
-                    if dl < MIN_LOAD_INCREMENT {
-                        return fail(
-                            &p,
-                            &opts,
-                            &effort,
-                            lambda,
-                            "no load step converged (load increment underflow)",
-                        );
-                    }
-                }
-            }
+        if !(model.loads().is_unloaded() && p.tip.is_none()) {
+            // (Otherwise nothing is stepped: load factor 0 is the problem.)
+            x = match step_loads(&mut p, x, &opts, &mut effort) {
+                Ok(x) => x,
+                Err((lambda, why)) => return fail(&p, &opts, &effort, lambda, why),
+            };
         }
         reached = Some(x);
     }
@@ -840,19 +881,11 @@ fn fail(
     })
 }
 
-/// The solution at the converged unknowns `x`: the shape with its contact forces, the tip
-/// reaction, the contacts, the stability.
-fn finish(
-    p: &mut Constrained<'_>,
-    model: &Arc<RobotModel>,
-    actuation: &Actuation,
-    options: &SolveOptions,
-    x: &[f64],
-    effort: &Effort,
-) -> Result<ContactSolution> {
-    // Polish: exact Newton steps (fresh Jacobians) toward round-off, so that the balance of
-    // the reactions holds to the digits of the loads, not only of the tolerance.
-    let polish = NewtonOptions {
+/// Exact Newton steps (fresh Jacobians) from the converged `x` toward round-off, so that the
+/// balance of the reactions holds to the digits of the loads, not only of the tolerance;
+/// `x` itself if they do not lower the residual.
+fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Vec<f64> {
+    let opts = NewtonOptions {
         tolerance: (options.newton.tolerance * 1e-4).max(f64::EPSILON),
         max_iterations: 2,
         ..options.newton
@@ -863,58 +896,27 @@ fn finish(
     } else {
         max_norm(&r)
     };
-    let polished = newton(p, x, 1.0, &polish, &settings(false, None, false));
-    let x: &[f64] = if polished.residual < before && polished.residual.is_finite() {
-        &polished.x
+    let out = newton(p, x, 1.0, &opts, &settings(false, None, false));
+    if out.residual < before && out.residual.is_finite() {
+        out.x
     } else {
-        x
-    };
-    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
-        return fail(
-            p,
-            &options.newton,
-            effort,
-            1.0,
-            "the solution could not be integrated",
-        );
+        x.to_vec()
     }
-    let residual = max_norm(&r);
-    let forces = p.normal_forces(x);
-    let Some(pass) = p.last.take() else {
-        return fail(p, &options.newton, effort, 1.0, "no pass");
-    };
-    let cm = Arc::clone(&pass.model);
-    let plan = match options.integrator {
-        Integrator::Rk4 { steps } => rk4_plan(cm.breaks(), steps),
-        Integrator::Adaptive(_) => Vec::new(),
-    };
-    let eq = Equations {
-        model: &cm,
-        tensions: &p.tensions,
-        pressures: &p.pressures,
-        load_factor: 1.0,
-    };
-    let mut sh = Shooting::new(eq, options.integrator, plan);
-    let (res, cols, _) = sh.pass::<FULL>(&x[..6], 1.0).map_err(|e| {
-        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
-    })?;
-    let tip_twist = sh.tip_twist;
-    let stats = SolverStats {
-        iterations: effort.iterations,
-        residual,
-        function_evaluations: p.evaluations + sh.evaluations,
-        converged: residual <= options.newton.tolerance,
-        load_steps: effort.load_steps,
-        load_factor: 1.0,
-    };
-    let fs = model.force_scale();
+}
+
+/// The contacts of a solution and the contact force at its samples (an interval's
+/// distributed reaction lumped by the trapezoid rule).
+fn report(
+    active: &[Active],
+    forces: &Forces,
+    model: &RobotModel,
+    cm: &RobotModel,
+    sol: &crate::cosserat::StaticsSolution,
+) -> (Vec<Contact>, Vec<[f64; 3]>) {
     let l = model.length();
-    let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
-    sol.actuation = actuation.clone();
-    sol.options = *options;
     let mut contact_force = vec![[0.0; 3]; sol.s.len()];
     let mut contacts = Vec::with_capacity(forces.len());
-    for ((fnorm, n, s, pc), a) in forces.iter().zip(&p.active) {
+    for ((fnorm, n, s, pc), a) in forces.iter().zip(active) {
         let radius = model.rod().section_at(*s).radius;
         let point = pc - n * radius;
         contacts.push(Contact {
@@ -981,6 +983,97 @@ fn finish(
             });
         }
     }
+    (contacts, contact_force)
+}
+
+/// The stability of a rod with a held tip (see [`super::stability`]): whether stable, the
+/// margin (the free directions' smallest stiffness; `+inf` for a full clamp, minus the
+/// number of conjugate points when there are some) and the conjugate points.
+fn held_stability(
+    sh: &mut Shooting<'_>,
+    x: &[f64],
+    c: &TipConstraint,
+    cols: &[Vector6<f64>],
+    tw: &[Vector6<f64>; 6],
+) -> (bool, f64, Option<usize>) {
+    let l = sh.eq.model.length();
+    let mut y = Matrix6::zeros();
+    let mut xt = Matrix6::zeros();
+    for k in 0..6 {
+        for i in 0..6 {
+            y[(i, k)] = cols[k][i];
+            xt[(i, k)] = tw[k][i] / if i < 3 { l } else { 1.0 };
+        }
+    }
+    let count = conjugate_points(sh, x).map(|c| c.0);
+    let free: Vec<usize> = (0..6).filter(|k| !c.held[*k]).collect();
+    let stiff = free_stiffness(&y, &xt, &c.pose.rotation(), &free);
+    let (stable, margin) = match (count, stiff) {
+        (Some(0), Some((m, neg))) => (neg == 0 && m > -NEUTRAL_MARGIN, m),
+        (Some(0), None) if free.is_empty() => (true, f64::INFINITY),
+        (Some(n), _) if n > 0 => (false, -(n as f64)),
+        _ => (false, 0.0),
+    };
+    (stable, margin, count)
+}
+
+/// The solution at the converged unknowns `x`: the shape with its contact forces, the tip
+/// reaction, the contacts, the stability.
+fn finish(
+    p: &mut Constrained<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    x: &[f64],
+    effort: &Effort,
+) -> Result<ContactSolution> {
+    let polished = polish(p, x, options);
+    let x: &[f64] = &polished;
+    let mut r = vec![0.0; p.dim()];
+    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
+        return fail(
+            p,
+            &options.newton,
+            effort,
+            1.0,
+            "the solution could not be integrated",
+        );
+    }
+    let residual = max_norm(&r);
+    let forces = p.normal_forces(x);
+    let Some(pass) = p.last.take() else {
+        return fail(p, &options.newton, effort, 1.0, "no pass");
+    };
+    let cm = Arc::clone(&pass.model);
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(cm.breaks(), steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let eq = Equations {
+        model: &cm,
+        tensions: &p.tensions,
+        pressures: &p.pressures,
+        load_factor: 1.0,
+    };
+    let mut sh = Shooting::new(eq, options.integrator, plan);
+    let (res, cols, _) = sh.pass::<FULL>(&x[..6], 1.0).map_err(|e| {
+        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
+    })?;
+    let tip_twist = sh.tip_twist;
+    let stats = SolverStats {
+        iterations: effort.iterations,
+        residual,
+        function_evaluations: p.evaluations + sh.evaluations,
+        converged: residual <= options.newton.tolerance,
+        load_steps: effort.load_steps,
+        load_factor: 1.0,
+    };
+    let fs = model.force_scale();
+    let l = model.length();
+    let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
+    sol.actuation = actuation.clone();
+    sol.options = *options;
+    let (contacts, contact_force) = report(&p.active, &forces, model, &cm, &sol);
     let tip_reaction = p.tip.as_ref().map(|_| {
         let f = res.fixed_rows::<3>(0) * fs;
         let m = res.fixed_rows::<3>(3) * (fs * l);
@@ -990,24 +1083,8 @@ fn finish(
     // a free tip, the tip criterion of `solve_statics` (contacts as dead loads).
     let mut conjugate = None;
     if let (Some(c), Some(tw)) = (p.tip, tip_twist) {
-        let mut y = Matrix6::zeros();
-        let mut xt = Matrix6::zeros();
-        for k in 0..6 {
-            for i in 0..6 {
-                y[(i, k)] = cols[k][i];
-                xt[(i, k)] = tw[k][i] / if i < 3 { l } else { 1.0 };
-            }
-        }
-        let count = conjugate_points(&mut sh, &x[..6]).map(|c| c.0);
+        let (stable, margin, count) = held_stability(&mut sh, &x[..6], &c, &cols, &tw);
         conjugate = count;
-        let free: Vec<usize> = (0..6).filter(|k| !c.held[*k]).collect();
-        let stiff = free_stiffness(&y, &xt, &c.pose.rotation(), &free);
-        let (stable, margin) = match (count, stiff) {
-            (Some(0), Some((m, neg))) => (neg == 0 && m > -NEUTRAL_MARGIN, m),
-            (Some(0), None) if free.is_empty() => (true, f64::INFINITY),
-            (Some(n), _) if n > 0 => (false, -(n as f64)),
-            _ => (false, 0.0),
-        };
         sol.stable = stable && sol.stats.converged;
         let _ = sol.margin.set(margin);
     } else {
