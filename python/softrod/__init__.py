@@ -43,6 +43,7 @@ from ._core import (
     UniaxialLaw,
     Yeoh,
     __version__,
+    actuation_jacobian,
     compliance,
     eigenscrews,
     fit_uniaxial,
@@ -68,6 +69,7 @@ from .analysis import (
     workspace_map,
 )
 from .contact import Capsule, Clamp, Cylinder, Pin, Plane, Slide, Sphere
+from .inverse import InverseSolution, inverse_statics
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
 from .vision import Backbone, BackboneQuality
@@ -87,6 +89,7 @@ __all__ = [
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
+    "InverseSolution",
     "LinearElastic",
     "Linearised",
     "Loads",
@@ -123,6 +126,7 @@ __all__ = [
     "WorkspaceMap",
     "Yeoh",
     "__version__",
+    "actuation_jacobian",
     "backbone_distance",
     "compare_models",
     "compliance",
@@ -131,6 +135,7 @@ __all__ = [
     "examples",
     "extract_backbone",
     "fit_uniaxial",
+    "inverse_statics",
     "load_robot",
     "pcc",
     "read_backbone_csv",

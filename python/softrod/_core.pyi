@@ -408,6 +408,10 @@ class StaticsSolution:
     def tip_reaction(self) -> NDArray[np.float64] | None:
         """Reaction wrench of the tip constraint (N, N m; world), shape (6,)."""
     @property
+    def tendon_tensions(self) -> NDArray[np.float64]: ...
+    @property
+    def tendon_displacements(self) -> NDArray[np.float64]: ...
+    @property
     def base_wrench(self) -> NDArray[np.float64]: ...
     @property
     def stable(self) -> bool:
@@ -450,15 +454,48 @@ def solve_statics(
     s_out: Sequence[float] | NDArray[np.float64] | None = None,
     seek_stable: bool | None = None,
     on_unstable: Literal["warn", "raise", "ignore"] | None = None,
+    displacements: Sequence[float | None] | NDArray[np.float64] | None = None,
+    tendon_stiffness: float | Sequence[float] | NDArray[np.float64] | None = None,
     obstacles: Sequence[Any] | None = None,
     tip_constraint: Any = None,
 ) -> StaticsSolution:
     """Options not given keep the core's defaults: integrator "rk4" with 40 steps (rtol 1e-8,
     atol 1e-10 for "adaptive"), tolerance 1e-10, max_iterations 30, continuation True,
     max_load_steps 64, throw True, seek_stable True, on_unstable "warn". ``s_out`` (m) adds
-    nodes at those arc lengths. ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``,
-    ``Cylinder``) are touched by the rod's surface without friction; ``tip_constraint``
-    (``softrod.Clamp(pose)``, ``Pin(point)``, ``Slide(point, normal)``) holds the tip."""
+    nodes at those arc lengths. ``displacements`` (m, one per tendon, None: tension control)
+    holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness.
+    ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``, ``Cylinder``) are touched by the
+    rod's surface without friction; ``tip_constraint`` (``softrod.Clamp(pose)``, ``Pin(point)``,
+    ``Slide(point, normal)``) holds the tip."""
+
+def _inverse_statics(
+    rod: Rod,
+    tendons: Sequence[Tendon],
+    loads: Loads | None,
+    chambers: Sequence[Chamber],
+    target_position: _Vec3,
+    *,
+    target_rotation: Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
+    weights: Sequence[float] | NDArray[np.float64] | None = None,
+    tension_bounds: tuple[float, float | None] | None = None,
+    pressure_bounds: tuple[float, float | None] | None = None,
+    warm_start: Sequence[float] | NDArray[np.float64] | None = None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    integrator: Literal["rk4", "adaptive"] | None = None,
+    steps: int | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+) -> dict[str, Any]:
+    """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
+
+def actuation_jacobian(
+    solution: StaticsSolution | PccSolution,
+    node: int = ...,
+) -> NDArray[np.float64]:
+    """d[δp; δθ] (world; m, rad) of node ``node`` / d(tensions (N), pressures (Pa)),
+    shape (6, n_tendons + n_chambers); exact (linearised boundary-value problem)."""
 
 # ----------------------------------------------------------------------------- materials
 

@@ -340,6 +340,9 @@ class Robot:
         self,
         tensions: Sequence[float] | np.ndarray | None = None,
         pressures: Sequence[float] | np.ndarray | None = None,
+        *,
+        displacements: Sequence[float | None] | np.ndarray | None = None,
+        tendon_stiffness: float | Sequence[float] | np.ndarray | None = None,
         **options: Any,
     ) -> StaticsSolution:
         """Solves the statics under an actuation.
@@ -347,6 +350,13 @@ class Robot:
         Args:
             tensions: Tendon tensions (N), one per tendon; default the robot's.
             pressures: Chamber pressures (Pa, gauge), one per chamber; default the robot's.
+            displacements: Tendon displacement control: one entry per tendon, a number (m)
+                holds the tendon's base end at that shortening of its path relative to the
+                robot at zero actuation (negative: paid out), ``None`` (or NaN) keeps it
+                tension-controlled at ``tensions``. A held tendon that would be compressed goes
+                slack (tension 0); the solved tensions are ``solution.tendon_tensions``.
+            tendon_stiffness: Axial stiffness of the held tendons (N/m; one number or one per
+                tendon; default inextensible).
             **options: Options of :func:`softrod.solve_statics` overriding the robot's
                 (``steps``, ``warm_start``, ``throw``, ...).
 
@@ -366,6 +376,10 @@ class Robot:
             merged.setdefault("obstacles", list(self._obstacles))
         if self._tip_constraint is not None:
             merged.setdefault("tip_constraint", self._tip_constraint)
+        if displacements is not None:
+            merged["displacements"] = displacements
+        if tendon_stiffness is not None:
+            merged["tendon_stiffness"] = tendon_stiffness
         return solve_statics(self._rod, tendons, self._loads, **merged)
 
     def _tensioned(self, tensions: Any) -> tuple[Tendon, ...]:

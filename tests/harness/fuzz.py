@@ -552,6 +552,39 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("solve_statics(displacements)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=_rod(),
+                tendons=_tendons(),
+                loads=_loads(),
+                displacements=[0.0005, None],
+                tendon_stiffness=[1e4, 1e4],
+            ),
+        )
+    )
+    t("actuation_jacobian")(lambda d: (sr.actuation_jacobian, dict(solution=_solution(), node=10)))
+    t("actuation_jacobian(pcc)")(
+        lambda d: (sr.actuation_jacobian, dict(solution=_pcc_solution(), node=-1))
+    )
+    t("inverse_statics")(
+        lambda d: (
+            sr.inverse_statics,
+            dict(
+                robot=_niti(),
+                target_position=[0.03388176, 0.03906025, 0.3958294],
+                target_rotation=None,
+                weights=[1.0] * 6,
+                tension_bounds=(0.0, 10.0),
+                pressure_bounds=(0.0, None),
+                warm_start=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                throw=False,
+                tolerance=1e-9,
+                max_iterations=60,
+            ),
+        )
+    )
     t("solve_statics(chambers)")(
         lambda d: (
             sr.solve_statics,
@@ -680,6 +713,16 @@ def _define_targets() -> None:
     t("Robot.from_toml")(lambda d: (sr.Robot.from_toml, dict(text=_TOML, name="r")))
     t("Robot.solve")(lambda d: (_niti().solve, dict(tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0])))
     t("Robot.solve(pressures)")(lambda d: (_chambered().solve, dict(pressures=[3e3])))
+    t("Robot.solve(displacements)")(
+        lambda d: (
+            _niti().solve,
+            dict(
+                tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                displacements=[None, 0.0, None, None, None, -0.001],
+                tendon_stiffness=1e5,
+            ),
+        )
+    )
     t("Robot.with_tensions")(
         lambda d: (_niti().with_tensions, dict(tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]))
     )
@@ -1483,6 +1526,7 @@ NOT_CONSTRUCTED = {
     "Compliance",
     "ConvergenceError",
     "Eigenscrews",
+    "InverseSolution",
     "ModelComparison",
     "ModelResult",
     "ParameterError",
@@ -1492,6 +1536,7 @@ NOT_CONSTRUCTED = {
     "Silicone",
     "StaticsSolution",
     "TangentCompliance",
+    "TargetUnreachableError",
     "UniaxialFit",
     "UniaxialLaw",
     "WorkspaceMap",

@@ -57,7 +57,7 @@ impl<'a, 'py> Arg<'a, 'py> for bool {
         let numpy_bool = obj
             .get_type()
             .name()
-            .is_ok_and(|n| n.to_string() == "bool" || n.to_string() == "bool_");
+            .is_ok_and(|n| n == "bool" || n == "bool_");
         if numpy_bool {
             if let Ok(b) = obj
                 .call_method0("__bool__")
@@ -125,7 +125,7 @@ impl<'a, 'py, T: Arg<'a, 'py>> Arg<'a, 'py> for Option<T> {
 impl<'a, 'py, T: PyClass + PyTypeInfo> Arg<'a, 'py> for Bound<'py, T> {
     fn from_arg(obj: &'a Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
         obj.cast::<T>()
-            .map(|b| b.clone())
+            .cloned()
             .map_err(|_| type_err(name, obj, &format!("a {}", T::NAME)))
     }
 }
@@ -138,7 +138,7 @@ impl<'a, 'py, T: PyClass + PyTypeInfo> Arg<'a, 'py> for Vec<Bound<'py, T>> {
             .enumerate()
             .map(|(i, item)| {
                 item.cast::<T>()
-                    .map(|b| b.clone())
+                    .cloned()
                     .map_err(|_| type_err(&format!("{name}[{i}]"), item, &format!("a {}", T::NAME)))
             })
             .collect()
@@ -156,7 +156,7 @@ impl<'a, 'py> Arg<'a, 'py> for Vec<i64> {
 }
 
 /// The items of a list, tuple or other sequence (not text, not a mapping, not a number).
-fn sequence<'py>(
+pub(crate) fn sequence<'py>(
     obj: &Bound<'py, PyAny>,
     name: &str,
     what: &str,

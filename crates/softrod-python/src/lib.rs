@@ -14,6 +14,7 @@ mod compliance;
 mod contact;
 mod convert;
 mod errors;
+mod inverse;
 mod materials;
 mod model;
 mod pcc;
@@ -72,6 +73,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::actuation_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::_inverse_statics, m)?)?;
     m.add_function(wrap_pyfunction!(model::_rebuild, m)?)?;
     m.add_class::<materials::PyUniaxialLaw>()?;
     m.add_class::<materials::Hookean>()?;

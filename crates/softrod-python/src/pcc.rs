@@ -818,6 +818,8 @@ pub(crate) struct PccSolution {
     pub(crate) inner: statics::PccStaticsSolution,
     /// The robot it solves (rest lengths for the compliance).
     pub(crate) robot: CoreRobot,
+    /// The loads (actuation and tip wrench) it was solved with.
+    pub(crate) loads: PccLoads,
     s: Vec<f64>,
     frames: Vec<Matrix4<f64>>,
     /// The call that produced it (for pickling: it is solved again, bit for bit).
@@ -1069,6 +1071,7 @@ pub(crate) fn pcc_solve<'py>(
         None => None,
     };
     let model = &robot.inner;
+    let solved_loads = loads.clone();
     let (inner, s, frames) = run(py, "pcc.solve", move || {
         let sol = statics::solve_pcc_statics(model, &loads, &options)?;
         let chain = sol.chain();
@@ -1083,6 +1086,7 @@ pub(crate) fn pcc_solve<'py>(
     Ok(PccSolution {
         inner,
         robot: model.clone(),
+        loads: solved_loads,
         s,
         frames,
         call,

@@ -138,6 +138,93 @@ impl Problem {
     }
 }
 
+/// Applies `displacements` (one per tendon: a number (m) holds the tendon at that pull-in of
+/// its base end, `None` or NaN keeps it tension-controlled) and `tendon_stiffness` (N/m, one
+/// number or one per tendon; default inextensible) to `actuation`.
+pub(crate) fn apply_displacements(
+    actuation: &mut softrod::Actuation,
+    n_tendons: usize,
+    displacements: Option<&Bound<'_, PyAny>>,
+    stiffness: Option<&Bound<'_, PyAny>>,
+) -> PyResult<()> {
+    let Some(d) = displacements.filter(|d| !d.is_none()) else {
+        if stiffness.is_some_and(|k| !k.is_none()) {
+            return Err(param_err(
+                "tendon_stiffness",
+                "(given)",
+                "given only with displacements (it is the stiffness of the held tendons)",
+            ));
+        }
+        return Ok(());
+    };
+    let what = "a sequence of one number (m) or None per tendon";
+    let items = crate::convert::sequence(d, "displacements", what)?;
+    if items.len() != n_tendons {
+        return Err(param_err(
+            "displacements.len()",
+            items.len(),
+            &format!("the number of tendons, {n_tendons}"),
+        ));
+    }
+    let values: Vec<f64> = items
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            if x.is_none() {
+                Ok(f64::NAN)
+            } else {
+                crate::convert::Arg::from_arg(x, &format!("displacements[{i}]"))
+            }
+        })
+        .collect::<PyResult<_>>()?;
+    let k: Vec<f64> = match stiffness.filter(|k| !k.is_none()) {
+        None => vec![f64::INFINITY; n_tendons],
+        Some(k) => {
+            let v = crate::convert::floats_opt(Some(k), "tendon_stiffness")?;
+            match v.len() {
+                1 => vec![v[0]; n_tendons],
+                n if n == n_tendons => v,
+                n => {
+                    return Err(param_err(
+                        "tendon_stiffness.len()",
+                        n,
+                        &format!("1 or the number of tendons, {n_tendons}"),
+                    ))
+                }
+            }
+        }
+    };
+    if actuation.tendons.len() != n_tendons {
+        actuation.tendons = vec![softrod::TendonInput::Tension(0.0); n_tendons];
+    }
+    for (i, (&x, &ki)) in values.iter().zip(&k).enumerate() {
+        if !x.is_nan() {
+            if !(x.is_finite() && x.abs() <= softrod::limits::MAX_LENGTH) {
+                return Err(param_err(
+                    &format!("displacements[{i}]"),
+                    x,
+                    &format!(
+                        "finite, |value| <= {} m (or None: tension control)",
+                        softrod::limits::MAX_LENGTH
+                    ),
+                ));
+            }
+            if ki.is_nan() || ki <= 0.0 {
+                return Err(param_err(
+                    &format!("tendon_stiffness[{i}]"),
+                    ki,
+                    "> 0 N/m (inf: inextensible)",
+                ));
+            }
+            actuation.tendons[i] = softrod::TendonInput::Displacement {
+                displacement: x,
+                stiffness: ki,
+            };
+        }
+    }
+    Ok(())
+}
+
 /// The core's `tensions[i]` / `pressures[i]` as the Python objects that carry them:
 /// `tendons[i].tension`, `chambers[i].pressure`.
 pub(crate) fn actuator_names(e: softrod::Error) -> softrod::Error {
@@ -299,6 +386,33 @@ impl StaticsSolution {
             .tip_reaction
             .map(|r| r.to_vec().into_pyarray(py).into_any().unbind())
     }
+    /// Tension carried by each tendon (N), shape (n_tendons,): the input of a
+    /// tension-controlled tendon, the solved tension of a displacement-controlled one (0 when
+    /// slack).
+    #[getter]
+    fn tendon_tensions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.tendon_tensions.clone().into_pyarray(py)
+    }
+    /// Displacement of each tendon (m, shape (n_tendons,)): the shortening of its path at the
+    /// base relative to the robot at zero actuation, `reference - tendon_lengths` (computed
+    /// once per solution: one more solve at zero actuation unless it was displacement
+    /// controlled).
+    #[getter]
+    fn tendon_displacements<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let inner = &self.inner;
+        let reference = match &inner.actuation.reference_lengths {
+            Some(r) => r.clone(),
+            None => run(py, "tendon_displacements", || {
+                softrod::reference_lengths(&inner.model, &inner.options)
+            })?,
+        };
+        Ok(reference
+            .iter()
+            .zip(&inner.tendon_lengths)
+            .map(|(r, l)| r - l)
+            .collect::<Vec<f64>>()
+            .into_pyarray(py))
+    }
     /// Total base wrench [force; moment] (N, N m; world), shape (6,).
     #[getter]
     fn base_wrench(&self, py: Python<'_>) -> Py<PyAny> {
@@ -311,7 +425,7 @@ impl StaticsSolution {
                 .unbind()
         })
     }
-    /// Tendon tensions it was solved for (N), shape (n_tendons,).
+    /// Tendon tensions (N), shape (n_tendons,), as `tendon_tensions`.
     #[getter]
     fn tensions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.inner.tensions().into_pyarray(py)
@@ -463,6 +577,7 @@ fn report_unstable(
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
                     continuation=None, max_load_steps=None, warm_start=None, throw=None,
                     chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None,
+                    displacements=None, tendon_stiffness=None,
                     obstacles=None, tip_constraint=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
@@ -484,6 +599,8 @@ pub(crate) fn solve_statics<'py>(
     s_out: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
     on_unstable: Option<&'py str>,
+    displacements: Option<Bound<'py, PyAny>>,
+    tendon_stiffness: Option<Bound<'py, PyAny>>,
     obstacles: Option<Bound<'py, PyAny>>,
     tip_constraint: Option<Bound<'py, PyAny>>,
 ) -> PyResult<StaticsSolution> {
@@ -520,7 +637,34 @@ pub(crate) fn solve_statics<'py>(
         loads.as_ref().map(Bound::get),
         &chambers,
     )?;
-    let (model, act) = (&problem.model, &problem.actuation);
+    let mut actuation = problem.actuation.clone();
+    apply_displacements(
+        &mut actuation,
+        problem.model.tendons().len(),
+        displacements.as_ref(),
+        tendon_stiffness.as_ref(),
+    )?;
+    if actuation.has_held() {
+        if let Some(w) = warm_start
+            .as_ref()
+            .and_then(|w| w.cast::<StaticsSolution>().ok())
+        {
+            let prev = &w.get().inner;
+            if prev.tendon_tensions.len() == problem.model.tendons().len()
+                && prev.tendon_tensions.iter().all(|t| t.is_finite())
+            {
+                actuation.tension_guess = Some(prev.tendon_tensions.clone());
+            }
+        }
+    }
+    if constrained && actuation.has_held() {
+        return Err(crate::errors::param_err(
+            "displacements",
+            "given",
+            "None with obstacles or a tip constraint (tension control only)",
+        ));
+    }
+    let (model, act) = (&problem.model, &actuation);
     let (result, contact) = run(py, "solve_statics", || {
         if constrained {
             let c = softrod::solve_constrained(model, act, &options, tip.as_ref(), &obstacle_list)
@@ -578,6 +722,8 @@ pub(crate) fn solve_statics<'py>(
                 "on_unstable",
                 "ignore".into_pyobject(py)?.into_any().unbind(),
             ),
+            ("displacements", o(displacements.map(Bound::unbind))),
+            ("tendon_stiffness", o(tendon_stiffness.map(Bound::unbind))),
             ("obstacles", o(obstacles.map(Bound::unbind))),
             ("tip_constraint", o(tip_constraint.map(Bound::unbind))),
         ],
@@ -589,6 +735,60 @@ pub(crate) fn solve_statics<'py>(
         contact,
     };
     report_unstable(py, sol, unstable)
+}
+
+/// The actuation Jacobian of a statics solution (Cosserat `StaticsSolution` or
+/// `PccSolution`): the derivative of the pose twist `[δp; δθ]` (m, rad; world frame, the
+/// robot's base frame for PCC) of node `node` (default -1: the tip; negative counts from the
+/// end; PCC: the tip only) with respect to each tendon tension (per N), then each chamber
+/// pressure (per Pa), every tendon at fixed tension; shape (6, n_tendons + n_chambers). Exact:
+/// from the linearised boundary-value problem (Cosserat) or the equilibrium Jacobian (PCC),
+/// no finite differences.
+#[pyfunction]
+#[pyo3(signature = (solution, node=-1))]
+pub(crate) fn actuation_jacobian<'py>(
+    py: Python<'py>,
+    solution: Bound<'py, PyAny>,
+    #[pyo3(from_py_with = arg::node)] node: i64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let to_array = |m: &softrod::nalgebra::DMatrix<f64>| {
+        Array::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
+    };
+    if let Ok(s) = solution.cast::<StaticsSolution>() {
+        let inner = &s.get().inner;
+        let n = inner.s.len() as i64;
+        let index = if node < 0 { n + node } else { node };
+        if !(0..n).contains(&index) {
+            return Err(param_err(
+                "node",
+                node,
+                &format!("a node index in [-{n}, {n})"),
+            ));
+        }
+        let j = run(py, "actuation_jacobian", || {
+            softrod::actuation_jacobian(inner, Some(index as usize))
+        })?;
+        return Ok(to_array(&j));
+    }
+    if let Ok(s) = solution.cast::<crate::pcc::PccSolution>() {
+        let sol = s.get();
+        if node != -1 {
+            return Err(param_err(
+                "node",
+                node,
+                "-1 (the tip: the PCC actuation Jacobian is at the tip)",
+            ));
+        }
+        let j = run(py, "actuation_jacobian", || {
+            softrod::pcc::pcc_actuation_jacobian(&sol.robot, &sol.loads, &sol.inner)
+        })?;
+        return Ok(to_array(&j));
+    }
+    Err(crate::errors::type_err(
+        "solution",
+        &solution,
+        "a StaticsSolution or a PccSolution",
+    ))
 }
 
 /// Benchmark hook: runs the same solve `repeats` times inside Rust and returns each call's

@@ -145,6 +145,7 @@ pub fn check_load(name: &str, value: f64, magnitude: f64, scale: f64, unit: &str
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::*;
 
     #[test]

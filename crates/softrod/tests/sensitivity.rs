@@ -2,6 +2,8 @@
 //! of the nonlinear solve, parameter by parameter, on tendon robots (unloaded, tip-loaded,
 //! under gravity) and on a hyperelastic tube with chambers and a tendon.
 
+#![allow(clippy::unwrap_used, clippy::too_many_lines)]
+
 /// RK4 steps of the solves (the pneumatic arm file uses 100, the NiTi file 50).
 const STEPS: usize = 100;
 

@@ -215,6 +215,7 @@ pub(crate) fn solve_held(
 }
 
 /// [`solve_held`] on the integration mesh.
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 fn solve_held_on_mesh(
     model: &Arc<RobotModel>,
     actuation: &Actuation,

@@ -158,6 +158,8 @@ pub(crate) struct Request<'r> {
     pub load_node: Option<usize>,
     /// Whether to record the nodes of the march.
     pub record_nodes: bool,
+    /// Arc lengths inside the rod where the march puts a node (a solution's `s_out`).
+    pub stops: &'r [f64],
 }
 
 /// The result of integrating the columns of a [`Request`].
@@ -203,6 +205,7 @@ pub(crate) fn scheme_of<'p>(
     }
 }
 
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 fn pass<const N: usize>(
     eq: Equations<'_>,
     scheme: Scheme<'_>,
@@ -251,7 +254,7 @@ fn pass<const N: usize>(
     let y = march(
         &mut ev,
         model.breaks(),
-        &[],
+        req.stops,
         y0,
         scheme,
         |_, s, interval, y| {
@@ -520,6 +523,7 @@ pub(crate) struct Linear {
 /// tendons' displacements, the unit right-hand sides in `displaced`: indices into `held`),
 /// observing the nodes `observe` (increasing) and the path lengths of `lengths`.
 /// Right-hand sides are ordered: `seeds`, then `displaced`.
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub(crate) fn linearise(
     solution: &StaticsSolution,
     held: &[HeldRow],
@@ -555,7 +559,46 @@ pub(crate) fn linearise(
         }
     }
     let mut plan = Vec::new();
+    let stops = super::statics::interior(&solution.s_out, model.length());
     let scheme = scheme_of(&solution.options.integrator, model, &mut plan);
+    // A solution reported at `s_out` keeps some nodes of its march: map its node indices to
+    // the march's (the last node at each arc length, as the solution reports).
+    let (observe, load_node) = if solution.s_out.is_empty() {
+        (observe.to_vec(), load_node)
+    } else {
+        let nodes = integrate(
+            eq,
+            scheme,
+            &x,
+            &Request {
+                seeds: &[],
+                lengths: &[],
+                observe: &[],
+                load_node: None,
+                record_nodes: true,
+                stops: &stops,
+            },
+        )?
+        .nodes;
+        let map = |i: usize| -> Result<usize> {
+            let s = *solution
+                .s
+                .get(i)
+                .ok_or_else(|| Error::invalid("node", i, "a node of the solution"))?;
+            nodes
+                .iter()
+                .rposition(|n| n.s == s)
+                .ok_or_else(|| Error::invalid("node", i, "a node of the solution"))
+        };
+        (
+            observe
+                .iter()
+                .map(|&i| map(i))
+                .collect::<Result<Vec<_>>>()?,
+            load_node.map(map).transpose()?,
+        )
+    };
+    let observe = &observe[..];
     let cols = integrate(
         eq,
         scheme,
@@ -566,6 +609,7 @@ pub(crate) fn linearise(
             observe,
             load_node,
             record_nodes: false,
+            stops: &stops,
         },
     )?;
     // Unknowns z = [δx (nb); δτ_H / f_ref (nh)]; rows: tip residual (nb), held slack / scale.

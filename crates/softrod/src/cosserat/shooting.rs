@@ -267,6 +267,7 @@ impl<'a> Shooting<'a> {
             observe: &[],
             load_node: None,
             record_nodes: true,
+            stops: &[],
         };
         let Ok(cols) = integrate(eq, scheme, &x, &req) else {
             return Evaluated::Failed;

@@ -537,13 +537,16 @@ pub const IMPERFECTION: f64 = 1e-1;
 /// solved by continuation, and the perfect rod solved again from there by Newton. Returns
 /// the unknowns and the stability of the first converged, stable equilibrium found, and the
 /// Newton iterations spent.
+/// A stable equilibrium found: its scaled unknowns, stability and Jacobian.
+type Found = (Vec<f64>, Stability, Vec<f64>);
+
 fn seek_stable(
     p: &mut Shooting<'_>,
     model: &Arc<RobotModel>,
     actuation: &Actuation,
     options: &SolveOptions,
     (x, stability): (&[f64], &Stability),
-) -> (Option<(Vec<f64>, Stability, Vec<f64>)>, usize) {
+) -> (Option<Found>, usize) {
     let mut iterations = 0;
     if options.newton.continuation {
         p.require_stable = true;
@@ -718,6 +721,7 @@ pub fn solve_statics_at(
 }
 
 /// [`solve_statics_at`], the continuation refusing unstable states if `require_stable`.
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 fn solve_with(
     model: &Arc<RobotModel>,
     actuation: &Actuation,

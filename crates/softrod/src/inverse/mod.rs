@@ -255,7 +255,7 @@ fn bfgs_update(
     let y = ws - (j1 - j0).tr_mul(lambda);
     let hs = &*h * &s;
     let shs = s.dot(&hs);
-    if !(shs > 0.0 && shs.is_finite()) || !y.iter().all(|v| v.is_finite()) {
+    if !(shs > 0.0 && shs.is_finite() && y.iter().all(|v| v.is_finite())) {
         return false;
     }
     let sy = s.dot(&y);
@@ -266,7 +266,7 @@ fn bfgs_update(
         &y * theta + &hs * (1.0 - theta)
     };
     let sr = s.dot(&r);
-    if !(sr > 0.0) {
+    if sr.is_nan() || sr <= 0.0 {
         return false;
     }
     *h += &r * r.transpose() / sr - &hs * hs.transpose() / shs;
@@ -422,6 +422,7 @@ fn error_rows(
 /// [`Error::InvalidParameter`] naming a bad option or target; [`Error::TargetUnreachable`]
 /// for a target out of reach and [`Error::NotConverged`] otherwise when `throw` is set; the
 /// forward model's errors at the first evaluation.
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub fn solve_inverse<F: Forward + ?Sized>(
     forward: &mut F,
     target: &Target,
@@ -830,6 +831,7 @@ impl Forward for CosseratForward {
                     observe: &sorted,
                     load_node: None,
                     record_nodes: self.nodes.is_some(),
+                    stops: &[],
                 },
             )?;
             let to_matrix =

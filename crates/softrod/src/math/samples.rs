@@ -50,6 +50,7 @@ pub fn in_range(name: impl FnOnce() -> String, s: f64, length: f64) -> Result<f6
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::*;
 
     #[test]

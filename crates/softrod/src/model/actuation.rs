@@ -205,7 +205,7 @@ impl Actuation {
                             "finite (m)",
                         ));
                     }
-                    if !(*stiffness > 0.0) {
+                    if stiffness.is_nan() || *stiffness <= 0.0 {
                         return Err(Error::invalid(
                             format!("tendon_stiffness[{i}]"),
                             stiffness,

@@ -299,7 +299,7 @@ fn check_routing(i: usize, tendon: &Tendon, rod: &Rod, end: f64) -> Result<f64> 
         }
         let (v, u) = (rod.rest_strain().at(s), rod.rest_curvature().at(s));
         let forward = v[2] + u[0] * r[1] - u[1] * r[0];
-        if !(forward > 0.0) {
+        if forward.is_nan() || forward <= 0.0 {
             return Err(Error::invalid(
                 format!("tendons[{i}].offset({s})"),
                 format!("{r:?}"),

@@ -203,7 +203,7 @@ impl Rod {
     pub fn with_rest_strain(mut self, rest_strain: Profile) -> Result<Self> {
         for (at, v) in rest_strain.check_points(self.length) {
             check_finite_vec("rest_strain", &at, &v)?;
-            if !(v[2] > 0.0) {
+            if v[2].is_nan() || v[2] <= 0.0 {
                 return Err(Error::invalid(
                     format!("rest_strain{at}[2]"),
                     v[2],

@@ -196,7 +196,7 @@ impl PccRobot {
         let l: f64 = self.bodies.iter().map(ElasticSegment::rest_length).sum();
         let max = crate::limits::MAX_OFFSET_RATIO * l;
         for (i, &d) in distances.iter().enumerate() {
-            if !(d <= max) {
+            if d.is_nan() || d > max {
                 return Err(Error::invalid(
                     format!("distances[{i}]"),
                     d,

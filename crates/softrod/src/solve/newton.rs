@@ -306,6 +306,7 @@ fn last_step<P: Problem + ?Sized>(
 }
 
 /// Damped Newton on `problem` at load factor `lambda` from `x0`.
+#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub fn newton<P: Problem + ?Sized>(
     problem: &mut P,
     x0: &[f64],

@@ -98,7 +98,7 @@ impl UniaxialData {
                     ),
                 ));
             }
-            if !(l <= crate::model::material::hyperelastic::INVERSE_STRETCH_MAX) {
+            if l.is_nan() || l > crate::model::material::hyperelastic::INVERSE_STRETCH_MAX {
                 return Err(Error::invalid(
                     format!("strain[{i}]"),
                     e,

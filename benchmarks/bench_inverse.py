@@ -1,0 +1,88 @@
+"""Inverse statics and actuation Jacobians on the two-segment NiTi robot: medians (µs).
+
+Rows: the forward solve; the exact actuation Jacobian of a solution; softrod's inverse statics
+cold (from zero actuation) and warm (the previous target's solution, target moved by 1 mm);
+and, on the same targets, SciPy ``least_squares`` over softrod's forward solve (bounded
+tensions, finite-difference Jacobian: what a user writes without the inverse). Every method
+runs in this one process, side by side.
+
+    python benchmarks/bench_inverse.py [--targets N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+from scipy.optimize import least_squares
+
+import softrod
+
+
+def _admissible(rng):
+    t = np.zeros(6)
+    for seg in range(2):
+        o = rng.integers(3)
+        t[3 * seg + o] = rng.random() * 3.0
+        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
+    return t
+
+
+def _time(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--targets", type=int, default=20)
+    n = ap.parse_args().targets
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    rng = np.random.default_rng(7)
+    targets = [robot.solve(_admissible(rng)).tip_position for _ in range(n)]
+    rows: dict[str, list[float]] = {k: [] for k in ("forward", "jacobian", "cold", "warm", "scipy")}
+    misses = {"cold": 0, "warm": 0, "scipy": 0}
+    sol = robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0])
+    for _ in range(200):
+        rows["forward"].append(_time(lambda: robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0]))[0])
+        rows["jacobian"].append(_time(lambda: softrod.actuation_jacobian(sol))[0])
+    for target in targets:
+        dt, cold = _time(lambda t=target: softrod.inverse_statics(robot, t, throw=False))
+        rows["cold"].append(dt)
+        misses["cold"] += not cold.converged
+        moved = target + np.array([1e-3, 0.0, 0.0])
+        dt, warm = _time(
+            lambda m=moved, c=cold: softrod.inverse_statics(robot, m, warm_start=c, throw=False)
+        )
+        rows["warm"].append(dt)
+        misses["warm"] += not warm.converged
+
+        def residual(t, target=target):
+            return robot.solve(t).tip_position - target
+
+        dt, ls = _time(
+            lambda: least_squares(residual, np.full(6, 0.5), bounds=(0.0, np.inf), xtol=1e-15)
+        )
+        rows["scipy"].append(dt)
+        misses["scipy"] += not np.linalg.norm(ls.fun) <= 1e-9
+    med = {k: statistics.median(v) * 1e6 for k, v in rows.items()}
+    print(f"two-segment NiTi robot, {n} targets from forward solves at admissible tensions")
+    print(f"{'method':<44}{'median (µs)':>14}{'not reached':>14}")
+    names = {
+        "forward": "forward solve (robot.solve)",
+        "jacobian": "actuation_jacobian",
+        "cold": "inverse_statics, cold",
+        "warm": "inverse_statics, warm (target moved 1 mm)",
+        "scipy": "scipy least_squares over robot.solve",
+    }
+    for k, name in names.items():
+        miss = f"{misses[k]}/{n}" if k in misses else ""
+        print(f"{name:<44}{med[k]:>14.1f}{miss:>14}")
+    print(f"scipy / cold: {med['scipy'] / med['cold']:.0f}x")
+
+
+if __name__ == "__main__":
+    main()

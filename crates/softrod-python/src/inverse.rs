@@ -1,0 +1,138 @@
+//! Binding of the inverse statics: the actuation reaching a target, as a dict the Python
+//! wrapper (`softrod.inverse_statics`) turns into an `InverseSolution`.
+
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use softrod::nalgebra::{Matrix3, Vector3};
+use softrod::{InverseOptions, InverseWarmStart, Target};
+
+use crate::callbacks::run;
+use crate::convert::{arg, floats_opt, vec3, Matrix};
+use crate::errors::param_err;
+use crate::model::{Chamber, Loads, Rod, Tendon};
+use crate::statics::{actuator_names, solve_options, OptionArgs, Problem};
+
+/// A pair of bounds `(lo, hi)` (`hi` None: unbounded) or the default.
+fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> PyResult<(f64, f64)> {
+    let Some(b) = obj.filter(|b| !b.is_none()) else {
+        return Ok(default);
+    };
+    let what = "a pair (lo, hi) of numbers (hi may be None: unbounded)";
+    let items = crate::convert::sequence(b, name, what)?;
+    if items.len() != 2 {
+        return Err(param_err(
+            &format!("{name}.len()"),
+            items.len(),
+            "2: (lo, hi)",
+        ));
+    }
+    let lo: f64 = crate::convert::Arg::from_arg(&items[0], &format!("{name}[0]"))?;
+    let hi: f64 = if items[1].is_none() {
+        f64::INFINITY
+    } else {
+        crate::convert::Arg::from_arg(&items[1], &format!("{name}[1]"))?
+    };
+    Ok((lo, hi))
+}
+
+/// Inverse statics of the robot `(rod, tendons, loads, chambers)` for a tip target (see
+/// `softrod.inverse_statics`). Returns a dict: `actuation` (tensions then pressures),
+/// `n_tendons`, `position_error` (m), `rotation_error` (rad), `iterations`, `evaluations`,
+/// `converged`, `reached`.
+#[pyfunction]
+#[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
+                    weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
+                    throw=true, tolerance=None, max_iterations=None, integrator=None, steps=None,
+                    rtol=None, atol=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _inverse_statics<'py>(
+    py: Python<'py>,
+    #[pyo3(from_py_with = arg::rod)] rod: Bound<'py, Rod>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: Vec<Bound<'py, Tendon>>,
+    #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'py, Loads>>,
+    #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
+    target_position: Bound<'py, PyAny>,
+    target_rotation: Option<Bound<'py, PyAny>>,
+    weights: Option<Bound<'py, PyAny>>,
+    tension_bounds: Option<Bound<'py, PyAny>>,
+    pressure_bounds: Option<Bound<'py, PyAny>>,
+    warm_start: Option<Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = arg::throw)] throw: bool,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+    #[pyo3(from_py_with = arg::integrator)] integrator: Option<&'py str>,
+    #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let position = vec3(&target_position, "target_position")?;
+    let rotation = match target_rotation.filter(|r| !r.is_none()) {
+        None => None,
+        Some(r) => {
+            let m: Matrix = crate::convert::Arg::from_arg(&r, "target_rotation")?;
+            if m.0.shape() != [3, 3] {
+                return Err(param_err(
+                    "target_rotation",
+                    format!("shape {:?}", m.0.shape()),
+                    "a 3x3 rotation matrix (body -> world)",
+                ));
+            }
+            Some(Matrix3::from_fn(|i, j| m.0[(i, j)]))
+        }
+    };
+    let mut o = InverseOptions {
+        throw,
+        ..InverseOptions::default()
+    };
+    o.tension_bounds = bounds(tension_bounds.as_ref(), "tension_bounds", o.tension_bounds)?;
+    o.pressure_bounds = bounds(
+        pressure_bounds.as_ref(),
+        "pressure_bounds",
+        o.pressure_bounds,
+    )?;
+    let w = floats_opt(weights.as_ref(), "weights")?;
+    o.weights = (!w.is_empty()).then_some(w);
+    if let Some(t) = tolerance {
+        o.tolerance = t;
+    }
+    if let Some(m) = max_iterations {
+        o.max_iterations =
+            crate::convert::count("max_iterations", m, 1, softrod::limits::MAX_ITERATIONS)?;
+    }
+    let warm = floats_opt(warm_start.as_ref(), "warm_start")?;
+    let warm = (!warm.is_empty()).then(|| InverseWarmStart::actuation(warm));
+    let solve = solve_options(&OptionArgs {
+        integrator,
+        steps,
+        rtol,
+        atol,
+        ..OptionArgs::default()
+    })?;
+    let problem = Problem::new(
+        rod.get(),
+        &tendons,
+        loads.as_ref().map(Bound::get),
+        &chambers,
+    )?;
+    let model = &problem.model;
+    let target = Target {
+        points: vec![Vector3::new(position.x, position.y, position.z)],
+        s: None,
+        rotation,
+    };
+    let (inv, _) = run(py, "inverse_statics", || {
+        softrod::inverse_statics(model, &target, &o, &solve, warm.as_ref()).map_err(actuator_names)
+    })?;
+    let d = PyDict::new(py);
+    d.set_item("actuation", inv.actuation.clone().into_pyarray(py))?;
+    d.set_item("n_tendons", inv.n_tendons)?;
+    d.set_item("position_error", inv.position_error)?;
+    d.set_item("rotation_error", inv.rotation_error)?;
+    d.set_item("iterations", inv.iterations)?;
+    d.set_item("evaluations", inv.evaluations)?;
+    d.set_item("converged", inv.converged)?;
+    d.set_item("reached", inv.reached)?;
+    Ok(d)
+}

@@ -1,0 +1,124 @@
+"""Inverse statics: the actuation that puts the tip of a robot at a target.
+
+Objective (see ``docs/command.md``): among the actuations inside the bounds that reach the
+target, the one of least weighted norm ``½ Σ w_i a_i²`` (default weights: 1/N² per tension and
+A²/N² per chamber pressure of area A: the norm of the actuator forces), so that antagonistic
+tendons do not pull against each other. Solved by sequential quadratic programming on the exact
+actuation Jacobian; external loads and gravity are those of the robot.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from .robot import Robot
+
+
+@dataclass(frozen=True)
+class InverseSolution:
+    """The result of :func:`inverse_statics`.
+
+    Attributes:
+        tensions: Tendon tensions found (N), shape (n_tendons,).
+        pressures: Chamber pressures found (Pa, gauge), shape (n_chambers,).
+        solution: The forward statics solution at that actuation.
+        position_error: Distance from the tip to the target (m).
+        rotation_error: Angle from the tip rotation to the target's (rad; 0 without one).
+        iterations: Iterations of the SQP.
+        converged: Whether the target was reached and the actuation is the minimum-norm one.
+    """
+
+    tensions: np.ndarray
+    pressures: np.ndarray
+    solution: Any
+    position_error: float
+    rotation_error: float
+    iterations: int
+    converged: bool
+
+    @property
+    def actuation(self) -> np.ndarray:
+        """Tensions then pressures (N, Pa), the form ``warm_start`` takes."""
+        return np.concatenate([self.tensions, self.pressures])
+
+
+def inverse_statics(
+    robot: Robot,
+    target_position: Sequence[float] | np.ndarray,
+    *,
+    target_rotation: Sequence[Sequence[float]] | np.ndarray | None = None,
+    weights: Sequence[float] | np.ndarray | None = None,
+    tension_bounds: tuple[float, float | None] = (0.0, None),
+    pressure_bounds: tuple[float, float | None] | None = None,
+    warm_start: InverseSolution | Sequence[float] | np.ndarray | None = None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+) -> InverseSolution:
+    """The minimum-norm actuation that puts the tip of ``robot`` at ``target_position``.
+
+    Args:
+        robot: The robot (:func:`softrod.load_robot` or built in code); its loads apply.
+        target_position: Tip position (m, world), shape (3,).
+        target_rotation: Tip rotation (body -> world, 3x3), or None for a position target.
+        weights: Weights of the actuation norm, one per tendon then chamber (1/N², 1/Pa²).
+        tension_bounds: (lo, hi) of every tension (N; hi None: unbounded).
+        pressure_bounds: (lo, hi) of every pressure (Pa; default (0, None)).
+        warm_start: A previous :class:`InverseSolution` or actuation (tensions then pressures).
+        throw: Raise :class:`softrod.TargetUnreachableError` (with the remaining distance) for
+            a target out of reach; False: return the closest pose with ``converged=False``.
+        tolerance: Tolerance on the distance to the target (m; default 1e-10).
+        max_iterations: Cap on the iterations (default 60).
+
+    Returns:
+        The actuation, its forward solution and the remaining errors.
+
+    Raises:
+        ParameterError: A bad argument (named).
+        TargetUnreachableError: The target is out of reach (``throw=True``).
+        ConvergenceError: The iteration did not converge (``throw=True``).
+    """
+    if not isinstance(robot, Robot):
+        err = _core.ParameterTypeError(
+            f"robot = {robot!r:.60} ({type(robot).__name__}): expected a softrod.Robot"
+        )
+        err.parameter = "robot"
+        raise err
+    if isinstance(warm_start, InverseSolution):
+        warm_start = warm_start.actuation
+    out = _core._inverse_statics(
+        robot._rod,
+        list(robot._tendons),
+        robot._loads,
+        list(robot._chambers),
+        target_position,
+        target_rotation=target_rotation,
+        weights=weights,
+        tension_bounds=tension_bounds,
+        pressure_bounds=pressure_bounds,
+        warm_start=warm_start,
+        throw=throw,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        **{k: v for k, v in robot.solver.items() if k in ("integrator", "steps", "rtol", "atol")},
+    )
+    a = np.asarray(out["actuation"])
+    nt = out["n_tendons"]
+    tensions, pressures = a[:nt].copy(), a[nt:].copy()
+    solution = robot.solve(
+        tensions if nt else None, pressures if len(pressures) else None, on_unstable="ignore"
+    )
+    return InverseSolution(
+        tensions=tensions,
+        pressures=pressures,
+        solution=solution,
+        position_error=float(out["position_error"]),
+        rotation_error=float(out["rotation_error"]),
+        iterations=int(out["iterations"]),
+        converged=bool(out["converged"]),
+    )

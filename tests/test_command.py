@@ -1,0 +1,311 @@
+"""Command the robot: actuation Jacobians and tendon displacement control.
+
+Oracles: central finite differences of the nonlinear solve (the Jacobian is computed from the
+linearised boundary-value problem, never by differences); the round trip tension ->
+displacement -> tension; a slack tendon is the same as no tendon.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod import pcc
+
+TENSIONS = np.array([4.0, 0.0, 0.0, 0.0, 2.0, 0.0])
+
+
+def _niti():
+    return softrod.load_robot(softrod.examples.path("niti_two_segment"))
+
+
+def _niti_parts(loads):
+    robot = _niti()
+    return robot.rod, list(robot.tendons), loads
+
+
+def _tip(sol):
+    return np.concatenate([sol.tip_position, np.zeros(3)])
+
+
+def _rotation_difference(r_plus, r_minus):
+    """World rotation vector of r_plus r_minus^T (small)."""
+    d = r_plus @ r_minus.T
+    return 0.5 * np.array([d[2, 1] - d[1, 2], d[0, 2] - d[2, 0], d[1, 0] - d[0, 1]])
+
+
+def _tip_rotation(sol):
+    if isinstance(sol, pcc.PccSolution):
+        return np.asarray(sol.tip_pose)[:3, :3]
+    return np.asarray(sol.tip_rotation)
+
+
+def _central_differences(solve, values, h_of):
+    """(6, n) central differences of the tip twist of solve(values)."""
+    cols = []
+    for i in range(len(values)):
+        h = h_of(values[i])
+        up, down = values.copy(), values.copy()
+        up[i] += h
+        down[i] -= h
+        sp, sm = solve(up), solve(down)
+        dp = (np.asarray(sp.tip_position) - sm.tip_position) / (2 * h)
+        dth = _rotation_difference(_tip_rotation(sp), _tip_rotation(sm)) / (2 * h)
+        cols.append(np.concatenate([dp, dth]))
+    return np.array(cols).T
+
+
+def _relative_error(j, fd):
+    return np.abs(j - fd).max() / np.abs(fd).max()
+
+
+@pytest.mark.parametrize(
+    "loads",
+    [
+        None,
+        softrod.Loads(tip_force=(0.05, -0.1, -0.2)),
+        softrod.Loads(gravity=(0.0, 0.0, -9.81)),
+    ],
+    ids=["unloaded", "tip-load", "gravity"],
+)
+def test_niti_actuation_jacobian_matches_central_differences(loads):
+    robot = _niti()
+    tendons = list(robot.tendons)
+
+    def solve(tensions):
+        ts = [t.with_tension(x) for t, x in zip(tendons, tensions, strict=True)]
+        return softrod.solve_statics(robot.rod, ts, loads, tolerance=1e-14, max_iterations=60)
+
+    # Every tendon taut (a tendon at zero tension is at the kink of its complementarity).
+    base = TENSIONS + 0.5
+    j = softrod.actuation_jacobian(solve(base))
+    assert j.shape == (6, 6)
+    fd = _central_differences(solve, base, lambda x: 1e-4)
+    assert _relative_error(j, fd) <= 1e-6
+
+
+def test_actuation_jacobian_at_an_interior_node_matches_central_differences():
+    robot = _niti()
+    base = TENSIONS + 0.5
+    sol = robot.solve(base, s_out=[0.2, 0.4])
+    j = softrod.actuation_jacobian(sol, node=0)
+    cols = []
+    h = 1e-4
+    for i in range(6):
+        up, down = base.copy(), base.copy()
+        up[i] += h
+        down[i] -= h
+        sp, sm = robot.solve(up, s_out=[0.2, 0.4]), robot.solve(down, s_out=[0.2, 0.4])
+        dp = (sp.position[0] - sm.position[0]) / (2 * h)
+        dth = _rotation_difference(sp.rotation[0], sm.rotation[0]) / (2 * h)
+        cols.append(np.concatenate([dp, dth]))
+    fd = np.array(cols).T
+    assert _relative_error(j, fd) <= 1e-6
+    # Segment 2's tendons end beyond s = 0.2 m but pull on the first segment too; the node
+    # index counts from the end like a Python index.
+    assert np.array_equal(softrod.actuation_jacobian(sol, node=-1), softrod.actuation_jacobian(sol))
+
+
+def test_pneumatic_actuation_jacobian_matches_central_differences():
+    robot = softrod.load_robot(softrod.examples.path("seed001_pneumatic_arm"))
+    base = np.array([30e3, 30e3, 15e3, 15e3, 5e3, 5e3])
+
+    def solve(p):
+        return robot.solve(pressures=p, tolerance=1e-14, max_iterations=60)
+
+    j = softrod.actuation_jacobian(solve(base))
+    assert j.shape == (6, 6)
+    fd = _central_differences(solve, base, lambda x: 10.0)
+    assert _relative_error(j, fd) <= 1e-6
+
+
+def _pcc_robot():
+    angles = [np.pi / 2, -np.pi / 6, 7 * np.pi / 6]
+    return (
+        pcc.Robot.solid_circle([0.2, 0.2], 0.7e-3, 54e9)
+        .with_tendons(0, [0.01] * 3, angles)
+        .with_tendons(1, [0.01] * 3, angles)
+    )
+
+
+def test_pcc_actuation_jacobian_matches_central_differences():
+    robot = _pcc_robot()
+    base = TENSIONS + 0.5
+
+    def solve(t):
+        return pcc.solve(robot, t, tolerance=1e-14)
+
+    j = softrod.actuation_jacobian(solve(base))
+    fd = _central_differences(solve, base, lambda x: 1e-4)
+    assert _relative_error(j, fd) <= 1e-6
+    with pytest.raises(softrod.ParameterError, match="node"):
+        softrod.actuation_jacobian(solve(base), node=3)
+
+
+def test_actuation_jacobian_names_bad_arguments():
+    sol = _niti().solve()
+    with pytest.raises(softrod.ParameterError, match="node"):
+        softrod.actuation_jacobian(sol, node=len(sol))
+    with pytest.raises(softrod.ParameterError, match="solution"):
+        softrod.actuation_jacobian("tip")
+
+
+# ----------------------------------------------------------------------------- displacements
+
+
+@pytest.mark.parametrize(
+    "loads", [None, softrod.Loads(tip_force=(0.05, -0.1, -0.2))], ids=["unloaded", "tip-load"]
+)
+def test_displacement_round_trip_recovers_the_tensions_and_the_shape(loads):
+    rod, tendons, _ = _niti_parts(loads)
+    ts = [t.with_tension(x) for t, x in zip(tendons, TENSIONS + 0.5, strict=True)]
+    forward = softrod.solve_statics(rod, ts, loads, tolerance=1e-13)
+    delta = forward.tendon_displacements
+    held = softrod.solve_statics(rod, ts, loads, displacements=list(delta), tolerance=1e-13)
+    np.testing.assert_allclose(held.tendon_tensions, TENSIONS + 0.5, rtol=1e-8, atol=0)
+    assert np.abs(held.position - forward.position).max() <= 1e-10
+    np.testing.assert_allclose(held.tendon_displacements, delta, rtol=0, atol=1e-12)
+
+
+def test_mixed_control_and_robot_solve():
+    robot = _niti()
+    forward = robot.solve(TENSIONS)
+    delta = forward.tendon_displacements
+    # Tendon 0 displacement-controlled, the others at their tensions.
+    mixed = robot.solve(TENSIONS, displacements=[delta[0], None, None, None, None, None])
+    assert mixed.tendon_tensions[0] == pytest.approx(TENSIONS[0], rel=1e-8)
+    np.testing.assert_array_equal(mixed.tendon_tensions[1:], TENSIONS[1:])
+    assert np.abs(mixed.tip_position - forward.tip_position).max() <= 1e-10
+
+
+def test_a_paid_out_tendon_goes_slack_and_the_shape_is_the_solve_without_it():
+    robot = _niti()
+    without = robot.solve([4.0, 0.0, 0.0, 0.0, 2.0, 0.0])
+    slack = robot.solve(
+        [4.0, 0.0, 0.0, 0.0, 2.0, 0.0], displacements=[None, -1e-3, None, None, None, None]
+    )
+    assert slack.tendon_tensions[1] == 0.0
+    assert np.abs(slack.position - without.position).max() <= 1e-12
+
+
+def test_tendon_stiffness_lowers_the_held_tension():
+    robot = _niti()
+    forward = robot.solve(TENSIONS + 0.5)
+    delta = list(forward.tendon_displacements)
+    rigid = robot.solve(TENSIONS, displacements=delta)
+    soft = robot.solve(TENSIONS, displacements=delta, tendon_stiffness=2e3)
+    assert np.all(soft.tendon_tensions < rigid.tendon_tensions)
+    # A taut held tendon stretches by tension / stiffness; a slack one carries nothing and its
+    # path is shorter than the tendon (complementarity).
+    gap = np.asarray(delta) - np.asarray(soft.tendon_displacements)
+    taut = soft.tendon_tensions > 0
+    assert taut.any() and (~taut).any()
+    np.testing.assert_allclose(gap[taut], soft.tendon_tensions[taut] / 2e3, rtol=1e-6)
+    assert np.all(gap[~taut] <= 1e-12)
+
+
+def test_displacement_arguments_are_named():
+    robot = _niti()
+    with pytest.raises(softrod.ParameterError, match="displacements"):
+        robot.solve(displacements=[0.0] * 5)
+    with pytest.raises(softrod.ParameterError, match=r"displacements\[2\]"):
+        robot.solve(displacements=[0.0, 0.0, float("inf"), 0, 0, 0])
+    with pytest.raises(softrod.ParameterError, match="tendon_stiffness"):
+        robot.solve(displacements=[0.0] * 6, tendon_stiffness=-1.0)
+    with pytest.raises(softrod.ParameterError, match="tendon_stiffness"):
+        robot.solve(tendon_stiffness=1e4)
+
+
+# ----------------------------------------------------------------------------- inverse statics
+
+
+def _admissible(rng):
+    """Random tensions: each segment pulled by at most two of its tendons (N)."""
+    t = np.zeros(6)
+    for seg in range(2):
+        o = rng.integers(3)
+        t[3 * seg + o] = rng.random() * 3.0
+        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
+    return t
+
+
+def _round_trip(count, seed):
+    robot = _niti()
+    rng = np.random.default_rng(seed)
+    misses = []
+    for k in range(count):
+        target = robot.solve(_admissible(rng)).tip_position
+        inv = softrod.inverse_statics(robot, target, throw=False)
+        reached = np.linalg.norm(inv.solution.tip_position - target) <= 1e-9
+        inside = np.all(inv.tensions >= 0.0)
+        if not (inv.converged and reached and inside):
+            misses.append((k, inv.position_error, inv.converged))
+    return misses
+
+
+def test_round_trip_reaches_the_targets_inside_the_bounds():
+    misses = _round_trip(40, 1)
+    assert len(misses) <= 0.01 * 40, misses
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="26 of 1,000 targets are missed (the SQP stops without converging and says so); "
+    "the aim is at most 10",
+)
+def test_round_trip_of_a_thousand_targets():
+    misses = _round_trip(1000, 2)
+    assert len(misses) <= 10, misses
+
+
+def test_the_actuation_is_the_minimum_norm_one_of_an_independent_qp():
+    """One segment, three tendons at 120 degrees: at most two taut, and the tensions solve the
+    minimum-norm program of the linearised target (scipy's SLSQP) to 1e-8."""
+    scipy_optimize = pytest.importorskip("scipy.optimize")
+    rod = softrod.Rod(0.2, softrod.CircularSection(0.7e-3), softrod.LinearElastic(54e9, 0.3))
+    tendons = [
+        softrod.Tendon((0.01 * np.cos(a), 0.01 * np.sin(a)), 0.0)
+        for a in (np.pi / 2, -np.pi / 6, 7 * np.pi / 6)
+    ]
+    robot = softrod.Robot(rod, tendons)
+    target = robot.solve([2.0, 0.7, 0.0]).tip_position
+    inv = softrod.inverse_statics(robot, target)
+    assert inv.converged and np.sum(inv.tensions > 1e-12) <= 2
+    j = softrod.actuation_jacobian(inv.solution)[:3]
+    b = j @ inv.tensions
+    qp = scipy_optimize.minimize(
+        lambda t: 0.5 * t @ t,
+        np.ones(3),
+        jac=lambda t: t,
+        constraints=[{"type": "eq", "fun": lambda t: j @ t - b, "jac": lambda t: j}],
+        bounds=[(0.0, None)] * 3,
+        method="SLSQP",
+        options={"ftol": 1e-16, "maxiter": 500},
+    )
+    assert qp.success
+    np.testing.assert_allclose(inv.tensions, qp.x, rtol=0, atol=1e-8)
+
+
+def test_a_target_out_of_reach_is_named_with_its_distance():
+    robot = _niti()
+    with pytest.raises(softrod.TargetUnreachableError) as e:
+        softrod.inverse_statics(robot, [0.3, 0.3, 0.0])
+    assert e.value.distance > 0.05
+    inv = softrod.inverse_statics(robot, [0.3, 0.3, 0.0], throw=False)
+    assert not inv.converged and inv.position_error == pytest.approx(e.value.distance, rel=1e-6)
+
+
+def test_warm_started_tracking_and_named_arguments():
+    robot = _niti()
+    target = robot.solve(_admissible(np.random.default_rng(1))).tip_position
+    first = softrod.inverse_statics(robot, target)
+    moved = softrod.inverse_statics(robot, target + np.array([1e-3, 0, 0]), warm_start=first)
+    assert moved.converged and moved.iterations <= first.iterations
+    with pytest.raises(softrod.ParameterError, match="target_position"):
+        softrod.inverse_statics(robot, [0.0, 0.0])
+    with pytest.raises(softrod.ParameterError, match="tension_bounds"):
+        softrod.inverse_statics(robot, target, tension_bounds=(-1.0, None))
+    with pytest.raises(softrod.ParameterError, match="robot"):
+        softrod.inverse_statics("robot.toml", target)
