@@ -71,6 +71,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
+from .contact import Capsule, Clamp, Cylinder, Pin, Plane, Slide, Sphere
 from .inverse import InverseSolution, inverse_statics
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot, solve_path
@@ -82,10 +83,13 @@ __all__ = [
     "BackboneDistance",
     "BackboneQuality",
     "Calibration",
+    "Capsule",
     "Chamber",
     "CircularSection",
+    "Clamp",
     "Compliance",
     "ConvergenceError",
+    "Cylinder",
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
@@ -101,15 +105,19 @@ __all__ = [
     "Ogden",
     "ParameterError",
     "Pareto",
+    "Pin",
     "PlanarBatch",
     "PlanarCableArm",
     "PlanarSolution",
+    "Plane",
     "PointLoad",
     "Robot",
     "Rod",
     "SampleTable",
     "Section",
     "Silicone",
+    "Slide",
+    "Sphere",
     "StaticsSolution",
     "TableSection",
     "TangentCompliance",

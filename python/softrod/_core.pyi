@@ -427,6 +427,16 @@ class StaticsSolution:
     @property
     def friction_iterations(self) -> int: ...
     @property
+    def contacts(self) -> list[dict[str, Any]]:
+        """Active contacts: obstacle, s (m), length (m), point, normal, normal_force (N),
+        tangential_force (N)."""
+    @property
+    def contact_force(self) -> NDArray[np.float64]:
+        """Contact force on the rod at every sample (N, world), shape (N, 3)."""
+    @property
+    def tip_reaction(self) -> NDArray[np.float64] | None:
+        """Reaction wrench of the tip constraint (N, N m; world), shape (6,)."""
+    @property
     def tendon_tensions(self) -> NDArray[np.float64]: ...
     @property
     def tendon_displacements(self) -> NDArray[np.float64]: ...
@@ -480,12 +490,17 @@ def solve_statics(
     previous: StaticsSolution | None = None,
     displacements: Sequence[float | None] | NDArray[np.float64] | None = None,
     tendon_stiffness: float | Sequence[float] | NDArray[np.float64] | None = None,
+    obstacles: Sequence[Any] | None = None,
+    tip_constraint: Any = None,
 ) -> StaticsSolution:
     """Options not given keep the core's defaults: integrator "rk4" with 40 steps (rtol 1e-8,
     atol 1e-10 for "adaptive"), tolerance 1e-10, max_iterations 30, continuation True,
     max_load_steps 64, throw True, seek_stable True, on_unstable "warn". ``s_out`` (m) adds
     nodes at those arc lengths. ``displacements`` (m, one per tendon, None: tension control)
-    holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness."""
+    holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness.
+    ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``, ``Cylinder``) are touched by the
+    rod's surface without friction; ``tip_constraint`` (``softrod.Clamp(pose)``, ``Pin(point)``,
+    ``Slide(point, normal)``) holds the tip."""
 
 def _inverse_statics(
     rod: Rod,

@@ -129,10 +129,12 @@ class Robot:
         "_loads",
         "_loads_given",
         "_name",
+        "_obstacles",
         "_rod",
         "_solver",
         "_spec",
         "_tendons",
+        "_tip_constraint",
     )
 
     def __init__(
@@ -145,6 +147,8 @@ class Robot:
         name: str = "robot",
         description: str = "",
         source: Mapping[str, Any] | None = None,
+        obstacles: Sequence[Any] = (),
+        tip_constraint: Any = None,
     ) -> None:
         """Builds a robot from model objects.
 
@@ -159,6 +163,11 @@ class Robot:
             description: Free text.
             source: A description (the file's tables) to adopt as the robot's ``spec``
                 instead of reading one back from the objects; it must describe them.
+            obstacles: Rigid obstacles the rod's surface touches (``softrod.Plane``,
+                ``Sphere``, ``Capsule``, ``Cylinder`` or dicts with ``type``), passed to
+                :func:`softrod.solve_statics` as ``obstacles=``.
+            tip_constraint: ``softrod.Clamp(pose)``, ``Pin(point)`` or ``Slide(point,
+                normal)`` (default a free tip), passed as ``tip_constraint=``.
 
         Raises:
             TypeError: An argument of the wrong type (named).
@@ -190,6 +199,10 @@ class Robot:
             options,
             None,
         )
+        from .plot.obstacles import as_obstacles
+
+        object.__setattr__(self, "_obstacles", tuple(as_obstacles(obstacles)))
+        object.__setattr__(self, "_tip_constraint", tip_constraint)
         if source:
             with _argument("source"):
                 spec = _rf.validate_robot_dict(_plain(dict(source)))
@@ -206,6 +219,8 @@ class Robot:
             ("_loads_given", given),
             ("_solver", solver),
             ("_spec", spec),
+            ("_obstacles", ()),
+            ("_tip_constraint", None),
         ):
             object.__setattr__(self, key, value)
 
@@ -240,6 +255,8 @@ class Robot:
             parts.solver,
             spec,
         )
+        object.__setattr__(robot, "_obstacles", parts.obstacles)
+        object.__setattr__(robot, "_tip_constraint", parts.tip_constraint)
         return robot
 
     @classmethod
@@ -276,6 +293,10 @@ class Robot:
     tendons = property(lambda self: self._tendons, doc="Tendons, in order.")
     chambers = property(lambda self: self._chambers, doc="Pneumatic chambers, in order.")
     loads = property(lambda self: self._loads, doc="External loads.")
+    obstacles = property(lambda self: self._obstacles, doc="Obstacles the rod touches.")
+    tip_constraint = property(
+        lambda self: self._tip_constraint, doc="The tip constraint (None: a free tip)."
+    )
 
     @property
     def solver(self) -> dict[str, Any]:
@@ -292,6 +313,15 @@ class Robot:
         """
         if self._spec is None:
             spec = _objects.describe(*self._parts())
+            if self._obstacles:
+                tables = [_objects.obstacle_spec(o) for o in self._obstacles]
+                spec = spec.model_copy(
+                    update={
+                        "obstacles": _rf.validate_robot_dict(
+                            {"rod": _MINIMAL_ROD, "obstacles": tables}
+                        ).obstacles
+                    }
+                )
             object.__setattr__(self, "_spec", spec)
         return self._spec
 
@@ -344,6 +374,10 @@ class Robot:
         merged = {**self._solver, **options}
         if chambers:
             merged.setdefault("chambers", chambers)
+        if self._obstacles:
+            merged.setdefault("obstacles", list(self._obstacles))
+        if self._tip_constraint is not None:
+            merged.setdefault("tip_constraint", self._tip_constraint)
         if displacements is not None:
             merged["displacements"] = displacements
         if tendon_stiffness is not None:
@@ -511,6 +545,8 @@ class Robot:
             and all(x is y for x, y in zip(self._chambers, other._chambers, strict=True))
             and self._loads is other._loads
             and self._solver == other._solver
+            and self._obstacles == other._obstacles
+            and self._tip_constraint is other._tip_constraint
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -536,6 +572,8 @@ class Robot:
         )
 
     def __reduce__(self):
+        if self._tip_constraint is not None or (self._obstacles and self._spec is None):
+            return (_rebuild, (self._parts(), self._obstacles, self._tip_constraint))
         if self._spec is not None:
             return (_from_pickled_spec, (self._spec,))
         parts = self._parts()
@@ -547,6 +585,13 @@ class Robot:
             except ParameterError as exc:
                 raise pickle.PicklingError(f"cannot pickle this Robot: {exc}") from None
         return (Robot, parts)
+
+
+def _rebuild(parts: tuple, obstacles: tuple, tip_constraint: Any) -> Robot:
+    robot = Robot(*parts)
+    object.__setattr__(robot, "_obstacles", obstacles)
+    object.__setattr__(robot, "_tip_constraint", tip_constraint)
+    return robot
 
 
 def _from_pickled_spec(spec: RobotFile) -> Robot:

@@ -562,6 +562,41 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("solve_statics(contact)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=sr.Rod(1.0, sr.CircularSection(1e-3), sr.LinearElastic(2e9, 0.3)),
+                tendons=[],
+                loads=sr.Loads(tip_force=(-1e-5, 0.0, 0.0)),
+                steps=60,
+                obstacles=[sr.Plane((-2e-3, 0.0, 0.0), (1.0, 0.0, 0.0))],
+                tip_constraint=None,
+            ),
+        )
+    )
+    t("solve_statics(tip_constraint)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=sr.Rod(1.0, sr.CircularSection(1e-3), sr.LinearElastic(2e9, 0.3)),
+                tendons=[],
+                loads=sr.Loads(point_loads=[sr.PointLoad(0.5, (1e-6, 0.0, 0.0))]),
+                steps=60,
+                obstacles=None,
+                tip_constraint=sr.Pin((0.0, 0.0, 1.0)),
+            ),
+        )
+    )
+    t("Plane")(lambda d: (sr.Plane, dict(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0))))
+    t("Sphere")(lambda d: (sr.Sphere, dict(center=(0.0, 0.0, 0.1), radius=0.02)))
+    t("Capsule")(lambda d: (sr.Capsule, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
+    t("Cylinder")(lambda d: (sr.Cylinder, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
+    t("Clamp")(
+        lambda d: (sr.Clamp, dict(pose=np.eye(4), held=[True, True, False, True, True, False]))
+    )
+    t("Pin")(lambda d: (sr.Pin, dict(point=(0.0, 0.0, 0.1))))
+    t("Slide")(lambda d: (sr.Slide, dict(point=(0.0, 0.0, 0.1), normal=(0.0, 0.0, 1.0))))
     t("solve_statics(adaptive, warm)")(
         lambda d: (
             sr.solve_statics,
@@ -718,6 +753,8 @@ def _define_targets() -> None:
                 solver={"steps": 40},
                 name="r",
                 description="d",
+                obstacles=[],
+                tip_constraint=None,
             ),
         )
     )

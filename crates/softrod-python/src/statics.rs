@@ -266,6 +266,8 @@ pub(crate) struct StaticsSolution {
     cache: [PyOnceLock<Py<PyAny>>; 12],
     /// The call that produced it (for pickling: it is solved again, bit for bit).
     call: Args,
+    /// Contacts, contact forces and the tip reaction (with obstacles or a tip constraint).
+    contact: crate::contact::ContactData,
 }
 
 fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
@@ -427,6 +429,31 @@ impl StaticsSolution {
     #[getter]
     fn friction_iterations(&self) -> usize {
         self.friction.as_ref().map_or(0, |f| f.iterations)
+    }
+    /// The active contacts, one dict each: `obstacle` (index), `s` (m), `length` (m, 0 for a
+    /// point contact; a contact interval on a plane otherwise), `point` (m, world, on the
+    /// rod's surface), `normal` (the obstacle's outward unit normal), `normal_force` (N,
+    /// >= 0), `tangential_force` (N, world; zero without friction). Empty without obstacles.
+    #[getter]
+    fn contacts(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.contact.contacts_py(py)
+    }
+    /// Contact force on the rod at every sample (N, world), shape (N, 3); zeros without
+    /// obstacles.
+    #[getter]
+    fn contact_force(&self, py: Python<'_>) -> Py<PyAny> {
+        match &self.contact.contact_force {
+            Some(f) => rows3(py, f),
+            None => rows3(py, &vec![[0.0; 3]; self.inner.s.len()]),
+        }
+    }
+    /// Reaction wrench [force; moment] of the tip constraint on the rod (N, N m; world),
+    /// shape (6,), or None without a tip constraint.
+    #[getter]
+    fn tip_reaction(&self, py: Python<'_>) -> Option<Py<PyAny>> {
+        self.contact
+            .tip_reaction
+            .map(|r| r.to_vec().into_pyarray(py).into_any().unbind())
     }
     /// Tension carried by each tendon (N), shape (n_tendons,): the input of a
     /// tension-controlled tendon, the solved tension of a displacement-controlled one (0 when
@@ -699,7 +726,8 @@ fn report_unstable(
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
                     continuation=None, max_load_steps=None, warm_start=None, throw=None,
                     chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None,
-                    previous=None, displacements=None, tendon_stiffness=None))]
+                    previous=None, displacements=None, tendon_stiffness=None,
+                    obstacles=None, tip_constraint=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
     py: Python<'py>,
@@ -723,6 +751,8 @@ pub(crate) fn solve_statics<'py>(
     previous: Option<Bound<'py, PyAny>>,
     displacements: Option<Bound<'py, PyAny>>,
     tendon_stiffness: Option<Bound<'py, PyAny>>,
+    obstacles: Option<Bound<'py, PyAny>>,
+    tip_constraint: Option<Bound<'py, PyAny>>,
 ) -> PyResult<StaticsSolution> {
     let previous = previous.filter(|p| !p.is_none());
     let prev_state: Option<Arc<softrod::FrictionalSolution>> = match &previous {
@@ -743,9 +773,19 @@ pub(crate) fn solve_statics<'py>(
             }
         }
     };
+    let obstacle_list = crate::contact::obstacles(py, obstacles.as_ref())?;
+    let tip = crate::contact::tip_constraint(tip_constraint.as_ref())?;
+    let constrained = tip.is_some() || !obstacle_list.is_empty();
     let warm_start = warm_start.filter(|w| !w.is_none());
     let unstable = self::on_unstable(on_unstable)?;
     let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
+    if constrained && !s_values.is_empty() {
+        return Err(crate::errors::param_err(
+            "s_out",
+            format!("{s_values:?}"),
+            "None with obstacles or a tip constraint (the solution is at the integration mesh)",
+        ));
+    }
     let args = OptionArgs {
         integrator,
         steps,
@@ -786,6 +826,13 @@ pub(crate) fn solve_statics<'py>(
             }
         }
     }
+    if constrained && actuation.has_held() {
+        return Err(crate::errors::param_err(
+            "displacements",
+            "given",
+            "None with obstacles or a tip constraint (tension control only)",
+        ));
+    }
     let (model, act) = (&problem.model, &actuation);
     let frictional = prev_state.is_some() || model.tendons().iter().any(|t| t.friction() > 0.0);
     if frictional && !s_values.is_empty() {
@@ -795,7 +842,14 @@ pub(crate) fn solve_statics<'py>(
             "None with friction (the solution is reported at the friction mesh)",
         ));
     }
-    let (result, friction) = if frictional {
+    if frictional && constrained {
+        return Err(param_err(
+            "obstacles",
+            "obstacles or a tip constraint with tendon friction",
+            "no obstacles and no tip constraint when a tendon has friction (not modelled together)",
+        ));
+    }
+    let (result, friction, contact) = if frictional {
         let fo = softrod::FrictionOptions {
             statics: options,
             ..Default::default()
@@ -804,12 +858,26 @@ pub(crate) fn solve_statics<'py>(
             softrod::solve_frictional(model, act, &fo, prev_state.as_deref())
                 .map_err(actuator_names)
         })?;
-        (f.statics.clone(), Some(Arc::new(f)))
+        (
+            f.statics.clone(),
+            Some(Arc::new(f)),
+            crate::contact::ContactData::default(),
+        )
     } else {
-        let r = run(py, "solve_statics", || {
-            softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
+        let (r, c) = run(py, "solve_statics", || {
+            if constrained {
+                let c =
+                    softrod::solve_constrained(model, act, &options, tip.as_ref(), &obstacle_list)
+                        .map_err(actuator_names)?;
+                let data = crate::contact::ContactData::from_solution(&c);
+                Ok((c.solution, data))
+            } else {
+                softrod::solve_statics_at(model, act, &options, &s_values)
+                    .map_err(actuator_names)
+                    .map(|r| (r, crate::contact::ContactData::default()))
+            }
         })?;
-        (r, None)
+        (r, None, c)
     };
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(
@@ -859,6 +927,8 @@ pub(crate) fn solve_statics<'py>(
             ("previous", o(previous.map(Bound::unbind))),
             ("displacements", o(displacements.map(Bound::unbind))),
             ("tendon_stiffness", o(tendon_stiffness.map(Bound::unbind))),
+            ("obstacles", o(obstacles.map(Bound::unbind))),
+            ("tip_constraint", o(tip_constraint.map(Bound::unbind))),
         ],
     )?;
     let sol = StaticsSolution {
@@ -866,6 +936,7 @@ pub(crate) fn solve_statics<'py>(
         friction,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
+        contact,
     };
     report_unstable(py, sol, unstable)
 }

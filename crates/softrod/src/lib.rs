@@ -9,6 +9,8 @@
 //! The crate is laid out as the architecture (see `docs/architecture.md`):
 //! * [`model`]: the validated, immutable [`RobotModel`] (rod, section, material, tendon
 //!   routings, chamber geometry, loads) and the [`Actuation`] input (tensions, pressures);
+//! * [`contact`]: end constraints and unilateral contact with obstacles through the
+//!   shooting problem, [`solve_constrained`];
 //! * [`cosserat`]: the Cosserat-rod statics, [`solve_statics`]`(&model, &actuation,
 //!   &options)`, whose [`StaticsSolution`] keeps its model, actuation and options;
 //! * [`compliance`](mod@compliance): integrated and tangent compliance, eigenscrews;
@@ -26,6 +28,7 @@
 
 pub mod batch;
 pub mod compliance;
+pub mod contact;
 pub mod cosserat;
 pub mod error;
 pub mod integrate;
@@ -47,6 +50,7 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
+pub use contact::{solve_constrained, Contact, ContactSolution, Obstacle, TipConstraint};
 pub use cosserat::displacement::reference_lengths;
 pub use cosserat::friction::{
     friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,

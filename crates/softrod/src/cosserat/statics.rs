@@ -300,7 +300,7 @@ pub(crate) fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
 /// integrator the residual carries the integration error and exact Jacobians are evaluated.
 /// A loaded solve ends on an exact Jacobian at the solution (the stability test needs its
 /// columns).
-fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
+pub(crate) fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
     NewtonSettings {
         line_search: LineSearch {
             factor: 0.5,
@@ -491,7 +491,7 @@ fn attempt(p: &mut Shooting<'_>, options: &SolveOptions, x0: &[f64; 6], exact: b
 }
 
 /// Scaled unknowns of a base wrench (N, N m).
-fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
+pub(crate) fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();
     [
@@ -876,7 +876,7 @@ fn solve_with(
 }
 
 /// The base wrench (N, N m) of scaled unknowns.
-fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
+pub(crate) fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();
     [
