@@ -1,7 +1,7 @@
 //! Independent oracles shared by the compliance tests (written from closed-form geometry,
 //! not from the library): Castigliano's compliance of a circular arc and a block-wise
 //! comparison of 6×6 compliances.
-#![allow(dead_code, missing_docs)]
+#![allow(dead_code, unused_imports, missing_docs)]
 
 pub mod robot;
 pub use robot::*;
