@@ -68,7 +68,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
-from .inverse import InverseSolution, inverse_statics
+from .inverse import InversePath, InverseSolution, inverse_statics, inverse_statics_path
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot
 from .vision import Backbone, BackboneQuality
@@ -85,6 +85,7 @@ __all__ = [
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
+    "InversePath",
     "InverseSolution",
     "LinearElastic",
     "Linearised",
@@ -128,6 +129,7 @@ __all__ = [
     "extract_backbone",
     "fit_uniaxial",
     "inverse_statics",
+    "inverse_statics_path",
     "load_robot",
     "pcc",
     "read_backbone_csv",

@@ -122,3 +122,132 @@ def inverse_statics(
         iterations=int(out["iterations"]),
         converged=bool(out["converged"]),
     )
+
+
+@dataclass(frozen=True)
+class InversePath:
+    """The result of :func:`inverse_statics_path`: one row per target.
+
+    Attributes:
+        tensions: Tendon tensions (N), shape (n_targets, n_tendons).
+        pressures: Chamber pressures (Pa, gauge), shape (n_targets, n_chambers).
+        tip_position: Tip positions reached (m, world), shape (n_targets, 3).
+        position_error: Distance from each tip to its target (m), shape (n_targets,).
+        rotation_error: Angle to each target rotation (rad; 0 without one), shape (n_targets,).
+        iterations: SQP iterations per target, shape (n_targets,).
+        converged: Whether each target was reached, shape (n_targets,).
+        solutions: The forward statics solution of each target (a list of n_targets).
+    """
+
+    tensions: np.ndarray
+    pressures: np.ndarray
+    tip_position: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+    iterations: np.ndarray
+    converged: np.ndarray
+    solutions: list
+
+    def __len__(self) -> int:
+        return len(self.position_error)
+
+    @property
+    def actuation(self) -> np.ndarray:
+        """Tensions then pressures per target (N, Pa), shape (n_targets, n_actuators)."""
+        return np.concatenate([self.tensions, self.pressures], axis=1)
+
+
+def _parameter_error(name: str, value: object, expected: str) -> Exception:
+    text = np.array2string(np.asarray(value, dtype=object), threshold=6)
+    err = _core.ParameterError(f"invalid parameter `{name}` = {text:.80}: {expected}")
+    err.parameter = name
+    return err
+
+
+def inverse_statics_path(
+    robot: Robot,
+    targets: Sequence[Sequence[float]] | np.ndarray,
+    *,
+    target_rotations: Sequence[Any] | np.ndarray | None = None,
+    weights: Sequence[float] | np.ndarray | None = None,
+    tension_bounds: tuple[float, float | None] = (0.0, None),
+    pressure_bounds: tuple[float, float | None] | None = None,
+    warm_start: InverseSolution | Sequence[float] | np.ndarray | None = None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+) -> InversePath:
+    """Tracks a path of tip targets: :func:`inverse_statics` at each, warm-started from the last.
+
+    Args:
+        robot: The robot (its loads and gravity apply).
+        targets: Tip positions (m, world), shape (n_targets, 3).
+        target_rotations: Tip rotations (body -> world), shape (n_targets, 3, 3), or None.
+        weights, tension_bounds, pressure_bounds, tolerance, max_iterations: As
+            :func:`inverse_statics`.
+        warm_start: Start of the first target (an :class:`InverseSolution` or an actuation).
+        throw: Raise at the first target not reached; False: mark it ``converged=False`` and go
+            on, the next target warm-started from the last one reached.
+
+    Returns:
+        An :class:`InversePath` (arrays, one row per target).
+
+    Raises:
+        ParameterError: Bad ``targets`` or ``target_rotations`` (named), or a bad argument of
+            :func:`inverse_statics`.
+        TargetUnreachableError, ConvergenceError: A target not reached (``throw=True``).
+    """
+    try:
+        pts = np.asarray(targets, dtype=float)
+    except (TypeError, ValueError):
+        raise _parameter_error(
+            "targets", targets, "an array (n_targets, 3) of numbers (m)"
+        ) from None
+    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] == 0:
+        raise _parameter_error(
+            "targets", f"shape {pts.shape}", "an array (n_targets, 3) with n_targets >= 1 (m)"
+        )
+    if not np.all(np.isfinite(pts)):
+        raise _parameter_error("targets", pts, "finite numbers (m)")
+    rots = None
+    if target_rotations is not None:
+        try:
+            rots = np.asarray(target_rotations, dtype=float)
+        except (TypeError, ValueError):
+            raise _parameter_error(
+                "target_rotations", target_rotations, "an array (n_targets, 3, 3)"
+            ) from None
+        if rots.shape != (len(pts), 3, 3):
+            raise _parameter_error(
+                "target_rotations",
+                f"shape {rots.shape}",
+                f"an array ({len(pts)}, 3, 3): one rotation per target",
+            )
+    rows: list[InverseSolution] = []
+    warm = warm_start
+    for i, p in enumerate(pts):
+        inv = inverse_statics(
+            robot,
+            p,
+            target_rotation=None if rots is None else rots[i],
+            weights=weights,
+            tension_bounds=tension_bounds,
+            pressure_bounds=pressure_bounds,
+            warm_start=warm,
+            throw=throw,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+        )
+        rows.append(inv)
+        if inv.converged:  # a miss does not seed the next target: the last reached one does
+            warm = inv
+    return InversePath(
+        tensions=np.array([r.tensions for r in rows]).reshape(len(rows), -1),
+        pressures=np.array([r.pressures for r in rows]).reshape(len(rows), -1),
+        tip_position=np.array([np.asarray(r.solution.tip_position) for r in rows]),
+        position_error=np.array([r.position_error for r in rows]),
+        rotation_error=np.array([r.rotation_error for r in rows]),
+        iterations=np.array([r.iterations for r in rows], dtype=int),
+        converged=np.array([r.converged for r in rows], dtype=bool),
+        solutions=[r.solution for r in rows],
+    )

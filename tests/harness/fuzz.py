@@ -550,6 +550,23 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("inverse_statics_path")(
+        lambda d: (
+            sr.inverse_statics_path,
+            dict(
+                robot=_niti(),
+                targets=[[0.03388176, 0.03906025, 0.3958294], [0.03488176, 0.03906025, 0.3958]],
+                target_rotations=None,
+                weights=[1.0] * 6,
+                tension_bounds=(0.0, 10.0),
+                pressure_bounds=(0.0, None),
+                warm_start=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                throw=False,
+                tolerance=1e-9,
+                max_iterations=60,
+            ),
+        )
+    )
     t("solve_statics(chambers)")(
         lambda d: (
             sr.solve_statics,
@@ -1490,6 +1507,7 @@ NOT_CONSTRUCTED = {
     "ConvergenceError",
     "Eigenscrews",
     "InverseSolution",
+    "InversePath",
     "ModelComparison",
     "ModelResult",
     "ParameterError",
