@@ -353,3 +353,62 @@ def test_path_arguments_are_named():
         softrod.inverse_statics_path(robot, [[0.0, 0.0, 0.4]], target_rotations=np.eye(3))
     with pytest.raises(softrod.ParameterError, match="robot"):
         softrod.inverse_statics_path("robot.toml", [[0.0, 0.0, 0.4]])
+
+
+def _min_norm_by_enumeration(a, b):
+    """The least-norm t >= 0 with a t = b, by enumerating the taut subsets (brute force)."""
+    best = None
+    n = a.shape[1]
+    for mask in range(1, 2**n):
+        idx = [i for i in range(n) if mask >> i & 1]
+        sub = a[:, idx]
+        t_sub, *_ = np.linalg.lstsq(sub, b, rcond=None)
+        if np.abs(sub @ t_sub - b).max() > 1e-9 * np.abs(b).max() or t_sub.min() < -1e-12:
+            continue
+        t = np.zeros(n)
+        t[idx] = t_sub
+        if best is None or t @ t < best @ best:
+            best = t
+    return best
+
+
+def test_pcc_inverse_is_the_brute_force_minimum_norm_actuation():
+    """One inextensible PCC segment, three tendons at 120 degrees, unloaded: the curvature
+    vector is linear in the tensions (checked), so the minimum-norm actuation is found by
+    enumerating the taut subsets."""
+    angles = [np.pi / 2, -np.pi / 6, 7 * np.pi / 6]
+    robot = pcc.Robot.solid_circle([0.2], 0.7e-3, 54e9, extensible=False)
+    robot = robot.with_tendons(0, [0.01] * 3, angles)
+    target = np.asarray(pcc.solve(robot, [2.0, 0.7, 0.0]).tip_pose)[:3, 3]
+    inv = pcc.inverse_statics(robot, target)
+    assert inv.converged and isinstance(inv.solution, pcc.PccSolution)
+    assert np.linalg.norm(np.asarray(inv.solution.tip_pose)[:3, 3] - target) <= 1e-9
+    assert np.sum(inv.tensions > 1e-12) <= 2
+
+    def u(t):
+        k, phi, _ = np.asarray(pcc.solve(robot, t).arcs)[0]
+        return k * np.array([-np.sin(phi), np.cos(phi)])
+
+    a = np.array([u(np.eye(3)[i]) for i in range(3)]).T
+    np.testing.assert_allclose(u(np.array([1.0, 2.0, 0.5])), a @ [1.0, 2.0, 0.5], atol=1e-12)
+    brute = _min_norm_by_enumeration(a, u(inv.tensions))
+    np.testing.assert_allclose(inv.tensions, brute, rtol=0, atol=1e-8)
+
+
+def test_pcc_inverse_round_trip_with_a_tip_load_and_named_errors():
+    robot = _pcc_robot()
+    rng = np.random.default_rng(3)
+    force = [0.0, 0.05, -0.1]
+    for _ in range(5):
+        t = rng.uniform(0.0, 3.0, 6) * (rng.uniform(size=6) < 0.5)
+        target = np.asarray(pcc.solve(robot, t, tip_force=force).tip_pose)[:3, 3]
+        inv = pcc.inverse_statics(robot, target, tip_force=force, tension_bounds=(0.0, 10.0))
+        tip = np.asarray(pcc.solve(robot, inv.tensions, tip_force=force).tip_pose)[:3, 3]
+        assert inv.converged and np.linalg.norm(tip - target) <= 1e-9
+        assert inv.tensions.min() >= 0.0 and inv.tensions.max() <= 10.0
+    with pytest.raises(softrod.TargetUnreachableError):
+        pcc.inverse_statics(robot, [0.5, 0.5, 0.0])
+    with pytest.raises(softrod.ParameterError, match="target_position"):
+        pcc.inverse_statics(robot, [0.0, 0.0])
+    with pytest.raises(softrod.ParameterError, match="tip_force"):
+        pcc.inverse_statics(robot, target, tip_force=[0.0, np.nan, 0.0])

@@ -799,6 +799,25 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("pcc.inverse_statics")(
+        lambda d: (
+            pcc.inverse_statics,
+            dict(
+                robot=_pcc_robot(),
+                target_position=np.asarray(_pcc_solution().tip_pose)[:3, 3] + [1e-3, 0.0, 0.0],
+                target_rotation=None,
+                weights=[1.0] * 6,
+                tension_bounds=(0.0, 10.0),
+                pressure_bounds=(0.0, None),
+                tip_force=(0.0, -0.01, 0.0),
+                tip_moment=(0.0, 0.0, 0.0),
+                warm_start=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                throw=False,
+                tolerance=1e-9,
+                max_iterations=60,
+            ),
+        )
+    )
     t("pcc.solve(s)")(
         lambda d: (
             pcc.solve,
