@@ -412,3 +412,21 @@ def test_pcc_inverse_round_trip_with_a_tip_load_and_named_errors():
         pcc.inverse_statics(robot, [0.0, 0.0])
     with pytest.raises(softrod.ParameterError, match="tip_force"):
         pcc.inverse_statics(robot, target, tip_force=[0.0, np.nan, 0.0])
+
+
+def test_a_shape_target_recovers_the_tensions_of_a_measured_backbone():
+    """Backbone points at four arc lengths of a forward solve (a 'measured' backbone): the shape
+    fixes each segment's bending, so the minimum-norm actuation is the generating one (at most
+    two tendons taut per segment); the points are reached to 1e-9 m (independent forward solve)."""
+    robot = _niti()
+    s = [0.1, 0.2, 0.3, 0.4]
+    truth = np.array([0.0, 1.5, 0.4, 0.8, 0.0, 0.0])
+    points = np.asarray(robot.solve(truth, s_out=s).position)
+    assert points.shape == (4, 3)
+    inv = softrod.inverse_statics(robot, points, target_s=s)
+    assert inv.converged and inv.position_error <= 1e-9
+    reached = np.asarray(robot.solve(inv.tensions, s_out=s).position)
+    assert np.abs(reached - points).max() <= 1e-9
+    np.testing.assert_allclose(inv.tensions, truth, rtol=0, atol=1e-6)
+    with pytest.raises(softrod.ParameterError, match="target_position"):
+        softrod.inverse_statics(robot, points[:3], target_s=s)

@@ -461,6 +461,7 @@ def _inverse_statics(
     target_position: _Vec3,
     *,
     target_rotation: Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
+    target_s: Sequence[float] | NDArray[np.float64] | None = None,
     weights: Sequence[float] | NDArray[np.float64] | None = None,
     tension_bounds: tuple[float, float | None] | None = None,
     pressure_bounds: tuple[float, float | None] | None = None,

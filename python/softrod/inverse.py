@@ -27,7 +27,8 @@ class InverseSolution:
         tensions: Tendon tensions found (N), shape (n_tendons,).
         pressures: Chamber pressures found (Pa, gauge), shape (n_chambers,).
         solution: The forward statics solution at that actuation.
-        position_error: Distance from the tip to the target (m).
+        position_error: Distance from the tip to the target (m; for a shape target, the
+            largest distance of a backbone point to its target).
         rotation_error: Angle from the tip rotation to the target's (rad; 0 without one).
         iterations: Iterations of the SQP.
         converged: Whether the target was reached and the actuation is the minimum-norm one.
@@ -59,12 +60,14 @@ def inverse_statics(
     throw: bool = True,
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    target_s: Sequence[float] | np.ndarray | None = None,
 ) -> InverseSolution:
     """The minimum-norm actuation that puts the tip of ``robot`` at ``target_position``.
 
     Args:
         robot: The robot (:func:`softrod.load_robot` or built in code); its loads apply.
-        target_position: Tip position (m, world), shape (3,).
+        target_position: Tip position (m, world), shape (3,); with ``target_s``, a shape
+            target: backbone points (m, world), shape (k, 3).
         target_rotation: Tip rotation (body -> world, 3x3), or None for a position target.
         weights: Weights of the actuation norm, one per tendon then chamber (1/N², 1/Pa²).
         tension_bounds: (lo, hi) of every tension (N; hi None: unbounded).
@@ -74,6 +77,8 @@ def inverse_statics(
             a target out of reach; False: return the closest pose with ``converged=False``.
         tolerance: Tolerance on the distance to the target (m; default 1e-10).
         max_iterations: Cap on the iterations (default 60).
+        target_s: Undeformed arc lengths (m, 0..length) of the backbone points that go to the
+            rows of ``target_position`` (e.g. a measured backbone), shape (k,); None: the tip.
 
     Returns:
         The actuation, its forward solution and the remaining errors.
@@ -98,6 +103,7 @@ def inverse_statics(
         list(robot._chambers),
         target_position,
         target_rotation=target_rotation,
+        target_s=target_s,
         weights=weights,
         tension_bounds=tension_bounds,
         pressure_bounds=pressure_bounds,
@@ -207,8 +213,8 @@ def inverse_statics_path(
         raise _parameter_error(
             "targets", f"shape {pts.shape}", "an array (n_targets, 3) with n_targets >= 1 (m)"
         )
-    if not np.all(np.isfinite(pts)):
-        raise _parameter_error("targets", pts, "finite numbers (m)")
+    if not np.all(np.isfinite(pts)) or np.abs(pts).max() > 1e6:
+        raise _parameter_error("targets", pts, "finite numbers within ±1e6 m")
     rots = None
     if target_rotations is not None:
         try:

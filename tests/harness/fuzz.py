@@ -550,6 +550,19 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("inverse_statics(shape)")(
+        lambda d: (
+            sr.inverse_statics,
+            dict(
+                robot=_niti(),
+                target_position=np.asarray(
+                    _niti().solve([0.0, 1.5, 0.4, 0.8, 0.0, 0.0], s_out=[0.2, 0.4]).position
+                ),
+                target_s=[0.2, 0.4],
+                throw=False,
+            ),
+        )
+    )
     t("inverse_statics_path")(
         lambda d: (
             sr.inverse_statics_path,

@@ -19,6 +19,7 @@ use crate::statics::{actuator_names, solve_options, OptionArgs, Problem};
 #[allow(clippy::too_many_arguments)]
 fn target_and_options(
     target_position: &Bound<'_, PyAny>,
+    target_s: Option<&Bound<'_, PyAny>>,
     target_rotation: Option<&Bound<'_, PyAny>>,
     weights: Option<&Bound<'_, PyAny>>,
     tension_bounds: Option<&Bound<'_, PyAny>>,
@@ -28,7 +29,25 @@ fn target_and_options(
     tolerance: Option<f64>,
     max_iterations: Option<i64>,
 ) -> PyResult<(Target, InverseOptions, Option<InverseWarmStart>)> {
-    let position = vec3(target_position, "target_position")?;
+    let arcs = floats_opt(target_s, "target_s")?;
+    let points = if target_s.is_some_and(|t| !t.is_none()) {
+        let m: Matrix = crate::convert::Arg::from_arg(target_position, "target_position")?;
+        if m.0.ncols() != 3 || m.0.nrows() != arcs.len() {
+            return Err(param_err(
+                "target_position",
+                format!("shape {:?}", m.0.shape()),
+                &format!(
+                    "({}, 3): one point (m, world) per arc length of target_s",
+                    arcs.len()
+                ),
+            ));
+        }
+        (0..m.0.nrows())
+            .map(|k| Vector3::new(m.0[(k, 0)], m.0[(k, 1)], m.0[(k, 2)]))
+            .collect()
+    } else {
+        vec![vec3(target_position, "target_position")?]
+    };
     let rotation = match target_rotation.filter(|r| !r.is_none()) {
         None => None,
         Some(r) => {
@@ -61,8 +80,8 @@ fn target_and_options(
     let warm = floats_opt(warm_start, "warm_start")?;
     let warm = (!warm.is_empty()).then(|| InverseWarmStart::actuation(warm));
     let target = Target {
-        points: vec![Vector3::new(position.x, position.y, position.z)],
-        s: None,
+        points,
+        s: target_s.is_some_and(|t| !t.is_none()).then_some(arcs),
         rotation,
     };
     Ok((target, o, warm))
@@ -114,7 +133,7 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 /// `converged`, `reached`.
 #[pyfunction]
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
-                    weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
+                    target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
                     throw=true, tolerance=None, max_iterations=None, integrator=None, steps=None,
                     rtol=None, atol=None))]
 #[allow(clippy::too_many_arguments)]
@@ -126,6 +145,7 @@ pub(crate) fn _inverse_statics<'py>(
     #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
     target_position: Bound<'py, PyAny>,
     target_rotation: Option<Bound<'py, PyAny>>,
+    target_s: Option<Bound<'py, PyAny>>,
     weights: Option<Bound<'py, PyAny>>,
     tension_bounds: Option<Bound<'py, PyAny>>,
     pressure_bounds: Option<Bound<'py, PyAny>>,
@@ -140,6 +160,7 @@ pub(crate) fn _inverse_statics<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (target, o, warm) = target_and_options(
         &target_position,
+        target_s.as_ref(),
         target_rotation.as_ref(),
         weights.as_ref(),
         tension_bounds.as_ref(),
@@ -194,6 +215,7 @@ pub(crate) fn _pcc_inverse_statics<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (target, o, warm) = target_and_options(
         &target_position,
+        None,
         target_rotation.as_ref(),
         weights.as_ref(),
         tension_bounds.as_ref(),
