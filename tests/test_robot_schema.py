@@ -221,6 +221,8 @@ def test_the_json_schema_names_every_table_and_law():
         "chambers",
         "loads",
         "solver",
+        "obstacles",
+        "tip_constraint",
     }
     assert {
         "CircularSectionSpec",

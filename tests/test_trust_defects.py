@@ -421,14 +421,7 @@ def _table_yeoh_rod(base_rotation):
 @pytest.mark.parametrize(
     ("integrator", "at"),
     [
-        pytest.param(
-            "rk4",
-            0.25,
-            marks=xfail(
-                "the RK4 solve stops in a hyperelastic section solve at s = 0.1375 m "
-                "(residual NaN) on a mild body wrench"
-            ),
-        ),
+        ("rk4", 0.25),
         ("adaptive", 0.4),
     ],
 )

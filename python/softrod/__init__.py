@@ -53,6 +53,8 @@ from ._core import (
 )
 from .analysis import (
     BackboneDistance,
+    Calibration,
+    IdentifiabilityWarning,
     ModelComparison,
     ModelResult,
     Pareto,
@@ -60,6 +62,7 @@ from .analysis import (
     TensileCurve,
     WorkspaceMap,
     backbone_distance,
+    calibrate,
     compare_models,
     design_summary,
     read_tensile_csv,
@@ -68,9 +71,10 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
+from .contact import Capsule, Clamp, Cylinder, Pin, Plane, Slide, Sphere
 from .inverse import InversePath, InverseSolution, inverse_statics, inverse_statics_path
 from .io import read_backbone_csv, write_samples_csv
-from .robot import Robot, load_robot
+from .robot import Robot, load_robot, solve_path
 from .vision import Backbone, BackboneQuality
 
 __all__ = [
@@ -78,13 +82,18 @@ __all__ = [
     "Backbone",
     "BackboneDistance",
     "BackboneQuality",
+    "Calibration",
+    "Capsule",
     "Chamber",
     "CircularSection",
+    "Clamp",
     "Compliance",
     "ConvergenceError",
+    "Cylinder",
     "Eigenscrews",
     "FunctionSection",
     "Hookean",
+    "IdentifiabilityWarning",
     "InversePath",
     "InverseSolution",
     "LinearElastic",
@@ -97,15 +106,19 @@ __all__ = [
     "Ogden",
     "ParameterError",
     "Pareto",
+    "Pin",
     "PlanarBatch",
     "PlanarCableArm",
     "PlanarSolution",
+    "Plane",
     "PointLoad",
     "Robot",
     "Rod",
     "SampleTable",
     "Section",
     "Silicone",
+    "Slide",
+    "Sphere",
     "StaticsSolution",
     "TableSection",
     "TangentCompliance",
@@ -121,6 +134,7 @@ __all__ = [
     "__version__",
     "actuation_jacobian",
     "backbone_distance",
+    "calibrate",
     "compare_models",
     "compliance",
     "design_summary",
@@ -136,6 +150,7 @@ __all__ = [
     "read_tensile_csv",
     "samples",
     "silicone",
+    "solve_path",
     "solve_statics",
     "sweep",
     "tangent_compliance",

@@ -158,6 +158,7 @@ class PlanarCableArm:
         atol: float = 1e-10,
         max_steps: int = 100000,
     ) -> PlanarBatch: ...
+    def sensitivities(self, tension: float, s: _Floats) -> dict[str, Any]: ...
 
 def backbone_distance(
     a: NDArray[np.float64], b: NDArray[np.float64], n_index: int | None = None
@@ -300,20 +301,35 @@ class Tendon:
         end: float | None = None,
         *,
         derivative: Callable[[float], Sequence[float]] | None = None,
+        friction: float = 0.0,
     ) -> None: ...
     @staticmethod
     def radius_proportional(
-        ratio: float, angle: float, tension: float, end: float | None = None
+        ratio: float,
+        angle: float,
+        tension: float,
+        end: float | None = None,
+        *,
+        friction: float = 0.0,
     ) -> Tendon: ...
     @staticmethod
     def helical(
-        radius: float, pitch: float, tension: float, phase: float = 0.0, end: float | None = None
+        radius: float,
+        pitch: float,
+        tension: float,
+        phase: float = 0.0,
+        end: float | None = None,
+        *,
+        friction: float = 0.0,
     ) -> Tendon: ...
     def with_tension(self, tension: float) -> Tendon: ...
     @property
     def tension(self) -> float: ...
     @property
     def end(self) -> float | None: ...
+    @property
+    def friction(self) -> float:
+        """Friction coefficient between the tendon and its channel (>= 0)."""
     @property
     def routing(self) -> Literal["constant", "function", "radius_proportional", "helical"]: ...
     @property
@@ -398,6 +414,29 @@ class StaticsSolution:
     @property
     def tendon_lengths(self) -> NDArray[np.float64]: ...
     @property
+    def tendon_tension(self) -> NDArray[np.float64]:
+        """Tension (N) along each tendon at every sample, shape (N, n_tendons)."""
+    @property
+    def friction_force(self) -> NDArray[np.float64]:
+        """Friction force on the rod (N/m, world), shape (N, n_tendons, 3)."""
+    @property
+    def slip(self) -> NDArray[np.int8]:
+        """+1 sliding toward the base, -1 toward the tip, 0 sticking; (N, n_tendons)."""
+    @property
+    def frictional(self) -> bool: ...
+    @property
+    def friction_iterations(self) -> int: ...
+    @property
+    def contacts(self) -> list[dict[str, Any]]:
+        """Active contacts: obstacle, s (m), length (m), point, normal, normal_force (N),
+        tangential_force (N)."""
+    @property
+    def contact_force(self) -> NDArray[np.float64]:
+        """Contact force on the rod at every sample (N, world), shape (N, 3)."""
+    @property
+    def tip_reaction(self) -> NDArray[np.float64] | None:
+        """Reaction wrench of the tip constraint (N, N m; world), shape (6,)."""
+    @property
     def tendon_tensions(self) -> NDArray[np.float64]: ...
     @property
     def tendon_displacements(self) -> NDArray[np.float64]: ...
@@ -421,6 +460,10 @@ class StaticsSolution:
     def tip_rotation(self) -> NDArray[np.float64]: ...
     @property
     def converged(self) -> bool: ...
+    def sensitivities(
+        self, parameters: Sequence[str], nodes: Sequence[int] | None = None
+    ) -> dict[str, Any]:
+        """Exact derivatives of the equilibrium (pose per unit of each parameter, world)."""
     @property
     def stats(self) -> dict[str, float | int | bool]: ...
     def __len__(self) -> int: ...
@@ -444,14 +487,20 @@ def solve_statics(
     s_out: Sequence[float] | NDArray[np.float64] | None = None,
     seek_stable: bool | None = None,
     on_unstable: Literal["warn", "raise", "ignore"] | None = None,
+    previous: StaticsSolution | None = None,
     displacements: Sequence[float | None] | NDArray[np.float64] | None = None,
     tendon_stiffness: float | Sequence[float] | NDArray[np.float64] | None = None,
+    obstacles: Sequence[Any] | None = None,
+    tip_constraint: Any = None,
 ) -> StaticsSolution:
     """Options not given keep the core's defaults: integrator "rk4" with 40 steps (rtol 1e-8,
     atol 1e-10 for "adaptive"), tolerance 1e-10, max_iterations 30, continuation True,
     max_load_steps 64, throw True, seek_stable True, on_unstable "warn". ``s_out`` (m) adds
     nodes at those arc lengths. ``displacements`` (m, one per tendon, None: tension control)
-    holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness."""
+    holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness.
+    ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``, ``Cylinder``) are touched by the
+    rod's surface without friction; ``tip_constraint`` (``softrod.Clamp(pose)``, ``Pin(point)``,
+    ``Slide(point, normal)``) holds the tip."""
 
 def _inverse_statics(
     rod: Rod,

@@ -36,7 +36,7 @@ from .io import objects as _objects
 from .io import robot_file as _rf
 from .io.robot_file import FieldError, RobotFile
 
-__all__ = ["Robot", "load_robot"]
+__all__ = ["Robot", "load_robot", "solve_path"]
 
 _PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)\Z")
 
@@ -129,10 +129,12 @@ class Robot:
         "_loads",
         "_loads_given",
         "_name",
+        "_obstacles",
         "_rod",
         "_solver",
         "_spec",
         "_tendons",
+        "_tip_constraint",
     )
 
     def __init__(
@@ -145,6 +147,8 @@ class Robot:
         name: str = "robot",
         description: str = "",
         source: Mapping[str, Any] | None = None,
+        obstacles: Sequence[Any] = (),
+        tip_constraint: Any = None,
     ) -> None:
         """Builds a robot from model objects.
 
@@ -159,6 +163,11 @@ class Robot:
             description: Free text.
             source: A description (the file's tables) to adopt as the robot's ``spec``
                 instead of reading one back from the objects; it must describe them.
+            obstacles: Rigid obstacles the rod's surface touches (``softrod.Plane``,
+                ``Sphere``, ``Capsule``, ``Cylinder`` or dicts with ``type``), passed to
+                :func:`softrod.solve_statics` as ``obstacles=``.
+            tip_constraint: ``softrod.Clamp(pose)``, ``Pin(point)`` or ``Slide(point,
+                normal)`` (default a free tip), passed as ``tip_constraint=``.
 
         Raises:
             TypeError: An argument of the wrong type (named).
@@ -190,6 +199,10 @@ class Robot:
             options,
             None,
         )
+        from .plot.obstacles import as_obstacles
+
+        object.__setattr__(self, "_obstacles", tuple(as_obstacles(obstacles)))
+        object.__setattr__(self, "_tip_constraint", tip_constraint)
         if source:
             with _argument("source"):
                 spec = _rf.validate_robot_dict(_plain(dict(source)))
@@ -206,6 +219,8 @@ class Robot:
             ("_loads_given", given),
             ("_solver", solver),
             ("_spec", spec),
+            ("_obstacles", ()),
+            ("_tip_constraint", None),
         ):
             object.__setattr__(self, key, value)
 
@@ -240,6 +255,8 @@ class Robot:
             parts.solver,
             spec,
         )
+        object.__setattr__(robot, "_obstacles", parts.obstacles)
+        object.__setattr__(robot, "_tip_constraint", parts.tip_constraint)
         return robot
 
     @classmethod
@@ -276,6 +293,10 @@ class Robot:
     tendons = property(lambda self: self._tendons, doc="Tendons, in order.")
     chambers = property(lambda self: self._chambers, doc="Pneumatic chambers, in order.")
     loads = property(lambda self: self._loads, doc="External loads.")
+    obstacles = property(lambda self: self._obstacles, doc="Obstacles the rod touches.")
+    tip_constraint = property(
+        lambda self: self._tip_constraint, doc="The tip constraint (None: a free tip)."
+    )
 
     @property
     def solver(self) -> dict[str, Any]:
@@ -292,6 +313,15 @@ class Robot:
         """
         if self._spec is None:
             spec = _objects.describe(*self._parts())
+            if self._obstacles:
+                tables = [_objects.obstacle_spec(o) for o in self._obstacles]
+                spec = spec.model_copy(
+                    update={
+                        "obstacles": _rf.validate_robot_dict(
+                            {"rod": _MINIMAL_ROD, "obstacles": tables}
+                        ).obstacles
+                    }
+                )
             object.__setattr__(self, "_spec", spec)
         return self._spec
 
@@ -328,7 +358,9 @@ class Robot:
             tendon_stiffness: Axial stiffness of the held tendons (N/m; one number or one per
                 tendon; default inextensible).
             **options: Options of :func:`softrod.solve_statics` overriding the robot's
-                (``steps``, ``warm_start``, ``throw``, ...).
+                (``steps``, ``warm_start``, ``throw``, ...); ``previous``: the frictional
+                solution this actuation follows (stick and slip depend on it; see
+                :func:`solve_path`).
 
         Returns:
             The solution.
@@ -342,6 +374,10 @@ class Robot:
         merged = {**self._solver, **options}
         if chambers:
             merged.setdefault("chambers", chambers)
+        if self._obstacles:
+            merged.setdefault("obstacles", list(self._obstacles))
+        if self._tip_constraint is not None:
+            merged.setdefault("tip_constraint", self._tip_constraint)
         if displacements is not None:
             merged["displacements"] = displacements
         if tendon_stiffness is not None:
@@ -509,6 +545,8 @@ class Robot:
             and all(x is y for x, y in zip(self._chambers, other._chambers, strict=True))
             and self._loads is other._loads
             and self._solver == other._solver
+            and self._obstacles == other._obstacles
+            and self._tip_constraint is other._tip_constraint
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -534,6 +572,8 @@ class Robot:
         )
 
     def __reduce__(self):
+        if self._tip_constraint is not None or (self._obstacles and self._spec is None):
+            return (_rebuild, (self._parts(), self._obstacles, self._tip_constraint))
         if self._spec is not None:
             return (_from_pickled_spec, (self._spec,))
         parts = self._parts()
@@ -545,6 +585,13 @@ class Robot:
             except ParameterError as exc:
                 raise pickle.PicklingError(f"cannot pickle this Robot: {exc}") from None
         return (Robot, parts)
+
+
+def _rebuild(parts: tuple, obstacles: tuple, tip_constraint: Any) -> Robot:
+    robot = Robot(*parts)
+    object.__setattr__(robot, "_obstacles", obstacles)
+    object.__setattr__(robot, "_tip_constraint", tip_constraint)
+    return robot
 
 
 def _from_pickled_spec(spec: RobotFile) -> Robot:
@@ -611,3 +658,64 @@ def load_robot(path: str | os.PathLike[str]) -> Robot:
     stem = os.path.splitext(os.path.basename(name))[0]
     spec = _rf.validate_robot_dict(data, source=name)
     return Robot.from_spec(spec, name=stem, source=name)
+
+
+def solve_path(
+    robot: Robot,
+    actuations: Sequence[Sequence[float]] | np.ndarray,
+    pressures: Sequence[Sequence[float]] | np.ndarray | None = None,
+    **options: Any,
+) -> list[StaticsSolution]:
+    """Solves a quasi-static actuation path: each step from the equilibrium of the one before.
+
+    With tendon friction (a tendon with ``friction > 0``) the tension along each tendon
+    depends on the history: every tendon element slides toward the base, toward the tip, or
+    sticks, according to the change of its tension from the previous step
+    (``docs/friction.md``). The first step starts from rest (every element sliding toward
+    the base). Without friction every step is the frictionless equilibrium.
+
+    Args:
+        robot: The robot.
+        actuations: Tendon tensions (N), shape (n_steps, n_tendons).
+        pressures: Chamber pressures (Pa), shape (n_steps, n_chambers); default the robot's.
+        **options: Options of :meth:`Robot.solve` (not ``previous``).
+
+    Returns:
+        One solution per step.
+
+    Raises:
+        ParameterError: Bad actuations (shape, values) or options.
+        ConvergenceError: A step did not converge (unless ``throw=False``).
+    """
+    if not isinstance(robot, Robot):
+        raise ParameterError(f"robot = {robot!r}: expected a softrod.Robot")
+    if "previous" in options:
+        raise ParameterError("previous: not an option of solve_path (each step follows the last)")
+    try:
+        table = np.asarray(actuations, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"actuations = {actuations!r}: expected tensions (N), shape (n_steps, n_tendons)"
+        ) from None
+    nt = len(robot.tendons)
+    if table.ndim != 2 or table.shape[1] != nt:
+        raise ParameterError(
+            f"actuations.shape = {table.shape}: expected (n_steps, {nt}) tensions (N)"
+        )
+    if pressures is not None:
+        try:
+            ptable = np.asarray(pressures, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"pressures = {pressures!r}: expected pressures (Pa), shape (n_steps, n_chambers)"
+            ) from None
+        if ptable.ndim != 2 or ptable.shape[0] != table.shape[0]:
+            raise ParameterError(
+                f"pressures.shape = {ptable.shape}: expected ({table.shape[0]}, n_chambers)"
+            )
+    out: list[StaticsSolution] = []
+    for k, row in enumerate(table):
+        p = None if pressures is None else ptable[k]
+        previous = out[-1] if out and out[-1].frictional else None
+        out.append(robot.solve(row, p, previous=previous, **options))
+    return out

@@ -98,9 +98,28 @@ def _pcc_solution():
     return pcc.solve(_pcc_robot(), [1.0, 0.0, 0.0, 0.0, 0.5, 0.0])
 
 
+def _planar_shapes():
+    import numpy as np
+
+    arm = _sr().PlanarCableArm(0.27, 0.015, 0.0074, 0.3, 1.3e5)
+    out = []
+    for t in (0.5, 1.0):
+        sol = arm.solve(t, 15)
+        out.append((t, np.column_stack([sol.x, sol.y])))
+    return out
+
+
 def _niti():
     sr = _sr()
     return sr.load_robot(sr.examples.path("niti_two_segment"))
+
+
+def _niti_friction():
+    robot = _niti()
+    spec = robot.spec.model_dump(mode="python", exclude_none=True)
+    for t in spec["tendons"]:
+        t["friction"] = 0.2
+    return _sr().Robot.from_dict(spec)
 
 
 def _chambered():
@@ -448,6 +467,45 @@ def _define_targets() -> None:
             dict(radius=0.001, pitch=0.2, tension=0.5, phase=0.0, end=0.25),
         )
     )
+    t("Tendon(friction)")(
+        lambda d: (sr.Tendon, dict(offset=(0.001, 0.0), tension=0.5, end=0.2, friction=0.2))
+    )
+    t("Tendon.radius_proportional(friction)")(
+        lambda d: (
+            sr.Tendon.radius_proportional,
+            dict(ratio=1 / 3, angle=0.0, tension=1.0, friction=0.2),
+        )
+    )
+    t("Tendon.helical(friction)")(
+        lambda d: (
+            sr.Tendon.helical,
+            dict(radius=0.001, pitch=0.2, tension=0.5, friction=0.2),
+        )
+    )
+    t("solve_statics(friction, previous)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=_rod(),
+                tendons=[sr.Tendon((0.001, 0.0), 0.3, friction=0.2)],
+                loads=_loads(),
+                previous=sr.solve_statics(
+                    _rod(), [sr.Tendon((0.001, 0.0), 0.5, friction=0.2)], _loads()
+                ),
+            ),
+        )
+    )
+    t("solve_path")(
+        lambda d: (
+            sr.solve_path,
+            dict(
+                robot=_niti_friction(),
+                actuations=[[1.0, 0, 0, 0, 0.5, 0], [2.0, 0, 0, 0, 0.5, 0], [1.0, 0, 0, 0, 0.5, 0]],
+                pressures=None,
+                steps=30,
+            ),
+        )
+    )
     t("Tendon.with_tension")(
         lambda d: (sr.Tendon((0.001, 0.0), 0.5).with_tension, dict(tension=1.0))
     )
@@ -504,6 +562,41 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("solve_statics(contact)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=sr.Rod(1.0, sr.CircularSection(1e-3), sr.LinearElastic(2e9, 0.3)),
+                tendons=[],
+                loads=sr.Loads(tip_force=(-1e-5, 0.0, 0.0)),
+                steps=60,
+                obstacles=[sr.Plane((-2e-3, 0.0, 0.0), (1.0, 0.0, 0.0))],
+                tip_constraint=None,
+            ),
+        )
+    )
+    t("solve_statics(tip_constraint)")(
+        lambda d: (
+            sr.solve_statics,
+            dict(
+                rod=sr.Rod(1.0, sr.CircularSection(1e-3), sr.LinearElastic(2e9, 0.3)),
+                tendons=[],
+                loads=sr.Loads(point_loads=[sr.PointLoad(0.5, (1e-6, 0.0, 0.0))]),
+                steps=60,
+                obstacles=None,
+                tip_constraint=sr.Pin((0.0, 0.0, 1.0)),
+            ),
+        )
+    )
+    t("Plane")(lambda d: (sr.Plane, dict(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0))))
+    t("Sphere")(lambda d: (sr.Sphere, dict(center=(0.0, 0.0, 0.1), radius=0.02)))
+    t("Capsule")(lambda d: (sr.Capsule, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
+    t("Cylinder")(lambda d: (sr.Cylinder, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
+    t("Clamp")(
+        lambda d: (sr.Clamp, dict(pose=np.eye(4), held=[True, True, False, True, True, False]))
+    )
+    t("Pin")(lambda d: (sr.Pin, dict(point=(0.0, 0.0, 0.1))))
+    t("Slide")(lambda d: (sr.Slide, dict(point=(0.0, 0.0, 0.1), normal=(0.0, 0.0, 1.0))))
     t("solve_statics(adaptive, warm)")(
         lambda d: (
             sr.solve_statics,
@@ -690,6 +783,8 @@ def _define_targets() -> None:
                 solver={"steps": 40},
                 name="r",
                 description="d",
+                obstacles=[],
+                tip_constraint=None,
             ),
         )
     )
@@ -736,6 +831,51 @@ def _define_targets() -> None:
         )
     )
     t("ModelComparison.table")(lambda d: (sr.compare_models(_niti(), repeats=1).table, {}))
+    # calibration
+    t("StaticsSolution.sensitivities")(
+        lambda d: (
+            _niti().solve().sensitivities,
+            dict(parameters=["stiffness_scale", "tension[0]"], nodes=[0, 10]),
+        )
+    )
+    t("PlanarCableArm.sensitivities")(
+        lambda d: (sr.PlanarCableArm.seed_arm().sensitivities, dict(tension=1.0, s=[0.0, 0.1]))
+    )
+    t("calibrate")(
+        lambda d: (
+            sr.calibrate,
+            dict(
+                robot=sr.PlanarCableArm.seed_arm(),
+                measurements=_planar_shapes(),
+                parameters=["youngs_modulus", "offset_ratio"],
+                bounds={"youngs_modulus": (1e4, 1e6)},
+                metric="arm-index",
+                actuations=None,
+                initial={"youngs_modulus": 1e5},
+                loss="linear",
+                max_evaluations=50,
+                condition_limit=1e8,
+            ),
+        )
+    )
+    t("calibrate(nearest)")(
+        lambda d: (
+            sr.calibrate,
+            dict(
+                robot=sr.PlanarCableArm.seed_arm(),
+                measurements=[p for _, p in _planar_shapes()],
+                parameters=["E"],
+                metric="nearest",
+                actuations=[0.5, 1.0],
+            ),
+        )
+    )
+    t("Calibration.interval")(
+        lambda d: (
+            sr.calibrate(sr.PlanarCableArm.seed_arm(), _planar_shapes(), ["E", "a"]).interval,
+            dict(level=0.9),
+        )
+    )
     # backbones from photographs
     t("extract_backbone")(
         lambda d: (
@@ -1533,6 +1673,8 @@ def summary(outcomes: list[Outcome]) -> dict:
 #: constructors are not fuzzed (their public methods are).
 NOT_CONSTRUCTED = {
     "Backbone",
+    "Calibration",
+    "IdentifiabilityWarning",
     "BackboneQuality",
     "BackboneDistance",
     "Compliance",

@@ -428,6 +428,7 @@ pub(crate) mod arg {
         end,
         extensible,
         frame,
+        friction,
         held,
         inextensible,
         integrator,

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 mod batch;
 mod callbacks;
 mod compliance;
+mod contact;
 mod convert;
 mod errors;
 mod inverse;

@@ -296,13 +296,14 @@ impl Tendon {
     /// `offset`: `(x, y)` (m, body frame) or a function `s -> (x, y)`; `derivative`: the
     /// function's exact derivative `s -> (dx/ds, dy/ds)` (required with a function offset).
     #[new]
-    #[pyo3(signature = (offset, tension, end=None, *, derivative=None))]
+    #[pyo3(signature = (offset, tension, end=None, *, derivative=None, friction=0.0))]
     fn new(
         py: Python<'_>,
         offset: &Bound<'_, PyAny>,
         #[pyo3(from_py_with = arg::tension)] tension: f64,
         #[pyo3(from_py_with = arg::end)] end: Option<f64>,
         derivative: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = arg::friction)] friction: f64,
     ) -> PyResult<Self> {
         let derivative = derivative.filter(|d| !d.is_none());
         let routing = match (offset.is_callable(), derivative) {
@@ -337,7 +338,7 @@ impl Tendon {
                     }
                 }
             }
-            softrod::Tendon::new(routing, end)
+            softrod::Tendon::new(routing, end)?.with_friction(friction)
         })?;
         let args = Args::new(
             py,
@@ -349,6 +350,7 @@ impl Tendon {
                     "derivative",
                     derivative.map_or_else(|| py.None(), |d| d.clone().unbind()),
                 ),
+                ("friction", obj(py, friction)?),
             ],
         )?;
         Ok(Self {
@@ -362,16 +364,18 @@ impl Tendon {
     /// Tendon at `ratio` times the local section radius, at `angle` (rad) from body x
     /// (seed 000's cable: `ratio = a`, `angle = 0`).
     #[staticmethod]
-    #[pyo3(signature = (ratio, angle, tension, end=None))]
+    #[pyo3(signature = (ratio, angle, tension, end=None, *, friction=0.0))]
     fn radius_proportional(
         py: Python<'_>,
         #[pyo3(from_py_with = arg::ratio)] ratio: f64,
         #[pyo3(from_py_with = arg::angle)] angle: f64,
         #[pyo3(from_py_with = arg::tension)] tension: f64,
         #[pyo3(from_py_with = arg::end)] end: Option<f64>,
+        #[pyo3(from_py_with = arg::friction)] friction: f64,
     ) -> PyResult<Self> {
         let inner =
             softrod::Tendon::new(softrod::Routing::RadiusProportional { ratio, angle }, end)
+                .and_then(|t| t.with_friction(friction))
                 .map_err(to_py_err)?;
         let tension = check_tension(tension)?;
         let args = Args::new(
@@ -381,6 +385,7 @@ impl Tendon {
                 ("angle", obj(py, angle)?),
                 ("tension", obj(py, tension)?),
                 ("end", obj(py, end)?),
+                ("friction", obj(py, friction)?),
             ],
         )?;
         Ok(Self {
@@ -394,7 +399,8 @@ impl Tendon {
     /// Helical tendon of `radius` (m) and signed `pitch` (m per turn; > 0 right-handed),
     /// starting at `phase` (rad) from body x.
     #[staticmethod]
-    #[pyo3(signature = (radius, pitch, tension, phase=0.0, end=None))]
+    #[pyo3(signature = (radius, pitch, tension, phase=0.0, end=None, *, friction=0.0))]
+    #[allow(clippy::too_many_arguments)]
     fn helical(
         py: Python<'_>,
         #[pyo3(from_py_with = arg::radius)] radius: f64,
@@ -402,6 +408,7 @@ impl Tendon {
         #[pyo3(from_py_with = arg::tension)] tension: f64,
         #[pyo3(from_py_with = arg::phase)] phase: f64,
         #[pyo3(from_py_with = arg::end)] end: Option<f64>,
+        #[pyo3(from_py_with = arg::friction)] friction: f64,
     ) -> PyResult<Self> {
         let inner = softrod::Tendon::new(
             softrod::Routing::Helical {
@@ -411,6 +418,7 @@ impl Tendon {
             },
             end,
         )
+        .and_then(|t| t.with_friction(friction))
         .map_err(to_py_err)?;
         let tension = check_tension(tension)?;
         let args = Args::new(
@@ -421,6 +429,7 @@ impl Tendon {
                 ("tension", obj(py, tension)?),
                 ("phase", obj(py, phase)?),
                 ("end", obj(py, end)?),
+                ("friction", obj(py, friction)?),
             ],
         )?;
         Ok(Self {
@@ -457,6 +466,12 @@ impl Tendon {
     fn end(&self) -> Option<f64> {
         self.inner.end()
     }
+    /// Friction coefficient between the tendon and its channel (dimensionless, >= 0; 0:
+    /// frictionless).
+    #[getter]
+    fn friction(&self) -> f64 {
+        self.inner.friction()
+    }
     /// Routing kind: "constant", "function", "radius_proportional" or "helical".
     #[getter]
     fn routing(&self) -> &'static str {
@@ -474,8 +489,12 @@ impl Tendon {
         self.args.0.bind(py).copy()
     }
     fn __repr__(&self) -> String {
+        let friction = match self.inner.friction() {
+            0.0 => String::new(),
+            mu => format!(", friction={mu}"),
+        };
         format!(
-            "Tendon({:?}, tension={}, end={:?})",
+            "Tendon({:?}, tension={}, end={:?}{friction})",
             self.inner.routing(),
             self.tension,
             self.inner.end()

@@ -367,6 +367,49 @@ impl PlanarCableArm {
         })
     }
 
+    /// Exact sensitivities of the backbone at arc lengths `s` (m) for one tension (N).
+    ///
+    /// Returns a dict: `parameters` (the column names), `s`, `x`, `y` (m), `angle` (rad),
+    /// `strain`, `arc` (deformed arc length, m), their derivatives `d_x`, `d_y`, `d_angle`,
+    /// `d_arc` of shape (n, 5) per unit of each parameter, `tip` (x, y, angle, arc) and `d_tip`
+    /// (4, 5). Forward mode on the closed-form profile, no finite differences.
+    #[pyo3(signature = (tension, s))]
+    fn sensitivities<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = arg::tension)] tension: f64,
+        #[pyo3(from_py_with = arg::s)] s: Floats,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let samples = s.to_vec()?;
+        let arm = self.inner;
+        let r = run(py, "PlanarCableArm.sensitivities", move || {
+            softrod::planar_sensitivities(&arm, tension, &samples)
+        })?;
+        let n = r.s.len();
+        let np = softrod::PlanarParameter::COUNT;
+        let d = PyDict::new(py);
+        let names: Vec<&str> = softrod::PlanarParameter::ALL
+            .iter()
+            .map(|p| p.name())
+            .collect();
+        d.set_item("parameters", names)?;
+        d.set_item("tension", r.tension)?;
+        d.set_item("s", r.s.into_pyarray(py))?;
+        d.set_item("x", r.x.into_pyarray(py))?;
+        d.set_item("y", r.y.into_pyarray(py))?;
+        d.set_item("angle", r.angle.into_pyarray(py))?;
+        d.set_item("strain", r.strain.into_pyarray(py))?;
+        d.set_item("arc", r.arc.into_pyarray(py))?;
+        d.set_item("d_x", to_2d(py, r.d_x, n, np)?)?;
+        d.set_item("d_y", to_2d(py, r.d_y, n, np)?)?;
+        d.set_item("d_angle", to_2d(py, r.d_angle, n, np)?)?;
+        d.set_item("d_arc", to_2d(py, r.d_arc, n, np)?)?;
+        d.set_item("tip", r.tip.to_vec().into_pyarray(py))?;
+        let dt: Vec<f64> = r.d_tip.iter().flatten().copied().collect();
+        d.set_item("d_tip", to_2d(py, dt, 4, np)?)?;
+        Ok(d)
+    }
+
     #[pyo3(signature = (tensions, n_points=201, *, s=None, method="closed-form", rtol=1e-8, atol=1e-10, max_steps=100_000))]
     #[allow(clippy::too_many_arguments)]
     fn solve_many<'py>(

@@ -17,7 +17,7 @@ use softrod::{AdaptiveOptions, Integrator, SolveOptions};
 
 use crate::callbacks::{run, run_attached};
 use crate::convert::{arg, count, floats_n};
-use crate::errors::{param_err, to_py_err, StabilityError, StabilityWarning};
+use crate::errors::{param_err, to_py_err, type_err, StabilityError, StabilityWarning};
 use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 
 /// The user's options, each `None` when not given.
@@ -261,9 +261,13 @@ pub(crate) fn actuator_names(e: softrod::Error) -> softrod::Error {
 #[pyclass(frozen, module = "softrod._core")]
 pub(crate) struct StaticsSolution {
     pub(crate) inner: softrod::StaticsSolution,
+    /// The friction state of a frictional solve (tension along the tendons, slip).
+    pub(crate) friction: Option<Arc<softrod::FrictionalSolution>>,
     cache: [PyOnceLock<Py<PyAny>>; 12],
     /// The call that produced it (for pickling: it is solved again, bit for bit).
     call: Args,
+    /// Contacts, contact forces and the tip reaction (with obstacles or a tip constraint).
+    contact: crate::contact::ContactData,
 }
 
 fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
@@ -359,6 +363,98 @@ impl StaticsSolution {
                 .unbind()
         })
     }
+    /// Tension (N) along each tendon at every sample, shape (N, n_tendons): the base tension
+    /// for a frictionless tendon, the capstan profile with friction; 0 beyond a termination.
+    #[getter]
+    fn tendon_tension<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let sol = &self.inner;
+        let model = &sol.model;
+        let nt = model.tendons().len();
+        let a = match &self.friction {
+            Some(f) => Array::from_shape_fn((f.tension.len(), nt), |(j, i)| f.tension[j][i]),
+            None => {
+                let base = sol.tensions();
+                let (ends, l) = (model.tendon_ends(), model.length());
+                Array::from_shape_fn((sol.s.len(), nt), |(j, i)| {
+                    let s = sol.s[j];
+                    if s < ends[i] || (ends[i] == l && s == l) {
+                        base[i]
+                    } else {
+                        0.0
+                    }
+                })
+            }
+        };
+        a.into_pyarray(py)
+    }
+    /// Friction force on the rod per unit length (N/m, world), `dτ/ds` times the tendon's
+    /// path tangent, shape (N, n_tendons, 3); zero without friction.
+    #[getter]
+    fn friction_force<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let n = self.inner.s.len();
+        let nt = self.inner.model.tendons().len();
+        let a = match &self.friction {
+            Some(f) => Array::from_shape_fn((n, nt, 3), |(j, i, k)| f.friction_force[j][i][k]),
+            None => Array::zeros((n, nt, 3)),
+        };
+        a.into_pyarray(py)
+    }
+    /// Slip state of every tendon element, shape (N, n_tendons): +1 sliding toward the base
+    /// (loading), -1 sliding toward the tip (unloading), 0 sticking or beyond the
+    /// termination; +1 for a frictionless solve's tendons within their length.
+    #[getter]
+    fn slip<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i8>> {
+        let sol = &self.inner;
+        let model = &sol.model;
+        let nt = model.tendons().len();
+        let a = match &self.friction {
+            Some(f) => Array::from_shape_fn((f.slip.len(), nt), |(j, i)| f.slip[j][i].sign()),
+            None => {
+                let (ends, l) = (model.tendon_ends(), model.length());
+                Array::from_shape_fn((sol.s.len(), nt), |(j, i)| {
+                    let s = sol.s[j];
+                    i8::from(s < ends[i] || (ends[i] == l && s == l))
+                })
+            }
+        };
+        a.into_pyarray(py)
+    }
+    /// Whether the solve modelled tendon friction (a tendon with `friction > 0` or a
+    /// `previous` state).
+    #[getter]
+    fn frictional(&self) -> bool {
+        self.friction.is_some()
+    }
+    /// Rod solves of the friction fixed point (0 without friction).
+    #[getter]
+    fn friction_iterations(&self) -> usize {
+        self.friction.as_ref().map_or(0, |f| f.iterations)
+    }
+    /// The active contacts, one dict each: `obstacle` (index), `s` (m), `length` (m, 0 for a
+    /// point contact; a contact interval on a plane otherwise), `point` (m, world, on the
+    /// rod's surface), `normal` (the obstacle's outward unit normal), `normal_force` (N,
+    /// >= 0), `tangential_force` (N, world; zero without friction). Empty without obstacles.
+    #[getter]
+    fn contacts(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.contact.contacts_py(py)
+    }
+    /// Contact force on the rod at every sample (N, world), shape (N, 3); zeros without
+    /// obstacles.
+    #[getter]
+    fn contact_force(&self, py: Python<'_>) -> Py<PyAny> {
+        match &self.contact.contact_force {
+            Some(f) => rows3(py, f),
+            None => rows3(py, &vec![[0.0; 3]; self.inner.s.len()]),
+        }
+    }
+    /// Reaction wrench [force; moment] of the tip constraint on the rod (N, N m; world),
+    /// shape (6,), or None without a tip constraint.
+    #[getter]
+    fn tip_reaction(&self, py: Python<'_>) -> Option<Py<PyAny>> {
+        self.contact
+            .tip_reaction
+            .map(|r| r.to_vec().into_pyarray(py).into_any().unbind())
+    }
     /// Tension carried by each tendon (N), shape (n_tendons,): the input of a
     /// tension-controlled tendon, the solved tension of a displacement-controlled one (0 when
     /// slack).
@@ -448,6 +544,86 @@ impl StaticsSolution {
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         stats_dict(py, &self.inner.stats)
+    }
+    /// Exact derivatives of this equilibrium with respect to named inputs and parameters (the
+    /// linearised boundary-value problem on the solution's own mesh; no finite differences).
+    ///
+    /// `parameters`: names `tension[i]` (per N), `pressure[j]` (per Pa), `tension_scale`,
+    /// `stiffness_scale`, `tendon_offset_scale[i]`, `chamber_area_scale[j]` (per unit factor at
+    /// 1), `base_translation[k]` (per m), `base_rotation[k]` (per rad, world axis k). `nodes`:
+    /// sample indices (default all). Returns a dict: `parameters`, `nodes`, `s` (m), `pose`
+    /// (n_nodes, 6, n_parameters: position in m and rotation in rad, world frame, per unit of
+    /// each parameter), `base_wrench` (6, n_parameters; N, N m) and `tendon_lengths`
+    /// (n_tendons, n_parameters; m).
+    #[pyo3(signature = (parameters, nodes=None))]
+    fn sensitivities<'py>(
+        &self,
+        py: Python<'py>,
+        parameters: Bound<'py, PyAny>,
+        nodes: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let parameters: Vec<String> = items(&parameters, "parameters", "a list of names")?
+            .iter()
+            .enumerate()
+            .map(|(k, item)| {
+                item.extract::<String>()
+                    .map_err(|_| type_err(&format!("parameters[{k}]"), item, "a name (str)"))
+            })
+            .collect::<PyResult<_>>()?;
+        let nodes: Option<Vec<i64>> = nodes
+            .filter(|b| !b.is_none())
+            .map(|b| {
+                items(&b, "nodes", "a list of node indices")?
+                    .iter()
+                    .enumerate()
+                    .map(|(k, item)| {
+                        if item.is_instance_of::<pyo3::types::PyBool>() {
+                            return Err(type_err(&format!("nodes[{k}]"), item, "an integer"));
+                        }
+                        item.extract::<i64>()
+                            .map_err(|_| type_err(&format!("nodes[{k}]"), item, "an integer"))
+                    })
+                    .collect::<PyResult<Vec<_>>>()
+            })
+            .transpose()?;
+        let params = parameters
+            .iter()
+            .enumerate()
+            .map(|(k, name)| parse_parameter(k, name))
+            .collect::<PyResult<Vec<_>>>()?;
+        let n = self.inner.s.len();
+        let nodes: Vec<usize> = match nodes {
+            None => (0..n).collect(),
+            Some(v) => v
+                .iter()
+                .enumerate()
+                .map(|(k, &i)| {
+                    usize::try_from(i).ok().filter(|&i| i < n).ok_or_else(|| {
+                        param_err(&format!("nodes[{k}]"), i, &format!("in [0, {n})"))
+                    })
+                })
+                .collect::<PyResult<_>>()?,
+        };
+        let sol = &self.inner;
+        let sens = py
+            .detach(|| {
+                softrod::sensitivities(sol, &params, &nodes, softrod::Linearisation::Actuated)
+            })
+            .map_err(to_py_err)?;
+        let np = params.len();
+        let nn = sens.nodes.len();
+        let pose = Array::from_shape_fn((nn, 6, np), |(i, r, c)| sens.pose[i][(r, c)]);
+        let bw = Array::from_shape_fn((6, np), |(r, c)| sens.base_wrench[(r, c)]);
+        let nt = sens.tendon_lengths.nrows();
+        let tl = Array::from_shape_fn((nt, np), |(r, c)| sens.tendon_lengths[(r, c)]);
+        let d = PyDict::new(py);
+        d.set_item("parameters", parameters)?;
+        d.set_item("nodes", sens.nodes.clone())?;
+        d.set_item("s", sens.s.clone().into_pyarray(py))?;
+        d.set_item("pose", pose.into_pyarray(py))?;
+        d.set_item("base_wrench", bw.into_pyarray(py))?;
+        d.set_item("tendon_lengths", tl.into_pyarray(py))?;
+        Ok(d)
     }
     fn __len__(&self) -> usize {
         self.inner.s.len()
@@ -550,7 +726,8 @@ fn report_unstable(
                     rtol=None, atol=None, tolerance=None, max_iterations=None,
                     continuation=None, max_load_steps=None, warm_start=None, throw=None,
                     chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None,
-                    displacements=None, tendon_stiffness=None))]
+                    previous=None, displacements=None, tendon_stiffness=None,
+                    obstacles=None, tip_constraint=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_statics<'py>(
     py: Python<'py>,
@@ -571,12 +748,44 @@ pub(crate) fn solve_statics<'py>(
     s_out: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
     on_unstable: Option<&'py str>,
+    previous: Option<Bound<'py, PyAny>>,
     displacements: Option<Bound<'py, PyAny>>,
     tendon_stiffness: Option<Bound<'py, PyAny>>,
+    obstacles: Option<Bound<'py, PyAny>>,
+    tip_constraint: Option<Bound<'py, PyAny>>,
 ) -> PyResult<StaticsSolution> {
+    let previous = previous.filter(|p| !p.is_none());
+    let prev_state: Option<Arc<softrod::FrictionalSolution>> = match &previous {
+        None => None,
+        Some(p) => {
+            let Ok(p) = p.cast::<StaticsSolution>() else {
+                return Err(type_err("previous", p, "a StaticsSolution (or None)"));
+            };
+            match &p.get().friction {
+                Some(f) => Some(Arc::clone(f)),
+                None => {
+                    return Err(param_err(
+                        "previous",
+                        "a frictionless solution",
+                        "a solution of a solve with friction (a tendon with friction > 0)",
+                    ))
+                }
+            }
+        }
+    };
+    let obstacle_list = crate::contact::obstacles(py, obstacles.as_ref())?;
+    let tip = crate::contact::tip_constraint(tip_constraint.as_ref())?;
+    let constrained = tip.is_some() || !obstacle_list.is_empty();
     let warm_start = warm_start.filter(|w| !w.is_none());
     let unstable = self::on_unstable(on_unstable)?;
     let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
+    if constrained && !s_values.is_empty() {
+        return Err(crate::errors::param_err(
+            "s_out",
+            format!("{s_values:?}"),
+            "None with obstacles or a tip constraint (the solution is at the integration mesh)",
+        ));
+    }
     let args = OptionArgs {
         integrator,
         steps,
@@ -617,10 +826,59 @@ pub(crate) fn solve_statics<'py>(
             }
         }
     }
+    if constrained && actuation.has_held() {
+        return Err(crate::errors::param_err(
+            "displacements",
+            "given",
+            "None with obstacles or a tip constraint (tension control only)",
+        ));
+    }
     let (model, act) = (&problem.model, &actuation);
-    let result = run(py, "solve_statics", || {
-        softrod::solve_statics_at(model, act, &options, &s_values).map_err(actuator_names)
-    })?;
+    let frictional = prev_state.is_some() || model.tendons().iter().any(|t| t.friction() > 0.0);
+    if frictional && !s_values.is_empty() {
+        return Err(param_err(
+            "s_out",
+            format!("{} arc lengths", s_values.len()),
+            "None with friction (the solution is reported at the friction mesh)",
+        ));
+    }
+    if frictional && constrained {
+        return Err(param_err(
+            "obstacles",
+            "obstacles or a tip constraint with tendon friction",
+            "no obstacles and no tip constraint when a tendon has friction (not modelled together)",
+        ));
+    }
+    let (result, friction, contact) = if frictional {
+        let fo = softrod::FrictionOptions {
+            statics: options,
+            ..Default::default()
+        };
+        let f = run(py, "solve_statics", || {
+            softrod::solve_frictional(model, act, &fo, prev_state.as_deref())
+                .map_err(actuator_names)
+        })?;
+        (
+            f.statics.clone(),
+            Some(Arc::new(f)),
+            crate::contact::ContactData::default(),
+        )
+    } else {
+        let (r, c) = run(py, "solve_statics", || {
+            if constrained {
+                let c =
+                    softrod::solve_constrained(model, act, &options, tip.as_ref(), &obstacle_list)
+                        .map_err(actuator_names)?;
+                let data = crate::contact::ContactData::from_solution(&c);
+                Ok((c.solution, data))
+            } else {
+                softrod::solve_statics_at(model, act, &options, &s_values)
+                    .map_err(actuator_names)
+                    .map(|r| (r, crate::contact::ContactData::default()))
+            }
+        })?;
+        (r, None, c)
+    };
     let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
     let call = Args::new(
         py,
@@ -666,14 +924,19 @@ pub(crate) fn solve_statics<'py>(
                 "on_unstable",
                 "ignore".into_pyobject(py)?.into_any().unbind(),
             ),
+            ("previous", o(previous.map(Bound::unbind))),
             ("displacements", o(displacements.map(Bound::unbind))),
             ("tendon_stiffness", o(tendon_stiffness.map(Bound::unbind))),
+            ("obstacles", o(obstacles.map(Bound::unbind))),
+            ("tip_constraint", o(tip_constraint.map(Bound::unbind))),
         ],
     )?;
     let sol = StaticsSolution {
         inner: result,
+        friction,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
+        contact,
     };
     report_unstable(py, sol, unstable)
 }
@@ -772,4 +1035,50 @@ pub(crate) fn _time_solve_statics<'py>(
         }
         Ok(times)
     })
+}
+
+/// A sensitivity parameter from its name (`tension[2]`, `stiffness_scale`, ...).
+fn parse_parameter(k: usize, name: &str) -> PyResult<softrod::Parameter> {
+    use softrod::Parameter as P;
+    let bad = || {
+        param_err(
+            &format!("parameters[{k}]"),
+            format!("{name:?}"),
+            "one of tension[i], pressure[j], tension_scale, stiffness_scale, \
+             tendon_offset_scale[i], chamber_area_scale[j], base_translation[k], base_rotation[k]",
+        )
+    };
+    match name {
+        "tension_scale" => return Ok(P::TensionScale),
+        "stiffness_scale" => return Ok(P::StiffnessScale),
+        _ => {}
+    }
+    let (head, rest) = name.split_once('[').ok_or_else(bad)?;
+    let index: usize = rest
+        .strip_suffix(']')
+        .and_then(|i| i.parse().ok())
+        .ok_or_else(bad)?;
+    Ok(match head {
+        "tension" => P::Tension(index),
+        "pressure" => P::Pressure(index),
+        "tendon_offset_scale" => P::TendonOffsetScale(index),
+        "chamber_area_scale" => P::ChamberAreaScale(index),
+        "base_translation" if index < 3 => P::BaseTranslation(index),
+        "base_rotation" if index < 3 => P::BaseRotation(index),
+        _ => return Err(bad()),
+    })
+}
+
+/// The items of a list-like argument (not a string), or a type error naming it.
+fn items<'py>(
+    b: &Bound<'py, PyAny>,
+    name: &str,
+    expected: &str,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    if b.is_instance_of::<pyo3::types::PyString>() || b.is_none() {
+        return Err(type_err(name, b, expected));
+    }
+    let it = b.try_iter().map_err(|_| type_err(name, b, expected))?;
+    it.collect::<PyResult<Vec<_>>>()
+        .map_err(|_| type_err(name, b, expected))
 }

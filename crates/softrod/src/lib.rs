@@ -9,6 +9,8 @@
 //! The crate is laid out as the architecture (see `docs/architecture.md`):
 //! * [`model`]: the validated, immutable [`RobotModel`] (rod, section, material, tendon
 //!   routings, chamber geometry, loads) and the [`Actuation`] input (tensions, pressures);
+//! * [`contact`]: end constraints and unilateral contact with obstacles through the
+//!   shooting problem, [`solve_constrained`];
 //! * [`cosserat`]: the Cosserat-rod statics, [`solve_statics`]`(&model, &actuation,
 //!   &options)`, whose [`StaticsSolution`] keeps its model, actuation and options;
 //! * [`compliance`](mod@compliance): integrated and tangent compliance, eigenscrews;
@@ -26,6 +28,7 @@
 
 pub mod batch;
 pub mod compliance;
+pub mod contact;
 pub mod cosserat;
 pub mod error;
 pub mod integrate;
@@ -47,7 +50,11 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
+pub use contact::{solve_constrained, Contact, ContactSolution, Obstacle, TipConstraint};
 pub use cosserat::displacement::reference_lengths;
+pub use cosserat::friction::{
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+};
 pub use cosserat::sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
     Parameter, Sensitivities,
@@ -62,6 +69,7 @@ pub use inverse::{
     inverse_statics, inverse_statics_path, solve_inverse, CosseratForward, Evaluation, Forward,
     InverseOptions, InverseSolution, InverseWarmStart, Target,
 };
+pub use model::actuation::TensionProfile;
 pub use model::chamber::{Chamber, ChamberArea};
 pub use model::loads::{Frame, Loads, PointLoad};
 pub use model::material::fit::{
@@ -79,7 +87,7 @@ pub use model::tendon::{Routing, Tendon};
 pub use model::{Actuation, RobotModel, TendonInput};
 pub use nalgebra;
 pub use planar::{
-    solve_planar, solve_planar_many, uniform_samples, PlanarBatch, PlanarCableArm, PlanarMethod,
-    PlanarSolution,
+    planar_sensitivities, solve_planar, solve_planar_many, uniform_samples, PlanarBatch,
+    PlanarCableArm, PlanarMethod, PlanarParameter, PlanarSensitivities, PlanarSolution,
 };
 pub use solve::{NewtonOptions, SolverStats};

@@ -130,6 +130,60 @@ fn stress_free_arc_matches_castigliano() {
 }
 
 #[test]
+fn compliance_is_under_tolerance_control_on_arcs_up_to_two_pi() {
+    use softrod::compliance::compliance_at;
+    use softrod::AdaptiveOptions;
+    let (ei, gj, ea, gas) = section_constants(
+        Rod::new(
+            LENGTH,
+            Section::circular(RADIUS).unwrap(),
+            LinearElastic::new(E, NU).unwrap(),
+        )
+        .unwrap()
+        .shear_coefficient(),
+    );
+    let stiff = [gas, gas, ea, ei, ei, gj];
+    for angle in [PI / 2.0, PI, 1.5 * PI, 2.0 * PI] {
+        let rod = arc_rod(angle);
+        let kappa = angle / LENGTH;
+        // Defaults (RK4 kinematics, compliance marched at COMPLIANCE_RTOL): <= 1e-6.
+        let sol = common::solve(&rod, &[], &Loads::default(), &SolveOptions::default()).unwrap();
+        let exact = castigliano_arc(kappa, LENGTH, stiff);
+        let what = format!("defaults, arc {angle}");
+        let marched = compliance_at(&sol, &sol.s).unwrap();
+        assert_blocks_close(&marched.tip_world(), &exact, 1e-6, &what);
+        // Output at chosen arc lengths (not mesh nodes): the sub-arc [0, s].
+        let s_out = [0.3 * LENGTH, 0.77 * LENGTH];
+        let c = compliance_at(&sol, &s_out).unwrap();
+        assert_eq!(c.s, s_out);
+        for (i, &s) in s_out.iter().enumerate() {
+            let exact = castigliano_arc(kappa, s, stiff);
+            assert_blocks_close(
+                &c.world[i],
+                &exact,
+                1e-6,
+                &format!("s_out {s}, arc {angle}"),
+            );
+        }
+        // Adaptive: within 10 rtol.
+        for rtol in [1e-6, 1e-8, 1e-10] {
+            let opts = SolveOptions {
+                integrator: Integrator::Adaptive(AdaptiveOptions {
+                    rtol,
+                    atol: rtol * 1e-2,
+                    ..Default::default()
+                }),
+                ..Default::default()
+            };
+            let sol = common::solve(&rod, &[], &Loads::default(), &opts).unwrap();
+            let what = format!("adaptive rtol {rtol}, arc {angle}");
+            let got = compliance(&sol).unwrap().tip_world();
+            assert_blocks_close(&got, &exact, 10.0 * rtol, &what);
+        }
+    }
+}
+
+#[test]
 fn frames_are_related_by_the_adjoint_and_k_inverts_c() {
     let rod = common::niti_rod();
     let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);

@@ -1,7 +1,9 @@
-"""Analyses built on the solvers: backbone comparison at equal arm index, models side by side,
+"""Analyses built on the solvers: backbone comparison at equal arm index, calibration of model
+parameters to measured shapes, models side by side,
 workspace maps, tensile curves and material fits, the compliance study of soft arms, and design
 sweeps with their summaries."""
 
+from .calibration import Calibration, IdentifiabilityWarning, calibrate
 from .compare import BackboneDistance, backbone_distance
 from .design import Pareto, design_summary
 from .materials import TensileCurve, read_tensile_csv
@@ -12,6 +14,8 @@ from .workspace import WorkspaceMap, tension_grid, workspace_map
 
 __all__ = [
     "BackboneDistance",
+    "Calibration",
+    "IdentifiabilityWarning",
     "ModelComparison",
     "ModelResult",
     "Pareto",
@@ -19,6 +23,7 @@ __all__ = [
     "TensileCurve",
     "WorkspaceMap",
     "backbone_distance",
+    "calibrate",
     "compare_models",
     "design_summary",
     "read_tensile_csv",

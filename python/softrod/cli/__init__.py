@@ -9,6 +9,7 @@ Subcommands (one module each family; :func:`build_parser` lists them all):
     compare, study       models side by side and the compliance study (:mod:`softrod.cli.models`);
     view                 the live 3-D view in the browser (:mod:`softrod.cli.view`);
     backbone             an arm's backbone from a photograph (:mod:`softrod.cli.backbone`);
+    calibrate            parameters fitted to measured backbones (:mod:`softrod.cli.calibrate`);
     sweep                design studies over design and actuation grids (:mod:`softrod.cli.sweep`).
 
 Bad input exits with status 2 and a one-line message naming the parameter; non-convergence
@@ -23,11 +24,11 @@ import sys
 from collections.abc import Sequence
 
 from .._core import ConvergenceError, ParameterError, __version__
-from . import backbone, command, materials, models, planar, robot, sweep, view
+from . import backbone, calibrate, command, materials, models, planar, robot, sweep, view
 from ._common import NoResultError, Parser, UsageError, check_files, resolve_robot
 
 #: The command modules, in the order their subcommands are listed in ``softrod --help``.
-COMMAND_MODULES = (planar, robot, command, materials, models, view, backbone, sweep)
+COMMAND_MODULES = (planar, robot, command, materials, models, view, backbone, calibrate, sweep)
 
 #: Exit statuses: bad input (a parameter, a file's content, the command line), no convergence
 #: (or no result at all), an unreadable or unwritable file, an unexpected error.

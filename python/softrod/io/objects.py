@@ -54,6 +54,8 @@ class Parts:
     chambers: tuple[Chamber, ...]
     loads: Loads
     solver: dict[str, Any]
+    obstacles: tuple = ()
+    tip_constraint: Any = None
 
 
 _CORE_MESSAGE = re.compile(r"invalid parameter `([^`]*)` = (.*?): (.*)", re.DOTALL)
@@ -137,10 +139,14 @@ def build_material(m: Any, errors: list[FieldError]) -> Any:
 def _tendon(t: Any) -> Tendon:
     if isinstance(t, rf.ConstantTendonSpec):
         offset = t.offset if t.offset is not None else _polar(t.distance, t.angle_deg)
-        return Tendon(offset, t.tension, t.end)
+        return Tendon(offset, t.tension, t.end, friction=t.friction)
     if isinstance(t, rf.RadiusProportionalTendonSpec):
-        return Tendon.radius_proportional(t.ratio, math.radians(t.angle_deg), t.tension, t.end)
-    return Tendon.helical(t.radius, t.pitch, t.tension, math.radians(t.phase_deg), t.end)
+        return Tendon.radius_proportional(
+            t.ratio, math.radians(t.angle_deg), t.tension, t.end, friction=t.friction
+        )
+    return Tendon.helical(
+        t.radius, t.pitch, t.tension, math.radians(t.phase_deg), t.end, friction=t.friction
+    )
 
 
 def _chamber(c: rf.ChamberSpec) -> Chamber:
@@ -219,7 +225,71 @@ def build(spec: rf.RobotFile, source: str | None = None) -> Parts:
     if errors:
         rf.raise_errors(errors, source)
     solver = spec.solver.options() if spec.solver is not None else {}
-    return Parts(rod, tuple(tendons), tuple(chambers), loads, solver)
+    return Parts(
+        rod,
+        tuple(tendons),
+        tuple(chambers),
+        loads,
+        solver,
+        tuple(obstacle_of(o) for o in spec.obstacles),
+        tip_constraint_of(spec.tip_constraint),
+    )
+
+
+def obstacle_of(o: Any) -> Any:
+    """The obstacle dataclass of an ``[[obstacles]]`` table."""
+    from ..contact import Capsule, Cylinder, Plane, Sphere
+
+    if isinstance(o, rf.PlaneSpec):
+        return Plane(tuple(o.point), tuple(o.normal))
+    if isinstance(o, rf.SphereSpec):
+        return Sphere(tuple(o.center), o.radius)
+    kind = Capsule if isinstance(o, rf.CapsuleSpec) else Cylinder
+    return kind(tuple(o.a), tuple(o.b), o.radius)
+
+
+def tip_constraint_of(t: Any) -> Any:
+    """The tip constraint of a ``[tip_constraint]`` table (None without one)."""
+    import numpy as np
+
+    from ..contact import Clamp, Pin, Slide
+
+    if t is None:
+        return None
+    missing = [
+        k
+        for k in {"clamp": ["position"], "pin": ["point"], "slide": ["point", "normal"]}[t.type]
+        if getattr(t, k) is None
+    ]
+    if missing:
+        rf.raise_errors(
+            [
+                FieldError(f"tip_constraint.{k}", f"needed by `{t.type}`", kind="missing")
+                for k in missing
+            ]
+        )
+    if t.type == "clamp":
+        pose = np.eye(4)
+        pose[:3, 3] = t.position
+        if t.rotation is not None:
+            pose[:3, :3] = t.rotation
+        return Clamp(pose, tuple(t.held) if t.held is not None else None)
+    if t.type == "pin":
+        return Pin(tuple(t.point))
+    return Slide(tuple(t.point), tuple(t.normal))
+
+
+def obstacle_spec(o: Any) -> dict[str, Any]:
+    """The ``[[obstacles]]`` table of an obstacle dataclass."""
+    from ..plot.obstacles import as_obstacle
+
+    o = as_obstacle(o)
+    kind = type(o).__name__.lower()
+    fields = {k: getattr(o, k) for k in o.__dataclass_fields__}
+    out: dict[str, Any] = {"type": kind}
+    for k, v in fields.items():
+        out[k] = float(v) if k == "radius" else [float(x) for x in v]
+    return out
 
 
 # ----------------------------------------------------------------------------- objects -> spec
@@ -321,6 +391,8 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
     out: dict[str, Any] = {"tension": float(t.tension)}
     if t.end is not None:
         out["end"] = float(t.end)
+    if t.friction:
+        out["friction"] = float(t.friction)
     routing, p = r.get(t, "routing"), r.get(t, "parameters")
     if routing is None or p is None:
         return None

@@ -275,6 +275,7 @@ def _union(key: str, default: str, members: dict[str, type], by_key=None) -> Any
 class _TendonBase(_Table):
     tension: _num("tension (N)", ge=0) = 0.0
     end: _num("arc length where the tendon ends (m); default the tip", gt=0) | None = None
+    friction: _num("friction coefficient between tendon and channel (capstan law)", ge=0) = 0.0
 
 
 class ConstantTendonSpec(_TendonBase):
@@ -440,6 +441,69 @@ class SolverSpec(_Table):
         return {k: v for k, v in self.__dict__.items() if v is not None}
 
 
+class PlaneSpec(_Table):
+    """A plane obstacle through `point` with outward `normal` (world)."""
+
+    type: Literal["plane"]
+    point: _vec(3, "a point of the plane (m, world)")
+    normal: _vec(3, "outward normal (world; any nonzero length)")
+
+
+class SphereSpec(_Table):
+    """A sphere obstacle."""
+
+    type: Literal["sphere"]
+    center: _vec(3, "centre (m, world)")
+    radius: _num("radius (m)", gt=0)
+
+
+class CapsuleSpec(_Table):
+    """The points within `radius` of the segment `a`-`b` (world)."""
+
+    type: Literal["capsule"]
+    a: _vec(3, "first end of the axis (m, world)")
+    b: _vec(3, "second end of the axis (m, world)")
+    radius: _num("radius (m)", gt=0)
+
+
+class CylinderSpec(_Table):
+    """A closed cylinder with cap centres `a` and `b` (world)."""
+
+    type: Literal["cylinder"]
+    a: _vec(3, "centre of the first cap (m, world)")
+    b: _vec(3, "centre of the second cap (m, world)")
+    radius: _num("radius (m)", gt=0)
+
+
+ObstacleSpec = Annotated[
+    PlaneSpec | SphereSpec | CapsuleSpec | CylinderSpec, Field(discriminator="type")
+]
+
+
+class TipConstraintSpec(_Table):
+    """The tip held: `clamp` at `position` and `rotation` (optionally only the `held`
+    directions), `pin` at `point`, or `slide` on the plane through `point` with `normal`."""
+
+    type: Literal["clamp", "pin", "slide"]
+    position: _vec(3, "clamped tip position (m, world)") | None = None
+    rotation: (
+        Annotated[
+            list[_vec(3, "row")],
+            Field(min_length=3, max_length=3, description="3x3 rotation rows (body -> world)"),
+        ]
+        | None
+    ) = None
+    held: (
+        Annotated[
+            list[Bool],
+            Field(min_length=6, max_length=6, description="held [x, y, z, rx, ry, rz]"),
+        ]
+        | None
+    ) = None
+    point: _vec(3, "pin or plane point (m, world)") | None = None
+    normal: _vec(3, "plane normal of `slide` (world)") | None = None
+
+
 class RobotFile(_Table):
     """A whole robot description file."""
 
@@ -450,6 +514,8 @@ class RobotFile(_Table):
     chambers: list[ChamberSpec] = []
     loads: LoadsSpec | None = None
     solver: SolverSpec | None = None
+    obstacles: list[ObstacleSpec] = []
+    tip_constraint: TipConstraintSpec | None = None
 
 
 # ----------------------------------------------------------------------------- errors

@@ -17,12 +17,53 @@ from .._core import ParameterError
 __all__ = ["Capsule", "Cylinder", "Plane", "Sphere", "as_obstacle", "obstacle_surface"]
 
 
+def _field_error(name: str, value: object, why: str) -> ParameterError:
+    err = ParameterError(f"invalid parameter `{name}` = {value!r}: {why}")
+    err.parameter = name
+    return err
+
+
+def _vector(name: str, value: object) -> tuple[float, float, float]:
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise _field_error(name, value, "must be 3 finite numbers (m, world)") from None
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise _field_error(name, value, "must be 3 finite numbers (m, world)")
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def _radius(value: object) -> float:
+    try:
+        r = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise _field_error("radius", value, "must be a number > 0 (m)") from None
+    if not (np.isfinite(r) and r > 0):
+        raise _field_error("radius", value, "must be finite and > 0 (m)")
+    return r
+
+
+def _check(obj, vectors: tuple[str, ...], radius: bool) -> None:
+    for name in vectors:
+        object.__setattr__(obj, name, _vector(name, getattr(obj, name)))
+    if radius:
+        object.__setattr__(obj, "radius", _radius(obj.radius))
+
+
 @dataclass(frozen=True)
 class Plane:
     """A plane through ``point`` (m, world, shape (3,)) with unit ``normal`` (shape (3,))."""
 
     point: tuple[float, float, float]
     normal: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        _check(self, ("point", "normal"), False)
+        n = np.asarray(self.normal)
+        length = float(np.linalg.norm(n))
+        if not (np.isfinite(length) and length > 0):
+            raise _field_error("normal", self.normal, "must be a nonzero vector")
+        object.__setattr__(self, "normal", tuple(float(x) for x in n / length))
 
 
 @dataclass(frozen=True)
@@ -31,6 +72,9 @@ class Sphere:
 
     center: tuple[float, float, float]
     radius: float
+
+    def __post_init__(self) -> None:
+        _check(self, ("center",), True)
 
 
 @dataclass(frozen=True)
@@ -41,6 +85,11 @@ class Capsule:
     b: tuple[float, float, float]
     radius: float
 
+    def __post_init__(self) -> None:
+        _check(self, ("a", "b"), True)
+        if self.a == self.b:
+            raise _field_error("b", self.b, "must differ from `a` (the axis)")
+
 
 @dataclass(frozen=True)
 class Cylinder:
@@ -49,6 +98,11 @@ class Cylinder:
     a: tuple[float, float, float]
     b: tuple[float, float, float]
     radius: float
+
+    def __post_init__(self) -> None:
+        _check(self, ("a", "b"), True)
+        if self.a == self.b:
+            raise _field_error("b", self.b, "must differ from `a` (the axis)")
 
 
 _KINDS = {"plane": Plane, "sphere": Sphere, "capsule": Capsule, "cylinder": Cylinder}
@@ -75,7 +129,7 @@ def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder:
         fields = {k: v for k, v in obj.items() if k != "type"}
         try:
             out = _KINDS[kind](**fields)
-        except TypeError as exc:
+        except (TypeError, ParameterError) as exc:
             raise _bad(index, obj, str(exc)) from None
     elif hasattr(obj, "normal") and hasattr(obj, "point"):
         out = Plane(obj.point, obj.normal)
@@ -95,7 +149,13 @@ def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder:
 
 def as_obstacles(obstacles: Sequence | None) -> list:
     """Every entry of ``obstacles`` through :func:`as_obstacle`."""
-    return [as_obstacle(o, i) for i, o in enumerate(obstacles or ())]
+    if obstacles is None:
+        return []
+    if isinstance(obstacles, (str, bytes, Mapping)) or not isinstance(obstacles, Sequence):
+        raise _field_error(
+            "obstacles", obstacles, "must be a list of Plane, Sphere, Capsule or Cylinder"
+        )
+    return [as_obstacle(o, i) for i, o in enumerate(obstacles)]
 
 
 def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

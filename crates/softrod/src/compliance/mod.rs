@@ -1,10 +1,12 @@
 //! Configuration-dependent compliance (seed 001): the integrated compliance along a solved
 //! configuration, the exact tangent compliance of the equilibrium, eigenscrews.
 
+mod controlled;
 pub mod eigenscrew;
 mod integrated;
 mod tangent;
 
+pub use controlled::{COMPLIANCE_ATOL, COMPLIANCE_RTOL};
 pub use integrated::*;
 pub use tangent::{
     tangent_compliance, tangent_compliance_held, TangentCompliance, TendonControl, COLUMNS_PER_PASS,

@@ -186,6 +186,7 @@ pub(crate) fn solve_held(
             pressures: actuation.pressures.clone(),
             reference_lengths: None,
             tension_guess: None,
+            profile: None,
         };
         let opts = SolveOptions {
             warm_start: Some(WarmStart::wrench(sol.base_wrench)),
@@ -265,6 +266,7 @@ fn solve_held_on_mesh(
                 tensions: &tensions,
                 pressures: &pressures,
                 load_factor: 0.0,
+                profile: None,
             };
             let mut p = Shooting::new(eq, options.integrator, plan.clone());
             let mut r = [0.0; 6];
@@ -286,6 +288,7 @@ fn solve_held_on_mesh(
         tensions: &inputs,
         pressures: &pressures,
         load_factor: 1.0,
+        profile: None,
     };
     let mut p = Shooting::new(eq, options.integrator, plan);
     // A tension or slack counts as negative beyond the shooting tolerance.

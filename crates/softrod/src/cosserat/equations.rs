@@ -69,6 +69,7 @@ use crate::integrate::march::Piecewise;
 use crate::integrate::System;
 use crate::math::linalg::Lu6;
 use crate::math::so3::{hat, reorthonormalise};
+use crate::model::actuation::TensionProfile;
 use crate::model::loads::Frame;
 use crate::model::section::SectionProperties;
 use crate::model::RobotModel;
@@ -218,6 +219,9 @@ pub(crate) struct Equations<'a> {
     pub tensions: &'a [f64],
     pub pressures: &'a [f64],
     pub load_factor: f64,
+    /// The tension along the tendons when it varies (friction, `cosserat::friction`);
+    /// `None`: `tensions` over each tendon's whole length.
+    pub profile: Option<&'a TensionProfile>,
 }
 
 /// What a sensitivity column is a derivative with respect to: its forcing along the rod
@@ -567,10 +571,15 @@ impl Evaluator<'_, '_> {
         self.ws.offsets.clear();
         for &i in &self.ws.active {
             let (r, rp) = tendons[i].routing().offset(s, props);
+            let tau = self
+                .eq
+                .profile
+                .and_then(|p| p.at(i, s))
+                .unwrap_or(self.eq.tensions[i]);
             self.ws.offsets.push((
                 Vector3::new(r[0], r[1], 0.0),
                 Vector3::new(rp[0], rp[1], 0.0),
-                self.eq.tensions[i],
+                tau,
             ));
         }
     }
@@ -850,9 +859,10 @@ impl Evaluator<'_, '_> {
     }
 
     /// The right-hand side of the state and of the active columns (`N >= STATE + COLUMN
-    /// ncol`), and the stage integrands (tendon speeds, path-length sensitivities).
+    /// ncol`), and the stage integrands (tendon speeds, path-length sensitivities); returns
+    /// the local solution (strains, actuator sums) at `s`.
     #[inline]
-    pub fn rhs_into<const N: usize>(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) {
+    pub fn rhs_into<const N: usize>(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) -> Local {
         self.ws.evaluations += 1;
         let eq = self.eq;
         let props = eq.model.rod().section_at(s);
@@ -875,7 +885,7 @@ impl Evaluator<'_, '_> {
         let nt = self.ws.tendon_speed.len();
         self.ws.integrand[..nt].copy_from_slice(&self.ws.tendon_speed);
         if ncol == 0 {
-            return;
+            return loc;
         }
         if !loc.v.x.is_finite() {
             self.ws.tangent.diag = [f64::NAN; 6];
@@ -946,13 +956,14 @@ impl Evaluator<'_, '_> {
         for k in STATE + COLUMN * ncol..N {
             out[k] = 0.0;
         }
+        loc
     }
 }
 
 impl<const N: usize> System<N> for Evaluator<'_, '_> {
     #[inline]
     fn rhs(&mut self, t: f64, y: &[f64; N], dy: &mut [f64; N]) {
-        self.rhs_into(t, y, dy);
+        let _ = self.rhs_into(t, y, dy);
     }
     #[inline]
     fn stage_evaluated(&mut self, stage: usize) {

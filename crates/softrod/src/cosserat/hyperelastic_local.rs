@@ -102,7 +102,8 @@ impl Evaluator<'_, '_> {
             }
         };
         let this = &*self;
-        let (x, h, converged, hit_zero) = damped_newton(|x| eval(this, x), x, g, h);
+        let rho = (props.ix.max(props.iy) / props.area).sqrt();
+        let (x, h, converged, hit_zero) = damped_newton(|x| eval(this, x), x, g, h, rho);
         let e: [f64; 6] = (x - xs).into();
         let (Some(law), Some(state)) = (
             material.uniaxial_law(),
@@ -178,16 +179,31 @@ fn check_fibres(
     ))
 }
 
+/// The size of a strain vector `x = (v, u)` in fibre strain: `max(|v_i|, ρ |u_i|)` with `ρ`
+/// (m) the section's radius of gyration. Curvatures (1/m) carry the round-off of the fibre sums
+/// at the scale `1/ρ`; measured in 1/m against `1 + |x|` a thin rod's curvature cannot meet the
+/// tolerance near zero (the iteration cycles at the round-off floor).
+fn fibre_norm(x: &Vector6<f64>, rho: f64) -> f64 {
+    (0..6).fold(0.0, |m: f64, i| {
+        m.max(x[i].abs() * if i < 3 { 1.0 } else { rho })
+    })
+}
+
 /// Newton's method on the local residual `eval(x) = (g, ∂g/∂x)` from `x` (with `g`, `h` at
-/// `x`), halving a step while a fibre stretch would not be positive. Returns the last iterate,
-/// its Jacobian, whether it converged and whether a step was shortened.
+/// `x`), halving a step while a fibre stretch would not be positive; converged when the step,
+/// in fibre strain ([`fibre_norm`], `rho` the radius of gyration), is below
+/// [`LOCAL_TOLERANCE`] relative to `1 +` the strain, or when at most 1e3 times that it stops
+/// shrinking (the round-off floor). Returns the last iterate, its Jacobian, whether it converged
+/// and whether a step was shortened.
 fn damped_newton(
     eval: impl Fn(&Vector6<f64>) -> Option<(Vector6<f64>, Matrix6<f64>)>,
     mut x: Vector6<f64>,
     mut g: Vector6<f64>,
     mut h: Matrix6<f64>,
+    rho: f64,
 ) -> (Vector6<f64>, Matrix6<f64>, bool, bool) {
     let mut hit_zero = false;
+    let mut last_step = f64::INFINITY;
     for _ in 0..LOCAL_MAX_ITERATIONS {
         let Some(lu) = Lu6::new(&h) else {
             break;
@@ -212,9 +228,12 @@ fn damped_newton(
         };
         x = xt;
         (g, h) = (gt, ht);
-        if dx.amax() * t <= LOCAL_TOLERANCE * (1.0 + x.amax()) {
+        let step = fibre_norm(&dx, rho) * t;
+        let tol = LOCAL_TOLERANCE * (1.0 + fibre_norm(&x, rho));
+        if step <= tol || (step <= 1e3 * tol && step >= 0.5 * last_step) {
             return (x, h, true, hit_zero);
         }
+        last_step = step;
     }
     (x, h, false, hit_zero)
 }

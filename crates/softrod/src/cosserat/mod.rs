@@ -6,6 +6,7 @@
 
 pub mod displacement;
 pub(crate) mod equations;
+pub mod friction;
 mod hyperelastic_local;
 pub mod sensitivity;
 pub(crate) mod shooting;
@@ -14,6 +15,9 @@ pub mod statics;
 
 pub use displacement::reference_lengths;
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+pub use friction::{
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+};
 pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
     Parameter, Sensitivities,

@@ -543,6 +543,7 @@ pub(crate) fn linearise(
         tensions,
         pressures: &pressures,
         load_factor: lambda,
+        profile: solution.actuation.profile.as_deref(),
     };
     let loads_seeded = seeds.iter().any(|s| matches!(s, Seed::Load(_)));
     let free = !loads_seeded && force_free_at(model, &x, lambda);

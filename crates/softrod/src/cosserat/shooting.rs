@@ -127,6 +127,7 @@ impl<'a> Shooting<'a> {
             tensions: &self.tensions,
             pressures: self.eq.pressures,
             load_factor: self.eq.load_factor,
+            profile: self.eq.profile,
         }
     }
 
@@ -160,6 +161,7 @@ impl<'a> Shooting<'a> {
             tensions: &self.tensions,
             pressures: self.eq.pressures,
             load_factor: lambda,
+            profile: self.eq.profile,
         };
         let mut ev = Evaluator {
             eq,
@@ -260,6 +262,7 @@ impl<'a> Shooting<'a> {
             tensions: &self.tensions,
             pressures: self.eq.pressures,
             load_factor: lambda,
+            profile: self.eq.profile,
         };
         let req = Request {
             seeds: &seeds,
@@ -556,6 +559,7 @@ mod tests {
             tensions: &tensions,
             pressures: &pressures,
             load_factor: 1.0,
+            profile: None,
         };
         let plan = crate::integrate::march::rk4_plan(model.breaks(), 40 * 6);
         let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 240 }, plan);
@@ -613,6 +617,7 @@ mod taper_tests {
             tensions: &tensions,
             pressures: &[],
             load_factor: 1.0,
+            profile: None,
         };
         let plan = crate::integrate::march::rk4_plan(model.breaks(), 40);
         let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 40 }, plan);

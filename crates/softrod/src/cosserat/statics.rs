@@ -274,6 +274,7 @@ fn margin_of(sol: &StaticsSolution) -> Option<f64> {
         tensions: &tensions,
         pressures: &pressures,
         load_factor: 1.0,
+        profile: sol.actuation.profile.as_deref(),
     };
     let plan = match sol.options.integrator {
         Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
@@ -299,7 +300,7 @@ pub(crate) fn interior(s_out: &[f64], length: f64) -> Vec<f64> {
 /// integrator the residual carries the integration error and exact Jacobians are evaluated.
 /// A loaded solve ends on an exact Jacobian at the solution (the stability test needs its
 /// columns).
-fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
+pub(crate) fn settings(broyden: bool, jacobian: Option<&[f64]>, exact: bool) -> NewtonSettings<'_> {
     NewtonSettings {
         line_search: LineSearch {
             factor: 0.5,
@@ -490,7 +491,7 @@ fn attempt(p: &mut Shooting<'_>, options: &SolveOptions, x0: &[f64; 6], exact: b
 }
 
 /// Scaled unknowns of a base wrench (N, N m).
-fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
+pub(crate) fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();
     [
@@ -529,6 +530,9 @@ fn stability_at(
 /// force scale `E I(0) / L²` (and `E I(0) / L` for its moment) along the unstable mode.
 pub const IMPERFECTION: f64 = 1e-1;
 
+/// A stable equilibrium found: its unknowns, stability and shooting Jacobian (column-major).
+type Found = (Vec<f64>, Stability, Vec<f64>);
+
 /// A stable equilibrium instead of the unstable one at `x` (see [`SolveOptions::seek_stable`]):
 /// first continuation from the unloaded rod in load steps of at most 1/8, refusing unstable
 /// states (the stable branch connected to the unloaded rod); then, for a symmetric problem whose
@@ -537,9 +541,6 @@ pub const IMPERFECTION: f64 = 1e-1;
 /// solved by continuation, and the perfect rod solved again from there by Newton. Returns
 /// the unknowns and the stability of the first converged, stable equilibrium found, and the
 /// Newton iterations spent.
-/// A stable equilibrium found: its scaled unknowns, stability and Jacobian.
-type Found = (Vec<f64>, Stability, Vec<f64>);
-
 fn seek_stable(
     p: &mut Shooting<'_>,
     model: &Arc<RobotModel>,
@@ -720,6 +721,47 @@ pub fn solve_statics_at(
     solve_with(model, actuation, options, s_out, false)
 }
 
+/// The stability of the converged `reached`, replaced by a stable equilibrium when one is
+/// sought and found ([`seek_stable`]).
+fn stable_outcome(
+    p: &mut Shooting<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    reached: &mut Reached,
+) -> Option<Stability> {
+    let o = &reached.outcome;
+    let stability = stability_at(p, &o.x, o.jacobian.as_deref(), o.exact).map(|(s, _)| s);
+    if let Some(s) = stability.filter(|s| !s.stable && options.seek_stable) {
+        let x = reached.outcome.x.clone();
+        let (found, its) = seek_stable(p, model, actuation, options, (&x, &s));
+        reached.iterations += its;
+        if let Some((x, s, j)) = found {
+            reached.outcome.x = x;
+            reached.outcome.jacobian = Some(j);
+            reached.outcome.at_x = false;
+            return Some(s);
+        }
+    }
+    stability
+}
+
+/// The options, output arc lengths, actuation and warm start of a solve of `model`.
+fn check_inputs(
+    model: &RobotModel,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    s_out: &[f64],
+) -> Result<()> {
+    options.validate()?;
+    check_s_out(s_out, model.length())?;
+    model.check_actuation(actuation)?;
+    if let Some(w) = &options.warm_start {
+        model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
+    }
+    Ok(())
+}
+
 /// [`solve_statics_at`], the continuation refusing unstable states if `require_stable`.
 #[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 fn solve_with(
@@ -729,13 +771,8 @@ fn solve_with(
     s_out: &[f64],
     require_stable: bool,
 ) -> Result<StaticsSolution> {
-    options.validate()?;
-    check_s_out(s_out, model.length())?;
+    check_inputs(model, actuation, options, s_out)?;
     let (nt, nc) = (model.tendons().len(), model.chambers().len());
-    model.check_actuation(actuation)?;
-    if let Some(w) = &options.warm_start {
-        model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
-    }
     if actuation.has_held() {
         return super::displacement::solve_held(model, actuation, options, s_out);
     }
@@ -750,6 +787,7 @@ fn solve_with(
         tensions: &tensions,
         pressures: &pressures,
         load_factor: 1.0,
+        profile: actuation.profile.as_deref(),
     };
     let mut p = Shooting::new(eq, options.integrator, plan);
     p.stops = interior(s_out, model.length());
@@ -762,22 +800,11 @@ fn solve_with(
     // Without external loads the equilibrium is unique (x = 0) and stable (docs/stability.md).
     let loaded = !model.loads().is_unloaded();
     let mut reached = attempt(&mut p, options, &x0, loaded);
-    let mut stability = None;
-    if reached.outcome.converged && loaded {
-        let o = &reached.outcome;
-        stability = stability_at(&mut p, &o.x, o.jacobian.as_deref(), o.exact).map(|(s, _)| s);
-        if let Some(s) = stability.filter(|s| !s.stable && options.seek_stable) {
-            let x = reached.outcome.x.clone();
-            let (found, its) = seek_stable(&mut p, model, actuation, options, (&x, &s));
-            reached.iterations += its;
-            if let Some((x, s, j)) = found {
-                reached.outcome.x = x;
-                reached.outcome.jacobian = Some(j);
-                reached.outcome.at_x = false;
-                stability = Some(s);
-            }
-        }
-    }
+    let stability = if reached.outcome.converged && loaded {
+        stable_outcome(&mut p, model, actuation, options, &mut reached)
+    } else {
+        None
+    };
     let result = &mut reached.outcome;
     // The recorded pass must be the one at the returned unknowns (and their load factor).
     if !result.at_x {
@@ -789,6 +816,10 @@ fn solve_with(
         }
         result.converged =
             result.converged && result.residual <= p.tolerance(&result.x, opts.tolerance);
+    }
+    if result.converged {
+        // Material failures of rejected trial iterates are not the returned state's.
+        p.ws.material_error = None;
     }
     let finite = p.nodes.iter().all(|n| n.y.iter().all(|v| v.is_finite()));
     let mut stats = SolverStats {
@@ -845,7 +876,7 @@ fn solve_with(
 }
 
 /// The base wrench (N, N m) of scaled unknowns.
-fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
+pub(crate) fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();
     [
@@ -950,6 +981,9 @@ pub(crate) fn assemble(
         sol.m_body.push(arr(&mb));
         sol.v.push(arr(&loc.v));
         sol.u.push(arr(&loc.u));
+    }
+    if let Some(e) = ws.material_error.take() {
+        p.ws.material_error.get_or_insert(e);
     }
     sol
 }

@@ -817,6 +817,7 @@ impl Forward for CosseratForward {
                 tensions,
                 pressures,
                 load_factor: 1.0,
+                profile: None,
             };
             let seeds: Vec<Seed> = (0..nt)
                 .map(|i| Seed::Forced(Column::Tension(i)))

@@ -22,6 +22,8 @@
 //! (`τ = 0`) has more length than its path needs. The statics solve this complementarity
 //! exactly (see `cosserat/shooting.rs`).
 
+use std::sync::Arc;
+
 use crate::error::{Error, Result};
 use crate::model::chamber::check_pressure;
 
@@ -82,6 +84,73 @@ pub struct Actuation {
     /// e.g. a previous solution's `tendon_tensions`; `None`: taut where the tendon would be
     /// stretched at zero tension, from zero tension.
     pub tension_guess: Option<Vec<f64>>,
+    /// The tension along the tendons when it varies (friction): `None`, every tendon carries
+    /// its base tension over its whole length. Set by the frictional solve
+    /// (`cosserat::friction`), which finds it with the shape.
+    pub profile: Option<Arc<TensionProfile>>,
+}
+
+/// The tension along each tendon (N) at the nodes of an arc-length mesh (m), interpolated
+/// geometrically between them (`ln τ` linear in `s`: exact for the capstan law on an arc).
+/// A tendon without a profile carries its base tension.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TensionProfile {
+    tendons: Vec<Option<Track>>,
+}
+
+/// The profile of one tendon: nodes (m), tensions (N) and their logarithms.
+#[derive(Debug, Clone, PartialEq)]
+struct Track {
+    s: Vec<f64>,
+    tau: Vec<f64>,
+    log: Vec<f64>,
+}
+
+impl TensionProfile {
+    /// Per tendon: the nodes `s` (m, increasing) and the tensions there (N, >= 0), or `None`
+    /// for a tendon that carries its base tension.
+    pub fn new(tendons: Vec<Option<(Vec<f64>, Vec<f64>)>>) -> Self {
+        Self {
+            tendons: tendons
+                .into_iter()
+                .map(|t| {
+                    t.map(|(s, tau)| {
+                        let log = tau.iter().map(|t| t.ln()).collect();
+                        Track { s, tau, log }
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// The nodes (m) and tensions (N) of tendon `i`, if it has a profile.
+    pub fn tendon(&self, i: usize) -> Option<(&[f64], &[f64])> {
+        let t = self.tendons.get(i)?.as_ref()?;
+        Some((&t.s, &t.tau))
+    }
+
+    /// Tension (N) of tendon `i` at `s` (m): `None` if the tendon has no profile.
+    #[inline]
+    pub fn at(&self, i: usize, s: f64) -> Option<f64> {
+        let t = self.tendons.get(i)?.as_ref()?;
+        let (nodes, tau) = (&t.s, &t.tau);
+        let n = nodes.len();
+        if n == 1 || s <= nodes[0] {
+            return Some(tau[0]);
+        }
+        if s >= nodes[n - 1] {
+            return Some(tau[n - 1]);
+        }
+        let k = nodes.partition_point(|&x| x <= s).clamp(1, n - 1);
+        let (a, b) = (nodes[k - 1], nodes[k]);
+        let w = (s - a) / (b - a);
+        let (ta, tb) = (tau[k - 1], tau[k]);
+        Some(if ta > 0.0 && tb > 0.0 {
+            (t.log[k - 1] + (t.log[k] - t.log[k - 1]) * w).exp()
+        } else {
+            ta + (tb - ta) * w
+        })
+    }
 }
 
 impl Actuation {

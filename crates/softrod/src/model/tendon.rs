@@ -107,6 +107,7 @@ impl Routing {
 pub struct Tendon {
     routing: Routing,
     end: Option<f64>,
+    friction: f64,
 }
 
 impl Tendon {
@@ -154,7 +155,28 @@ impl Tendon {
             }
             Routing::Function { .. } => {}
         }
-        Ok(Self { routing, end })
+        Ok(Self {
+            routing,
+            end,
+            friction: 0.0,
+        })
+    }
+
+    /// The same tendon with the Coulomb friction coefficient `mu` (dimensionless, >= 0)
+    /// between the tendon and its channel: the capstan law `|dτ/dσ| <= μ τ κ_path` along the
+    /// path (see `cosserat::friction`). `0` (the default) is a frictionless tendon.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `friction` (not finite or negative).
+    pub fn with_friction(mut self, mu: f64) -> Result<Self> {
+        check_non_negative("friction", mu, "")?;
+        self.friction = mu;
+        Ok(self)
+    }
+
+    /// Friction coefficient of the tendon in its channel (dimensionless, >= 0).
+    pub fn friction(&self) -> f64 {
+        self.friction
     }
 
     /// Tendon at the constant offset `(x, y)` (m).

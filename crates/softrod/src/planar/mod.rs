@@ -28,6 +28,9 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
+pub mod sensitivity;
+pub use sensitivity::{planar_sensitivities, PlanarParameter, PlanarSensitivities};
+
 use crate::error::{check_positive, Error, Result};
 use crate::integrate::driver::adaptive_dense;
 use crate::integrate::{AdaptiveOptions, FnSystem, IntegrationStats, BS3};
@@ -319,7 +322,7 @@ pub use crate::math::samples::uniform_samples;
 
 /// Checks user-given arc lengths: non-decreasing, in `[0, length]` (round-off at the ends
 /// clamped, see [`crate::math::samples::in_range`]).
-fn check_samples(samples: &[f64], length: f64) -> Result<Vec<f64>> {
+pub(crate) fn check_samples(samples: &[f64], length: f64) -> Result<Vec<f64>> {
     if samples.is_empty() {
         return Err(Error::invalid("s", "[]", "at least one arc length"));
     }

@@ -305,6 +305,65 @@ fn last_step<P: Problem + ?Sized>(
     false
 }
 
+/// The full Newton step `dx` without line search (a step predicted to converge); whether it
+/// was accepted (counted as an iteration).
+fn full_step<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+    settings: &NewtonSettings<'_>,
+    options: &NewtonOptions,
+    out: &mut NewtonOutcome,
+) -> bool {
+    out.at_x = false;
+    let single = NewtonSettings {
+        line_search: LineSearch {
+            max_halvings: 0,
+            ..settings.line_search
+        },
+        ..*settings
+    };
+    if !line_search(problem, it, dx, lambda, &single, options) {
+        return false;
+    }
+    out.at_x = true;
+    out.iterations += 1;
+    true
+}
+
+/// The exact Jacobian at the current iterate; false if the evaluation fails.
+fn exact_jacobian<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    lambda: f64,
+    out: &mut NewtonOutcome,
+) -> bool {
+    if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian {
+        out.at_x = false;
+        return false;
+    }
+    (it.rn, it.exact, out.at_x) = (problem.norm(&it.r), true, true);
+    true
+}
+
+/// After convergence on a residual-only evaluation: the exact Jacobian at the solution.
+fn jacobian_at_solution<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    lambda: f64,
+    options: &NewtonOptions,
+    out: &mut NewtonOutcome,
+) {
+    out.at_x = false;
+    if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) == Evaluated::Jacobian {
+        it.rn = problem.norm(&it.r);
+        it.exact = true;
+        out.at_x = true;
+        out.converged = it.rn <= problem.tolerance(&it.x, options.tolerance);
+    }
+}
+
 /// Damped Newton on `problem` at load factor `lambda` from `x0`.
 #[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub fn newton<P: Problem + ?Sized>(
@@ -315,16 +374,7 @@ pub fn newton<P: Problem + ?Sized>(
     settings: &NewtonSettings<'_>,
 ) -> NewtonOutcome {
     let n = problem.dim();
-    let mut out = NewtonOutcome {
-        x: x0.to_vec(),
-        residual: f64::INFINITY,
-        converged: false,
-        iterations: 0,
-        first_step: 0.0,
-        jacobian: None,
-        at_x: false,
-        exact: false,
-    };
+    let mut out = NewtonOutcome::unsolved(x0);
     let Some(mut it) = start(problem, x0, lambda, options, settings, &mut out) else {
         return out;
     };
@@ -334,24 +384,14 @@ pub fn newton<P: Problem + ?Sized>(
     let mut refresh = false;
     let mut single_failed = false;
     while out.iterations < options.max_iterations {
-        if refresh && !it.exact {
-            // Evaluate the exact Jacobian at the current iterate.
-            if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian
-            {
-                out.at_x = false;
-                break;
-            }
-            it.rn = problem.norm(&it.r);
-            it.exact = true;
-            out.at_x = true;
+        if refresh && !it.exact && !exact_jacobian(problem, &mut it, lambda, &mut out) {
+            break;
         }
         refresh = false;
         if !lu.factor(n, &it.jac) {
             break;
         }
-        for k in 0..n {
-            dx[k] = -it.r[k];
-        }
+        dx.iter_mut().zip(&it.r).for_each(|(d, r)| *d = -r);
         if !lu.solve_in_place(&mut dx) {
             break;
         }
@@ -370,18 +410,8 @@ pub fn newton<P: Problem + ?Sized>(
             && r_prev.is_finite()
             && rn * (rn / r_prev) <= 10.0 * tol
         {
-            out.at_x = false;
-            let single = NewtonSettings {
-                line_search: LineSearch {
-                    max_halvings: 0,
-                    ..settings.line_search
-                },
-                ..*settings
-            };
-            if line_search(problem, &mut it, &dx, lambda, &single, options) {
+            if full_step(problem, &mut it, &dx, lambda, settings, options, &mut out) {
                 r_prev = rn;
-                out.at_x = true;
-                out.iterations += 1;
                 if it.rn <= problem.tolerance(&it.x, options.tolerance) {
                     out.converged = true;
                     break;
@@ -444,20 +474,34 @@ pub fn newton<P: Problem + ?Sized>(
         }
     }
     if out.converged && settings.exact_at_solution && !(it.exact && out.at_x) {
-        // Converged on a residual-only evaluation: the Jacobian at the solution.
-        out.at_x = false;
-        if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) == Evaluated::Jacobian {
-            it.rn = problem.norm(&it.r);
-            it.exact = true;
-            out.at_x = true;
-            out.converged = it.rn <= problem.tolerance(&it.x, options.tolerance);
+        jacobian_at_solution(problem, &mut it, lambda, options, &mut out);
+    }
+    out.finish(it)
+}
+
+impl NewtonOutcome {
+    /// No iteration yet from `x0`.
+    fn unsolved(x0: &[f64]) -> Self {
+        Self {
+            x: x0.to_vec(),
+            residual: f64::INFINITY,
+            converged: false,
+            iterations: 0,
+            first_step: 0.0,
+            jacobian: None,
+            at_x: false,
+            exact: false,
         }
     }
-    out.exact = it.exact && out.at_x;
-    out.x = it.x;
-    out.residual = it.rn;
-    out.jacobian = Some(it.jac);
-    out
+
+    /// The outcome at the last iterate `it`.
+    fn finish(mut self, it: Iterate) -> Self {
+        self.exact = it.exact && self.at_x;
+        self.x = it.x;
+        self.residual = it.rn;
+        self.jacobian = Some(it.jac);
+        self
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,69 @@
+//! Tendon friction on the two-segment NiTi robot (tensions [4, 0, 0, 0, 2, 0] N, 50 RK4
+//! steps): the frictionless solve at the default nodes and at the friction mesh, and the
+//! frictional solve (μ = 0.1 and 0.2) from rest and as an unloading step, side by side.
+//!
+//! Run: `cargo bench -p softrod --bench friction`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use softrod::{
+    friction_mesh, solve_frictional, solve_statics, solve_statics_at, Actuation, FrictionOptions,
+    Integrator, LinearElastic, Loads, RobotModel, Rod, Section, Tendon,
+};
+
+fn niti(mu: f64) -> Arc<RobotModel> {
+    let rod = Rod::new(
+        0.4,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap();
+    let tendons = (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            let end = Some(if i < 3 { 0.2 } else { 0.4 });
+            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end)
+                .unwrap()
+                .with_friction(mu)
+                .unwrap()
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), Loads::default()).unwrap()
+}
+
+fn friction(c: &mut Criterion) {
+    let mut opts = FrictionOptions::default();
+    opts.statics.integrator = Integrator::Rk4 { steps: 50 };
+    let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let release = Actuation::tensions(&[3.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let plain = niti(0.0);
+    let mesh = friction_mesh(&plain, &opts.statics.integrator);
+    let mut g = c.benchmark_group("friction_niti");
+    g.bench_function("frictionless", |b| {
+        b.iter(|| solve_statics(black_box(&plain), &act, &opts.statics).unwrap())
+    });
+    g.bench_function("frictionless_at_friction_mesh", |b| {
+        b.iter(|| solve_statics_at(black_box(&plain), &act, &opts.statics, &mesh).unwrap())
+    });
+    for mu in [0.1, 0.2] {
+        let model = niti(mu);
+        g.bench_function(format!("mu_{mu}_from_rest"), |b| {
+            b.iter(|| solve_frictional(black_box(&model), &act, &opts, None).unwrap())
+        });
+        let first = solve_frictional(&model, &act, &opts, None).unwrap();
+        g.bench_function(format!("mu_{mu}_unloading_step"), |b| {
+            b.iter(|| solve_frictional(black_box(&model), &release, &opts, Some(&first)).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(2));
+    targets = friction
+}
+criterion_main!(benches);

@@ -1,0 +1,78 @@
+//! Contact with the environment and end constraints, through the shooting problem.
+//!
+//! [`solve_constrained`] solves the statics of a robot whose tip is held by a
+//! [`TipConstraint`] (clamped at a pose, pinned at a point, sliding on a plane, or any held
+//! directions of a frame) and whose surface touches rigid [`Obstacle`]s (planes, spheres,
+//! capsules, cylinders) without friction. The constraints are exact: the held tip directions
+//! and the contact gaps are residual rows of the shooting problem, their reactions unknowns,
+//! solved by the crate's Newton and continuation (see `docs/contact.md`). The solution
+//! ([`ContactSolution`]) carries the reactions: the tip reaction wrench and, per contact, its
+//! arc length, point, normal and force.
+
+mod constraint;
+mod obstacle;
+mod solve;
+mod stability;
+
+use nalgebra::Vector3;
+
+pub use constraint::TipConstraint;
+pub use obstacle::Obstacle;
+pub use solve::{solve_constrained, MAX_ACTIVE_SET_ROUNDS};
+
+use crate::cosserat::StaticsSolution;
+
+/// Two unit vectors completing the unit `n` to a right-handed orthonormal basis `(t1, t2, n)`.
+pub(crate) fn obstacle_normal_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let a = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let t1 = (a - n * n.dot(&a)).normalize();
+    (t1, n.cross(&t1))
+}
+
+/// One active contact of a solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    /// Index of the obstacle in the list solved with.
+    pub obstacle: usize,
+    /// Arc length of the contact (m): of the point, or where a contact interval starts.
+    pub s: f64,
+    /// Length of a contact interval (m; 0 for a point contact): the segment `[s, s + length]`
+    /// lies on a plane under a distributed reaction, whose resultant is `normal_force` and
+    /// whose `point` is the tip end of the segment.
+    pub length: f64,
+    /// Contact point on the rod's surface (m, world).
+    pub point: [f64; 3],
+    /// Outward unit normal of the obstacle at the contact (world): the direction of the
+    /// force on the rod.
+    pub normal: [f64; 3],
+    /// Normal force on the rod (N, >= 0).
+    pub normal_force: f64,
+    /// Tangential (friction) force on the rod (N, world); zero without friction.
+    pub tangential_force: [f64; 3],
+}
+
+/// A solution of [`solve_constrained`].
+#[derive(Debug, Clone)]
+pub struct ContactSolution {
+    /// The shape, internal wrenches and statistics. Its model is the robot with the contact
+    /// forces added as world-frame point loads (so its tangent compliance is that of the
+    /// contacts as dead loads). `stable` and `stability_margin` account for the tip
+    /// constraint: with a held tip, `stable` is the absence of conjugate points on the rod
+    /// and of negative stiffness in the free tip directions, and the margin is the smallest
+    /// eigenvalue of the free directions' dimensionless stiffness (`+inf` for a clamp without
+    /// conjugate points; minus the number of conjugate points when there are some).
+    pub solution: StaticsSolution,
+    /// Reaction wrench of the tip constraint on the rod, `[f; m]` (N, N m; world), if held.
+    pub tip_reaction: Option<[f64; 6]>,
+    /// The active contacts.
+    pub contacts: Vec<Contact>,
+    /// Contact force on the rod at every sample of `solution` (N, world), shape (N, 3): each
+    /// contact's force at the sample of its arc length (after the jump at a break).
+    pub contact_force: Vec<[f64; 3]>,
+    /// Conjugate points of the doubly clamped rod on `(0, L)` (with a held tip).
+    pub conjugate_points: Option<usize>,
+}

@@ -1,0 +1,248 @@
+//! Rigid obstacles and their signed distance: planes, spheres, capsules and finite cylinders.
+//!
+//! Geometry follows the plotting classes of the Python package (`softrod.Plane(point,
+//! normal)`, `Sphere(center, radius)`, `Capsule(a, b, radius)`, `Cylinder(a, b, radius)`), all
+//! in world coordinates (m). The rod's surface is the envelope of the spheres of its local
+//! outer radius `R(s)` centred on the backbone, so the gap at `s` is the signed distance of
+//! the backbone point to the obstacle minus `R(s)`.
+
+use nalgebra::Vector3;
+
+use crate::error::{Error, Result};
+
+/// A rigid obstacle (world frame, m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Obstacle {
+    /// The half-space behind the plane through `point` with unit outward `normal`.
+    Plane {
+        /// A point of the plane (m).
+        point: Vector3<f64>,
+        /// Unit outward normal (the free side).
+        normal: Vector3<f64>,
+    },
+    /// A solid ball.
+    Sphere {
+        /// Centre (m).
+        center: Vector3<f64>,
+        /// Radius (m), > 0.
+        radius: f64,
+    },
+    /// The points within `radius` of the segment `a`–`b`.
+    Capsule {
+        /// First end of the axis (m).
+        a: Vector3<f64>,
+        /// Second end of the axis (m).
+        b: Vector3<f64>,
+        /// Radius (m), > 0.
+        radius: f64,
+    },
+    /// A solid circular cylinder with flat end caps at `a` and `b`.
+    Cylinder {
+        /// Centre of the first cap (m).
+        a: Vector3<f64>,
+        /// Centre of the second cap (m).
+        b: Vector3<f64>,
+        /// Radius (m), > 0.
+        radius: f64,
+    },
+}
+
+fn finite3(name: &str, v: [f64; 3]) -> Result<Vector3<f64>> {
+    for (k, x) in v.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(Error::invalid(format!("{name}[{k}]"), x, "finite (m)"));
+        }
+    }
+    Ok(Vector3::from(v))
+}
+
+fn positive(name: &str, r: f64) -> Result<f64> {
+    if r.is_finite() && r > 0.0 {
+        Ok(r)
+    } else {
+        Err(Error::invalid(name, r, "finite and > 0 (m)"))
+    }
+}
+
+fn axis(a: [f64; 3], b: [f64; 3]) -> Result<(Vector3<f64>, Vector3<f64>)> {
+    let (a, b) = (finite3("a", a)?, finite3("b", b)?);
+    let l = (b - a).norm();
+    if l.is_finite() && l > 0.0 {
+        Ok((a, b))
+    } else {
+        Err(Error::invalid(
+            "b",
+            format!("{b:?}"),
+            "a point other than a (m)",
+        ))
+    }
+}
+
+/// A unit vector normal to `n` (for a degenerate direction).
+fn any_normal(n: &Vector3<f64>) -> Vector3<f64> {
+    let t = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    n.cross(&t).normalize()
+}
+
+impl Obstacle {
+    /// The plane through `point` (m) with outward `normal` (any non-zero length).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `point[k]` or `normal` (not finite or zero).
+    pub fn plane(point: [f64; 3], normal: [f64; 3]) -> Result<Self> {
+        let point = finite3("point", point)?;
+        let n = finite3("normal", normal)?;
+        let l = n.norm();
+        if !(l.is_finite() && l > 0.0) {
+            return Err(Error::invalid(
+                "normal",
+                format!("{normal:?}"),
+                "a non-zero vector",
+            ));
+        }
+        Ok(Self::Plane {
+            point,
+            normal: n / l,
+        })
+    }
+
+    /// The ball of `radius` (m) about `center` (m).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `center[k]` or `radius`.
+    pub fn sphere(center: [f64; 3], radius: f64) -> Result<Self> {
+        Ok(Self::Sphere {
+            center: finite3("center", center)?,
+            radius: positive("radius", radius)?,
+        })
+    }
+
+    /// The capsule of `radius` (m) about the segment `a`–`b` (m).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `a[k]`, `b[k]`, `b` (equal to `a`) or `radius`.
+    pub fn capsule(a: [f64; 3], b: [f64; 3], radius: f64) -> Result<Self> {
+        let (a, b) = axis(a, b)?;
+        Ok(Self::Capsule {
+            a,
+            b,
+            radius: positive("radius", radius)?,
+        })
+    }
+
+    /// The cylinder of `radius` (m) between the cap centres `a` and `b` (m).
+    ///
+    /// # Errors
+    /// As [`Obstacle::capsule`].
+    pub fn cylinder(a: [f64; 3], b: [f64; 3], radius: f64) -> Result<Self> {
+        let (a, b) = axis(a, b)?;
+        Ok(Self::Cylinder {
+            a,
+            b,
+            radius: positive("radius", radius)?,
+        })
+    }
+
+    /// Signed distance (m; negative inside) of the point `x` (m) to the obstacle's surface,
+    /// and the unit outward normal of the surface at the closest point (the gradient of the
+    /// distance).
+    pub fn distance(&self, x: &Vector3<f64>) -> (f64, Vector3<f64>) {
+        let radial = |d: Vector3<f64>, r: f64, fallback: Vector3<f64>| {
+            let l = d.norm();
+            if l > 0.0 {
+                (l - r, d / l)
+            } else {
+                (-r, fallback)
+            }
+        };
+        match *self {
+            Self::Plane { point, normal } => (normal.dot(&(x - point)), normal),
+            Self::Sphere { center, radius } => radial(x - center, radius, Vector3::z()),
+            Self::Capsule { a, b, radius } => {
+                let u = b - a;
+                let t = ((x - a).dot(&u) / u.norm_squared()).clamp(0.0, 1.0);
+                radial(x - (a + u * t), radius, any_normal(&u))
+            }
+            Self::Cylinder { a, b, radius } => {
+                let h = (b - a).norm();
+                let u = (b - a) / h;
+                let t = (x - a).dot(&u);
+                let rho = x - a - u * t;
+                let r = rho.norm();
+                let e = if r > 0.0 { rho / r } else { any_normal(&u) };
+                let dr = r - radius;
+                let (dz, axial) = if t < 0.5 * h { (-t, -u) } else { (t - h, u) };
+                if dr > 0.0 && dz > 0.0 {
+                    let d = (dr * dr + dz * dz).sqrt();
+                    (d, (e * dr + axial * dz) / d)
+                } else if dr > dz {
+                    (dr, e)
+                } else {
+                    (dz, axial)
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// The returned normal is the gradient of the distance (central differences), and the
+    /// distances are the closed forms at a few points.
+    #[test]
+    fn normals_are_gradients_of_the_distance() {
+        let obstacles = [
+            Obstacle::plane([0.0, 0.0, 0.1], [0.0, 1.0, 1.0]).unwrap(),
+            Obstacle::sphere([0.1, 0.0, 0.0], 0.05).unwrap(),
+            Obstacle::capsule([0.0, 0.0, 0.0], [0.0, 0.0, 0.2], 0.03).unwrap(),
+            Obstacle::cylinder([0.0, 0.0, 0.0], [0.0, 0.0, 0.2], 0.03).unwrap(),
+        ];
+        let points = [
+            Vector3::new(0.07, 0.02, 0.25),
+            Vector3::new(0.01, 0.011, 0.1),
+            Vector3::new(0.2, -0.1, -0.05),
+            Vector3::new(0.0, 0.01, 0.19),
+        ];
+        let h = 1e-7;
+        for o in &obstacles {
+            for x in &points {
+                let (_, n) = o.distance(x);
+                for k in 0..3 {
+                    let mut e = Vector3::zeros();
+                    e[k] = h;
+                    let g = (o.distance(&(x + e)).0 - o.distance(&(x - e)).0) / (2.0 * h);
+                    assert!((g - n[k]).abs() < 1e-6, "{o:?} at {x:?}: {g} vs {}", n[k]);
+                }
+            }
+        }
+        let d = obstacles[1].distance(&Vector3::new(0.1, 0.0, 0.2)).0;
+        assert!((d - 0.15).abs() < 1e-15);
+        let d = obstacles[3].distance(&Vector3::new(0.0, 0.01, 0.19)).0;
+        assert!((d + 0.01).abs() < 1e-15);
+        let d = obstacles[3].distance(&Vector3::new(0.07, 0.0, 0.23)).0;
+        assert!((d - 0.05).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_geometry_is_a_named_error() {
+        assert!(Obstacle::sphere([0.0; 3], -1.0)
+            .unwrap_err()
+            .to_string()
+            .contains("radius"));
+        assert!(Obstacle::plane([0.0; 3], [0.0; 3])
+            .unwrap_err()
+            .to_string()
+            .contains("normal"));
+        assert!(Obstacle::capsule([0.0; 3], [0.0; 3], 0.1)
+            .unwrap_err()
+            .to_string()
+            .contains('b'));
+    }
+}

@@ -1,0 +1,1111 @@
+//! The constrained shooting problem: base wrench, tip constraint and contact unknowns, solved
+//! by the crate's Newton and continuation, with an active set of contacts.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
+
+use super::constraint::TipConstraint;
+use super::obstacle::Obstacle;
+use super::stability::{conjugate_points, free_stiffness};
+use super::{obstacle_normal_basis, Contact, ContactSolution};
+use crate::cosserat::equations::{rot, v3, Equations, Evaluator, FULL, STATE};
+use crate::cosserat::shooting::{Node, Shooting};
+use crate::cosserat::statics::{
+    assemble, scaled, scaled_back, settings, solve_statics, Integrator, SolveOptions,
+    MAX_LOAD_STEP_TURN,
+};
+use crate::cosserat::NEUTRAL_MARGIN;
+use crate::error::{Error, Result};
+use crate::integrate::march::rk4_plan;
+use crate::model::loads::{Loads, PointLoad};
+use crate::model::rod::Profile;
+use crate::model::{Actuation, RobotModel};
+use crate::solve::{
+    continuation, max_norm, newton, ContinuationSettings, Evaluated, NewtonOptions, Problem,
+    SolverStats, MIN_LOAD_INCREMENT,
+};
+
+/// Most rounds of the active-set loop (contacts added or released) per load step.
+pub const MAX_ACTIVE_SET_ROUNDS: usize = 40;
+/// Relative step of the forward differences of the Jacobian columns with contacts.
+const DIFFERENCE_STEP: f64 = 1e-7;
+
+/// Where a contact acts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Site {
+    /// At the tip `s = L` (unknown: the force).
+    Tip,
+    /// Inside the rod at an unknown arc length where the gap is least (unknowns: `s`, force).
+    Interior,
+    /// On a plane, from an unknown arc length `a` to the tip: a concentrated force at `a`
+    /// (unknowns: `a`, force) and, on `(a, L]`, the distributed reaction that cancels the
+    /// normal component of the distributed loads (the segment lies flat on the plane).
+    Interval,
+}
+
+/// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
+/// was added, relaxed to zero as the problem's parameter goes from 0 to 1).
+#[derive(Debug, Clone, Copy)]
+struct Active {
+    obstacle: usize,
+    site: Site,
+    g0: f64,
+    dg0: f64,
+}
+
+impl Active {
+    fn size(&self) -> usize {
+        match self.site {
+            Site::Tip => 3,
+            Site::Interior | Site::Interval => 4,
+        }
+    }
+}
+
+/// The loads of `loads` times `lambda`.
+fn scaled_loads(loads: &Loads, lambda: f64) -> Loads {
+    let mut l = loads.clone();
+    if lambda == 1.0 {
+        return l;
+    }
+    l.tip_force *= lambda;
+    l.tip_moment *= lambda;
+    l.gravity *= lambda;
+    for p in &mut l.point_loads {
+        p.force *= lambda;
+        p.moment *= lambda;
+    }
+    let scale = |p: &Option<Profile>| {
+        p.as_ref().map(|p| match p {
+            Profile::Constant(v) => Profile::Constant(v * lambda),
+            Profile::Function(f) => {
+                let f = Arc::clone(f);
+                Profile::Function(Arc::new(move |s| f(s) * lambda))
+            }
+        })
+    };
+    l.distributed_force = scale(&loads.distributed_force);
+    l.distributed_moment = scale(&loads.distributed_moment);
+    l
+}
+
+/// What one evaluation left: the model it marched (with the contact forces as point loads),
+/// its nodes, its raw shooting residual.
+struct Pass {
+    model: Arc<RobotModel>,
+    nodes: Vec<Node>,
+    residual: Vector6<f64>,
+}
+
+/// The residual rows of one evaluation and, when asked, the exact Jacobian columns of the tip
+/// rows along the base wrench.
+type Rows = (Vec<f64>, Option<[[f64; 6]; 6]>);
+
+/// The constrained shooting problem at load factor `load`; the parameter of
+/// [`Problem::evaluate`] relaxes the gap targets of newly added contacts.
+pub(crate) struct Constrained<'m> {
+    model: &'m RobotModel,
+    shared: &'m Arc<RobotModel>,
+    tensions: Vec<f64>,
+    pressures: Vec<f64>,
+    integrator: Integrator,
+    tip: Option<TipConstraint>,
+    /// Tip pose of the actuated rod without loads (the target at load factor 0).
+    start: (Vector3<f64>, Matrix3<f64>),
+    obstacles: &'m [Obstacle],
+    active: Vec<Active>,
+    load: f64,
+    last: Option<Pass>,
+    reference: Vec<Vector3<f64>>,
+    evaluations: usize,
+}
+
+impl<'m> Constrained<'m> {
+    fn dim_of(active: &[Active]) -> usize {
+        6 + active.iter().map(Active::size).sum::<usize>()
+    }
+
+    fn offsets(&self) -> Vec<usize> {
+        let mut o = Vec::with_capacity(self.active.len());
+        let mut k = 6;
+        for a in &self.active {
+            o.push(k);
+            k += a.size();
+        }
+        o
+    }
+
+    /// The target position and rotation of the tip at the current load factor.
+    fn target(&self, c: &TipConstraint) -> (Vector3<f64>, Matrix3<f64>) {
+        let l = self.load;
+        let p = self.start.0 + (c.pose.position() - self.start.0) * l;
+        let q0 = UnitQuaternion::from_matrix(&self.start.1);
+        let q1 = UnitQuaternion::from_matrix(&c.pose.rotation());
+        let q = q0
+            .try_slerp(&q1, l, 1e-12)
+            .unwrap_or(if l < 0.5 { q0 } else { q1 });
+        (p, *q.to_rotation_matrix().matrix())
+    }
+
+    /// The six tip rows at the tip pose `(p, r)` with shooting residual `res`.
+    fn tip_rows(&self, res: &Vector6<f64>, p: &Vector3<f64>, r: &Matrix3<f64>) -> [f64; 6] {
+        let Some(c) = &self.tip else {
+            return std::array::from_fn(|k| res[k]);
+        };
+        let (pt, rt) = self.target(c);
+        let frame = c.pose.rotation();
+        let l = self.model.length();
+        let dp = frame.tr_mul(&(p - pt)) / l;
+        let f = frame.tr_mul(&res.fixed_rows::<3>(0).into_owned());
+        let mut out = [0.0; 6];
+        for k in 0..3 {
+            out[k] = if c.held[k] { dp[k] } else { f[k] };
+        }
+        let m = res.fixed_rows::<3>(3).into_owned();
+        match c.rotations_held() {
+            3 => {
+                let a = rt.tr_mul(r);
+                out[3] = 0.5 * (a[(2, 1)] - a[(1, 2)]);
+                out[4] = 0.5 * (a[(0, 2)] - a[(2, 0)]);
+                out[5] = 0.5 * (a[(1, 0)] - a[(0, 1)]);
+            }
+            2 => {
+                let d = rt.tr_mul(&r.column(2).into_owned());
+                out[3] = -d.y;
+                out[4] = d.x;
+                out[5] = rt.tr_mul(&m).z;
+            }
+            _ => {
+                let mm = frame.tr_mul(&m);
+                out[3..6].copy_from_slice(mm.as_slice());
+            }
+        }
+        out
+    }
+
+    /// The derivative of [`Self::tip_rows`] along a column: residual change `dres`, tip
+    /// displacement `dp` and rotation `w` (world).
+    fn tip_rows_dot(
+        &self,
+        dres: &Vector6<f64>,
+        dp: &Vector3<f64>,
+        w: &Vector3<f64>,
+        r: &Matrix3<f64>,
+    ) -> [f64; 6] {
+        let Some(c) = &self.tip else {
+            return std::array::from_fn(|k| dres[k]);
+        };
+        let (_, rt) = self.target(c);
+        let frame = c.pose.rotation();
+        let l = self.model.length();
+        let ddp = frame.tr_mul(dp) / l;
+        let df = frame.tr_mul(&dres.fixed_rows::<3>(0).into_owned());
+        let mut out = [0.0; 6];
+        for k in 0..3 {
+            out[k] = if c.held[k] { ddp[k] } else { df[k] };
+        }
+        let dm = dres.fixed_rows::<3>(3).into_owned();
+        match c.rotations_held() {
+            3 => {
+                let da = rt.tr_mul(&(crate::math::so3::hat(w) * r));
+                out[3] = 0.5 * (da[(2, 1)] - da[(1, 2)]);
+                out[4] = 0.5 * (da[(0, 2)] - da[(2, 0)]);
+                out[5] = 0.5 * (da[(1, 0)] - da[(0, 1)]);
+            }
+            2 => {
+                let dd = rt.tr_mul(&w.cross(&r.column(2).into_owned()));
+                out[3] = -dd.y;
+                out[4] = dd.x;
+                out[5] = rt.tr_mul(&dm).z;
+            }
+            _ => {
+                let mm = frame.tr_mul(&dm);
+                out[3..6].copy_from_slice(mm.as_slice());
+            }
+        }
+        out
+    }
+
+    /// The model with the loads at the current load factor and the contact forces of `x` as
+    /// world point loads; `None` if an arc length left the rod.
+    fn contact_model(&self, x: &[f64]) -> Option<Arc<RobotModel>> {
+        if self.active.is_empty() && (self.load == 1.0 || self.model.loads().is_unloaded()) {
+            return Some(Arc::clone(self.shared));
+        }
+        let l = self.model.length();
+        let f = self.model.force_scale();
+        let mut loads = scaled_loads(self.model.loads(), self.load);
+        for (a, o) in self.active.iter().zip(self.offsets()) {
+            let (s, k) = match a.site {
+                Site::Tip => (l, o),
+                Site::Interior | Site::Interval => (x[o] * l, o + 1),
+            };
+            if !(s > 0.0 && s <= l) {
+                return None;
+            }
+            let force = Vector3::new(x[k], x[k + 1], x[k + 2]) * f;
+            loads.point_loads.push(PointLoad::force(s, force));
+            if a.site == Site::Interval {
+                if s >= l {
+                    return None;
+                }
+                let Obstacle::Plane { normal, .. } = self.obstacles[a.obstacle] else {
+                    return None;
+                };
+                // The reaction starts just after the break at `s` (its own break), so that
+                // no Runge-Kutta stage of the interval before sees it.
+                let after = f64::from_bits(s.to_bits() + 1);
+                loads
+                    .point_loads
+                    .push(PointLoad::force(after, Vector3::zeros()));
+                let base = loads.distributed_force.clone();
+                let rho_g = self.model.rod().density().map(|d| loads.gravity * d);
+                let rod = self.model.rod().clone();
+                loads.distributed_force = Some(Profile::Function(Arc::new(move |t| {
+                    let mut f = base.as_ref().map_or(Vector3::zeros(), |p| p.at(t));
+                    if t < after {
+                        return f;
+                    }
+                    let mut applied = f;
+                    if let Some(g) = rho_g {
+                        applied += g * rod.section_at(t).area;
+                    }
+                    let push = normal.dot(&applied);
+                    if push < 0.0 {
+                        f -= normal * push;
+                    }
+                    f
+                })));
+            }
+        }
+        self.model.with_loads(loads).ok()
+    }
+
+    /// One march at `x`; with `full`, the six base-wrench columns too. Returns the residual
+    /// rows, and with `full` the exact Jacobian of the tip rows along the base wrench.
+    fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<Rows> {
+        let model = self.contact_model(x)?;
+        let plan = match self.integrator {
+            Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
+            Integrator::Adaptive(_) => Vec::new(),
+        };
+        let eq = Equations {
+            model: &model,
+            tensions: &self.tensions,
+            pressures: &self.pressures,
+            load_factor: 1.0,
+            profile: None,
+        };
+        let mut sh = Shooting::new(eq, self.integrator, plan);
+        let pass = if full {
+            sh.pass::<FULL>(&x[..6], 1.0)
+        } else {
+            sh.pass::<STATE>(&x[..6], 1.0)
+        };
+        self.evaluations += sh.evaluations;
+        let (res, cols, _) = pass.ok()?;
+        let tip = sh.nodes.last()?;
+        let (p, r) = (v3(&tip.y, 0), rot(&tip.y));
+        let mut rows = self.tip_rows(&res, &p, &r).to_vec();
+        let jac = if full {
+            let tw = sh.tip_twist?;
+            Some(std::array::from_fn(|c| {
+                let dp = tw[c].fixed_rows::<3>(0).into_owned();
+                let w = tw[c].fixed_rows::<3>(3).into_owned();
+                self.tip_rows_dot(&cols[c], &dp, &w, &r)
+            }))
+        } else {
+            None
+        };
+        let l = self.model.length();
+        for (a, o) in self.active.iter().zip(self.offsets()) {
+            let ob = &self.obstacles[a.obstacle];
+            let (s, k) = match a.site {
+                Site::Tip => (l, o),
+                Site::Interior | Site::Interval => (x[o] * l, o + 1),
+            };
+            let props = model.rod().section_at(s);
+            let first = sh.nodes.iter().position(|n| n.s == s)?;
+            let last = sh.nodes.iter().rposition(|n| n.s == s)?;
+            let pc = v3(&sh.nodes[first].y, 0);
+            let (d, n) = ob.distance(&pc);
+            let g = d - props.radius;
+            rows.push((g - (1.0 - mu) * a.g0) / l);
+            if a.site != Site::Tip {
+                // A point contact sits at the kink of the gap (the shear jumps with the
+                // force): the mean slope of its two sides vanishes; the segment of an
+                // interval lies flat from just after its edge.
+                let sides: &[usize] = if a.site == Site::Interval {
+                    &[last, last]
+                } else {
+                    &[first, last]
+                };
+                let mut slope = 0.0;
+                for &j in sides {
+                    let node = sh.nodes[j];
+                    let mut ev = Evaluator {
+                        eq: sh.eq,
+                        ws: &mut sh.ws,
+                    };
+                    ev.set_interval(node.interval);
+                    let mut dy = [0.0; STATE];
+                    ev.rhs_into::<STATE>(node.s, &node.y, &mut dy);
+                    slope += 0.5 * n.dot(&v3(&dy, 0));
+                }
+                let dg = slope - props.radius_rate;
+                rows.push(dg - (1.0 - mu) * a.dg0);
+            }
+            let (t1, t2) = obstacle_normal_basis(&n);
+            let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
+            rows.push(f.dot(&t1));
+            rows.push(f.dot(&t2));
+        }
+        if !rows.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        self.last = Some(Pass {
+            nodes: std::mem::take(&mut sh.nodes),
+            residual: res,
+            model: Arc::clone(&model),
+        });
+        Some((rows, jac))
+    }
+
+    /// The gap (m) and outward normal of obstacle `o` at every node of the last pass (first
+    /// copy of a break).
+    fn gaps(&self, o: usize) -> Vec<(usize, f64, f64, Vector3<f64>)> {
+        let Some(pass) = &self.last else {
+            return Vec::new();
+        };
+        let mut out: Vec<(usize, f64, f64, Vector3<f64>)> = Vec::new();
+        for (j, n) in pass.nodes.iter().enumerate() {
+            if out.last().is_some_and(|l| l.1 == n.s) {
+                continue;
+            }
+            let (d, normal) = self.obstacles[o].distance(&v3(&n.y, 0));
+            let r = pass.model.rod().section_at(n.s).radius;
+            out.push((j, n.s, d - r, normal));
+        }
+        out
+    }
+
+    /// The normal force (N, signed) and normal of each active contact at `x` (last pass).
+    fn normal_forces(&self, x: &[f64]) -> Forces {
+        let Some(pass) = &self.last else {
+            return Vec::new();
+        };
+        let l = self.model.length();
+        let fs = self.model.force_scale();
+        self.active
+            .iter()
+            .zip(self.offsets())
+            .map(|(a, o)| {
+                let (s, k) = match a.site {
+                    Site::Tip => (l, o),
+                    Site::Interior | Site::Interval => (x[o] * l, o + 1),
+                };
+                let node = pass
+                    .nodes
+                    .iter()
+                    .find(|n| n.s == s)
+                    .unwrap_or(&pass.nodes[0]);
+                let p = v3(&node.y, 0);
+                let (_, n) = self.obstacles[a.obstacle].distance(&p);
+                let f = Vector3::new(x[k], x[k + 1], x[k + 2]) * fs;
+                (f.dot(&n), n, s, p)
+            })
+            .collect()
+    }
+}
+
+impl Problem for Constrained<'_> {
+    fn dim(&self) -> usize {
+        Self::dim_of(&self.active)
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
+        let n = self.dim();
+        let exact = self.active.is_empty();
+        let Some((rows, jac)) = self.run(x, lambda, jacobian.is_some() && exact) else {
+            return Evaluated::Failed;
+        };
+        r.copy_from_slice(&rows);
+        let Some(j) = jacobian else {
+            return Evaluated::Residual;
+        };
+        if let Some(cols) = jac {
+            for (c, col) in cols.iter().enumerate() {
+                j[n * c..n * c + 6].copy_from_slice(col);
+            }
+            return Evaluated::Jacobian;
+        }
+        // Forward differences over every unknown (the contact forces move the breaks).
+        let saved = self.last.take();
+        let mut xp = x.to_vec();
+        for c in 0..n {
+            let h = DIFFERENCE_STEP * (1.0 + x[c].abs());
+            xp[c] = x[c] + h;
+            let plus = self.run(&xp, lambda, false);
+            xp[c] = x[c];
+            let Some((a, _)) = plus else {
+                self.last = saved;
+                return Evaluated::Failed;
+            };
+            for i in 0..n {
+                j[i + n * c] = (a[i] - rows[i]) / h;
+            }
+        }
+        self.last = saved;
+        Evaluated::Jacobian
+    }
+
+    fn commit(&mut self) {
+        if let Some(p) = &self.last {
+            self.reference = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
+        }
+    }
+
+    fn close(&self) -> bool {
+        let (Some(p), false) = (&self.last, self.reference.is_empty()) else {
+            return false;
+        };
+        let limit = 0.5 * MAX_LOAD_STEP_TURN * self.model.length();
+        let now: Vec<Vector3<f64>> = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
+        if now.len() == self.reference.len() {
+            now.iter()
+                .zip(&self.reference)
+                .all(|(a, b)| (a - b).norm() <= limit)
+        } else {
+            match (now.last(), self.reference.last()) {
+                (Some(a), Some(b)) => (a - b).norm() <= limit,
+                _ => false,
+            }
+        }
+    }
+}
+
+/// Effort of a solve.
+#[derive(Default)]
+struct Effort {
+    iterations: usize,
+    load_steps: usize,
+}
+
+/// Newton at the full contact targets from `x`; the last pass left at the result.
+fn correct(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let s = crate::solve::NewtonSettings {
+        residual_first: true,
+        ..settings(true, None, false)
+    };
+    let out = newton(p, x, 1.0, opts, &s);
+    effort.iterations += out.iterations;
+    if !out.converged {
+        return None;
+    }
+    if !out.at_x {
+        let mut r = vec![0.0; p.dim()];
+        if p.evaluate(&out.x, 1.0, None, &mut r) == Evaluated::Failed {
+            return None;
+        }
+    }
+    Some(out.x)
+}
+
+/// Normal forces, normal, arc length and point of each active contact at `x`.
+type Forces = Vec<(f64, Vector3<f64>, f64, Vector3<f64>)>;
+
+/// New contacts at the local minima of the gaps below `-penetration` (not at an existing
+/// contact, not inside an interval).
+fn candidates(p: &Constrained<'_>, forces: &Forces, penetration: f64) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let mut added = Vec::new();
+    for o in 0..p.obstacles.len() {
+        let g = p.gaps(o);
+        for i in 1..g.len() {
+            let (_, s, gi, _) = g[i];
+            let at_tip = i + 1 == g.len();
+            let minimum = gi < -penetration && gi <= g[i - 1].2 && (at_tip || gi <= g[i + 1].2);
+            let taken = forces
+                .iter()
+                .zip(&p.active)
+                .any(|(f, a)| a.obstacle == o && (f.2 - s).abs() <= 1e-12 * l);
+            let inside = p
+                .active
+                .iter()
+                .zip(forces)
+                .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
+            if minimum && !taken && !inside {
+                added.push((o, if at_tip { Site::Tip } else { Site::Interior }, s));
+            }
+        }
+    }
+    added
+}
+
+/// A plane touched twice (or an interval touched before its edge) becomes one interval from
+/// the first contact to the tip; `true` if a merge was made.
+fn merge_plane(
+    p: &mut Constrained<'_>,
+    x: &mut Vec<f64>,
+    forces: &Forces,
+    added: &[(usize, Site, f64)],
+) -> bool {
+    let l = p.model.length();
+    for &(o, _, s) in added {
+        if !matches!(p.obstacles[o], Obstacle::Plane { .. }) {
+            continue;
+        }
+        let offsets = p.offsets();
+        let on: Vec<usize> = (0..p.active.len())
+            .filter(|i| p.active[*i].obstacle == o)
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        let mut a = s;
+        for &i in &on {
+            a = a.min(forces[i].2);
+        }
+        if a >= l {
+            continue;
+        }
+        for &i in on.iter().rev() {
+            let size = p.active[i].size();
+            p.active.remove(i);
+            x.drain(offsets[i]..offsets[i] + size);
+        }
+        p.active.push(Active {
+            obstacle: o,
+            site: Site::Interval,
+            g0: 0.0,
+            dg0: 0.0,
+        });
+        x.push(a / l);
+        x.extend([0.0; 3]);
+        return true;
+    }
+    false
+}
+
+/// Adds the contacts `added` at zero force and relaxes their gaps from the values found to
+/// zero by continuation; the state at full contact targets.
+fn add_contacts(
+    p: &mut Constrained<'_>,
+    mut x: Vec<f64>,
+    added: Vec<(usize, Site, f64)>,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+    }
+    for (o, site, s) in added {
+        p.active.push(Active {
+            obstacle: o,
+            site,
+            g0: 0.0,
+            dg0: 0.0,
+        });
+        if site != Site::Tip {
+            x.push(s / l);
+        }
+        x.extend([0.0; 3]);
+    }
+    // The gap targets of the new contacts: their rows at zero force.
+    let mut r = vec![0.0; p.dim()];
+    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
+        return None;
+    }
+    let offsets = p.offsets();
+    for (a, o) in p.active.iter_mut().zip(offsets) {
+        a.g0 = r[o] * l;
+        if a.site != Site::Tip {
+            a.dg0 = r[o + 1];
+        }
+    }
+    let start = ContinuationSettings {
+        x0: &x,
+        jacobian0: None,
+        first_increment: 1.0,
+        max_increment: 1.0,
+    };
+    let c = continuation(p, &start, opts, &settings(true, None, false));
+    effort.iterations += c.iterations;
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+    }
+    if !(c.outcome.converged && c.load_factor >= 1.0) {
+        return None;
+    }
+    correct(p, &c.outcome.x, opts, effort)
+}
+
+/// The active-set loop at the current load factor from the state `x` (converged at the
+/// previous load factor): Newton; release the contact pulling hardest; add one contact at
+/// each local minimum of a gap below `-penetration`, reached by relaxing its gap from the
+/// current value; until no contact pulls and nothing penetrates.
+fn active_set(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
+    let fs = p.model.force_scale();
+    let penetration = 10.0 * opts.tolerance * l;
+    let mut x = correct(p, x, opts, effort)?;
+    for _ in 0..MAX_ACTIVE_SET_ROUNDS {
+        // Release the most negative contact force.
+        let forces = p.normal_forces(&x);
+        let worst = forces
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.0 < -opts.tolerance * fs)
+            .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+            .map(|(i, _)| i);
+        if let Some(i) = worst {
+            let o = p.offsets()[i];
+            let size = p.active[i].size();
+            p.active.remove(i);
+            x.drain(o..o + size);
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        let added = candidates(p, &forces, penetration);
+        if merge_plane(p, &mut x, &forces, &added) {
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        // An interval whose segment lifts off the plane is only its edge contact.
+        let lifted = p.active.iter().enumerate().position(|(i, a)| {
+            a.site == Site::Interval
+                && p.gaps(a.obstacle)
+                    .iter()
+                    .any(|g| g.1 > forces[i].2 && g.2 > penetration)
+        });
+        if let Some(i) = lifted {
+            p.active[i].site = Site::Interior;
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        if added.is_empty() {
+            return Some(x);
+        }
+        x = add_contacts(p, x, added, opts, effort)?;
+    }
+    None
+}
+
+/// Steps the load factor (external loads and tip target) from 0 to 1 from the state `x`
+/// at load factor 0, halving a step whose active-set loop fails or moves the shape too far;
+/// on failure, the load factor reached and why.
+fn step_loads(
+    p: &mut Constrained<'_>,
+    mut x: Vec<f64>,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> std::result::Result<Vec<f64>, (f64, &'static str)> {
+    let mut lambda = 0.0;
+    let mut dl: f64 = 1.0;
+    while lambda < 1.0 {
+        if effort.load_steps >= opts.max_load_steps {
+            return Err((lambda, "the load steps ran out"));
+        }
+        let target = (lambda + dl).min(1.0);
+        let saved = (x.clone(), p.active.clone());
+        p.load = target;
+        effort.load_steps += 1;
+        match active_set(p, &x, opts, effort) {
+            Some(xs) if p.close() || !opts.continuation => {
+                x = xs;
+                lambda = target;
+                p.commit();
+                dl = (dl * 2.0).min(1.0);
+            }
+            _ => {
+                (x, p.active) = saved;
+                p.load = lambda;
+                if !opts.continuation {
+                    return Err((lambda, "the direct solve failed"));
+                }
+                dl *= 0.5;
+                if dl < MIN_LOAD_INCREMENT {
+                    return Err((lambda, "no load step converged (load increment underflow)"));
+                }
+            }
+        }
+    }
+    Ok(x)
+}
+
+/// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
+/// the rod's surface kept out of `obstacles` by frictionless unilateral contact.
+///
+/// The unknowns are the base wrench (as in [`solve_statics`]), the force of every active
+/// contact and, for a contact inside the rod, its arc length; the residual the tip
+/// conditions (the held directions' pose error, the free directions' wrench balance), and per
+/// contact its gap (zero), the slope of the gap along the rod (zero: the contact sits at the
+/// least gap), and the force's components along the obstacle's surface (zero: frictionless).
+/// The contacts are found by an active set: a contact is added at every local minimum of a
+/// gap below `-10 tolerance L` (reached by relaxing its gap from the penetration found) and
+/// released when its normal force is negative, until no force pulls and nothing penetrates.
+/// The external loads and the tip target (from the unloaded tip pose) are stepped by load
+/// continuation when the direct solve fails.
+///
+/// # Errors
+/// As [`solve_statics`] for the model, actuation and options; [`Error::NotConverged`] (with
+/// the iterations, residual and load factor reached) when no equilibrium with a consistent
+/// active set is found and `options.newton.throw` is set.
+pub fn solve_constrained(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    tip: Option<&TipConstraint>,
+    obstacles: &[Obstacle],
+) -> Result<ContactSolution> {
+    options.validate()?;
+    model.check_actuation(actuation)?;
+    if tip.is_none() && obstacles.is_empty() {
+        let solution = solve_statics(model, actuation, options)?;
+        let n = solution.s.len();
+        return Ok(ContactSolution {
+            solution,
+            tip_reaction: None,
+            contacts: Vec::new(),
+            contact_force: vec![[0.0; 3]; n],
+            conjugate_points: None,
+        });
+    }
+    let tensions = actuation.tension_values(model.tendons().len());
+    let pressures = actuation.pressure_values(model.chambers().len());
+    let mut p = Constrained {
+        model,
+        shared: model,
+        tensions,
+        pressures,
+        integrator: options.integrator,
+        tip: tip.copied(),
+        start: (Vector3::zeros(), Matrix3::identity()),
+        obstacles,
+        active: Vec::new(),
+        load: 0.0,
+        last: None,
+        reference: Vec::new(),
+        evaluations: 0,
+    };
+    // The actuated rod without loads: the target of the tip at load factor 0.
+    let zero = vec![0.0; 6];
+    let free_tip = p.tip.take();
+    let unloaded = p.run(&zero, 1.0, false).map(|_| ());
+    p.tip = free_tip;
+    let start_node = p.last.as_ref().and_then(|l| l.nodes.last().copied());
+    let (Some(()), Some(node)) = (unloaded, start_node) else {
+        return Err(Error::not_converged(
+            "constrained shooting: the actuated rod without external loads could not be \
+             integrated",
+            0,
+            f64::INFINITY,
+        ));
+    };
+    p.start = (v3(&node.y, 0), rot(&node.y));
+    p.commit();
+    let opts = options.newton;
+    let mut effort = Effort::default();
+    let mut x: Vec<f64> = match &options.warm_start {
+        Some(w) => scaled(model, &w.base_wrench).to_vec(),
+        None => zero.clone(),
+    };
+    let mut reached = None;
+    if options.warm_start.is_some() {
+        p.load = 1.0;
+        if let Some(xs) = active_set(&mut p, &x, &opts, &mut effort) {
+            reached = Some(xs);
+        } else {
+            p.active.clear();
+            x = zero.clone();
+            p.load = 0.0;
+        }
+    }
+    if reached.is_none() {
+        // Load factor 0 (contacts of the actuated rod), then the loads and the target.
+        match active_set(&mut p, &x, &opts, &mut effort) {
+            Some(xs) => x = xs,
+            None => return fail(&p, &opts, &effort, 0.0, "no contact set at load factor 0"),
+        }
+        p.commit();
+        if !(model.loads().is_unloaded() && p.tip.is_none()) {
+            // (Otherwise nothing is stepped: load factor 0 is the problem.)
+            x = match step_loads(&mut p, x, &opts, &mut effort) {
+                Ok(x) => x,
+                Err((lambda, why)) => return fail(&p, &opts, &effort, lambda, why),
+            };
+        }
+        reached = Some(x);
+    }
+    let x = reached.unwrap_or_default();
+    p.load = 1.0;
+    finish(&mut p, model, actuation, options, &x, &effort)
+}
+
+/// The error (or, without `throw`, nothing better to return) of a failed solve.
+fn fail(
+    p: &Constrained<'_>,
+    opts: &NewtonOptions,
+    effort: &Effort,
+    lambda: f64,
+    why: &str,
+) -> Result<ContactSolution> {
+    let _ = opts;
+    Err(Error::NotConverged {
+        what: format!("constrained shooting (tip constraint, contact): {why}"),
+        iterations: effort.iterations,
+        residual: p
+            .last
+            .as_ref()
+            .map_or(f64::INFINITY, |l| max_norm(l.residual.as_slice())),
+        load_factor: lambda,
+    })
+}
+
+/// Exact Newton steps (fresh Jacobians) from the converged `x` toward round-off, so that the
+/// balance of the reactions holds to the digits of the loads, not only of the tolerance;
+/// `x` itself if they do not lower the residual.
+fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Vec<f64> {
+    let opts = NewtonOptions {
+        tolerance: (options.newton.tolerance * 1e-4).max(f64::EPSILON),
+        max_iterations: 2,
+        ..options.newton
+    };
+    let mut r = vec![0.0; p.dim()];
+    let before = if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
+        f64::INFINITY
+    } else {
+        max_norm(&r)
+    };
+    let out = newton(p, x, 1.0, &opts, &settings(false, None, false));
+    if out.residual < before && out.residual.is_finite() {
+        out.x
+    } else {
+        x.to_vec()
+    }
+}
+
+/// The contacts of a solution and the contact force at its samples (an interval's
+/// distributed reaction lumped by the trapezoid rule).
+fn report(
+    active: &[Active],
+    forces: &Forces,
+    model: &RobotModel,
+    cm: &RobotModel,
+    sol: &crate::cosserat::StaticsSolution,
+) -> (Vec<Contact>, Vec<[f64; 3]>) {
+    let l = model.length();
+    let mut contact_force = vec![[0.0; 3]; sol.s.len()];
+    let mut contacts = Vec::with_capacity(forces.len());
+    for ((fnorm, n, s, pc), a) in forces.iter().zip(active) {
+        let radius = model.rod().section_at(*s).radius;
+        let point = pc - n * radius;
+        contacts.push(Contact {
+            obstacle: a.obstacle,
+            s: *s,
+            length: 0.0,
+            point: [point.x, point.y, point.z],
+            normal: [n.x, n.y, n.z],
+            normal_force: *fnorm,
+            tangential_force: [0.0; 3],
+        });
+        if let Some(j) = sol.s.iter().rposition(|v| v == s) {
+            for k in 0..3 {
+                contact_force[j][k] += fnorm * n[k];
+            }
+        }
+        if a.site == Site::Interval {
+            // The distributed reaction on (a, L], lumped at the samples by the trapezoid rule.
+            let after = f64::from_bits(s.to_bits() + 1);
+            let density = |t: f64| {
+                let mut f = cm
+                    .loads()
+                    .distributed_force
+                    .as_ref()
+                    .map_or(Vector3::zeros(), |p| p.at(t));
+                // The model's distributed force already carries the reaction: take it alone.
+                if let Some(g) = cm.rho_g() {
+                    f += g * cm.rod().section_at(t).area;
+                }
+                f
+            };
+            let base = model.loads().distributed_force.as_ref();
+            let mut total = 0.0;
+            let idx: Vec<usize> = (0..sol.s.len()).filter(|j| sol.s[*j] >= after).collect();
+            for w in idx.windows(2) {
+                let (j0, j1) = (w[0], w[1]);
+                let h = sol.s[j1] - sol.s[j0];
+                if h <= 0.0 {
+                    continue;
+                }
+                for j in [j0, j1] {
+                    let t = sol.s[j];
+                    let applied = base.map_or(Vector3::zeros(), |p| p.at(t));
+                    let reaction = density(t)
+                        - applied
+                        - cm.rho_g()
+                            .map_or(Vector3::zeros(), |g| g * cm.rod().section_at(t).area);
+                    let lump = reaction * (0.5 * h);
+                    total += lump.dot(n);
+                    for k in 0..3 {
+                        contact_force[j][k] += lump[k];
+                    }
+                }
+            }
+            let tip = Vector3::from(sol.tip_position()) - n * radius;
+            contacts.push(Contact {
+                obstacle: a.obstacle,
+                s: after,
+                length: l - after,
+                point: [tip.x, tip.y, tip.z],
+                normal: [n.x, n.y, n.z],
+                normal_force: total,
+                tangential_force: [0.0; 3],
+            });
+        }
+    }
+    (contacts, contact_force)
+}
+
+/// The stability of a rod with a held tip (see [`super::stability`]): whether stable, the
+/// margin (the free directions' smallest stiffness; `+inf` for a full clamp, minus the
+/// number of conjugate points when there are some) and the conjugate points.
+fn held_stability(
+    sh: &mut Shooting<'_>,
+    x: &[f64],
+    c: &TipConstraint,
+    cols: &[Vector6<f64>],
+    tw: &[Vector6<f64>; 6],
+) -> (bool, f64, Option<usize>) {
+    let l = sh.eq.model.length();
+    let mut y = Matrix6::zeros();
+    let mut xt = Matrix6::zeros();
+    for k in 0..6 {
+        for i in 0..6 {
+            y[(i, k)] = cols[k][i];
+            xt[(i, k)] = tw[k][i] / if i < 3 { l } else { 1.0 };
+        }
+    }
+    let count = conjugate_points(sh, x).map(|c| c.0);
+    let free: Vec<usize> = (0..6).filter(|k| !c.held[*k]).collect();
+    let stiff = free_stiffness(&y, &xt, &c.pose.rotation(), &free);
+    let (stable, margin) = match (count, stiff) {
+        (Some(0), Some((m, neg))) => (neg == 0 && m > -NEUTRAL_MARGIN, m),
+        (Some(0), None) if free.is_empty() => (true, f64::INFINITY),
+        (Some(n), _) if n > 0 => (false, -(n as f64)),
+        _ => (false, 0.0),
+    };
+    (stable, margin, count)
+}
+
+/// The solution at the converged unknowns `x`: the shape with its contact forces, the tip
+/// reaction, the contacts, the stability.
+fn finish(
+    p: &mut Constrained<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    x: &[f64],
+    effort: &Effort,
+) -> Result<ContactSolution> {
+    let polished = polish(p, x, options);
+    let x: &[f64] = &polished;
+    let mut r = vec![0.0; p.dim()];
+    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
+        return fail(
+            p,
+            &options.newton,
+            effort,
+            1.0,
+            "the solution could not be integrated",
+        );
+    }
+    let residual = max_norm(&r);
+    let forces = p.normal_forces(x);
+    let Some(pass) = p.last.take() else {
+        return fail(p, &options.newton, effort, 1.0, "no pass");
+    };
+    let cm = Arc::clone(&pass.model);
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(cm.breaks(), steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let eq = Equations {
+        model: &cm,
+        tensions: &p.tensions,
+        pressures: &p.pressures,
+        load_factor: 1.0,
+        profile: None,
+    };
+    let mut sh = Shooting::new(eq, options.integrator, plan);
+    let (res, cols, _) = sh.pass::<FULL>(&x[..6], 1.0).map_err(|e| {
+        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
+    })?;
+    let tip_twist = sh.tip_twist;
+    let stats = SolverStats {
+        iterations: effort.iterations,
+        residual,
+        function_evaluations: p.evaluations + sh.evaluations,
+        converged: residual <= options.newton.tolerance,
+        load_steps: effort.load_steps,
+        load_factor: 1.0,
+    };
+    let fs = model.force_scale();
+    let l = model.length();
+    let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
+    sol.actuation = actuation.clone();
+    sol.options = *options;
+    let (contacts, contact_force) = report(&p.active, &forces, model, &cm, &sol);
+    let tip_reaction = p.tip.as_ref().map(|_| {
+        let f = res.fixed_rows::<3>(0) * fs;
+        let m = res.fixed_rows::<3>(3) * (fs * l);
+        [f.x, f.y, f.z, m.x, m.y, m.z]
+    });
+    // Stability: with a held tip, conjugate points and the free directions' stiffness; with
+    // a free tip, the tip criterion of `solve_statics` (contacts as dead loads).
+    let mut conjugate = None;
+    if let (Some(c), Some(tw)) = (p.tip, tip_twist) {
+        let (stable, margin, count) = held_stability(&mut sh, &x[..6], &c, &cols, &tw);
+        conjugate = count;
+        sol.stable = stable && sol.stats.converged;
+        let _ = sol.margin.set(margin);
+    } else {
+        sol.stable = sol.stats.converged && sol.stability_margin() > -NEUTRAL_MARGIN;
+    }
+    if !sol.stats.converged && options.newton.throw {
+        return fail(
+            p,
+            &options.newton,
+            effort,
+            1.0,
+            "the residual at the solution is above the tolerance",
+        );
+    }
+    Ok(ContactSolution {
+        solution: sol,
+        tip_reaction,
+        contacts,
+        contact_force,
+        conjugate_points: conjugate,
+    })
+}

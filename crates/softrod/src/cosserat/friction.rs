@@ -1,0 +1,558 @@
+//! Capstan friction between the tendons and their channels, with stick and slip.
+//!
+//! A tendon with friction coefficient `μ` ([`Tendon::with_friction`]) carries a tension that
+//! varies along its path: where it slides, `|dτ/dσ| = μ τ κ_path` (σ the path's arc length,
+//! `κ_path` its curvature), the tension decreasing away from the side it slides toward; where
+//! it sticks, `|dτ/dσ| <= μ τ κ_path`. Along the rod's arc length `s`, `κ_path dσ = |dt_i|` is
+//! the turning of the path tangent `t_i`, so over a mesh cell of turning angle `Δθ`:
+//!
+//! ```text
+//! τ_{k+1} ∈ [τ_k e^(−μ Δθ), τ_k e^(+μ Δθ)],
+//! ```
+//!
+//! the lower end when the element slides toward the base (loading: pulled at the base), the
+//! upper end when it slides toward the tip (unloading), and anywhere inside when it sticks.
+//! On an arc the cell rule is the exact capstan law; at a kink of the path (where a tendon of
+//! another segment ends) it is the capstan law of a guide of that wrap angle.
+//!
+//! **History.** Without a previous state every element slides toward the base (a first
+//! loading from rest). With a previous state `τ_prev` on the same mesh, an element keeps its
+//! previous tension (sticks) if that tension is admissible, and otherwise slides, the
+//! tension clamped to the nearer end of the admissible interval:
+//! `τ_{k+1} = clamp(τ_prev,k+1, τ_k e^(−μΔθ), τ_k e^(+μΔθ))`. A sticking element keeps its
+//! tension because the tendon is taken inextensible (its own elasticity is not modelled).
+//!
+//! **Coupling with the rod.** The rod equations are in total-wrench form (see
+//! [`equations`](super::equations)): the friction force is internal to rod + tendons, so the
+//! balance `N' = −f`, `M' = −p' × N − l` holds unchanged and only the tension profile enters
+//! the constitutive split `n = N − Σ τ_i(s) t_i`. The rod therefore receives from each tendon
+//! the distributed load `d(τ_i t_i)/ds = τ_i t_i' + τ_i' t_i` (normal load plus the friction
+//! force, opposite to the friction on the tendon) and, at the termination, the point force
+//! `−τ_i(σ) t_i(σ)` with the local tension. The shape and the profile are found together by a
+//! fixed-point iteration: solve the rod for the current profile (interpolated geometrically
+//! between the mesh nodes), recompute the profile from the shape, until the tension changes by
+//! less than [`FrictionOptions::tolerance`] relative to the largest base tension.
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+use crate::cosserat::statics::{solve_statics_at, Integrator, SolveOptions, StaticsSolution};
+use crate::error::{Error, Result};
+use crate::model::actuation::TensionProfile;
+use crate::model::{Actuation, RobotModel};
+
+/// Default relative tolerance of the fixed point on the tension profile.
+pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-9;
+/// Default cap on the fixed-point iterations.
+pub const DEFAULT_FRICTION_ITERATIONS: usize = 200;
+/// Mesh nodes per interval between breaks with the adaptive integrator.
+pub const ADAPTIVE_FRICTION_NODES: usize = 32;
+/// Offset (relative to the rod length) of the node placed just before every interior break,
+/// where the path kinks and tendons end.
+pub const BREAK_OFFSET: f64 = 1e-9;
+
+/// Relative change of an element's tension from its previous state below which it is
+/// reported sticking (the tension itself is always clamped exactly).
+pub const STICK_TOLERANCE: f64 = 1e-9;
+
+/// Options of the frictional solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionOptions {
+    /// The rod solve (integrator, Newton options).
+    pub statics: SolveOptions,
+    /// Relative change of the tension profile (to the largest base tension) that ends the
+    /// fixed point.
+    pub tolerance: f64,
+    /// Cap on the fixed-point iterations.
+    pub max_iterations: usize,
+}
+
+impl Default for FrictionOptions {
+    fn default() -> Self {
+        Self {
+            statics: SolveOptions::default(),
+            tolerance: DEFAULT_FRICTION_TOLERANCE,
+            max_iterations: DEFAULT_FRICTION_ITERATIONS,
+        }
+    }
+}
+
+/// The sliding state of a tendon element.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slip {
+    /// Sliding toward the base (the tension decreases toward the tip): loading.
+    Loading,
+    /// Sliding toward the tip (the tension increases toward the tip): unloading.
+    Unloading,
+    /// Sticking: the element keeps its previous tension.
+    Stick,
+    /// No tendon there (beyond its termination).
+    Absent,
+}
+
+impl Slip {
+    /// `+1` loading, `-1` unloading, `0` sticking or absent.
+    pub fn sign(self) -> i8 {
+        match self {
+            Slip::Loading => 1,
+            Slip::Unloading => -1,
+            Slip::Stick | Slip::Absent => 0,
+        }
+    }
+}
+
+/// A frictional equilibrium: the rod solution at the friction mesh and, per node and tendon,
+/// the tension, the slip state, the path tangent and the friction force on the rod.
+#[derive(Debug, Clone)]
+pub struct FrictionalSolution {
+    /// The rod's solution, at the nodes of the friction mesh ([`friction_mesh`]); its
+    /// actuation carries the tension profile.
+    pub statics: StaticsSolution,
+    /// Tension (N) per node and tendon, `[node][tendon]`; `0` beyond a tendon's termination.
+    pub tension: Vec<Vec<f64>>,
+    /// Slip state per node and tendon.
+    pub slip: Vec<Vec<Slip>>,
+    /// Unit tangent of each tendon's path (world) per node; zero beyond its termination.
+    pub tangent: Vec<Vec<[f64; 3]>>,
+    /// Friction force on the rod per unit length of rod (N/m, world), `τ_i'(s) t_i`, per node
+    /// and tendon (the normal load `τ_i t_i'` is not included).
+    pub friction_force: Vec<Vec<[f64; 3]>>,
+    /// Fixed-point iterations (rod solves).
+    pub iterations: usize,
+    /// Last relative change of the profile.
+    pub change: f64,
+}
+
+impl FrictionalSolution {
+    /// Tip position (m, world).
+    pub fn tip_position(&self) -> [f64; 3] {
+        self.statics.tip_position()
+    }
+}
+
+/// The nodes of the friction mesh of `model` (m): with RK4 the nodes of its steps, with the
+/// adaptive integrator [`ADAPTIVE_FRICTION_NODES`] per interval, plus a node
+/// [`BREAK_OFFSET`] `L` before every interior break (the end of the tendons there and the
+/// path before its kink).
+pub fn friction_mesh(model: &RobotModel, integrator: &Integrator) -> Vec<f64> {
+    let breaks = model.breaks();
+    let l = model.length();
+    let per: Vec<usize> = match integrator {
+        Integrator::Rk4 { steps } => crate::integrate::march::rk4_plan(breaks, *steps),
+        Integrator::Adaptive(_) => vec![ADAPTIVE_FRICTION_NODES; breaks.len() - 1],
+    };
+    let mut mesh = Vec::new();
+    for (k, w) in breaks.windows(2).enumerate() {
+        let (a, b) = (w[0], w[1]);
+        let n = per[k].max(1);
+        for j in 0..n {
+            mesh.push(a + (b - a) * j as f64 / n as f64);
+        }
+        if k + 2 < breaks.len() {
+            let before = b - BREAK_OFFSET * l;
+            if before > mesh[mesh.len() - 1] {
+                mesh.push(before);
+            }
+        }
+    }
+    mesh.push(l);
+    mesh
+}
+
+/// Per node and tendon: the unit path tangent (world) and whether the tendon is there.
+fn tangents(model: &RobotModel, sol: &StaticsSolution) -> Vec<Vec<Option<Vector3<f64>>>> {
+    let l = model.length();
+    let ends = model.tendon_ends();
+    sol.s
+        .iter()
+        .enumerate()
+        .map(|(j, &s)| {
+            let r = Matrix3::from_fn(|a, b| sol.rotation[j][a][b]);
+            let v = Vector3::from(sol.v[j]);
+            let u = Vector3::from(sol.u[j]);
+            let props = model.rod().section_at(s);
+            model
+                .tendons()
+                .iter()
+                .enumerate()
+                .map(|(i, t)| {
+                    let present = s < ends[i] || (ends[i] == l && s == l);
+                    present.then(|| {
+                        let (o, op) = t.routing().offset(s, &props);
+                        let w = v
+                            + u.cross(&Vector3::new(o[0], o[1], 0.0))
+                            + Vector3::new(op[0], op[1], 0.0);
+                        (r * w).normalize()
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The angle (rad) between two unit vectors.
+fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// The capstan rule on the shape `sol`: the tension and slip state per node and tendon.
+fn profile_on(
+    model: &RobotModel,
+    sol: &StaticsSolution,
+    dirs: &[Vec<Option<Vector3<f64>>>],
+    base: &[f64],
+    previous: Option<&[Vec<f64>]>,
+) -> (Vec<Vec<f64>>, Vec<Vec<Slip>>) {
+    let n = sol.s.len();
+    let nt = base.len();
+    let mut tau = vec![vec![0.0; nt]; n];
+    let mut slip = vec![vec![Slip::Absent; nt]; n];
+    for i in 0..nt {
+        let mu = model.tendons()[i].friction();
+        tau[0][i] = base[i];
+        slip[0][i] = match previous {
+            None => Slip::Loading,
+            Some(p) if (base[i] - p[0][i]).abs() <= STICK_TOLERANCE * p[0][i] => Slip::Stick,
+            Some(p) if base[i] > p[0][i] => Slip::Loading,
+            Some(_) => Slip::Unloading,
+        };
+        for j in 1..n {
+            let (Some(ta), Some(tb)) = (&dirs[j - 1][i], &dirs[j][i]) else {
+                break;
+            };
+            let g = (mu * angle(ta, tb)).exp();
+            let (lo, hi) = (tau[j - 1][i] / g, tau[j - 1][i] * g);
+            let (t, st) = match previous {
+                None => (lo, Slip::Loading),
+                Some(p) => {
+                    let q = p[j][i];
+                    let t = q.clamp(lo, hi);
+                    // An element within rounding of its previous tension sticks.
+                    if (t - q).abs() <= STICK_TOLERANCE * q {
+                        (t, Slip::Stick)
+                    } else if q > hi {
+                        (t, Slip::Unloading)
+                    } else {
+                        (t, Slip::Loading)
+                    }
+                }
+            };
+            tau[j][i] = t;
+            slip[j][i] = st;
+        }
+    }
+    (tau, slip)
+}
+
+/// The tension profile of the frictional tendons (the others carry their base tension).
+fn to_profile(model: &RobotModel, s: &[f64], tau: &[Vec<f64>]) -> TensionProfile {
+    let nt = model.tendons().len();
+    let ends = model.tendon_ends();
+    let l = model.length();
+    TensionProfile::new(
+        (0..nt)
+            .map(|i| {
+                (model.tendons()[i].friction() > 0.0).then(|| {
+                    let (mut nodes, mut vals) = (Vec::new(), Vec::new());
+                    for (j, &sj) in s.iter().enumerate() {
+                        if sj < ends[i] || (ends[i] == l && sj == l) {
+                            nodes.push(sj);
+                            vals.push(tau[j][i]);
+                        }
+                    }
+                    (nodes, vals)
+                })
+            })
+            .collect(),
+    )
+}
+
+/// The relative change between two profiles.
+fn change(a: &[Vec<f64>], b: &[Vec<f64>], scale: f64) -> f64 {
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / scale
+}
+
+/// Checks the options and the actuation of a frictional solve.
+fn check_inputs(
+    model: &RobotModel,
+    actuation: &Actuation,
+    options: &FrictionOptions,
+) -> Result<()> {
+    if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
+        return Err(Error::invalid(
+            "friction.tolerance",
+            options.tolerance,
+            "finite and > 0",
+        ));
+    }
+    if options.max_iterations == 0 {
+        return Err(Error::invalid("friction.max_iterations", 0, ">= 1"));
+    }
+    model.check_actuation(actuation)?;
+    if let Some(i) = actuation.held().first() {
+        return Err(Error::invalid(
+            format!("tendons[{i}]"),
+            "displacement-controlled",
+            "tension-controlled (friction with displacement control is not modelled)",
+        ));
+    }
+    Ok(())
+}
+
+/// Every tendon at its base tension over its length, 0 beyond (per node and tendon).
+fn base_profile(model: &RobotModel, mesh: &[f64], base: &[f64]) -> Vec<Vec<f64>> {
+    let (ends, l) = (model.tendon_ends(), model.length());
+    mesh.iter()
+        .map(|&s| {
+            (0..base.len())
+                .map(|i| {
+                    if s < ends[i] || (ends[i] == l && s == l) {
+                        base[i]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Solves the statics of `model` under `actuation` with capstan friction along the tendons
+/// (see the module documentation), from the state `previous` (a solution of the same model
+/// and options: the history of stick and slip) or from rest (`None`: every element slides
+/// toward the base).
+///
+/// # Errors
+/// What [`solve_statics_at`] reports; [`Error::InvalidParameter`] naming `previous` if it is
+/// on another mesh, or `friction.tolerance` / `friction.max_iterations`;
+/// [`Error::NotConverged`] if the fixed point does not converge (`what` says so, `iterations`
+/// are the rod solves, `residual` the last relative change of the profile).
+pub fn solve_frictional(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &FrictionOptions,
+    previous: Option<&FrictionalSolution>,
+) -> Result<FrictionalSolution> {
+    check_inputs(model, actuation, options)?;
+    let nt = model.tendons().len();
+    let base = actuation.tension_values(nt);
+    let mesh = friction_mesh(model, &options.statics.integrator);
+    let prev = match previous {
+        Some(p) => {
+            if p.statics.s != mesh || p.tension.first().map_or(0, Vec::len) != nt {
+                return Err(Error::invalid(
+                    "previous",
+                    format!("a solution on {} nodes", p.statics.s.len()),
+                    format!(
+                        "a frictional solution of the same robot and integrator ({} nodes, \
+                         {nt} tendons)",
+                        mesh.len()
+                    ),
+                ));
+            }
+            Some(p.tension.as_slice())
+        }
+        None => None,
+    };
+    let scale = base
+        .iter()
+        .fold(0.0, |a: f64, &b| a.max(b))
+        .max(f64::MIN_POSITIVE);
+    // The first profile: the rule on the previous shape, or the base tensions.
+    let mut tau = match previous {
+        Some(p) => {
+            let dirs = tangents(model, &p.statics);
+            profile_on(model, &p.statics, &dirs, &base, prev).0
+        }
+        None => base_profile(model, &mesh, &base),
+    };
+    let mut statics_options = options.statics;
+    // Without external loads the zero base wrench is exact (docs/statics.md): no warm start.
+    let loaded = !model.loads().is_unloaded();
+    if let Some(p) = previous.filter(|_| loaded) {
+        statics_options.warm_start = Some(p.statics.warm_start());
+    }
+    let mut iterations = 0;
+    let mut anderson = Anderson::new();
+    loop {
+        let mut act = actuation.clone();
+        act.profile = Some(Arc::new(to_profile(model, &mesh, &tau)));
+        let sol = solve_statics_at(model, &act, &statics_options, &mesh)?;
+        iterations += 1;
+        let dirs = tangents(model, &sol);
+        let (next, slip) = profile_on(model, &sol, &dirs, &base, prev);
+        let delta = change(&next, &tau, scale);
+        if !delta.is_finite() {
+            return Err(Error::NotConverged {
+                what: "friction: the tension profile became non-finite".into(),
+                iterations,
+                residual: delta,
+                load_factor: sol.stats.load_factor,
+            });
+        }
+        if delta <= options.tolerance {
+            let forces = friction_forces(&sol.s, &next, &dirs);
+            let tangent = dirs
+                .iter()
+                .map(|row| {
+                    row.iter()
+                        .map(|t| t.map_or([0.0; 3], |t| [t.x, t.y, t.z]))
+                        .collect()
+                })
+                .collect();
+            return Ok(FrictionalSolution {
+                statics: sol,
+                tension: next,
+                slip,
+                tangent,
+                friction_force: forces,
+                iterations,
+                change: delta,
+            });
+        }
+        if iterations >= options.max_iterations {
+            return Err(Error::NotConverged {
+                what: format!(
+                    "friction: the tension profile did not settle in {iterations} rod solves \
+                     (relative change {delta:e} > tolerance {:e})",
+                    options.tolerance
+                ),
+                iterations,
+                residual: delta,
+                load_factor: sol.stats.load_factor,
+            });
+        }
+        if loaded {
+            statics_options.warm_start = Some(sol.warm_start());
+        }
+        tau = anderson.update(&tau, next);
+    }
+}
+
+/// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of the fixed point `x = g(x)` on
+/// the tension profile: the next iterate combines the last images so as to minimise the
+/// linearised residual `g(x) - x` (Walker & Ni, SIAM J. Numer. Anal. 49(4), 2011). The rule
+/// is applied to the rod's shape at every iterate, so the accepted profile always satisfies
+/// the capstan bounds; the acceleration only chooses where the rod is solved next.
+struct Anderson {
+    /// Past residuals `f = g(x) - x` and images `g(x)` (flattened profiles).
+    f: Vec<Vec<f64>>,
+    g: Vec<Vec<f64>>,
+}
+
+/// Depth of the Anderson acceleration.
+const ANDERSON_DEPTH: usize = 3;
+
+impl Anderson {
+    fn new() -> Self {
+        Self {
+            f: Vec::new(),
+            g: Vec::new(),
+        }
+    }
+
+    /// The next iterate from the current `x` and its image `gx`.
+    fn update(&mut self, x: &[Vec<f64>], gx: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let flat_g: Vec<f64> = gx.iter().flatten().copied().collect();
+        let flat_f: Vec<f64> = flat_g
+            .iter()
+            .zip(x.iter().flatten())
+            .map(|(g, x)| g - x)
+            .collect();
+        self.f.push(flat_f);
+        self.g.push(flat_g);
+        if self.f.len() > ANDERSON_DEPTH + 1 {
+            self.f.remove(0);
+            self.g.remove(0);
+        }
+        let m = self.f.len() - 1;
+        if m == 0 {
+            return gx;
+        }
+        let n = self.f[0].len();
+        let last = &self.f[m];
+        // Differences of consecutive residuals and images.
+        let df = DMatrix::from_fn(n, m, |r, c| self.f[c + 1][r] - self.f[c][r]);
+        let dg = DMatrix::from_fn(n, m, |r, c| self.g[c + 1][r] - self.g[c][r]);
+        let rhs = DVector::from_column_slice(last);
+        let Ok(gamma) = df.clone().svd(true, true).solve(&rhs, 1e-12) else {
+            return gx;
+        };
+        let next = DVector::from_column_slice(&self.g[m]) - dg * gamma;
+        if !next.iter().all(|v| v.is_finite()) {
+            self.f.clear();
+            self.g.clear();
+            return gx;
+        }
+        let cols = gx.first().map_or(0, Vec::len);
+        next.as_slice()
+            .chunks(cols.max(1))
+            .zip(&gx)
+            .map(|(row, g)| {
+                row.iter()
+                    .zip(g)
+                    // A tendon absent at a node stays absent; tensions stay >= 0.
+                    .map(|(v, g)| if *g == 0.0 { 0.0 } else { v.max(0.0) })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// `τ_i'(s) t_i` at the nodes (N/m): the slope of `ln τ` over the neighbouring cells longer
+/// than the break offset, times `τ`.
+fn friction_forces(
+    s: &[f64],
+    tau: &[Vec<f64>],
+    dirs: &[Vec<Option<Vector3<f64>>>],
+) -> Vec<Vec<[f64; 3]>> {
+    let n = s.len();
+    let nt = tau.first().map_or(0, Vec::len);
+    let tiny = BREAK_OFFSET * 10.0 * s[n - 1];
+    let mut out = vec![vec![[0.0; 3]; nt]; n];
+    for i in 0..nt {
+        for j in 0..n {
+            let Some(t) = dirs[j][i] else { continue };
+            let mut slopes = Vec::with_capacity(2);
+            for (a, b) in [(j.wrapping_sub(1), j), (j, j + 1)] {
+                if a >= n || b >= n || s[b] - s[a] <= tiny || dirs[a][i].is_none() {
+                    continue;
+                }
+                if dirs[b][i].is_none() {
+                    continue;
+                }
+                slopes.push((tau[b][i] - tau[a][i]) / (s[b] - s[a]));
+            }
+            if slopes.is_empty() {
+                continue;
+            }
+            let d = slopes.iter().sum::<f64>() / slopes.len() as f64;
+            out[j][i] = [d * t.x, d * t.y, d * t.z];
+        }
+    }
+    out
+}
+
+/// Solves a quasi-static actuation path with friction: each actuation from the equilibrium of
+/// the one before (the first from rest), so that stick and slip follow the history.
+///
+/// # Errors
+/// What [`solve_frictional`] reports, for the first actuation that fails.
+pub fn solve_path(
+    model: &Arc<RobotModel>,
+    actuations: &[Actuation],
+    options: &FrictionOptions,
+) -> Result<Vec<FrictionalSolution>> {
+    let mut out: Vec<FrictionalSolution> = Vec::with_capacity(actuations.len());
+    for a in actuations {
+        let next = solve_frictional(model, a, options, out.last())?;
+        out.push(next);
+    }
+    Ok(out)
+}

@@ -1,0 +1,246 @@
+//! Unilateral frictionless contact with obstacles, against beam theory: a cantilever pushed
+//! onto a parallel plane at its tip; every contact solution checked for penetration, the sign
+//! and direction of the forces and global balance.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+mod common;
+
+use softrod::nalgebra::Vector3;
+use softrod::{
+    solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, Obstacle,
+    RobotModel, Rod, Section, SolveOptions,
+};
+
+const E: f64 = 2e9;
+const NU: f64 = 0.3;
+const L: f64 = 1.0;
+
+fn rod(radius: f64) -> Rod {
+    Rod::new(
+        L,
+        Section::circular(radius).unwrap(),
+        LinearElastic::new(E, NU).unwrap(),
+    )
+    .unwrap()
+}
+
+fn options(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        ..SolveOptions::default()
+    }
+}
+
+/// The checks of every contact solution: no penetration beyond 1e-9 m at any node,
+/// non-negative normal forces along the obstacle normal, and the base wrench equal to the
+/// applied tip force and the contact forces (about the base) to 1e-10 of `scale`.
+fn assert_contact_solution(
+    sol: &ContactSolution,
+    obstacles: &[Obstacle],
+    radius: f64,
+    applied: &[(Vector3<f64>, Vector3<f64>)],
+    scale: f64,
+) {
+    for p in &sol.solution.position {
+        for o in obstacles {
+            let g = o.distance(&Vector3::from(*p)).0 - radius;
+            assert!(g >= -1e-9, "penetration {g:e} at {p:?}");
+        }
+    }
+    let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
+    for c in &sol.contacts {
+        assert!(c.normal_force >= 0.0, "pulling contact {c:?}");
+        assert!(c.tangential_force.iter().all(|t| *t == 0.0));
+        let (_, n) = obstacles[c.obstacle].distance(&Vector3::from(c.point));
+        assert!((n - Vector3::from(c.normal)).norm() < 1e-9);
+    }
+    let total: Vector3<f64> = sol.contact_force.iter().map(|v| Vector3::from(*v)).sum();
+    let by_contact: Vector3<f64> = sol
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.normal) * c.normal_force)
+        .sum();
+    assert!((total - by_contact).norm() <= 1e-12 * scale);
+    for (j, cf) in sol.contact_force.iter().enumerate() {
+        let cf = Vector3::from(*cf);
+        f += cf;
+        m += Vector3::from(sol.solution.position[j]).cross(&cf);
+    }
+    for (p, force) in applied {
+        f += force;
+        m += p.cross(force);
+    }
+    let b = sol.solution.base_wrench;
+    for k in 0..3 {
+        assert!(
+            (b[k] - f[k]).abs() <= 1e-10 * scale,
+            "force {k}: {} vs {}",
+            b[k],
+            f[k]
+        );
+        assert!(
+            (b[3 + k] - m[k]).abs() <= 1e-10 * scale * L,
+            "moment {k}: {} vs {}",
+            b[3 + k],
+            m[k]
+        );
+    }
+}
+
+/// A cantilever along z pushed by a tip force toward the plane x = -(R + δ) (normal +x):
+/// no contact below the force 3 E I δ / L³ that closes the gap, and beyond it a tip reaction
+/// R = F - 3 E I δ / L³ (slender rod: shear below 1e-5 of it).
+#[test]
+fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let closing = 3.0 * ei * delta / L.powi(3);
+    let plane = Obstacle::plane([-(radius + delta), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    let obstacles = [plane];
+    for factor in [0.5, 0.99, 1.5, 2.0, 4.0] {
+        let force = Vector3::new(-factor * closing, 0.0, 0.0);
+        let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+        let sol = solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(100),
+            None,
+            &obstacles,
+        )
+        .unwrap();
+        assert!(sol.solution.stats.converged);
+        let tip = Vector3::from(sol.solution.tip_position());
+        assert_contact_solution(&sol, &obstacles, radius, &[(tip, force)], closing);
+        if factor < 1.0 {
+            assert!(sol.contacts.is_empty(), "contact at F = {factor} F_c");
+            let gap = plane.distance(&tip).0 - radius;
+            assert!(gap > 0.0);
+            continue;
+        }
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        let c = sol.contacts[0];
+        assert_eq!(c.s, L);
+        let exact = (factor - 1.0) * closing;
+        let err = (c.normal_force / exact - 1.0).abs();
+        assert!(
+            err < 1e-4,
+            "F = {factor} F_c: R = {:e} vs {exact:e} ({err:e})",
+            c.normal_force
+        );
+        println!(
+            "tip contact F = {factor} F_c: R = {:e}, closed form {exact:e}, rel. error {err:e}",
+            c.normal_force
+        );
+    }
+}
+
+/// A cantilever under a uniform load q above a frictionless floor at surface gap δ: it lies
+/// on the floor from a = (72 E I δ / q)^(1/4) to the tip, with a concentrated reaction q a / 3
+/// at the edge and the distributed reaction q beyond; the base, the edge and the floor carry
+/// the total load q L.
+#[test]
+fn distributed_contact_with_a_floor_is_the_beam_closed_form() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let floor = Obstacle::plane([-(radius + delta), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    let obstacles = [floor];
+    // Below 8 E I δ / L⁴ the tip does not reach the floor.
+    for a_exact in [f64::INFINITY, 0.8 * L, 0.5 * L, 0.3 * L] {
+        let q = if a_exact.is_finite() {
+            72.0 * ei * delta / a_exact.powi(4)
+        } else {
+            4.0 * ei * delta / L.powi(4)
+        };
+        let loads = Loads {
+            distributed_force: Some(softrod::Profile::Constant(Vector3::new(-q, 0.0, 0.0))),
+            ..Loads::default()
+        };
+        let model = RobotModel::rod_only(rod(radius), loads).unwrap();
+        let sol = solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(400),
+            None,
+            &obstacles,
+        )
+        .unwrap();
+        assert!(sol.solution.stats.converged);
+        if !a_exact.is_finite() {
+            assert!(sol.contacts.is_empty());
+            continue;
+        }
+        let edge = sol.contacts.iter().find(|c| c.length == 0.0).unwrap();
+        let err_a = (edge.s / a_exact - 1.0).abs();
+        let err_r = (edge.normal_force / (q * a_exact / 3.0) - 1.0).abs();
+        let floor_part: f64 = sol
+            .contacts
+            .iter()
+            .filter(|c| c.length > 0.0)
+            .map(|c| c.normal_force)
+            .sum();
+        println!(
+            "floor contact a = {:.5} (exact {a_exact:.5}, err {err_a:e}); edge reaction {:e} \
+             (q a/3 = {:e}, err {err_r:e}); floor {floor_part:e} (q (L - a) = {:e})",
+            edge.s,
+            edge.normal_force,
+            q * a_exact / 3.0,
+            q * (L - a_exact)
+        );
+        assert!(err_a < 1e-2, "free length {} vs {a_exact}", edge.s);
+        assert!(err_r < 3e-2, "edge reaction");
+        for p in &sol.solution.position {
+            let g = floor.distance(&Vector3::from(*p)).0 - radius;
+            assert!(g >= -1e-9, "penetration {g:e}");
+        }
+        // Global force balance: base force (the base wrench is what the base carries) and the
+        // contact forces against the load q L.
+        let contact: Vector3<f64> = sol.contact_force.iter().map(|v| Vector3::from(*v)).sum();
+        let b = sol.solution.base_wrench;
+        let fx = b[0] - (contact.x - q * L);
+        assert!(fx.abs() <= 1e-10 * q * L, "force balance {fx:e}");
+    }
+}
+
+/// A cantilever pushed at its tip onto a sphere beside its middle: one interior contact at
+/// the point of least gap, whose force is the propped-cantilever reaction
+/// `R = (F c² (3L - c) / (6 E I) - δ) 3 E I / c³` (c the height of the sphere's centre, δ the
+/// surface gap there).
+#[test]
+fn interior_contact_with_a_sphere_is_the_propped_cantilever() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let (c, rs) = (0.6 * L, 0.05 * L);
+    let sphere = Obstacle::sphere([-(radius + delta + rs), 0.0, c], rs).unwrap();
+    let obstacles = [sphere];
+    let closing = delta * 6.0 * ei / (c * c * (3.0 * L - c));
+    for factor in [0.8, 1.5, 3.0] {
+        let force = Vector3::new(-factor * closing, 0.0, 0.0);
+        let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+        let sol = solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(200),
+            None,
+            &obstacles,
+        )
+        .unwrap();
+        assert!(sol.solution.stats.converged);
+        let tip = Vector3::from(sol.solution.tip_position());
+        assert_contact_solution(&sol, &obstacles, radius, &[(tip, force)], closing);
+        if factor < 1.0 {
+            assert!(sol.contacts.is_empty());
+            continue;
+        }
+        assert_eq!(sol.contacts.len(), 1);
+        let k = sol.contacts[0];
+        assert!((k.s - c).abs() < 1e-2 * L, "contact at {}", k.s);
+        let f = factor * closing;
+        let exact = (f * c * c * (3.0 * L - c) / (6.0 * ei) - delta) * 3.0 * ei / c.powi(3);
+        let err = (k.normal_force / exact - 1.0).abs();
+        println!("sphere contact F = {factor} F_c at s = {:.6}: R = {:e}, propped cantilever {exact:e}, rel. error {err:e}", k.s, k.normal_force);
+        assert!(err < 1e-3, "R = {:e} vs {exact:e}", k.normal_force);
+    }
+}

@@ -1,0 +1,93 @@
+//! Robustness of contact: the two-segment NiTi robot driven into a sphere by random tendon
+//! tensions, solved from a straight initial guess (no warm start).
+#![allow(clippy::unwrap_used, missing_docs)]
+
+mod common;
+
+use softrod::nalgebra::Vector3;
+use softrod::{solve_constrained, Loads, Obstacle, SolveOptions};
+
+/// A small deterministic generator (xorshift64*), so the sample is reproducible.
+struct Rng(u64);
+
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Fraction of the tension vectors whose contact-free shape penetrates the sphere that the
+/// contact solve converges for, and how many penetrated.
+fn run(samples: usize, seed: u64, sphere: Obstacle) -> (usize, usize, Vec<[f64; 6]>) {
+    let rod = common::niti_rod();
+    let obstacles = [sphere];
+    let mut rng = Rng(seed);
+    let (mut touching, mut solved) = (0, 0);
+    let mut failed = Vec::new();
+    let options = SolveOptions::default();
+    for _ in 0..samples {
+        let t: [f64; 6] = std::array::from_fn(|_| 3.0 * rng.uniform());
+        let tendons = common::niti_tendons(&t);
+        let (model, act) = common::split(&rod, &tendons, &[], &Loads::default()).unwrap();
+        let free = softrod::solve_statics(&model, &act, &options).unwrap();
+        let radius = 0.7e-3;
+        let penetrates = free
+            .position
+            .iter()
+            .any(|p| sphere.distance(&Vector3::from(*p)).0 < radius);
+        if !penetrates {
+            continue;
+        }
+        touching += 1;
+        match solve_constrained(&model, &act, &options, None, &obstacles) {
+            Ok(sol) if sol.solution.stats.converged => {
+                let ok = sol
+                    .solution
+                    .position
+                    .iter()
+                    .all(|p| sphere.distance(&Vector3::from(*p)).0 - radius >= -1e-9)
+                    && sol.contacts.iter().all(|c| c.normal_force >= 0.0)
+                    && !sol.contacts.is_empty();
+                if ok {
+                    solved += 1;
+                } else {
+                    failed.push(t);
+                }
+            }
+            _ => failed.push(t),
+        }
+    }
+    (touching, solved, failed)
+}
+
+#[test]
+fn niti_robot_into_a_sphere_converges_from_a_straight_guess() {
+    let sphere = Obstacle::sphere([0.06, 0.0, 0.3], 0.04).unwrap();
+    let (touching, solved, failed) = run(200, 0x5eed, sphere);
+    println!("{solved} of {touching} contact solves converged; failed: {failed:?}");
+    assert!(touching >= 20, "only {touching} samples touch the sphere");
+    assert!(
+        solved as f64 >= 0.99 * touching as f64,
+        "{solved} of {touching}"
+    );
+}
+
+/// The sample size (run with `--ignored`).
+#[test]
+#[ignore = "1,000 random tension vectors: a long run"]
+fn niti_robot_into_a_sphere_converges_for_1000_tension_vectors() {
+    for sphere in [
+        Obstacle::sphere([0.06, 0.0, 0.3], 0.04).unwrap(),
+        Obstacle::sphere([0.0, 0.07, 0.25], 0.06).unwrap(),
+    ] {
+        let (touching, solved, failed) = run(1000, 0x5eed, sphere);
+        println!("{sphere:?}: {solved} of {touching} contact solves converged; failed: {failed:?}");
+        assert!(
+            solved as f64 >= 0.99 * touching as f64,
+            "{solved} of {touching}"
+        );
+    }
+}

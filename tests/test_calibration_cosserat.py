@@ -1,0 +1,190 @@
+"""Calibration of Cosserat robots: recovery of known parameters of the NiTi tendon robot and of
+a hyperelastic pneumatic arm from noise-free shapes and tips, the exact Jacobian (linearised
+boundary-value problem) against central differences of full solves, the stiffness-load identity
+and identifiability."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod.analysis import calibration as cal
+
+TENSIONS = [
+    [4.0, 0.0, 0.0, 0.0, 2.0, 0.0],
+    [0.0, 3.0, 0.0, 0.0, 0.0, 1.0],
+    [0.0, 0.0, 3.0, 1.5, 0.0, 0.0],
+    [2.0, 2.0, 0.0, 0.0, 1.0, 1.0],
+    [1.0, 0.0, 2.0, 2.0, 0.0, 0.5],
+]
+S = np.linspace(0.0, 0.4, 30)
+
+
+@pytest.fixture(scope="module")
+def niti():
+    return softrod.load_robot(softrod.examples.path("niti_two_segment"))
+
+
+@pytest.fixture(scope="module")
+def truth(niti):
+    return niti.with_parameters({"rod.material.youngs_modulus": 50e9, "tendons[0].distance": 0.011})
+
+
+def rel(a, b):
+    return abs(a / b - 1.0)
+
+
+def pneumatic(mu=60e3, area=2.0e-5):
+    return softrod.Robot.from_dict(
+        {
+            "rod": {
+                "length": 0.12,
+                "section": {"type": "circular", "radius": 0.01},
+                "material": {"type": "neo_hookean", "mu": mu},
+            },
+            "chambers": [
+                {"pressure": 0.0, "area": area, "distance": 0.005, "angle_deg": 0.0},
+                {"pressure": 0.0, "area": 2.0e-5, "distance": 0.005, "angle_deg": 120.0},
+                {"pressure": 0.0, "area": 2.0e-5, "distance": 0.005, "angle_deg": 240.0},
+            ],
+        }
+    )
+
+
+def test_markers_on_the_niti_robot_recover_e_and_a_tendon_distance(niti, truth):
+    data = [(t, truth.solve(t, s_out=S).position, S) for t in TENSIONS]
+    names = ["rod.material.youngs_modulus", "tendons[0].distance"]
+    c = softrod.calibrate(niti, data, names)
+    assert rel(c.values["rod.material.youngs_modulus"], 50e9) < 1e-6
+    assert rel(c.values["tendons[0].distance"], 0.011) < 1e-6
+    assert c.residuals[0].shape == (30, 3)
+    assert isinstance(c.robot, softrod.Robot)
+    assert rel(c.robot.parameter("rod.material.youngs_modulus"), 50e9) < 1e-6
+
+
+def test_backbones_at_equal_arm_index_recover_e(niti):
+    truth = niti.with_parameters({"rod.material.youngs_modulus": 50e9})
+    data = [(t, truth.solve(t, s_out=S).position) for t in TENSIONS]
+    c = softrod.calibrate(niti, data, ["youngs_modulus"])
+    # The undeformed arm index differs from the measured (deformed) one by the axial strain
+    # of NiTi under the tendons (~5e-5): the floor of this metric on a Cosserat rod.
+    assert rel(c.values["rod.material.youngs_modulus"], 50e9) < 1e-4
+
+
+def test_tip_poses_recover_e_and_a_base_rotation(niti):
+    truth = niti.with_parameters({"rod.material.youngs_modulus": 50e9})
+    tilt = truth.with_parameters({"rod.base_pose.rotation": cal_rot_x(0.02).tolist()})
+    data = []
+    for t in TENSIONS:
+        sol = tilt.solve(t)
+        pose = np.eye(4)
+        pose[:3, :3], pose[:3, 3] = sol.tip_rotation, sol.tip_position
+        data.append((t, pose))
+    c = softrod.calibrate(niti, data, ["rod.material.youngs_modulus", "base_rotation_x"])
+    assert rel(c.values["rod.material.youngs_modulus"], 50e9) < 1e-6
+    assert abs(c.values["base_rotation_x"] - 0.02) < 1e-8
+    assert c.residuals[0].shape == (6,)
+
+
+def cal_rot_x(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def test_hyperelastic_pneumatic_arm_recovers_mu_and_a_chamber_area():
+    truth = pneumatic(mu=75e3, area=2.4e-5)
+    pressures = [[20e3, 0.0, 0.0], [0.0, 20e3, 5e3], [10e3, 0.0, 20e3], [15e3, 15e3, 0.0]]
+    s = np.linspace(0.0, 0.12, 20)
+    data = [({"pressures": p}, truth.solve(pressures=p, s_out=s).position, s) for p in pressures]
+    c = softrod.calibrate(pneumatic(), data, ["rod.material.mu", "chambers[0].area"])
+    assert rel(c.values["rod.material.mu"], 75e3) < 1e-6
+    assert rel(c.values["chambers[0].area"], 2.4e-5) < 1e-6
+
+
+def test_jacobian_matches_central_differences_of_full_solves(niti):
+    rng = np.random.default_rng(2)
+    s = np.linspace(0.0, 0.4, 12) + 0.004
+    s[-1] = 0.4
+    data = [
+        (t, niti.solve(t, s_out=s).position + rng.normal(0, 1e-3, (12, 3)), s) for t in TENSIONS[:2]
+    ]
+    data.append((TENSIONS[2], niti.solve(TENSIONS[2], s_out=s).position + 1e-3))
+    sol = niti.solve(TENSIONS[3])
+    pose = np.eye(4)
+    pose[:3, :3] = cal_rot_x(0.05) @ sol.tip_rotation
+    pose[:3, 3] = sol.tip_position + 1e-3
+    data.append((TENSIONS[3], pose))
+    names = [
+        "rod.material.youngs_modulus",
+        "tendons[0].distance",
+        "tension_scale",
+        "tendon_offset_scale",
+        "base_rotation_y",
+    ]
+    values = {
+        "rod.material.youngs_modulus": 50e9,
+        "tendons[0].distance": 0.011,
+        "tension_scale": 1.1,
+        "tendon_offset_scale": 0.95,
+        "base_rotation_y": 0.01,
+    }
+    model = cal._model_for(niti)
+    meas = cal._measurements(data, None, 3, model.check_actuation)
+    _, jac, _ = cal._stack(model, values, names, meas, "arm-index")
+    for j, n in enumerate(names):
+        h = 1e-5 * max(abs(values[n]), 0.1)
+        plus, minus = dict(values), dict(values)
+        plus[n] += h
+        minus[n] -= h
+        fd = (
+            cal._stack(model, plus, names, meas, "arm-index")[0]
+            - cal._stack(model, minus, names, meas, "arm-index")[0]
+        ) / (2 * h)
+        err = np.max(np.abs(jac[:, j] - fd)) / np.max(np.abs(fd))
+        assert err < 1e-6, (n, err)
+
+
+def test_stiffness_column_is_minus_the_sum_of_the_load_columns(niti):
+    # A linear-elastic (or stress-scaled) rod under actuation loads only: scaling every
+    # modulus and every load by the same factor leaves the equilibrium unchanged, so
+    # E d/dE = -(sum of T_i d/dT_i + sum of p_j d/dp_j) exactly.
+    sol = niti.solve(TENSIONS[3])
+    d = sol.sensitivities(["stiffness_scale", "tension_scale"])
+    pose = d["pose"]
+    assert np.max(np.abs(pose[:, :, 0] + pose[:, :, 1])) < 1e-10 * np.max(np.abs(pose))
+    p = [20e3, 5e3, 0.0]
+    sol = pneumatic().solve(pressures=p)
+    d = sol.sensitivities(["stiffness_scale", "pressure[0]", "pressure[1]", "pressure[2]"])
+    pose = d["pose"]
+    loads = sum(p[j] * pose[:, :, 1 + j] for j in range(3))
+    assert np.max(np.abs(pose[:, :, 0] + loads)) < 1e-10 * np.max(np.abs(pose))
+
+
+def test_modulus_with_tension_scale_is_not_identifiable(niti, truth):
+    data = [(t, truth.solve(t, s_out=S).position, S) for t in TENSIONS]
+    with pytest.warns(softrod.IdentifiabilityWarning, match="tension_scale"):
+        c = softrod.calibrate(niti, data, ["rod.material.youngs_modulus", "tension_scale"])
+    assert not c.identifiable
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        ({"parameters": ["rod.material.poisson_ratio"]}, "poisson_ratio"),
+        ({"parameters": ["tendons[9].distance"]}, "tendons\\[9\\]"),
+        ({"parameters": ["rod.length"]}, "rod.length"),
+        ({"metric": "nearest"}, "nearest"),
+        ({"measurements": [([1.0, 2.0], np.linspace([0, 0, 0], [0, 0, 0.4], 5))]}, "6 tendons"),
+        ({"measurements": [(TENSIONS[0], np.zeros((5, 2)))]}, "measurements\\[0\\]"),
+        ({"measurements": [(TENSIONS[0], np.ones((3, 3)), [0.1, 0.2])]}, "arc length"),
+    ],
+)
+def test_bad_input_is_a_named_error(niti, args, match):
+    kwargs = {
+        "measurements": [(TENSIONS[0], niti.solve(TENSIONS[0], s_out=S).position)],
+        "parameters": ["youngs_modulus"],
+    }
+    kwargs.update(args)
+    with pytest.raises(softrod.ParameterError, match=match):
+        softrod.calibrate(niti, kwargs.pop("measurements"), kwargs.pop("parameters"), **kwargs)

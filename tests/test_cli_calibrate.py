@@ -1,0 +1,61 @@
+"""``softrod calibrate``: the fit from backbone CSVs, outputs, exit codes, files it must not
+touch."""
+
+import json
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod.cli import main
+
+TRUTH = softrod.PlanarCableArm(0.27, 0.015, 0.0074, 0.3, 140e3)
+
+
+@pytest.fixture
+def csvs(tmp_path):
+    paths = []
+    for t in (0.5, 1.0, 2.0):
+        sol = TRUTH.solve(t, 80)
+        p = tmp_path / f"shape-{t}.csv"
+        # millimetres, with a header, as a lab's digitised backbone
+        np.savetxt(p, np.column_stack([sol.x, sol.y]) * 1e3, delimiter=",", header="x,y")
+        paths.append((t, p))
+    return paths
+
+
+def test_planar_fit_from_csvs_prints_and_writes_json(csvs, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "fit.json"
+    args = ["calibrate", "planar", "--measurements", *(f"{t}:{p}" for t, p in csvs)]
+    args += ["--parameters", "E", "a", "--unit-scale", "1e-3", "--json", str(out)]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "youngs_modulus" in text and "correlation" in text
+    fit = json.loads(out.read_text())
+    assert abs(fit["values"]["youngs_modulus"] / 140e3 - 1) < 1e-6
+    assert abs(fit["values"]["offset_ratio"] / 0.3 - 1) < 1e-6
+    before = out.read_text()
+    assert main(args) == 2  # refuses to overwrite
+    assert out.read_text() == before
+    assert main([*args, "--overwrite"]) == 0
+
+
+def test_bad_input_exits_2_with_the_option(csvs, capsys):
+    t, p = csvs[0]
+    assert main(["calibrate", "planar", "--measurements", f"{t}:{p}", "--parameters", "Q"]) == 2
+    assert "parameters" in capsys.readouterr().err
+    assert main(["calibrate", "planar", "--measurements", f"x:{p}", "--parameters", "E"]) == 2
+    assert "--measurements" in capsys.readouterr().err
+    assert main(["calibrate", "planar", "--measurements", "1:none.csv", "--parameters", "E"]) == 2
+    args = ["calibrate", "planar", "--measurements", f"{t}:{p}", "--parameters", "E"]
+    assert main([*args, "--bounds", "E=1"]) == 2
+    assert "--bounds" in capsys.readouterr().err
+
+
+def test_not_identifiable_is_a_warning_line(csvs, capsys):
+    args = ["calibrate", "planar", "--measurements", *(f"{t}:{p}" for t, p in csvs)]
+    args += ["--parameters", "E", "tension_scale", "--unit-scale", "1e-3"]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "softrod: warning: the measurements cannot determine" in err

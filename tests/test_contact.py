@@ -1,0 +1,94 @@
+"""Contact and end constraints from Python: the tip-contact oracle, clamped and pinned tips,
+obstacles in a Robot and in robot files, pickling."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import softrod as sr
+
+E, NU, R, L = 2e9, 0.3, 1e-3, 1.0
+EI = E * np.pi * R**4 / 4
+
+
+def _rod():
+    return sr.Rod(L, sr.CircularSection(R), sr.LinearElastic(E, NU))
+
+
+def test_tip_contact_reaction_is_the_cantilever_closed_form():
+    delta = 1e-3
+    closing = 3 * EI * delta / L**3
+    plane = sr.Plane((-(R + delta), 0.0, 0.0), (1.0, 0.0, 0.0))
+    sol = sr.solve_statics(
+        _rod(), loads=sr.Loads(tip_force=(-2 * closing, 0, 0)), obstacles=[plane], steps=100
+    )
+    assert len(sol.contacts) == 1
+    c = sol.contacts[0]
+    assert c["s"] == L and c["normal"] == [1.0, 0.0, 0.0]
+    assert abs(c["normal_force"] / closing - 1) < 1e-4
+    assert sol.contact_force.shape == (len(sol.s), 3)
+    np.testing.assert_allclose(sol.contact_force.sum(axis=0), [c["normal_force"], 0, 0])
+    free = sr.solve_statics(
+        _rod(), loads=sr.Loads(tip_force=(-0.5 * closing, 0, 0)), obstacles=[plane]
+    )
+    assert free.contacts == [] and not free.contact_force.any()
+    assert free.tip_reaction is None
+
+
+def test_clamped_clamped_midspan_and_pin():
+    p = 1e-8
+    loads = sr.Loads(point_loads=[sr.PointLoad(0.5, (p, 0.0, 0.0))])
+    pose = np.eye(4)
+    pose[2, 3] = L
+    sol = sr.solve_statics(_rod(), loads=loads, tip_constraint=sr.Clamp(pose), steps=200)
+    mid = sol.position[np.flatnonzero(sol.s == 0.5)[-1]]
+    assert abs(mid[0] / (p * L**3 / (192 * EI)) - 1) < 1e-3
+    assert sol.tip_reaction.shape == (6,) and sol.stable
+    pinned = sr.solve_statics(_rod(), loads=loads, tip_constraint=sr.Pin((0, 0, L)), steps=200)
+    mid = pinned.position[np.flatnonzero(pinned.s == 0.5)[-1]]
+    assert abs(mid[0] / (7 * p * L**3 / (768 * EI)) - 1) < 1e-3
+    # A solution with a constraint pickles (by solving again).
+    again = pickle.loads(pickle.dumps(pinned))
+    np.testing.assert_array_equal(again.position, pinned.position)
+
+
+def test_bad_obstacles_and_constraints_are_named():
+    with pytest.raises(sr.ParameterError, match="radius"):
+        sr.Sphere((0, 0, 0), -1.0)
+    with pytest.raises(sr.ParameterError, match="normal"):
+        sr.Plane((0, 0, 0), (0, 0, 0))
+    with pytest.raises(sr.ParameterError, match="pose"):
+        sr.Clamp(np.ones((4, 4)))
+    with pytest.raises(sr.ParameterError, match="obstacles"):
+        sr.solve_statics(_rod(), obstacles=3.0)
+    with pytest.raises((sr.ParameterError, TypeError), match="tip_constraint"):
+        sr.solve_statics(_rod(), tip_constraint="clamp")
+    with pytest.raises(sr.ParameterError, match="s_out"):
+        sr.solve_statics(_rod(), obstacles=[sr.Plane((0, 0, -1), (0, 0, 1))], s_out=[0.5])
+
+
+def test_robot_and_robot_file_carry_obstacles():
+    plane = sr.Plane((-(R + 1e-3), 0.0, 0.0), (1.0, 0.0, 0.0))
+    robot = sr.Robot(
+        _rod(), loads=sr.Loads(tip_force=(-4 * 3 * EI * 1e-3, 0, 0)), obstacles=[plane]
+    )
+    sol = robot.solve()
+    assert len(sol.contacts) == 1
+    text = robot.to_toml()
+    assert "[[obstacles]]" in text
+    back = sr.Robot.from_toml(text)
+    assert back.obstacles == (plane,)
+    np.testing.assert_allclose(back.solve().position, sol.position)
+    data = {
+        "rod": {
+            "length": 1.0,
+            "section": {"radius": R},
+            "material": {"youngs_modulus": E, "poisson_ratio": NU},
+        },
+        "tip_constraint": {"type": "pin", "point": [0.0, 0.0, 1.0]},
+        "obstacles": [{"type": "sphere", "center": [0.0, 0.1, 0.5], "radius": 0.01}],
+    }
+    r2 = sr.Robot.from_dict(data)
+    assert isinstance(r2.tip_constraint, sr.Pin) and isinstance(r2.obstacles[0], sr.Sphere)
+    assert r2.solve().tip_reaction is not None
