@@ -3,8 +3,10 @@
 Rows: the forward solve; the exact actuation Jacobian of a solution; softrod's inverse statics
 cold (from zero actuation) and warm (the previous target's solution, target moved by 1 mm);
 and, on the same targets, SciPy ``least_squares`` over softrod's forward solve (bounded
-tensions, finite-difference Jacobian: what a user writes without the inverse). Every method
-runs in this one process, side by side.
+tensions, finite-difference Jacobian: what a user writes without the inverse); a 41-point
+circle of radius 10 mm tracked with ``inverse_statics_path`` (time per target); and the PCC
+inverse (``softrod.pcc.inverse_statics``) of the same robot as two constant-curvature
+segments, cold and warm. Every method runs in this one process, side by side.
 
     python benchmarks/bench_inverse.py [--targets N]
 """
@@ -19,6 +21,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 import softrod
+from softrod import pcc
 
 
 def _admissible(rng):
@@ -43,8 +46,15 @@ def main() -> None:
     robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
     rng = np.random.default_rng(7)
     targets = [robot.solve(_admissible(rng)).tip_position for _ in range(n)]
-    rows: dict[str, list[float]] = {k: [] for k in ("forward", "jacobian", "cold", "warm", "scipy")}
-    misses = {"cold": 0, "warm": 0, "scipy": 0}
+    keys = ("forward", "jacobian", "cold", "warm", "scipy", "path", "pcc_cold", "pcc_warm")
+    rows: dict[str, list[float]] = {k: [] for k in keys}
+    misses = {"cold": 0, "warm": 0, "scipy": 0, "path": 0, "pcc_cold": 0, "pcc_warm": 0}
+    angles = [np.pi / 2, -np.pi / 6, 7 * np.pi / 6]
+    probot = (
+        pcc.Robot.solid_circle([0.2, 0.2], 0.7e-3, 54e9)
+        .with_tendons(0, [0.01] * 3, angles)
+        .with_tendons(1, [0.01] * 3, angles)
+    )
     sol = robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0])
     for _ in range(200):
         rows["forward"].append(_time(lambda: robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0]))[0])
@@ -68,6 +78,25 @@ def main() -> None:
         )
         rows["scipy"].append(dt)
         misses["scipy"] += not np.linalg.norm(ls.fun) <= 1e-9
+    centre = robot.solve([2.0, 0.0, 0.0, 0.0, 2.0, 0.0]).tip_position - [0.0, 0.0, 0.005]
+    th = np.linspace(0.0, 2.0 * np.pi, 41)
+    circle = centre + 0.01 * np.stack([np.cos(th), np.sin(th), 0.0 * th], axis=1)
+    for _ in range(3):
+        dt, path = _time(lambda: softrod.inverse_statics_path(robot, circle, throw=False))
+        rows["path"].append(dt / len(circle))
+    misses["path"] = int(np.sum(~path.converged))
+    prng = np.random.default_rng(8)
+    for _ in range(n):
+        target = np.asarray(pcc.solve(probot, _admissible(prng)).tip_pose)[:3, 3]
+        dt, cold = _time(lambda t=target: pcc.inverse_statics(probot, t, throw=False))
+        rows["pcc_cold"].append(dt)
+        misses["pcc_cold"] += not cold.converged
+        moved = target + np.array([1e-3, 0.0, 0.0])
+        dt, warm = _time(
+            lambda m=moved, c=cold: pcc.inverse_statics(probot, m, warm_start=c, throw=False)
+        )
+        rows["pcc_warm"].append(dt)
+        misses["pcc_warm"] += not warm.converged
     med = {k: statistics.median(v) * 1e6 for k, v in rows.items()}
     print(f"two-segment NiTi robot, {n} targets from forward solves at admissible tensions")
     print(f"{'method':<44}{'median (µs)':>14}{'not reached':>14}")
@@ -77,9 +106,13 @@ def main() -> None:
         "cold": "inverse_statics, cold",
         "warm": "inverse_statics, warm (target moved 1 mm)",
         "scipy": "scipy least_squares over robot.solve",
+        "path": "inverse_statics_path, per target (circle)",
+        "pcc_cold": "pcc.inverse_statics, cold",
+        "pcc_warm": "pcc.inverse_statics, warm (moved 1 mm)",
     }
     for k, name in names.items():
-        miss = f"{misses[k]}/{n}" if k in misses else ""
+        total = len(circle) if k == "path" else n
+        miss = f"{misses[k]}/{total}" if k in misses else ""
         print(f"{name:<44}{med[k]:>14.1f}{miss:>14}")
     print(f"scipy / cold: {med['scipy'] / med['cold']:.0f}x")
 

@@ -88,7 +88,17 @@ def _mutate_robot(rng: random.Random) -> bytes:
     return ("\n".join(lines) + "\n").encode()
 
 
-COMMANDS = ["solve", "compliance", "workspace", "compare", "planar", "fit", "study", "schema"]
+COMMANDS = [
+    "solve",
+    "compliance",
+    "workspace",
+    "compare",
+    "planar",
+    "fit",
+    "study",
+    "schema",
+    "inverse",
+]
 
 
 def _argv(rng: random.Random, tmp: Path, inputs: list[Path]) -> tuple[list[str], list[Path]]:
@@ -104,7 +114,7 @@ def _argv(rng: random.Random, tmp: Path, inputs: list[Path]) -> tuple[list[str],
             ["niti_two_segment", "seed000_arm", "seed001_pneumatic_arm", "nope", "x/y.toml"]
         )
     argv = [command]
-    if command in ("solve", "compliance", "workspace", "compare"):
+    if command in ("solve", "compliance", "workspace", "compare", "inverse"):
         argv.append(robot)
     elif command == "study" and rng.random() < 0.5:
         argv.append(robot)
@@ -148,6 +158,13 @@ def _argv(rng: random.Random, tmp: Path, inputs: list[Path]) -> tuple[list[str],
         "-m": lambda: rng.choices(["yeoh", "ogden", "mooney-rivlin", "neo-hookean", "zz"], k=2),
         "--terms": lambda: [rng.choice(["0", "1", "3", "9", "x"])],
         "--stretch-max": lambda: [rng.choice(ARG_NUMBERS)],
+        "--target": lambda: rng.choice(
+            [["0.13", "0.036", "0.3625"], ["0.3", "0.3", "0"], rng.choices(ARG_NUMBERS, k=3)]
+        ),
+        "--rotation": lambda: rng.choices(["1", "0", "0", "nan", "2"], k=rng.choice([9, 9, 3])),
+        "--tension-bounds": lambda: rng.choices(ARG_NUMBERS, k=rng.choice([2, 2, 1])),
+        "--weights": lambda: rng.choices(ARG_NUMBERS, k=rng.randint(0, 7)),
+        "--tolerance": lambda: [rng.choice(ARG_NUMBERS)],
         "--bogus": lambda: [],
     }
     names = list(options)
@@ -160,6 +177,8 @@ def _argv(rng: random.Random, tmp: Path, inputs: list[Path]) -> tuple[list[str],
         argv += ["--n", "3"]
     if command == "compare" and "--repeats" not in argv:
         argv += ["--repeats", "1"]
+    if command == "inverse" and "--target" not in argv and rng.random() < 0.8:
+        argv += ["--target", "0.1305", "0.0366", "0.3625"]
     if command == "demo":
         argv += ["--plot", out("png")]
     if command == "":

@@ -309,3 +309,124 @@ def test_warm_started_tracking_and_named_arguments():
         softrod.inverse_statics(robot, target, tension_bounds=(-1.0, None))
     with pytest.raises(softrod.ParameterError, match="robot"):
         softrod.inverse_statics("robot.toml", target)
+
+
+def test_a_path_of_targets_is_tracked_with_arrays_out():
+    """A circle of radius 10 mm traced by the tip: every target reached to 1e-9 m (checked by an
+    independent forward solve at the tensions found), inside the bounds, arrays per target."""
+    robot = _niti()
+    centre = robot.solve([2.0, 0.0, 0.0, 0.0, 2.0, 0.0]).tip_position - [0.0, 0.0, 0.005]
+    th = np.linspace(0.0, 2.0 * np.pi, 25)
+    targets = centre + 0.01 * np.stack([np.cos(th), np.sin(th), 0.0 * th], axis=1)
+    path = softrod.inverse_statics_path(robot, targets, tension_bounds=(0.0, 10.0))
+    assert len(path) == 25 and path.tensions.shape == (25, 6) and path.pressures.shape == (25, 0)
+    assert path.tip_position.shape == (25, 3) and path.converged.all()
+    assert np.all(path.tensions >= 0.0) and np.all(path.tensions <= 10.0)
+    for k in (0, 7, 24):
+        tip = robot.solve(path.tensions[k]).tip_position
+        assert np.linalg.norm(tip - targets[k]) <= 1e-9
+    np.testing.assert_allclose(
+        path.position_error, np.linalg.norm(path.tip_position - targets, axis=1), atol=1e-15
+    )
+    # Warm-started from the previous target: far fewer iterations than the first (cold) one.
+    assert np.median(path.iterations[1:]) < path.iterations[0]
+
+
+def test_a_path_marks_a_target_out_of_reach_and_goes_on():
+    robot = _niti()
+    near = robot.solve([1.0, 0.0, 0.0, 0.0, 0.5, 0.0]).tip_position
+    targets = np.array([near, [0.3, 0.3, 0.0], near])
+    with pytest.raises(softrod.TargetUnreachableError):
+        softrod.inverse_statics_path(robot, targets)
+    path = softrod.inverse_statics_path(robot, targets, throw=False)
+    assert path.converged.tolist() == [True, False, True]
+    assert path.position_error[1] > 0.05 and path.position_error[2] <= 1e-9
+
+
+def test_path_arguments_are_named():
+    robot = _niti()
+    with pytest.raises(softrod.ParameterError, match="targets"):
+        softrod.inverse_statics_path(robot, [0.0, 0.0, 0.4])
+    with pytest.raises(softrod.ParameterError, match="targets"):
+        softrod.inverse_statics_path(robot, [[0.0, np.nan, 0.4]])
+    with pytest.raises(softrod.ParameterError, match="target_rotations"):
+        softrod.inverse_statics_path(robot, [[0.0, 0.0, 0.4]], target_rotations=np.eye(3))
+    with pytest.raises(softrod.ParameterError, match="robot"):
+        softrod.inverse_statics_path("robot.toml", [[0.0, 0.0, 0.4]])
+
+
+def _min_norm_by_enumeration(a, b):
+    """The least-norm t >= 0 with a t = b, by enumerating the taut subsets (brute force)."""
+    best = None
+    n = a.shape[1]
+    for mask in range(1, 2**n):
+        idx = [i for i in range(n) if mask >> i & 1]
+        sub = a[:, idx]
+        t_sub, *_ = np.linalg.lstsq(sub, b, rcond=None)
+        if np.abs(sub @ t_sub - b).max() > 1e-9 * np.abs(b).max() or t_sub.min() < -1e-12:
+            continue
+        t = np.zeros(n)
+        t[idx] = t_sub
+        if best is None or t @ t < best @ best:
+            best = t
+    return best
+
+
+def test_pcc_inverse_is_the_brute_force_minimum_norm_actuation():
+    """One inextensible PCC segment, three tendons at 120 degrees, unloaded: the curvature
+    vector is linear in the tensions (checked), so the minimum-norm actuation is found by
+    enumerating the taut subsets."""
+    angles = [np.pi / 2, -np.pi / 6, 7 * np.pi / 6]
+    robot = pcc.Robot.solid_circle([0.2], 0.7e-3, 54e9, extensible=False)
+    robot = robot.with_tendons(0, [0.01] * 3, angles)
+    target = np.asarray(pcc.solve(robot, [2.0, 0.7, 0.0]).tip_pose)[:3, 3]
+    inv = pcc.inverse_statics(robot, target)
+    assert inv.converged and isinstance(inv.solution, pcc.PccSolution)
+    assert np.linalg.norm(np.asarray(inv.solution.tip_pose)[:3, 3] - target) <= 1e-9
+    assert np.sum(inv.tensions > 1e-12) <= 2
+
+    def u(t):
+        k, phi, _ = np.asarray(pcc.solve(robot, t).arcs)[0]
+        return k * np.array([-np.sin(phi), np.cos(phi)])
+
+    a = np.array([u(np.eye(3)[i]) for i in range(3)]).T
+    np.testing.assert_allclose(u(np.array([1.0, 2.0, 0.5])), a @ [1.0, 2.0, 0.5], atol=1e-12)
+    brute = _min_norm_by_enumeration(a, u(inv.tensions))
+    np.testing.assert_allclose(inv.tensions, brute, rtol=0, atol=1e-8)
+
+
+def test_pcc_inverse_round_trip_with_a_tip_load_and_named_errors():
+    robot = _pcc_robot()
+    rng = np.random.default_rng(3)
+    force = [0.0, 0.05, -0.1]
+    for _ in range(5):
+        t = rng.uniform(0.0, 3.0, 6) * (rng.uniform(size=6) < 0.5)
+        target = np.asarray(pcc.solve(robot, t, tip_force=force).tip_pose)[:3, 3]
+        inv = pcc.inverse_statics(robot, target, tip_force=force, tension_bounds=(0.0, 10.0))
+        tip = np.asarray(pcc.solve(robot, inv.tensions, tip_force=force).tip_pose)[:3, 3]
+        assert inv.converged and np.linalg.norm(tip - target) <= 1e-9
+        assert inv.tensions.min() >= 0.0 and inv.tensions.max() <= 10.0
+    with pytest.raises(softrod.TargetUnreachableError):
+        pcc.inverse_statics(robot, [0.5, 0.5, 0.0])
+    with pytest.raises(softrod.ParameterError, match="target_position"):
+        pcc.inverse_statics(robot, [0.0, 0.0])
+    with pytest.raises(softrod.ParameterError, match="tip_force"):
+        pcc.inverse_statics(robot, target, tip_force=[0.0, np.nan, 0.0])
+
+
+def test_a_shape_target_recovers_the_tensions_of_a_measured_backbone():
+    """Backbone points at four arc lengths of a forward solve (a 'measured' backbone): the shape
+    fixes each segment's bending, so the minimum-norm actuation is the generating one (at most
+    two tendons taut per segment); the points are reached to 1e-9 m (independent forward solve)."""
+    robot = _niti()
+    s = [0.1, 0.2, 0.3, 0.4]
+    truth = np.array([0.0, 1.5, 0.4, 0.8, 0.0, 0.0])
+    points = np.asarray(robot.solve(truth, s_out=s).position)
+    assert points.shape == (4, 3)
+    inv = softrod.inverse_statics(robot, points, target_s=s)
+    assert inv.converged and inv.position_error <= 1e-9
+    reached = np.asarray(robot.solve(inv.tensions, s_out=s).position)
+    assert np.abs(reached - points).max() <= 1e-9
+    np.testing.assert_allclose(inv.tensions, truth, rtol=0, atol=1e-6)
+    with pytest.raises(softrod.ParameterError, match="target_position"):
+        softrod.inverse_statics(robot, points[:3], target_s=s)

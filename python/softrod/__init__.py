@@ -72,7 +72,7 @@ from .analysis import (
     workspace_map,
 )
 from .contact import Capsule, Clamp, Cylinder, Pin, Plane, Slide, Sphere
-from .inverse import InverseSolution, inverse_statics
+from .inverse import InversePath, InverseSolution, inverse_statics, inverse_statics_path
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot, solve_path
 from .vision import Backbone, BackboneQuality
@@ -94,6 +94,7 @@ __all__ = [
     "FunctionSection",
     "Hookean",
     "IdentifiabilityWarning",
+    "InversePath",
     "InverseSolution",
     "LinearElastic",
     "Linearised",
@@ -142,6 +143,7 @@ __all__ = [
     "extract_backbone",
     "fit_uniaxial",
     "inverse_statics",
+    "inverse_statics_path",
     "load_robot",
     "pcc",
     "read_backbone_csv",

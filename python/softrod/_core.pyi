@@ -510,6 +510,7 @@ def _inverse_statics(
     target_position: _Vec3,
     *,
     target_rotation: Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
+    target_s: Sequence[float] | NDArray[np.float64] | None = None,
     weights: Sequence[float] | NDArray[np.float64] | None = None,
     tension_bounds: tuple[float, float | None] | None = None,
     pressure_bounds: tuple[float, float | None] | None = None,
@@ -523,6 +524,23 @@ def _inverse_statics(
     atol: float | None = None,
 ) -> dict[str, Any]:
     """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
+
+def _pcc_inverse_statics(
+    robot: PccRobot,
+    target_position: _Vec3,
+    *,
+    target_rotation: Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
+    weights: Sequence[float] | NDArray[np.float64] | None = None,
+    tension_bounds: tuple[float, float | None] | None = None,
+    pressure_bounds: tuple[float, float | None] | None = None,
+    tip_force: _Vec3 | None = None,
+    tip_moment: _Vec3 | None = None,
+    warm_start: Sequence[float] | NDArray[np.float64] | None = None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+) -> dict[str, Any]:
+    """Inverse statics of a PCC robot (softrod.pcc.inverse_statics wraps it)."""
 
 def actuation_jacobian(
     solution: StaticsSolution | PccSolution,

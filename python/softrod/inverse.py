@@ -27,7 +27,8 @@ class InverseSolution:
         tensions: Tendon tensions found (N), shape (n_tendons,).
         pressures: Chamber pressures found (Pa, gauge), shape (n_chambers,).
         solution: The forward statics solution at that actuation.
-        position_error: Distance from the tip to the target (m).
+        position_error: Distance from the tip to the target (m; for a shape target, the
+            largest distance of a backbone point to its target).
         rotation_error: Angle from the tip rotation to the target's (rad; 0 without one).
         iterations: Iterations of the SQP.
         converged: Whether the target was reached and the actuation is the minimum-norm one.
@@ -59,12 +60,14 @@ def inverse_statics(
     throw: bool = True,
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    target_s: Sequence[float] | np.ndarray | None = None,
 ) -> InverseSolution:
     """The minimum-norm actuation that puts the tip of ``robot`` at ``target_position``.
 
     Args:
         robot: The robot (:func:`softrod.load_robot` or built in code); its loads apply.
-        target_position: Tip position (m, world), shape (3,).
+        target_position: Tip position (m, world), shape (3,); with ``target_s``, a shape
+            target: backbone points (m, world), shape (k, 3).
         target_rotation: Tip rotation (body -> world, 3x3), or None for a position target.
         weights: Weights of the actuation norm, one per tendon then chamber (1/N², 1/Pa²).
         tension_bounds: (lo, hi) of every tension (N; hi None: unbounded).
@@ -74,6 +77,8 @@ def inverse_statics(
             a target out of reach; False: return the closest pose with ``converged=False``.
         tolerance: Tolerance on the distance to the target (m; default 1e-10).
         max_iterations: Cap on the iterations (default 60).
+        target_s: Undeformed arc lengths (m, 0..length) of the backbone points that go to the
+            rows of ``target_position`` (e.g. a measured backbone), shape (k,); None: the tip.
 
     Returns:
         The actuation, its forward solution and the remaining errors.
@@ -98,6 +103,7 @@ def inverse_statics(
         list(robot._chambers),
         target_position,
         target_rotation=target_rotation,
+        target_s=target_s,
         weights=weights,
         tension_bounds=tension_bounds,
         pressure_bounds=pressure_bounds,
@@ -121,4 +127,133 @@ def inverse_statics(
         rotation_error=float(out["rotation_error"]),
         iterations=int(out["iterations"]),
         converged=bool(out["converged"]),
+    )
+
+
+@dataclass(frozen=True)
+class InversePath:
+    """The result of :func:`inverse_statics_path`: one row per target.
+
+    Attributes:
+        tensions: Tendon tensions (N), shape (n_targets, n_tendons).
+        pressures: Chamber pressures (Pa, gauge), shape (n_targets, n_chambers).
+        tip_position: Tip positions reached (m, world), shape (n_targets, 3).
+        position_error: Distance from each tip to its target (m), shape (n_targets,).
+        rotation_error: Angle to each target rotation (rad; 0 without one), shape (n_targets,).
+        iterations: SQP iterations per target, shape (n_targets,).
+        converged: Whether each target was reached, shape (n_targets,).
+        solutions: The forward statics solution of each target (a list of n_targets).
+    """
+
+    tensions: np.ndarray
+    pressures: np.ndarray
+    tip_position: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+    iterations: np.ndarray
+    converged: np.ndarray
+    solutions: list
+
+    def __len__(self) -> int:
+        return len(self.position_error)
+
+    @property
+    def actuation(self) -> np.ndarray:
+        """Tensions then pressures per target (N, Pa), shape (n_targets, n_actuators)."""
+        return np.concatenate([self.tensions, self.pressures], axis=1)
+
+
+def _parameter_error(name: str, value: object, expected: str) -> Exception:
+    text = np.array2string(np.asarray(value, dtype=object), threshold=6)
+    err = _core.ParameterError(f"invalid parameter `{name}` = {text:.80}: {expected}")
+    err.parameter = name
+    return err
+
+
+def inverse_statics_path(
+    robot: Robot,
+    targets: Sequence[Sequence[float]] | np.ndarray,
+    *,
+    target_rotations: Sequence[Any] | np.ndarray | None = None,
+    weights: Sequence[float] | np.ndarray | None = None,
+    tension_bounds: tuple[float, float | None] = (0.0, None),
+    pressure_bounds: tuple[float, float | None] | None = None,
+    warm_start: InverseSolution | Sequence[float] | np.ndarray | None = None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+) -> InversePath:
+    """Tracks a path of tip targets: :func:`inverse_statics` at each, warm-started from the last.
+
+    Args:
+        robot: The robot (its loads and gravity apply).
+        targets: Tip positions (m, world), shape (n_targets, 3).
+        target_rotations: Tip rotations (body -> world), shape (n_targets, 3, 3), or None.
+        weights, tension_bounds, pressure_bounds, tolerance, max_iterations: As
+            :func:`inverse_statics`.
+        warm_start: Start of the first target (an :class:`InverseSolution` or an actuation).
+        throw: Raise at the first target not reached; False: mark it ``converged=False`` and go
+            on, the next target warm-started from the last one reached.
+
+    Returns:
+        An :class:`InversePath` (arrays, one row per target).
+
+    Raises:
+        ParameterError: Bad ``targets`` or ``target_rotations`` (named), or a bad argument of
+            :func:`inverse_statics`.
+        TargetUnreachableError, ConvergenceError: A target not reached (``throw=True``).
+    """
+    try:
+        pts = np.asarray(targets, dtype=float)
+    except (TypeError, ValueError):
+        raise _parameter_error(
+            "targets", targets, "an array (n_targets, 3) of numbers (m)"
+        ) from None
+    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] == 0:
+        raise _parameter_error(
+            "targets", f"shape {pts.shape}", "an array (n_targets, 3) with n_targets >= 1 (m)"
+        )
+    if not np.all(np.isfinite(pts)) or np.abs(pts).max() > 1e6:
+        raise _parameter_error("targets", pts, "finite numbers within ±1e6 m")
+    rots = None
+    if target_rotations is not None:
+        try:
+            rots = np.asarray(target_rotations, dtype=float)
+        except (TypeError, ValueError):
+            raise _parameter_error(
+                "target_rotations", target_rotations, "an array (n_targets, 3, 3)"
+            ) from None
+        if rots.shape != (len(pts), 3, 3):
+            raise _parameter_error(
+                "target_rotations",
+                f"shape {rots.shape}",
+                f"an array ({len(pts)}, 3, 3): one rotation per target",
+            )
+    rows: list[InverseSolution] = []
+    warm = warm_start
+    for i, p in enumerate(pts):
+        inv = inverse_statics(
+            robot,
+            p,
+            target_rotation=None if rots is None else rots[i],
+            weights=weights,
+            tension_bounds=tension_bounds,
+            pressure_bounds=pressure_bounds,
+            warm_start=warm,
+            throw=throw,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+        )
+        rows.append(inv)
+        if inv.converged:  # a miss does not seed the next target: the last reached one does
+            warm = inv
+    return InversePath(
+        tensions=np.array([r.tensions for r in rows]).reshape(len(rows), -1),
+        pressures=np.array([r.pressures for r in rows]).reshape(len(rows), -1),
+        tip_position=np.array([np.asarray(r.solution.tip_position) for r in rows]),
+        position_error=np.array([r.position_error for r in rows]),
+        rotation_error=np.array([r.rotation_error for r in rows]),
+        iterations=np.array([r.iterations for r in rows], dtype=int),
+        converged=np.array([r.converged for r in rows], dtype=bool),
+        solutions=[r.solution for r in rows],
     )

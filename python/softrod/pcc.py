@@ -25,6 +25,11 @@ Example:
     array([0.0637, 0.    , 0.0637])
 """
 
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
 from ._core import PccRobot, PccSolution
 from ._core import pcc_arc_frames as arc_frames
 from ._core import pcc_arc_from_pressures as arc_from_pressures
@@ -46,6 +51,86 @@ from ._core import pcc_chain_pose as chain_pose
 from ._core import pcc_solve as solve
 from ._core import pcc_tendon_displacement_jacobian as tendon_displacement_jacobian
 from ._core import pcc_tendon_displacements as tendon_displacements
+
+
+def inverse_statics(
+    robot: PccRobot,
+    target_position,
+    *,
+    target_rotation=None,
+    weights=None,
+    tension_bounds: tuple[float, float | None] = (0.0, None),
+    pressure_bounds: tuple[float, float | None] | None = None,
+    tip_force=None,
+    tip_moment=None,
+    warm_start=None,
+    throw: bool = True,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+):
+    """The minimum-norm actuation that puts the tip of the PCC ``robot`` at a target.
+
+    The same objective and algorithm as :func:`softrod.inverse_statics` (least weighted norm
+    of the actuation inside the bounds among those reaching the target; SQP on the exact PCC
+    actuation Jacobian), on the PCC equilibrium (closed form without a tip wrench).
+
+    Args:
+        robot: The PCC robot.
+        target_position: Tip position (m, base frame), shape (3,).
+        target_rotation: Tip rotation (3x3, tip -> base), or None for a position target.
+        weights, tension_bounds, pressure_bounds, throw, tolerance, max_iterations: As
+            :func:`softrod.inverse_statics`.
+        tip_force: Tip force (N, world), shape (3,), or None.
+        tip_moment: Tip moment (N m, world), shape (3,), or None.
+        warm_start: A previous :class:`softrod.InverseSolution` or actuation (tensions then
+            pressures).
+
+    Returns:
+        A :class:`softrod.InverseSolution` whose ``solution`` is the :class:`PccSolution`.
+
+    Raises:
+        ParameterError: A bad argument (named).
+        TargetUnreachableError: The target is out of reach (``throw=True``).
+        ConvergenceError: The iteration did not converge (``throw=True``).
+    """
+    from .inverse import InverseSolution
+
+    if isinstance(warm_start, InverseSolution):
+        warm_start = warm_start.actuation
+    out = _core._pcc_inverse_statics(
+        robot,
+        target_position,
+        target_rotation=target_rotation,
+        weights=weights,
+        tension_bounds=tension_bounds,
+        pressure_bounds=pressure_bounds,
+        tip_force=tip_force,
+        tip_moment=tip_moment,
+        warm_start=warm_start,
+        throw=throw,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+    )
+    a = np.asarray(out["actuation"])
+    nt = out["n_tendons"]
+    tensions, pressures = a[:nt].copy(), a[nt:].copy()
+    solution = solve(
+        robot,
+        tensions if nt else None,
+        pressures if len(pressures) else None,
+        tip_force=tip_force,
+        tip_moment=tip_moment,
+    )
+    return InverseSolution(
+        tensions=tensions,
+        pressures=pressures,
+        solution=solution,
+        position_error=float(out["position_error"]),
+        rotation_error=float(out["rotation_error"]),
+        iterations=int(out["iterations"]),
+        converged=bool(out["converged"]),
+    )
+
 
 # The names of the first release, kept: ``softrod.pcc.Robot`` is ``PccRobot``.
 Robot = PccRobot
@@ -71,6 +156,7 @@ __all__ = [
     "chain_frames",
     "chain_jacobian",
     "chain_pose",
+    "inverse_statics",
     "solve",
     "tendon_displacement_jacobian",
     "tendon_displacements",

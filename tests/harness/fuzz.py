@@ -643,6 +643,36 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("inverse_statics(shape)")(
+        lambda d: (
+            sr.inverse_statics,
+            dict(
+                robot=_niti(),
+                target_position=np.asarray(
+                    _niti().solve([0.0, 1.5, 0.4, 0.8, 0.0, 0.0], s_out=[0.2, 0.4]).position
+                ),
+                target_s=[0.2, 0.4],
+                throw=False,
+            ),
+        )
+    )
+    t("inverse_statics_path")(
+        lambda d: (
+            sr.inverse_statics_path,
+            dict(
+                robot=_niti(),
+                targets=[[0.03388176, 0.03906025, 0.3958294], [0.03488176, 0.03906025, 0.3958]],
+                target_rotations=None,
+                weights=[1.0] * 6,
+                tension_bounds=(0.0, 10.0),
+                pressure_bounds=(0.0, None),
+                warm_start=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                throw=False,
+                tolerance=1e-9,
+                max_iterations=60,
+            ),
+        )
+    )
     t("solve_statics(chambers)")(
         lambda d: (
             sr.solve_statics,
@@ -919,6 +949,25 @@ def _define_targets() -> None:
                 max_load_steps=64,
                 warm_start=None,
                 throw=True,
+            ),
+        )
+    )
+    t("pcc.inverse_statics")(
+        lambda d: (
+            pcc.inverse_statics,
+            dict(
+                robot=_pcc_robot(),
+                target_position=np.asarray(_pcc_solution().tip_pose)[:3, 3] + [1e-3, 0.0, 0.0],
+                target_rotation=None,
+                weights=[1.0] * 6,
+                tension_bounds=(0.0, 10.0),
+                pressure_bounds=(0.0, None),
+                tip_force=(0.0, -0.01, 0.0),
+                tip_moment=(0.0, 0.0, 0.0),
+                warm_start=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+                throw=False,
+                tolerance=1e-9,
+                max_iterations=60,
             ),
         )
     )
@@ -1632,6 +1681,7 @@ NOT_CONSTRUCTED = {
     "ConvergenceError",
     "Eigenscrews",
     "InverseSolution",
+    "InversePath",
     "ModelComparison",
     "ModelResult",
     "ParameterError",

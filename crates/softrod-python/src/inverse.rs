@@ -6,13 +6,103 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use softrod::nalgebra::{Matrix3, Vector3};
-use softrod::{InverseOptions, InverseWarmStart, Target};
+use softrod::pcc::statics::{PccLoads, PccSolveOptions};
+use softrod::{InverseOptions, InverseWarmStart, PccForward, Target};
 
 use crate::callbacks::run;
 use crate::convert::{arg, floats_opt, vec3, Matrix};
 use crate::errors::param_err;
 use crate::model::{Chamber, Loads, Rod, Tendon};
 use crate::statics::{actuator_names, solve_options, OptionArgs, Problem};
+
+/// The target and the options of an inverse call, checked and named.
+#[allow(clippy::too_many_arguments)]
+fn target_and_options(
+    target_position: &Bound<'_, PyAny>,
+    target_s: Option<&Bound<'_, PyAny>>,
+    target_rotation: Option<&Bound<'_, PyAny>>,
+    weights: Option<&Bound<'_, PyAny>>,
+    tension_bounds: Option<&Bound<'_, PyAny>>,
+    pressure_bounds: Option<&Bound<'_, PyAny>>,
+    warm_start: Option<&Bound<'_, PyAny>>,
+    throw: bool,
+    tolerance: Option<f64>,
+    max_iterations: Option<i64>,
+) -> PyResult<(Target, InverseOptions, Option<InverseWarmStart>)> {
+    let arcs = floats_opt(target_s, "target_s")?;
+    let points = if target_s.is_some_and(|t| !t.is_none()) {
+        let m: Matrix = crate::convert::Arg::from_arg(target_position, "target_position")?;
+        if m.0.ncols() != 3 || m.0.nrows() != arcs.len() {
+            return Err(param_err(
+                "target_position",
+                format!("shape {:?}", m.0.shape()),
+                &format!(
+                    "({}, 3): one point (m, world) per arc length of target_s",
+                    arcs.len()
+                ),
+            ));
+        }
+        (0..m.0.nrows())
+            .map(|k| Vector3::new(m.0[(k, 0)], m.0[(k, 1)], m.0[(k, 2)]))
+            .collect()
+    } else {
+        vec![vec3(target_position, "target_position")?]
+    };
+    let rotation = match target_rotation.filter(|r| !r.is_none()) {
+        None => None,
+        Some(r) => {
+            let m: Matrix = crate::convert::Arg::from_arg(r, "target_rotation")?;
+            if m.0.shape() != [3, 3] {
+                return Err(param_err(
+                    "target_rotation",
+                    format!("shape {:?}", m.0.shape()),
+                    "a 3x3 rotation matrix (body -> world)",
+                ));
+            }
+            Some(Matrix3::from_fn(|i, j| m.0[(i, j)]))
+        }
+    };
+    let mut o = InverseOptions {
+        throw,
+        ..InverseOptions::default()
+    };
+    o.tension_bounds = bounds(tension_bounds, "tension_bounds", o.tension_bounds)?;
+    o.pressure_bounds = bounds(pressure_bounds, "pressure_bounds", o.pressure_bounds)?;
+    let w = floats_opt(weights, "weights")?;
+    o.weights = (!w.is_empty()).then_some(w);
+    if let Some(t) = tolerance {
+        o.tolerance = t;
+    }
+    if let Some(m) = max_iterations {
+        o.max_iterations =
+            crate::convert::count("max_iterations", m, 1, softrod::limits::MAX_ITERATIONS)?;
+    }
+    let warm = floats_opt(warm_start, "warm_start")?;
+    let warm = (!warm.is_empty()).then(|| InverseWarmStart::actuation(warm));
+    let target = Target {
+        points,
+        s: target_s.is_some_and(|t| !t.is_none()).then_some(arcs),
+        rotation,
+    };
+    Ok((target, o, warm))
+}
+
+/// The result of an inverse call as the dict the Python wrappers read.
+fn result_dict<'py>(
+    py: Python<'py>,
+    inv: &softrod::InverseSolution,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("actuation", inv.actuation.clone().into_pyarray(py))?;
+    d.set_item("n_tendons", inv.n_tendons)?;
+    d.set_item("position_error", inv.position_error)?;
+    d.set_item("rotation_error", inv.rotation_error)?;
+    d.set_item("iterations", inv.iterations)?;
+    d.set_item("evaluations", inv.evaluations)?;
+    d.set_item("converged", inv.converged)?;
+    d.set_item("reached", inv.reached)?;
+    Ok(d)
+}
 
 /// A pair of bounds `(lo, hi)` (`hi` None: unbounded) or the default.
 fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> PyResult<(f64, f64)> {
@@ -43,7 +133,7 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 /// `converged`, `reached`.
 #[pyfunction]
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
-                    weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
+                    target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
                     throw=true, tolerance=None, max_iterations=None, integrator=None, steps=None,
                     rtol=None, atol=None))]
 #[allow(clippy::too_many_arguments)]
@@ -55,6 +145,7 @@ pub(crate) fn _inverse_statics<'py>(
     #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
     target_position: Bound<'py, PyAny>,
     target_rotation: Option<Bound<'py, PyAny>>,
+    target_s: Option<Bound<'py, PyAny>>,
     weights: Option<Bound<'py, PyAny>>,
     tension_bounds: Option<Bound<'py, PyAny>>,
     pressure_bounds: Option<Bound<'py, PyAny>>,
@@ -67,42 +158,18 @@ pub(crate) fn _inverse_statics<'py>(
     #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
     #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let position = vec3(&target_position, "target_position")?;
-    let rotation = match target_rotation.filter(|r| !r.is_none()) {
-        None => None,
-        Some(r) => {
-            let m: Matrix = crate::convert::Arg::from_arg(&r, "target_rotation")?;
-            if m.0.shape() != [3, 3] {
-                return Err(param_err(
-                    "target_rotation",
-                    format!("shape {:?}", m.0.shape()),
-                    "a 3x3 rotation matrix (body -> world)",
-                ));
-            }
-            Some(Matrix3::from_fn(|i, j| m.0[(i, j)]))
-        }
-    };
-    let mut o = InverseOptions {
-        throw,
-        ..InverseOptions::default()
-    };
-    o.tension_bounds = bounds(tension_bounds.as_ref(), "tension_bounds", o.tension_bounds)?;
-    o.pressure_bounds = bounds(
+    let (target, o, warm) = target_and_options(
+        &target_position,
+        target_s.as_ref(),
+        target_rotation.as_ref(),
+        weights.as_ref(),
+        tension_bounds.as_ref(),
         pressure_bounds.as_ref(),
-        "pressure_bounds",
-        o.pressure_bounds,
+        warm_start.as_ref(),
+        throw,
+        tolerance,
+        max_iterations,
     )?;
-    let w = floats_opt(weights.as_ref(), "weights")?;
-    o.weights = (!w.is_empty()).then_some(w);
-    if let Some(t) = tolerance {
-        o.tolerance = t;
-    }
-    if let Some(m) = max_iterations {
-        o.max_iterations =
-            crate::convert::count("max_iterations", m, 1, softrod::limits::MAX_ITERATIONS)?;
-    }
-    let warm = floats_opt(warm_start.as_ref(), "warm_start")?;
-    let warm = (!warm.is_empty()).then(|| InverseWarmStart::actuation(warm));
     let solve = solve_options(&OptionArgs {
         integrator,
         steps,
@@ -117,22 +184,62 @@ pub(crate) fn _inverse_statics<'py>(
         &chambers,
     )?;
     let model = &problem.model;
-    let target = Target {
-        points: vec![Vector3::new(position.x, position.y, position.z)],
-        s: None,
-        rotation,
-    };
     let (inv, _) = run(py, "inverse_statics", || {
         softrod::inverse_statics(model, &target, &o, &solve, warm.as_ref()).map_err(actuator_names)
     })?;
-    let d = PyDict::new(py);
-    d.set_item("actuation", inv.actuation.clone().into_pyarray(py))?;
-    d.set_item("n_tendons", inv.n_tendons)?;
-    d.set_item("position_error", inv.position_error)?;
-    d.set_item("rotation_error", inv.rotation_error)?;
-    d.set_item("iterations", inv.iterations)?;
-    d.set_item("evaluations", inv.evaluations)?;
-    d.set_item("converged", inv.converged)?;
-    d.set_item("reached", inv.reached)?;
-    Ok(d)
+    result_dict(py, &inv)
+}
+
+/// Inverse statics of the PCC robot `robot` under a tip wrench (`tip_force` N, `tip_moment`
+/// N m, world) for a tip target (see `softrod.pcc.inverse_statics`); the same dict as
+/// `_inverse_statics`.
+#[pyfunction]
+#[pyo3(signature = (robot, target_position, *, target_rotation=None, weights=None,
+                    tension_bounds=None, pressure_bounds=None, tip_force=None, tip_moment=None,
+                    warm_start=None, throw=true, tolerance=None, max_iterations=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _pcc_inverse_statics<'py>(
+    py: Python<'py>,
+    robot: PyRef<'py, crate::pcc::PccRobot>,
+    target_position: Bound<'py, PyAny>,
+    target_rotation: Option<Bound<'py, PyAny>>,
+    weights: Option<Bound<'py, PyAny>>,
+    tension_bounds: Option<Bound<'py, PyAny>>,
+    pressure_bounds: Option<Bound<'py, PyAny>>,
+    tip_force: Option<Bound<'py, PyAny>>,
+    tip_moment: Option<Bound<'py, PyAny>>,
+    warm_start: Option<Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = arg::throw)] throw: bool,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (target, o, warm) = target_and_options(
+        &target_position,
+        None,
+        target_rotation.as_ref(),
+        weights.as_ref(),
+        tension_bounds.as_ref(),
+        pressure_bounds.as_ref(),
+        warm_start.as_ref(),
+        throw,
+        tolerance,
+        max_iterations,
+    )?;
+    let vec_or_zero = |v: Option<Bound<'py, PyAny>>, name: &str| -> PyResult<Vector3<f64>> {
+        match v.filter(|b| !b.is_none()) {
+            None => Ok(Vector3::zeros()),
+            Some(b) => vec3(&b, name),
+        }
+    };
+    let loads = PccLoads {
+        tip_force: vec_or_zero(tip_force, "tip_force")?,
+        tip_moment: vec_or_zero(tip_moment, "tip_moment")?,
+        ..PccLoads::default()
+    };
+    let model = &robot.inner;
+    let inv = run(py, "pcc.inverse_statics", || {
+        let mut fwd = PccForward::new(model, &loads, &PccSolveOptions::default());
+        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_ref())
+    })?;
+    result_dict(py, &inv)
 }

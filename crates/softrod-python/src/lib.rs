@@ -75,6 +75,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
     m.add_function(wrap_pyfunction!(statics::actuation_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::_inverse_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::_pcc_inverse_statics, m)?)?;
     m.add_function(wrap_pyfunction!(model::_rebuild, m)?)?;
     m.add_class::<materials::PyUniaxialLaw>()?;
     m.add_class::<materials::Hookean>()?;

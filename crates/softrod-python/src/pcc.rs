@@ -595,7 +595,7 @@ fn per_segment(v: Floats, n: usize, name: &str) -> PyResult<Vec<f64>> {
 /// A PCC robot (immutable): elastic segments, routed tendons, chambers.
 #[pyclass(frozen, module = "softrod._core", name = "PccRobot")]
 pub(crate) struct PccRobot {
-    inner: CoreRobot,
+    pub(crate) inner: CoreRobot,
 }
 
 #[pymethods]

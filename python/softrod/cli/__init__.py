@@ -4,6 +4,7 @@ Subcommands (one module each family; :func:`build_parser` lists them all):
     demo, planar         the planar tapered cable-driven arm (:mod:`softrod.cli.planar`);
     solve, compliance, workspace
                          robot description files (:mod:`softrod.cli.robot`);
+    inverse              the actuation reaching a target (:mod:`softrod.cli.command`);
     materials, fit       the silicone library and tensile-curve fits (:mod:`softrod.cli.materials`);
     compare, study       models side by side and the compliance study (:mod:`softrod.cli.models`);
     view                 the live 3-D view in the browser (:mod:`softrod.cli.view`);
@@ -23,11 +24,11 @@ import sys
 from collections.abc import Sequence
 
 from .._core import ConvergenceError, ParameterError, __version__
-from . import backbone, calibrate, materials, models, planar, robot, sweep, view
+from . import backbone, calibrate, command, materials, models, planar, robot, sweep, view
 from ._common import NoResultError, Parser, UsageError, check_files, resolve_robot
 
 #: The command modules, in the order their subcommands are listed in ``softrod --help``.
-COMMAND_MODULES = (planar, robot, materials, models, view, backbone, calibrate, sweep)
+COMMAND_MODULES = (planar, robot, command, materials, models, view, backbone, calibrate, sweep)
 
 #: Exit statuses: bad input (a parameter, a file's content, the command line), no convergence
 #: (or no result at all), an unreadable or unwritable file, an unexpected error.

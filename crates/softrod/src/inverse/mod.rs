@@ -348,11 +348,18 @@ fn check_target(target: &Target) -> Result<()> {
         return Err(Error::invalid("target_points", "[]", "at least one point"));
     }
     for (k, p) in target.points.iter().enumerate() {
-        if !p.iter().all(|v| v.is_finite()) {
+        // Beyond MAX_LENGTH the distance to the target would not be a number worth reporting.
+        if !p
+            .iter()
+            .all(|v| v.is_finite() && v.abs() <= crate::limits::MAX_LENGTH)
+        {
             return Err(Error::invalid(
                 format!("target_position[{k}]"),
                 format!("{:?}", p.as_slice()),
-                "finite (m)",
+                format!(
+                    "finite, each coordinate within ±{:e} m",
+                    crate::limits::MAX_LENGTH
+                ),
             ));
         }
     }

@@ -4,6 +4,7 @@
 #![allow(dead_code, unused_imports, missing_docs)]
 
 pub mod robot;
+#[allow(unused_imports)] // not every test binary uses the shared robots
 pub use robot::*;
 
 use std::f64::consts::PI;

@@ -1,0 +1,93 @@
+"""``softrod inverse``: the actuation printed and written reaches the target (checked by an
+independent forward solve at the tensions read back from the CSV); bad input is one line with
+exit status 2, a target out of reach exit status 3; inputs are never overwritten."""
+
+import csv
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod.cli import main
+
+NITI = softrod.examples.path("niti_two_segment")
+
+
+def _run(argv, capsys):
+    status = main([str(a) for a in argv])
+    cap = capsys.readouterr()
+    return status, cap.out, cap.err.strip().splitlines()
+
+
+def _one_error_line(err):
+    lines = [ln for ln in err if not ln.startswith("wrote ")]
+    assert len(lines) == 1 and lines[0].startswith("softrod: error: "), err
+    return lines[0]
+
+
+def _targets():
+    robot = softrod.load_robot(NITI)
+    first = robot.solve([2.0, 0.0, 0.0, 0.0, 2.0, 0.0]).tip_position
+    return robot, first, first + np.array([1e-3, 0.0, 0.0])
+
+
+def test_a_path_of_two_targets_to_csv_and_json(tmp_path, capsys):
+    robot, a, b = _targets()
+    out_csv, out_json = tmp_path / "inv.csv", tmp_path / "inv.json"
+    argv = ["inverse", "niti_two_segment", "--target", *a, "--target", *b]
+    status, out, _ = _run([*argv, "--csv", out_csv, "--json", out_json], capsys)
+    assert status == 0 and "target 2 (m)" in out and "converged True" in out
+    with open(out_csv, encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 2
+    for row, target in zip(rows, (a, b), strict=True):
+        tensions = [float(row[f"tension_{i}"]) for i in range(6)]
+        assert min(tensions) >= 0.0 and row["converged"] == "True"
+        tip = robot.solve(tensions).tip_position  # independent forward solve
+        assert np.linalg.norm(tip - target) <= 1e-9
+    data = json.loads(out_json.read_text())
+    assert np.asarray(data["tensions"]).shape == (2, 6) and data["converged"] == [True, True]
+
+
+def test_bounds_are_honoured(capsys, tmp_path):
+    _, a, _ = _targets()
+    out_csv = tmp_path / "inv.csv"
+    argv = ["inverse", NITI, "--target", *a, "--tension-bounds", "0", "3", "--csv", out_csv]
+    status, _, _ = _run(argv, capsys)
+    assert status == 0
+    with open(out_csv, encoding="utf-8") as fh:
+        row = next(csv.DictReader(fh))
+    assert max(float(row[f"tension_{i}"]) for i in range(6)) <= 3.0 + 1e-12
+
+
+def test_a_target_out_of_reach_exits_3_with_the_distance(capsys):
+    status, _, err = _run(["inverse", "niti_two_segment", "--target", 0.3, 0.3, 0.0], capsys)
+    assert status == 3 and "out of reach" in _one_error_line(err)
+
+
+@pytest.mark.parametrize(
+    "extra, name",
+    [
+        (["--target", "0.1", "0"], "--target"),
+        (["--target", "0.1", "0", "nan"], "--target"),
+        (["--target", "0.1", "0", "0.3", "--rotation", *"1 0 0 0 1 0 0 0 2".split()], "--rotation"),
+        (["--target", "0.1", "0", "0.3", "--tension-bounds", "inf", "3"], "--tension-bounds"),
+        (["--target", "0.1", "0", "0.3", "--tension-bounds", "-1", "3"], "tension_bounds"),
+        (["--target", "0.1", "0", "0.3", "--tolerance", "-1"], "--tolerance"),
+        (["--target", "0.1", "0", "0.3", "--weights", "1", "1"], "weights"),
+        ([], "--target"),
+    ],
+)
+def test_bad_input_is_one_line_with_exit_2(extra, name, capsys):
+    status, _, err = _run(["inverse", "niti_two_segment", *extra], capsys)
+    assert status == 2 and name in _one_error_line(err)
+
+
+def test_the_robot_file_is_never_overwritten(tmp_path, capsys):
+    robot = tmp_path / "R.toml"
+    shutil.copy(NITI, robot)
+    before = robot.read_bytes()
+    status, _, err = _run(["inverse", robot, "--target", 0.1, 0.0, 0.3, "--csv", robot], capsys)
+    assert status == 2 and "--csv" in _one_error_line(err) and robot.read_bytes() == before
