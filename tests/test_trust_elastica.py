@@ -23,10 +23,6 @@ NEAR_AXIAL = pytest.mark.xfail(
     "axis and PL^2/EI >= ~5, RK4 too returns an equilibrium off the branch (tip 1.4-1.6 L away; "
     "warm-started continuation in small steps stays on the oracle's branch)",
 )
-NO_LOAD_FACTOR = pytest.mark.xfail(
-    strict=True,
-    reason="issue 10: ConvergenceError carries no load_factor",
-)
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +45,7 @@ def test_no_silent_wrong_branch(sweep, integrator):
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "integrator",
-    [pytest.param("rk4", marks=NO_LOAD_FACTOR), pytest.param("adaptive", marks=NO_LOAD_FACTOR)],
+    ["rk4", "adaptive"],
 )
 def test_every_failure_is_a_convergence_error_with_its_fields(sweep, integrator):
     errors = [

@@ -25,7 +25,7 @@ fn mats6<'py>(py: Python<'py>, v: &[Matrix6<f64>]) -> Bound<'py, PyArray3<f64>> 
     Array::from_shape_fn((v.len(), 6, 6), |(k, i, j)| v[k][(i, j)]).into_pyarray(py)
 }
 
-/// Integrated compliance and stiffness at every node of a solution (seed 001, eqs. 6-7).
+/// Integrated compliance and stiffness at every node of a solution (the compliance-methodology paper, eqs. 6-7).
 ///
 /// Compliances `C` (6x6: m/N, 1/N, rad/(N m) blocks) map a wrench [f; m] (N, N m) to a twist
 /// [translation (m); rotation (rad)], world and body frames; stiffness `K = C^-1`.
@@ -130,7 +130,7 @@ pub(crate) enum AnySolution<'py> {
     Pcc(PyRef<'py, PccSolution>),
 }
 
-/// The seed's integrated compliance along a solved rod (world and body frames), Cosserat or
+/// The paper's integrated compliance along a solved rod (world and body frames), Cosserat or
 /// PCC (same computation; the PCC arcs take `rod`'s section and material).
 ///
 /// Returns a `Compliance`: 6x6 matrices per node (m/N, 1/N, rad/(N m) blocks) in the world

@@ -362,7 +362,7 @@ impl Tendon {
     }
 
     /// Tendon at `ratio` times the local section radius, at `angle` (rad) from body x
-    /// (seed 000's cable: `ratio = a`, `angle = 0`).
+    /// (the planar cable-arm paper's cable: `ratio = a`, `angle = 0`).
     #[staticmethod]
     #[pyo3(signature = (ratio, angle, tension, end=None, *, friction=0.0))]
     fn radius_proportional(

@@ -1,4 +1,4 @@
-//! Binding of the seed-000 planar cable arm and the backbone distance.
+//! Binding of the planar cable-arm paper's planar cable arm and the backbone distance.
 
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
@@ -49,7 +49,7 @@ fn samples_from(length: f64, n_points: i64, s: Option<Floats>) -> PyResult<Vec<f
     }
 }
 
-/// The seed-000 tapered cable-driven arm (immutable).
+/// The planar cable-arm paper's tapered cable-driven arm (immutable).
 ///
 /// Length, radii (m), cable offset ratio (dimensionless), Young's modulus (Pa), cable anchor
 /// (m); `solve(tension)` with the tension in N.
@@ -215,7 +215,7 @@ impl PlanarCableArm {
         .map_err(to_py_err)
     }
 
-    /// The seed's experimental arm (L 270 mm, R0 15 mm, RL 7.4 mm, a 1/3, E 110 kPa).
+    /// The paper's experimental arm (L 270 mm, R0 15 mm, RL 7.4 mm, a 1/3, E 110 kPa).
     #[staticmethod]
     fn seed_arm() -> Self {
         Self {

@@ -1,4 +1,4 @@
-//! Seed-000 planar arm: one solve with 201 samples (closed form and ODE), and a batch.
+//! The planar arm of the planar cable-arm paper: one solve with 201 samples (closed form and ODE), and a batch.
 //!
 //! Run: `cargo bench -p softrod --bench planar`.
 #![allow(missing_docs, clippy::unwrap_used)]

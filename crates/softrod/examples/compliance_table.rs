@@ -1,4 +1,4 @@
-//! Side by side: the seed's integrated tip compliance, the exact tangent compliance (tendons at
+//! Side by side: the paper's integrated tip compliance, the exact tangent compliance (tendons at
 //! fixed tension and at fixed length) and a central finite difference of the nonlinear solve,
 //! on the two-segment NiTi robot as load and actuation grow.
 //!

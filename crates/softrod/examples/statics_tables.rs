@@ -1,5 +1,5 @@
 //! Tables for the documentation: the 3-D Cosserat-rod model (exact tendon direction,
-//! Rucker & Webster 2011) vs. seed 000's planar closed form on the seed's tapered arm, and the
+//! Rucker & Webster 2011) vs. the planar cable-arm paper's planar closed form on the paper's tapered arm, and the
 //! tip of the two-segment NiTi tendon robot.
 //!
 //! Run: `cargo run --release -p softrod --example statics_tables`.
@@ -30,7 +30,7 @@ fn tight() -> SolveOptions {
 }
 
 fn main() {
-    // Seed 000: L = 0.27 m, R0 = 15 mm, RL = 7.4 mm, a = 1/3, E = 110 kPa, cable at the tip.
+    // The planar cable-arm paper: L = 0.27 m, R0 = 15 mm, RL = 7.4 mm, a = 1/3, E = 110 kPa, cable at the tip.
     let arm = PlanarCableArm::seed_arm();
     let rod = Rod::new(
         arm.length(),
@@ -41,17 +41,17 @@ fn main() {
     let samples = uniform_samples(arm.length(), 201).unwrap();
     let rigid_shear = rod.clone().with_shear_coefficient(1e9).unwrap();
     println!(
-        "Seed-000 arm: planar closed form (seed) vs. 3-D Cosserat rod with exact tendon direction"
+        "the planar cable-arm paper's arm: planar closed form (planar cable-arm paper) vs. 3-D Cosserat rod with exact tendon direction"
     );
     println!("(planar x = rod axis = 3-D z; planar y = toward the cable = 3-D x; nu = 0.5;");
     println!(
-        " 'no shear': shear coefficient 1e9, i.e. shear-rigid like the seed; 'Cowper': default)"
+        " 'no shear': shear coefficient 1e9, i.e. shear-rigid like the paper; 'Cowper': default)"
     );
     println!(
         "{:>5} {:>9} {:>9} | {:>9} {:>9} {:>9} {:>8} | {:>9} {:>9} {:>9} {:>8}",
         "T [N]",
-        "seed x",
-        "seed y",
+        "paper x",
+        "paper y",
         "noshear z",
         "x",
         "|dtip|",
@@ -95,13 +95,13 @@ fn main() {
         }
         println!();
     }
-    println!("(|dtip| in m; rel. = |dtip| / |seed tip displacement|)");
+    println!("(|dtip| in m; rel. = |dtip| / |paper tip displacement|)");
     println!(
-        "Why they differ: the seed balances the cable moment as E I k = T d (1 - d k) with k per\n\
+        "Why they differ: the paper balances the cable moment as E I k = T d (1 - d k) with k per\n\
          deformed length and neglects shear; the Cosserat rod uses the exact tendon direction,\n\
          E I u = T d t_z with u per undeformed length, and shears under the cable's lateral pull\n\
          on the taper (d' != 0). Both agree to first order in T; the relative tip difference is\n\
-         of the order of the terms the seed linearises, |q| + d k (both ~ T): ~3.4 %/N shear-rigid,\n\
+         of the order of the terms the paper linearises, |q| + d k (both ~ T): ~3.4 %/N shear-rigid,\n\
          plus a T-independent ~0.3 % from shear (Cowper). It grows to ~12 % at 5 N, where the\n\
          arm is compressed by ~24 % at the tip and linear theory is stretched."
     );

@@ -301,7 +301,7 @@ fn loaded_tangent_matches_finite_difference() {
     let t = tangent_compliance(&sol, TendonControl::Tension, None).unwrap();
     let fd = fd_tip_compliance(&rod, &tendons, &loads, &opts, &sol, &t.world);
     assert_blocks_close(&t.world, &fd, 1e-6, "loaded tangent vs fd");
-    // The seed's integrated compliance differs under load and actuation.
+    // The paper's integrated compliance differs under load and actuation.
     let c = compliance(&sol).unwrap().tip_world();
     let rel = (c - t.world).amax() / t.world.amax();
     assert!(rel > 1e-3, "{rel}");

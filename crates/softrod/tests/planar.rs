@@ -1,4 +1,4 @@
-//! Oracle tests of the seed-000 planar model.
+//! Oracle tests of the planar cable-arm paper's planar model.
 #![allow(clippy::unwrap_used)]
 
 use softrod::integrate::AdaptiveOptions;
@@ -82,7 +82,7 @@ fn published_ode_is_the_derivative_of_the_closed_form() {
         // Corrected final value R(L)^4 equals the closed form at the anchor.
         let kl = arm.closed_form(arm.length(), t).0;
         assert!((arm.final_value(t) - kl).abs() <= 1e-14 * kl);
-        // Strain: closed form q = -T/(4D) equals the seed's T(aRk - 1)/(E pi R^2).
+        // Strain: closed form q = -T/(4D) equals the paper's T(aRk - 1)/(E pi R^2).
         let (k, q) = arm.closed_form(0.1, t);
         assert!((arm.strain(0.1, k, t) - q).abs() <= 1e-14 * q.abs());
     }

@@ -15,7 +15,7 @@ use softrod::{
     Yeoh,
 };
 
-/// Seed-001-like arm: length, outer radius, chamber radius, chamber centroid distance (m).
+/// An arm like the compliance-methodology paper's: length, outer radius, chamber radius, chamber centroid distance (m).
 const L: f64 = 0.16;
 const R: f64 = 0.012;
 const RC: f64 = 0.0025;

@@ -1,4 +1,4 @@
-//! Distance between two backbones at equal *arm index* (fraction of arm length), as seed 000
+//! Distance between two backbones at equal *arm index* (fraction of arm length), as the planar cable-arm paper
 //! compared a photographed arm with the model.
 //!
 //! Each backbone is a polyline of points in 2-D or 3-D, of any length (e.g. digitised from a

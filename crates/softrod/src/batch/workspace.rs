@@ -1,6 +1,6 @@
 //! Workspace maps: sweep the tendon tensions, solve every configuration (warm-started from its
 //! neighbour, in parallel across cores) and report the tip position with scalar stiffness
-//! measures of the integrated tip compliance (seed 001, Fig. 1d).
+//! measures of the integrated tip compliance (the compliance-methodology paper, Fig. 1d).
 //!
 //! The samples are cut into contiguous chunks; each chunk is solved in order on one thread,
 //! every solve warm-started from the previous converged one (so order the samples along a

@@ -2,7 +2,7 @@
 //!
 //! The cumulative integral `Q(s) = ∫₀ˢ Ad c Adᵀ dσ` (see [`super::integrated`]) is appended to
 //! the state and integrated with it from the solution's base wrench by the adaptive
-//! Dormand–Prince pair, with every component under error control (seed 001's eq. 8 integrates
+//! Dormand–Prince pair, with every component under error control (the compliance-methodology paper's eq. 8 integrates
 //! it with the kinematics in the same way). `Q` is carried dimensionless,
 //! `Q̂ = S Q S E I(0) / L` with `S = diag(1/L, 1/L, 1/L, 1, 1, 1)`, so that its entries are of
 //! order one and one relative tolerance applies to all of them; its 21 upper-triangle entries

@@ -1,4 +1,4 @@
-//! Configuration-dependent compliance and stiffness along a solved rod (seed 001).
+//! Configuration-dependent compliance and stiffness along a solved rod (the compliance-methodology paper).
 //!
 //! Conventions ([`crate::math::se3`]): twists `[δp; δθ]`, wrenches `[f; m]`, `t = C w`, `w = K t`.
 //! At a node `s` the **world** compliance relates a wrench applied at the node's position with
@@ -7,8 +7,8 @@
 //! `C_body = blockdiag(Rᵀ, Rᵀ) C_world blockdiag(R, R)`.
 //!
 //! * [`element_compliance`]: `c(s) = diag[1/(kGA), 1/(kGA), 1/(EA), 1/(EIx), 1/(EIy), 1/(GJ)]`
-//!   (seed eq. 1 with the torsion erratum), the material's tangent at the solved wrench.
-//! * [`compliance`]: the seed's integrated compliance (eqs. 6–7), the serial sum of the
+//!   (eq. 1 of the compliance-methodology paper, with its torsion correction), the material's tangent at the solved wrench.
+//! * [`compliance`]: the paper's integrated compliance (eqs. 6–7), the serial sum of the
 //!   element compliances frozen in the solved configuration,
 //!   `C_world(s) = ∫₀ˢ Ad_{h(σ)} c(σ) Ad_{h(σ)}ᵀ dσ`, `h(σ) = (R(σ), p(σ) - p(s))`.
 //!   Since `Ad_{h(σ)} = Ad_{(I, p(0) - p(s))} Ad_{(R(σ), p(σ) - p(0))}`, one cumulative
@@ -426,7 +426,7 @@ fn transport(
     (world, body)
 }
 
-/// The seed's integrated compliance (eqs. 6–7) at every node of a configuration of `rod`
+/// The paper's integrated compliance (eqs. 6–7) at every node of a configuration of `rod`
 /// (see the module documentation for the formula and the quadrature); `rod` scales
 /// [`Compliance::gamma_c`].
 ///
@@ -449,7 +449,7 @@ pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Comp
     })
 }
 
-/// The seed's integrated compliance (eqs. 6-7) at every node of `solution`. For an adaptive
+/// The paper's integrated compliance (eqs. 6-7) at every node of `solution`. For an adaptive
 /// solution it is integrated under step-size control to the solution's own tolerances
 /// ([`compliance_at`]); for an RK4 solution by the composite quadrature on the solution's mesh
 /// (see the module documentation: its error is that of the mesh, about 1e-6 relative on a
@@ -509,7 +509,7 @@ pub fn compliance_at(solution: &StaticsSolution, s_out: &[f64]) -> Result<Compli
     })
 }
 
-/// The seed's integrated compliance along the arcs of a PCC solution (same computation as
+/// The paper's integrated compliance along the arcs of a PCC solution (same computation as
 /// [`compliance`], on [`Configuration::from_pcc`] with `panels` per segment, default from
 /// [`PCC_PANEL_ANGLE`]); `rod` gives the section and material of `c(s)` and the base
 /// pose. The nodes' `s` is the undeformed arc length, junctions repeated.

@@ -1,4 +1,4 @@
-//! Configuration-dependent compliance (seed 001): the integrated compliance along a solved
+//! Configuration-dependent compliance (the compliance-methodology paper): the integrated compliance along a solved
 //! configuration, the exact tangent compliance of the equilibrium, eigenscrews.
 
 mod controlled;

@@ -11,7 +11,7 @@
 //! equilibrium branch), by continuation in `λ`, refusing load steps that change the shape by
 //! more than [`MAX_LOAD_STEP_TURN`], so that the solution found is the one connected to the
 //! unloaded, actuated rod. The ODE is integrated between the breaks at tendon terminations,
-//! chamber ends and point loads with fixed-step RK4 (the seed's method) or the adaptive
+//! chamber ends and point loads with fixed-step RK4 (the paper's method) or the adaptive
 //! Dormand–Prince 5(4) pair; rotation matrices are re-orthonormalised after every step.
 
 use std::sync::{Arc, OnceLock};

@@ -26,7 +26,7 @@ pub struct Tableau<const S: usize> {
     pub fsal: bool,
 }
 
-/// The classical fourth-order method (the seed's shooting integrator).
+/// The classical fourth-order method (the paper's shooting integrator).
 pub const RK4: Tableau<4> = Tableau {
     name: "rk4",
     c: [0.0, 0.5, 0.5, 1.0],

@@ -27,7 +27,7 @@ pub enum Routing {
     /// Constant offset `(x, y)` (m).
     Constant([f64; 2]),
     /// Offset `ratio * R(s) * (cos angle, sin angle)` proportional to the section's outer
-    /// radius `R(s)` (seed 000's cable: `ratio = a`, `angle = 0`); `angle` in rad from body x.
+    /// radius `R(s)` (the planar cable-arm paper's cable: `ratio = a`, `angle = 0`); `angle` in rad from body x.
     RadiusProportional {
         /// Offset over radius (dimensionless).
         ratio: f64,

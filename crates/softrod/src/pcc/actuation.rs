@@ -616,7 +616,7 @@ fn pressure_arc(
 /// `tendons` (moment balance at the tip, tendon forces taken along the tangent):
 /// `E I κ (cos φ, sin φ) = Σ τ_i d_i (cos β_i, sin β_i)`, axial strain `-Σ τ_i / E A`
 /// (`ℓ = ℓ0 (1 - Σ τ_i / E A)`; `ℓ = ℓ0` if inextensible). `κ` is per deformed length, as in
-/// seed 000. Returns `κ >= 0`.
+/// The planar cable-arm paper. Returns `κ >= 0`.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]` (negative or not

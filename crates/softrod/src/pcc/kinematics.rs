@@ -43,7 +43,7 @@
 //! side and bends the segment away from it (`φ = β_i + π`).
 //!
 //! The elastic maps (tensions, pressures) balance the actuators' tip moment with `E I κ`, `κ`
-//! per *deformed* length as in seed 000, and stretch the segment by the axial force over
+//! per *deformed* length as in the planar cable-arm paper, and stretch the segment by the axial force over
 //! `E A`. The Cosserat engine's `u` is per undeformed length, so for the same moment its
 //! bending angle is larger by the stretch `1 + ε`; keep this in mind when comparing models.
 //!

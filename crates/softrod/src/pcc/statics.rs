@@ -50,7 +50,7 @@
 //! replaced by the constraint `ℓ = ℓ0`.
 //!
 //! The tension map [`arc_from_tendon_tensions`](crate::pcc::arc_from_tendon_tensions) takes
-//! `κ` per deformed length (seed 000's convention); this module takes the Cosserat engine's.
+//! `κ` per deformed length (the planar cable-arm paper's convention); this module takes the Cosserat engine's.
 //! They agree for inextensible segments and differ by the factor `1 + ε` on `κ` otherwise.
 //!
 //! # References

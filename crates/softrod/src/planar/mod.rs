@@ -1,4 +1,4 @@
-//! Seed 000: the planar steady-state model of a tapered cable-driven arm.
+//! The planar cable-arm paper: the planar steady-state model of a tapered cable-driven arm.
 //!
 //! A silicone cone of length `L` with radius `R(s) = R0 + (RL - R0) s / L`, one cable at
 //! distance `a R(s)` from the backbone, anchored at `s = anchor` (default the tip) and pulled at
@@ -22,7 +22,7 @@
 //! below about `1e-10 L`. Panels break at the anchor, where `k` jumps.
 //!
 //! # References
-//! Seed 000 and its erratum (`shared/notes/seed-notes.md`).
+//! The planar cable-arm paper and its corrections (docs/planar.md).
 
 use std::f64::consts::PI;
 
@@ -41,7 +41,7 @@ use crate::math::samples::in_range;
 /// With the order-6 panel rule this keeps the backbone error below 1e-10 of the arm length.
 pub const MAX_PANEL_TURN: f64 = 0.1;
 
-/// The seed-000 tapered cable-driven arm (immutable, validated).
+/// The planar cable-arm paper's tapered cable-driven arm (immutable, validated).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarCableArm {
     length: f64,
@@ -183,7 +183,7 @@ impl PlanarCableArm {
         })
     }
 
-    /// The seed's experimental arm: `L = 270 mm`, `R0 = 15 mm`, `RL = 7.4 mm`, `a = 1/3`,
+    /// The paper's experimental arm: `L = 270 mm`, `R0 = 15 mm`, `RL = 7.4 mm`, `a = 1/3`,
     /// `E = 110 kPa`, cable anchored at the tip.
     pub fn seed_arm() -> Self {
         Self {
@@ -256,7 +256,7 @@ impl PlanarCableArm {
         (tension * a * inv_rd, -0.25 * tension * r * inv_rd)
     }
 
-    /// Axial strain `q = T (a R k - 1) / (E pi R^2)` for a given curvature `k` (seed eq. 1).
+    /// Axial strain `q = T (a R k - 1) / (E pi R^2)` for a given curvature `k` (eq. 1 of the planar cable-arm paper).
     #[inline]
     pub fn strain(&self, s: f64, curvature: f64, tension: f64) -> f64 {
         let r = self.radius(s);
@@ -264,7 +264,7 @@ impl PlanarCableArm {
     }
 
     /// Final value of the ODE, `k(anchor) = T a R / (T a^2 R^2 + E (pi/4) R^4)` (1/m), with
-    /// the seed's `R(L)^2` corrected to `R(L)^4`.
+    /// the paper's `R(L)^2` corrected to `R(L)^4`.
     pub fn final_value(&self, tension: f64) -> f64 {
         let r = self.radius(self.anchor);
         let a = self.offset_ratio;

@@ -29,7 +29,7 @@
 //! * R. S. Rivlin, D. W. Saunders, Phil. Trans. R. Soc. A 243, 1951 (Mooney–Rivlin).
 //! * O. H. Yeoh, Rubber Chem. Technol. 66(5), 1993 (the Yeoh form).
 //! * R. W. Ogden, Proc. R. Soc. A 326, 1972 (the Ogden form).
-//! * Seed 001, section II.B, and its corrections in `shared/notes/seed-notes.md`.
+//! * the compliance-methodology paper, section II.B, and its corrections (docs/materials.md).
 
 use std::fmt;
 
@@ -453,7 +453,7 @@ impl UniaxialLaw for Hookean {
 }
 
 /// A linearised law: the linear law `P = E_l (λ − 1)` whose modulus `E_l` is the secant
-/// modulus of a nonlinear curve at a reference strain (seed 001, II.B.1: "100 % modulus"), or a
+/// modulus of a nonlinear curve at a reference strain (the compliance-methodology paper, II.B.1: "100 % modulus"), or a
 /// straight line through the origin fitted to data (`crate::model::material::fit::fit_uniaxial` with
 /// `ModelKind::Linearised`). The reference strain records where the line is exact (or the
 /// largest strain of the fitted data).

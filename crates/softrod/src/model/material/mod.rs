@@ -378,7 +378,7 @@ impl Material {
         None
     }
 
-    /// Element compliance `c(s)` (seed 001, eq. 1) at the elastic strain
+    /// Element compliance `c(s)` (the compliance-methodology paper, eq. 1) at the elastic strain
     /// `e = (v - v*, u - u*)` (zero rows in the inextensible limit):
     /// `diag(1/(k G A), 1/(k G A), 1/(E_t A), 1/(E_t Ix), 1/(E_t Iy), 1/(G J))` with the tangent
     /// stiffnesses of the section at that strain (`E_t A = ∂n_z/∂v_z`, `E_t Ix = ∂m_x/∂u_x`,
