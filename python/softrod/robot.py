@@ -27,6 +27,7 @@ from ._core import (
     Chamber,
     Loads,
     ParameterError,
+    ParameterTypeError,
     Rod,
     StaticsSolution,
     Tendon,
@@ -202,6 +203,15 @@ class Robot:
         from .plot.obstacles import as_obstacles
 
         object.__setattr__(self, "_obstacles", tuple(as_obstacles(obstacles)))
+        from .contact import Clamp, Pin, Slide
+
+        if tip_constraint is not None and not isinstance(tip_constraint, (Clamp, Pin, Slide)):
+            exc = ParameterTypeError(
+                f"tip_constraint = {tip_constraint!r} is invalid: must be softrod.Clamp(pose), "
+                "softrod.Pin(point), softrod.Slide(point, normal) or None"
+            )
+            exc.parameter = "tip_constraint"
+            raise exc
         object.__setattr__(self, "_tip_constraint", tip_constraint)
         if source:
             with _argument("source"):
