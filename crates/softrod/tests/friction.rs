@@ -352,3 +352,27 @@ fn bad_friction_is_a_named_error() {
     assert!(e.to_string().contains("previous"), "{e}");
     let _ = SolveOptions::default();
 }
+
+#[test]
+fn the_frictionless_solver_refuses_a_tendon_with_friction() {
+    // A uniform tension would be the frictionless answer: the plain solve names the
+    // coefficient instead of returning it; with mu = 0 it solves.
+    let e = solve_statics_at(
+        &arc_model(MU),
+        &Actuation::tensions(&[1e-4]),
+        &SolveOptions::default(),
+        &[],
+    )
+    .unwrap_err();
+    match e {
+        softrod::Error::InvalidParameter { name, .. } => assert_eq!(name, "tendons[0].friction"),
+        other => panic!("expected a named error, got {other:?}"),
+    }
+    assert!(solve_statics_at(
+        &arc_model(0.0),
+        &Actuation::tensions(&[1e-4]),
+        &SolveOptions::default(),
+        &[]
+    )
+    .is_ok());
+}

@@ -756,6 +756,17 @@ fn check_inputs(
     options.validate()?;
     check_s_out(s_out, model.length())?;
     model.check_actuation(actuation)?;
+    // A tendon with friction needs its tension profile (solve_frictional): a uniform tension
+    // would be the frictionless answer, reported as if friction had been modelled.
+    if actuation.profile.is_none() {
+        if let Some(i) = model.tendons().iter().position(|t| t.friction() > 0.0) {
+            return Err(Error::invalid(
+                format!("tendons[{i}].friction"),
+                model.tendons()[i].friction(),
+                "0 here: a tendon with friction is solved by solve_frictional",
+            ));
+        }
+    }
     if let Some(w) = &options.warm_start {
         model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
     }
