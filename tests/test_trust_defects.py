@@ -368,7 +368,6 @@ def test_solve_statics_reports_exactly_at_s_out():
     assert np.max(np.abs(np.asarray(sol.position) - exact)) < 1e-9 * arcs.LENGTH
 
 
-@xfail("no compliance at chosen arc lengths (`s_out=`)")
 def test_compliance_at_s_out_matches_castigliano():
     theta = 1.5 * math.pi
     sol = arcs.solve("precurved", theta, **arcs.adaptive_options(1e-10))

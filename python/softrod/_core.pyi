@@ -958,7 +958,11 @@ class Eigenscrews:
     def kind(self) -> str: ...
 
 def compliance(
-    solution: StaticsSolution | PccSolution, rod: Rod | None = None, *, panels: int | None = None
+    solution: StaticsSolution | PccSolution,
+    rod: Rod | None = None,
+    *,
+    panels: int | None = None,
+    s_out: Sequence[float] | NDArray[np.float64] | None = None,
 ) -> Compliance: ...
 def tangent_compliance(
     solution: StaticsSolution,
