@@ -319,7 +319,6 @@ def test_workspace_map_keeps_the_chambers():
     assert abs(wmap.tip_position[0, 0]) > 1e-3  # the chamber bends the arm
 
 
-@xfail("`softrod workspace` refuses (or drops) the chambers of a tendon-plus-chamber robot")
 def test_cli_workspace_keeps_the_chambers(tmp_path):
     import json
 

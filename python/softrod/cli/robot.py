@@ -204,13 +204,6 @@ def _cmd_workspace(args) -> int:
     if args.n < 1:
         raise bad("--n", args.n, "must be >= 1")
     robot = load_actuated(args)
-    if robot.chambers:
-        raise bad(
-            "ROBOT",
-            args.robot,
-            "has chambers, which workspace maps do not model yet (sweep tensions of a "
-            "tendon-only robot, or use `softrod study` for pressures)",
-        )
     if len(robot.tendons) == 0:
         raise bad("ROBOT", args.robot, "has no tendons to sweep")
     axes = _sweep_axes(args.sweep, len(robot.tendons), args.n)
@@ -228,6 +221,7 @@ def _cmd_workspace(args) -> int:
         robot.loads,
         progress=True if args.progress else None,
         tangent=args.tangent,
+        chambers=list(robot.chambers),
         **opts,
     )
     dt = time.perf_counter() - t0
