@@ -205,7 +205,10 @@ def _cmd_workspace(args) -> int:
         raise bad("--n", args.n, "must be >= 1")
     robot = load_actuated(args)
     if len(robot.tendons) == 0:
-        raise bad("ROBOT", args.robot, "has no tendons to sweep")
+        why = "has no tendons to sweep"
+        if robot.chambers:
+            why += " (its chambers stay at the file's pressures; sweep them with `softrod study`)"
+        raise bad("ROBOT", args.robot, why)
     axes = _sweep_axes(args.sweep, len(robot.tendons), args.n)
     grid = tension_grid(len(robot.tendons), axes)
     opts = {
