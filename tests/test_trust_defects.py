@@ -85,10 +85,6 @@ def test_a_residual_below_tolerance_comes_with_the_real_cause():
         assert getattr(e.value, "load_factor", 1.0) < 1.0
 
 
-@xfail(
-    "the 7 Pa tapered arm: 'did not converge after 3 iterations (residual 0)', and "
-    "throw=False returns the unloaded rod as if nothing was applied"
-)
 def test_seven_pascal_arm_error_is_consistent():
     rod, tendons = _seven_pa_arm()
     with pytest.raises((softrod.ConvergenceError, softrod.ParameterError)) as e:
