@@ -351,7 +351,6 @@ def test_workspace_tangent_at_fixed_length_is_finite_on_a_ten_tendon_robot():
 # ----------------------------------------------------------------------------- output at chosen s
 
 
-@xfail("no output at chosen arc lengths (`s_out=`)")
 def test_solve_statics_reports_exactly_at_s_out():
     kappa = 1.5 * math.pi / arcs.LENGTH
     s_out = np.array([0.0, 0.0123, 0.1, 0.1777, arcs.LENGTH])

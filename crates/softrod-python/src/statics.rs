@@ -872,7 +872,7 @@ pub(crate) fn solve_statics<'py>(
                 let data = crate::contact::ContactData::from_solution(&c);
                 Ok((c.solution, data))
             } else {
-                softrod::solve_statics_at(model, act, &options, &s_values)
+                softrod::compliance::solve_at_output(model, act, &options, &s_values)
                     .map_err(actuator_names)
                     .map(|r| (r, crate::contact::ContactData::default()))
             }

@@ -452,7 +452,8 @@ pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Comp
 /// The paper's integrated compliance (eqs. 6-7) at every node of `solution`. For an adaptive
 /// solution it is integrated under step-size control to the solution's own tolerances
 /// ([`compliance_at`]); for an RK4 solution by the composite quadrature on the solution's
-/// mesh, or, where the mesh's estimated rotational truncation error exceeds
+/// mesh, or, for a solution at the default steps where the mesh's estimated rotational
+/// truncation error exceeds
 /// [`super::MESH_ROTATION_TARGET`] (strongly curved rods), on a finer nested mesh re-solved
 /// from the solution ([`super::refine`]): about 1e-7 relative on stress-free arcs up to 2π.
 /// [`compliance_at`] with `solution.s` gives the values under step-size control at

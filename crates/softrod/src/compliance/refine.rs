@@ -12,9 +12,14 @@
 //! mesh `m` times finer (`m` the smallest integer with `error / m⁴` below the target whose
 //! plan nests the solution's nodes), warm-started from the solution (one or two Newton
 //! iterations), and the compliance is evaluated there at the solution's own nodes. The
-//! refinement costs a solve on the finer mesh, only for strongly curved rods.
+//! refinement costs a solve on the finer mesh, only for strongly curved rods, and applies to
+//! solutions at the default mesh ([`DEFAULT_RK4_STEPS`]): a mesh chosen with other `steps` is
+//! kept (the integrated compliance is the quadrature on it, the tangent compliance the exact
+//! derivative of its discrete march, as a finite difference of solves on it gives).
 
-use crate::cosserat::statics::{solve_statics_at, Integrator, StaticsSolution, MAX_RK4_STEPS};
+use crate::cosserat::statics::{
+    solve_statics_at, Integrator, StaticsSolution, DEFAULT_RK4_STEPS, MAX_RK4_STEPS,
+};
 use crate::integrate::march::rk4_plan;
 
 /// Target of [`rk4_rotation_error`] (rad) above which the compliance of an RK4 solution is
@@ -47,18 +52,19 @@ pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
 
 /// The solution re-solved on a finer RK4 mesh that contains its nodes, with, for each node of
 /// `solution`, its index in the finer one; `None` where no refinement is needed (an adaptive
-/// solution, an estimate below [`MESH_ROTATION_TARGET`]) or possible (a solution at `s_out`,
+/// solution, an estimate below [`MESH_ROTATION_TARGET`]), wanted (RK4 steps other than
+/// [`DEFAULT_RK4_STEPS`]) or possible (a solution at `s_out`,
 /// one that did not converge, no nested plan within [`MAX_REFINEMENT`], a re-solve that fails
 /// or lands elsewhere).
 pub(crate) fn refined(solution: &StaticsSolution) -> Option<(StaticsSolution, Vec<usize>)> {
     let Integrator::Rk4 { steps } = solution.options.integrator else {
         return None;
     };
-    if !solution.s_out.is_empty() || !solution.stats.converged {
+    if steps != DEFAULT_RK4_STEPS || !solution.s_out.is_empty() || !solution.stats.converged {
         return None;
     }
     let error = rk4_rotation_error(solution);
-    if !(error > MESH_ROTATION_TARGET) {
+    if error.is_nan() || error <= MESH_ROTATION_TARGET {
         return None;
     }
     let model = &solution.model;
@@ -94,11 +100,56 @@ pub(crate) fn refined(solution: &StaticsSolution) -> Option<(StaticsSolution, Ve
         }
         let (a, b) = (solution.position[i], fine.position[j]);
         let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-        if !(d <= SAME_BRANCH * length) {
+        if d.is_nan() || d > SAME_BRANCH * length {
             return None;
         }
         map.push(j);
         j += 1;
     }
     Some((fine, map))
+}
+
+/// Target of [`rk4_rotation_error`] (rad) for a solve reported at chosen arc lengths
+/// ([`solve_at_output`]): positions there within about `1e-9 L` on stress-free arcs up to
+/// `2π`.
+pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
+
+/// [`solve_statics_at`] with the values at `s_out` under error control at the default RK4
+/// mesh: the problem is solved on the default mesh, its rotational truncation error estimated
+/// ([`rk4_rotation_error`]) and, above [`OUTPUT_ROTATION_TARGET`], solved again with `s_out` on
+/// a mesh `m` times finer (warm-started; `m` from the fourth-order convergence, at most 32),
+/// whose steps the returned solution's options record. Other integrators and meshes, an
+/// empty `s_out` and a default solve that fails are [`solve_statics_at`] as they are.
+///
+/// # Errors
+/// As [`solve_statics_at`].
+pub fn solve_at_output(
+    model: &std::sync::Arc<crate::model::RobotModel>,
+    actuation: &crate::model::Actuation,
+    options: &crate::cosserat::statics::SolveOptions,
+    s_out: &[f64],
+) -> crate::error::Result<StaticsSolution> {
+    let default =
+        matches!(options.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
+    if !default || s_out.is_empty() {
+        return solve_statics_at(model, actuation, options, s_out);
+    }
+    let mut quiet = *options;
+    quiet.newton.throw = true;
+    let Ok(mesh) = solve_statics_at(model, actuation, &quiet, &[]) else {
+        return solve_statics_at(model, actuation, options, s_out);
+    };
+    let error = rk4_rotation_error(&mesh);
+    if error.is_nan() || error <= OUTPUT_ROTATION_TARGET {
+        return solve_statics_at(model, actuation, options, s_out);
+    }
+    let m = ((error / OUTPUT_ROTATION_TARGET).powf(0.25).ceil() as usize).clamp(2, MAX_REFINEMENT);
+    let mut fine = *options;
+    fine.integrator = Integrator::Rk4 {
+        steps: m * DEFAULT_RK4_STEPS,
+    };
+    fine.warm_start = Some(mesh.warm_start());
+    // The branch was settled (and a stable equilibrium sought) on the default mesh.
+    fine.seek_stable = false;
+    solve_statics_at(model, actuation, &fine, s_out)
 }
