@@ -77,6 +77,20 @@ def test_convergence_error_carries_iterations_residual_and_load_factor():
     assert 0.0 <= e.value.load_factor < 1.0
 
 
+def test_load_steps_running_out_after_an_accepted_step_is_not_converged():
+    # The near-axial push at PL^2/EI = 300 (8.1 degrees off -z): the continuation's last
+    # accepted step is at load factor ~0.47 when the steps run out; that state was returned as
+    # converged at the full load.
+    u = np.array([0.14097948, 0.0049786, -0.99])
+    f = 300 * elastica.EI / elastica.LENGTH**2 * u / np.linalg.norm(u)
+    loads = softrod.Loads(tip_force=tuple(f))
+    with pytest.raises(softrod.ConvergenceError) as e:
+        softrod.solve_statics(elastica.rod(), [], loads)
+    assert 0.0 < e.value.load_factor < 1.0
+    sol = softrod.solve_statics(elastica.rod(), [], loads, throw=False)
+    assert not sol.converged and sol.stats["load_factor"] < 1.0
+
+
 def test_a_residual_below_tolerance_comes_with_the_real_cause():
     rod, loads = _cantilever_failure()
     with pytest.raises(softrod.ConvergenceError) as e:
