@@ -44,7 +44,7 @@ pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option
                 .enumerate()
                 .max_by(|a, b| a.1.total_cmp(b.1))?;
             return Some(Error::invalid(
-                format!("tendons[{i}].tension"),
+                format!("tensions[{i}]"),
                 tau,
                 format!(
                     "tensions summing to less than the rod's axial stiffness E A = {ea:.4e} N at \
