@@ -1098,6 +1098,7 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("compliance(s_out)")(lambda d: (sr.compliance, dict(solution=_solution(), s_out=[0.1, 0.2])))
 
 
 def _photo() -> str:
