@@ -312,7 +312,7 @@ impl Actuation {
             }
         }
         for (i, &p) in self.pressures.iter().enumerate() {
-            check_pressure(&format!("pressures[{i}]"), p)?;
+            check_pressure(format_args!("pressures[{i}]"), p)?;
         }
         Ok(())
     }
