@@ -479,9 +479,7 @@ fn check_load_limits(robot: &PccRobot, loads: &PccLoads) -> Result<()> {
 fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
     let (nt, nc) = (robot.n_tendons(), robot.n_chambers());
     // The same inputs as the Cosserat statics, checked the same way.
-    crate::model::Actuation::tensions(&loads.tensions)
-        .with_pressures(&loads.pressures)
-        .validate(nt, nc)?;
+    crate::model::actuation::validate_values(&loads.tensions, &loads.pressures, nt, nc)?;
     check_vector("tip_force", &loads.tip_force)?;
     check_vector("tip_moment", &loads.tip_moment)?;
     check_load_limits(robot, loads)?;
