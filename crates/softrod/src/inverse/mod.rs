@@ -20,14 +20,29 @@
 //!
 //! # Method
 //! Sequential quadratic programming on the exact actuation Jacobian of the linearised
-//! boundary-value problem ([`crate::cosserat::sensitivity`], or the PCC equilibrium): at the
-//! actuation `a_k` with pose error `e_k` and Jacobian `J_k`, the next actuation solves the
-//! quadratic program `min ½ |a - a_ref|²_W` s.t. `J_k (a - a_k) = e_k`, `lo <= a <= hi`
-//! ([`qp::min_norm`], exact); when the linearised target cannot be met inside the bounds, the
-//! bounded least squares `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the
-//! same norm as a vanishing regularisation) instead. Steps are accepted when the pose error
-//! falls (backtracking otherwise), or near the target (within [`NEAR_TARGET`] of the rod
-//! length), where the SQP converges by itself. The iteration stops when the pose error is
+//! boundary-value problem ([`crate::cosserat::sensitivity`], or the PCC equilibrium), in two
+//! phases.
+//!
+//! * Far from the target (pose error above [`NEAR_TARGET`] of the rod length): a trust region
+//!   on the scaled actuation norm. The SQP step (below) is taken if it fits; otherwise the
+//!   bounded Levenberg–Marquardt step `min |J_k d - e_k|² + μ |d|²_W` inside the bounds, `μ`
+//!   set so that `|d|_W` meets the radius. The first radius moves the linearised pose by a
+//!   quarter of the rod length: from a straight rod the linearisation asks for tensions of
+//!   hundreds of newtons (its shortening is of second order in the bending).
+//! * Near the target: the SQP step `min ½ dᵀ H d + (W (a_k - a_ref))ᵀ d` s.t. `J_k d = e_k`,
+//!   `lo <= a_k + d <= hi` ([`qp::min_norm`] for `H = W`, then [`qp::active_set_qp`]), with
+//!   a backtracking line search on the merit function `½ |a - a_ref|²_W + ν |e|` (`ν` 1.5
+//!   times the multipliers' norm); steps below [`LOCAL_STEP`] are taken in full. `H` is the
+//!   Hessian of the Lagrangian `W - Σ λ_k ∇²p_k` on the null space `Z` of the free columns of
+//!   `J` (the only part that matters), from one directional difference of the exact Jacobian
+//!   per null direction, `H z = W z - (J(a + εz) - J(a))ᵀ λ / ε`; it is made when the free
+//!   set changes or the steps stop contracting ([`STALLED`]). With `H = W` alone the
+//!   iteration oscillates where the curvature of the target manifold exceeds that of the
+//!   norm.
+//!
+//! When the linearised target cannot be met inside the bounds, the bounded least squares
+//! `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the same norm as a
+//! vanishing regularisation) is the step instead. The iteration stops when the pose error is
 //! within the tolerances and the step is below `optimality_tolerance` (relative): the KKT
 //! conditions of the program above hold. Every forward evaluation is one solve with its
 //! Jacobian (for a robot without external loads, one march of the state with one column per
