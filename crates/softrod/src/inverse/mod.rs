@@ -86,6 +86,9 @@ pub const LEAST_SQUARES_REGULARISATION: f64 = 1e-12;
 pub const LOCAL_STEP: f64 = 1e-5;
 /// Ratio of successive steps near the target above which the curvature is made again.
 pub const STALLED: f64 = 0.1;
+/// The first trust radius: the scaled actuation that moves the linearised pose by this
+/// fraction of the rod length.
+pub const FIRST_RADIUS: f64 = 1.0;
 /// Most halvings of a step.
 pub const MAX_STEP_HALVINGS: usize = 30;
 
@@ -632,7 +635,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
             // length (the linearisation of a straight rod asks for huge tensions to shorten it).
             let sigma = scaled_jacobian_norm(&jac, &bounds.weights);
             radius = if sigma > 0.0 {
-                (0.25 * length / sigma).max(norm_a)
+                (FIRST_RADIUS * length / sigma).max(norm_a)
             } else {
                 f64::INFINITY
             };
@@ -693,7 +696,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                             1.0
                         };
                         if ratio > 0.75 {
-                            radius = 2.0 * radius.max(step_norm);
+                            radius = 4.0 * radius.max(step_norm);
                         } else if ratio < 0.25 {
                             radius = 0.5 * step_norm;
                         }
