@@ -257,6 +257,48 @@ impl From<&InverseSolution> for InverseWarmStart {
     }
 }
 
+/// The damped BFGS update (Powell) of the Lagrangian Hessian `h` for the step `a0 → a1`, with
+/// the Jacobians (scaled rows) `j0`, `j1` and the multipliers `lambda`: `s = a1 - a0`,
+/// `y = W s - (j1 - j0)ᵀ λ`. Returns whether it was updated.
+fn bfgs_update(
+    h: &mut DMatrix<f64>,
+    weights: &[f64],
+    a0: &[f64],
+    a1: &[f64],
+    j0: &DMatrix<f64>,
+    j1: &DMatrix<f64>,
+    lambda: &DVector<f64>,
+) -> bool {
+    let n = a0.len();
+    let s = DVector::from_fn(n, |i, _| a1[i] - a0[i]);
+    if j0.shape() != j1.shape() || lambda.len() != j0.nrows() {
+        return false;
+    }
+    let ws = DVector::from_fn(n, |i, _| weights[i] * s[i]);
+    let y = ws - (j1 - j0).tr_mul(lambda);
+    let hs = &*h * &s;
+    let shs = s.dot(&hs);
+    if !(shs > 0.0 && shs.is_finite() && y.iter().all(|v| v.is_finite())) {
+        return false;
+    }
+    let sy = s.dot(&y);
+    let r = if sy >= 0.2 * shs {
+        y
+    } else {
+        let theta = 0.8 * shs / (shs - sy);
+        &y * theta + &hs * (1.0 - theta)
+    };
+    let sr = s.dot(&r);
+    if sr.is_nan() || sr <= 0.0 {
+        return false;
+    }
+    *h += &r * r.transpose() / sr - &hs * hs.transpose() / shs;
+    // Keep it symmetric to round-off.
+    let sym = (&*h + h.transpose()) * 0.5;
+    h.copy_from(&sym);
+    true
+}
+
 fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f64) -> Result<()> {
     let n = nt + nc;
     let (tl, th) = o.tension_bounds;
@@ -588,6 +630,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         if let Some(l) = &solved.lambda {
             nu = 1.5 * l.norm();
         }
+        let lambda_k = solved.lambda.clone();
         let y = solved.y;
         let mut step: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
         let norm_a = scaled_norm(&a);
@@ -715,6 +758,14 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         iterations += 1;
         match accepted {
             Some((trial, t)) => {
+                // Near the target, the curvature met along the step refines the Hessian.
+                if near_phase && curved_for.is_some() {
+                    if let (Some(lambda), Some(jn)) =
+                        (&lambda_k, error_rows(target, &t, rotation_weight).1)
+                    {
+                        bfgs_update(&mut hess, &bounds.weights, &a, &trial, &jac, &jn, lambda);
+                    }
+                }
                 a = trial;
                 ev = t;
             }
