@@ -522,8 +522,14 @@ def _inverse_statics(
     steps: int | None = None,
     rtol: float | None = None,
     atol: float | None = None,
+    warm_state: _InverseWarmState | None = None,
+    same_model: bool = False,
 ) -> dict[str, Any]:
     """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
+
+class _InverseWarmState:
+    """What an inverse result hands to the next call (opaque): its actuation, last evaluation
+    and Lagrangian Hessian."""
 
 def _pcc_inverse_statics(
     robot: PccRobot,
@@ -539,6 +545,8 @@ def _pcc_inverse_statics(
     throw: bool = True,
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    warm_state: _InverseWarmState | None = None,
+    same_model: bool = False,
 ) -> dict[str, Any]:
     """Inverse statics of a PCC robot (softrod.pcc.inverse_statics wraps it)."""
 
