@@ -10,6 +10,7 @@
 //! arc length, point, normal and force.
 
 mod constraint;
+mod jacobian;
 mod obstacle;
 mod solve;
 mod stability;

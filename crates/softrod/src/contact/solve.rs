@@ -9,7 +9,7 @@ use super::constraint::TipConstraint;
 use super::obstacle::Obstacle;
 use super::stability::{conjugate_points, free_stiffness};
 use super::{obstacle_normal_basis, Contact, ContactSolution};
-use crate::cosserat::equations::{rot, v3, Equations, Evaluator, FULL, STATE};
+use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL, STATE};
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
     assemble, scaled, scaled_back, settings, solve_statics, Integrator, SolveOptions,
@@ -33,7 +33,7 @@ const DIFFERENCE_STEP: f64 = 1e-7;
 
 /// Where a contact acts.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Site {
+pub(super) enum Site {
     /// At the tip `s = L` (unknown: the force).
     Tip,
     /// Inside the rod at an unknown arc length where the gap is least (unknowns: `s`, force).
@@ -47,15 +47,15 @@ enum Site {
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
 /// was added, relaxed to zero as the problem's parameter goes from 0 to 1).
 #[derive(Debug, Clone, Copy)]
-struct Active {
-    obstacle: usize,
-    site: Site,
-    g0: f64,
-    dg0: f64,
+pub(super) struct Active {
+    pub(super) obstacle: usize,
+    pub(super) site: Site,
+    pub(super) g0: f64,
+    pub(super) dg0: f64,
 }
 
 impl Active {
-    fn size(&self) -> usize {
+    pub(super) fn size(&self) -> usize {
         match self.site {
             Site::Tip => 3,
             Site::Interior | Site::Interval => 4,
@@ -92,10 +92,10 @@ fn scaled_loads(loads: &Loads, lambda: f64) -> Loads {
 
 /// What one evaluation left: the model it marched (with the contact forces as point loads),
 /// its nodes, its raw shooting residual.
-struct Pass {
-    model: Arc<RobotModel>,
-    nodes: Vec<Node>,
-    residual: Vector6<f64>,
+pub(super) struct Pass {
+    pub(super) model: Arc<RobotModel>,
+    pub(super) nodes: Vec<Node>,
+    pub(super) residual: Vector6<f64>,
 }
 
 /// The residual rows of one evaluation and, when asked, the exact Jacobian columns of the tip
@@ -105,20 +105,20 @@ type Rows = (Vec<f64>, Option<[[f64; 6]; 6]>);
 /// The constrained shooting problem at load factor `load`; the parameter of
 /// [`Problem::evaluate`] relaxes the gap targets of newly added contacts.
 pub(crate) struct Constrained<'m> {
-    model: &'m RobotModel,
-    shared: &'m Arc<RobotModel>,
-    tensions: Vec<f64>,
-    pressures: Vec<f64>,
-    integrator: Integrator,
-    tip: Option<TipConstraint>,
+    pub(super) model: &'m RobotModel,
+    pub(super) shared: &'m Arc<RobotModel>,
+    pub(super) tensions: Vec<f64>,
+    pub(super) pressures: Vec<f64>,
+    pub(super) integrator: Integrator,
+    pub(super) tip: Option<TipConstraint>,
     /// Tip pose of the actuated rod without loads (the target at load factor 0).
-    start: (Vector3<f64>, Matrix3<f64>),
-    obstacles: &'m [Obstacle],
-    active: Vec<Active>,
-    load: f64,
-    last: Option<Pass>,
-    reference: Vec<Vector3<f64>>,
-    evaluations: usize,
+    pub(super) start: (Vector3<f64>, Matrix3<f64>),
+    pub(super) obstacles: &'m [Obstacle],
+    pub(super) active: Vec<Active>,
+    pub(super) load: f64,
+    pub(super) last: Option<Pass>,
+    pub(super) reference: Vec<Vector3<f64>>,
+    pub(super) evaluations: usize,
 }
 
 impl<'m> Constrained<'m> {
@@ -126,7 +126,7 @@ impl<'m> Constrained<'m> {
         6 + active.iter().map(Active::size).sum::<usize>()
     }
 
-    fn offsets(&self) -> Vec<usize> {
+    pub(super) fn offsets(&self) -> Vec<usize> {
         let mut o = Vec::with_capacity(self.active.len());
         let mut k = 6;
         for a in &self.active {
@@ -149,7 +149,7 @@ impl<'m> Constrained<'m> {
     }
 
     /// The six tip rows at the tip pose `(p, r)` with shooting residual `res`.
-    fn tip_rows(&self, res: &Vector6<f64>, p: &Vector3<f64>, r: &Matrix3<f64>) -> [f64; 6] {
+    pub(super) fn tip_rows(&self, res: &Vector6<f64>, p: &Vector3<f64>, r: &Matrix3<f64>) -> [f64; 6] {
         let Some(c) = &self.tip else {
             return std::array::from_fn(|k| res[k]);
         };
@@ -186,7 +186,7 @@ impl<'m> Constrained<'m> {
 
     /// The derivative of [`Self::tip_rows`] along a column: residual change `dres`, tip
     /// displacement `dp` and rotation `w` (world).
-    fn tip_rows_dot(
+    pub(super) fn tip_rows_dot(
         &self,
         dres: &Vector6<f64>,
         dp: &Vector3<f64>,
@@ -229,7 +229,7 @@ impl<'m> Constrained<'m> {
 
     /// The model with the loads at the current load factor and the contact forces of `x` as
     /// world point loads; `None` if an arc length left the rod.
-    fn contact_model(&self, x: &[f64]) -> Option<Arc<RobotModel>> {
+    pub(super) fn contact_model(&self, x: &[f64]) -> Option<Arc<RobotModel>> {
         if self.active.is_empty() && (self.load == 1.0 || self.model.loads().is_unloaded()) {
             return Some(Arc::clone(self.shared));
         }
@@ -319,47 +319,31 @@ impl<'m> Constrained<'m> {
             None
         };
         let l = self.model.length();
+        let nt = model.tendons().len();
+        let mut scratch = Workspace::new(nt);
+        let mut ev = Evaluator {
+            eq: sh.eq,
+            ws: &mut scratch,
+        };
         for (a, o) in self.active.iter().zip(self.offsets()) {
-            let ob = &self.obstacles[a.obstacle];
             let (s, k) = match a.site {
                 Site::Tip => (l, o),
                 Site::Interior | Site::Interval => (x[o] * l, o + 1),
             };
-            let props = model.rod().section_at(s);
             let first = sh.nodes.iter().position(|n| n.s == s)?;
             let last = sh.nodes.iter().rposition(|n| n.s == s)?;
-            let pc = v3(&sh.nodes[first].y, 0);
-            let (d, n) = ob.distance(&pc);
-            let g = d - props.radius;
-            rows.push((g - (1.0 - mu) * a.g0) / l);
-            if a.site != Site::Tip {
-                // A point contact sits at the kink of the gap (the shear jumps with the
-                // force): the mean slope of its two sides vanishes; the segment of an
-                // interval lies flat from just after its edge.
-                let sides: &[usize] = if a.site == Site::Interval {
-                    &[last, last]
-                } else {
-                    &[first, last]
-                };
-                let mut slope = 0.0;
-                for &j in sides {
-                    let node = sh.nodes[j];
-                    let mut ev = Evaluator {
-                        eq: sh.eq,
-                        ws: &mut sh.ws,
-                    };
-                    ev.set_interval(node.interval);
-                    let mut dy = [0.0; STATE];
-                    ev.rhs_into::<STATE>(node.s, &node.y, &mut dy);
-                    slope += 0.5 * n.dot(&v3(&dy, 0));
-                }
-                let dg = slope - props.radius_rate;
-                rows.push(dg - (1.0 - mu) * a.dg0);
-            }
-            let (t1, t2) = obstacle_normal_basis(&n);
+            let (nf, nl) = (&sh.nodes[first], &sh.nodes[last]);
             let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
-            rows.push(f.dot(&t1));
-            rows.push(f.dot(&t2));
+            self.contact_rows(
+                &mut ev,
+                a,
+                s,
+                (&nf.y, nf.interval),
+                (&nl.y, nl.interval),
+                &f,
+                mu,
+                &mut rows,
+            );
         }
         if !rows.iter().all(|v| v.is_finite()) {
             return None;
@@ -370,6 +354,54 @@ impl<'m> Constrained<'m> {
             model: Arc::clone(&model),
         });
         Some((rows, jac))
+    }
+
+    /// The residual rows of the active contact `a` at arc length `s` (m) with scaled force
+    /// `f`, from the states (and intervals) of the first node at `s` (before the jump of the
+    /// force) and the last (after it): the gap over `L` (relaxed by `mu` from its value when
+    /// added), for a contact inside the rod the slope of the gap, and the force's two
+    /// components along the obstacle's surface. `ev` is a scratch evaluator of the contact
+    /// model.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn contact_rows(
+        &self,
+        ev: &mut Evaluator<'_, '_>,
+        a: &Active,
+        s: f64,
+        first: (&[f64; STATE], usize),
+        last: (&[f64; STATE], usize),
+        f: &Vector3<f64>,
+        mu: f64,
+        rows: &mut Vec<f64>,
+    ) {
+        let l = self.model.length();
+        let ob = &self.obstacles[a.obstacle];
+        let props = self.model.rod().section_at(s);
+        let (d, n) = ob.distance(&v3(first.0, 0));
+        let g = d - props.radius;
+        rows.push((g - (1.0 - mu) * a.g0) / l);
+        if a.site != Site::Tip {
+            // A point contact sits at the kink of the gap (the shear jumps with the force):
+            // the mean slope of its two sides vanishes; the segment of an interval lies flat
+            // from just after its edge.
+            let sides = if a.site == Site::Interval {
+                [last, last]
+            } else {
+                [first, last]
+            };
+            let mut slope = 0.0;
+            for (y, interval) in sides {
+                ev.set_interval(interval);
+                let mut dy = [0.0; STATE];
+                ev.rhs_into::<STATE>(s, y, &mut dy);
+                slope += 0.5 * n.dot(&v3(&dy, 0));
+            }
+            let dg = slope - props.radius_rate;
+            rows.push(dg - (1.0 - mu) * a.dg0);
+        }
+        let (t1, t2) = obstacle_normal_basis(&n);
+        rows.push(f.dot(&t1));
+        rows.push(f.dot(&t2));
     }
 
     /// The gap (m) and outward normal of obstacle `o` at every node of the last pass (first
@@ -428,11 +460,17 @@ impl Problem for Constrained<'_> {
         &mut self,
         x: &[f64],
         lambda: f64,
-        jacobian: Option<&mut [f64]>,
+        mut jacobian: Option<&mut [f64]>,
         r: &mut [f64],
     ) -> Evaluated {
         let n = self.dim();
         let exact = self.active.is_empty();
+        if let (Some(j), false) = (jacobian.as_deref_mut(), exact) {
+            if let Some(rows) = self.exact(x, lambda, j) {
+                r.copy_from_slice(&rows);
+                return Evaluated::Jacobian;
+            }
+        }
         let Some((rows, jac)) = self.run(x, lambda, jacobian.is_some() && exact) else {
             return Evaluated::Failed;
         };
