@@ -329,6 +329,8 @@ impl Constrained<'_> {
             model: std::sync::Arc::clone(&model),
             nodes,
             residual: res,
+            key: self.key(x, mu),
+            rows: rows.clone(),
         });
         Some(rows)
     }

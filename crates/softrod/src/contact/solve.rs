@@ -13,16 +13,17 @@ use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL,
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
     assemble, scaled, scaled_back, settings, solve_statics, Integrator, SolveOptions,
-    MAX_LOAD_STEP_TURN,
+    MAX_LINE_SEARCH_HALVINGS, MAX_LOAD_STEP_TURN,
 };
 use crate::cosserat::NEUTRAL_MARGIN;
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
+use crate::math::linalg::DenseLu;
 use crate::model::loads::{Loads, PointLoad};
 use crate::model::rod::Profile;
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{
-    continuation, max_norm, newton, ContinuationSettings, Evaluated, NewtonOptions, Problem,
+    continuation, max_norm, ContinuationSettings, Evaluated, NewtonOptions, Problem,
     SolverStats, MIN_LOAD_INCREMENT,
 };
 
@@ -46,7 +47,7 @@ pub(super) enum Site {
 
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
 /// was added, relaxed to zero as the problem's parameter goes from 0 to 1).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Active {
     pub(super) obstacle: usize,
     pub(super) site: Site,
@@ -96,7 +97,14 @@ pub(super) struct Pass {
     pub(super) model: Arc<RobotModel>,
     pub(super) nodes: Vec<Node>,
     pub(super) residual: Vector6<f64>,
+    /// What was evaluated, and its rows (a residual asked again is not marched again).
+    pub(super) key: Key,
+    pub(super) rows: Vec<f64>,
 }
+
+/// The unknowns, homotopy parameter, load factor, active set and tip constraint of an
+/// evaluation.
+pub(super) type Key = (Vec<f64>, f64, f64, Vec<Active>, Option<TipConstraint>);
 
 /// The residual rows of one evaluation and, when asked, the exact Jacobian columns of the tip
 /// rows along the base wrench.
@@ -134,6 +142,17 @@ impl<'m> Constrained<'m> {
             k += a.size();
         }
         o
+    }
+
+    /// The key of an evaluation at `x` and `mu` in the current state.
+    pub(super) fn key(&self, x: &[f64], mu: f64) -> Key {
+        // (The load factor steps nothing on an unloaded rod with a free tip.)
+        let load = if self.tip.is_none() && self.model.loads().is_unloaded() {
+            1.0
+        } else {
+            self.load
+        };
+        (x.to_vec(), mu, load, self.active.clone(), self.tip)
     }
 
     /// The target position and rotation of the tip at the current load factor.
@@ -352,6 +371,8 @@ impl<'m> Constrained<'m> {
             nodes: std::mem::take(&mut sh.nodes),
             residual: res,
             model: Arc::clone(&model),
+            key: self.key(x, mu),
+            rows: rows.clone(),
         });
         Some((rows, jac))
     }
@@ -460,11 +481,56 @@ impl Problem for Constrained<'_> {
         &mut self,
         x: &[f64],
         lambda: f64,
+        jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
+        self.evaluate_inner(x, lambda, jacobian, r)
+    }
+
+    fn commit(&mut self) {
+        if let Some(p) = &self.last {
+            self.reference = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
+        }
+    }
+
+    fn close(&self) -> bool {
+        let (Some(p), false) = (&self.last, self.reference.is_empty()) else {
+            return false;
+        };
+        let limit = 0.5 * MAX_LOAD_STEP_TURN * self.model.length();
+        let now: Vec<Vector3<f64>> = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
+        if now.len() == self.reference.len() {
+            now.iter()
+                .zip(&self.reference)
+                .all(|(a, b)| (a - b).norm() <= limit)
+        } else {
+            match (now.last(), self.reference.last()) {
+                (Some(a), Some(b)) => (a - b).norm() <= limit,
+                _ => false,
+            }
+        }
+    }
+}
+
+impl Constrained<'_> {
+    /// [`Problem::evaluate`]: a residual asked again at the last evaluation is not marched
+    /// again; a Jacobian with contacts comes from one march with the variational columns
+    /// (forward differences only when they do not fit in one march).
+    fn evaluate_inner(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
         mut jacobian: Option<&mut [f64]>,
         r: &mut [f64],
     ) -> Evaluated {
         let n = self.dim();
         let exact = self.active.is_empty();
+        if jacobian.is_none() {
+            if let Some(last) = self.last.as_ref().filter(|l| l.key == self.key(x, lambda)) {
+                r.copy_from_slice(&last.rows);
+                return Evaluated::Residual;
+            }
+        }
         if let (Some(j), false) = (jacobian.as_deref_mut(), exact) {
             if let Some(rows) = self.exact(x, lambda, j) {
                 r.copy_from_slice(&rows);
@@ -504,29 +570,6 @@ impl Problem for Constrained<'_> {
         Evaluated::Jacobian
     }
 
-    fn commit(&mut self) {
-        if let Some(p) = &self.last {
-            self.reference = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
-        }
-    }
-
-    fn close(&self) -> bool {
-        let (Some(p), false) = (&self.last, self.reference.is_empty()) else {
-            return false;
-        };
-        let limit = 0.5 * MAX_LOAD_STEP_TURN * self.model.length();
-        let now: Vec<Vector3<f64>> = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
-        if now.len() == self.reference.len() {
-            now.iter()
-                .zip(&self.reference)
-                .all(|(a, b)| (a - b).norm() <= limit)
-        } else {
-            match (now.last(), self.reference.last()) {
-                (Some(a), Some(b)) => (a - b).norm() <= limit,
-                _ => false,
-            }
-        }
-    }
 }
 
 /// Effort of a solve.
@@ -543,22 +586,96 @@ fn correct(
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    let s = crate::solve::NewtonSettings {
-        residual_first: true,
-        ..settings(true, None, false)
-    };
-    let out = newton(p, x, 1.0, opts, &s);
-    effort.iterations += out.iterations;
-    if !out.converged {
-        return None;
-    }
-    if !out.at_x {
-        let mut r = vec![0.0; p.dim()];
-        if p.evaluate(&out.x, 1.0, None, &mut r) == Evaluated::Failed {
+    exact_newton(p, x, opts, effort, true).map(|(x, _)| x)
+}
+
+/// Residual below which [`exact_newton`] stops refining a converged iterate (a fraction of
+/// the tolerance, above round-off).
+fn round_off(opts: &NewtonOptions) -> f64 {
+    (opts.tolerance * 1e-4).max(64.0 * f64::EPSILON)
+}
+
+/// Newton with exact Jacobians at the full contact targets from `x` (the residual alone
+/// first when `residual_first`): every evaluation brings its Jacobian from the same march,
+/// so a full step costs one march; a step is halved until the residual's max norm falls
+/// (Armijo). Once within the tolerance, up to two more steps are taken while they lower the
+/// residual toward round-off, so that the balance of the reactions holds to the digits of the
+/// loads. Returns the iterate and its residual, the last pass at it; `None` if the
+/// tolerance is not met.
+fn exact_newton(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+    residual_first: bool,
+) -> Option<(Vec<f64>, f64)> {
+    let n = p.dim();
+    let mut x = x.to_vec();
+    let mut r = vec![0.0; n];
+    let mut j = vec![0.0; n * n];
+    if residual_first {
+        if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
             return None;
         }
+        let norm = max_norm(&r);
+        if norm <= round_off(opts) {
+            return Some((x, norm));
+        }
     }
-    Some(out.x)
+    if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
+        return None;
+    }
+    let mut norm = max_norm(&r);
+    let (mut xt, mut rt, mut jt) = (vec![0.0; n], vec![0.0; n], vec![0.0; n * n]);
+    let mut lu = DenseLu::default();
+    let mut refined = 0;
+    for _ in 0..opts.max_iterations {
+        if norm <= opts.tolerance {
+            if norm <= round_off(opts) || refined >= 2 {
+                return Some((x, norm));
+            }
+            refined += 1;
+        }
+        let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
+        if !(lu.factor(n, &j) && lu.solve_in_place(&mut dx)) {
+            break;
+        }
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
+            for k in 0..n {
+                xt[k] = x[k] + alpha * dx[k];
+            }
+            if p.evaluate(&xt, 1.0, Some(&mut jt), &mut rt) == Evaluated::Jacobian {
+                let trial = max_norm(&rt);
+                if trial <= (1.0 - 1e-4 * alpha) * norm {
+                    accepted = true;
+                    break;
+                }
+            }
+            if norm <= opts.tolerance {
+                // Refining: a step that does not help ends it.
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
+        effort.iterations += 1;
+        std::mem::swap(&mut x, &mut xt);
+        std::mem::swap(&mut r, &mut rt);
+        std::mem::swap(&mut j, &mut jt);
+        norm = max_norm(&r);
+    }
+    if norm > opts.tolerance {
+        return None;
+    }
+    // The last pass back at the iterate.
+    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
+        return None;
+    }
+    Some((x, norm))
 }
 
 /// Normal forces, normal, arc length and point of each active contact at `x`.
@@ -662,6 +779,10 @@ fn add_contacts(
             x.push(s / l);
         }
         x.extend([0.0; 3]);
+    }
+    // Straight to the contact (one exact Newton solve), else by relaxing the gaps.
+    if let Some((xs, _)) = exact_newton(p, &x, opts, effort, false) {
+        return Some(xs);
     }
     // The gap targets of the new contacts: their rows at zero force.
     let mut r = vec![0.0; p.dim()];
@@ -920,27 +1041,17 @@ fn fail(
     })
 }
 
-/// Exact Newton steps (fresh Jacobians) from the converged `x` toward round-off, so that the
-/// balance of the reactions holds to the digits of the loads, not only of the tolerance;
-/// `x` itself if they do not lower the residual.
-fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Vec<f64> {
-    let opts = NewtonOptions {
-        tolerance: (options.newton.tolerance * 1e-4).max(f64::EPSILON),
-        max_iterations: 2,
-        ..options.newton
-    };
-    let mut r = vec![0.0; p.dim()];
-    let before = if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
-        f64::INFINITY
-    } else {
-        max_norm(&r)
-    };
-    let out = newton(p, x, 1.0, &opts, &settings(false, None, false));
-    if out.residual < before && out.residual.is_finite() {
-        out.x
-    } else {
-        x.to_vec()
+/// Exact Newton steps from the converged `x` toward round-off (see [`exact_newton`]), so
+/// that the balance of the reactions holds to the digits of the loads, not only of the
+/// tolerance; `x` itself if they do not lower the residual. The last pass is left at the
+/// result, whose residual is returned (`None` if it cannot be integrated).
+fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Option<(Vec<f64>, f64)> {
+    let mut effort = Effort::default();
+    if let Some(out) = exact_newton(p, x, &options.newton, &mut effort, true) {
+        return Some(out);
     }
+    let mut r = vec![0.0; p.dim()];
+    (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
 }
 
 /// The contacts of a solution and the contact force at its samples (an interval's
@@ -1066,10 +1177,7 @@ fn finish(
     x: &[f64],
     effort: &Effort,
 ) -> Result<ContactSolution> {
-    let polished = polish(p, x, options);
-    let x: &[f64] = &polished;
-    let mut r = vec![0.0; p.dim()];
-    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
+    let Some((polished, residual)) = polish(p, x, options) else {
         return fail(
             p,
             &options.newton,
@@ -1077,8 +1185,8 @@ fn finish(
             1.0,
             "the solution could not be integrated",
         );
-    }
-    let residual = max_norm(&r);
+    };
+    let x: &[f64] = &polished;
     let forces = p.normal_forces(x);
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
