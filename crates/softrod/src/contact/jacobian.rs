@@ -245,6 +245,7 @@ impl Constrained<'_> {
             v
         };
         let mut buf = Vec::with_capacity(4);
+        let mut twists = Vec::with_capacity(n);
         for c in 0..n {
             let (dres_c, dp, w) = match mcol[c] {
                 Some(m) => {
@@ -263,6 +264,7 @@ impl Constrained<'_> {
                     (d, Vector3::zeros(), Vector3::zeros())
                 }
             };
+            twists.push(nalgebra::Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z));
             let tip = self.tip_rows_dot(&dres_c, &dp, &w, &r_tip);
             j[n * c..n * c + 6].copy_from_slice(&tip);
             let mut row = 6;
@@ -331,7 +333,48 @@ impl Constrained<'_> {
             residual: res,
             key: self.key(x, mu),
             rows: rows.clone(),
+            jacobian: Some((j.to_vec(), twists)),
         });
         Some(rows)
+    }
+
+    /// The tip compliance at the converged `x` with the active contacts and the tip
+    /// constraint as constraints: `[δp; δθ]` of the tip (m, rad; world) per `[δF; δM]` of a
+    /// dead tip load (N, N m; world), from the linearised constrained problem
+    /// `J δx = -∂r/∂w` and the tip columns of the unknowns; `None` if the Jacobian is
+    /// singular or the march fails.
+    pub(super) fn compliance(&mut self, x: &[f64]) -> Option<nalgebra::Matrix6<f64>> {
+        let n = self.dim();
+        let key = self.key(x, 1.0);
+        let cached = self.last.as_ref().filter(|l| l.key == key && l.jacobian.is_some());
+        if cached.is_none() {
+            let mut j = vec![0.0; n * n];
+            self.exact(x, 1.0, &mut j)?;
+        }
+        let (j, twists) = self.last.as_ref()?.jacobian.clone()?;
+        let r_tip = rot(&self.last.as_ref()?.nodes.last()?.y);
+        let l = self.model.length();
+        let fs = self.model.force_scale();
+        let mut lu = crate::math::linalg::DenseLu::default();
+        if !lu.factor(n, &j) {
+            return None;
+        }
+        let mut c = nalgebra::Matrix6::zeros();
+        for k in 0..6 {
+            // The tip rows' change with a unit tip load: the free balance rows lose it.
+            let mut d = nalgebra::Vector6::zeros();
+            d[k] = -1.0 / if k < 3 { fs } else { fs * l };
+            let tip = self.tip_rows_dot(&d, &Vector3::zeros(), &Vector3::zeros(), &r_tip);
+            let mut dx = vec![0.0; n];
+            for i in 0..6 {
+                dx[i] = -tip[i];
+            }
+            if !lu.solve_in_place(&mut dx) {
+                return None;
+            }
+            let q: nalgebra::Vector6<f64> = twists.iter().zip(&dx).map(|(t, v)| t * *v).sum();
+            c.set_column(k, &q);
+        }
+        c.iter().all(|v| v.is_finite()).then_some(c)
     }
 }

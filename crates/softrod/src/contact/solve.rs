@@ -100,6 +100,9 @@ pub(super) struct Pass {
     /// What was evaluated, and its rows (a residual asked again is not marched again).
     pub(super) key: Key,
     pub(super) rows: Vec<f64>,
+    /// With an exact Jacobian: it (column-major) and the tip twist `[δp; δθ]` (m, rad;
+    /// world) per scaled unknown.
+    pub(super) jacobian: Option<(Vec<f64>, Vec<Vector6<f64>>)>,
 }
 
 /// The unknowns, homotopy parameter, load factor, active set and tip constraint of an
@@ -373,6 +376,7 @@ impl<'m> Constrained<'m> {
             model: Arc::clone(&model),
             key: self.key(x, mu),
             rows: rows.clone(),
+            jacobian: None,
         });
         Some((rows, jac))
     }
@@ -948,6 +952,7 @@ pub fn solve_constrained(
             contacts: Vec::new(),
             contact_force: vec![[0.0; 3]; n],
             conjugate_points: None,
+            compliance: None,
         });
     }
     let tensions = actuation.tension_values(model.tendons().len());
@@ -1188,6 +1193,12 @@ fn finish(
     };
     let x: &[f64] = &polished;
     let forces = p.normal_forces(x);
+    // The compliance under the constraints (its march leaves the last pass at `x`).
+    let compliance = if residual <= options.newton.tolerance {
+        p.compliance(x)
+    } else {
+        None
+    };
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
@@ -1253,5 +1264,6 @@ fn finish(
         contacts,
         contact_force,
         conjugate_points: conjugate,
+        compliance,
     })
 }
