@@ -882,12 +882,12 @@ fn step_loads(
     mut x: Vec<f64>,
     opts: &NewtonOptions,
     effort: &mut Effort,
-) -> std::result::Result<Vec<f64>, (f64, &'static str)> {
+) -> std::result::Result<Vec<f64>, (f64, &'static str, Vec<f64>)> {
     let mut lambda = 0.0;
     let mut dl: f64 = 1.0;
     while lambda < 1.0 {
         if effort.load_steps >= opts.max_load_steps {
-            return Err((lambda, "the load steps ran out"));
+            return Err((lambda, "the load steps ran out", x));
         }
         let target = (lambda + dl).min(1.0);
         let saved = (x.clone(), p.active.clone());
@@ -904,11 +904,15 @@ fn step_loads(
                 (x, p.active) = saved;
                 p.load = lambda;
                 if !opts.continuation {
-                    return Err((lambda, "the direct solve failed"));
+                    return Err((lambda, "the direct solve failed", x));
                 }
                 dl *= 0.5;
                 if dl < MIN_LOAD_INCREMENT {
-                    return Err((lambda, "no load step converged (load increment underflow)"));
+                    return Err((
+                        lambda,
+                        "no load step converged (load increment underflow)",
+                        x,
+                    ));
                 }
             }
         }
@@ -1009,21 +1013,46 @@ pub fn solve_constrained(
         // Load factor 0 (contacts of the actuated rod), then the loads and the target.
         match active_set(&mut p, &x, &opts, &mut effort) {
             Some(xs) => x = xs,
-            None => return fail(&p, &opts, &effort, 0.0, "no contact set at load factor 0"),
+            None => {
+                let why = "no contact set at load factor 0";
+                if opts.throw {
+                    return fail(&p, &opts, &effort, 0.0, why);
+                }
+                p.active.clear();
+                return unconverged(&mut p, model, actuation, options, &x[..6], &effort, 0.0);
+            }
         }
         p.commit();
         if !(model.loads().is_unloaded() && p.tip.is_none()) {
             // (Otherwise nothing is stepped: load factor 0 is the problem.)
             x = match step_loads(&mut p, x, &opts, &mut effort) {
                 Ok(x) => x,
-                Err((lambda, why)) => return fail(&p, &opts, &effort, lambda, why),
+                Err((lambda, _, x)) if !opts.throw => {
+                    return unconverged(&mut p, model, actuation, options, &x, &effort, lambda);
+                }
+                Err((lambda, why, _)) => return fail(&p, &opts, &effort, lambda, why),
             };
         }
         reached = Some(x);
     }
     let x = reached.unwrap_or_default();
     p.load = 1.0;
-    finish(&mut p, model, actuation, options, &x, &effort)
+    finish(&mut p, model, actuation, options, &x, &effort, 1.0)
+}
+
+/// Without `throw`: the solution at the last state reached (at load factor `lambda`, with its
+/// active set), under the full loads, marked not converged, with its statistics.
+fn unconverged(
+    p: &mut Constrained<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    x: &[f64],
+    effort: &Effort,
+    lambda: f64,
+) -> Result<ContactSolution> {
+    p.load = 1.0;
+    finish(p, model, actuation, options, x, effort, lambda)
 }
 
 /// The error (or, without `throw`, nothing better to return) of a failed solve.
@@ -1181,8 +1210,15 @@ fn finish(
     options: &SolveOptions,
     x: &[f64],
     effort: &Effort,
+    load_factor: f64,
 ) -> Result<ContactSolution> {
-    let Some((polished, residual)) = polish(p, x, options) else {
+    let reached = if load_factor >= 1.0 {
+        polish(p, x, options)
+    } else {
+        let mut r = vec![0.0; p.dim()];
+        (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
+    };
+    let Some((polished, residual)) = reached else {
         return fail(
             p,
             &options.newton,
@@ -1223,9 +1259,9 @@ fn finish(
         iterations: effort.iterations,
         residual,
         function_evaluations: p.evaluations + sh.evaluations,
-        converged: residual <= options.newton.tolerance,
+        converged: residual <= options.newton.tolerance && load_factor >= 1.0,
         load_steps: effort.load_steps,
-        load_factor: 1.0,
+        load_factor,
     };
     let fs = model.force_scale();
     let l = model.length();
