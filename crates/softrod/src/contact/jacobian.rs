@@ -295,10 +295,7 @@ impl Constrained<'_> {
                 if (first_force..first_force + 3).contains(&c) {
                     df[c - first_force] = 1.0;
                 }
-                let nu = scale(&dyf)
-                    .max(scale(&dyl))
-                    .max(ds / l)
-                    .max(df.amax());
+                let nu = scale(&dyf).max(scale(&dyl)).max(ds / l).max(df.amax());
                 if nu == 0.0 {
                     for i in 0..size {
                         j[n * c + row + i] = 0.0;
@@ -346,7 +343,10 @@ impl Constrained<'_> {
     pub(super) fn compliance(&mut self, x: &[f64]) -> Option<nalgebra::Matrix6<f64>> {
         let n = self.dim();
         let key = self.key(x, 1.0);
-        let cached = self.last.as_ref().filter(|l| l.key == key && l.jacobian.is_some());
+        let cached = self
+            .last
+            .as_ref()
+            .filter(|l| l.key == key && l.jacobian.is_some());
         if cached.is_none() {
             let mut j = vec![0.0; n * n];
             self.exact(x, 1.0, &mut j)?;

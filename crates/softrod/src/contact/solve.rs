@@ -23,8 +23,8 @@ use crate::model::loads::{Loads, PointLoad};
 use crate::model::rod::Profile;
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{
-    continuation, max_norm, ContinuationSettings, Evaluated, NewtonOptions, Problem,
-    SolverStats, MIN_LOAD_INCREMENT,
+    continuation, max_norm, ContinuationSettings, Evaluated, NewtonOptions, Problem, SolverStats,
+    MIN_LOAD_INCREMENT,
 };
 
 /// Most rounds of the active-set loop (contacts added or released) per load step.
@@ -171,7 +171,12 @@ impl<'m> Constrained<'m> {
     }
 
     /// The six tip rows at the tip pose `(p, r)` with shooting residual `res`.
-    pub(super) fn tip_rows(&self, res: &Vector6<f64>, p: &Vector3<f64>, r: &Matrix3<f64>) -> [f64; 6] {
+    pub(super) fn tip_rows(
+        &self,
+        res: &Vector6<f64>,
+        p: &Vector3<f64>,
+        r: &Matrix3<f64>,
+    ) -> [f64; 6] {
         let Some(c) = &self.tip else {
             return std::array::from_fn(|k| res[k]);
         };
@@ -573,7 +578,6 @@ impl Constrained<'_> {
         self.last = saved;
         Evaluated::Jacobian
     }
-
 }
 
 /// Effort of a solve.
