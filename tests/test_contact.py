@@ -16,13 +16,20 @@ def _rod():
     return sr.Rod(L, sr.CircularSection(R), sr.LinearElastic(E, NU))
 
 
+DELTA = 1e-3
+CLOSING = 3 * EI * DELTA / L**3  # the tip force that closes the gap to the plane
+PLANE = sr.Plane((-(R + DELTA), 0.0, 0.0), (1.0, 0.0, 0.0))
+
+
+def _pressed(factor, **kw):
+    """The cantilever pushed toward the plane by `factor` times the closing force."""
+    loads = sr.Loads(tip_force=(-factor * CLOSING, 0, 0))
+    return sr.solve_statics(_rod(), loads=loads, obstacles=[PLANE], steps=100, **kw)
+
+
 def test_tip_contact_reaction_is_the_cantilever_closed_form():
-    delta = 1e-3
-    closing = 3 * EI * delta / L**3
-    plane = sr.Plane((-(R + delta), 0.0, 0.0), (1.0, 0.0, 0.0))
-    sol = sr.solve_statics(
-        _rod(), loads=sr.Loads(tip_force=(-2 * closing, 0, 0)), obstacles=[plane], steps=100
-    )
+    closing, plane = CLOSING, PLANE
+    sol = _pressed(2)
     assert len(sol.contacts) == 1
     c = sol.contacts[0]
     assert c["s"] == L and c["normal"] == [1.0, 0.0, 0.0]
@@ -119,11 +126,8 @@ def test_tip_constraint_round_trips_through_a_robot_file(tmp_path, constraint):
 
 
 def test_failed_contact_solve_without_throw_returns_the_unconverged_solution():
-    delta = 1e-3
-    closing = 3 * EI * delta / L**3
-    plane = sr.Plane((-(R + delta), 0.0, 0.0), (1.0, 0.0, 0.0))
-    loads = sr.Loads(tip_force=(-40 * closing, 0, 0))
-    kw = {"obstacles": [plane], "max_iterations": 1, "continuation": False}
+    loads = sr.Loads(tip_force=(-40 * CLOSING, 0, 0))
+    kw = {"obstacles": [PLANE], "max_iterations": 1, "continuation": False}
     with pytest.raises(sr.ConvergenceError, match="contact"):
         sr.solve_statics(_rod(), loads=loads, **kw)
     sol = sr.solve_statics(_rod(), loads=loads, throw=False, **kw)
@@ -134,15 +138,7 @@ def test_failed_contact_solve_without_throw_returns_the_unconverged_solution():
 
 
 def test_contact_compliance_holds_the_normal_and_slides_along_the_plane():
-    delta = 1e-3
-    closing = 3 * EI * delta / L**3
-    plane = sr.Plane((-(R + delta), 0.0, 0.0), (1.0, 0.0, 0.0))
-    free = sr.solve_statics(
-        _rod(), loads=sr.Loads(tip_force=(-0.5 * closing, 0, 0)), obstacles=[plane], steps=100
-    )
-    pressed = sr.solve_statics(
-        _rod(), loads=sr.Loads(tip_force=(-2 * closing, 0, 0)), obstacles=[plane], steps=100
-    )
+    free, pressed = _pressed(0.5), _pressed(2)
     c0, c = free.contact_compliance, pressed.contact_compliance
     assert c.shape == (6, 6)
     assert abs(c[0, 0]) <= 1e-9 * c0[0, 0]

@@ -87,16 +87,23 @@ fn assert_contact_solution(
     }
 }
 
-/// A cantilever along z pushed by a tip force toward the plane x = -(R + δ) (normal +x):
-/// no contact below the force 3 E I δ / L³ that closes the gap, and beyond it a tip reaction
-/// R = F - 3 E I δ / L³ (slender rod: shear below 1e-5 of it).
-#[test]
-fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
+/// The cantilever of radius 1 mm beside the plane x = -(R + δ), δ = 1e-3 L (normal +x):
+/// `(radius, E I, the tip force 3 E I δ / L³ that closes the gap, δ, the plane)`.
+fn beside_a_plane() -> (f64, f64, f64, f64, Obstacle) {
     let radius = 1e-3;
     let delta = 1e-3 * L;
     let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
     let closing = 3.0 * ei * delta / L.powi(3);
     let plane = Obstacle::plane([-(radius + delta), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    (radius, ei, closing, delta, plane)
+}
+
+/// A cantilever along z pushed by a tip force toward the plane x = -(R + δ) (normal +x):
+/// no contact below the force 3 E I δ / L³ that closes the gap, and beyond it a tip reaction
+/// R = F - 3 E I δ / L³ (slender rod: shear below 1e-5 of it).
+#[test]
+fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
+    let (radius, _, closing, _, plane) = beside_a_plane();
     let obstacles = [plane];
     for factor in [0.5, 0.99, 1.5, 2.0, 4.0] {
         let force = Vector3::new(-factor * closing, 0.0, 0.0);
@@ -252,11 +259,7 @@ fn interior_contact_with_a_sphere_is_the_propped_cantilever() {
 /// constrained compliance is the tangent compliance of the solution.
 #[test]
 fn compliance_under_contact_is_the_constrained_derivative() {
-    let radius = 1e-3;
-    let delta = 1e-3 * L;
-    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
-    let closing = 3.0 * ei * delta / L.powi(3);
-    let plane = Obstacle::plane([-(radius + delta), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    let (radius, ei, closing, _, plane) = beside_a_plane();
     let obstacles = [plane];
     let solve = |force: Vector3<f64>| {
         let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();

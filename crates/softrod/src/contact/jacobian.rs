@@ -14,10 +14,9 @@
 
 use nalgebra::Vector3;
 
-use super::solve::{Constrained, Pass, Site};
+use super::solve::{equations, Constrained, Pass, Site};
 use crate::cosserat::equations::{
-    col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, DN,
-    STATE,
+    col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
 };
 use crate::cosserat::statics::Integrator;
 use crate::integrate::march::{march, rk4_plan, Scheme};
@@ -117,13 +116,7 @@ impl Constrained<'_> {
                 controlled: STATE,
             },
         };
-        let eq = Equations {
-            model: &model,
-            tensions: &self.tensions,
-            pressures: &self.pressures,
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = equations(&model, &self.tensions, &self.pressures);
         let nt = model.tendons().len();
         let mut ws = Workspace::new(nt);
         ws.set_columns(&vec![Column::Free; ncol], &[]);

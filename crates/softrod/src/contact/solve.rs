@@ -64,6 +64,21 @@ impl Active {
     }
 }
 
+/// The equations of `model` (a contact model) under the actuation, at full load.
+pub(super) fn equations<'a>(
+    model: &'a RobotModel,
+    tensions: &'a [f64],
+    pressures: &'a [f64],
+) -> Equations<'a> {
+    Equations {
+        model,
+        tensions,
+        pressures,
+        load_factor: 1.0,
+        profile: None,
+    }
+}
+
 /// The loads of `loads` times `lambda`.
 fn scaled_loads(loads: &Loads, lambda: f64) -> Loads {
     let mut l = loads.clone();
@@ -317,13 +332,7 @@ impl<'m> Constrained<'m> {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
             Integrator::Adaptive(_) => Vec::new(),
         };
-        let eq = Equations {
-            model: &model,
-            tensions: &self.tensions,
-            pressures: &self.pressures,
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = equations(&model, &self.tensions, &self.pressures);
         let mut sh = Shooting::new(eq, self.integrator, plan);
         let pass = if full {
             sh.pass::<FULL>(&x[..6], 1.0)
@@ -1022,8 +1031,10 @@ pub fn solve_constrained(
                 if opts.throw {
                     return fail(&p, &opts, &effort, 0.0, why);
                 }
+                // The last state reached (not converged), under the full loads.
                 p.active.clear();
-                return unconverged(&mut p, model, actuation, options, &x[..6], &effort, 0.0);
+                p.load = 1.0;
+                return finish(&mut p, model, actuation, options, &x[..6], &effort, 0.0);
             }
         }
         p.commit();
@@ -1032,7 +1043,8 @@ pub fn solve_constrained(
             x = match step_loads(&mut p, x, &opts, &mut effort) {
                 Ok(x) => x,
                 Err((lambda, _, x)) if !opts.throw => {
-                    return unconverged(&mut p, model, actuation, options, &x, &effort, lambda);
+                    p.load = 1.0;
+                    return finish(&mut p, model, actuation, options, &x, &effort, lambda);
                 }
                 Err((lambda, why, _)) => return fail(&p, &opts, &effort, lambda, why),
             };
@@ -1042,21 +1054,6 @@ pub fn solve_constrained(
     let x = reached.unwrap_or_default();
     p.load = 1.0;
     finish(&mut p, model, actuation, options, &x, &effort, 1.0)
-}
-
-/// Without `throw`: the solution at the last state reached (at load factor `lambda`, with its
-/// active set), under the full loads, marked not converged, with its statistics.
-fn unconverged(
-    p: &mut Constrained<'_>,
-    model: &Arc<RobotModel>,
-    actuation: &Actuation,
-    options: &SolveOptions,
-    x: &[f64],
-    effort: &Effort,
-    lambda: f64,
-) -> Result<ContactSolution> {
-    p.load = 1.0;
-    finish(p, model, actuation, options, x, effort, lambda)
 }
 
 /// The error (or, without `throw`, nothing better to return) of a failed solve.
