@@ -437,6 +437,10 @@ class StaticsSolution:
     def tip_reaction(self) -> NDArray[np.float64] | None:
         """Reaction wrench of the tip constraint (N, N m; world), shape (6,)."""
     @property
+    def contact_compliance(self) -> NDArray[np.float64] | None:
+        """Tip compliance with the active contacts and the tip constraint as constraints,
+        [dp; dtheta] per [dF; dM] (world), shape (6, 6)."""
+    @property
     def tendon_tensions(self) -> NDArray[np.float64]: ...
     @property
     def tendon_displacements(self) -> NDArray[np.float64]: ...
