@@ -376,3 +376,40 @@ fn the_frictionless_solver_refuses_a_tendon_with_friction() {
     )
     .is_ok());
 }
+
+/// The one march of an unloaded model (the tension a state of the march) against the fixed
+/// point on the profile (rod solves alternating with the capstan rule): the same discrete
+/// equations solved two independent ways, from rest and along an unloading/reloading path.
+#[test]
+fn one_march_equals_the_fixed_point() {
+    for mu in [0.05, 0.2, 0.5] {
+        let model = niti(mu, Vector3::zeros());
+        let path: Vec<Actuation> = [[4.0, 2.0], [2.5, 2.0], [3.0, 1.0], [0.5, 1.5]]
+            .iter()
+            .map(|t| Actuation::tensions(&[t[0], 0.0, 1.0, 0.0, t[1], 0.0]))
+            .collect();
+        let mut fixed_point = options(50);
+        fixed_point.single_march = false;
+        let a = solve_path(&model, &path, &options(50)).unwrap();
+        let b = solve_path(&model, &path, &fixed_point).unwrap();
+        let (mut dp, mut dt): (f64, f64) = (0.0, 0.0);
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.iterations, 1);
+            assert!(y.iterations > 1);
+            assert_eq!(x.slip.len(), y.slip.len());
+            for (p, q) in x.statics.position.iter().zip(&y.statics.position) {
+                for k in 0..3 {
+                    dp = dp.max((p[k] - q[k]).abs());
+                }
+            }
+            for (p, q) in x.tension.iter().zip(&y.tension) {
+                for (s, t) in p.iter().zip(q) {
+                    dt = dt.max((s - t).abs() / 4.0);
+                }
+            }
+            assert_eq!(x.slip, y.slip, "μ = {mu}: slip states differ");
+        }
+        eprintln!("μ = {mu}: one march vs fixed point: {dp:e} m, {dt:e} relative tension");
+        assert!(dp < 1e-10 && dt < 1e-10, "μ = {mu}: {dp:e} m, {dt:e}");
+    }
+}
