@@ -131,29 +131,30 @@ fn niti(mu: f64, tip: Vector3<f64>) -> Arc<RobotModel> {
     .unwrap()
 }
 
+/// With and without a tip force (the fixed point and the one march).
 #[test]
 fn zero_friction_is_the_frictionless_solver() {
-    let model = niti(0.0, Vector3::new(0.05, -0.02, 0.0));
-    let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
-    let opts = options(50);
-    let fr = solve_frictional(&model, &act, &opts, None).unwrap();
-    let plain = solve_statics_at(&model, &act, &opts.statics, &fr.statics.s).unwrap();
-    let mut worst: f64 = 0.0;
-    for (a, b) in fr.statics.position.iter().zip(&plain.position) {
-        for k in 0..3 {
-            worst = worst.max((a[k] - b[k]).abs());
+    for tip in [Vector3::new(0.05, -0.02, 0.0), Vector3::zeros()] {
+        let model = niti(0.0, tip);
+        let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+        let opts = options(50);
+        let fr = solve_frictional(&model, &act, &opts, None).unwrap();
+        let plain = solve_statics_at(&model, &act, &opts.statics, &fr.statics.s).unwrap();
+        let mut worst: f64 = 0.0;
+        for (a, b) in fr.statics.position.iter().zip(&plain.position) {
+            for k in 0..3 {
+                worst = worst.max((a[k] - b[k]).abs());
+            }
         }
-    }
-    eprintln!("μ = 0: {worst:e} m from the frictionless solve");
-    assert!(
-        worst < 1e-12,
-        "μ = 0 differs from the frictionless solve by {worst:e} m"
-    );
-    for row in &fr.tension {
-        for (i, &t) in row.iter().enumerate() {
-            let end = if i < 3 { 0.2 } else { 0.4 };
-            let _ = end;
-            assert!(t == act.tension_values(6)[i] || t == 0.0);
+        eprintln!("μ = 0, tip force {tip:?}: {worst:e} m from the frictionless solve");
+        assert!(
+            worst < 1e-12,
+            "μ = 0 differs from the frictionless solve by {worst:e} m"
+        );
+        for row in &fr.tension {
+            for (i, &t) in row.iter().enumerate() {
+                assert!(t == act.tension_values(6)[i] || t == 0.0);
+            }
         }
     }
 }
@@ -388,28 +389,36 @@ fn one_march_equals_the_fixed_point() {
             .iter()
             .map(|t| Actuation::tensions(&[t[0], 0.0, 1.0, 0.0, t[1], 0.0]))
             .collect();
-        let mut fixed_point = options(50);
-        fixed_point.single_march = false;
-        let a = solve_path(&model, &path, &options(50)).unwrap();
-        let b = solve_path(&model, &path, &fixed_point).unwrap();
-        let (mut dp, mut dt): (f64, f64) = (0.0, 0.0);
-        for (x, y) in a.iter().zip(&b) {
-            assert_eq!(x.iterations, 1);
-            assert!(y.iterations > 1);
-            assert_eq!(x.slip.len(), y.slip.len());
-            for (p, q) in x.statics.position.iter().zip(&y.statics.position) {
-                for k in 0..3 {
-                    dp = dp.max((p[k] - q[k]).abs());
+        let mut adaptive = options(50);
+        adaptive.statics.integrator = Integrator::Adaptive(softrod::AdaptiveOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..Default::default()
+        });
+        for opts in [options(50), adaptive] {
+            let mut fixed_point = opts;
+            fixed_point.single_march = false;
+            let a = solve_path(&model, &path, &opts).unwrap();
+            let b = solve_path(&model, &path, &fixed_point).unwrap();
+            let (mut dp, mut dt): (f64, f64) = (0.0, 0.0);
+            for (x, y) in a.iter().zip(&b) {
+                assert_eq!(x.iterations, 1);
+                assert!(y.iterations > 1);
+                assert_eq!(x.slip.len(), y.slip.len());
+                for (p, q) in x.statics.position.iter().zip(&y.statics.position) {
+                    for k in 0..3 {
+                        dp = dp.max((p[k] - q[k]).abs());
+                    }
                 }
-            }
-            for (p, q) in x.tension.iter().zip(&y.tension) {
-                for (s, t) in p.iter().zip(q) {
-                    dt = dt.max((s - t).abs() / 4.0);
+                for (p, q) in x.tension.iter().zip(&y.tension) {
+                    for (s, t) in p.iter().zip(q) {
+                        dt = dt.max((s - t).abs() / 4.0);
+                    }
                 }
+                assert_eq!(x.slip, y.slip, "μ = {mu}: slip states differ");
             }
-            assert_eq!(x.slip, y.slip, "μ = {mu}: slip states differ");
+            eprintln!("μ = {mu}: one march vs fixed point: {dp:e} m, {dt:e} relative tension");
+            assert!(dp < 1e-10 && dt < 1e-10, "μ = {mu}: {dp:e} m, {dt:e}");
         }
-        eprintln!("μ = {mu}: one march vs fixed point: {dp:e} m, {dt:e} relative tension");
-        assert!(dp < 1e-10 && dt < 1e-10, "μ = {mu}: {dp:e} m, {dt:e}");
     }
 }

@@ -45,9 +45,9 @@ use crate::cosserat::statics::{
 use crate::error::{Error, Result};
 use crate::integrate::march::Piecewise;
 use crate::integrate::{adaptive, fixed, DP5, RK4};
-use crate::solve::SolverStats;
 use crate::model::actuation::TensionProfile;
 use crate::model::{Actuation, RobotModel};
+use crate::solve::SolverStats;
 
 /// Default relative tolerance of the fixed point on the tension profile.
 pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-9;
@@ -183,7 +183,13 @@ fn tangents(model: &RobotModel, sol: &StaticsSolution) -> Vec<Vec<Option<Vector3
         .enumerate()
         .map(|(j, &s)| {
             let r = Matrix3::from_fn(|a, b| sol.rotation[j][a][b]);
-            node_tangents(model, s, &r, &Vector3::from(sol.v[j]), &Vector3::from(sol.u[j]))
+            node_tangents(
+                model,
+                s,
+                &r,
+                &Vector3::from(sol.v[j]),
+                &Vector3::from(sol.u[j]),
+            )
         })
         .collect()
 }
@@ -208,7 +214,8 @@ fn node_tangents(
             let present = s < ends[i] || (ends[i] == l && s == l);
             present.then(|| {
                 let (o, op) = t.routing().offset(s, &props);
-                let w = v + u.cross(&Vector3::new(o[0], o[1], 0.0)) + Vector3::new(op[0], op[1], 0.0);
+                let w =
+                    v + u.cross(&Vector3::new(o[0], o[1], 0.0)) + Vector3::new(op[0], op[1], 0.0);
                 (r * w).normalize()
             })
         })
@@ -558,7 +565,7 @@ fn friction_forces(
     for i in 0..nt {
         for j in 0..n {
             let Some(t) = dirs[j][i] else { continue };
-            let mut slopes = Vec::with_capacity(2);
+            let (mut sum, mut count) = (0.0, 0.0);
             for (a, b) in [(j.wrapping_sub(1), j), (j, j + 1)] {
                 if a >= n || b >= n || s[b] - s[a] <= tiny || dirs[a][i].is_none() {
                     continue;
@@ -566,12 +573,13 @@ fn friction_forces(
                 if dirs[b][i].is_none() {
                     continue;
                 }
-                slopes.push((tau[b][i] - tau[a][i]) / (s[b] - s[a]));
+                sum += (tau[b][i] - tau[a][i]) / (s[b] - s[a]);
+                count += 1.0;
             }
-            if slopes.is_empty() {
+            if count == 0.0 {
                 continue;
             }
-            let d = slopes.iter().sum::<f64>() / slopes.len() as f64;
+            let d = sum / count;
             out[j][i] = [d * t.x, d * t.y, d * t.z];
         }
     }
@@ -620,10 +628,34 @@ fn next_guess(guess: &mut [f64], rule: &[f64], last: Option<(&[f64], &[f64])>) {
     }
 }
 
-/// The turning rate (rad/m) of each tendon's path over one cell, for the first guess of the
-/// next: `None` for a cell that does not inform it (shorter than ten break offsets, across a
-/// break, or without the tendon).
-type Rates = Vec<Option<f64>>;
+/// Extrapolation weights of the next value of a smooth sequence from its last `m` values
+/// (polynomial of degree `m - 1`, most recent first).
+const EXTRAPOLATION: [&[f64]; 4] = [
+    &[1.0],
+    &[2.0, -1.0],
+    &[3.0, -3.0, 1.0],
+    &[4.0, -6.0, 4.0, -1.0],
+];
+
+/// The turning rate (rad/m) of tendon `i` over the next cell, extrapolated from the last (up
+/// to four) cells that inform it (`rates`: per cell and tendon, `None` for a cell shorter than
+/// ten break offsets, across a break, or without the tendon); 0 without one.
+fn extrapolated_rate(rates: &[Option<f64>], nt: usize, i: usize) -> f64 {
+    let last = rates
+        .chunks_exact(nt)
+        .rev()
+        .take(EXTRAPOLATION.len())
+        .map_while(|r| r[i]);
+    let values: Vec<f64> = last.collect();
+    match values.len() {
+        0 => 0.0,
+        m => EXTRAPOLATION[m - 1]
+            .iter()
+            .zip(&values)
+            .map(|(w, r)| w * r)
+            .sum(),
+    }
+}
 
 /// The frictional equilibrium of an unloaded model (no external load: the total wrench is
 /// zero all along, `x = 0` is the shooting solution) in one march over the friction mesh:
@@ -676,23 +708,39 @@ fn solve_unloaded(
         Integrator::Rk4 { steps } => crate::integrate::march::rk4_plan(breaks, steps),
         Integrator::Adaptive(_) => Vec::new(),
     };
-    // The strains at the node `s` of state `y` and the tendons' path tangents there.
-    let at_node = |ev: &mut Evaluator<'_, '_>, s: f64, y: &[f64; STATE]| {
+    // The strains at the node `s` of state `y` and the tendons' path tangents there. Without
+    // external loads the total wrench is zero all along, so the strains depend on `s` alone:
+    // after an RK4 step (`reuse`) they are those of its last stage, at the same `s`.
+    let at_node = |ev: &mut Evaluator<'_, '_>, s: f64, y: &[f64; STATE], reuse: bool| {
         let r = rot(y);
-        let props = model.rod().section_at(s);
-        let loc = ev.local(s, &props, &r.tr_mul(&v3(y, 12)), &r.tr_mul(&v3(y, 15)), false);
-        let finite = loc.v.iter().chain(loc.u.iter()).all(|c| c.is_finite());
-        finite.then(|| node_tangents(model, s, &r, &loc.v, &loc.u))
+        let (v, u) = match ev.ws.guess.filter(|_| reuse && !ev.ws.active.is_empty()) {
+            Some(x) => (
+                Vector3::new(x[0], x[1], x[2]),
+                Vector3::new(x[3], x[4], x[5]),
+            ),
+            None => {
+                let props = model.rod().section_at(s);
+                let loc = ev.local(
+                    s,
+                    &props,
+                    &r.tr_mul(&v3(y, 12)),
+                    &r.tr_mul(&v3(y, 15)),
+                    false,
+                );
+                (loc.v, loc.u)
+            }
+        };
+        let finite = v.iter().chain(u.iter()).all(|c| c.is_finite());
+        finite.then(|| node_tangents(model, s, &r, &v, &u))
     };
+    let reuse = matches!(options.statics.integrator, Integrator::Rk4 { .. });
     let failed = |ws: &mut Workspace, what: String, attempts: usize, residual: f64| {
-        ws.material_error
-            .take()
-            .unwrap_or(Error::NotConverged {
-                what,
-                iterations: attempts,
-                residual,
-                load_factor: 1.0,
-            })
+        ws.material_error.take().unwrap_or(Error::NotConverged {
+            what,
+            iterations: attempts,
+            residual,
+            load_factor: 1.0,
+        })
     };
     let mut y: [f64; STATE] = eq.initial(&[0.0; 6]);
     for i in 0..nt {
@@ -711,8 +759,13 @@ fn solve_unloaded(
             ws: &mut ws,
         };
         ev.set_interval(0);
-        let Some(d) = at_node(&mut ev, 0.0, &y) else {
-            return Err(failed(&mut ws, "friction: the constitutive solve failed at the base".into(), 0, f64::NAN));
+        let Some(d) = at_node(&mut ev, 0.0, &y, false) else {
+            return Err(failed(
+                &mut ws,
+                "friction: the constitutive solve failed at the base".into(),
+                0,
+                f64::NAN,
+            ));
         };
         dirs.push(d);
     }
@@ -722,7 +775,7 @@ fn solve_unloaded(
         y,
     });
     let tiny = 10.0 * BREAK_OFFSET * l;
-    let mut rates: Vec<Rates> = Vec::with_capacity(n);
+    let mut rates: Vec<Option<f64>> = Vec::with_capacity(n * nt);
     let (mut saved, mut guess, mut rule) = (Vec::new(), vec![0.0; nt], vec![0.0; nt]);
     let mut rule_slip = vec![Slip::Absent; nt];
     let mut last: Option<(Vec<f64>, Vec<f64>)> = None;
@@ -732,16 +785,13 @@ fn solve_unloaded(
         let (a, b) = (mesh[j], mesh[j + 1]);
         let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
         saved.clone_from(&ws.integral);
-        // First guess: the rule with the turning extrapolated from the last two cells.
+        // First guess: the rule with the turning rate extrapolated from the last cells.
         for i in 0..nt {
-            let r1 = rates.last().and_then(|r| r[i]);
-            let r0 = rates.len().checked_sub(2).and_then(|k| rates[k][i]);
-            let rate = match (r0, r1) {
-                (Some(r0), Some(r1)) if !crosses => 2.0 * r1 - r0,
-                (_, Some(r1)) => r1,
-                _ => 0.0,
+            let theta = if crosses {
+                0.0
+            } else {
+                (extrapolated_rate(&rates, nt, i) * (b - a)).max(0.0)
             };
-            let theta = if crosses { 0.0 } else { (rate * (b - a)).max(0.0) };
             guess[i] = if present(i, b) {
                 cell_rule(tau[j][i], mus[i] * theta, prev.map(|p| p[j + 1][i])).0
             } else {
@@ -782,7 +832,7 @@ fn solve_unloaded(
                 k1 += 1;
                 ev.set_interval(k1);
             }
-            let Some(d1) = at_node(&mut ev, b, &y1) else {
+            let Some(d1) = at_node(&mut ev, b, &y1, reuse && !crosses) else {
                 let what = format!("friction: the constitutive solve failed at s = {b} m");
                 return Err(failed(&mut ws, what, attempts, f64::NAN));
             };
@@ -790,7 +840,12 @@ fn solve_unloaded(
             for i in 0..nt {
                 (rule[i], rule_slip[i]) = match (&dirs[j][i], &d1[i]) {
                     (Some(ta), Some(tb)) => {
-                        cell_rule(tau[j][i], mus[i] * angle(ta, tb), prev.map(|p| p[j + 1][i]))
+                        let mu_theta = if mus[i] > 0.0 {
+                            mus[i] * angle(ta, tb)
+                        } else {
+                            0.0
+                        };
+                        cell_rule(tau[j][i], mu_theta, prev.map(|p| p[j + 1][i]))
                     }
                     _ => (0.0, Slip::Absent),
                 };
@@ -814,31 +869,27 @@ fn solve_unloaded(
                 return Err(failed(&mut ws, what, attempts, change / scale));
             }
             let before = guess.clone();
-            next_guess(&mut guess, &rule, last.as_ref().map(|(g, r)| (g.as_slice(), r.as_slice())));
+            next_guess(
+                &mut guess,
+                &rule,
+                last.as_ref().map(|(g, r)| (g.as_slice(), r.as_slice())),
+            );
             last = Some((before, rule.clone()));
             ws.integral.clone_from(&saved);
         };
         attempts_total += attempts;
-        rates.push(
-            (0..nt)
-                .map(|i| match (&dirs[j][i], &d1[i]) {
-                    (Some(ta), Some(tb)) if b - a > tiny && !crosses => {
-                        Some(angle(ta, tb) / (b - a))
-                    }
-                    _ => None,
-                })
-                .collect(),
-        );
+        rates.extend((0..nt).map(|i| match (&dirs[j][i], &d1[i]) {
+            (Some(ta), Some(tb)) if mus[i] > 0.0 && b - a > tiny && !crosses => {
+                Some(angle(ta, tb) / (b - a))
+            }
+            _ => None,
+        }));
         tau[j + 1].copy_from_slice(&rule);
         slip[j + 1].copy_from_slice(&rule_slip);
         dirs.push(d1);
         y = y1;
         interval = k1;
-        nodes.push(Node {
-            s: b,
-            interval,
-            y,
-        });
+        nodes.push(Node { s: b, interval, y });
     }
     let _ = last;
     // The solution at the nodes, with the whole profile.
