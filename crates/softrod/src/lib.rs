@@ -91,6 +91,3 @@ pub use planar::{
     PlanarCableArm, PlanarMethod, PlanarParameter, PlanarSensitivities, PlanarSolution,
 };
 pub use solve::{NewtonOptions, SolverStats};
-
-#[allow(missing_docs)]
-pub use cosserat::equations::LOCAL_COUNT;

@@ -89,7 +89,6 @@ pub(crate) const DM: usize = 15;
 /// Length of the state with the six shooting columns appended.
 pub(crate) const FULL: usize = STATE + 6 * COLUMN;
 
-pub static LOCAL_COUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 /// Relative step tolerance of the local (constitutive) Newton iteration.
 pub const LOCAL_TOLERANCE: f64 = 1e-14;
 /// Iteration cap of the local (constitutive) Newton iteration.
@@ -795,7 +794,6 @@ impl Evaluator<'_, '_> {
         let mut last_step = f64::INFINITY;
         let mut chord = self.ws.last_lu.is_some();
         for _ in 0..LOCAL_MAX_ITERATIONS {
-            LOCAL_COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let (tw, h) = self.tendon_sums(&x, c, !chord);
             let g = x - xs - cd.component_mul(&(wv - tw));
             if let Some(h) = h {
