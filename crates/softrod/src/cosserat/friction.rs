@@ -40,10 +40,10 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, STATE};
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
-    assemble, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
+    assemble, interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
 };
 use crate::error::{Error, Result};
-use crate::integrate::march::Piecewise;
+use crate::integrate::march::{march, Piecewise, Scheme};
 use crate::integrate::{adaptive, fixed, DP5, RK4};
 use crate::model::actuation::TensionProfile;
 use crate::model::{Actuation, RobotModel};
@@ -130,6 +130,11 @@ pub struct FrictionalSolution {
     /// Friction force on the rod per unit length of rod (N/m, world), `τ_i'(s) t_i`, per node
     /// and tendon (the normal load `τ_i t_i'` is not included).
     pub friction_force: Vec<Vec<[f64; 3]>>,
+    /// Path length (m) of each tendon from the base to each node, `[node][tendon]` (the
+    /// whole path length beyond its termination), from the integrator's quadrature. The
+    /// tendon being inextensible and anchored at its termination, its slip toward the base
+    /// at a node between two states is the change of `path length − path_length[node]`.
+    pub path_length: Vec<Vec<f64>>,
     /// Rod solves: 1 for the one march of an unloaded model, the fixed-point iterations
     /// otherwise.
     pub iterations: usize,
@@ -451,7 +456,9 @@ pub fn solve_frictional(
                         .collect()
                 })
                 .collect();
+            let path_length = node_path_lengths(model, &act, &statics_options, &mesh, &sol)?;
             return Ok(FrictionalSolution {
+                path_length,
                 statics: sol,
                 tension: next,
                 slip,
@@ -479,6 +486,60 @@ pub fn solve_frictional(
         }
         tau = anderson.update(&tau, next);
     }
+}
+
+/// The path length of every tendon from the base to every node of `mesh` (m, `[node][tendon]`)
+/// in the state `sol` of actuation `act` (with its profile): one march from its base wrench,
+/// the tendon-length quadrature read at the nodes.
+fn node_path_lengths(
+    model: &Arc<RobotModel>,
+    act: &Actuation,
+    options: &SolveOptions,
+    mesh: &[f64],
+    sol: &StaticsSolution,
+) -> Result<Vec<Vec<f64>>> {
+    let nt = model.tendons().len();
+    let tensions = act.tension_values(nt);
+    let pressures = act.pressure_values(model.chambers().len());
+    let eq = Equations {
+        model,
+        tensions: &tensions,
+        pressures: &pressures,
+        load_factor: 1.0,
+        profile: act.profile.as_deref(),
+    };
+    let mut ws = Workspace::new(nt);
+    ws.set_columns(&[], &[]);
+    ws.track_lengths = true;
+    let y0: [f64; STATE] = eq.initial(&scaled(model, &sol.base_wrench));
+    let breaks = model.breaks();
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => crate::integrate::march::rk4_plan(breaks, steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let scheme = match options.integrator {
+        Integrator::Rk4 { .. } => Scheme::Rk4(&plan),
+        Integrator::Adaptive(o) => Scheme::Adaptive {
+            options: o,
+            controlled: STATE,
+        },
+    };
+    let mut out = vec![vec![0.0; nt]; mesh.len()];
+    let mut ev = Evaluator { eq, ws: &mut ws };
+    march(
+        &mut ev,
+        breaks,
+        &interior(mesh, model.length()),
+        y0,
+        scheme,
+        |ev, s, _, _| {
+            let j = mesh.partition_point(|&m| m < s);
+            if j < mesh.len() && mesh[j] == s {
+                out[j].copy_from_slice(&ev.ws.integral[..nt]);
+            }
+        },
+    )?;
+    Ok(out)
 }
 
 /// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of the fixed point `x = g(x)` on
@@ -774,6 +835,7 @@ fn solve_unloaded(
         interval: 0,
         y,
     });
+    let mut path_length = vec![vec![0.0; nt]; n];
     let tiny = 10.0 * BREAK_OFFSET * l;
     let mut rates: Vec<Option<f64>> = Vec::with_capacity(n * nt);
     let (mut saved, mut guess, mut rule) = (Vec::new(), vec![0.0; nt], vec![0.0; nt]);
@@ -887,6 +949,7 @@ fn solve_unloaded(
         tau[j + 1].copy_from_slice(&rule);
         slip[j + 1].copy_from_slice(&rule_slip);
         dirs.push(d1);
+        path_length[j + 1].copy_from_slice(&ws.integral[..nt]);
         y = y1;
         interval = k1;
         nodes.push(Node { s: b, interval, y });
@@ -938,6 +1001,7 @@ fn solve_unloaded(
         slip,
         tangent,
         friction_force: forces,
+        path_length,
         iterations: 1,
         change: worst / scale,
         cell_steps: attempts_total,
