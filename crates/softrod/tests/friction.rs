@@ -488,3 +488,17 @@ fn cycle_dissipation_is_friction_force_times_slip() {
         last = w;
     }
 }
+
+#[test]
+fn the_actuation_jacobian_of_a_frictional_equilibrium_is_refused_by_name() {
+    let model = niti(0.2, Vector3::zeros());
+    let act = Actuation::tensions(&[3.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+    let sol = solve_frictional(&model, &act, &options(50), None).unwrap();
+    let e = softrod::actuation_jacobian(&sol.statics, None).unwrap_err();
+    assert!(e.to_string().contains("solution"), "{e}");
+    assert!(e.to_string().contains("friction"), "{e}");
+    // Without friction the profile-free Jacobian is unchanged.
+    let plain = niti(0.0, Vector3::zeros());
+    let sol = solve_frictional(&plain, &act, &options(50), None).unwrap();
+    assert!(softrod::actuation_jacobian(&sol.statics, None).is_ok());
+}
