@@ -825,7 +825,7 @@ fn solve_unloaded(
                 &mut ws,
                 "friction: the constitutive solve failed at the base".into(),
                 0,
-                f64::NAN,
+                f64::INFINITY,
             ));
         };
         dirs.push(d);
@@ -840,7 +840,7 @@ fn solve_unloaded(
     let mut rates: Vec<Option<f64>> = Vec::with_capacity(n * nt);
     let (mut saved, mut guess, mut rule) = (Vec::new(), vec![0.0; nt], vec![0.0; nt]);
     let mut rule_slip = vec![Slip::Absent; nt];
-    let mut last: Option<(Vec<f64>, Vec<f64>)> = None;
+    let mut last: Option<(Vec<f64>, Vec<f64>)>;
     let mut attempts_total = 0;
     let mut worst: f64 = 0.0;
     for j in 0..n - 1 {
@@ -896,7 +896,7 @@ fn solve_unloaded(
             }
             let Some(d1) = at_node(&mut ev, b, &y1, reuse && !crosses) else {
                 let what = format!("friction: the constitutive solve failed at s = {b} m");
-                return Err(failed(&mut ws, what, attempts, f64::NAN));
+                return Err(failed(&mut ws, what, attempts, f64::INFINITY));
             };
             let mut change: f64 = 0.0;
             for i in 0..nt {
@@ -954,7 +954,6 @@ fn solve_unloaded(
         interval = k1;
         nodes.push(Node { s: b, interval, y });
     }
-    let _ = last;
     // The solution at the nodes, with the whole profile.
     let mut act = actuation.clone();
     act.profile = Some(Arc::new(to_profile(model, mesh, &tau)));
