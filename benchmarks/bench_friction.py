@@ -27,23 +27,30 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5)
     a = ap.parse_args()
     plain = robot(0.0)
-    base = median_time(plain.solve, calls=a.calls, repeats=a.repeats)
-    print(f"{'case':<34} {'median (us)':>12} {'ratio':>7} {'rod solves':>11}")
-    print(f"{'frictionless':<34} {base * 1e6:12.1f} {1.0:7.2f} {1:11d}")
+    release = [3.0, 0, 0, 0, 2.0, 0]
+    print(
+        f"{'case':<30} {'frictionless (us)':>18} {'frictional (us)':>16} {'ratio':>6} {'solves':>7}"
+    )
     for mu in (0.05, 0.1, 0.2):
         r = robot(mu)
-        t = median_time(r.solve, calls=a.calls, repeats=a.repeats)
-        its = r.solve().friction_iterations
-        print(f"{f'friction mu = {mu} (from rest)':<34} {t * 1e6:12.1f} {t / base:7.2f} {its:11d}")
         first = r.solve()
-        unload = r.solve([3.0, 0, 0, 0, 2.0, 0], previous=first)
-        t = median_time(
-            lambda r=r, p=first: r.solve([3.0, 0, 0, 0, 2.0, 0], previous=p),
-            calls=a.calls,
-            repeats=a.repeats,
-        )
-        label = f"friction mu = {mu} (unloading step)"
-        print(f"{label:<34} {t * 1e6:12.1f} {t / base:7.2f} {unload.friction_iterations:11d}")
+        cases = [
+            (f"mu = {mu}, from rest", plain.solve, r.solve, first),
+            (
+                f"mu = {mu}, unloading step",
+                lambda: plain.solve(release),
+                lambda r=r, p=first: r.solve(release, previous=p),
+                r.solve(release, previous=first),
+            ),
+        ]
+        for label, base_fn, fn, sol in cases:
+            # Side by side: the frictionless and the frictional solve timed in turn.
+            base = median_time(base_fn, calls=a.calls, repeats=a.repeats)
+            t = median_time(fn, calls=a.calls, repeats=a.repeats)
+            print(
+                f"{label:<30} {base * 1e6:18.1f} {t * 1e6:16.1f} {t / base:6.2f} "
+                f"{sol.friction_iterations:7d}"
+            )
 
 
 if __name__ == "__main__":

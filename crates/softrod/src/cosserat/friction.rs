@@ -37,10 +37,17 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
-use crate::cosserat::statics::{solve_statics_at, Integrator, SolveOptions, StaticsSolution};
+use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, STATE};
+use crate::cosserat::shooting::{Node, Shooting};
+use crate::cosserat::statics::{
+    assemble, interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
+};
 use crate::error::{Error, Result};
+use crate::integrate::march::{march, Piecewise, Scheme};
+use crate::integrate::{adaptive, fixed, DP5, RK4};
 use crate::model::actuation::TensionProfile;
 use crate::model::{Actuation, RobotModel};
+use crate::solve::SolverStats;
 
 /// Default relative tolerance of the fixed point on the tension profile.
 pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-9;
@@ -66,6 +73,10 @@ pub struct FrictionOptions {
     pub tolerance: f64,
     /// Cap on the fixed-point iterations.
     pub max_iterations: usize,
+    /// Solve a model without external loads in one march with the tension as a state
+    /// (default `true`); `false`: by the fixed point on the profile, as loaded models are
+    /// (the same discrete equations, an independent solve of them).
+    pub single_march: bool,
 }
 
 impl Default for FrictionOptions {
@@ -74,6 +85,7 @@ impl Default for FrictionOptions {
             statics: SolveOptions::default(),
             tolerance: DEFAULT_FRICTION_TOLERANCE,
             max_iterations: DEFAULT_FRICTION_ITERATIONS,
+            single_march: true,
         }
     }
 }
@@ -118,8 +130,17 @@ pub struct FrictionalSolution {
     /// Friction force on the rod per unit length of rod (N/m, world), `τ_i'(s) t_i`, per node
     /// and tendon (the normal load `τ_i t_i'` is not included).
     pub friction_force: Vec<Vec<[f64; 3]>>,
-    /// Fixed-point iterations (rod solves).
+    /// Path length (m) of each tendon from the base to each node, `[node][tendon]` (the
+    /// whole path length beyond its termination), from the integrator's quadrature. The
+    /// tendon being inextensible and anchored at its termination, its slip toward the base
+    /// at a node between two states is the change of `path length − path_length[node]`.
+    pub path_length: Vec<Vec<f64>>,
+    /// Rod solves: 1 for the one march of an unloaded model, the fixed-point iterations
+    /// otherwise.
     pub iterations: usize,
+    /// Integration steps over the cells of the friction mesh, all rod solves and repeated
+    /// cells together (a rod solve without friction takes one per cell and Newton iteration).
+    pub cell_steps: usize,
     /// Last relative change of the profile.
     pub change: f64,
 }
@@ -162,31 +183,46 @@ pub fn friction_mesh(model: &RobotModel, integrator: &Integrator) -> Vec<f64> {
 
 /// Per node and tendon: the unit path tangent (world) and whether the tendon is there.
 fn tangents(model: &RobotModel, sol: &StaticsSolution) -> Vec<Vec<Option<Vector3<f64>>>> {
-    let l = model.length();
-    let ends = model.tendon_ends();
     sol.s
         .iter()
         .enumerate()
         .map(|(j, &s)| {
             let r = Matrix3::from_fn(|a, b| sol.rotation[j][a][b]);
-            let v = Vector3::from(sol.v[j]);
-            let u = Vector3::from(sol.u[j]);
-            let props = model.rod().section_at(s);
-            model
-                .tendons()
-                .iter()
-                .enumerate()
-                .map(|(i, t)| {
-                    let present = s < ends[i] || (ends[i] == l && s == l);
-                    present.then(|| {
-                        let (o, op) = t.routing().offset(s, &props);
-                        let w = v
-                            + u.cross(&Vector3::new(o[0], o[1], 0.0))
-                            + Vector3::new(op[0], op[1], 0.0);
-                        (r * w).normalize()
-                    })
-                })
-                .collect()
+            node_tangents(
+                model,
+                s,
+                &r,
+                &Vector3::from(sol.v[j]),
+                &Vector3::from(sol.u[j]),
+            )
+        })
+        .collect()
+}
+
+/// Per tendon, the unit path tangent (world) at `s` of a section of rotation `r` and strains
+/// `(v, u)`, `None` where the tendon is not there (beyond its termination).
+fn node_tangents(
+    model: &RobotModel,
+    s: f64,
+    r: &Matrix3<f64>,
+    v: &Vector3<f64>,
+    u: &Vector3<f64>,
+) -> Vec<Option<Vector3<f64>>> {
+    let l = model.length();
+    let ends = model.tendon_ends();
+    let props = model.rod().section_at(s);
+    model
+        .tendons()
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let present = s < ends[i] || (ends[i] == l && s == l);
+            present.then(|| {
+                let (o, op) = t.routing().offset(s, &props);
+                let w =
+                    v + u.cross(&Vector3::new(o[0], o[1], 0.0)) + Vector3::new(op[0], op[1], 0.0);
+                (r * w).normalize()
+            })
         })
         .collect()
 }
@@ -194,6 +230,39 @@ fn tangents(model: &RobotModel, sol: &StaticsSolution) -> Vec<Vec<Option<Vector3
 /// The angle (rad) between two unit vectors.
 fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// The slip state at the base of a tendon pulled with `base` (N) after `previous` (N; `None`:
+/// from rest).
+fn base_slip(base: f64, previous: Option<f64>) -> Slip {
+    match previous {
+        None => Slip::Loading,
+        Some(q) if (base - q).abs() <= STICK_TOLERANCE * q => Slip::Stick,
+        Some(q) if base > q => Slip::Loading,
+        Some(_) => Slip::Unloading,
+    }
+}
+
+/// The capstan rule of one cell: the tension (N) at its distal node from the tension `tau` at
+/// its proximal node, `mu_theta = μ Δθ` over the cell and the previous tension `q` at the
+/// distal node (`None`: from rest, sliding toward the base); an element within rounding of
+/// its previous tension sticks.
+fn cell_rule(tau: f64, mu_theta: f64, q: Option<f64>) -> (f64, Slip) {
+    let g = mu_theta.exp();
+    let (lo, hi) = (tau / g, tau * g);
+    match q {
+        None => (lo, Slip::Loading),
+        Some(q) => {
+            let t = q.max(lo).min(hi);
+            if (t - q).abs() <= STICK_TOLERANCE * q {
+                (t, Slip::Stick)
+            } else if q > hi {
+                (t, Slip::Unloading)
+            } else {
+                (t, Slip::Loading)
+            }
+        }
+    }
 }
 
 /// The capstan rule on the shape `sol`: the tension and slip state per node and tendon.
@@ -211,35 +280,13 @@ fn profile_on(
     for i in 0..nt {
         let mu = model.tendons()[i].friction();
         tau[0][i] = base[i];
-        slip[0][i] = match previous {
-            None => Slip::Loading,
-            Some(p) if (base[i] - p[0][i]).abs() <= STICK_TOLERANCE * p[0][i] => Slip::Stick,
-            Some(p) if base[i] > p[0][i] => Slip::Loading,
-            Some(_) => Slip::Unloading,
-        };
+        slip[0][i] = base_slip(base[i], previous.map(|p| p[0][i]));
         for j in 1..n {
             let (Some(ta), Some(tb)) = (&dirs[j - 1][i], &dirs[j][i]) else {
                 break;
             };
-            let g = (mu * angle(ta, tb)).exp();
-            let (lo, hi) = (tau[j - 1][i] / g, tau[j - 1][i] * g);
-            let (t, st) = match previous {
-                None => (lo, Slip::Loading),
-                Some(p) => {
-                    let q = p[j][i];
-                    let t = q.clamp(lo, hi);
-                    // An element within rounding of its previous tension sticks.
-                    if (t - q).abs() <= STICK_TOLERANCE * q {
-                        (t, Slip::Stick)
-                    } else if q > hi {
-                        (t, Slip::Unloading)
-                    } else {
-                        (t, Slip::Loading)
-                    }
-                }
-            };
-            tau[j][i] = t;
-            slip[j][i] = st;
+            let q = previous.map(|p| p[j][i]);
+            (tau[j][i], slip[j][i]) = cell_rule(tau[j - 1][i], mu * angle(ta, tb), q);
         }
     }
     (tau, slip)
@@ -360,6 +407,9 @@ pub fn solve_frictional(
         }
         None => None,
     };
+    if options.single_march && model.loads().is_unloaded() {
+        return solve_unloaded(model, actuation, options, &mesh, &base, prev);
+    }
     let scale = base
         .iter()
         .fold(0.0, |a: f64, &b| a.max(b))
@@ -406,7 +456,9 @@ pub fn solve_frictional(
                         .collect()
                 })
                 .collect();
+            let path_length = node_path_lengths(model, &act, &statics_options, &mesh, &sol)?;
             return Ok(FrictionalSolution {
+                path_length,
                 statics: sol,
                 tension: next,
                 slip,
@@ -414,6 +466,7 @@ pub fn solve_frictional(
                 friction_force: forces,
                 iterations,
                 change: delta,
+                cell_steps: iterations * (mesh.len() - 1),
             });
         }
         if iterations >= options.max_iterations {
@@ -433,6 +486,60 @@ pub fn solve_frictional(
         }
         tau = anderson.update(&tau, next);
     }
+}
+
+/// The path length of every tendon from the base to every node of `mesh` (m, `[node][tendon]`)
+/// in the state `sol` of actuation `act` (with its profile): one march from its base wrench,
+/// the tendon-length quadrature read at the nodes.
+fn node_path_lengths(
+    model: &Arc<RobotModel>,
+    act: &Actuation,
+    options: &SolveOptions,
+    mesh: &[f64],
+    sol: &StaticsSolution,
+) -> Result<Vec<Vec<f64>>> {
+    let nt = model.tendons().len();
+    let tensions = act.tension_values(nt);
+    let pressures = act.pressure_values(model.chambers().len());
+    let eq = Equations {
+        model,
+        tensions: &tensions,
+        pressures: &pressures,
+        load_factor: 1.0,
+        profile: act.profile.as_deref(),
+    };
+    let mut ws = Workspace::new(nt);
+    ws.set_columns(&[], &[]);
+    ws.track_lengths = true;
+    let y0: [f64; STATE] = eq.initial(&scaled(model, &sol.base_wrench));
+    let breaks = model.breaks();
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => crate::integrate::march::rk4_plan(breaks, steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let scheme = match options.integrator {
+        Integrator::Rk4 { .. } => Scheme::Rk4(&plan),
+        Integrator::Adaptive(o) => Scheme::Adaptive {
+            options: o,
+            controlled: STATE,
+        },
+    };
+    let mut out = vec![vec![0.0; nt]; mesh.len()];
+    let mut ev = Evaluator { eq, ws: &mut ws };
+    march(
+        &mut ev,
+        breaks,
+        &interior(mesh, model.length()),
+        y0,
+        scheme,
+        |ev, s, _, _| {
+            let j = mesh.partition_point(|&m| m < s);
+            if j < mesh.len() && mesh[j] == s {
+                out[j].copy_from_slice(&ev.ws.integral[..nt]);
+            }
+        },
+    )?;
+    Ok(out)
 }
 
 /// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of the fixed point `x = g(x)` on
@@ -519,7 +626,7 @@ fn friction_forces(
     for i in 0..nt {
         for j in 0..n {
             let Some(t) = dirs[j][i] else { continue };
-            let mut slopes = Vec::with_capacity(2);
+            let (mut sum, mut count) = (0.0, 0.0);
             for (a, b) in [(j.wrapping_sub(1), j), (j, j + 1)] {
                 if a >= n || b >= n || s[b] - s[a] <= tiny || dirs[a][i].is_none() {
                     continue;
@@ -527,12 +634,13 @@ fn friction_forces(
                 if dirs[b][i].is_none() {
                     continue;
                 }
-                slopes.push((tau[b][i] - tau[a][i]) / (s[b] - s[a]));
+                sum += (tau[b][i] - tau[a][i]) / (s[b] - s[a]);
+                count += 1.0;
             }
-            if slopes.is_empty() {
+            if count == 0.0 {
                 continue;
             }
-            let d = slopes.iter().sum::<f64>() / slopes.len() as f64;
+            let d = sum / count;
             out[j][i] = [d * t.x, d * t.y, d * t.z];
         }
     }
@@ -555,4 +663,346 @@ pub fn solve_path(
         out.push(next);
     }
     Ok(out)
+}
+
+/// Cap on the evaluations of one cell of the frictional march (each one step of the rod over
+/// the cell and a constitutive solve at its distal node).
+pub const MAX_CELL_ATTEMPTS: usize = 60;
+
+/// The next guess of the distal tensions of a cell from the last two attempts: per tendon, a
+/// secant step on `rule(g) = g` (the rule's slope `ρ` from the two attempts) where `|ρ| < 0.9`,
+/// else the rule's value (a fixed-point step).
+fn next_guess(guess: &mut [f64], rule: &[f64], last: Option<(&[f64], &[f64])>) {
+    for i in 0..guess.len() {
+        let (g, r) = (guess[i], rule[i]);
+        let mut next = r;
+        if let Some((g0, r0)) = last {
+            let rho = (r - r0[i]) / (g - g0[i]);
+            if rho.is_finite() && rho.abs() < 0.9 {
+                let secant = g + (r - g) / (1.0 - rho);
+                if secant.is_finite() && secant >= 0.0 {
+                    next = secant;
+                }
+            }
+        }
+        guess[i] = next;
+    }
+}
+
+/// Extrapolation weights of the next value of a smooth sequence from its last `m` values
+/// (polynomial of degree `m - 1`, most recent first).
+const EXTRAPOLATION: [&[f64]; 4] = [
+    &[1.0],
+    &[2.0, -1.0],
+    &[3.0, -3.0, 1.0],
+    &[4.0, -6.0, 4.0, -1.0],
+];
+
+/// The turning rate (rad/m) of tendon `i` over the next cell, extrapolated from the last (up
+/// to four) cells that inform it (`rates`: per cell and tendon, `None` for a cell shorter than
+/// ten break offsets, across a break, or without the tendon); 0 without one.
+fn extrapolated_rate(rates: &[Option<f64>], nt: usize, i: usize) -> f64 {
+    let last = rates
+        .chunks_exact(nt)
+        .rev()
+        .take(EXTRAPOLATION.len())
+        .map_while(|r| r[i]);
+    let values: Vec<f64> = last.collect();
+    match values.len() {
+        0 => 0.0,
+        m => EXTRAPOLATION[m - 1]
+            .iter()
+            .zip(&values)
+            .map(|(w, r)| w * r)
+            .sum(),
+    }
+}
+
+/// The frictional equilibrium of an unloaded model (no external load: the total wrench is
+/// zero all along, `x = 0` is the shooting solution) in one march over the friction mesh:
+/// the tension is a state of the march, the capstan rule applied cell by cell. Over a cell the
+/// distal tension `τ_{k+1}` sets the profile the rod is integrated with (geometric between the
+/// nodes) and the rule on the resulting shape sets `τ_{k+1}`: the cell is repeated from its
+/// proximal node until the two agree to `options.tolerance` times the largest base tension
+/// (a secant iteration from a first guess extrapolated from the turning rate of the last two
+/// cells; most cells take one or two steps).
+#[allow(clippy::too_many_lines)] // one sequential march
+fn solve_unloaded(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &FrictionOptions,
+    mesh: &[f64],
+    base: &[f64],
+    prev: Option<&[Vec<f64>]>,
+) -> Result<FrictionalSolution> {
+    let nt = base.len();
+    let pressures = actuation.pressure_values(model.chambers().len());
+    let (l, ends, breaks) = (model.length(), model.tendon_ends(), model.breaks());
+    let mus: Vec<f64> = model.tendons().iter().map(|t| t.friction()).collect();
+    let present = |i: usize, s: f64| s < ends[i] || (ends[i] == l && s == l);
+    let mut cell = TensionProfile::new(
+        (0..nt)
+            .map(|i| (mus[i] > 0.0).then(|| (vec![0.0, 0.0], vec![base[i]; 2])))
+            .collect(),
+    );
+    let scale = base
+        .iter()
+        .fold(0.0, |a: f64, &b| a.max(b))
+        .max(f64::MIN_POSITIVE);
+    let tol = options.tolerance * scale;
+    let n = mesh.len();
+    let mut tau = vec![vec![0.0; nt]; n];
+    let mut slip = vec![vec![Slip::Absent; nt]; n];
+    let mut dirs: Vec<Vec<Option<Vector3<f64>>>> = Vec::with_capacity(n);
+    let mut nodes = Vec::with_capacity(n);
+    let mut ws = Workspace::new(nt);
+    ws.set_columns(&[], &[]);
+    ws.track_lengths = true;
+    let eq = Equations {
+        model,
+        tensions: base,
+        pressures: &pressures,
+        load_factor: 1.0,
+        profile: None,
+    };
+    let plan = match options.statics.integrator {
+        Integrator::Rk4 { steps } => crate::integrate::march::rk4_plan(breaks, steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    // The strains at the node `s` of state `y` and the tendons' path tangents there. Without
+    // external loads the total wrench is zero all along, so the strains depend on `s` alone:
+    // after an RK4 step (`reuse`) they are those of its last stage, at the same `s`.
+    let at_node = |ev: &mut Evaluator<'_, '_>, s: f64, y: &[f64; STATE], reuse: bool| {
+        let r = rot(y);
+        let (v, u) = match ev.ws.guess.filter(|_| reuse && !ev.ws.active.is_empty()) {
+            Some(x) => (
+                Vector3::new(x[0], x[1], x[2]),
+                Vector3::new(x[3], x[4], x[5]),
+            ),
+            None => {
+                let props = model.rod().section_at(s);
+                let loc = ev.local(
+                    s,
+                    &props,
+                    &r.tr_mul(&v3(y, 12)),
+                    &r.tr_mul(&v3(y, 15)),
+                    false,
+                );
+                (loc.v, loc.u)
+            }
+        };
+        let finite = v.iter().chain(u.iter()).all(|c| c.is_finite());
+        finite.then(|| node_tangents(model, s, &r, &v, &u))
+    };
+    let reuse = matches!(options.statics.integrator, Integrator::Rk4 { .. });
+    let failed = |ws: &mut Workspace, what: String, attempts: usize, residual: f64| {
+        ws.material_error.take().unwrap_or(Error::NotConverged {
+            what,
+            iterations: attempts,
+            residual,
+            load_factor: 1.0,
+        })
+    };
+    let mut y: [f64; STATE] = eq.initial(&[0.0; 6]);
+    for i in 0..nt {
+        if present(i, 0.0) {
+            tau[0][i] = base[i];
+            slip[0][i] = base_slip(base[i], prev.map(|p| p[0][i]));
+        }
+    }
+    let mut interval = 0;
+    {
+        let mut ev = Evaluator {
+            eq: Equations {
+                profile: Some(&cell),
+                ..eq
+            },
+            ws: &mut ws,
+        };
+        ev.set_interval(0);
+        let Some(d) = at_node(&mut ev, 0.0, &y, false) else {
+            return Err(failed(
+                &mut ws,
+                "friction: the constitutive solve failed at the base".into(),
+                0,
+                f64::INFINITY,
+            ));
+        };
+        dirs.push(d);
+    }
+    nodes.push(Node {
+        s: 0.0,
+        interval: 0,
+        y,
+    });
+    let mut path_length = vec![vec![0.0; nt]; n];
+    let tiny = 10.0 * BREAK_OFFSET * l;
+    let mut rates: Vec<Option<f64>> = Vec::with_capacity(n * nt);
+    let (mut saved, mut guess, mut rule) = (Vec::new(), vec![0.0; nt], vec![0.0; nt]);
+    let mut rule_slip = vec![Slip::Absent; nt];
+    let mut last: Option<(Vec<f64>, Vec<f64>)>;
+    let mut attempts_total = 0;
+    let mut worst: f64 = 0.0;
+    for j in 0..n - 1 {
+        let (a, b) = (mesh[j], mesh[j + 1]);
+        let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
+        saved.clone_from(&ws.integral);
+        // First guess: the rule with the turning rate extrapolated from the last cells.
+        for i in 0..nt {
+            let theta = if crosses {
+                0.0
+            } else {
+                (extrapolated_rate(&rates, nt, i) * (b - a)).max(0.0)
+            };
+            guess[i] = if present(i, b) {
+                cell_rule(tau[j][i], mus[i] * theta, prev.map(|p| p[j + 1][i])).0
+            } else {
+                0.0
+            };
+        }
+        last = None;
+        let mut attempts = 0;
+        let (y1, k1, d1) = loop {
+            attempts += 1;
+            for i in 0..nt {
+                let distal = if present(i, b) { guess[i] } else { tau[j][i] };
+                cell.set_cell(i, [a, b], [tau[j][i], distal]);
+            }
+            let mut ev = Evaluator {
+                eq: Equations {
+                    profile: Some(&cell),
+                    ..eq
+                },
+                ws: &mut ws,
+            };
+            if ev.ws.interval != interval {
+                ev.set_interval(interval);
+            }
+            let stepped = match options.statics.integrator {
+                Integrator::Rk4 { .. } => fixed(&RK4, &mut ev, a, y, b, 1, |_, _, _| {}),
+                Integrator::Adaptive(o) => {
+                    adaptive(&DP5, &mut ev, [a, b], y, &o, STATE, |_, _, _| {}).map(|r| r.0)
+                }
+            };
+            let mut y1 = match stepped {
+                Ok(y1) => y1,
+                Err(e) => return Err(ev.ws.material_error.take().unwrap_or(e)),
+            };
+            let mut k1 = interval;
+            if crosses {
+                Piecewise::jump(&mut ev, b, &mut y1);
+                k1 += 1;
+                ev.set_interval(k1);
+            }
+            let Some(d1) = at_node(&mut ev, b, &y1, reuse && !crosses) else {
+                let what = format!("friction: the constitutive solve failed at s = {b} m");
+                return Err(failed(&mut ws, what, attempts, f64::INFINITY));
+            };
+            let mut change: f64 = 0.0;
+            for i in 0..nt {
+                (rule[i], rule_slip[i]) = match (&dirs[j][i], &d1[i]) {
+                    (Some(ta), Some(tb)) => {
+                        let mu_theta = if mus[i] > 0.0 {
+                            mus[i] * angle(ta, tb)
+                        } else {
+                            0.0
+                        };
+                        cell_rule(tau[j][i], mu_theta, prev.map(|p| p[j + 1][i]))
+                    }
+                    _ => (0.0, Slip::Absent),
+                };
+                change = change.max((rule[i] - guess[i]).abs());
+            }
+            if !change.is_finite() {
+                let what = "friction: the tension profile became non-finite".to_string();
+                return Err(failed(&mut ws, what, attempts, change));
+            }
+            if change <= tol {
+                worst = worst.max(change);
+                break (y1, k1, d1);
+            }
+            if attempts >= MAX_CELL_ATTEMPTS {
+                let what = format!(
+                    "friction: the tension at s = {b} m did not settle in {attempts} steps of \
+                     its cell (change {:e} > tolerance {:e} relative)",
+                    change / scale,
+                    options.tolerance
+                );
+                return Err(failed(&mut ws, what, attempts, change / scale));
+            }
+            let before = guess.clone();
+            next_guess(
+                &mut guess,
+                &rule,
+                last.as_ref().map(|(g, r)| (g.as_slice(), r.as_slice())),
+            );
+            last = Some((before, rule.clone()));
+            ws.integral.clone_from(&saved);
+        };
+        attempts_total += attempts;
+        rates.extend((0..nt).map(|i| match (&dirs[j][i], &d1[i]) {
+            (Some(ta), Some(tb)) if mus[i] > 0.0 && b - a > tiny && !crosses => {
+                Some(angle(ta, tb) / (b - a))
+            }
+            _ => None,
+        }));
+        tau[j + 1].copy_from_slice(&rule);
+        slip[j + 1].copy_from_slice(&rule_slip);
+        dirs.push(d1);
+        path_length[j + 1].copy_from_slice(&ws.integral[..nt]);
+        y = y1;
+        interval = k1;
+        nodes.push(Node { s: b, interval, y });
+    }
+    // The solution at the nodes, with the whole profile.
+    let mut act = actuation.clone();
+    act.profile = Some(Arc::new(to_profile(model, mesh, &tau)));
+    let profile = act.profile.clone();
+    let residual = eq.residual(&y, 0).0.amax();
+    let mut p = Shooting::new(
+        Equations {
+            profile: profile.as_deref(),
+            ..eq
+        },
+        options.statics.integrator,
+        plan,
+    );
+    p.nodes = nodes;
+    p.lengths = ws.integral[..nt].to_vec();
+    let stats = SolverStats {
+        iterations: 0,
+        residual,
+        function_evaluations: ws.evaluations,
+        converged: true,
+        load_steps: 0,
+        load_factor: 1.0,
+    };
+    let mut sol = assemble(&mut p, model, [0.0; 6], stats, &[]);
+    if let Some(e) = p.ws.material_error.take() {
+        return Err(e);
+    }
+    sol.actuation = act;
+    sol.options = options.statics;
+    sol.s_out = mesh.to_vec();
+    sol.stable = true;
+    let tangent = dirs
+        .iter()
+        .map(|row| {
+            row.iter()
+                .map(|t| t.map_or([0.0; 3], |t| [t.x, t.y, t.z]))
+                .collect()
+        })
+        .collect();
+    let forces = friction_forces(mesh, &tau, &dirs);
+    Ok(FrictionalSolution {
+        statics: sol,
+        tension: tau,
+        slip,
+        tangent,
+        friction_force: forces,
+        path_length,
+        iterations: 1,
+        change: worst / scale,
+        cell_steps: attempts_total,
+    })
 }

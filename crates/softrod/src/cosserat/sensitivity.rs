@@ -985,6 +985,22 @@ pub fn actuation_jacobians(
     nodes: &[usize],
     lin: Linearisation,
 ) -> Result<Vec<DMatrix<f64>>> {
+    // The Jacobian of a frictional equilibrium depends on its stick/slip state: not modelled
+    // (the linearisation would propagate a tension change along the whole tendon).
+    if solution.actuation.profile.is_some() {
+        if let Some(i) = solution
+            .model
+            .tendons()
+            .iter()
+            .position(|t| t.friction() > 0.0)
+        {
+            return Err(Error::invalid(
+                "solution",
+                format!("a frictional equilibrium (tendons[{i}].friction > 0)"),
+                "a frictionless solution (the actuation Jacobian with friction is not modelled)",
+            ));
+        }
+    }
     let params = actuation_parameters(solution, lin);
     let observe = check_nodes(solution, nodes)?;
     let held = held_for(solution, lin);

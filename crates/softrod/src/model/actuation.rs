@@ -123,6 +123,20 @@ impl TensionProfile {
         }
     }
 
+    /// Replaces the profile of tendon `i` (if it has one) by the single cell from `s[0]` to
+    /// `s[1]` (m) with tensions `tau` (N) at its ends, in place (the frictional march sets
+    /// one cell at a time).
+    pub(crate) fn set_cell(&mut self, i: usize, s: [f64; 2], tau: [f64; 2]) {
+        if let Some(Some(t)) = self.tendons.get_mut(i) {
+            t.s.clear();
+            t.s.extend_from_slice(&s);
+            t.tau.clear();
+            t.tau.extend_from_slice(&tau);
+            t.log.clear();
+            t.log.extend(tau.iter().map(|v| v.ln()));
+        }
+    }
+
     /// The nodes (m) and tensions (N) of tendon `i`, if it has a profile.
     pub fn tendon(&self, i: usize) -> Option<(&[f64], &[f64])> {
         let t = self.tendons.get(i)?.as_ref()?;
