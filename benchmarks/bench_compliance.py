@@ -6,13 +6,23 @@ two-segment NiTi robot (2 x 0.2 m, E 54 GPa, radius 0.7 mm, six tendons at 10 mm
 the arm, both together (ratio to the solve), the exact tangent tip compliance, eigenscrews, and a
 10 000-configuration workspace map. The Rust-side numbers come from
 ``cargo bench -p softrod --bench compliance``.
+
+``--arcs``: the tip compliance of stress-free arcs (``tests/harness/arcs.py``, precurved and
+under a tip moment, pi/2 ... 2 pi, RK4 at the default steps): time and Castigliano error of
+``compliance(sol)`` (on a finer nested mesh where the estimated truncation error of the
+rotations exceeds 1e-7), of the tangent compliance, and of ``compliance(sol, s_out=[L])``
+(marched under step-size control). Run it with another build's interpreter for a side-by-side
+table (a build without ``s_out`` prints ``-`` there).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 from _timing import median_time
@@ -20,13 +30,58 @@ from _timing import median_time
 import softrod
 
 
+def arcs_table(calls: int, reps: int) -> None:
+    """Time and Castigliano error of the compliance of stress-free arcs (RK4 defaults)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from harness import arcs
+    from harness.oracles import block_relative_error
+
+    def med(fn):
+        return median_time(fn, calls=calls, repeats=reps) * 1e6
+
+    print("tip compliance of stress-free arcs, RK4 default steps; medians in microseconds")
+    print(
+        "| arc | solve | compliance() | error | tangent | error "
+        "| compliance(s_out=[L]) marched | error |"
+    )
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+
+    def row(case: str, theta: float) -> list[str]:
+        sol = arcs.solve(case, theta)
+        exact = arcs.exact(theta)
+        cells = [f"{case} {theta / math.pi:g} pi", f"{med(lambda: arcs.solve(case, theta)):.1f}"]
+        cells.append(f"{med(lambda: softrod.compliance(sol)):.1f}")
+        cells.append(f"{block_relative_error(softrod.compliance(sol).tip_world, exact):.1e}")
+        if case == "precurved":
+            cells.append(f"{med(lambda: softrod.tangent_compliance(sol)):.1f}")
+            tangent = softrod.tangent_compliance(sol).world
+            cells.append(f"{block_relative_error(tangent, exact):.1e}")
+        else:
+            cells += ["-", "-"]
+        try:
+            marched = softrod.compliance(sol, s_out=[arcs.LENGTH]).world[0]
+        except TypeError:
+            return [*cells, "-", "-"]
+        cells.append(f"{med(lambda: softrod.compliance(sol, s_out=[arcs.LENGTH])):.1f}")
+        cells.append(f"{block_relative_error(marched, exact):.1e}")
+        return cells
+
+    for case in ("precurved", "moment"):
+        for theta in arcs.ANGLES:
+            print("| " + " | ".join(row(case, theta)) + " |")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__)
     p.add_argument("--repeats", type=int, default=15)
     p.add_argument("--quick", action="store_true", help="fewer repeats (smoke run)")
+    p.add_argument("--arcs", action="store_true", help="only the stress-free arcs table")
     args = p.parse_args()
     reps = 3 if args.quick else args.repeats
     calls = 30 if args.quick else 200
+    if args.arcs:
+        arcs_table(calls // 4, reps)
+        return
 
     robot = softrod.examples.load("niti_two_segment")
     rows = []

@@ -250,11 +250,6 @@ def test_round_trip_reaches_the_targets_inside_the_bounds():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="26 of 1,000 targets are missed (the SQP stops without converging and says so); "
-    "the aim is at most 10",
-)
 def test_round_trip_of_a_thousand_targets():
     misses = _round_trip(1000, 2)
     assert len(misses) <= 10, misses

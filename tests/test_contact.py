@@ -16,13 +16,20 @@ def _rod():
     return sr.Rod(L, sr.CircularSection(R), sr.LinearElastic(E, NU))
 
 
+DELTA = 1e-3
+CLOSING = 3 * EI * DELTA / L**3  # the tip force that closes the gap to the plane
+PLANE = sr.Plane((-(R + DELTA), 0.0, 0.0), (1.0, 0.0, 0.0))
+
+
+def _pressed(factor, **kw):
+    """The cantilever pushed toward the plane by `factor` times the closing force."""
+    loads = sr.Loads(tip_force=(-factor * CLOSING, 0, 0))
+    return sr.solve_statics(_rod(), loads=loads, obstacles=[PLANE], steps=100, **kw)
+
+
 def test_tip_contact_reaction_is_the_cantilever_closed_form():
-    delta = 1e-3
-    closing = 3 * EI * delta / L**3
-    plane = sr.Plane((-(R + delta), 0.0, 0.0), (1.0, 0.0, 0.0))
-    sol = sr.solve_statics(
-        _rod(), loads=sr.Loads(tip_force=(-2 * closing, 0, 0)), obstacles=[plane], steps=100
-    )
+    closing, plane = CLOSING, PLANE
+    sol = _pressed(2)
     assert len(sol.contacts) == 1
     c = sol.contacts[0]
     assert c["s"] == L and c["normal"] == [1.0, 0.0, 0.0]
@@ -92,3 +99,48 @@ def test_robot_and_robot_file_carry_obstacles():
     r2 = sr.Robot.from_dict(data)
     assert isinstance(r2.tip_constraint, sr.Pin) and isinstance(r2.obstacles[0], sr.Sphere)
     assert r2.solve().tip_reaction is not None
+
+
+@pytest.mark.parametrize(
+    "constraint",
+    [
+        sr.Pin((0.0, 0.01, 1.0)),
+        sr.Slide((0.0, 0.0, 1.0), (0.0, 0.0, 1.0)),
+        sr.Clamp(np.array([[1, 0, 0, 0.01], [0, 1, 0, 0], [0, 0, 1, 1.0], [0, 0, 0, 1.0]])),
+        sr.Clamp(np.eye(4) + np.diag([0, 0, 0, 0.0]), held=[True, True, True, True, True, False]),
+    ],
+)
+def test_tip_constraint_round_trips_through_a_robot_file(tmp_path, constraint):
+    robot = sr.Robot(_rod(), tip_constraint=constraint)
+    text = robot.to_toml()
+    assert "[tip_constraint]" in text
+    back = sr.Robot.from_toml(text)
+    assert back.tip_constraint == constraint or np.array_equal(
+        back.tip_constraint.pose, constraint.pose
+    )
+    path = tmp_path / "robot.toml"
+    robot.write_toml(path)
+    loaded = sr.load_robot(path)
+    assert sr.Robot.from_toml(loaded.to_toml()) == loaded
+    assert loaded.to_toml() == text
+
+
+def test_failed_contact_solve_without_throw_returns_the_unconverged_solution():
+    loads = sr.Loads(tip_force=(-40 * CLOSING, 0, 0))
+    kw = {"obstacles": [PLANE], "max_iterations": 1, "continuation": False}
+    with pytest.raises(sr.ConvergenceError, match="contact"):
+        sr.solve_statics(_rod(), loads=loads, **kw)
+    sol = sr.solve_statics(_rod(), loads=loads, throw=False, **kw)
+    assert not sol.converged
+    assert sol.stats["load_factor"] < 1 and sol.stats["residual"] > 1e-10
+    assert sol.stats["iterations"] == 1
+    assert np.isfinite(sol.position).all()
+
+
+def test_contact_compliance_holds_the_normal_and_slides_along_the_plane():
+    free, pressed = _pressed(0.5), _pressed(2)
+    c0, c = free.contact_compliance, pressed.contact_compliance
+    assert c.shape == (6, 6)
+    assert abs(c[0, 0]) <= 1e-9 * c0[0, 0]
+    assert c[1, 1] == pytest.approx(L**3 / (3 * EI), rel=1e-3)
+    assert sr.solve_statics(_rod()).contact_compliance is None

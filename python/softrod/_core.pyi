@@ -437,6 +437,10 @@ class StaticsSolution:
     def tip_reaction(self) -> NDArray[np.float64] | None:
         """Reaction wrench of the tip constraint (N, N m; world), shape (6,)."""
     @property
+    def contact_compliance(self) -> NDArray[np.float64] | None:
+        """Tip compliance with the active contacts and the tip constraint as constraints,
+        [dp; dtheta] per [dF; dM] (world), shape (6, 6)."""
+    @property
     def tendon_tensions(self) -> NDArray[np.float64]: ...
     @property
     def tendon_displacements(self) -> NDArray[np.float64]: ...
@@ -522,8 +526,14 @@ def _inverse_statics(
     steps: int | None = None,
     rtol: float | None = None,
     atol: float | None = None,
+    warm_state: _InverseWarmState | None = None,
+    same_model: bool = False,
 ) -> dict[str, Any]:
     """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
+
+class _InverseWarmState:
+    """What an inverse result hands to the next call (opaque): its actuation, last evaluation
+    and Lagrangian Hessian."""
 
 def _pcc_inverse_statics(
     robot: PccRobot,
@@ -539,6 +549,8 @@ def _pcc_inverse_statics(
     throw: bool = True,
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    warm_state: _InverseWarmState | None = None,
+    same_model: bool = False,
 ) -> dict[str, Any]:
     """Inverse statics of a PCC robot (softrod.pcc.inverse_statics wraps it)."""
 
@@ -958,7 +970,11 @@ class Eigenscrews:
     def kind(self) -> str: ...
 
 def compliance(
-    solution: StaticsSolution | PccSolution, rod: Rod | None = None, *, panels: int | None = None
+    solution: StaticsSolution | PccSolution,
+    rod: Rod | None = None,
+    *,
+    panels: int | None = None,
+    s_out: Sequence[float] | NDArray[np.float64] | None = None,
 ) -> Compliance: ...
 def tangent_compliance(
     solution: StaticsSolution,

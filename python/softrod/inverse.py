@@ -10,7 +10,7 @@ actuation Jacobian; external loads and gravity are those of the robot.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -41,11 +41,40 @@ class InverseSolution:
     rotation_error: float
     iterations: int
     converged: bool
+    # What the next call warm-started from this one reuses (the last evaluation, with its
+    # Jacobian, and the Lagrangian Hessian), and the model it belongs to.
+    _warm_state: Any = field(default=None, repr=False, compare=False)
+    _model_key: Any = field(default=None, repr=False, compare=False)
 
     @property
     def actuation(self) -> np.ndarray:
         """Tensions then pressures (N, Pa), the form ``warm_start`` takes."""
         return np.concatenate([self.tensions, self.pressures])
+
+
+def _warm_arguments(warm_start: Any, key: tuple) -> tuple[Any, dict[str, Any]]:
+    """The actuation of a warm start and, for a previous :class:`InverseSolution`, its state
+    (its evaluation reused only on the same model: ``key``'s objects are the same)."""
+    if not isinstance(warm_start, InverseSolution):
+        return warm_start, {}
+    old = warm_start._model_key
+    same = (
+        old is not None
+        and len(old) == len(key)
+        and all(a is b or (isinstance(a, tuple) and a == b) for a, b in zip(old, key, strict=True))
+    )
+    extra = {"warm_state": warm_start._warm_state, "same_model": same}
+    return warm_start.actuation, extra
+
+
+def _model_key(robot: Robot) -> tuple:
+    return (
+        robot._rod,
+        *robot._tendons,
+        robot._loads,
+        *robot._chambers,
+        tuple(sorted(robot.solver.items())),
+    )
 
 
 def inverse_statics(
@@ -94,8 +123,10 @@ def inverse_statics(
         )
         err.parameter = "robot"
         raise err
-    if isinstance(warm_start, InverseSolution):
-        warm_start = warm_start.actuation
+    key = _model_key(robot)
+    warm_start, extra = _warm_arguments(warm_start, key)
+    if target_s is not None:
+        extra = {}
     out = _core._inverse_statics(
         robot._rod,
         list(robot._tendons),
@@ -112,6 +143,7 @@ def inverse_statics(
         tolerance=tolerance,
         max_iterations=max_iterations,
         **{k: v for k, v in robot.solver.items() if k in ("integrator", "steps", "rtol", "atol")},
+        **extra,
     )
     a = np.asarray(out["actuation"])
     nt = out["n_tendons"]
@@ -127,6 +159,8 @@ def inverse_statics(
         rotation_error=float(out["rotation_error"]),
         iterations=int(out["iterations"]),
         converged=bool(out["converged"]),
+        _warm_state=None if target_s is not None else out["warm_state"],
+        _model_key=key,
     )
 
 

@@ -93,10 +93,13 @@ def inverse_statics(
         TargetUnreachableError: The target is out of reach (``throw=True``).
         ConvergenceError: The iteration did not converge (``throw=True``).
     """
-    from .inverse import InverseSolution
+    from .inverse import InverseSolution, _warm_arguments
 
-    if isinstance(warm_start, InverseSolution):
-        warm_start = warm_start.actuation
+    def _loads_key(v):
+        return None if v is None else tuple(np.asarray(v, dtype=float).ravel())
+
+    key = (robot, (_loads_key(tip_force), _loads_key(tip_moment)))
+    warm_start, extra = _warm_arguments(warm_start, key)
     out = _core._pcc_inverse_statics(
         robot,
         target_position,
@@ -110,6 +113,7 @@ def inverse_statics(
         throw=throw,
         tolerance=tolerance,
         max_iterations=max_iterations,
+        **extra,
     )
     a = np.asarray(out["actuation"])
     nt = out["n_tendons"]
@@ -129,6 +133,8 @@ def inverse_statics(
         rotation_error=float(out["rotation_error"]),
         iterations=int(out["iterations"]),
         converged=bool(out["converged"]),
+        _warm_state=out["warm_state"],
+        _model_key=key,
     )
 
 

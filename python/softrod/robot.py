@@ -323,15 +323,14 @@ class Robot:
         """
         if self._spec is None:
             spec = _objects.describe(*self._parts())
+            extra: dict[str, Any] = {}
             if self._obstacles:
-                tables = [_objects.obstacle_spec(o) for o in self._obstacles]
-                spec = spec.model_copy(
-                    update={
-                        "obstacles": _rf.validate_robot_dict(
-                            {"rod": _MINIMAL_ROD, "obstacles": tables}
-                        ).obstacles
-                    }
-                )
+                extra["obstacles"] = [_objects.obstacle_spec(o) for o in self._obstacles]
+            if self._tip_constraint is not None:
+                extra["tip_constraint"] = _objects.tip_constraint_spec(self._tip_constraint)
+            if extra:
+                checked = _rf.validate_robot_dict({"rod": _MINIMAL_ROD, **extra})
+                spec = spec.model_copy(update={k: getattr(checked, k) for k in extra})
             object.__setattr__(self, "_spec", spec)
         return self._spec
 

@@ -134,15 +134,20 @@ pub(crate) enum AnySolution<'py> {
 /// PCC (same computation; the PCC arcs take `rod`'s section and material).
 ///
 /// Returns a `Compliance`: 6x6 matrices per node (m/N, 1/N, rad/(N m) blocks) in the world
-/// and body frames, and the dimensionless `gamma_c`.
+/// and body frames, and the dimensionless `gamma_c`. With `s_out` (m, in `[0, L]`, a Cosserat
+/// solution only) it is marched under step-size control to those arc lengths (each a stop of
+/// the march: exact, not interpolated), one row per value.
 #[pyfunction]
-#[pyo3(signature = (solution, rod=None, *, panels=None))]
+#[pyo3(signature = (solution, rod=None, *, panels=None, s_out=None))]
 pub(crate) fn compliance<'py>(
     py: Python<'py>,
     solution: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = arg::rod)] rod: Option<Bound<'py, Rod>>,
     #[pyo3(from_py_with = arg::panels)] panels: Option<i64>,
+    s_out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Compliance> {
+    let s_out = s_out.filter(|s| !s.is_none());
+    let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
     let call = Args::new(
         py,
         &[
@@ -153,6 +158,12 @@ pub(crate) fn compliance<'py>(
                     .map_or_else(|| py.None(), |r| r.clone().into_any().unbind()),
             ),
             ("panels", panels.into_pyobject(py)?.into_any().unbind()),
+            (
+                "s_out",
+                s_out
+                    .as_ref()
+                    .map_or_else(|| py.None(), |s| s.clone().unbind()),
+            ),
         ],
     )?;
     let solution: AnySolution<'_> = solution.extract().map_err(|_| {
@@ -176,9 +187,25 @@ pub(crate) fn compliance<'py>(
                 ));
             }
             let sol = &solution.inner;
-            run(py, "compliance", || softrod::compliance(sol))
+            if s_out.is_some() {
+                if s_values.is_empty() {
+                    return Err(param_err("s_out", "[]", "at least one arc length (m)"));
+                }
+                run(py, "compliance", || {
+                    softrod::compliance::compliance_at(sol, &s_values)
+                })
+            } else {
+                run(py, "compliance", || softrod::compliance(sol))
+            }
         }
         AnySolution::Pcc(solution) => {
+            if s_out.is_some() {
+                return Err(param_err(
+                    "s_out",
+                    format!("{s_values:?}"),
+                    "None for a PCC solution (its panels are set by `panels`)",
+                ));
+            }
             let rod = rod.ok_or_else(|| {
                 param_err("rod", "None", "the Rod giving the section and material")
             })?;

@@ -15,6 +15,33 @@ use crate::errors::param_err;
 use crate::model::{Chamber, Loads, Rod, Tendon};
 use crate::statics::{actuator_names, solve_options, OptionArgs, Problem};
 
+/// The state an inverse result hands to the next call (its actuation, last evaluation with
+/// the Jacobian, and Lagrangian Hessian): opaque to Python, passed back as `warm_state`.
+#[pyclass(frozen, module = "softrod._core", name = "_InverseWarmState")]
+pub(crate) struct InverseWarmState {
+    inner: InverseWarmStart,
+}
+
+/// The warm start of a call: `warm_state` (if its actuation is that of `warm_start`, and with
+/// its evaluation only when `same_model`), else the actuation of `warm_start` alone.
+fn merge_warm(
+    warm: Option<InverseWarmStart>,
+    state: Option<&Bound<'_, InverseWarmState>>,
+    same_model: bool,
+) -> Option<InverseWarmStart> {
+    let w = warm?;
+    match state {
+        Some(st) if st.get().inner.actuation == w.actuation => {
+            let mut inner = st.get().inner.clone();
+            if !same_model {
+                inner.evaluation = None;
+            }
+            Some(inner)
+        }
+        _ => Some(w),
+    }
+}
+
 /// The target and the options of an inverse call, checked and named.
 #[allow(clippy::too_many_arguments)]
 fn target_and_options(
@@ -101,6 +128,15 @@ fn result_dict<'py>(
     d.set_item("evaluations", inv.evaluations)?;
     d.set_item("converged", inv.converged)?;
     d.set_item("reached", inv.reached)?;
+    d.set_item(
+        "warm_state",
+        Bound::new(
+            py,
+            InverseWarmState {
+                inner: InverseWarmStart::from(inv),
+            },
+        )?,
+    )?;
     Ok(d)
 }
 
@@ -135,7 +171,7 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
                     target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
                     throw=true, tolerance=None, max_iterations=None, integrator=None, steps=None,
-                    rtol=None, atol=None))]
+                    rtol=None, atol=None, warm_state=None, same_model=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _inverse_statics<'py>(
     py: Python<'py>,
@@ -157,6 +193,8 @@ pub(crate) fn _inverse_statics<'py>(
     #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
     #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
     #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+    warm_state: Option<Bound<'py, InverseWarmState>>,
+    same_model: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (target, o, warm) = target_and_options(
         &target_position,
@@ -183,6 +221,7 @@ pub(crate) fn _inverse_statics<'py>(
         loads.as_ref().map(Bound::get),
         &chambers,
     )?;
+    let warm = merge_warm(warm, warm_state.as_ref(), same_model);
     let model = &problem.model;
     let (inv, _) = run(py, "inverse_statics", || {
         softrod::inverse_statics(model, &target, &o, &solve, warm.as_ref()).map_err(actuator_names)
@@ -196,7 +235,8 @@ pub(crate) fn _inverse_statics<'py>(
 #[pyfunction]
 #[pyo3(signature = (robot, target_position, *, target_rotation=None, weights=None,
                     tension_bounds=None, pressure_bounds=None, tip_force=None, tip_moment=None,
-                    warm_start=None, throw=true, tolerance=None, max_iterations=None))]
+                    warm_start=None, throw=true, tolerance=None, max_iterations=None,
+                    warm_state=None, same_model=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _pcc_inverse_statics<'py>(
     py: Python<'py>,
@@ -212,6 +252,8 @@ pub(crate) fn _pcc_inverse_statics<'py>(
     #[pyo3(from_py_with = arg::throw)] throw: bool,
     #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
     #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+    warm_state: Option<Bound<'py, InverseWarmState>>,
+    same_model: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (target, o, warm) = target_and_options(
         &target_position,
@@ -236,6 +278,7 @@ pub(crate) fn _pcc_inverse_statics<'py>(
         tip_moment: vec_or_zero(tip_moment, "tip_moment")?,
         ..PccLoads::default()
     };
+    let warm = merge_warm(warm, warm_state.as_ref(), same_model);
     let model = &robot.inner;
     let inv = run(py, "pcc.inverse_statics", || {
         let mut fwd = PccForward::new(model, &loads, &PccSolveOptions::default());

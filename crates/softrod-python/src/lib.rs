@@ -74,6 +74,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
     m.add_function(wrap_pyfunction!(statics::actuation_jacobian, m)?)?;
+    m.add_class::<inverse::InverseWarmState>()?;
     m.add_function(wrap_pyfunction!(inverse::_inverse_statics, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::_pcc_inverse_statics, m)?)?;
     m.add_function(wrap_pyfunction!(model::_rebuild, m)?)?;

@@ -455,6 +455,17 @@ impl StaticsSolution {
             .tip_reaction
             .map(|r| r.to_vec().into_pyarray(py).into_any().unbind())
     }
+    /// Tangent compliance of the tip with the active contacts and the tip constraint as
+    /// constraints (frictionless contacts hold the normal only), `[dp; dtheta]` of the tip
+    /// (m, rad; world) per `[dF; dM]` of a dead tip load (N, N m; world), shape (6, 6); None
+    /// without obstacles and tip constraint (then `tangent_compliance`, which treats contact
+    /// forces as dead loads, is the same) or when not converged.
+    #[getter]
+    fn contact_compliance<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        self.contact
+            .compliance
+            .map(|m| Array::from_shape_fn((6, 6), |(i, j)| m[(i, j)]).into_pyarray(py))
+    }
     /// Tension carried by each tendon (N), shape (n_tendons,): the input of a
     /// tension-controlled tendon, the solved tension of a displacement-controlled one (0 when
     /// slack).
@@ -872,7 +883,7 @@ pub(crate) fn solve_statics<'py>(
                 let data = crate::contact::ContactData::from_solution(&c);
                 Ok((c.solution, data))
             } else {
-                softrod::solve_statics_at(model, act, &options, &s_values)
+                softrod::compliance::solve_at_output(model, act, &options, &s_values)
                     .map_err(actuator_names)
                     .map(|r| (r, crate::contact::ContactData::default()))
             }

@@ -126,21 +126,36 @@ pub fn check_parameter(name: &str, value: f64) -> Result<f64> {
 /// it, where `scale` is the load that has load number 1 (`EI / L²` for a force, ...).
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] naming `name`, with the largest magnitude in `unit`.
-pub fn check_load(name: &str, value: f64, magnitude: f64, scale: f64, unit: &str) -> Result<()> {
+/// [`Error::InvalidParameter`] naming `name`, with the largest magnitude in `unit`. The name
+/// is formatted only on error (pass `format_args!` for an indexed one: no allocation on the
+/// way of every solve).
+#[inline]
+pub fn check_load(
+    name: impl std::fmt::Display,
+    value: f64,
+    magnitude: f64,
+    scale: f64,
+    unit: &str,
+) -> Result<()> {
     let max = MAX_LOAD_NUMBER * scale;
     if magnitude.is_finite() && magnitude <= max {
         Ok(())
     } else {
-        Err(Error::invalid(
-            name,
-            value,
-            format!(
-                "finite and of magnitude <= {max:.3e} {unit} (load number <= {MAX_LOAD_NUMBER:e}, \
-                 see softrod's limits)"
-            ),
-        ))
+        Err(load_error(&name, value, max, unit))
     }
+}
+
+/// The error of [`check_load`] (off the path of every solve).
+#[cold]
+fn load_error(name: &dyn std::fmt::Display, value: f64, max: f64, unit: &str) -> Error {
+    Error::invalid(
+        name.to_string(),
+        value,
+        format!(
+            "finite and of magnitude <= {max:.3e} {unit} (load number <= {MAX_LOAD_NUMBER:e}, \
+             see softrod's limits)"
+        ),
+    )
 }
 
 #[cfg(test)]

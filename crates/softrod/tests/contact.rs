@@ -87,16 +87,23 @@ fn assert_contact_solution(
     }
 }
 
-/// A cantilever along z pushed by a tip force toward the plane x = -(R + δ) (normal +x):
-/// no contact below the force 3 E I δ / L³ that closes the gap, and beyond it a tip reaction
-/// R = F - 3 E I δ / L³ (slender rod: shear below 1e-5 of it).
-#[test]
-fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
+/// The cantilever of radius 1 mm beside the plane x = -(R + δ), δ = 1e-3 L (normal +x):
+/// `(radius, E I, the tip force 3 E I δ / L³ that closes the gap, δ, the plane)`.
+fn beside_a_plane() -> (f64, f64, f64, f64, Obstacle) {
     let radius = 1e-3;
     let delta = 1e-3 * L;
     let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
     let closing = 3.0 * ei * delta / L.powi(3);
     let plane = Obstacle::plane([-(radius + delta), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    (radius, ei, closing, delta, plane)
+}
+
+/// A cantilever along z pushed by a tip force toward the plane x = -(R + δ) (normal +x):
+/// no contact below the force 3 E I δ / L³ that closes the gap, and beyond it a tip reaction
+/// R = F - 3 E I δ / L³ (slender rod: shear below 1e-5 of it).
+#[test]
+fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
+    let (radius, _, closing, _, plane) = beside_a_plane();
     let obstacles = [plane];
     for factor in [0.5, 0.99, 1.5, 2.0, 4.0] {
         let force = Vector3::new(-factor * closing, 0.0, 0.0);
@@ -243,4 +250,67 @@ fn interior_contact_with_a_sphere_is_the_propped_cantilever() {
         println!("sphere contact F = {factor} F_c at s = {:.6}: R = {:e}, propped cantilever {exact:e}, rel. error {err:e}", k.s, k.normal_force);
         assert!(err < 1e-3, "R = {:e} vs {exact:e}", k.normal_force);
     }
+}
+
+/// Compliance under contact: the cantilever's tip pressed on the parallel plane (2 F_c). Along
+/// the plane's normal the contact holds the tip (compliance ≤ 1e-9 of the contact-free one);
+/// along the plane it slides, and its compliance is the central difference of the
+/// constrained nonlinear solve under a tip force along the plane. Without contact the
+/// constrained compliance is the tangent compliance of the solution.
+#[test]
+fn compliance_under_contact_is_the_constrained_derivative() {
+    let (radius, ei, closing, _, plane) = beside_a_plane();
+    let obstacles = [plane];
+    let solve = |force: Vector3<f64>| {
+        let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+        solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(100),
+            None,
+            &obstacles,
+        )
+        .unwrap()
+    };
+    // Contact-free (F below the closing force): the constrained compliance is the tangent one.
+    let free = solve(Vector3::new(-0.5 * closing, 0.0, 0.0));
+    assert!(free.contacts.is_empty());
+    let c_free = free.compliance.unwrap();
+    let tangent =
+        softrod::tangent_compliance(&free.solution, softrod::TendonControl::Tension, None)
+            .unwrap()
+            .world;
+    let err_free = (c_free - tangent).amax() / tangent.amax();
+    println!("contact-free: constrained vs tangent compliance, rel. {err_free:e}");
+    assert!(err_free < 1e-9, "{err_free:e}");
+    // Pressed on the plane.
+    let force = Vector3::new(-2.0 * closing, 0.0, 0.0);
+    let pressed = solve(force);
+    assert_eq!(pressed.contacts.len(), 1);
+    let c = pressed.compliance.unwrap();
+    let normal = (c[(0, 0)] / c_free[(0, 0)]).abs();
+    println!(
+        "normal compliance {:e} (contact-free {:e}, ratio {normal:e})",
+        c[(0, 0)],
+        c_free[(0, 0)]
+    );
+    assert!(normal <= 1e-9, "normal compliance ratio {normal:e}");
+    // In the plane (y): the central difference of the nonlinear solve.
+    let h = 1e-4 * closing;
+    let plus = solve(force + Vector3::new(0.0, h, 0.0));
+    let minus = solve(force - Vector3::new(0.0, h, 0.0));
+    assert!(plus.contacts.len() == 1 && minus.contacts.len() == 1);
+    let (tp, tm) = (plus.solution.tip_position(), minus.solution.tip_position());
+    for k in 0..3 {
+        let fd = (tp[k] - tm[k]) / (2.0 * h);
+        let err = (c[(k, 1)] - fd).abs() / c[(1, 1)].abs();
+        println!(
+            "in-plane: C[{k}][1] = {:e}, central difference {fd:e}, rel. {err:e}",
+            c[(k, 1)]
+        );
+        assert!(err < 1e-6, "C[{k}][1] = {:e} vs {fd:e}", c[(k, 1)]);
+    }
+    // The slender cantilever: L³ / (3 E I) along the plane.
+    let beam = L.powi(3) / (3.0 * ei);
+    assert!((c[(1, 1)] / beam - 1.0).abs() < 1e-3);
 }

@@ -204,15 +204,11 @@ def _cmd_workspace(args) -> int:
     if args.n < 1:
         raise bad("--n", args.n, "must be >= 1")
     robot = load_actuated(args)
-    if robot.chambers:
-        raise bad(
-            "ROBOT",
-            args.robot,
-            "has chambers, which workspace maps do not model yet (sweep tensions of a "
-            "tendon-only robot, or use `softrod study` for pressures)",
-        )
     if len(robot.tendons) == 0:
-        raise bad("ROBOT", args.robot, "has no tendons to sweep")
+        why = "has no tendons to sweep"
+        if robot.chambers:
+            why += " (its chambers stay at the file's pressures; sweep them with `softrod study`)"
+        raise bad("ROBOT", args.robot, why)
     axes = _sweep_axes(args.sweep, len(robot.tendons), args.n)
     grid = tension_grid(len(robot.tendons), axes)
     opts = {
@@ -228,6 +224,7 @@ def _cmd_workspace(args) -> int:
         robot.loads,
         progress=True if args.progress else None,
         tangent=args.tangent,
+        chambers=list(robot.chambers),
         **opts,
     )
     dt = time.perf_counter() - t0

@@ -279,6 +279,31 @@ def tip_constraint_of(t: Any) -> Any:
     return Slide(tuple(t.point), tuple(t.normal))
 
 
+def tip_constraint_spec(t: Any) -> dict[str, Any]:
+    """The ``[tip_constraint]`` table of a ``Clamp``, ``Pin`` or ``Slide``."""
+    import numpy as np
+
+    from ..contact import Clamp, Pin
+
+    if isinstance(t, Clamp):
+        pose = np.asarray(t.pose, dtype=float)
+        out: dict[str, Any] = {
+            "type": "clamp",
+            "position": [float(x) for x in pose[:3, 3]],
+            "rotation": [[float(x) for x in row] for row in pose[:3, :3]],
+        }
+        if t.held is not None:
+            out["held"] = [bool(h) for h in t.held]
+        return out
+    if isinstance(t, Pin):
+        return {"type": "pin", "point": [float(x) for x in t.point]}
+    return {
+        "type": "slide",
+        "point": [float(x) for x in t.point],
+        "normal": [float(x) for x in t.normal],
+    }
+
+
 def obstacle_spec(o: Any) -> dict[str, Any]:
     """The ``[[obstacles]]`` table of an obstacle dataclass."""
     from ..plot.obstacles import as_obstacle

@@ -451,10 +451,13 @@ pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Comp
 
 /// The paper's integrated compliance (eqs. 6-7) at every node of `solution`. For an adaptive
 /// solution it is integrated under step-size control to the solution's own tolerances
-/// ([`compliance_at`]); for an RK4 solution by the composite quadrature on the solution's mesh
-/// (see the module documentation: its error is that of the mesh, about 1e-6 relative on a
-/// stress-free arc of 3π/2 with the default steps; [`compliance_at`] with `solution.s` gives
-/// the values under step-size control at [`super::COMPLIANCE_RTOL`], at about 50× the cost).
+/// ([`compliance_at`]); for an RK4 solution by the composite quadrature on the solution's
+/// mesh, or, for a solution at the default steps where the mesh's estimated rotational
+/// truncation error exceeds
+/// [`super::MESH_ROTATION_TARGET`] (strongly curved rods), on a finer nested mesh re-solved
+/// from the solution ([`super::refine`]): about 1e-7 relative on stress-free arcs up to 2π.
+/// [`compliance_at`] with `solution.s` gives the values under step-size control at
+/// [`super::COMPLIANCE_RTOL`].
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `solution` if it has no nodes or its arrays differ in
@@ -463,7 +466,19 @@ pub fn compliance(solution: &StaticsSolution) -> Result<Compliance> {
     if marched(solution) {
         return compliance_at(solution, &solution.s);
     }
-    configuration_compliance(solution.model.rod(), Configuration::from_statics(solution)?)
+    let rod = solution.model.rod();
+    let Some((fine, map)) = super::refine::refined(solution) else {
+        return configuration_compliance(rod, Configuration::from_statics(solution)?);
+    };
+    // On the finer mesh, reported at the solution's nodes.
+    let all = configuration_compliance(rod, Configuration::from_statics(&fine)?)?;
+    Ok(Compliance {
+        s: solution.s.clone(),
+        element: map.iter().map(|&j| all.element[j]).collect(),
+        world: map.iter().map(|&j| all.world[j]).collect(),
+        body: map.iter().map(|&j| all.body[j]).collect(),
+        gamma_c: map.iter().map(|&j| all.gamma_c[j]).collect(),
+    })
 }
 
 /// The integrated compliance at the arc lengths `s_out` (m, any values in `[0, L]`, in any order; a

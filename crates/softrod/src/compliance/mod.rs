@@ -4,10 +4,14 @@
 mod controlled;
 pub mod eigenscrew;
 mod integrated;
+pub mod refine;
 mod tangent;
 
 pub use controlled::{COMPLIANCE_ATOL, COMPLIANCE_RTOL};
 pub use integrated::*;
+pub use refine::{
+    rk4_rotation_error, solve_at_output, MESH_ROTATION_TARGET, OUTPUT_ROTATION_TARGET,
+};
 pub use tangent::{
     tangent_compliance, tangent_compliance_held, TangentCompliance, TendonControl, COLUMNS_PER_PASS,
 };

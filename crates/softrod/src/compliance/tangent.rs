@@ -139,6 +139,25 @@ fn tangent_with_rows(
     rows: &[HeldRow],
     node: Option<usize>,
 ) -> Result<TangentCompliance> {
+    let n = solution.s.len();
+    let node = node.unwrap_or(n.saturating_sub(1));
+    if node < n {
+        // A strongly curved RK4 solution: the derivative of a finer march (super::refine).
+        if let Some((fine, map)) = super::refine::refined(solution) {
+            let mut out = tangent_on_mesh(&fine, rows, Some(map[node]))?;
+            out.node = node;
+            return Ok(out);
+        }
+    }
+    tangent_on_mesh(solution, rows, Some(node))
+}
+
+/// [`tangent_with_rows`] on the solution's own mesh.
+fn tangent_on_mesh(
+    solution: &StaticsSolution,
+    rows: &[HeldRow],
+    node: Option<usize>,
+) -> Result<TangentCompliance> {
     let model = &*solution.model;
     let nt = model.tendons().len();
     let n = solution.s.len();

@@ -10,6 +10,7 @@
 //! arc length, point, normal and force.
 
 mod constraint;
+mod jacobian;
 mod obstacle;
 mod solve;
 mod stability;
@@ -75,4 +76,10 @@ pub struct ContactSolution {
     pub contact_force: Vec<[f64; 3]>,
     /// Conjugate points of the doubly clamped rod on `(0, L)` (with a held tip).
     pub conjugate_points: Option<usize>,
+    /// Tangent compliance of the tip with the active contacts and the tip constraint as
+    /// constraints (frictionless contacts hold the normal only, the held tip directions
+    /// hold): `[δp; δθ]` of the tip (m, rad; world) per `[δF; δM]` of a dead tip load (N,
+    /// N m; world), 6×6 (`None` when not converged or singular). The compliance of
+    /// `solution` instead treats the contact forces as dead loads.
+    pub compliance: Option<nalgebra::Matrix6<f64>>,
 }

@@ -9,21 +9,22 @@ use super::constraint::TipConstraint;
 use super::obstacle::Obstacle;
 use super::stability::{conjugate_points, free_stiffness};
 use super::{obstacle_normal_basis, Contact, ContactSolution};
-use crate::cosserat::equations::{rot, v3, Equations, Evaluator, FULL, STATE};
+use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL, STATE};
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
     assemble, scaled, scaled_back, settings, solve_statics, Integrator, SolveOptions,
-    MAX_LOAD_STEP_TURN,
+    MAX_LINE_SEARCH_HALVINGS, MAX_LOAD_STEP_TURN,
 };
 use crate::cosserat::NEUTRAL_MARGIN;
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
+use crate::math::linalg::DenseLu;
 use crate::model::loads::{Loads, PointLoad};
 use crate::model::rod::Profile;
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{
-    continuation, max_norm, newton, ContinuationSettings, Evaluated, NewtonOptions, Problem,
-    SolverStats, MIN_LOAD_INCREMENT,
+    continuation, max_norm, ContinuationSettings, Evaluated, NewtonOptions, Problem, SolverStats,
+    MIN_LOAD_INCREMENT,
 };
 
 /// Most rounds of the active-set loop (contacts added or released) per load step.
@@ -33,7 +34,7 @@ const DIFFERENCE_STEP: f64 = 1e-7;
 
 /// Where a contact acts.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Site {
+pub(super) enum Site {
     /// At the tip `s = L` (unknown: the force).
     Tip,
     /// Inside the rod at an unknown arc length where the gap is least (unknowns: `s`, force).
@@ -46,20 +47,35 @@ enum Site {
 
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
 /// was added, relaxed to zero as the problem's parameter goes from 0 to 1).
-#[derive(Debug, Clone, Copy)]
-struct Active {
-    obstacle: usize,
-    site: Site,
-    g0: f64,
-    dg0: f64,
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Active {
+    pub(super) obstacle: usize,
+    pub(super) site: Site,
+    pub(super) g0: f64,
+    pub(super) dg0: f64,
 }
 
 impl Active {
-    fn size(&self) -> usize {
+    pub(super) fn size(&self) -> usize {
         match self.site {
             Site::Tip => 3,
             Site::Interior | Site::Interval => 4,
         }
+    }
+}
+
+/// The equations of `model` (a contact model) under the actuation, at full load.
+pub(super) fn equations<'a>(
+    model: &'a RobotModel,
+    tensions: &'a [f64],
+    pressures: &'a [f64],
+) -> Equations<'a> {
+    Equations {
+        model,
+        tensions,
+        pressures,
+        load_factor: 1.0,
+        profile: None,
     }
 }
 
@@ -92,11 +108,21 @@ fn scaled_loads(loads: &Loads, lambda: f64) -> Loads {
 
 /// What one evaluation left: the model it marched (with the contact forces as point loads),
 /// its nodes, its raw shooting residual.
-struct Pass {
-    model: Arc<RobotModel>,
-    nodes: Vec<Node>,
-    residual: Vector6<f64>,
+pub(super) struct Pass {
+    pub(super) model: Arc<RobotModel>,
+    pub(super) nodes: Vec<Node>,
+    pub(super) residual: Vector6<f64>,
+    /// What was evaluated, and its rows (a residual asked again is not marched again).
+    pub(super) key: Key,
+    pub(super) rows: Vec<f64>,
+    /// With an exact Jacobian: it (column-major) and the tip twist `[δp; δθ]` (m, rad;
+    /// world) per scaled unknown.
+    pub(super) jacobian: Option<(Vec<f64>, Vec<Vector6<f64>>)>,
 }
+
+/// The unknowns, homotopy parameter, load factor, active set and tip constraint of an
+/// evaluation.
+pub(super) type Key = (Vec<f64>, f64, f64, Vec<Active>, Option<TipConstraint>);
 
 /// The residual rows of one evaluation and, when asked, the exact Jacobian columns of the tip
 /// rows along the base wrench.
@@ -105,20 +131,20 @@ type Rows = (Vec<f64>, Option<[[f64; 6]; 6]>);
 /// The constrained shooting problem at load factor `load`; the parameter of
 /// [`Problem::evaluate`] relaxes the gap targets of newly added contacts.
 pub(crate) struct Constrained<'m> {
-    model: &'m RobotModel,
-    shared: &'m Arc<RobotModel>,
-    tensions: Vec<f64>,
-    pressures: Vec<f64>,
-    integrator: Integrator,
-    tip: Option<TipConstraint>,
+    pub(super) model: &'m RobotModel,
+    pub(super) shared: &'m Arc<RobotModel>,
+    pub(super) tensions: Vec<f64>,
+    pub(super) pressures: Vec<f64>,
+    pub(super) integrator: Integrator,
+    pub(super) tip: Option<TipConstraint>,
     /// Tip pose of the actuated rod without loads (the target at load factor 0).
-    start: (Vector3<f64>, Matrix3<f64>),
-    obstacles: &'m [Obstacle],
-    active: Vec<Active>,
-    load: f64,
-    last: Option<Pass>,
-    reference: Vec<Vector3<f64>>,
-    evaluations: usize,
+    pub(super) start: (Vector3<f64>, Matrix3<f64>),
+    pub(super) obstacles: &'m [Obstacle],
+    pub(super) active: Vec<Active>,
+    pub(super) load: f64,
+    pub(super) last: Option<Pass>,
+    pub(super) reference: Vec<Vector3<f64>>,
+    pub(super) evaluations: usize,
 }
 
 impl<'m> Constrained<'m> {
@@ -126,7 +152,7 @@ impl<'m> Constrained<'m> {
         6 + active.iter().map(Active::size).sum::<usize>()
     }
 
-    fn offsets(&self) -> Vec<usize> {
+    pub(super) fn offsets(&self) -> Vec<usize> {
         let mut o = Vec::with_capacity(self.active.len());
         let mut k = 6;
         for a in &self.active {
@@ -134,6 +160,17 @@ impl<'m> Constrained<'m> {
             k += a.size();
         }
         o
+    }
+
+    /// The key of an evaluation at `x` and `mu` in the current state.
+    pub(super) fn key(&self, x: &[f64], mu: f64) -> Key {
+        // (The load factor steps nothing on an unloaded rod with a free tip.)
+        let load = if self.tip.is_none() && self.model.loads().is_unloaded() {
+            1.0
+        } else {
+            self.load
+        };
+        (x.to_vec(), mu, load, self.active.clone(), self.tip)
     }
 
     /// The target position and rotation of the tip at the current load factor.
@@ -149,7 +186,12 @@ impl<'m> Constrained<'m> {
     }
 
     /// The six tip rows at the tip pose `(p, r)` with shooting residual `res`.
-    fn tip_rows(&self, res: &Vector6<f64>, p: &Vector3<f64>, r: &Matrix3<f64>) -> [f64; 6] {
+    pub(super) fn tip_rows(
+        &self,
+        res: &Vector6<f64>,
+        p: &Vector3<f64>,
+        r: &Matrix3<f64>,
+    ) -> [f64; 6] {
         let Some(c) = &self.tip else {
             return std::array::from_fn(|k| res[k]);
         };
@@ -186,7 +228,7 @@ impl<'m> Constrained<'m> {
 
     /// The derivative of [`Self::tip_rows`] along a column: residual change `dres`, tip
     /// displacement `dp` and rotation `w` (world).
-    fn tip_rows_dot(
+    pub(super) fn tip_rows_dot(
         &self,
         dres: &Vector6<f64>,
         dp: &Vector3<f64>,
@@ -229,7 +271,7 @@ impl<'m> Constrained<'m> {
 
     /// The model with the loads at the current load factor and the contact forces of `x` as
     /// world point loads; `None` if an arc length left the rod.
-    fn contact_model(&self, x: &[f64]) -> Option<Arc<RobotModel>> {
+    pub(super) fn contact_model(&self, x: &[f64]) -> Option<Arc<RobotModel>> {
         if self.active.is_empty() && (self.load == 1.0 || self.model.loads().is_unloaded()) {
             return Some(Arc::clone(self.shared));
         }
@@ -290,13 +332,7 @@ impl<'m> Constrained<'m> {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
             Integrator::Adaptive(_) => Vec::new(),
         };
-        let eq = Equations {
-            model: &model,
-            tensions: &self.tensions,
-            pressures: &self.pressures,
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = equations(&model, &self.tensions, &self.pressures);
         let mut sh = Shooting::new(eq, self.integrator, plan);
         let pass = if full {
             sh.pass::<FULL>(&x[..6], 1.0)
@@ -319,47 +355,31 @@ impl<'m> Constrained<'m> {
             None
         };
         let l = self.model.length();
+        let nt = model.tendons().len();
+        let mut scratch = Workspace::new(nt);
+        let mut ev = Evaluator {
+            eq: sh.eq,
+            ws: &mut scratch,
+        };
         for (a, o) in self.active.iter().zip(self.offsets()) {
-            let ob = &self.obstacles[a.obstacle];
             let (s, k) = match a.site {
                 Site::Tip => (l, o),
                 Site::Interior | Site::Interval => (x[o] * l, o + 1),
             };
-            let props = model.rod().section_at(s);
             let first = sh.nodes.iter().position(|n| n.s == s)?;
             let last = sh.nodes.iter().rposition(|n| n.s == s)?;
-            let pc = v3(&sh.nodes[first].y, 0);
-            let (d, n) = ob.distance(&pc);
-            let g = d - props.radius;
-            rows.push((g - (1.0 - mu) * a.g0) / l);
-            if a.site != Site::Tip {
-                // A point contact sits at the kink of the gap (the shear jumps with the
-                // force): the mean slope of its two sides vanishes; the segment of an
-                // interval lies flat from just after its edge.
-                let sides: &[usize] = if a.site == Site::Interval {
-                    &[last, last]
-                } else {
-                    &[first, last]
-                };
-                let mut slope = 0.0;
-                for &j in sides {
-                    let node = sh.nodes[j];
-                    let mut ev = Evaluator {
-                        eq: sh.eq,
-                        ws: &mut sh.ws,
-                    };
-                    ev.set_interval(node.interval);
-                    let mut dy = [0.0; STATE];
-                    ev.rhs_into::<STATE>(node.s, &node.y, &mut dy);
-                    slope += 0.5 * n.dot(&v3(&dy, 0));
-                }
-                let dg = slope - props.radius_rate;
-                rows.push(dg - (1.0 - mu) * a.dg0);
-            }
-            let (t1, t2) = obstacle_normal_basis(&n);
+            let (nf, nl) = (&sh.nodes[first], &sh.nodes[last]);
             let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
-            rows.push(f.dot(&t1));
-            rows.push(f.dot(&t2));
+            self.contact_rows(
+                &mut ev,
+                a,
+                s,
+                (&nf.y, nf.interval),
+                (&nl.y, nl.interval),
+                &f,
+                mu,
+                &mut rows,
+            );
         }
         if !rows.iter().all(|v| v.is_finite()) {
             return None;
@@ -368,8 +388,59 @@ impl<'m> Constrained<'m> {
             nodes: std::mem::take(&mut sh.nodes),
             residual: res,
             model: Arc::clone(&model),
+            key: self.key(x, mu),
+            rows: rows.clone(),
+            jacobian: None,
         });
         Some((rows, jac))
+    }
+
+    /// The residual rows of the active contact `a` at arc length `s` (m) with scaled force
+    /// `f`, from the states (and intervals) of the first node at `s` (before the jump of the
+    /// force) and the last (after it): the gap over `L` (relaxed by `mu` from its value when
+    /// added), for a contact inside the rod the slope of the gap, and the force's two
+    /// components along the obstacle's surface. `ev` is a scratch evaluator of the contact
+    /// model.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn contact_rows(
+        &self,
+        ev: &mut Evaluator<'_, '_>,
+        a: &Active,
+        s: f64,
+        first: (&[f64; STATE], usize),
+        last: (&[f64; STATE], usize),
+        f: &Vector3<f64>,
+        mu: f64,
+        rows: &mut Vec<f64>,
+    ) {
+        let l = self.model.length();
+        let ob = &self.obstacles[a.obstacle];
+        let props = self.model.rod().section_at(s);
+        let (d, n) = ob.distance(&v3(first.0, 0));
+        let g = d - props.radius;
+        rows.push((g - (1.0 - mu) * a.g0) / l);
+        if a.site != Site::Tip {
+            // A point contact sits at the kink of the gap (the shear jumps with the force):
+            // the mean slope of its two sides vanishes; the segment of an interval lies flat
+            // from just after its edge.
+            let sides = if a.site == Site::Interval {
+                [last, last]
+            } else {
+                [first, last]
+            };
+            let mut slope = 0.0;
+            for (y, interval) in sides {
+                ev.set_interval(interval);
+                let mut dy = [0.0; STATE];
+                ev.rhs_into::<STATE>(s, y, &mut dy);
+                slope += 0.5 * n.dot(&v3(&dy, 0));
+            }
+            let dg = slope - props.radius_rate;
+            rows.push(dg - (1.0 - mu) * a.dg0);
+        }
+        let (t1, t2) = obstacle_normal_basis(&n);
+        rows.push(f.dot(&t1));
+        rows.push(f.dot(&t2));
     }
 
     /// The gap (m) and outward normal of obstacle `o` at every node of the last pass (first
@@ -431,8 +502,59 @@ impl Problem for Constrained<'_> {
         jacobian: Option<&mut [f64]>,
         r: &mut [f64],
     ) -> Evaluated {
+        self.evaluate_inner(x, lambda, jacobian, r)
+    }
+
+    fn commit(&mut self) {
+        if let Some(p) = &self.last {
+            self.reference = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
+        }
+    }
+
+    fn close(&self) -> bool {
+        let (Some(p), false) = (&self.last, self.reference.is_empty()) else {
+            return false;
+        };
+        let limit = 0.5 * MAX_LOAD_STEP_TURN * self.model.length();
+        let now: Vec<Vector3<f64>> = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
+        if now.len() == self.reference.len() {
+            now.iter()
+                .zip(&self.reference)
+                .all(|(a, b)| (a - b).norm() <= limit)
+        } else {
+            match (now.last(), self.reference.last()) {
+                (Some(a), Some(b)) => (a - b).norm() <= limit,
+                _ => false,
+            }
+        }
+    }
+}
+
+impl Constrained<'_> {
+    /// [`Problem::evaluate`]: a residual asked again at the last evaluation is not marched
+    /// again; a Jacobian with contacts comes from one march with the variational columns
+    /// (forward differences only when they do not fit in one march).
+    fn evaluate_inner(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        mut jacobian: Option<&mut [f64]>,
+        r: &mut [f64],
+    ) -> Evaluated {
         let n = self.dim();
         let exact = self.active.is_empty();
+        if jacobian.is_none() {
+            if let Some(last) = self.last.as_ref().filter(|l| l.key == self.key(x, lambda)) {
+                r.copy_from_slice(&last.rows);
+                return Evaluated::Residual;
+            }
+        }
+        if let (Some(j), false) = (jacobian.as_deref_mut(), exact) {
+            if let Some(rows) = self.exact(x, lambda, j) {
+                r.copy_from_slice(&rows);
+                return Evaluated::Jacobian;
+            }
+        }
         let Some((rows, jac)) = self.run(x, lambda, jacobian.is_some() && exact) else {
             return Evaluated::Failed;
         };
@@ -465,30 +587,6 @@ impl Problem for Constrained<'_> {
         self.last = saved;
         Evaluated::Jacobian
     }
-
-    fn commit(&mut self) {
-        if let Some(p) = &self.last {
-            self.reference = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
-        }
-    }
-
-    fn close(&self) -> bool {
-        let (Some(p), false) = (&self.last, self.reference.is_empty()) else {
-            return false;
-        };
-        let limit = 0.5 * MAX_LOAD_STEP_TURN * self.model.length();
-        let now: Vec<Vector3<f64>> = p.nodes.iter().map(|n| v3(&n.y, 0)).collect();
-        if now.len() == self.reference.len() {
-            now.iter()
-                .zip(&self.reference)
-                .all(|(a, b)| (a - b).norm() <= limit)
-        } else {
-            match (now.last(), self.reference.last()) {
-                (Some(a), Some(b)) => (a - b).norm() <= limit,
-                _ => false,
-            }
-        }
-    }
 }
 
 /// Effort of a solve.
@@ -505,22 +603,96 @@ fn correct(
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    let s = crate::solve::NewtonSettings {
-        residual_first: true,
-        ..settings(true, None, false)
-    };
-    let out = newton(p, x, 1.0, opts, &s);
-    effort.iterations += out.iterations;
-    if !out.converged {
-        return None;
-    }
-    if !out.at_x {
-        let mut r = vec![0.0; p.dim()];
-        if p.evaluate(&out.x, 1.0, None, &mut r) == Evaluated::Failed {
+    exact_newton(p, x, opts, effort, true).map(|(x, _)| x)
+}
+
+/// Residual below which [`exact_newton`] stops refining a converged iterate (a fraction of
+/// the tolerance, above round-off).
+fn round_off(opts: &NewtonOptions) -> f64 {
+    (opts.tolerance * 1e-4).max(64.0 * f64::EPSILON)
+}
+
+/// Newton with exact Jacobians at the full contact targets from `x` (the residual alone
+/// first when `residual_first`): every evaluation brings its Jacobian from the same march,
+/// so a full step costs one march; a step is halved until the residual's max norm falls
+/// (Armijo). Once within the tolerance, up to two more steps are taken while they lower the
+/// residual toward round-off, so that the balance of the reactions holds to the digits of the
+/// loads. Returns the iterate and its residual, the last pass at it; `None` if the
+/// tolerance is not met.
+fn exact_newton(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+    residual_first: bool,
+) -> Option<(Vec<f64>, f64)> {
+    let n = p.dim();
+    let mut x = x.to_vec();
+    let mut r = vec![0.0; n];
+    let mut j = vec![0.0; n * n];
+    if residual_first {
+        if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
             return None;
         }
+        let norm = max_norm(&r);
+        if norm <= round_off(opts) {
+            return Some((x, norm));
+        }
     }
-    Some(out.x)
+    if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
+        return None;
+    }
+    let mut norm = max_norm(&r);
+    let (mut xt, mut rt, mut jt) = (vec![0.0; n], vec![0.0; n], vec![0.0; n * n]);
+    let mut lu = DenseLu::default();
+    let mut refined = 0;
+    for _ in 0..opts.max_iterations {
+        if norm <= opts.tolerance {
+            if norm <= round_off(opts) || refined >= 2 {
+                return Some((x, norm));
+            }
+            refined += 1;
+        }
+        let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
+        if !(lu.factor(n, &j) && lu.solve_in_place(&mut dx)) {
+            break;
+        }
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
+            for k in 0..n {
+                xt[k] = x[k] + alpha * dx[k];
+            }
+            if p.evaluate(&xt, 1.0, Some(&mut jt), &mut rt) == Evaluated::Jacobian {
+                let trial = max_norm(&rt);
+                if trial <= (1.0 - 1e-4 * alpha) * norm {
+                    accepted = true;
+                    break;
+                }
+            }
+            if norm <= opts.tolerance {
+                // Refining: a step that does not help ends it.
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
+        effort.iterations += 1;
+        std::mem::swap(&mut x, &mut xt);
+        std::mem::swap(&mut r, &mut rt);
+        std::mem::swap(&mut j, &mut jt);
+        norm = max_norm(&r);
+    }
+    if norm > opts.tolerance {
+        return None;
+    }
+    // The last pass back at the iterate.
+    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
+        return None;
+    }
+    Some((x, norm))
 }
 
 /// Normal forces, normal, arc length and point of each active contact at `x`.
@@ -625,6 +797,10 @@ fn add_contacts(
         }
         x.extend([0.0; 3]);
     }
+    // Straight to the contact (one exact Newton solve), else by relaxing the gaps.
+    if let Some((xs, _)) = exact_newton(p, &x, opts, effort, false) {
+        return Some(xs);
+    }
     // The gap targets of the new contacts: their rows at zero force.
     let mut r = vec![0.0; p.dim()];
     if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
@@ -719,12 +895,12 @@ fn step_loads(
     mut x: Vec<f64>,
     opts: &NewtonOptions,
     effort: &mut Effort,
-) -> std::result::Result<Vec<f64>, (f64, &'static str)> {
+) -> std::result::Result<Vec<f64>, (f64, &'static str, Vec<f64>)> {
     let mut lambda = 0.0;
     let mut dl: f64 = 1.0;
     while lambda < 1.0 {
         if effort.load_steps >= opts.max_load_steps {
-            return Err((lambda, "the load steps ran out"));
+            return Err((lambda, "the load steps ran out", x));
         }
         let target = (lambda + dl).min(1.0);
         let saved = (x.clone(), p.active.clone());
@@ -741,11 +917,15 @@ fn step_loads(
                 (x, p.active) = saved;
                 p.load = lambda;
                 if !opts.continuation {
-                    return Err((lambda, "the direct solve failed"));
+                    return Err((lambda, "the direct solve failed", x));
                 }
                 dl *= 0.5;
                 if dl < MIN_LOAD_INCREMENT {
-                    return Err((lambda, "no load step converged (load increment underflow)"));
+                    return Err((
+                        lambda,
+                        "no load step converged (load increment underflow)",
+                        x,
+                    ));
                 }
             }
         }
@@ -789,6 +969,7 @@ pub fn solve_constrained(
             contacts: Vec::new(),
             contact_force: vec![[0.0; 3]; n],
             conjugate_points: None,
+            compliance: None,
         });
     }
     let tensions = actuation.tension_values(model.tendons().len());
@@ -845,21 +1026,34 @@ pub fn solve_constrained(
         // Load factor 0 (contacts of the actuated rod), then the loads and the target.
         match active_set(&mut p, &x, &opts, &mut effort) {
             Some(xs) => x = xs,
-            None => return fail(&p, &opts, &effort, 0.0, "no contact set at load factor 0"),
+            None => {
+                let why = "no contact set at load factor 0";
+                if opts.throw {
+                    return fail(&p, &opts, &effort, 0.0, why);
+                }
+                // The last state reached (not converged), under the full loads.
+                p.active.clear();
+                p.load = 1.0;
+                return finish(&mut p, model, actuation, options, &x[..6], &effort, 0.0);
+            }
         }
         p.commit();
         if !(model.loads().is_unloaded() && p.tip.is_none()) {
             // (Otherwise nothing is stepped: load factor 0 is the problem.)
             x = match step_loads(&mut p, x, &opts, &mut effort) {
                 Ok(x) => x,
-                Err((lambda, why)) => return fail(&p, &opts, &effort, lambda, why),
+                Err((lambda, _, x)) if !opts.throw => {
+                    p.load = 1.0;
+                    return finish(&mut p, model, actuation, options, &x, &effort, lambda);
+                }
+                Err((lambda, why, _)) => return fail(&p, &opts, &effort, lambda, why),
             };
         }
         reached = Some(x);
     }
     let x = reached.unwrap_or_default();
     p.load = 1.0;
-    finish(&mut p, model, actuation, options, &x, &effort)
+    finish(&mut p, model, actuation, options, &x, &effort, 1.0)
 }
 
 /// The error (or, without `throw`, nothing better to return) of a failed solve.
@@ -882,27 +1076,17 @@ fn fail(
     })
 }
 
-/// Exact Newton steps (fresh Jacobians) from the converged `x` toward round-off, so that the
-/// balance of the reactions holds to the digits of the loads, not only of the tolerance;
-/// `x` itself if they do not lower the residual.
-fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Vec<f64> {
-    let opts = NewtonOptions {
-        tolerance: (options.newton.tolerance * 1e-4).max(f64::EPSILON),
-        max_iterations: 2,
-        ..options.newton
-    };
-    let mut r = vec![0.0; p.dim()];
-    let before = if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
-        f64::INFINITY
-    } else {
-        max_norm(&r)
-    };
-    let out = newton(p, x, 1.0, &opts, &settings(false, None, false));
-    if out.residual < before && out.residual.is_finite() {
-        out.x
-    } else {
-        x.to_vec()
+/// Exact Newton steps from the converged `x` toward round-off (see [`exact_newton`]), so
+/// that the balance of the reactions holds to the digits of the loads, not only of the
+/// tolerance; `x` itself if they do not lower the residual. The last pass is left at the
+/// result, whose residual is returned (`None` if it cannot be integrated).
+fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Option<(Vec<f64>, f64)> {
+    let mut effort = Effort::default();
+    if let Some(out) = exact_newton(p, x, &options.newton, &mut effort, true) {
+        return Some(out);
     }
+    let mut r = vec![0.0; p.dim()];
+    (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
 }
 
 /// The contacts of a solution and the contact force at its samples (an interval's
@@ -1027,11 +1211,15 @@ fn finish(
     options: &SolveOptions,
     x: &[f64],
     effort: &Effort,
+    load_factor: f64,
 ) -> Result<ContactSolution> {
-    let polished = polish(p, x, options);
-    let x: &[f64] = &polished;
-    let mut r = vec![0.0; p.dim()];
-    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
+    let reached = if load_factor >= 1.0 {
+        polish(p, x, options)
+    } else {
+        let mut r = vec![0.0; p.dim()];
+        (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
+    };
+    let Some((polished, residual)) = reached else {
         return fail(
             p,
             &options.newton,
@@ -1039,9 +1227,15 @@ fn finish(
             1.0,
             "the solution could not be integrated",
         );
-    }
-    let residual = max_norm(&r);
+    };
+    let x: &[f64] = &polished;
     let forces = p.normal_forces(x);
+    // The compliance under the constraints (its march leaves the last pass at `x`).
+    let compliance = if residual <= options.newton.tolerance {
+        p.compliance(x)
+    } else {
+        None
+    };
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
@@ -1066,9 +1260,9 @@ fn finish(
         iterations: effort.iterations,
         residual,
         function_evaluations: p.evaluations + sh.evaluations,
-        converged: residual <= options.newton.tolerance,
+        converged: residual <= options.newton.tolerance && load_factor >= 1.0,
         load_steps: effort.load_steps,
-        load_factor: 1.0,
+        load_factor,
     };
     let fs = model.force_scale();
     let l = model.length();
@@ -1107,5 +1301,6 @@ fn finish(
         contacts,
         contact_force,
         conjugate_points: conjugate,
+        compliance,
     })
 }

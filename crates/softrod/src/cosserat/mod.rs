@@ -4,6 +4,7 @@
 //! sensitivities of an equilibrium from the linearised boundary-value problem
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
 
+mod collapse;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;

@@ -861,6 +861,11 @@ fn solve_with(
         if let Some(e) = p.ws.material_error.take() {
             return Err(e);
         }
+        if matches!(reached.stopped, Some(Stopped::StartFailed)) {
+            if let Some(e) = super::collapse::compressed_to_zero(model, &tensions) {
+                return Err(e);
+            }
+        }
         let mut what = failure(&reached, opts.max_load_steps);
         if !finite || !strains_finite {
             what.push_str(": non-finite values along the rod");

@@ -20,14 +20,29 @@
 //!
 //! # Method
 //! Sequential quadratic programming on the exact actuation Jacobian of the linearised
-//! boundary-value problem ([`crate::cosserat::sensitivity`], or the PCC equilibrium): at the
-//! actuation `a_k` with pose error `e_k` and Jacobian `J_k`, the next actuation solves the
-//! quadratic program `min ½ |a - a_ref|²_W` s.t. `J_k (a - a_k) = e_k`, `lo <= a <= hi`
-//! ([`qp::min_norm`], exact); when the linearised target cannot be met inside the bounds, the
-//! bounded least squares `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the
-//! same norm as a vanishing regularisation) instead. Steps are accepted when the pose error
-//! falls (backtracking otherwise), or near the target (within [`NEAR_TARGET`] of the rod
-//! length), where the SQP converges by itself. The iteration stops when the pose error is
+//! boundary-value problem ([`crate::cosserat::sensitivity`], or the PCC equilibrium), in two
+//! phases.
+//!
+//! * Far from the target (pose error above [`NEAR_TARGET`] of the rod length): a trust region
+//!   on the scaled actuation norm. The SQP step (below) is taken if it fits; otherwise the
+//!   bounded Levenberg–Marquardt step `min |J_k d - e_k|² + μ |d|²_W` inside the bounds, `μ`
+//!   set so that `|d|_W` meets the radius. The first radius moves the linearised pose by a
+//!   quarter of the rod length: from a straight rod the linearisation asks for tensions of
+//!   hundreds of newtons (its shortening is of second order in the bending).
+//! * Near the target: the SQP step `min ½ dᵀ H d + (W (a_k - a_ref))ᵀ d` s.t. `J_k d = e_k`,
+//!   `lo <= a_k + d <= hi` ([`qp::min_norm`] for `H = W`, then [`qp::active_set_qp`]), with
+//!   a backtracking line search on the merit function `½ |a - a_ref|²_W + ν |e|` (`ν` 1.5
+//!   times the multipliers' norm); steps below [`LOCAL_STEP`] are taken in full. `H` is the
+//!   Hessian of the Lagrangian `W - Σ λ_k ∇²p_k` on the null space `Z` of the free columns of
+//!   `J` (the only part that matters), from one directional difference of the exact Jacobian
+//!   per null direction, `H z = W z - (J(a + εz) - J(a))ᵀ λ / ε`; it is made when the free
+//!   set changes or the steps stop contracting ([`STALLED`]). With `H = W` alone the
+//!   iteration oscillates where the curvature of the target manifold exceeds that of the
+//!   norm.
+//!
+//! When the linearised target cannot be met inside the bounds, the bounded least squares
+//! `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the same norm as a
+//! vanishing regularisation) is the step instead. The iteration stops when the pose error is
 //! within the tolerances and the step is below `optimality_tolerance` (relative): the KKT
 //! conditions of the program above hold. Every forward evaluation is one solve with its
 //! Jacobian (for a robot without external loads, one march of the state with one column per
@@ -66,6 +81,14 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 60;
 pub const NEAR_TARGET: f64 = 1e-4;
 /// Regularisation of the bounded least squares, relative to the scale of `JᵀJ`.
 pub const LEAST_SQUARES_REGULARISATION: f64 = 1e-12;
+/// Relative length of an SQP step below which it is taken in full near the target (the merit
+/// function cannot resolve smaller ones).
+pub const LOCAL_STEP: f64 = 1e-5;
+/// Ratio of successive steps near the target above which the curvature is made again.
+pub const STALLED: f64 = 0.1;
+/// The first trust radius: the scaled actuation that moves the linearised pose by this
+/// fraction of the rod length.
+pub const FIRST_RADIUS: f64 = 1.0;
 /// Most halvings of a step.
 pub const MAX_STEP_HALVINGS: usize = 30;
 
@@ -503,13 +526,15 @@ pub fn solve_inverse<F: Forward + ?Sized>(
     };
     let near = NEAR_TARGET * length;
     let mut iterations = 0;
-    // The Hessian of the Lagrangian: W, then its damped BFGS updates (`curved`).
+    // The Hessian of the Lagrangian: W, then W corrected on the null space of the free
+    // constraints by directional differences of the exact Jacobian (`curved_for`: the free set
+    // it was made for).
     let mut hess = DMatrix::from_diagonal(&DVector::from_column_slice(&bounds.weights));
-    let mut curved = false;
+    let mut curved_for: Option<Vec<bool>> = None;
     if let Some(h) = warm.and_then(|w| w.hessian.as_ref()) {
-        if h.shape() == (n, n) && h.iter().all(|v| v.is_finite()) {
+        if h.shape() == (n, n) && h.iter().all(|v| v.is_finite()) && *h != hess {
             hess.copy_from(h);
-            curved = true;
+            curved_for = Some(free_set(&a, &bounds));
         }
     }
     let scaled_norm = |v: &[f64]| -> f64 {
@@ -518,6 +543,32 @@ pub fn solve_inverse<F: Forward + ?Sized>(
             .map(|(x, w)| x * x * w)
             .sum::<f64>()
             .sqrt()
+    };
+    // The penalty of the pose error in the merit function ½|a - c|²_W + ν |e| near the target.
+    let mut nu = 0.0f64;
+    // The scaled length of the last step taken near the target (0: none).
+    let mut last_step = 0.0f64;
+    // The trust radius (scaled actuation norm): unset until the first Jacobian is known.
+    let mut radius = f64::NAN;
+    let finish = |a: Vec<f64>,
+                  ev: Evaluation,
+                  dist: f64,
+                  rot: f64,
+                  iterations: usize,
+                  evaluations: usize,
+                  converged: bool,
+                  reached: bool,
+                  hessian: DMatrix<f64>| InverseSolution {
+        actuation: a,
+        n_tendons: nt,
+        position_error: dist,
+        rotation_error: rot,
+        iterations,
+        evaluations,
+        converged,
+        reached,
+        evaluation: ev,
+        hessian,
     };
     loop {
         let (e, jac, dist, rot) = error_rows(target, &ev, rotation_weight);
@@ -530,79 +581,81 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 load_factor: 1.0,
             });
         };
-        // The quadratic program in y = a + Δ: min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ, J y = b, bounds.
+        // The quadratic program in y = a + Δ: min ½ |y - c|²_W, J y = b, bounds.
         let av = DVector::from_column_slice(&a);
         let b = &e + &jac * &av;
         let tol_qp = 1e-3
             * options
                 .tolerance
                 .min(options.rotation_tolerance * rotation_weight);
-        let mut least_squares = shape;
-        let mut multipliers = None;
-        let feasible = if shape {
-            None
-        } else {
-            qp::min_norm(&jac, &b, &bounds, tol_qp)
-        };
-        let y = match feasible {
-            Some((y_w, l_w)) if !curved => {
-                multipliers = Some(l_w);
-                y_w
-            }
-            Some((y_w, l_w)) => {
-                let wd = DVector::from_fn(n, |i, _| bounds.weights[i] * (a[i] - bounds.centre[i]));
-                let q = wd - &hess * &av;
-                match qp::active_set_qp(&hess, &q, &jac, &bounds, &y_w) {
-                    Some((y, l)) => {
-                        multipliers = Some(l);
-                        y
-                    }
-                    None => {
-                        multipliers = Some(l_w);
-                        y_w
+        let merit = e.norm();
+        let mut solved = solve_qp(
+            &jac,
+            &b,
+            &a,
+            &bounds,
+            &hess,
+            curved_for.is_some(),
+            tol_qp,
+            shape,
+        );
+        if !solved.least_squares && merit <= near {
+            let free = free_set(solved.y.as_slice(), &bounds);
+            // A step that does not contract: the curvature is stale (a warm start's, or
+            // another point's); made again here.
+            let d: Vec<f64> = (0..n).map(|i| solved.y[i] - a[i]).collect();
+            let stalled = last_step > 0.0 && scaled_norm(&d) > STALLED * last_step;
+            if stalled || curved_for.as_ref() != Some(&free) {
+                if let Some(lambda) = &solved.lambda {
+                    let (h, used) = curvature(
+                        forward,
+                        target,
+                        &a,
+                        &jac,
+                        lambda,
+                        &free,
+                        &bounds,
+                        rotation_weight,
+                    );
+                    evaluations += used;
+                    if let Some(h) = h {
+                        hess = h;
+                        curved_for = Some(free);
+                        solved = solve_qp(&jac, &b, &a, &bounds, &hess, true, tol_qp, shape);
                     }
                 }
             }
-            None => {
-                least_squares = true;
-                let scale = jac
-                    .iter()
-                    .fold(0.0f64, |m, v| m.max(v.abs()))
-                    .powi(2)
-                    .max(1e-300);
-                let wmax = bounds.weights.iter().fold(0.0f64, |m, v| m.max(*v));
-                qp::bounded_least_squares(
-                    &jac,
-                    &b,
-                    &bounds,
-                    LEAST_SQUARES_REGULARISATION * scale / wmax,
-                )
-            }
-        };
-        let step: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
+        }
+        let least_squares = solved.least_squares;
+        if let Some(l) = &solved.lambda {
+            nu = 1.5 * l.norm();
+        }
+        let lambda_k = solved.lambda.clone();
+        let y = solved.y;
+        let mut step: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
+        let norm_a = scaled_norm(&a);
+        let small = scaled_norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
         if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
             eprintln!(
-                "it {iterations}: dist {dist:.3e} rot {rot:.3e} ls {least_squares} |step| {:.3e} a {:?}",
+                "it {iterations}: dist {dist:.3e} rot {rot:.3e} ls {least_squares} |step| {:.3e} radius {radius:.3e} a {:?}",
                 scaled_norm(&step),
                 a
             );
         }
-        let small = scaled_norm(&step) <= options.optimality_tolerance * (1.0 + scaled_norm(&a));
         let stationary = small && (reached || least_squares);
         if stationary || iterations >= options.max_iterations {
             let converged = stationary && (reached || shape);
-            let out = InverseSolution {
-                actuation: a,
-                n_tendons: nt,
-                position_error: dist,
-                rotation_error: rot,
+            let out = finish(
+                a,
+                ev,
+                dist,
+                rot,
                 iterations,
                 evaluations,
                 converged,
                 reached,
-                evaluation: ev,
-                hessian: hess,
-            };
+                hess,
+            );
             if !converged && options.throw {
                 if stationary || (least_squares && !reached) {
                     return Err(Error::TargetUnreachable {
@@ -620,50 +673,116 @@ pub fn solve_inverse<F: Forward + ?Sized>(
             }
             return Ok(out);
         }
-        // Backtracking on the pose error, full steps near the target.
-        let merit = e.norm();
-        let mut alpha = 1.0;
+        if radius.is_nan() {
+            // A first step that moves the linearised pose by at most a quarter of the rod
+            // length (the linearisation of a straight rod asks for huge tensions to shorten it).
+            let sigma = scaled_jacobian_norm(&jac, &bounds.weights);
+            radius = if sigma > 0.0 {
+                (FIRST_RADIUS * length / sigma).max(norm_a)
+            } else {
+                f64::INFINITY
+            };
+        }
+        // Steps: the SQP step if inside the trust region, else the bounded Levenberg–Marquardt
+        // step on the pose error of that length; a rejected step shrinks the region.
         let mut accepted = None;
-        for _ in 0..=MAX_STEP_HALVINGS {
+        // Near the target: the SQP step with a backtracking line search on the merit function.
+        let near_phase = merit <= near;
+        let slope = {
+            let d = DVector::from_column_slice(&step);
+            let grad: f64 = (0..n)
+                .map(|i| bounds.weights[i] * (a[i] - bounds.centre[i]) * step[i])
+                .sum();
+            grad + nu * ((&e - &jac * d).norm() - merit)
+        };
+        let mut alpha = 1.0;
+        while radius > 1e-14 * (1.0 + norm_a) && alpha > 1e-10 {
+            let full = near_phase || scaled_norm(&step) <= radius;
+            if !full {
+                step = levenberg_marquardt_step(&jac, &e, &a, &bounds, radius);
+            }
+            let step_norm = scaled_norm(&step) * alpha;
+            if step_norm <= 1e-15 * (1.0 + norm_a) {
+                break;
+            }
             let mut trial: Vec<f64> = (0..n).map(|i| a[i] + alpha * step[i]).collect();
             clamp(&mut trial);
             evaluations += 1;
+            let predicted = {
+                let d = DVector::from_column_slice(&step);
+                merit - (&e - &jac * d).norm()
+            };
             if let Ok(t) = forward.evaluate(&trial, true) {
                 let (et, _, _, _) = error_rows(target, &t, rotation_weight);
                 let mt = et.norm();
-                if mt.is_finite() && (mt <= (1.0 - 1e-4 * alpha) * merit || mt <= near) {
+                let ok = if near_phase {
+                    // The change of the merit, summed without cancellation.
+                    let df: f64 = (0..n)
+                        .map(|i| {
+                            let d = trial[i] - a[i];
+                            bounds.weights[i] * d * (a[i] - bounds.centre[i] + 0.5 * d)
+                        })
+                        .sum();
+                    let dphi = df + nu * (mt - merit);
+                    let local = step_norm <= LOCAL_STEP * (1.0 + norm_a);
+                    (local && mt <= near) || dphi <= 1e-4 * alpha * slope.min(0.0)
+                } else {
+                    mt <= (1.0 - 1e-4) * merit || (full && mt <= near)
+                };
+                if mt.is_finite() && ok {
+                    if full {
+                        radius = radius.max(2.0 * step_norm);
+                    } else {
+                        let ratio = if predicted > 0.0 {
+                            (merit - mt) / predicted
+                        } else {
+                            1.0
+                        };
+                        if ratio > 0.75 {
+                            radius = 4.0 * radius.max(step_norm);
+                        } else if ratio < 0.25 {
+                            radius = 0.5 * step_norm;
+                        }
+                    }
+                    last_step = if near_phase { step_norm } else { 0.0 };
                     accepted = Some((trial, t));
                     break;
                 }
             }
-            alpha *= 0.5;
+            if near_phase {
+                alpha *= 0.5;
+            } else {
+                radius = 0.25 * step_norm.min(radius);
+            }
         }
         iterations += 1;
         match accepted {
             Some((trial, t)) => {
-                if let (Some(lambda), Some(jn)) =
-                    (&multipliers, error_rows(target, &t, rotation_weight).1)
-                {
-                    curved |=
+                // Near the target, the curvature met along the step refines the Hessian.
+                if near_phase && curved_for.is_some() {
+                    if let (Some(lambda), Some(jn)) =
+                        (&lambda_k, error_rows(target, &t, rotation_weight).1)
+                    {
                         bfgs_update(&mut hess, &bounds.weights, &a, &trial, &jac, &jn, lambda);
+                    }
                 }
                 a = trial;
                 ev = t;
             }
             None => {
-                // No decrease along the step: the closest pose (a local minimum of the error).
-                let out = InverseSolution {
-                    actuation: a,
-                    n_tendons: nt,
-                    position_error: dist,
-                    rotation_error: rot,
+                // No decrease in any direction: the closest pose (a local minimum of the error).
+                let converged = shape && !reached;
+                let out = finish(
+                    a,
+                    ev,
+                    dist,
+                    rot,
                     iterations,
                     evaluations,
-                    converged: shape && !reached,
+                    converged,
                     reached,
-                    evaluation: ev,
-                    hessian: hess,
-                };
+                    hess,
+                );
                 if options.throw && !out.converged {
                     return Err(Error::TargetUnreachable {
                         distance: dist,
@@ -675,6 +794,77 @@ pub fn solve_inverse<F: Forward + ?Sized>(
             }
         }
     }
+}
+
+/// The regularisation of the bounded least squares (a vanishing pull to the reference).
+fn ls_regularisation(jac: &DMatrix<f64>, bounds: &Bounds) -> f64 {
+    let scale = jac
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        .powi(2)
+        .max(1e-300);
+    let wmax = bounds.weights.iter().fold(0.0f64, |m, v| m.max(*v));
+    LEAST_SQUARES_REGULARISATION * scale / wmax
+}
+
+/// The spectral norm of `J W^{-1/2}` (the pose change per unit scaled actuation).
+fn scaled_jacobian_norm(jac: &DMatrix<f64>, weights: &[f64]) -> f64 {
+    let js = DMatrix::from_fn(jac.nrows(), jac.ncols(), |r, c| {
+        jac[(r, c)] / weights[c].sqrt()
+    });
+    let g = &js * js.transpose();
+    g.symmetric_eigenvalues()
+        .iter()
+        .fold(0.0f64, |m, v| m.max(*v))
+        .sqrt()
+}
+
+/// The bounded Levenberg–Marquardt step `d` of scaled length about `radius`:
+/// `min |J d - e|² + μ |d|²_W` with `lo <= a + d <= hi`, `μ` raised until `|d|_W <= radius`.
+fn levenberg_marquardt_step(
+    jac: &DMatrix<f64>,
+    e: &DVector<f64>,
+    a: &[f64],
+    bounds: &Bounds,
+    radius: f64,
+) -> Vec<f64> {
+    let n = a.len();
+    let av = DVector::from_column_slice(a);
+    let b = e + jac * &av;
+    let local = Bounds {
+        centre: a.to_vec(),
+        ..bounds.clone()
+    };
+    let norm = |d: &[f64]| -> f64 {
+        d.iter()
+            .zip(&bounds.weights)
+            .map(|(x, w)| x * x * w)
+            .sum::<f64>()
+            .sqrt()
+    };
+    let sigma = scaled_jacobian_norm(jac, &bounds.weights).max(1e-300);
+    // |d| ≈ |e| / μ-scaled: start from μ with |Jᵀe| / μ ≈ radius.
+    let mut mu = (sigma * e.norm() / radius).max(1e-6 * sigma * sigma);
+    let mut best = vec![0.0; n];
+    let mut fitted = false;
+    for _ in 0..60 {
+        let y = qp::bounded_least_squares(jac, &b, &local, mu);
+        let d: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
+        if norm(&d) <= radius * 1.000_001 {
+            best = d;
+            fitted = true;
+            // Lengthen it while it fits (a few times).
+            mu *= 0.25;
+            if mu < 1e-3 * sigma * sigma * 1e-6 {
+                break;
+            }
+        } else if fitted {
+            break;
+        } else {
+            mu *= 4.0;
+        }
+    }
+    best
 }
 
 /// Whether no external load acts (zero point loads only mark integration breaks).
@@ -951,4 +1141,164 @@ pub fn inverse_statics_path<F: Forward + ?Sized>(
         out.push(s);
     }
     Ok(out)
+}
+
+/// The free variables of `y`: strictly inside their bounds.
+fn free_set(y: &[f64], bounds: &Bounds) -> Vec<bool> {
+    y.iter()
+        .enumerate()
+        .map(|(i, &v)| v > bounds.lo[i] && v < bounds.hi[i])
+        .collect()
+}
+
+/// A solved quadratic program of one iteration.
+struct QpStep {
+    /// The new actuation.
+    y: DVector<f64>,
+    /// The multipliers of the linearised target (feasible programs).
+    lambda: Option<DVector<f64>>,
+    /// Whether the target could not be met inside the bounds (the bounded least squares).
+    least_squares: bool,
+}
+
+/// The program of one iteration at `a`: `min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ` (or `½ |y - c|²_W`
+/// when `H = W`, `curved == false`) s.t. `J y = b`, bounds; the bounded least squares if the
+/// target cannot be met (or for a shape target).
+#[allow(clippy::too_many_arguments)]
+fn solve_qp(
+    jac: &DMatrix<f64>,
+    b: &DVector<f64>,
+    a: &[f64],
+    bounds: &Bounds,
+    hess: &DMatrix<f64>,
+    curved: bool,
+    tol: f64,
+    shape: bool,
+) -> QpStep {
+    let n = a.len();
+    let feasible = if shape {
+        None
+    } else {
+        qp::min_norm(jac, b, bounds, tol)
+    };
+    match feasible {
+        Some((y_w, l_w)) if curved => {
+            let av = DVector::from_column_slice(a);
+            let wd = DVector::from_fn(n, |i, _| bounds.weights[i] * (a[i] - bounds.centre[i]));
+            let q = wd - hess * &av;
+            // The multipliers of the program with W (those of the target at a solution).
+            let r = qp::active_set_qp(hess, &q, jac, bounds, &y_w);
+            let y = r.map_or(y_w, |(y, _)| y);
+            QpStep {
+                y,
+                lambda: Some(l_w),
+                least_squares: false,
+            }
+        }
+        Some((y, l)) => QpStep {
+            y,
+            lambda: Some(l),
+            least_squares: false,
+        },
+        None => QpStep {
+            y: qp::bounded_least_squares(jac, b, bounds, ls_regularisation(jac, bounds)),
+            lambda: None,
+            least_squares: true,
+        },
+    }
+}
+
+/// Relative step of the directional differences of the Jacobian.
+const CURVATURE_STEP: f64 = 1e-6;
+
+/// The Hessian of the Lagrangian `½|a - c|²_W - λᵀ p(a)` on the null space `Z` of the free
+/// columns of `J`: `H z = W z - (J(a + ε z) - J(a))ᵀ λ / ε` for each column `z` (one
+/// evaluation each), as `W + Z (Zᵀ H Z - Zᵀ W Z) Zᵀ` (positive definite on `Z`). Returns the
+/// matrix (`None` if an evaluation fails) and the evaluations used.
+#[allow(clippy::too_many_arguments)]
+fn curvature<F: Forward + ?Sized>(
+    forward: &mut F,
+    target: &Target,
+    a: &[f64],
+    jac: &DMatrix<f64>,
+    lambda: &DVector<f64>,
+    free: &[bool],
+    bounds: &Bounds,
+    rotation_weight: f64,
+) -> (Option<DMatrix<f64>>, usize) {
+    let n = a.len();
+    let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+    let k = idx.len();
+    let m = jac.nrows();
+    let w = DMatrix::from_diagonal(&DVector::from_column_slice(&bounds.weights));
+    if k <= m {
+        return (None, 0);
+    }
+    // Null space of the free columns, in the scaled variables W^{1/2} a.
+    let jf = DMatrix::from_fn(m, k, |r, c| {
+        jac[(r, idx[c])] / bounds.weights[idx[c]].sqrt()
+    });
+    let g = jf.tr_mul(&jf);
+    let eig = g.symmetric_eigen();
+    let top = eig.eigenvalues.iter().fold(0.0f64, |x, v| x.max(v.abs()));
+    let cols: Vec<usize> = (0..k)
+        .filter(|&c| eig.eigenvalues[c].abs() <= 1e-10 * top)
+        .collect();
+    if cols.is_empty() {
+        return (None, 0);
+    }
+    let d = cols.len();
+    let mut z = DMatrix::zeros(n, d);
+    for (j, &c) in cols.iter().enumerate() {
+        for (r, &i) in idx.iter().enumerate() {
+            z[(i, j)] = eig.eigenvectors[(r, c)] / bounds.weights[i].sqrt();
+        }
+    }
+    let scale = 1.0
+        + a.iter()
+            .zip(&bounds.weights)
+            .map(|(x, w)| x * x * w)
+            .sum::<f64>()
+            .sqrt();
+    let mut hz = DMatrix::zeros(n, d);
+    let mut used = 0;
+    for j in 0..d {
+        let zj = z.column(j).into_owned();
+        // The scaled length of z_j is 1: a step of CURVATURE_STEP relative to the actuation,
+        // toward the inside of the bounds.
+        let mut eps = CURVATURE_STEP * scale;
+        let inside = |e: f64| {
+            (0..n).all(|i| {
+                let v = a[i] + e * zj[i];
+                v >= bounds.lo[i] && v <= bounds.hi[i]
+            })
+        };
+        if !inside(eps) {
+            eps = -eps;
+            if !inside(eps) {
+                return (None, used);
+            }
+        }
+        let trial: Vec<f64> = (0..n).map(|i| a[i] + eps * zj[i]).collect();
+        used += 1;
+        let Ok(ev) = forward.evaluate(&trial, true) else {
+            return (None, used);
+        };
+        let Some(j2) = error_rows(target, &ev, rotation_weight).1 else {
+            return (None, used);
+        };
+        let col = &w * &zj - (j2 - jac).tr_mul(lambda) / eps;
+        hz.set_column(j, &col);
+    }
+    let mut mz = z.tr_mul(&hz);
+    mz = (&mz + mz.transpose()) * 0.5;
+    // Positive definite on Z (a strict local minimum has it; clamp otherwise).
+    let e = mz.clone().symmetric_eigen();
+    let floor = 1e-3;
+    let vals = e.eigenvalues.map(|v| v.max(floor));
+    let mz = &e.eigenvectors * DMatrix::from_diagonal(&vals) * e.eigenvectors.transpose();
+    let zwz = z.tr_mul(&(&w * &z));
+    let h = &w + &z * (mz - zwz) * z.transpose();
+    let h = (&h + h.transpose()) * 0.5;
+    (Some(h), used)
 }

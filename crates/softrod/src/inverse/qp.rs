@@ -168,7 +168,37 @@ pub fn active_set_qp(
             p[i] = sol[r];
         }
         let scale = 1.0 + y.amax();
-        if p.amax() <= 1e-14 * scale {
+        let mut at_minimum = p.amax() <= 1e-14 * scale;
+        if !at_minimum {
+            let mut t = 1.0;
+            let mut blocking = None;
+            for &i in &free {
+                if p[i] < 0.0 && y[i] + p[i] < bx.lo[i] {
+                    let ti = (bx.lo[i] - y[i]) / p[i];
+                    if ti < t {
+                        t = ti;
+                        blocking = Some((i, bx.lo[i]));
+                    }
+                } else if p[i] > 0.0 && y[i] + p[i] > bx.hi[i] {
+                    let ti = (bx.hi[i] - y[i]) / p[i];
+                    if ti < t {
+                        t = ti;
+                        blocking = Some((i, bx.hi[i]));
+                    }
+                }
+            }
+            y += &p * t.max(0.0);
+            match blocking {
+                Some((i, v)) => {
+                    y[i] = v;
+                    fixed[i] = true;
+                }
+                // The full step: the minimiser on this face (its multipliers are `lambda`).
+                None => at_minimum = true,
+            }
+        }
+        if at_minimum {
+            let grad = h * &y + q;
             // Bound multipliers μ = H y + q - Aᵀ λ: >= 0 at a lower bound, <= 0 at an upper.
             let mu = &grad - a.tr_mul(&lambda);
             let gscale = 1e-12 * (1.0 + grad.amax());
@@ -185,29 +215,6 @@ pub fn active_set_qp(
                 Some((i, _)) => fixed[i] = false,
                 None => return Some((y, lambda)),
             }
-            continue;
-        }
-        let mut t = 1.0;
-        let mut blocking = None;
-        for &i in &free {
-            if p[i] < 0.0 && y[i] + p[i] < bx.lo[i] {
-                let ti = (bx.lo[i] - y[i]) / p[i];
-                if ti < t {
-                    t = ti;
-                    blocking = Some((i, bx.lo[i]));
-                }
-            } else if p[i] > 0.0 && y[i] + p[i] > bx.hi[i] {
-                let ti = (bx.hi[i] - y[i]) / p[i];
-                if ti < t {
-                    t = ti;
-                    blocking = Some((i, bx.hi[i]));
-                }
-            }
-        }
-        y += p * t.max(0.0);
-        if let Some((i, v)) = blocking {
-            y[i] = v;
-            fixed[i] = true;
         }
     }
     None

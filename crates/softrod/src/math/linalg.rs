@@ -89,25 +89,52 @@ impl Lu6 {
     }
 }
 
-/// LU factorisation with partial pivoting of an `n × n` matrix (column-major storage).
-#[derive(Debug, Clone, Default)]
+/// Largest dimension [`DenseLu`] factorises without heap storage (the shooting problems and
+/// PCC chains of up to four segments).
+const SMALL: usize = 12;
+
+/// LU factorisation with partial pivoting of an `n × n` matrix (column-major storage); up to
+/// `12 × 12` in place, without allocation.
+#[derive(Debug, Clone)]
 pub struct DenseLu {
     n: usize,
+    small: [f64; SMALL * SMALL],
+    small_perm: [usize; SMALL],
     lu: Vec<f64>,
     perm: Vec<usize>,
     scratch: Vec<f64>,
 }
 
+impl Default for DenseLu {
+    fn default() -> Self {
+        Self {
+            n: 0,
+            small: [0.0; SMALL * SMALL],
+            small_perm: [0; SMALL],
+            lu: Vec::new(),
+            perm: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+}
+
 impl DenseLu {
     /// Factorises the column-major `n × n` matrix `a` into `self` (reusing its storage);
     /// `false` if it is singular to working precision or not finite.
+    #[inline]
     pub fn factor(&mut self, n: usize, a: &[f64]) -> bool {
         self.n = n;
-        self.lu.clear();
-        self.lu.extend_from_slice(&a[..n * n]);
-        self.perm.clear();
-        self.perm.extend(0..n);
-        let lu = &mut self.lu;
+        let (lu, perm): (&mut [f64], &mut [usize]) = if n <= SMALL {
+            (&mut self.small[..n * n], &mut self.small_perm[..n])
+        } else {
+            self.lu.resize(n * n, 0.0);
+            self.perm.resize(n, 0);
+            (&mut self.lu, &mut self.perm)
+        };
+        lu.copy_from_slice(&a[..n * n]);
+        for (i, p) in perm.iter_mut().enumerate() {
+            *p = i;
+        }
         for k in 0..n {
             let (mut piv, mut best) = (k, lu[k + k * n].abs());
             for r in k + 1..n {
@@ -124,7 +151,7 @@ impl DenseLu {
                 for c in 0..n {
                     lu.swap(k + c * n, piv + c * n);
                 }
-                self.perm.swap(k, piv);
+                perm.swap(k, piv);
             }
             let inv = 1.0 / lu[k + k * n];
             for r in k + 1..n {
@@ -141,12 +168,23 @@ impl DenseLu {
     }
 
     /// Solves `A x = b` in place (`b` of length `n`); `false` if the result is not finite.
+    #[inline]
     pub fn solve_in_place(&mut self, b: &mut [f64]) -> bool {
         let n = self.n;
-        let lu = &self.lu;
-        let x = &mut self.scratch;
-        x.clear();
-        x.extend(self.perm.iter().map(|&p| b[p]));
+        let mut small_x = [0.0; SMALL];
+        let (lu, perm, x): (&[f64], &[usize], &mut [f64]) = if n <= SMALL {
+            (
+                &self.small[..n * n],
+                &self.small_perm[..n],
+                &mut small_x[..n],
+            )
+        } else {
+            self.scratch.resize(n, 0.0);
+            (&self.lu, &self.perm, &mut self.scratch)
+        };
+        for (xi, &p) in x.iter_mut().zip(perm) {
+            *xi = b[p];
+        }
         for i in 0..n {
             let mut v = x[i];
             for j in 0..i {

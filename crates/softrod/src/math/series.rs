@@ -6,12 +6,13 @@
 //! straight segment); above it the closed forms lose at most `~1e-14` relative. The PCC
 //! kinematics ([`crate::pcc`]) and the PCC statics use these functions and nothing else.
 
-/// `θ²` (rad²) below which the arc functions are summed as series (7 terms: error below
-/// `1e-25` for `θ² < 0.01`); above it the closed forms of the values lose at most `~1e-13`
-/// relative, those of the second derivatives `~1e-11`.
-pub const SERIES_BOUND: f64 = 0.01;
+/// `θ²` (rad²) below which the arc functions are summed as series (13 terms: error below
+/// `1e-20` for `θ² < 1`); above it the closed forms of the values lose at most `~1e-15`
+/// relative, those of the second derivatives `~1e-13`. The series is also the cheaper way
+/// below it (no sine and cosine, no division).
+pub const SERIES_BOUND: f64 = 1.0;
 /// Number of series terms.
-pub const SERIES_TERMS: usize = 7;
+pub const SERIES_TERMS: usize = 13;
 
 // ---------------------------------------------------------------------------------------------
 
@@ -77,6 +78,7 @@ fn series(c: &[f64; SERIES_TERMS], x: f64) -> (f64, f64, f64) {
 }
 
 /// `S`, `B`, `C` and their derivatives at `x = θ²`.
+#[inline]
 pub fn arc_fns(x: f64) -> ArcFns {
     if x < SERIES_BOUND {
         let (s, s1, s2) = series(&SERIES_S, x);
@@ -137,8 +139,8 @@ pub fn arc_s1(x: f64) -> f64 {
 }
 
 /// Terms of the `S` and `B` series of [`arc_sb`] and [`arc_s1`]: the first neglected one is
-/// below `3e-18` relative for `x < 0.01`.
-const POSE_TERMS: usize = 5;
+/// below `3e-19` relative for `x < 1`.
+const POSE_TERMS: usize = 10;
 
 /// `Σ_k c_k x^k` by Horner's rule.
 #[inline]

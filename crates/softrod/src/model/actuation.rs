@@ -252,31 +252,15 @@ impl Actuation {
     /// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]`, `displacements[i]`,
     /// `tendon_stiffness[i]`, `reference_lengths[i]`, `pressures.len()` or `pressures[i]`.
     pub fn validate(&self, n_tendons: usize, n_chambers: usize) -> Result<()> {
-        if !(self.tendons.is_empty() || self.tendons.len() == n_tendons) {
-            return Err(Error::invalid(
-                "tensions.len()",
-                self.tendons.len(),
-                format!("the number of tendons, {n_tendons} (or 0 for none)"),
-            ));
-        }
-        if !(self.pressures.is_empty() || self.pressures.len() == n_chambers) {
-            return Err(Error::invalid(
-                "pressures.len()",
-                self.pressures.len(),
-                format!("the number of chambers, {n_chambers} (or 0 for none)"),
-            ));
-        }
+        check_counts(
+            self.tendons.len(),
+            self.pressures.len(),
+            n_tendons,
+            n_chambers,
+        )?;
         for (i, t) in self.tendons.iter().enumerate() {
             match t {
-                TendonInput::Tension(v) => {
-                    if !(v.is_finite() && *v >= 0.0) {
-                        return Err(Error::invalid(
-                            format!("tensions[{i}]"),
-                            v,
-                            "finite and >= 0 N",
-                        ));
-                    }
-                }
+                TendonInput::Tension(v) => check_tension(i, *v)?,
                 TendonInput::Displacement {
                     displacement,
                     stiffness,
@@ -326,8 +310,68 @@ impl Actuation {
             }
         }
         for (i, &p) in self.pressures.iter().enumerate() {
-            check_pressure(&format!("pressures[{i}]"), p)?;
+            check_pressure(format_args!("pressures[{i}]"), p)?;
         }
         Ok(())
+    }
+}
+
+/// [`Actuation::validate`] of tensions and pressures given as plain values (the PCC statics'
+/// inputs), without building an [`Actuation`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `tensions.len()`, `tensions[i]`, `pressures.len()` or
+/// `pressures[i]`.
+pub(crate) fn validate_values(
+    tensions: &[f64],
+    pressures: &[f64],
+    n_tendons: usize,
+    n_chambers: usize,
+) -> Result<()> {
+    check_counts(tensions.len(), pressures.len(), n_tendons, n_chambers)?;
+    for (i, &v) in tensions.iter().enumerate() {
+        check_tension(i, v)?;
+    }
+    for (i, &p) in pressures.iter().enumerate() {
+        check_pressure(format_args!("pressures[{i}]"), p)?;
+    }
+    Ok(())
+}
+
+/// One input per actuator, or none at all.
+fn check_counts(
+    tendons: usize,
+    pressures: usize,
+    n_tendons: usize,
+    n_chambers: usize,
+) -> Result<()> {
+    if !(tendons == 0 || tendons == n_tendons) {
+        return Err(Error::invalid(
+            "tensions.len()",
+            tendons,
+            format!("the number of tendons, {n_tendons} (or 0 for none)"),
+        ));
+    }
+    if !(pressures == 0 || pressures == n_chambers) {
+        return Err(Error::invalid(
+            "pressures.len()",
+            pressures,
+            format!("the number of chambers, {n_chambers} (or 0 for none)"),
+        ));
+    }
+    Ok(())
+}
+
+/// A tension finite and >= 0 N.
+#[inline]
+fn check_tension(i: usize, v: f64) -> Result<()> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            format!("tensions[{i}]"),
+            v,
+            "finite and >= 0 N",
+        ))
     }
 }

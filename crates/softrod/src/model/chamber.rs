@@ -80,11 +80,13 @@ pub struct Chamber {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `name`.
-pub fn check_pressure(name: &str, pressure: f64) -> Result<f64> {
-    check_finite(name, pressure)?;
+pub fn check_pressure(name: impl std::fmt::Display, pressure: f64) -> Result<f64> {
+    if !pressure.is_finite() {
+        check_finite(&name.to_string(), pressure)?;
+    }
     if pressure < -ATMOSPHERIC_PRESSURE {
         return Err(Error::invalid(
-            name,
+            name.to_string(),
             pressure,
             format!(">= -{ATMOSPHERIC_PRESSURE} Pa (gauge; below is more than vacuum)"),
         ));

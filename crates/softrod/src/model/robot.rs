@@ -228,7 +228,7 @@ impl RobotModel {
             match input {
                 TendonInput::Tension(t) => {
                     let scale = self.force_scale / (1.0 + self.tendon_reach[i] / l);
-                    check_load(&format!("tensions[{i}]"), *t, t.abs(), scale, "N")?;
+                    check_load(format_args!("tensions[{i}]"), *t, t.abs(), scale, "N")?;
                 }
                 TendonInput::Displacement { .. } => {}
             }
@@ -237,7 +237,7 @@ impl RobotModel {
             let [x, y] = self.chambers[i].offset();
             let arm = 1.0 + x.hypot(y) / l;
             let scale = self.force_scale / (self.chamber_area_max[i] * arm);
-            check_load(&format!("pressures[{i}]"), p, p.abs(), scale, "Pa")?;
+            check_load(format_args!("pressures[{i}]"), p, p.abs(), scale, "Pa")?;
         }
         Ok(())
     }
@@ -255,7 +255,7 @@ impl RobotModel {
             } else {
                 (self.force_scale * self.length(), "N m")
             };
-            check_load(&format!("{name}[{k}]"), w, w.abs(), scale, unit)?;
+            check_load(format_args!("{name}[{k}]"), w, w.abs(), scale, unit)?;
         }
         Ok(())
     }
@@ -335,8 +335,14 @@ fn check_load_limits(loads: &Loads, rod: &Rod, force_scale: f64) -> Result<()> {
     )?;
     for (i, p) in loads.point_loads.iter().enumerate() {
         let (f, m) = (norm(&p.force), norm(&p.moment));
-        check_load(&format!("loads.point_loads[{i}].force"), f, f, f0, "N")?;
-        check_load(&format!("loads.point_loads[{i}].moment"), m, m, m0, "N m")?;
+        check_load(format_args!("loads.point_loads[{i}].force"), f, f, f0, "N")?;
+        check_load(
+            format_args!("loads.point_loads[{i}].moment"),
+            m,
+            m,
+            m0,
+            "N m",
+        )?;
     }
     for (name, profile, scale, unit) in [
         (
@@ -354,7 +360,7 @@ fn check_load_limits(loads: &Loads, rod: &Rod, force_scale: f64) -> Result<()> {
     ] {
         if let Some(p) = profile {
             for (at, v) in p.check_points(l) {
-                check_load(&format!("{name}{at}"), v.norm(), v.norm(), scale, unit)?;
+                check_load(format_args!("{name}{at}"), v.norm(), v.norm(), scale, unit)?;
             }
         }
     }

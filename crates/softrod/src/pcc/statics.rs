@@ -352,6 +352,7 @@ struct SegKin {
     dw: [[Vector3<f64>; 2]; 2],
 }
 
+#[inline]
 fn seg_kin(a: f64, b: f64, l: f64) -> SegKin {
     let x = a * a + b * b;
     let f = arc_fns(x);
@@ -458,14 +459,14 @@ fn check_load_limits(robot: &PccRobot, loads: &PccLoads) -> Result<()> {
     let f0 = ei / (l * l);
     for (i, (t, &tau)) in robot.tendons.iter().zip(&loads.tensions).enumerate() {
         let scale = f0 / (1.0 + t.distance / l);
-        check_load(&format!("tensions[{i}]"), tau, tau.abs(), scale, "N")?;
+        check_load(format_args!("tensions[{i}]"), tau, tau.abs(), scale, "N")?;
     }
     let mut k = 0;
     for (_, ch) in &robot.chambers {
         for i in 0..ch.len() {
             if let Some(&p) = loads.pressures.get(k) {
                 let scale = f0 / (ch.areas()[i] * (1.0 + ch.distances()[i] / l));
-                check_load(&format!("pressures[{k}]"), p, p.abs(), scale, "Pa")?;
+                check_load(format_args!("pressures[{k}]"), p, p.abs(), scale, "Pa")?;
             }
             k += 1;
         }
@@ -478,9 +479,7 @@ fn check_load_limits(robot: &PccRobot, loads: &PccLoads) -> Result<()> {
 fn prepare(robot: &PccRobot, loads: &PccLoads) -> Result<Prepared> {
     let (nt, nc) = (robot.n_tendons(), robot.n_chambers());
     // The same inputs as the Cosserat statics, checked the same way.
-    crate::model::Actuation::tensions(&loads.tensions)
-        .with_pressures(&loads.pressures)
-        .validate(nt, nc)?;
+    crate::model::actuation::validate_values(&loads.tensions, &loads.pressures, nt, nc)?;
     check_vector("tip_force", &loads.tip_force)?;
     check_vector("tip_moment", &loads.tip_moment)?;
     check_load_limits(robot, loads)?;
@@ -949,11 +948,12 @@ pub fn solve_pcc_statics(
             .collect(),
         None => q_act.clone(),
     };
+    let x0 = flat(&q0);
     let mut p = Equilibrium {
         robot,
         prep: &prep,
         work: Work::new(n),
-        q: q0.clone(),
+        q: q0,
         scaled: f64::INFINITY,
         evaluations: 0,
     };
@@ -976,7 +976,7 @@ pub fn solve_pcc_statics(
         jacobian: None,
         exact_at_solution: false,
     };
-    let mut result = newton(&mut p, &flat(&q0), 1.0, opts, &settings);
+    let mut result = newton(&mut p, &x0, 1.0, opts, &settings);
     stats.iterations = result.iterations;
     if !result.converged && opts.continuation {
         let x_act = flat(&q_act);

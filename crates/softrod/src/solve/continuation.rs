@@ -160,5 +160,9 @@ pub fn continuation<P: Problem + ?Sized>(
         }
     }
     out.load_factor = lambda;
+    if out.stopped != Stopped::Converged {
+        // The last accepted step converged at a load factor below 1: not the full load.
+        out.outcome.converged = false;
+    }
     out
 }

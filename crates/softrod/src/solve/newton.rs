@@ -193,6 +193,24 @@ fn start<P: Problem + ?Sized>(
     Some(it)
 }
 
+/// The residual norm at the trial point `x + dx` (into `it.xt`, `it.rt`), from the residual
+/// alone; infinite if the evaluation fails.
+fn trial_residual<P: Problem + ?Sized>(
+    problem: &mut P,
+    it: &mut Iterate,
+    dx: &[f64],
+    lambda: f64,
+) -> f64 {
+    for k in 0..dx.len() {
+        it.xt[k] = it.x[k] + dx[k];
+    }
+    if problem.evaluate(&it.xt, lambda, None, &mut it.rt) == Evaluated::Failed {
+        f64::INFINITY
+    } else {
+        problem.norm(&it.rt)
+    }
+}
+
 /// What a Broyden step did.
 enum Broyden {
     /// Accepted; `true` when the residual fell slowly (evaluate the Jacobian next).
@@ -212,15 +230,7 @@ fn broyden_step<P: Problem + ?Sized>(
     tol: f64,
 ) -> Broyden {
     let n = dx.len();
-    for k in 0..n {
-        it.xt[k] = it.x[k] + dx[k];
-    }
-    let ev = problem.evaluate(&it.xt, lambda, None, &mut it.rt);
-    let rtn = if ev == Evaluated::Failed {
-        f64::INFINITY
-    } else {
-        problem.norm(&it.rt)
-    };
+    let rtn = trial_residual(problem, it, dx, lambda);
     if !(rtn <= tol || settings.condition.accept(1.0, it.rn, rtn)) {
         return Broyden::Refused;
     }
@@ -290,13 +300,7 @@ fn last_step<P: Problem + ?Sized>(
     lambda: f64,
     options: &NewtonOptions,
 ) -> bool {
-    for k in 0..dx.len() {
-        it.xt[k] = it.x[k] + dx[k];
-    }
-    if problem.evaluate(&it.xt, lambda, None, &mut it.rt) == Evaluated::Failed {
-        return false;
-    }
-    let rtn = problem.norm(&it.rt);
+    let rtn = trial_residual(problem, it, dx, lambda);
     if rtn <= problem.tolerance(&it.xt, options.tolerance) {
         it.x.copy_from_slice(&it.xt);
         it.rn = rtn;

@@ -1,0 +1,58 @@
+//! The named cause of an actuated rod that cannot be integrated: tendons that compress an
+//! extensible rod to zero length.
+//!
+//! Without external loads the rod carries the tendons' pull as compression: at a section
+//! reached by the tendons `i` the axial force is about `Σ τ_i` (exactly for tendons parallel to
+//! the backbone). A linear elastic rod's stretch there is `1 - Σ τ_i / (E A(s))`, zero or
+//! negative once the tensions reach the axial stiffness `E A(s)`: no configuration exists, and
+//! the solve says which tension and which stiffness instead of a bare non-convergence.
+
+use crate::error::Error;
+use crate::model::RobotModel;
+
+/// Sections checked along the rod (uniformly, plus the tendon ends).
+const SAMPLES: usize = 64;
+
+/// An [`Error::InvalidParameter`] naming the largest tendon tension if the tensions reach the
+/// axial stiffness `E A(s)` of an extensible, linear elastic rod at some section (the rod would
+/// be compressed to zero length); `None` otherwise.
+pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option<Error> {
+    let rod = model.rod();
+    if rod.inextensible() || !rod.material().is_linear() {
+        return None;
+    }
+    let length = rod.length();
+    let tendons = model.tendons();
+    let mut points: Vec<f64> = (0..=SAMPLES)
+        .map(|k| length * k as f64 / SAMPLES as f64)
+        .collect();
+    points.extend(tendons.iter().filter_map(|t| t.end()));
+    for s in points {
+        let reach: f64 = tendons
+            .iter()
+            .zip(tensions)
+            .filter(|(t, _)| t.end().is_none_or(|e| s <= e))
+            .map(|(_, &tau)| tau.max(0.0))
+            .sum();
+        let c = rod
+            .material()
+            .compliance(&rod.section_at(s), rod.shear_coefficient(), false);
+        let ea = 1.0 / c[2];
+        if reach > 0.0 && reach >= ea {
+            let (i, tau) = tensions
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.total_cmp(b.1))?;
+            return Some(Error::invalid(
+                format!("tensions[{i}]"),
+                tau,
+                format!(
+                    "tensions summing to less than the rod's axial stiffness E A = {ea:.4e} N at \
+                     s = {s:.4} m (they total {reach:.4e} N there: the rod would be compressed \
+                     to zero length; raise youngs_modulus or lower the tensions)"
+                ),
+            ));
+        }
+    }
+    None
+}
