@@ -263,11 +263,17 @@ fn global_balance_with_friction() {
     assert!(sol.tension[n][4] < 2.0 * 0.99);
 }
 
-/// A load/unload cycle of tendon 0 between `lo` and `hi` N (tendon 4 at 1 N), `k` steps each
-/// way: tip x and the tendon-0 path length at every step.
-fn cycle(mu: f64, cycles: usize) -> (Vec<f64>, Vec<[f64; 3]>, Vec<f64>) {
+/// `cycles` load/unload cycles of tendon 0 between 0.5 and 4 N (tendon 4 at 1 N) on the NiTi
+/// robot with friction `mu`, `k` steps each way and `steps` RK4 steps: the tensions of
+/// tendon 0 and the solutions.
+fn cycles_of(
+    mu: f64,
+    cycles: usize,
+    k: usize,
+    steps: usize,
+) -> (Vec<f64>, Vec<FrictionalSolution>) {
     let model = niti(mu, Vector3::zeros());
-    let (lo, hi, k) = (0.5, 4.0, 14);
+    let (lo, hi) = (0.5, 4.0);
     let mut taus = vec![lo];
     for _ in 0..cycles {
         taus.extend((1..=k).map(|j| lo + (hi - lo) * j as f64 / k as f64));
@@ -277,7 +283,14 @@ fn cycle(mu: f64, cycles: usize) -> (Vec<f64>, Vec<[f64; 3]>, Vec<f64>) {
         .iter()
         .map(|&t| Actuation::tensions(&[t, 0.0, 0.0, 0.0, 1.0, 0.0]))
         .collect();
-    let sols = solve_path(&model, &path, &options(50)).unwrap();
+    let sols = solve_path(&model, &path, &options(steps)).unwrap();
+    (taus, sols)
+}
+
+/// A load/unload cycle of tendon 0 between `lo` and `hi` N (tendon 4 at 1 N), `k` steps each
+/// way: tip x and the tendon-0 path length at every step.
+fn cycle(mu: f64, cycles: usize) -> (Vec<f64>, Vec<[f64; 3]>, Vec<f64>) {
+    let (taus, sols) = cycles_of(mu, cycles, 14, 50);
     let tips = sols.iter().map(FrictionalSolution::tip_position).collect();
     let lengths = sols.iter().map(|s| s.statics.tendon_lengths[0]).collect();
     (taus, tips, lengths)
@@ -427,18 +440,7 @@ fn one_march_equals_the_fixed_point() {
 /// load/unload cycle of tendon 0 (0.5 → 4 → 0.5 N, tendon 4 at 1 N) in `k` steps each way,
 /// with `steps` RK4 steps along the rod; time quadrature by trapezoids.
 fn cycle_energy(mu: f64, steps: usize, k: usize) -> (f64, f64) {
-    let model = niti(mu, Vector3::zeros());
-    let (lo, hi) = (0.5, 4.0);
-    let mut taus = vec![lo];
-    for _ in 0..2 {
-        taus.extend((1..=k).map(|j| lo + (hi - lo) * j as f64 / k as f64));
-        taus.extend((0..k).rev().map(|j| lo + (hi - lo) * j as f64 / k as f64));
-    }
-    let path: Vec<Actuation> = taus
-        .iter()
-        .map(|&t| Actuation::tensions(&[t, 0.0, 0.0, 0.0, 1.0, 0.0]))
-        .collect();
-    let sols = solve_path(&model, &path, &options(steps)).unwrap();
+    let (_, sols) = cycles_of(mu, 2, k, steps);
     let (mut work, mut friction) = (0.0, 0.0);
     for w in sols[2 * k..].windows(2) {
         let (a, b) = (&w[0], &w[1]);

@@ -227,6 +227,17 @@ fn node_tangents(
         .collect()
 }
 
+/// The tangents per node and tendon as arrays (zero where the tendon is not there).
+fn tangent_rows(dirs: &[Vec<Option<Vector3<f64>>>]) -> Vec<Vec<[f64; 3]>> {
+    dirs.iter()
+        .map(|row| {
+            row.iter()
+                .map(|t| t.map_or([0.0; 3], |t| [t.x, t.y, t.z]))
+                .collect()
+        })
+        .collect()
+}
+
 /// The angle (rad) between two unit vectors.
 fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
@@ -448,14 +459,7 @@ pub fn solve_frictional(
         }
         if delta <= options.tolerance {
             let forces = friction_forces(&sol.s, &next, &dirs);
-            let tangent = dirs
-                .iter()
-                .map(|row| {
-                    row.iter()
-                        .map(|t| t.map_or([0.0; 3], |t| [t.x, t.y, t.z]))
-                        .collect()
-                })
-                .collect();
+            let tangent = tangent_rows(&dirs);
             let path_length = node_path_lengths(model, &act, &statics_options, &mesh, &sol)?;
             return Ok(FrictionalSolution {
                 path_length,
@@ -985,14 +989,7 @@ fn solve_unloaded(
     sol.options = options.statics;
     sol.s_out = mesh.to_vec();
     sol.stable = true;
-    let tangent = dirs
-        .iter()
-        .map(|row| {
-            row.iter()
-                .map(|t| t.map_or([0.0; 3], |t| [t.x, t.y, t.z]))
-                .collect()
-        })
-        .collect();
+    let tangent = tangent_rows(&dirs);
     let forces = friction_forces(mesh, &tau, &dirs);
     Ok(FrictionalSolution {
         statics: sol,

@@ -936,7 +936,6 @@ pub fn solve_pcc_statics(
 ) -> Result<PccStaticsSolution> {
     check_options(robot, options)?;
     let prep = prepare(robot, loads)?;
-    let n = robot.bodies.len();
     let q_act = actuated(robot, &prep, loads)?;
     let q0 = match &options.warm_start {
         Some(ws) => ws
@@ -952,7 +951,7 @@ pub fn solve_pcc_statics(
     let mut p = Equilibrium {
         robot,
         prep: &prep,
-        work: Work::new(n),
+        work: Work::new(robot.bodies.len()),
         q: q0,
         scaled: f64::INFINITY,
         evaluations: 0,
