@@ -17,8 +17,6 @@ pytest.importorskip("viser")
 from softrod.plot.live import serve
 
 NITI = Path(__file__).resolve().parent.parent / "examples" / "robots" / "niti_two_segment.toml"
-#: Budget from the end of a solve to the scene update sent to the browser (s).
-RENDER_BUDGET = 0.1
 
 
 @pytest.fixture
@@ -124,7 +122,6 @@ def test_slider_move_in_a_real_browser(view, tmp_path):
         assert np.abs(view.last_vertices - v0).max() > 0.01  # the tube moved (m)
         timing = view.timings[-1]
         assert timing.converged
-        assert timing.render < RENDER_BUDGET
         time.sleep(1.0)
         after_png = driver.get_screenshot_as_png()
         from io import BytesIO
