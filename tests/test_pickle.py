@@ -143,3 +143,22 @@ def test_pcc_and_planar_types_pickle():
     batch = arm.solve_many([0.5, 1.0], n_points=11)
     np.testing.assert_array_equal(round_trip(batch).y, batch.y)
     assert round_trip(arm).length == arm.length
+
+
+def test_inverse_solutions_pickle_and_warm_start_identically():
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    target = robot.with_tensions([1.0, 0, 0, 0, 0.5, 0]).solve().tip_position
+    inv = softrod.inverse_statics(robot, target)
+    back = pickle.loads(pickle.dumps(inv))
+    assert np.array_equal(back.tensions, inv.tensions)
+    assert np.array_equal(back.solution.position, inv.solution.position)
+    assert (back.converged, back.iterations) == (inv.converged, inv.iterations)
+    moved = target + np.array([0.001, 0.0, 0.0])
+    # Unpickled, it warm-starts from its actuation: the same answer as from the tensions.
+    a = softrod.inverse_statics(robot, moved, warm_start=back)
+    b = softrod.inverse_statics(robot, moved, warm_start=inv.actuation)
+    assert a.converged and np.array_equal(a.tensions, b.tensions)
+    assert a.position_error < 1e-9
+    path = softrod.inverse_statics_path(robot, [target, moved])
+    again = pickle.loads(pickle.dumps(path))
+    assert np.array_equal(again.tensions, path.tensions)

@@ -51,6 +51,18 @@ class InverseSolution:
         """Tensions then pressures (N, Pa), the form ``warm_start`` takes."""
         return np.concatenate([self.tensions, self.pressures])
 
+    def __getstate__(self) -> dict[str, Any]:
+        # The reusable solver state lives in the extension and is not pickled: an unpickled
+        # solution warm-starts from its actuation, as any other previous answer does.
+        state = dict(self.__dict__)
+        state["_warm_state"] = None
+        state["_model_key"] = None
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        for k, v in state.items():
+            object.__setattr__(self, k, v)
+
 
 def _warm_arguments(warm_start: Any, key: tuple) -> tuple[Any, dict[str, Any]]:
     """The actuation of a warm start and, for a previous :class:`InverseSolution`, its state
