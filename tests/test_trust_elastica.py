@@ -12,15 +12,6 @@ from harness import elastica
 
 import softrod
 
-NEAR_AXIAL = pytest.mark.xfail(
-    strict=True,
-    reason="1 of 2,100 RK4 answers: direction 2 at PL^2/EI = 178 lands 1.1e-6 L from the "
-    "oracle (bound 1e-6) and the classifier's refined re-solve (320 steps, warm-started Newton "
-    "without continuation) stalls at residual 3e-10, above the 1e-10 tolerance, so the answer "
-    "cannot be confirmed on the branch (the states at load factor < 1 once returned as converged "
-    "now raise ConvergenceError)",
-)
-
 
 @pytest.fixture(scope="module")
 def sweep():
@@ -30,7 +21,7 @@ def sweep():
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "integrator",
-    [pytest.param("rk4", marks=NEAR_AXIAL), "adaptive"],
+    ["rk4", "adaptive"],
 )
 def test_no_silent_wrong_branch(sweep, integrator):
     c = sweep.counts(integrator)
