@@ -1423,12 +1423,19 @@ def nonfinite_paths(obj, path: str = "", depth: int = 0, seen=None) -> set[str]:
 
 def documented_nonfinite(result, kwargs: dict) -> set[str]:
     """Non-finite fields the docs promise: stiffness at the clamp (the compliance is zero
-    there), and the measures of failed workspace-map samples (``converged`` False) or of the
-    tangent compliance when it was not requested."""
+    there; only at the nodes with ``s = 0``), and the measures of failed workspace-map samples
+    (``converged`` False) or of the tangent compliance when it was not requested."""
     name = type(result).__name__
     out: set[str] = set()
     if name == "TangentCompliance" and float(result.s) == 0.0:
         out |= {".condition", ".stiffness_body", ".stiffness_world"}
+    if name == "Compliance":
+        at_clamp = np.asarray(result.s) == 0.0
+        if all(
+            np.all(np.isfinite(np.asarray(getattr(result, f))[~at_clamp]))
+            for f in ("condition", "stiffness_body", "stiffness_world")
+        ):
+            out |= {".condition", ".stiffness_body", ".stiffness_world"}
     if name == "WorkspaceMap":
         failed = ~np.asarray(result.converged, dtype=bool)
         for f in fields(result):
