@@ -6,30 +6,9 @@
 mod common;
 
 use softrod::nalgebra::Vector3;
-use softrod::{
-    solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, Obstacle,
-    RobotModel, Rod, Section, SolveOptions,
-};
+use softrod::{solve_constrained, Actuation, ContactSolution, Loads, Obstacle, RobotModel};
 
-const E: f64 = 2e9;
-const NU: f64 = 0.3;
-const L: f64 = 1.0;
-
-fn rod(radius: f64) -> Rod {
-    Rod::new(
-        L,
-        Section::circular(radius).unwrap(),
-        LinearElastic::new(E, NU).unwrap(),
-    )
-    .unwrap()
-}
-
-fn options(steps: usize) -> SolveOptions {
-    SolveOptions {
-        integrator: Integrator::Rk4 { steps },
-        ..SolveOptions::default()
-    }
-}
+use common::{beam as rod, rk4_options as options, BEAM_E as E, BEAM_LENGTH as L, BEAM_NU as NU};
 
 /// The checks of every contact solution: no penetration beyond 1e-9 m at any node,
 /// non-negative normal forces along the obstacle normal, and the base wrench equal to the

@@ -9,29 +9,11 @@ use std::sync::Arc;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::{
-    solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, PointLoad,
-    Pose, RobotModel, Rod, Section, SolveOptions, TipConstraint,
+    solve_constrained, Actuation, ContactSolution, Loads, PointLoad, Pose, RobotModel,
+    TipConstraint,
 };
 
-const E: f64 = 2e9;
-const NU: f64 = 0.3;
-const L: f64 = 1.0;
-
-fn rod(radius: f64) -> Rod {
-    Rod::new(
-        L,
-        Section::circular(radius).unwrap(),
-        LinearElastic::new(E, NU).unwrap(),
-    )
-    .unwrap()
-}
-
-fn options(steps: usize) -> SolveOptions {
-    SolveOptions {
-        integrator: Integrator::Rk4 { steps },
-        ..SolveOptions::default()
-    }
-}
+use common::{beam as rod, rk4_options as options, BEAM_E as E, BEAM_LENGTH as L, BEAM_NU as NU};
 
 fn straight_tip() -> Pose {
     Pose::new(Vector3::new(0.0, 0.0, L), Matrix3::identity()).unwrap()

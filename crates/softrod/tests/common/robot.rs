@@ -6,8 +6,8 @@
 use std::sync::Arc;
 
 use softrod::{
-    solve_statics, Actuation, Chamber, ChamberArea, LinearElastic, Loads, Result, RobotModel, Rod,
-    Routing, Section, SolveOptions, StaticsSolution, Tendon,
+    solve_statics, Actuation, Chamber, ChamberArea, Integrator, LinearElastic, Loads, Result,
+    RobotModel, Rod, Routing, Section, SolveOptions, StaticsSolution, Tendon,
 };
 
 /// A tendon and the tension it is pulled with (N).
@@ -132,4 +132,28 @@ pub fn niti_tendons(tensions: &[f64; 6]) -> Vec<Tensioned> {
             .expect("tendon")
         })
         .collect()
+}
+
+/// The beam of the contact and end-constraint tests: length 1 m (m), E = 2 GPa (Pa),
+/// ν = 0.3.
+pub const BEAM_LENGTH: f64 = 1.0;
+pub const BEAM_E: f64 = 2e9;
+pub const BEAM_NU: f64 = 0.3;
+
+/// That beam with a solid circular section of `radius` (m).
+pub fn beam(radius: f64) -> Rod {
+    Rod::new(
+        BEAM_LENGTH,
+        Section::circular(radius).expect("radius"),
+        LinearElastic::new(BEAM_E, BEAM_NU).expect("material"),
+    )
+    .expect("rod")
+}
+
+/// Default solver options with RK4 on `steps` fixed steps.
+pub fn rk4_options(steps: usize) -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        ..SolveOptions::default()
+    }
 }
