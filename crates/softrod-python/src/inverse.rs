@@ -7,7 +7,7 @@ use pyo3::types::PyDict;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::pcc::statics::{PccLoads, PccSolveOptions};
-use softrod::{InverseOptions, InverseWarmStart, PccForward, Target};
+use softrod::{InverseOptions, InverseWarmStart, Target};
 
 use crate::callbacks::run;
 use crate::convert::{arg, floats_opt, vec3, Matrix};
@@ -281,8 +281,14 @@ pub(crate) fn _pcc_inverse_statics<'py>(
     let warm = merge_warm(warm, warm_state.as_ref(), same_model);
     let model = &robot.inner;
     let inv = run(py, "pcc.inverse_statics", || {
-        let mut fwd = PccForward::new(model, &loads, &PccSolveOptions::default());
-        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_ref())
+        softrod::pcc_inverse_statics(
+            model,
+            &loads,
+            &target,
+            &o,
+            &PccSolveOptions::default(),
+            warm.as_ref(),
+        )
     })?;
     result_dict(py, &inv)
 }

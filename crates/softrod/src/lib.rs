@@ -64,7 +64,7 @@ pub use cosserat::statics::{
 };
 pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
-pub use inverse::pcc::PccForward;
+pub use inverse::pcc::{pcc_inverse_statics, PccForward};
 pub use inverse::{
     inverse_statics, inverse_statics_path, solve_inverse, CosseratForward, Evaluation, Forward,
     InverseOptions, InverseSolution, InverseWarmStart, Target,

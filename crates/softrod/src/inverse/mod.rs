@@ -299,7 +299,7 @@ fn bfgs_update(
     true
 }
 
-fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f64) -> Result<()> {
+pub(crate) fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f64) -> Result<()> {
     let n = nt + nc;
     let (tl, th) = o.tension_bounds;
     if !(tl.is_finite() && tl >= 0.0 && !th.is_nan() && th >= tl) {
@@ -366,7 +366,7 @@ fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f64) -> Resul
     Ok(())
 }
 
-fn check_target(target: &Target) -> Result<()> {
+pub(crate) fn check_target(target: &Target) -> Result<()> {
     if target.points.is_empty() {
         return Err(Error::invalid("target_points", "[]", "at least one point"));
     }

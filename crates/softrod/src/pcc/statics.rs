@@ -339,21 +339,22 @@ pub struct PccEquilibrium {
 
 /// One segment's tip pose (segment base frame) and its derivatives in `(θ_x, θ_y, ℓ)`.
 #[derive(Debug, Clone, Copy)]
-struct SegKin {
-    r: Matrix3<f64>,
-    p: Vector3<f64>,
+pub(crate) struct SegKin {
+    pub(crate) r: Matrix3<f64>,
+    pub(crate) p: Vector3<f64>,
     /// `∂p/∂(θ_x, θ_y, ℓ)`.
-    dp: [Vector3<f64>; 3],
+    pub(crate) dp: [Vector3<f64>; 3],
     /// Spatial angular velocity per unit `θ_x`, `θ_y` (zero for `ℓ`).
-    w: [Vector3<f64>; 2],
+    pub(crate) w: [Vector3<f64>; 2],
     /// `∂²p/∂q_k∂q_m`.
-    ddp: [[Vector3<f64>; 3]; 3],
+    pub(crate) ddp: [[Vector3<f64>; 3]; 3],
     /// `∂w_k/∂θ_m`.
-    dw: [[Vector3<f64>; 2]; 2],
+    pub(crate) dw: [[Vector3<f64>; 2]; 2],
 }
 
+/// One segment's kinematics at `(θ_x, θ_y, ℓ) = (a, b, l)`.
 #[inline]
-fn seg_kin(a: f64, b: f64, l: f64) -> SegKin {
+pub(crate) fn seg_kin(a: f64, b: f64, l: f64) -> SegKin {
     let x = a * a + b * b;
     let f = arc_fns(x);
     let (ab, a2, b2) = (a * b, a * a, b * b);
@@ -818,8 +819,8 @@ struct Equilibrium<'a> {
     robot: &'a PccRobot,
     prep: &'a Prepared,
     work: Work,
-    /// Number of segments.
-    n: usize,
+    /// The unknowns of the last evaluation, per segment.
+    q: Vec<[f64; 3]>,
     /// Scaled residual of the last evaluation.
     scaled: f64,
     evaluations: usize,
@@ -827,7 +828,7 @@ struct Equilibrium<'a> {
 
 impl Problem for Equilibrium<'_> {
     fn dim(&self) -> usize {
-        3 * self.n
+        3 * self.q.len()
     }
 
     fn evaluate(
@@ -837,13 +838,15 @@ impl Problem for Equilibrium<'_> {
         jacobian: Option<&mut [f64]>,
         r: &mut [f64],
     ) -> Evaluated {
-        let (q, _) = x.as_chunks::<3>();
-        if q.iter().any(|qi| qi[2].is_nan() || qi[2] <= 0.0) {
-            return Evaluated::Failed;
+        for (qi, xi) in self.q.iter_mut().zip(x.chunks_exact(3)) {
+            *qi = [xi[0], xi[1], xi[2]];
+            if qi[2].is_nan() || qi[2] <= 0.0 {
+                return Evaluated::Failed;
+            }
         }
         self.evaluations += 1;
         let want = jacobian.is_some();
-        self.scaled = evaluate(self.robot, self.prep, q, lambda, want, &mut self.work);
+        self.scaled = evaluate(self.robot, self.prep, &self.q, lambda, want, &mut self.work);
         r.copy_from_slice(self.work.g.as_slice());
         if !self.scaled.is_finite() {
             return Evaluated::Failed;
@@ -955,14 +958,14 @@ pub fn solve_pcc_statics(
                 function_evaluations: 1,
                 ..SolverStats::default()
             };
-            return solution(robot, &q_act, stats);
+            return solution(robot, q_act.as_flattened(), stats);
         }
     }
     let mut p = Equilibrium {
         robot,
         prep: &prep,
         work: Work::new(robot.bodies.len()),
-        n: robot.bodies.len(),
+        q: vec![[0.0; 3]; robot.bodies.len()],
         scaled: f64::INFINITY,
         evaluations: 0,
     };
@@ -1019,21 +1022,21 @@ pub fn solve_pcc_statics(
             result.residual,
         ));
     }
-    solution(robot, result.x.as_chunks::<3>().0, stats)
+    solution(robot, &result.x, stats)
 }
 
-/// The solution at the coordinates `q` (`(u_x, u_y, ℓ)` per segment) with `stats`.
-fn solution(robot: &PccRobot, q: &[[f64; 3]], stats: SolverStats) -> Result<PccStaticsSolution> {
-    let segments = q
-        .iter()
+/// The solution at the coordinates `x` (`(u_x, u_y, ℓ)` per segment, flat) with `stats`.
+fn solution(robot: &PccRobot, x: &[f64], stats: SolverStats) -> Result<PccStaticsSolution> {
+    let segments = x
+        .chunks_exact(3)
         .map(|qi| PccSegment::from_curvature_vector(qi[0], qi[1], qi[2]))
         .collect::<Result<Vec<_>>>()?;
     let tendon_lengths = robot
         .tendons
         .iter()
         .map(|t| {
-            q[..=t.last_segment]
-                .iter()
+            x[..3 * (t.last_segment + 1)]
+                .chunks_exact(3)
                 .map(|qi| {
                     let (a, b) = (qi[2] * qi[0], qi[2] * qi[1]);
                     qi[2] - t.distance * (b * t.cos - a * t.sin)
