@@ -127,5 +127,46 @@ fn pcc_statics(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, pcc, pcc_statics);
+/// PCC inverse statics (issue 11) of the same robot: the minimum-norm tensions that put the
+/// tip at a target, cold (from zero) and warm (the previous answer, target moved by 1 mm).
+fn pcc_inverse(c: &mut Criterion) {
+    use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
+    use softrod::{pcc_inverse_statics, InverseOptions, InverseWarmStart, Target};
+    let body = ElasticSegment::solid_circle(0.2, 0.0007, 54e9, true).unwrap();
+    let angles = [90.0f64, -30.0, 210.0].map(f64::to_radians);
+    let tendons = PccTendons::new(&[0.01; 3], &angles).unwrap();
+    let robot = PccRobot::new(vec![body, body])
+        .unwrap()
+        .with_segment_tendons(0, &tendons)
+        .unwrap()
+        .with_segment_tendons(1, &tendons)
+        .unwrap();
+    let o = PccSolveOptions::default();
+    let loads = PccLoads {
+        tensions: vec![0.0, 1.7, 0.9, 2.2, 0.0, 0.4],
+        ..Default::default()
+    };
+    let tip = solve_pcc_statics(&robot, &loads, &o).unwrap().tip_pose;
+    let p = Vector3::new(tip[(0, 3)], tip[(1, 3)], tip[(2, 3)]);
+    let (target, moved) = (
+        Target::tip(p),
+        Target::tip(p + Vector3::new(1e-3, 0.0, 0.0)),
+    );
+    let io = InverseOptions::default();
+    let none = PccLoads::default();
+    let cold = pcc_inverse_statics(&robot, &none, &target, &io, &o, None).unwrap();
+    let warm = InverseWarmStart::from(&cold);
+    let mut g = c.benchmark_group("pcc_inverse");
+    g.bench_function("niti_2_segment_cold", |b| {
+        b.iter(|| pcc_inverse_statics(&robot, &none, black_box(&target), &io, &o, None).unwrap())
+    });
+    g.bench_function("niti_2_segment_warm_1mm", |b| {
+        b.iter(|| {
+            pcc_inverse_statics(&robot, &none, black_box(&moved), &io, &o, Some(&warm)).unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, pcc, pcc_statics, pcc_inverse);
 criterion_main!(benches);
