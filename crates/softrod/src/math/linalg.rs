@@ -160,7 +160,7 @@ impl Inverse6 {
         }
         let s = c.map(f64::sqrt);
         let k = |i: usize, j: usize| s[i] * d[i][j] * s[j] + if i == j { 1.0 } else { 0.0 };
-        let a = Matrix3::from_fn(|i, j| k(i, j));
+        let a = Matrix3::from_fn(k);
         let bm = Matrix3::from_fn(|i, j| k(i, j + 3));
         let e = Matrix3::from_fn(|i, j| k(i + 3, j + 3));
         let ai = a.try_inverse()?;
