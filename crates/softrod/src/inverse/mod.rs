@@ -644,7 +644,10 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 a
             );
         }
-        let stationary = small && (reached || least_squares);
+        // A small step that still moves an actuator onto its bound (or off it) is taken: the
+        // minimum-norm actuation has it exactly there, not a round-off away.
+        let same_bounds = free_set(y.as_slice(), &bounds) == free_set(&a, &bounds);
+        let stationary = small && (reached || least_squares) && same_bounds;
         if stationary || iterations >= options.max_iterations {
             let converged = stationary && (reached || shape);
             let out = finish(
