@@ -8,6 +8,7 @@ mod collapse;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
+mod friction_march;
 mod hyperelastic_local;
 pub mod sensitivity;
 pub(crate) mod shooting;

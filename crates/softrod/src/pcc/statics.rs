@@ -818,7 +818,8 @@ struct Equilibrium<'a> {
     robot: &'a PccRobot,
     prep: &'a Prepared,
     work: Work,
-    q: Vec<[f64; 3]>,
+    /// Number of segments.
+    n: usize,
     /// Scaled residual of the last evaluation.
     scaled: f64,
     evaluations: usize,
@@ -826,7 +827,7 @@ struct Equilibrium<'a> {
 
 impl Problem for Equilibrium<'_> {
     fn dim(&self) -> usize {
-        3 * self.q.len()
+        3 * self.n
     }
 
     fn evaluate(
@@ -836,16 +837,13 @@ impl Problem for Equilibrium<'_> {
         jacobian: Option<&mut [f64]>,
         r: &mut [f64],
     ) -> Evaluated {
-        let n = self.q.len();
-        for i in 0..n {
-            self.q[i] = [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
-            if self.q[i][2].is_nan() || self.q[i][2] <= 0.0 {
-                return Evaluated::Failed;
-            }
+        let (q, _) = x.as_chunks::<3>();
+        if q.iter().any(|qi| qi[2].is_nan() || qi[2] <= 0.0) {
+            return Evaluated::Failed;
         }
         self.evaluations += 1;
         let want = jacobian.is_some();
-        self.scaled = evaluate(self.robot, self.prep, &self.q, lambda, want, &mut self.work);
+        self.scaled = evaluate(self.robot, self.prep, q, lambda, want, &mut self.work);
         r.copy_from_slice(self.work.g.as_slice());
         if !self.scaled.is_finite() {
             return Evaluated::Failed;
@@ -862,10 +860,6 @@ impl Problem for Equilibrium<'_> {
     fn norm(&self, _r: &[f64]) -> f64 {
         self.scaled
     }
-}
-
-fn flat(q: &[[f64; 3]]) -> Vec<f64> {
-    q.iter().flatten().copied().collect()
 }
 
 fn check_options(robot: &PccRobot, opts: &PccSolveOptions) -> Result<()> {
@@ -937,31 +931,45 @@ pub fn solve_pcc_statics(
     check_options(robot, options)?;
     let prep = prepare(robot, loads)?;
     let q_act = actuated(robot, &prep, loads)?;
-    let q0 = match &options.warm_start {
-        Some(ws) => ws
-            .iter()
-            .map(|s| {
+    let warm: Option<Vec<f64>> = options.warm_start.as_ref().map(|ws| {
+        ws.iter()
+            .flat_map(|s| {
                 let u = s.curvature_vector();
                 [u.x, u.y, s.length()]
             })
-            .collect(),
-        None => q_act.clone(),
-    };
-    let x0 = flat(&q0);
+            .collect()
+    });
+    let x0: &[f64] = warm.as_deref().unwrap_or(q_act.as_flattened());
+    let unloaded = prep.force == Vector3::zeros() && prep.moment == Vector3::zeros();
+    let opts = &options.newton;
+    if unloaded && options.warm_start.is_none() {
+        // Without a tip load the actuator-only start is exact: its residual alone checks it
+        // (what Newton's first evaluation would do, without its set-up).
+        let mut work = Work::new(robot.bodies.len());
+        let scaled = evaluate(robot, &prep, &q_act, 1.0, false, &mut work);
+        if scaled <= opts.tolerance {
+            let stats = SolverStats {
+                load_factor: 1.0,
+                residual: scaled,
+                converged: true,
+                function_evaluations: 1,
+                ..SolverStats::default()
+            };
+            return solution(robot, &q_act, stats);
+        }
+    }
     let mut p = Equilibrium {
         robot,
         prep: &prep,
         work: Work::new(robot.bodies.len()),
-        q: q0,
+        n: robot.bodies.len(),
         scaled: f64::INFINITY,
         evaluations: 0,
     };
-    let opts = &options.newton;
     let mut stats = SolverStats {
         load_factor: 1.0,
         ..SolverStats::default()
     };
-    let unloaded = prep.force == Vector3::zeros() && prep.moment == Vector3::zeros();
     let settings = NewtonSettings {
         line_search: LineSearch {
             factor: 0.5,
@@ -975,12 +983,12 @@ pub fn solve_pcc_statics(
         jacobian: None,
         exact_at_solution: false,
     };
-    let mut result = newton(&mut p, &x0, 1.0, opts, &settings);
+    let mut result = newton(&mut p, x0, 1.0, opts, &settings);
     stats.iterations = result.iterations;
     if !result.converged && opts.continuation {
-        let x_act = flat(&q_act);
+        let x_act = q_act.as_flattened();
         let start = ContinuationSettings {
-            x0: &x_act,
+            x0: x_act,
             jacobian0: None,
             first_increment: 0.25,
             max_increment: 0.5,
@@ -1011,7 +1019,11 @@ pub fn solve_pcc_statics(
             result.residual,
         ));
     }
-    let q: Vec<[f64; 3]> = result.x.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    solution(robot, result.x.as_chunks::<3>().0, stats)
+}
+
+/// The solution at the coordinates `q` (`(u_x, u_y, ℓ)` per segment) with `stats`.
+fn solution(robot: &PccRobot, q: &[[f64; 3]], stats: SolverStats) -> Result<PccStaticsSolution> {
     let segments = q
         .iter()
         .map(|qi| PccSegment::from_curvature_vector(qi[0], qi[1], qi[2]))
