@@ -100,7 +100,7 @@ fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
         assert_contact_solution(&sol, &obstacles, radius, &[(tip, force)], closing);
         if factor < 1.0 {
             assert!(sol.contacts.is_empty(), "contact at F = {factor} F_c");
-            let gap = plane.distance(&tip).0 - radius;
+            let gap = obstacles[0].distance(&tip).0 - radius;
             assert!(gap > 0.0);
             continue;
         }
@@ -177,7 +177,7 @@ fn distributed_contact_with_a_floor_is_the_beam_closed_form() {
         assert!(err_a < 1e-2, "free length {} vs {a_exact}", edge.s);
         assert!(err_r < 3e-2, "edge reaction");
         for p in &sol.solution.position {
-            let g = floor.distance(&Vector3::from(*p)).0 - radius;
+            let g = obstacles[0].distance(&Vector3::from(*p)).0 - radius;
             assert!(g >= -1e-9, "penetration {g:e}");
         }
         // Global force balance: base force (the base wrench is what the base carries) and the

@@ -536,6 +536,13 @@ fn loaded_one_march_equals_the_fixed_point() {
             },
             Some(6450.0),
         ),
+        // Far from the unloaded rod: the start there may be refused (then the frictionless
+        // solve's base wrench).
+        (
+            "large tip force",
+            Loads::tip_force(Vector3::new(0.3, -0.2, 0.05)),
+            None,
+        ),
         (
             "tip force and gravity",
             Loads {

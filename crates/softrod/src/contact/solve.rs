@@ -653,10 +653,9 @@ fn exact_newton(
     }
     let mut lu = DenseLu::default();
     let mut refined = 0;
-    // Marches allowed: an exact iteration may be followed by a few Broyden ones.
-    let mut budget = 4 * opts.max_iterations;
-    while budget > 0 {
-        budget -= 1;
+    // At most `max_iterations` accepted steps, and as many exact re-evaluations.
+    let (mut steps, mut retries) = (0, 0);
+    while steps < opts.max_iterations && retries <= opts.max_iterations {
         if norm <= opts.tolerance {
             if norm <= round_off(opts) || refined >= 2 {
                 return Some((x, norm));
@@ -669,6 +668,7 @@ fn exact_newton(
                 break;
             }
             // A singular update: the exact Jacobian here.
+            retries += 1;
             if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
                 break;
             }
@@ -700,6 +700,7 @@ fn exact_newton(
                 break;
             }
             // The exact Jacobian at the iterate, and its step.
+            retries += 1;
             if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
                 break;
             }
@@ -708,6 +709,7 @@ fn exact_newton(
             continue;
         }
         effort.iterations += 1;
+        steps += 1;
         let step: Vec<f64> = dx.iter().map(|v| alpha * v).collect();
         broyden(&mut j, &step, &r, &rt);
         exact = false;

@@ -28,10 +28,13 @@
 //! the constitutive split `n = N − Σ τ_i(s) t_i`. The rod therefore receives from each tendon
 //! the distributed load `d(τ_i t_i)/ds = τ_i t_i' + τ_i' t_i` (normal load plus the friction
 //! force, opposite to the friction on the tendon) and, at the termination, the point force
-//! `−τ_i(σ) t_i(σ)` with the local tension. The shape and the profile are found together by a
-//! fixed-point iteration: solve the rod for the current profile (interpolated geometrically
-//! between the mesh nodes), recompute the profile from the shape, until the tension changes by
-//! less than [`FrictionOptions::tolerance`] relative to the largest base tension.
+//! `−τ_i(σ) t_i(σ)` with the local tension. The shape and the profile are found together in
+//! one march with the tension a state (`friction_march`): without external loads at the known
+//! zero base wrench, with them at every iterate of a quasi-Newton iteration on the base
+//! wrench. The independent formulation, and the fallback when that iteration fails, is a
+//! fixed point: solve the rod for the current profile (interpolated geometrically between the
+//! mesh nodes), recompute the profile from the shape, until the tension changes by less than
+//! [`FrictionOptions::tolerance`] relative to the largest base tension.
 
 use std::sync::Arc;
 
@@ -72,9 +75,10 @@ pub struct FrictionOptions {
     pub tolerance: f64,
     /// Cap on the fixed-point iterations.
     pub max_iterations: usize,
-    /// Solve a model without external loads in one march with the tension as a state
-    /// (default `true`); `false`: by the fixed point on the profile, as loaded models are
-    /// (the same discrete equations, an independent solve of them).
+    /// Solve in one march with the tension as a state (default `true`; with external loads,
+    /// one march per quasi-Newton iterate of the base wrench, the fixed point if that
+    /// iteration fails); `false`: by the fixed point on the profile (the same discrete
+    /// equations, an independent solve of them).
     pub single_march: bool,
 }
 
@@ -134,8 +138,8 @@ pub struct FrictionalSolution {
     /// tendon being inextensible and anchored at its termination, its slip toward the base
     /// at a node between two states is the change of `path length − path_length[node]`.
     pub path_length: Vec<Vec<f64>>,
-    /// Rod solves: 1 for the one march of an unloaded model, the fixed-point iterations
-    /// otherwise.
+    /// Marches: 1 for an unloaded model, one per quasi-Newton iterate of a loaded one; the
+    /// rod solves of the fixed point when it was used.
     pub iterations: usize,
     /// Integration steps over the cells of the friction mesh, all rod solves and repeated
     /// cells together (a rod solve without friction takes one per cell and Newton iteration).
