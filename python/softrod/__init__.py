@@ -71,7 +71,7 @@ from .analysis import (
     tension_grid,
     workspace_map,
 )
-from .contact import Capsule, Clamp, Cylinder, Pin, Plane, Slide, Sphere
+from .contact import Capsule, Clamp, Cylinder, Mesh, Pin, Plane, Slide, Sphere
 from .inverse import InversePath, InverseSolution, inverse_statics, inverse_statics_path
 from .io import read_backbone_csv, write_samples_csv
 from .robot import Robot, load_robot, solve_path
@@ -99,6 +99,7 @@ __all__ = [
     "LinearElastic",
     "Linearised",
     "Loads",
+    "Mesh",
     "ModelComparison",
     "ModelResult",
     "MooneyRivlin",

@@ -427,6 +427,10 @@ class StaticsSolution:
     @property
     def friction_iterations(self) -> int: ...
     @property
+    def path_length(self) -> NDArray[np.float64] | None:
+        """Path length (m) of each tendon from the base to every sample, (N, n_tendons);
+        None without friction."""
+    @property
     def contacts(self) -> list[dict[str, Any]]:
         """Active contacts: obstacle, s (m), length (m), point, normal, normal_force (N),
         tangential_force (N)."""

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .plot.obstacles import Capsule, Cylinder, Plane, Sphere, _field_error, _vector
+from .plot.obstacles import Capsule, Cylinder, Mesh, Plane, Sphere, _field_error, _vector
 
-__all__ = ["Capsule", "Clamp", "Cylinder", "Pin", "Plane", "Slide", "Sphere"]
+__all__ = ["Capsule", "Clamp", "Cylinder", "Mesh", "Pin", "Plane", "Slide", "Sphere"]
 
 
 @dataclass(frozen=True, eq=False)

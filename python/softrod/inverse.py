@@ -55,6 +55,7 @@ class InverseSolution:
         # The reusable solver state lives in the extension and is not pickled: an unpickled
         # solution warm-starts from its actuation, as any other previous answer does.
         state = dict(self.__dict__)
+        state["_solution"] = self.solution
         state["_warm_state"] = None
         state["_model_key"] = None
         return state
@@ -62,6 +63,34 @@ class InverseSolution:
     def __setstate__(self, state: dict[str, Any]) -> None:
         for k, v in state.items():
             object.__setattr__(self, k, v)
+
+
+class _Deferred:
+    """A forward solution made when it is first asked for (``InverseSolution.solution``)."""
+
+    __slots__ = ("make",)
+
+    def __init__(self, make: Any) -> None:
+        self.make = make
+
+
+def _get_solution(self: InverseSolution) -> Any:
+    value = self.__dict__["_solution"]
+    if isinstance(value, _Deferred):
+        value = value.make()
+        self.__dict__["_solution"] = value
+    return value
+
+
+def _set_solution(self: InverseSolution, value: Any) -> None:
+    self.__dict__["_solution"] = value
+
+
+# The forward solution at the actuation found is solved on first access (a tracking loop that
+# reads only the actuation does not pay for it); it is the same solution either way.
+InverseSolution.solution = property(  # type: ignore[assignment]
+    _get_solution, _set_solution, doc="The forward statics solution at the actuation found."
+)
 
 
 def _warm_arguments(warm_start: Any, key: tuple) -> tuple[Any, dict[str, Any]]:
@@ -160,8 +189,10 @@ def inverse_statics(
     a = np.asarray(out["actuation"])
     nt = out["n_tendons"]
     tensions, pressures = a[:nt].copy(), a[nt:].copy()
-    solution = robot.solve(
-        tensions if nt else None, pressures if len(pressures) else None, on_unstable="ignore"
+    solution = _Deferred(
+        lambda: robot.solve(
+            tensions if nt else None, pressures if len(pressures) else None, on_unstable="ignore"
+        )
     )
     return InverseSolution(
         tensions=tensions,

@@ -40,11 +40,22 @@ pub(crate) fn obstacles(
             "Sphere" => softrod::Obstacle::sphere(v("center")?, r()?),
             "Capsule" => softrod::Obstacle::capsule(v("a")?, v("b")?, r()?),
             "Cylinder" => softrod::Obstacle::cylinder(v("a")?, v("b")?, r()?),
+            "Mesh" => {
+                let vertices: Vec<[f64; 3]> = o
+                    .getattr("vertices")?
+                    .extract()
+                    .map_err(|_| type_err(&name("vertices"), &o, "an (N, 3) array (m)"))?;
+                let faces: Vec<[usize; 3]> = o
+                    .getattr("faces")?
+                    .extract()
+                    .map_err(|_| type_err(&name("faces"), &o, "an (M, 3) array of indices"))?;
+                softrod::Obstacle::mesh(vertices, faces)
+            }
             _ => {
                 return Err(type_err(
                     &format!("obstacles[{i}]"),
                     &o,
-                    "a Plane, Sphere, Capsule or Cylinder",
+                    "a Plane, Sphere, Capsule, Cylinder or Mesh",
                 ))
             }
         };

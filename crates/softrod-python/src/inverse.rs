@@ -223,8 +223,11 @@ pub(crate) fn _inverse_statics<'py>(
     )?;
     let warm = merge_warm(warm, warm_state.as_ref(), same_model);
     let model = &problem.model;
-    let (inv, _) = run(py, "inverse_statics", || {
-        softrod::inverse_statics(model, &target, &o, &solve, warm.as_ref()).map_err(actuator_names)
+    // The forward solution is made in Python (when it is asked for), not here.
+    let inv = run(py, "inverse_statics", || {
+        let mut fwd = softrod::CosseratForward::new(model, &solve, target.s.as_deref())
+            .map_err(actuator_names)?;
+        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_ref()).map_err(actuator_names)
     })?;
     result_dict(py, &inv)
 }

@@ -425,10 +425,23 @@ impl StaticsSolution {
     fn frictional(&self) -> bool {
         self.friction.is_some()
     }
-    /// Rod solves of the friction fixed point (0 without friction).
+    /// Marches (one per quasi-Newton iterate of the base wrench, 1 without external loads)
+    /// or, when the one-march solve fell back to it, rod solves of the fixed point on the
+    /// profile; 0 without friction.
     #[getter]
     fn friction_iterations(&self) -> usize {
         self.friction.as_ref().map_or(0, |f| f.iterations)
+    }
+    /// Path length (m) of every tendon from the base to every sample, shape (N, n_tendons)
+    /// (the whole path length beyond its termination), from the integrator's quadrature;
+    /// `None` for a frictionless solve. The slip of a tendon toward the base at a sample
+    /// between two states is the change of `tendon_lengths - path_length` there.
+    #[getter]
+    fn path_length<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        let f = self.friction.as_ref()?;
+        let nt = self.inner.model.tendons().len();
+        let a = Array::from_shape_fn((f.path_length.len(), nt), |(j, i)| f.path_length[j][i]);
+        Some(a.into_pyarray(py))
     }
     /// The active contacts, one dict each: `obstacle` (index), `s` (m), `length` (m, 0 for a
     /// point contact; a contact interval on a plane otherwise), `point` (m, world, on the

@@ -9,12 +9,17 @@ use std::hint::black_box;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use softrod::nalgebra::Vector3;
 use softrod::{
     friction_mesh, solve_frictional, solve_statics, solve_statics_at, Actuation, FrictionOptions,
     Integrator, LinearElastic, Loads, RobotModel, Rod, Section, Tendon,
 };
 
 fn niti(mu: f64) -> Arc<RobotModel> {
+    niti_with(mu, Loads::default())
+}
+
+fn niti_with(mu: f64, loads: Loads) -> Arc<RobotModel> {
     let rod = Rod::new(
         0.4,
         Section::circular(0.7e-3).unwrap(),
@@ -31,7 +36,7 @@ fn niti(mu: f64) -> Arc<RobotModel> {
                 .unwrap()
         })
         .collect();
-    RobotModel::new(rod, tendons, Vec::new(), Loads::default()).unwrap()
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
 }
 
 fn friction(c: &mut Criterion) {
@@ -50,6 +55,24 @@ fn friction(c: &mut Criterion) {
     });
     for mu in [0.1, 0.2] {
         let model = niti(mu);
+        g.bench_function(format!("mu_{mu}_from_rest"), |b| {
+            b.iter(|| solve_frictional(black_box(&model), &act, &opts, None).unwrap())
+        });
+        let first = solve_frictional(&model, &act, &opts, None).unwrap();
+        g.bench_function(format!("mu_{mu}_unloading_step"), |b| {
+            b.iter(|| solve_frictional(black_box(&model), &release, &opts, Some(&first)).unwrap())
+        });
+    }
+    g.finish();
+    // With a tip force (N): Newton on the base wrench, one frictional march per iterate.
+    let tip = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
+    let plain = niti_with(0.0, tip.clone());
+    let mut g = c.benchmark_group("friction_niti_tip_force");
+    g.bench_function("frictionless", |b| {
+        b.iter(|| solve_statics(black_box(&plain), &act, &opts.statics).unwrap())
+    });
+    for mu in [0.1, 0.2] {
+        let model = niti_with(mu, tip.clone());
         g.bench_function(format!("mu_{mu}_from_rest"), |b| {
             b.iter(|| solve_frictional(black_box(&model), &act, &opts, None).unwrap())
         });

@@ -50,7 +50,9 @@ pub use compliance::{
     compliance, pcc_compliance, tangent_compliance, Compliance, Configuration, TangentCompliance,
     TendonControl,
 };
-pub use contact::{solve_constrained, Contact, ContactSolution, Obstacle, TipConstraint};
+pub use contact::{
+    solve_constrained, Contact, ContactSolution, Obstacle, TipConstraint, TriangleMesh,
+};
 pub use cosserat::displacement::reference_lengths;
 pub use cosserat::friction::{
     friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,

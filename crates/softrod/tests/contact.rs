@@ -100,7 +100,7 @@ fn tip_contact_with_a_parallel_plane_is_the_cantilever_closed_form() {
         assert_contact_solution(&sol, &obstacles, radius, &[(tip, force)], closing);
         if factor < 1.0 {
             assert!(sol.contacts.is_empty(), "contact at F = {factor} F_c");
-            let gap = plane.distance(&tip).0 - radius;
+            let gap = obstacles[0].distance(&tip).0 - radius;
             assert!(gap > 0.0);
             continue;
         }
@@ -177,7 +177,7 @@ fn distributed_contact_with_a_floor_is_the_beam_closed_form() {
         assert!(err_a < 1e-2, "free length {} vs {a_exact}", edge.s);
         assert!(err_r < 3e-2, "edge reaction");
         for p in &sol.solution.position {
-            let g = floor.distance(&Vector3::from(*p)).0 - radius;
+            let g = obstacles[0].distance(&Vector3::from(*p)).0 - radius;
             assert!(g >= -1e-9, "penetration {g:e}");
         }
         // Global force balance: base force (the base wrench is what the base carries) and the
@@ -292,4 +292,102 @@ fn compliance_under_contact_is_the_constrained_derivative() {
     // The slender cantilever: L³ / (3 E I) along the plane.
     let beam = L.powi(3) / (3.0 * ei);
     assert!((c[(1, 1)] / beam - 1.0).abs() < 1e-3);
+}
+
+/// Compliance under an interior contact: the cantilever propped by the sphere at 0.6 L
+/// (1.5 F_c). The frictionless contact holds the normal and slides along the sphere; every
+/// column of the constrained tip compliance (tip forces and moments) is the central
+/// difference of the constrained nonlinear solve to 1e-6 of its largest entry.
+#[test]
+fn compliance_under_an_interior_contact_is_the_constrained_derivative() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let (c, rs) = (0.6 * L, 0.05 * L);
+    let obstacles = [Obstacle::sphere([-(radius + delta + rs), 0.0, c], rs).unwrap()];
+    let closing = delta * 6.0 * ei / (c * c * (3.0 * L - c));
+    let base = [-1.5 * closing, 0.2 * closing, 0.0, 0.0, 0.0, 0.0];
+    let solve = |w: [f64; 6]| {
+        let loads = Loads {
+            tip_force: Vector3::new(w[0], w[1], w[2]),
+            tip_moment: Vector3::new(w[3], w[4], w[5]),
+            ..Loads::default()
+        };
+        let model = RobotModel::rod_only(rod(radius), loads).unwrap();
+        solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(200),
+            None,
+            &obstacles,
+        )
+        .unwrap()
+    };
+    let sol = solve(base);
+    assert_eq!(sol.contacts.len(), 1);
+    assert!(sol.contacts[0].s < 0.99 * L, "an interior contact");
+    let cm = sol.compliance.unwrap();
+    let big = cm.amax();
+    for k in 0..6 {
+        let h = if k < 3 {
+            1e-4 * closing
+        } else {
+            1e-4 * closing * L
+        };
+        let (mut wp, mut wm) = (base, base);
+        wp[k] += h;
+        wm[k] -= h;
+        let (p, m) = (solve(wp), solve(wm));
+        assert!(p.contacts.len() == 1 && m.contacts.len() == 1);
+        let tip = |s: &ContactSolution| {
+            let q = s.solution.tip_position();
+            let r = s.solution.rotation.last().copied().unwrap();
+            (
+                Vector3::from(q),
+                softrod::nalgebra::Matrix3::from_row_slice(r.concat().as_slice()),
+            )
+        };
+        let ((pp, rp), (pm, rm)) = (tip(&p), tip(&m));
+        // The rotation change as the axial vector of (R+ - R-) R0ᵀ / 2h (skew part).
+        let (_, r0) = tip(&sol);
+        let d = (rp - rm) * r0.transpose() / (2.0 * h);
+        let w = Vector3::new(
+            d[(2, 1)] - d[(1, 2)],
+            d[(0, 2)] - d[(2, 0)],
+            d[(1, 0)] - d[(0, 1)],
+        ) * 0.5;
+        let dp = (pp - pm) / (2.0 * h);
+        let fd = [dp.x, dp.y, dp.z, w.x, w.y, w.z];
+        let err = (0..6)
+            .map(|i| (cm[(i, k)] - fd[i]).abs())
+            .fold(0.0, f64::max)
+            / big;
+        println!("interior contact: compliance column {k} vs central difference, rel. {err:e}");
+        assert!(err < 1e-6, "column {k}: rel. {err:e}");
+    }
+}
+
+/// The stability of a contact solution with a free tip comes from the exact Jacobian at the
+/// solution; it equals the margin of the same rod with the contact forces as dead loads
+/// solved again without obstacles (one march with the base-wrench columns).
+#[test]
+fn contact_stability_is_that_of_the_contacts_as_dead_loads() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    let (c, rs) = (0.6 * L, 0.05 * L);
+    let obstacles = [Obstacle::sphere([-(radius + delta + rs), 0.0, c], rs).unwrap()];
+    let closing = delta * 6.0 * ei / (c * c * (3.0 * L - c));
+    let force = Vector3::new(-1.5 * closing, 0.0, 0.0);
+    let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+    let opts = options(200);
+    let sol = solve_constrained(&model, &Actuation::default(), &opts, None, &obstacles).unwrap();
+    assert_eq!(sol.contacts.len(), 1);
+    let margin = sol.solution.stability_margin();
+    let again = softrod::solve_statics(&sol.solution.model, &Actuation::default(), &opts).unwrap();
+    let reference = again.stability_margin();
+    let err = (margin / reference - 1.0).abs();
+    println!("contact stability margin {margin:e}, dead-load re-solve {reference:e}, rel. {err:e}");
+    assert!(sol.solution.stable && again.stable);
+    assert!(err < 1e-6, "{margin:e} vs {reference:e}");
 }

@@ -23,7 +23,7 @@ impl Rng {
 /// contact solve converges for, and how many penetrated.
 fn run(samples: usize, seed: u64, sphere: Obstacle) -> (usize, usize, Vec<[f64; 6]>) {
     let rod = common::niti_rod();
-    let obstacles = [sphere];
+    let obstacles = [sphere.clone()];
     let mut rng = Rng(seed);
     let (mut touching, mut solved) = (0, 0);
     let mut failed = Vec::new();
@@ -83,7 +83,7 @@ fn niti_robot_into_a_sphere_converges_for_1000_tension_vectors() {
         Obstacle::sphere([0.06, 0.0, 0.3], 0.04).unwrap(),
         Obstacle::sphere([0.0, 0.07, 0.25], 0.06).unwrap(),
     ] {
-        let (touching, solved, failed) = run(1000, 0x5eed, sphere);
+        let (touching, solved, failed) = run(1000, 0x5eed, sphere.clone());
         println!("{sphere:?}: {solved} of {touching} contact solves converged; failed: {failed:?}");
         assert!(
             solved as f64 >= 0.99 * touching as f64,

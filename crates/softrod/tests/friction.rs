@@ -504,3 +504,104 @@ fn the_actuation_jacobian_of_a_frictional_equilibrium_is_refused_by_name() {
     let sol = solve_frictional(&plain, &act, &options(50), None).unwrap();
     assert!(softrod::actuation_jacobian(&sol.statics, None).is_ok());
 }
+
+/// The NiTi robot with friction `mu` on every tendon under `loads`.
+fn niti_loaded(mu: f64, loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
+    let tendons = common::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .map(|t| t.tendon.with_friction(mu).unwrap())
+        .collect();
+    let mut rod = common::niti_rod();
+    if let Some(d) = density {
+        rod = rod.with_density(d).unwrap();
+    }
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+}
+
+/// Loaded models (tip force, gravity, both): the one march per Newton iterate of the base
+/// wrench against the fixed point on the profile (a full rod solve per profile), the same
+/// discrete equations solved two independent ways, from rest and along an
+/// unloading/reloading path.
+#[test]
+fn loaded_one_march_equals_the_fixed_point() {
+    let tip = Vector3::new(0.05, -0.02, 0.01);
+    let g = Vector3::new(0.0, -9.81, 0.0);
+    let cases = [
+        ("tip force", Loads::tip_force(tip), None),
+        (
+            "gravity",
+            Loads {
+                gravity: g,
+                ..Loads::default()
+            },
+            Some(6450.0),
+        ),
+        // Far from the unloaded rod: the start there may be refused (then the frictionless
+        // solve's base wrench).
+        (
+            "large tip force",
+            Loads::tip_force(Vector3::new(0.3, -0.2, 0.05)),
+            None,
+        ),
+        (
+            "tip force and gravity",
+            Loads {
+                gravity: g,
+                ..Loads::tip_force(tip)
+            },
+            Some(6450.0),
+        ),
+    ];
+    let path: Vec<Actuation> = [[4.0, 2.0], [2.5, 2.0], [3.0, 1.0], [0.5, 1.5]]
+        .iter()
+        .map(|t| Actuation::tensions(&[t[0], 0.0, 1.0, 0.0, t[1], 0.0]))
+        .collect();
+    for (name, loads, density) in cases {
+        for mu in [0.05, 0.2, 0.5] {
+            let model = niti_loaded(mu, loads.clone(), density);
+            let mut adaptive = options(50);
+            adaptive.statics.integrator = Integrator::Adaptive(softrod::AdaptiveOptions {
+                // The Newton tolerance of the adaptive integrator is 10 rtol (1 + |x|): tight
+                // enough for both solves to resolve the equations below 1e-10 m.
+                rtol: 1e-12,
+                atol: 1e-14,
+                ..Default::default()
+            });
+            for mut opts in [options(50), adaptive] {
+                let mut fixed_point = opts;
+                fixed_point.single_march = false;
+                // One fixed-point iteration at most: a fall back to the fixed point fails.
+                opts.max_iterations = 1;
+                let a = solve_path(&model, &path, &opts).unwrap();
+                let b = solve_path(&model, &path, &fixed_point).unwrap();
+                let (mut dp, mut dt): (f64, f64) = (0.0, 0.0);
+                let mut marches = Vec::new();
+                for (x, y) in a.iter().zip(&b) {
+                    marches.push(x.iterations);
+                    // The one-march solve (cell steps of its marches only, no rod solve of
+                    // the fixed point).
+                    for (p, q) in x.statics.position.iter().zip(&y.statics.position) {
+                        for k in 0..3 {
+                            dp = dp.max((p[k] - q[k]).abs());
+                        }
+                    }
+                    for (p, q) in x.tension.iter().zip(&y.tension) {
+                        for (s, t) in p.iter().zip(q) {
+                            dt = dt.max((s - t).abs() / 4.0);
+                        }
+                    }
+                    assert_eq!(x.slip, y.slip, "{name}, μ = {mu}: slip states differ");
+                }
+                eprintln!(
+                    "{name}, μ = {mu}: one march vs fixed point: {dp:e} m, {dt:e} relative \
+                     tension; marches {marches:?}, fixed point {:?}",
+                    b.iter().map(|s| s.iterations).collect::<Vec<_>>()
+                );
+                assert!(
+                    dp < 1e-10 && dt < 1e-10,
+                    "{name}, μ = {mu}: {dp:e} m, {dt:e}"
+                );
+            }
+        }
+    }
+}

@@ -304,11 +304,24 @@ def tip_constraint_spec(t: Any) -> dict[str, Any]:
     }
 
 
+def _mesh_not_described(o: Any) -> Exception:
+    from ..plot.obstacles import _field_error
+
+    return _field_error(
+        "obstacles",
+        f"Mesh({len(o.vertices)} vertices, {len(o.faces)} faces)",
+        "a robot (and its robot file) does not describe a Mesh yet: pass it as "
+        "solve_statics(..., obstacles=[mesh])",
+    )
+
+
 def obstacle_spec(o: Any) -> dict[str, Any]:
     """The ``[[obstacles]]`` table of an obstacle dataclass."""
     from ..plot.obstacles import as_obstacle
 
     o = as_obstacle(o)
+    if type(o).__name__ == "Mesh":
+        raise _mesh_not_described(o)
     kind = type(o).__name__.lower()
     fields = {k: getattr(o, k) for k in o.__dataclass_fields__}
     out: dict[str, Any] = {"type": kind}

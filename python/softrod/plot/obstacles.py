@@ -14,7 +14,15 @@ import numpy as np
 
 from .._core import ParameterError
 
-__all__ = ["Capsule", "Cylinder", "Plane", "Sphere", "as_obstacle", "obstacle_surface"]
+__all__ = [
+    "Capsule",
+    "Cylinder",
+    "Mesh",
+    "Plane",
+    "Sphere",
+    "as_obstacle",
+    "obstacle_surface",
+]
 
 
 def _field_error(name: str, value: object, why: str) -> ParameterError:
@@ -105,7 +113,62 @@ class Cylinder:
             raise _field_error("b", self.b, "must differ from `a` (the axis)")
 
 
-_KINDS = {"plane": Plane, "sphere": Sphere, "capsule": Capsule, "cylinder": Cylinder}
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """A triangle mesh: ``vertices`` (m, world, shape (N, 3)) and ``faces`` (vertex indices,
+    shape (M, 3), counter-clockwise seen from outside). The gap is the signed distance to
+    its triangles (negative inside a closed mesh), computed in the Rust core.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    def __post_init__(self) -> None:
+        try:
+            v = np.array(self.vertices, dtype=float)
+        except (TypeError, ValueError):
+            raise _field_error("vertices", self.vertices, "must be an (N, 3) array (m)") from None
+        if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
+            raise _field_error("vertices", self.vertices, "must be an (N, 3) finite array (m)")
+        try:
+            f = np.array(self.faces)
+        except (TypeError, ValueError):
+            raise _field_error("faces", self.faces, "must be an (M, 3) index array") from None
+        if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or not np.issubdtype(f.dtype, np.integer):
+            raise _field_error("faces", self.faces, "must be an (M, 3) integer array, M >= 1")
+        if f.min() < 0 or f.max() >= len(v):
+            raise _field_error("faces", self.faces, f"indices must be in [0, {len(v) - 1}]")
+        v.setflags(write=False)
+        f = f.astype(np.int64)
+        f.setflags(write=False)
+        object.__setattr__(self, "vertices", v)
+        object.__setattr__(self, "faces", f)
+
+    @classmethod
+    def from_file(cls, path) -> Mesh:
+        """A mesh read by trimesh from ``path`` (STL, OBJ, PLY, ...; coordinates in m)."""
+        import trimesh
+
+        try:
+            m = trimesh.load_mesh(str(path), process=False)
+        except (OSError, ValueError) as exc:
+            raise _field_error("file", str(path), f"could not be read as a mesh ({exc})") from None
+        return cls(np.asarray(m.vertices, dtype=float), np.asarray(m.faces, dtype=np.int64))
+
+
+def _mesh_of(fields: dict) -> Mesh:
+    if "file" in fields:
+        return Mesh.from_file(fields["file"])
+    return Mesh(fields.get("vertices"), fields.get("faces"))
+
+
+_KINDS = {
+    "plane": Plane,
+    "sphere": Sphere,
+    "capsule": Capsule,
+    "cylinder": Cylinder,
+    "mesh": lambda **f: _mesh_of(f),
+}
 
 
 def _bad(i: int, value: object, why: str) -> ParameterError:
@@ -114,13 +177,13 @@ def _bad(i: int, value: object, why: str) -> ParameterError:
     return err
 
 
-def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder:
+def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder | Mesh:
     """Converts a dict or a duck-typed object to one of the obstacle dataclasses.
 
     Raises:
         ParameterError: Unknown type, missing field or a non-positive radius.
     """
-    if isinstance(obj, (Plane, Sphere, Capsule, Cylinder)):
+    if isinstance(obj, (Plane, Sphere, Capsule, Cylinder, Mesh)):
         out = obj
     elif isinstance(obj, Mapping):
         kind = str(obj.get("type", "")).lower()
@@ -131,6 +194,8 @@ def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder:
             out = _KINDS[kind](**fields)
         except (TypeError, ParameterError) as exc:
             raise _bad(index, obj, str(exc)) from None
+    elif hasattr(obj, "vertices") and hasattr(obj, "faces"):
+        out = Mesh(obj.vertices, obj.faces)
     elif hasattr(obj, "normal") and hasattr(obj, "point"):
         out = Plane(obj.point, obj.normal)
     elif hasattr(obj, "center") and hasattr(obj, "radius"):
@@ -168,8 +233,12 @@ def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def obstacle_surface(obstacle, extent_centre: np.ndarray, extent: float, n: int = 32):
     """Grid ``(X, Y, Z)`` (m) of an obstacle's surface; a plane is drawn as a square of side
-    ``extent`` (m) centred on the foot of ``extent_centre`` (m)."""
-    if isinstance(obstacle, Sphere):
+    ``extent`` (m) centred on the foot of ``extent_centre`` (m); a mesh gives its vertices
+    (shape (N, 1) each)."""
+    if isinstance(obstacle, Mesh):
+        # The vertices, as an (N, 1) grid (drawn as triangles by the views).
+        pts = obstacle.vertices[:, None, :]
+    elif isinstance(obstacle, Sphere):
         c = np.asarray(obstacle.center, dtype=float)
         u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2 + 1))
         pts = obstacle.radius * np.stack(

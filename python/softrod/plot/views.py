@@ -25,7 +25,7 @@ from ._figure import (
     set_equal_3d,
 )
 from .geometry import RobotGeometry, robot_geometry
-from .obstacles import Plane, as_obstacles, obstacle_surface
+from .obstacles import Mesh, Plane, as_obstacles, obstacle_surface
 from .tube import (
     chamber_grid,
     disk_polygon,
@@ -291,7 +291,19 @@ def _draw_obstacles(ax, obstacles, pts_mm: np.ndarray, mm: float, projected=None
     extent = float(np.ptp(pts_mm, axis=0).max()) / mm * 1.2
     for k, ob in enumerate(obstacles):
         x, y, z = obstacle_surface(ob, centre, extent)
-        if projected is None:
+        if projected is None and isinstance(ob, Mesh):
+            surf = ax.plot_trisurf(
+                x.ravel() * mm,
+                y.ravel() * mm,
+                z.ravel() * mm,
+                triangles=ob.faces,
+                color="tab:cyan",
+                alpha=0.45,
+                linewidth=0,
+            )
+            surf.set_gid(f"obstacle-{k}")
+            out.append(surf)
+        elif projected is None:
             surf = ax.plot_surface(
                 x * mm,
                 y * mm,

@@ -11,6 +11,7 @@
 
 mod constraint;
 mod jacobian;
+mod mesh;
 mod obstacle;
 mod solve;
 mod stability;
@@ -18,7 +19,7 @@ mod stability;
 use nalgebra::Vector3;
 
 pub use constraint::TipConstraint;
-pub use obstacle::Obstacle;
+pub use obstacle::{Obstacle, TriangleMesh};
 pub use solve::{solve_constrained, MAX_ACTIVE_SET_ROUNDS};
 
 use crate::cosserat::StaticsSolution;

@@ -6,12 +6,16 @@
 //! outer radius `R(s)` centred on the backbone, so the gap at `s` is the signed distance of
 //! the backbone point to the obstacle minus `R(s)`.
 
+use std::sync::Arc;
+
 use nalgebra::Vector3;
+
+pub use super::mesh::TriangleMesh;
 
 use crate::error::{Error, Result};
 
 /// A rigid obstacle (world frame, m).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Obstacle {
     /// The half-space behind the plane through `point` with unit outward `normal`.
     Plane {
@@ -45,6 +49,9 @@ pub enum Obstacle {
         /// Radius (m), > 0.
         radius: f64,
     },
+    /// A triangle mesh ([`TriangleMesh`]; world frame, m): the signed distance to its
+    /// triangles, negative inside a closed mesh (outward faces counter-clockwise).
+    Mesh(Arc<TriangleMesh>),
 }
 
 fn finite3(name: &str, v: [f64; 3]) -> Result<Vector3<f64>> {
@@ -147,6 +154,15 @@ impl Obstacle {
         })
     }
 
+    /// A triangle mesh from its vertices (m, world) and faces (vertex indices,
+    /// counter-clockwise seen from outside).
+    ///
+    /// # Errors
+    /// As [`TriangleMesh::new`].
+    pub fn mesh(vertices: Vec<[f64; 3]>, faces: Vec<[usize; 3]>) -> Result<Self> {
+        Ok(Self::Mesh(Arc::new(TriangleMesh::new(vertices, faces)?)))
+    }
+
     /// Signed distance (m; negative inside) of the point `x` (m) to the obstacle's surface,
     /// and the unit outward normal of the surface at the closest point (the gradient of the
     /// distance).
@@ -160,6 +176,7 @@ impl Obstacle {
             }
         };
         match *self {
+            Self::Mesh(ref m) => m.distance(x),
             Self::Plane { point, normal } => (normal.dot(&(x - point)), normal),
             Self::Sphere { center, radius } => radial(x - center, radius, Vector3::z()),
             Self::Capsule { a, b, radius } => {

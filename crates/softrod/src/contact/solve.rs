@@ -15,7 +15,7 @@ use crate::cosserat::statics::{
     assemble, scaled, scaled_back, settings, solve_statics, Integrator, SolveOptions,
     MAX_LINE_SEARCH_HALVINGS, MAX_LOAD_STEP_TURN,
 };
-use crate::cosserat::NEUTRAL_MARGIN;
+use crate::cosserat::{tip_stability, Stability, NEUTRAL_MARGIN};
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
 use crate::math::linalg::DenseLu;
@@ -603,7 +603,7 @@ fn correct(
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    exact_newton(p, x, opts, effort, true).map(|(x, _)| x)
+    exact_newton(p, x, opts, effort, true, false).map(|(x, _)| x)
 }
 
 /// Residual below which [`exact_newton`] stops refining a converged iterate (a fraction of
@@ -612,19 +612,21 @@ fn round_off(opts: &NewtonOptions) -> f64 {
     (opts.tolerance * 1e-4).max(64.0 * f64::EPSILON)
 }
 
-/// Newton with exact Jacobians at the full contact targets from `x` (the residual alone
-/// first when `residual_first`): every evaluation brings its Jacobian from the same march,
-/// so a full step costs one march; a step is halved until the residual's max norm falls
-/// (Armijo). Once within the tolerance, up to two more steps are taken while they lower the
-/// residual toward round-off, so that the balance of the reactions holds to the digits of the
-/// loads. Returns the iterate and its residual, the last pass at it; `None` if the
-/// tolerance is not met.
+/// Newton at the full contact targets from `x` (the residual alone first when
+/// `residual_first`): an exact Jacobian (one march with the variational columns) at the
+/// start, then Broyden's rank-one updates between residual-only marches; a full step that
+/// does not lower the residual's max norm (Armijo) is retried with the exact Jacobian at the
+/// current iterate, and an exact step is halved until it does. Once within the tolerance, up
+/// to two more steps are taken while they lower the residual toward round-off, so that the
+/// balance of the reactions holds to the digits of the loads. Returns the iterate and its
+/// residual, the last pass at it; `None` if the tolerance is not met.
 fn exact_newton(
     p: &mut Constrained<'_>,
     x: &[f64],
     opts: &NewtonOptions,
     effort: &mut Effort,
     residual_first: bool,
+    normal_first: bool,
 ) -> Option<(Vec<f64>, f64)> {
     let n = p.dim();
     let mut x = x.to_vec();
@@ -642,11 +644,18 @@ fn exact_newton(
     if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
         return None;
     }
+    let mut exact = true;
     let mut norm = max_norm(&r);
-    let (mut xt, mut rt, mut jt) = (vec![0.0; n], vec![0.0; n], vec![0.0; n * n]);
+    let (mut xt, mut rt) = (vec![0.0; n], vec![0.0; n]);
+    if normal_first && predict(p, &mut x, &mut j, &mut r, effort) {
+        exact = false;
+        norm = max_norm(&r);
+    }
     let mut lu = DenseLu::default();
     let mut refined = 0;
-    for _ in 0..opts.max_iterations {
+    // At most `max_iterations` accepted steps, and as many exact re-evaluations.
+    let (mut steps, mut retries) = (0, 0);
+    while steps < opts.max_iterations && retries <= opts.max_iterations {
         if norm <= opts.tolerance {
             if norm <= round_off(opts) || refined >= 2 {
                 return Some((x, norm));
@@ -655,7 +664,17 @@ fn exact_newton(
         }
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
         if !(lu.factor(n, &j) && lu.solve_in_place(&mut dx)) {
-            break;
+            if exact {
+                break;
+            }
+            // A singular update: the exact Jacobian here.
+            retries += 1;
+            if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
+                break;
+            }
+            exact = true;
+            norm = max_norm(&r);
+            continue;
         }
         let mut alpha = 1.0;
         let mut accepted = false;
@@ -663,26 +682,39 @@ fn exact_newton(
             for k in 0..n {
                 xt[k] = x[k] + alpha * dx[k];
             }
-            if p.evaluate(&xt, 1.0, Some(&mut jt), &mut rt) == Evaluated::Jacobian {
+            if p.evaluate(&xt, 1.0, None, &mut rt) != Evaluated::Failed {
                 let trial = max_norm(&rt);
                 if trial <= (1.0 - 1e-4 * alpha) * norm {
                     accepted = true;
                     break;
                 }
             }
-            if norm <= opts.tolerance {
-                // Refining: a step that does not help ends it.
+            if norm <= opts.tolerance || !exact {
+                // Refining, or a Broyden step: a step that does not help is not halved.
                 break;
             }
             alpha *= 0.5;
         }
         if !accepted {
-            break;
+            if exact {
+                break;
+            }
+            // The exact Jacobian at the iterate, and its step.
+            retries += 1;
+            if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
+                break;
+            }
+            exact = true;
+            norm = max_norm(&r);
+            continue;
         }
         effort.iterations += 1;
+        steps += 1;
+        let step: Vec<f64> = dx.iter().map(|v| alpha * v).collect();
+        broyden(&mut j, &step, &r, &rt);
+        exact = false;
         std::mem::swap(&mut x, &mut xt);
         std::mem::swap(&mut r, &mut rt);
-        std::mem::swap(&mut j, &mut jt);
         norm = max_norm(&r);
     }
     if norm > opts.tolerance {
@@ -693,6 +725,100 @@ fn exact_newton(
         return None;
     }
     Some((x, norm))
+}
+
+/// The predictor of newly added contacts ([`normal_step`]) from `x` with the exact Jacobian
+/// `j` and residual `r` there: taken (and `j` updated by Broyden's formula) if it lowers the
+/// gaps; `true` then, with `x`, `j` and `r` at the new iterate.
+fn predict(
+    p: &mut Constrained<'_>,
+    x: &mut Vec<f64>,
+    j: &mut [f64],
+    r: &mut Vec<f64>,
+    effort: &mut Effort,
+) -> bool {
+    let Some(dx) = normal_step(p, x, j, r) else {
+        return false;
+    };
+    let xt: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
+    let mut rt = vec![0.0; r.len()];
+    let offsets = p.offsets();
+    let gaps = |r: &[f64]| offsets.iter().map(|&o| r[o].abs()).fold(0.0, f64::max);
+    if p.evaluate(&xt, 1.0, None, &mut rt) == Evaluated::Failed || gaps(&rt) >= gaps(r) {
+        return false;
+    }
+    effort.iterations += 1;
+    broyden(j, &dx, r, &rt);
+    *x = xt;
+    *r = rt;
+    true
+}
+
+/// Broyden's update of the column-major Jacobian `j` by the step `dx` that took the
+/// residual from `r` to `rt`: `J += (Δr - J Δx) Δxᵀ / (Δxᵀ Δx)`.
+fn broyden(j: &mut [f64], dx: &[f64], r: &[f64], rt: &[f64]) {
+    let n = dx.len();
+    let ss: f64 = dx.iter().map(|v| v * v).sum();
+    if ss <= 0.0 {
+        return;
+    }
+    let mut u: Vec<f64> = (0..n).map(|i| rt[i] - r[i]).collect();
+    for (c, sc) in dx.iter().enumerate() {
+        for (i, ui) in u.iter_mut().enumerate() {
+            *ui -= j[i + n * c] * sc;
+        }
+    }
+    for (c, sc) in dx.iter().enumerate() {
+        let w = sc / ss;
+        for (i, ui) in u.iter().enumerate() {
+            j[i + n * c] += ui * w;
+        }
+    }
+}
+
+/// The step from `x` (Jacobian `j`, residual `r`, the last pass at `x`) of the linearised
+/// problem with every contact held at its arc length and its force changed along the
+/// obstacle's normal there: the tip rows and the gap rows solved for the base wrench and one
+/// normal force per contact (the contact-free compliance along the normal gives the force
+/// that closes the gap). `None` if that system is singular.
+fn normal_step(p: &Constrained<'_>, x: &[f64], j: &[f64], r: &[f64]) -> Option<Vec<f64>> {
+    let n = p.dim();
+    let forces = p.normal_forces(x);
+    let offsets = p.offsets();
+    let m = 6 + p.active.len();
+    let rows: Vec<usize> = (0..6).chain(offsets.iter().copied()).collect();
+    let first_force: Vec<usize> = p
+        .active
+        .iter()
+        .zip(&offsets)
+        .map(|(a, &o)| if a.site == Site::Tip { o } else { o + 1 })
+        .collect();
+    let mut a = vec![0.0; m * m];
+    for c in 0..6 {
+        for (ri, &i) in rows.iter().enumerate() {
+            a[ri + m * c] = j[i + n * c];
+        }
+    }
+    for (k, &f0) in first_force.iter().enumerate() {
+        let normal = forces.get(k)?.1;
+        for (ri, &i) in rows.iter().enumerate() {
+            a[ri + m * (6 + k)] = (0..3).map(|q| j[i + n * (f0 + q)] * normal[q]).sum();
+        }
+    }
+    let mut rhs: Vec<f64> = rows.iter().map(|&i| -r[i]).collect();
+    let mut lu = DenseLu::default();
+    if !(lu.factor(m, &a) && lu.solve_in_place(&mut rhs)) {
+        return None;
+    }
+    let mut dx = vec![0.0; n];
+    dx[..6].copy_from_slice(&rhs[..6]);
+    for (k, &f0) in first_force.iter().enumerate() {
+        let normal = forces[k].1;
+        for q in 0..3 {
+            dx[f0 + q] = rhs[6 + k] * normal[q];
+        }
+    }
+    Some(dx)
 }
 
 /// Normal forces, normal, arc length and point of each active contact at `x`.
@@ -719,11 +845,31 @@ fn candidates(p: &Constrained<'_>, forces: &Forces, penetration: f64) -> Vec<(us
                 .zip(forces)
                 .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
             if minimum && !taken && !inside {
-                added.push((o, if at_tip { Site::Tip } else { Site::Interior }, s));
+                if at_tip {
+                    added.push((o, Site::Tip, s));
+                } else {
+                    added.push((o, Site::Interior, parabola_minimum(&g[i - 1..=i + 1])));
+                }
             }
         }
     }
     added
+}
+
+/// The arc length of the least gap of the parabola through three consecutive samples
+/// `(_, s, gap, _)` whose middle one is a local minimum (its own arc length if the three are
+/// collinear): a new contact starts where the gap is least, not at the nearest node.
+fn parabola_minimum(g: &[(usize, f64, f64, Vector3<f64>)]) -> f64 {
+    let ((_, s0, g0, _), (_, s1, g1, _), (_, s2, g2, _)) = (g[0], g[1], g[2]);
+    let (h0, h1) = (s1 - s0, s2 - s1);
+    let (d0, d1) = ((g1 - g0) / h0, (g2 - g1) / h1);
+    let curvature = 2.0 * (d1 - d0) / (h0 + h1);
+    if !(curvature > 0.0 && h0 > 0.0 && h1 > 0.0) {
+        return s1;
+    }
+    // The slope at s1 of the parabola, and its zero.
+    let slope = (d0 * h1 + d1 * h0) / (h0 + h1);
+    (s1 - slope / curvature).clamp(s0, s2)
 }
 
 /// A plane touched twice (or an interval touched before its edge) becomes one interval from
@@ -798,7 +944,7 @@ fn add_contacts(
         x.extend([0.0; 3]);
     }
     // Straight to the contact (one exact Newton solve), else by relaxing the gaps.
-    if let Some((xs, _)) = exact_newton(p, &x, opts, effort, false) {
+    if let Some((xs, _)) = exact_newton(p, &x, opts, effort, false, true) {
         return Some(xs);
     }
     // The gap targets of the new contacts: their rows at zero force.
@@ -1082,7 +1228,7 @@ fn fail(
 /// result, whose residual is returned (`None` if it cannot be integrated).
 fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Option<(Vec<f64>, f64)> {
     let mut effort = Effort::default();
-    if let Some(out) = exact_newton(p, x, &options.newton, &mut effort, true) {
+    if let Some(out) = exact_newton(p, x, &options.newton, &mut effort, true, false) {
         return Some(out);
     }
     let mut r = vec![0.0; p.dim()];
@@ -1202,6 +1348,23 @@ fn held_stability(
     (stable, margin, count)
 }
 
+/// With a free tip, the stability of the contacts as dead loads from the exact Jacobian of
+/// the pass at `x` (its base-wrench block and tip columns, as the compliance left it), so
+/// that no march with the columns is needed again; `None` otherwise.
+fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) -> Option<Stability> {
+    let (j, twists) = pass.jacobian.as_ref()?;
+    if p.tip.is_some() || pass.key != p.key(x, 1.0) || twists.len() < 6 {
+        return None;
+    }
+    let n = p.dim();
+    let mut y = [0.0; 36];
+    for c in 0..6 {
+        y[6 * c..6 * c + 6].copy_from_slice(&j[n * c..n * c + 6]);
+    }
+    let tw: [Vector6<f64>; 6] = std::array::from_fn(|k| twists[k]);
+    tip_stability(&y, &tw, p.model.length())
+}
+
 /// The solution at the converged unknowns `x`: the shape with its contact forces, the tip
 /// reaction, the contacts, the stability.
 fn finish(
@@ -1239,6 +1402,7 @@ fn finish(
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
+    let free_stability = jacobian_stability(p, &pass, x);
     let cm = Arc::clone(&pass.model);
     let plan = match options.integrator {
         Integrator::Rk4 { steps } => rk4_plan(cm.breaks(), steps),
@@ -1252,7 +1416,12 @@ fn finish(
         profile: None,
     };
     let mut sh = Shooting::new(eq, options.integrator, plan);
-    let (res, cols, _) = sh.pass::<FULL>(&x[..6], 1.0).map_err(|e| {
+    let marched = if p.tip.is_none() {
+        sh.pass::<STATE>(&x[..6], 1.0)
+    } else {
+        sh.pass::<FULL>(&x[..6], 1.0)
+    };
+    let (res, cols, _) = marched.map_err(|e| {
         Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
     })?;
     let tip_twist = sh.tip_twist;
@@ -1283,6 +1452,9 @@ fn finish(
         conjugate = count;
         sol.stable = stable && sol.stats.converged;
         let _ = sol.margin.set(margin);
+    } else if let Some(st) = free_stability.filter(|_| sol.stats.converged) {
+        let _ = sol.margin.set(st.margin);
+        sol.stable = st.stable;
     } else {
         sol.stable = sol.stats.converged && sol.stability_margin() > -NEUTRAL_MARGIN;
     }

@@ -67,7 +67,7 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use crate::error::Error;
 use crate::integrate::march::Piecewise;
 use crate::integrate::System;
-use crate::math::linalg::Lu6;
+use crate::math::linalg::Inverse6;
 use crate::math::so3::{hat, reorthonormalise};
 use crate::model::actuation::TensionProfile;
 use crate::model::loads::Frame;
@@ -129,6 +129,38 @@ pub(crate) fn rotation_variation(r: &Matrix3<f64>, dr: &Matrix3<f64>) -> Vector3
     )
 }
 
+/// `A û` (column-major, into `out`): column `j` is `A (u × e_j)`, 18 products instead of
+/// the 27 of a 3×3 product.
+#[inline]
+pub(crate) fn mul_hat(a: &Matrix3<f64>, u: &Vector3<f64>, out: &mut [f64]) {
+    let (a0, a1, a2) = (a.column(0), a.column(1), a.column(2));
+    let c0 = a1 * u.z - a2 * u.y;
+    let c1 = a2 * u.x - a0 * u.z;
+    let c2 = a0 * u.y - a1 * u.x;
+    out[..3].copy_from_slice(c0.as_slice());
+    out[3..6].copy_from_slice(c1.as_slice());
+    out[6..9].copy_from_slice(c2.as_slice());
+}
+
+/// `A û + B ŵ` (column-major, into `out`), as [`mul_hat`].
+#[inline]
+pub(crate) fn mul_hat2(
+    a: &Matrix3<f64>,
+    u: &Vector3<f64>,
+    b: &Matrix3<f64>,
+    w: &Vector3<f64>,
+    out: &mut [f64],
+) {
+    let (a0, a1, a2) = (a.column(0), a.column(1), a.column(2));
+    let (b0, b1, b2) = (b.column(0), b.column(1), b.column(2));
+    let c0 = a1 * u.z - a2 * u.y + b1 * w.z - b2 * w.y;
+    let c1 = a2 * u.x - a0 * u.z + b2 * w.x - b0 * w.z;
+    let c2 = a0 * u.y - a1 * u.x + b0 * w.y - b1 * w.x;
+    out[..3].copy_from_slice(c0.as_slice());
+    out[3..6].copy_from_slice(c1.as_slice());
+    out[6..9].copy_from_slice(c2.as_slice());
+}
+
 /// Re-orthonormalises the rotation part of a state, and maps each column's `δR` by the
 /// derivative of the same step, `δR (3I - RᵀR)/2 - R (δRᵀR + RᵀδR)/2` (at the unprojected
 /// `R`).
@@ -149,29 +181,20 @@ pub(crate) fn project<const N: usize>(y: &mut [f64; N]) {
 }
 
 /// The tangent `d(v, u)/d(n_b, m_b)` of one constitutive solve: `(I + C D)⁻¹ C` with active
-/// tendons (`lu` the factorised `I + C D`), `C` (`diag`) without.
+/// tendons (`lu` the inverted `I + C D`), `C` (`diag`) without.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Tangent {
     pub diag: [f64; 6],
-    pub lu: Option<Lu6>,
+    pub lu: Option<Inverse6>,
 }
 
 impl Tangent {
     /// `d(v, u)` for the body-wrench perturbation `e`.
-    #[inline]
+    #[inline(always)]
     pub fn apply(&self, e: &[f64; 6]) -> [f64; 6] {
-        let c = &self.diag;
-        let cw = [
-            c[0] * e[0],
-            c[1] * e[1],
-            c[2] * e[2],
-            c[3] * e[3],
-            c[4] * e[4],
-            c[5] * e[5],
-        ];
         match &self.lu {
-            None => cw,
-            Some(lu) => lu.solve(&cw),
+            None => std::array::from_fn(|k| self.diag[k] * e[k]),
+            Some(lu) => lu.solve_scaled(&self.diag, e),
         }
     }
 }
@@ -270,8 +293,8 @@ pub(crate) struct Workspace {
     pub offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
     /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
     pub guess: Option<Vector6<f64>>,
-    /// Factorised local Jacobian of the last local Newton iteration (chord steps).
-    pub last_lu: Option<Lu6>,
+    /// Inverted local Jacobian of the last local Newton iteration (chord steps).
+    pub last_lu: Option<Inverse6>,
     /// `|p_i'|` of every tendon at the last evaluation (zero for tendons not in the interval).
     pub tendon_speed: Vec<f64>,
     /// Right-hand-side evaluations so far.
@@ -622,6 +645,23 @@ impl Evaluator<'_, '_> {
         Vector6::new(t.x, t.y, t.z, q.x, q.y, q.z)
     }
 
+    /// Tendon load sums `(Σ τ t, Σ τ r × t)` at the strains `x = (v, u)` (the chord steps of
+    /// the local iteration: [`Self::tendon_sums`] without the Jacobian).
+    #[inline]
+    pub(crate) fn tendon_load(&self, x: &Vector6<f64>) -> Vector6<f64> {
+        let v = Vector3::new(x[0], x[1], x[2]);
+        let u = Vector3::new(x[3], x[4], x[5]);
+        let mut tf = Vector3::zeros();
+        let mut tm = Vector3::zeros();
+        for (r, rp, tau) in &self.ws.offsets {
+            let w = v + u.cross(r) + rp;
+            let t = w * (*tau / w.norm());
+            tf += t;
+            tm += r.cross(&t);
+        }
+        Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)
+    }
+
     /// Tendon load sums `(Σ τ t, Σ τ r × t)` at the strains `x = (v, u)`, and, if `jac`, the
     /// local Jacobian `I + C D` (see the module documentation).
     ///
@@ -635,6 +675,20 @@ impl Evaluator<'_, '_> {
         c: &[f64; 6],
         jac: bool,
     ) -> (Vector6<f64>, Option<Matrix6<f64>>) {
+        self.tendon_sums_into(x, c, jac, None)
+    }
+
+    /// [`Self::tendon_sums`]; with `stiffness`, `D` itself goes there (rows) instead of
+    /// `I + C D`.
+    #[inline]
+    pub(crate) fn tendon_sums_into(
+        &self,
+        x: &Vector6<f64>,
+        c: &[f64; 6],
+        jac: bool,
+        stiffness: Option<&mut [[f64; 6]; 6]>,
+    ) -> (Vector6<f64>, Option<Matrix6<f64>>) {
+        let jac = jac || stiffness.is_some();
         let v = Vector3::new(x[0], x[1], x[2]);
         let u = Vector3::new(x[3], x[4], x[5]);
         let mut tf = Vector3::zeros();
@@ -674,6 +728,18 @@ impl Evaluator<'_, '_> {
         let dfu = -(rh + tq);
         let dmv = rh - tq.transpose();
         let dmu = Matrix3::identity() * ar2 - rr - qq;
+        if let Some(out) = stiffness {
+            // D is symmetric: [[dfv, dfu], [dmv = dfuᵀ, dmu]].
+            for i in 0..3 {
+                for j in 0..3 {
+                    out[i][j] = dfv[(i, j)];
+                    out[i][j + 3] = dfu[(i, j)];
+                    out[i + 3][j] = dmv[(i, j)];
+                    out[i + 3][j + 3] = dmu[(i, j)];
+                }
+            }
+            return (sums, None);
+        }
         let mut h = Matrix6::identity();
         for i in 0..3 {
             for j in 0..3 {
@@ -764,9 +830,15 @@ impl Evaluator<'_, '_> {
         };
         let mut out = Local::strains(&x);
         if tangent {
-            // (I + C D)⁻¹ C at the solution.
-            let (_, h) = self.tendon_sums(&x, &c, true);
-            let Some(lu) = h.as_ref().and_then(Lu6::new) else {
+            // (I + C D)⁻¹ C at the solution: by Cholesky of the similar I + C^½ D C^½
+            // (D is symmetric positive semi-definite), else by Gauss–Jordan.
+            let mut d = [[0.0; 6]; 6];
+            self.tendon_sums_into(&x, &c, true, Some(&mut d));
+            let lu = Inverse6::of_compliance_stiffness(&c, &d).or_else(|| {
+                let (_, h) = self.tendon_sums(&x, &c, true);
+                h.as_ref().and_then(Inverse6::new)
+            });
+            let Some(lu) = lu else {
                 return Local::nan();
             };
             self.ws.tangent = Tangent {
@@ -794,11 +866,14 @@ impl Evaluator<'_, '_> {
         let mut last_step = f64::INFINITY;
         let mut chord = self.ws.last_lu.is_some();
         for _ in 0..LOCAL_MAX_ITERATIONS {
-            let (tw, h) = self.tendon_sums(&x, c, !chord);
+            let tw = if chord {
+                self.tendon_load(&x)
+            } else {
+                let (tw, h) = self.tendon_sums(&x, c, true);
+                self.ws.last_lu = Some(Inverse6::new(&h?)?);
+                tw
+            };
             let g = x - xs - cd.component_mul(&(wv - tw));
-            if let Some(h) = h {
-                self.ws.last_lu = Some(Lu6::new(&h)?);
-            }
             let lu = self.ws.last_lu.as_ref()?;
             let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
             x -= dx;
@@ -875,11 +950,10 @@ impl Evaluator<'_, '_> {
         let loc = self.local(s, &props, &nb, &mb, ncol > 0);
         let (v, u) = (loc.v, loc.u);
         let pd = r * v;
-        let rd = r * hat(&u);
         let nd = -eq.distributed_force(s, &props);
         let md = -pd.cross(&nw) - eq.distributed_moment(s);
         put3(out, 0, &pd);
-        out[3..12].copy_from_slice(rd.as_slice());
+        mul_hat(&r, &u, &mut out[3..12]);
         put3(out, 12, &nd);
         put3(out, 15, &md);
         let nt = self.ws.tendon_speed.len();
@@ -909,6 +983,7 @@ impl Evaluator<'_, '_> {
             mb.y - loc.tendon_moment.y,
             mb.z - loc.tendon_moment.z,
         );
+        let tangent = self.ws.tangent;
         for c in 0..ncol {
             let b = STATE + COLUMN * c;
             let dr = col_rot(y, b);
@@ -927,16 +1002,15 @@ impl Evaluator<'_, '_> {
                 }
                 offset_rate = rate;
             }
-            let d = self.ws.tangent.apply(&e);
+            let d = tangent.apply(&e);
             let (dv, du) = (
                 Vector3::new(d[0], d[1], d[2]),
                 Vector3::new(d[3], d[4], d[5]),
             );
             let dpd = dr * v + r * dv;
-            let drd = dr * hat(&u) + r * hat(&du);
             let dmd = -(dpd.cross(&nw) + pd.cross(&dn));
             put3(out, b, &dpd);
-            out[b + DR..b + DR + 9].copy_from_slice(drd.as_slice());
+            mul_hat2(&dr, &u, &r, &du, &mut out[b + DR..b + DR + 9]);
             put3(out, b + DN, &Vector3::zeros());
             put3(out, b + DM, &dmd);
             for h in 0..nl {

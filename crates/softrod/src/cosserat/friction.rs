@@ -28,26 +28,28 @@
 //! the constitutive split `n = N − Σ τ_i(s) t_i`. The rod therefore receives from each tendon
 //! the distributed load `d(τ_i t_i)/ds = τ_i t_i' + τ_i' t_i` (normal load plus the friction
 //! force, opposite to the friction on the tendon) and, at the termination, the point force
-//! `−τ_i(σ) t_i(σ)` with the local tension. The shape and the profile are found together by a
-//! fixed-point iteration: solve the rod for the current profile (interpolated geometrically
-//! between the mesh nodes), recompute the profile from the shape, until the tension changes by
-//! less than [`FrictionOptions::tolerance`] relative to the largest base tension.
+//! `−τ_i(σ) t_i(σ)` with the local tension. The shape and the profile are found together in
+//! one march with the tension a state (`friction_march`): without external loads at the known
+//! zero base wrench, with them at every iterate of a quasi-Newton iteration on the base
+//! wrench. The independent formulation, and the fallback when that iteration fails, is a
+//! fixed point: solve the rod for the current profile (interpolated geometrically between the
+//! mesh nodes), recompute the profile from the shape, until the tension changes by less than
+//! [`FrictionOptions::tolerance`] relative to the largest base tension.
 
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
-use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, STATE};
-use crate::cosserat::shooting::{Node, Shooting};
+pub use super::friction_march::MAX_CELL_ATTEMPTS;
+use super::friction_march::{solve_marched, Setup};
+use crate::cosserat::equations::{Equations, Evaluator, Workspace, STATE};
 use crate::cosserat::statics::{
-    assemble, interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
+    interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
 };
 use crate::error::{Error, Result};
-use crate::integrate::march::{march, Piecewise, Scheme};
-use crate::integrate::{adaptive, fixed, DP5, RK4};
+use crate::integrate::march::{march, Scheme};
 use crate::model::actuation::TensionProfile;
 use crate::model::{Actuation, RobotModel};
-use crate::solve::SolverStats;
 
 /// Default relative tolerance of the fixed point on the tension profile.
 pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-9;
@@ -73,9 +75,10 @@ pub struct FrictionOptions {
     pub tolerance: f64,
     /// Cap on the fixed-point iterations.
     pub max_iterations: usize,
-    /// Solve a model without external loads in one march with the tension as a state
-    /// (default `true`); `false`: by the fixed point on the profile, as loaded models are
-    /// (the same discrete equations, an independent solve of them).
+    /// Solve in one march with the tension as a state (default `true`; with external loads,
+    /// one march per quasi-Newton iterate of the base wrench, the fixed point if that
+    /// iteration fails); `false`: by the fixed point on the profile (the same discrete
+    /// equations, an independent solve of them).
     pub single_march: bool,
 }
 
@@ -135,8 +138,8 @@ pub struct FrictionalSolution {
     /// tendon being inextensible and anchored at its termination, its slip toward the base
     /// at a node between two states is the change of `path length − path_length[node]`.
     pub path_length: Vec<Vec<f64>>,
-    /// Rod solves: 1 for the one march of an unloaded model, the fixed-point iterations
-    /// otherwise.
+    /// Marches: 1 for an unloaded model, one per quasi-Newton iterate of a loaded one; the
+    /// rod solves of the fixed point when it was used.
     pub iterations: usize,
     /// Integration steps over the cells of the friction mesh, all rod solves and repeated
     /// cells together (a rod solve without friction takes one per cell and Newton iteration).
@@ -201,7 +204,7 @@ fn tangents(model: &RobotModel, sol: &StaticsSolution) -> Vec<Vec<Option<Vector3
 
 /// Per tendon, the unit path tangent (world) at `s` of a section of rotation `r` and strains
 /// `(v, u)`, `None` where the tendon is not there (beyond its termination).
-fn node_tangents(
+pub(super) fn node_tangents(
     model: &RobotModel,
     s: f64,
     r: &Matrix3<f64>,
@@ -228,7 +231,7 @@ fn node_tangents(
 }
 
 /// The tangents per node and tendon as arrays (zero where the tendon is not there).
-fn tangent_rows(dirs: &[Vec<Option<Vector3<f64>>>]) -> Vec<Vec<[f64; 3]>> {
+pub(super) fn tangent_rows(dirs: &[Vec<Option<Vector3<f64>>>]) -> Vec<Vec<[f64; 3]>> {
     dirs.iter()
         .map(|row| {
             row.iter()
@@ -239,13 +242,13 @@ fn tangent_rows(dirs: &[Vec<Option<Vector3<f64>>>]) -> Vec<Vec<[f64; 3]>> {
 }
 
 /// The angle (rad) between two unit vectors.
-fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+pub(super) fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
 /// The slip state at the base of a tendon pulled with `base` (N) after `previous` (N; `None`:
 /// from rest).
-fn base_slip(base: f64, previous: Option<f64>) -> Slip {
+pub(super) fn base_slip(base: f64, previous: Option<f64>) -> Slip {
     match previous {
         None => Slip::Loading,
         Some(q) if (base - q).abs() <= STICK_TOLERANCE * q => Slip::Stick,
@@ -258,7 +261,7 @@ fn base_slip(base: f64, previous: Option<f64>) -> Slip {
 /// its proximal node, `mu_theta = μ Δθ` over the cell and the previous tension `q` at the
 /// distal node (`None`: from rest, sliding toward the base); an element within rounding of
 /// its previous tension sticks.
-fn cell_rule(tau: f64, mu_theta: f64, q: Option<f64>) -> (f64, Slip) {
+pub(super) fn cell_rule(tau: f64, mu_theta: f64, q: Option<f64>) -> (f64, Slip) {
     let g = mu_theta.exp();
     let (lo, hi) = (tau / g, tau * g);
     match q {
@@ -304,7 +307,7 @@ fn profile_on(
 }
 
 /// The tension profile of the frictional tendons (the others carry their base tension).
-fn to_profile(model: &RobotModel, s: &[f64], tau: &[Vec<f64>]) -> TensionProfile {
+pub(super) fn to_profile(model: &RobotModel, s: &[f64], tau: &[Vec<f64>]) -> TensionProfile {
     let nt = model.tendons().len();
     let ends = model.tendon_ends();
     let l = model.length();
@@ -364,7 +367,7 @@ fn check_inputs(
 }
 
 /// Every tendon at its base tension over its length, 0 beyond (per node and tendon).
-fn base_profile(model: &RobotModel, mesh: &[f64], base: &[f64]) -> Vec<Vec<f64>> {
+pub(super) fn base_profile(model: &RobotModel, mesh: &[f64], base: &[f64]) -> Vec<Vec<f64>> {
     let (ends, l) = (model.tendon_ends(), model.length());
     mesh.iter()
         .map(|&s| {
@@ -379,6 +382,29 @@ fn base_profile(model: &RobotModel, mesh: &[f64], base: &[f64]) -> Vec<Vec<f64>>
                 .collect()
         })
         .collect()
+}
+
+/// The tension profile of `previous`, checked to be on `mesh` with `nt` tendons.
+fn previous_profile<'p>(
+    previous: Option<&'p FrictionalSolution>,
+    mesh: &[f64],
+    nt: usize,
+) -> Result<Option<&'p [Vec<f64>]>> {
+    let Some(p) = previous else {
+        return Ok(None);
+    };
+    if p.statics.s != mesh || p.tension.first().map_or(0, Vec::len) != nt {
+        return Err(Error::invalid(
+            "previous",
+            format!("a solution on {} nodes", p.statics.s.len()),
+            format!(
+                "a frictional solution of the same robot and integrator ({} nodes, {nt} \
+                 tendons)",
+                mesh.len()
+            ),
+        ));
+    }
+    Ok(Some(p.tension.as_slice()))
 }
 
 /// Solves the statics of `model` under `actuation` with capstan friction along the tendons
@@ -401,25 +427,19 @@ pub fn solve_frictional(
     let nt = model.tendons().len();
     let base = actuation.tension_values(nt);
     let mesh = friction_mesh(model, &options.statics.integrator);
-    let prev = match previous {
-        Some(p) => {
-            if p.statics.s != mesh || p.tension.first().map_or(0, Vec::len) != nt {
-                return Err(Error::invalid(
-                    "previous",
-                    format!("a solution on {} nodes", p.statics.s.len()),
-                    format!(
-                        "a frictional solution of the same robot and integrator ({} nodes, \
-                         {nt} tendons)",
-                        mesh.len()
-                    ),
-                ));
-            }
-            Some(p.tension.as_slice())
+    let prev = previous_profile(previous, &mesh, nt)?;
+    if options.single_march {
+        let setup = Setup {
+            model,
+            actuation,
+            options,
+            mesh: &mesh,
+            base: &base,
+            prev,
+        };
+        if let Some(sol) = solve_marched(&setup, previous)? {
+            return Ok(sol);
         }
-        None => None,
-    };
-    if options.single_march && model.loads().is_unloaded() {
-        return solve_unloaded(model, actuation, options, &mesh, &base, prev);
     }
     let scale = base
         .iter()
@@ -618,7 +638,7 @@ impl Anderson {
 
 /// `τ_i'(s) t_i` at the nodes (N/m): the slope of `ln τ` over the neighbouring cells longer
 /// than the break offset, times `τ`.
-fn friction_forces(
+pub(super) fn friction_forces(
     s: &[f64],
     tau: &[Vec<f64>],
     dirs: &[Vec<Option<Vector3<f64>>>],
@@ -667,339 +687,4 @@ pub fn solve_path(
         out.push(next);
     }
     Ok(out)
-}
-
-/// Cap on the evaluations of one cell of the frictional march (each one step of the rod over
-/// the cell and a constitutive solve at its distal node).
-pub const MAX_CELL_ATTEMPTS: usize = 60;
-
-/// The next guess of the distal tensions of a cell from the last two attempts: per tendon, a
-/// secant step on `rule(g) = g` (the rule's slope `ρ` from the two attempts) where `|ρ| < 0.9`,
-/// else the rule's value (a fixed-point step).
-fn next_guess(guess: &mut [f64], rule: &[f64], last: Option<(&[f64], &[f64])>) {
-    for i in 0..guess.len() {
-        let (g, r) = (guess[i], rule[i]);
-        let mut next = r;
-        if let Some((g0, r0)) = last {
-            let rho = (r - r0[i]) / (g - g0[i]);
-            if rho.is_finite() && rho.abs() < 0.9 {
-                let secant = g + (r - g) / (1.0 - rho);
-                if secant.is_finite() && secant >= 0.0 {
-                    next = secant;
-                }
-            }
-        }
-        guess[i] = next;
-    }
-}
-
-/// Extrapolation weights of the next value of a smooth sequence from its last `m` values
-/// (polynomial of degree `m - 1`, most recent first).
-const EXTRAPOLATION: [&[f64]; 4] = [
-    &[1.0],
-    &[2.0, -1.0],
-    &[3.0, -3.0, 1.0],
-    &[4.0, -6.0, 4.0, -1.0],
-];
-
-/// The turning rate (rad/m) of tendon `i` over the next cell, extrapolated from the last (up
-/// to four) cells that inform it (`rates`: per cell and tendon, `None` for a cell shorter than
-/// ten break offsets, across a break, or without the tendon); 0 without one.
-fn extrapolated_rate(rates: &[Option<f64>], nt: usize, i: usize) -> f64 {
-    let last = rates
-        .chunks_exact(nt)
-        .rev()
-        .take(EXTRAPOLATION.len())
-        .map_while(|r| r[i]);
-    let values: Vec<f64> = last.collect();
-    match values.len() {
-        0 => 0.0,
-        m => EXTRAPOLATION[m - 1]
-            .iter()
-            .zip(&values)
-            .map(|(w, r)| w * r)
-            .sum(),
-    }
-}
-
-/// The frictional equilibrium of an unloaded model (no external load: the total wrench is
-/// zero all along, `x = 0` is the shooting solution) in one march over the friction mesh:
-/// the tension is a state of the march, the capstan rule applied cell by cell. Over a cell the
-/// distal tension `τ_{k+1}` sets the profile the rod is integrated with (geometric between the
-/// nodes) and the rule on the resulting shape sets `τ_{k+1}`: the cell is repeated from its
-/// proximal node until the two agree to `options.tolerance` times the largest base tension
-/// (a secant iteration from a first guess extrapolated from the turning rate of the last two
-/// cells; most cells take one or two steps).
-#[allow(clippy::too_many_lines)] // one sequential march
-fn solve_unloaded(
-    model: &Arc<RobotModel>,
-    actuation: &Actuation,
-    options: &FrictionOptions,
-    mesh: &[f64],
-    base: &[f64],
-    prev: Option<&[Vec<f64>]>,
-) -> Result<FrictionalSolution> {
-    let nt = base.len();
-    let pressures = actuation.pressure_values(model.chambers().len());
-    let (l, ends, breaks) = (model.length(), model.tendon_ends(), model.breaks());
-    let mus: Vec<f64> = model.tendons().iter().map(|t| t.friction()).collect();
-    let present = |i: usize, s: f64| s < ends[i] || (ends[i] == l && s == l);
-    let mut cell = TensionProfile::new(
-        (0..nt)
-            .map(|i| (mus[i] > 0.0).then(|| (vec![0.0, 0.0], vec![base[i]; 2])))
-            .collect(),
-    );
-    let scale = base
-        .iter()
-        .fold(0.0, |a: f64, &b| a.max(b))
-        .max(f64::MIN_POSITIVE);
-    let tol = options.tolerance * scale;
-    let n = mesh.len();
-    let mut tau = vec![vec![0.0; nt]; n];
-    let mut slip = vec![vec![Slip::Absent; nt]; n];
-    let mut dirs: Vec<Vec<Option<Vector3<f64>>>> = Vec::with_capacity(n);
-    let mut nodes = Vec::with_capacity(n);
-    let mut ws = Workspace::new(nt);
-    ws.set_columns(&[], &[]);
-    ws.track_lengths = true;
-    let eq = Equations {
-        model,
-        tensions: base,
-        pressures: &pressures,
-        load_factor: 1.0,
-        profile: None,
-    };
-    let plan = match options.statics.integrator {
-        Integrator::Rk4 { steps } => crate::integrate::march::rk4_plan(breaks, steps),
-        Integrator::Adaptive(_) => Vec::new(),
-    };
-    // The strains at the node `s` of state `y` and the tendons' path tangents there. Without
-    // external loads the total wrench is zero all along, so the strains depend on `s` alone:
-    // after an RK4 step (`reuse`) they are those of its last stage, at the same `s`.
-    let at_node = |ev: &mut Evaluator<'_, '_>, s: f64, y: &[f64; STATE], reuse: bool| {
-        let r = rot(y);
-        let (v, u) = match ev.ws.guess.filter(|_| reuse && !ev.ws.active.is_empty()) {
-            Some(x) => (
-                Vector3::new(x[0], x[1], x[2]),
-                Vector3::new(x[3], x[4], x[5]),
-            ),
-            None => {
-                let props = model.rod().section_at(s);
-                let loc = ev.local(
-                    s,
-                    &props,
-                    &r.tr_mul(&v3(y, 12)),
-                    &r.tr_mul(&v3(y, 15)),
-                    false,
-                );
-                (loc.v, loc.u)
-            }
-        };
-        let finite = v.iter().chain(u.iter()).all(|c| c.is_finite());
-        finite.then(|| node_tangents(model, s, &r, &v, &u))
-    };
-    let reuse = matches!(options.statics.integrator, Integrator::Rk4 { .. });
-    let failed = |ws: &mut Workspace, what: String, attempts: usize, residual: f64| {
-        ws.material_error.take().unwrap_or(Error::NotConverged {
-            what,
-            iterations: attempts,
-            residual,
-            load_factor: 1.0,
-        })
-    };
-    let mut y: [f64; STATE] = eq.initial(&[0.0; 6]);
-    for i in 0..nt {
-        if present(i, 0.0) {
-            tau[0][i] = base[i];
-            slip[0][i] = base_slip(base[i], prev.map(|p| p[0][i]));
-        }
-    }
-    let mut interval = 0;
-    {
-        let mut ev = Evaluator {
-            eq: Equations {
-                profile: Some(&cell),
-                ..eq
-            },
-            ws: &mut ws,
-        };
-        ev.set_interval(0);
-        let Some(d) = at_node(&mut ev, 0.0, &y, false) else {
-            return Err(failed(
-                &mut ws,
-                "friction: the constitutive solve failed at the base".into(),
-                0,
-                f64::INFINITY,
-            ));
-        };
-        dirs.push(d);
-    }
-    nodes.push(Node {
-        s: 0.0,
-        interval: 0,
-        y,
-    });
-    let mut path_length = vec![vec![0.0; nt]; n];
-    let tiny = 10.0 * BREAK_OFFSET * l;
-    let mut rates: Vec<Option<f64>> = Vec::with_capacity(n * nt);
-    let (mut saved, mut guess, mut rule) = (Vec::new(), vec![0.0; nt], vec![0.0; nt]);
-    let mut rule_slip = vec![Slip::Absent; nt];
-    let mut last: Option<(Vec<f64>, Vec<f64>)>;
-    let mut attempts_total = 0;
-    let mut worst: f64 = 0.0;
-    for j in 0..n - 1 {
-        let (a, b) = (mesh[j], mesh[j + 1]);
-        let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
-        saved.clone_from(&ws.integral);
-        // First guess: the rule with the turning rate extrapolated from the last cells.
-        for i in 0..nt {
-            let theta = if crosses {
-                0.0
-            } else {
-                (extrapolated_rate(&rates, nt, i) * (b - a)).max(0.0)
-            };
-            guess[i] = if present(i, b) {
-                cell_rule(tau[j][i], mus[i] * theta, prev.map(|p| p[j + 1][i])).0
-            } else {
-                0.0
-            };
-        }
-        last = None;
-        let mut attempts = 0;
-        let (y1, k1, d1) = loop {
-            attempts += 1;
-            for i in 0..nt {
-                let distal = if present(i, b) { guess[i] } else { tau[j][i] };
-                cell.set_cell(i, [a, b], [tau[j][i], distal]);
-            }
-            let mut ev = Evaluator {
-                eq: Equations {
-                    profile: Some(&cell),
-                    ..eq
-                },
-                ws: &mut ws,
-            };
-            if ev.ws.interval != interval {
-                ev.set_interval(interval);
-            }
-            let stepped = match options.statics.integrator {
-                Integrator::Rk4 { .. } => fixed(&RK4, &mut ev, a, y, b, 1, |_, _, _| {}),
-                Integrator::Adaptive(o) => {
-                    adaptive(&DP5, &mut ev, [a, b], y, &o, STATE, |_, _, _| {}).map(|r| r.0)
-                }
-            };
-            let mut y1 = match stepped {
-                Ok(y1) => y1,
-                Err(e) => return Err(ev.ws.material_error.take().unwrap_or(e)),
-            };
-            let mut k1 = interval;
-            if crosses {
-                Piecewise::jump(&mut ev, b, &mut y1);
-                k1 += 1;
-                ev.set_interval(k1);
-            }
-            let Some(d1) = at_node(&mut ev, b, &y1, reuse && !crosses) else {
-                let what = format!("friction: the constitutive solve failed at s = {b} m");
-                return Err(failed(&mut ws, what, attempts, f64::INFINITY));
-            };
-            let mut change: f64 = 0.0;
-            for i in 0..nt {
-                (rule[i], rule_slip[i]) = match (&dirs[j][i], &d1[i]) {
-                    (Some(ta), Some(tb)) => {
-                        let mu_theta = if mus[i] > 0.0 {
-                            mus[i] * angle(ta, tb)
-                        } else {
-                            0.0
-                        };
-                        cell_rule(tau[j][i], mu_theta, prev.map(|p| p[j + 1][i]))
-                    }
-                    _ => (0.0, Slip::Absent),
-                };
-                change = change.max((rule[i] - guess[i]).abs());
-            }
-            if !change.is_finite() {
-                let what = "friction: the tension profile became non-finite".to_string();
-                return Err(failed(&mut ws, what, attempts, change));
-            }
-            if change <= tol {
-                worst = worst.max(change);
-                break (y1, k1, d1);
-            }
-            if attempts >= MAX_CELL_ATTEMPTS {
-                let what = format!(
-                    "friction: the tension at s = {b} m did not settle in {attempts} steps of \
-                     its cell (change {:e} > tolerance {:e} relative)",
-                    change / scale,
-                    options.tolerance
-                );
-                return Err(failed(&mut ws, what, attempts, change / scale));
-            }
-            let before = guess.clone();
-            next_guess(
-                &mut guess,
-                &rule,
-                last.as_ref().map(|(g, r)| (g.as_slice(), r.as_slice())),
-            );
-            last = Some((before, rule.clone()));
-            ws.integral.clone_from(&saved);
-        };
-        attempts_total += attempts;
-        rates.extend((0..nt).map(|i| match (&dirs[j][i], &d1[i]) {
-            (Some(ta), Some(tb)) if mus[i] > 0.0 && b - a > tiny && !crosses => {
-                Some(angle(ta, tb) / (b - a))
-            }
-            _ => None,
-        }));
-        tau[j + 1].copy_from_slice(&rule);
-        slip[j + 1].copy_from_slice(&rule_slip);
-        dirs.push(d1);
-        path_length[j + 1].copy_from_slice(&ws.integral[..nt]);
-        y = y1;
-        interval = k1;
-        nodes.push(Node { s: b, interval, y });
-    }
-    // The solution at the nodes, with the whole profile.
-    let mut act = actuation.clone();
-    act.profile = Some(Arc::new(to_profile(model, mesh, &tau)));
-    let profile = act.profile.clone();
-    let residual = eq.residual(&y, 0).0.amax();
-    let mut p = Shooting::new(
-        Equations {
-            profile: profile.as_deref(),
-            ..eq
-        },
-        options.statics.integrator,
-        plan,
-    );
-    p.nodes = nodes;
-    p.lengths = ws.integral[..nt].to_vec();
-    let stats = SolverStats {
-        iterations: 0,
-        residual,
-        function_evaluations: ws.evaluations,
-        converged: true,
-        load_steps: 0,
-        load_factor: 1.0,
-    };
-    let mut sol = assemble(&mut p, model, [0.0; 6], stats, &[]);
-    if let Some(e) = p.ws.material_error.take() {
-        return Err(e);
-    }
-    sol.actuation = act;
-    sol.options = options.statics;
-    sol.s_out = mesh.to_vec();
-    sol.stable = true;
-    let tangent = tangent_rows(&dirs);
-    let forces = friction_forces(mesh, &tau, &dirs);
-    Ok(FrictionalSolution {
-        statics: sol,
-        tension: tau,
-        slip,
-        tangent,
-        friction_force: forces,
-        path_length,
-        iterations: 1,
-        change: worst / scale,
-        cell_steps: attempts_total,
-    })
 }

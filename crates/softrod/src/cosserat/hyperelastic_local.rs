@@ -15,7 +15,7 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 
 use super::equations::{Evaluator, Local, Tangent, LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 use crate::error::Error;
-use crate::math::linalg::Lu6;
+use crate::math::linalg::{Inverse6, Lu6};
 use crate::model::material::hyperelastic::UniaxialLaw;
 use crate::model::section::SectionProperties;
 
@@ -118,7 +118,7 @@ impl Evaluator<'_, '_> {
         }
         let mut out = Local::strains(&x);
         if tangent {
-            let Some(lu) = Lu6::new(&h) else {
+            let Some(lu) = Inverse6::new(&h) else {
                 return Local::nan();
             };
             self.ws.tangent = Tangent {

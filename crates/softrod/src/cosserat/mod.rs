@@ -8,6 +8,7 @@ mod collapse;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
+mod friction_march;
 mod hyperelastic_local;
 pub mod sensitivity;
 pub(crate) mod shooting;
@@ -23,6 +24,7 @@ pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
     Parameter, Sensitivities,
 };
+pub(crate) use stability::{tip_stability, Stability};
 pub use stability::{CONSTRAINT_COMPLIANCE, NEUTRAL_MARGIN};
 pub use statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,

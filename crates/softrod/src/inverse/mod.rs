@@ -61,12 +61,14 @@ use crate::cosserat::equations::{Column, Equations};
 use crate::cosserat::sensitivity::{
     actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
 };
-use crate::cosserat::statics::{solve_statics, SolveOptions, StaticsSolution, WarmStart};
+use crate::cosserat::shooting::{Node, Shooting};
+use crate::cosserat::statics::{assemble, solve_statics, SolveOptions, StaticsSolution, WarmStart};
 use crate::error::{Error, Result};
 use crate::math::so3::log_so3;
 use crate::model::chamber::ATMOSPHERIC_PRESSURE;
 use crate::model::loads::{Frame, PointLoad};
 use crate::model::{Actuation, RobotModel};
+use crate::solve::SolverStats;
 use qp::Bounds;
 
 /// Default tolerance on the distance to a target position (m).
@@ -642,7 +644,10 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 a
             );
         }
-        let stationary = small && (reached || least_squares);
+        // A small step that still moves an actuator onto its bound (or off it) is taken: the
+        // minimum-norm actuation has it exactly there, not a round-off away.
+        let same_bounds = free_set(y.as_slice(), &bounds) == free_set(&a, &bounds);
+        let stationary = small && (reached || least_squares) && same_bounds;
         if stationary || iterations >= options.max_iterations {
             let converged = stationary && (reached || shape);
             let out = finish(
@@ -890,6 +895,18 @@ pub struct CosseratForward {
     last: Option<WarmStart>,
     /// The last solution (loaded robots only).
     pub solution: Option<StaticsSolution>,
+    /// The last march of an unloaded robot: its actuation, nodes, tendon path lengths and
+    /// scaled tip residual (a statics solution is assembled from it without solving again).
+    march: Option<March>,
+}
+
+/// The state recorded along one march of an unloaded robot at the actuation `a`.
+struct March {
+    a: Vec<f64>,
+    nodes: Vec<Node>,
+    lengths: Vec<f64>,
+    residual: f64,
+    evaluations: usize,
 }
 
 impl CosseratForward {
@@ -907,6 +924,7 @@ impl CosseratForward {
             nodes: None,
             last: None,
             solution: None,
+            march: None,
         };
         if let Some(s) = s {
             let l = model.length();
@@ -968,11 +986,130 @@ impl CosseratForward {
     /// # Errors
     /// As [`solve_statics`].
     pub fn solve(&self, a: &[f64]) -> Result<StaticsSolution> {
+        if let Some(sol) = self.assembled(a) {
+            return Ok(sol);
+        }
         let opts = SolveOptions {
             warm_start: self.last,
             ..self.options
         };
         solve_statics(&self.model, &self.actuation(a), &opts)
+    }
+}
+
+impl CosseratForward {
+    /// The statics solution of an unloaded robot at `a` from the last march, if it was at `a`:
+    /// the zero base wrench, the nodes and path lengths of that march (the state integrated
+    /// there is the forward solve's, step for step); `None` otherwise.
+    fn assembled(&self, a: &[f64]) -> Option<StaticsSolution> {
+        let m = self.march.as_ref().filter(|m| m.a == a)?;
+        let model = &self.model;
+        let nt = model.tendons().len();
+        let (tensions, pressures) = (&a[..nt], &a[nt..]);
+        let eq = Equations {
+            model,
+            tensions,
+            pressures,
+            load_factor: 1.0,
+            profile: None,
+        };
+        let mut plan = Vec::new();
+        let _ = scheme_of(&self.options.integrator, model, &mut plan);
+        let mut p = Shooting::new(eq, self.options.integrator, plan);
+        p.nodes.clone_from(&m.nodes);
+        p.lengths.clone_from(&m.lengths);
+        let converged = m.residual <= self.options.newton.tolerance
+            && m.nodes.iter().all(|n| n.y.iter().all(|v| v.is_finite()));
+        let stats = SolverStats {
+            iterations: 0,
+            residual: m.residual,
+            function_evaluations: m.evaluations,
+            converged,
+            load_steps: 0,
+            load_factor: 1.0,
+        };
+        let mut sol = assemble(&mut p, model, [0.0; 6], stats, &[]);
+        if !converged || p.ws.material_error.is_some() {
+            return None;
+        }
+        sol.actuation = self.actuation(a);
+        sol.options = self.options;
+        sol.stable = true;
+        Some(sol)
+    }
+}
+
+impl CosseratForward {
+    /// The evaluation of an unloaded robot with its Jacobian: the base wrench is zero and does
+    /// not move with the actuation, so one march of the state with one column per actuator.
+    fn unloaded(&mut self, a: &[f64]) -> Result<Evaluation> {
+        let (nt, nc) = self.dims();
+        let (tensions, pressures) = (&a[..nt], &a[nt..]);
+        let act = self.actuation(a);
+        act.validate(nt, nc)?;
+        let eq = Equations {
+            model: &self.model,
+            tensions,
+            pressures,
+            load_factor: 1.0,
+            profile: None,
+        };
+        let seeds: Vec<Seed> = (0..nt)
+            .map(|i| Seed::Forced(Column::Tension(i)))
+            .chain((0..nc).map(|j| Seed::Forced(Column::Pressure(j))))
+            .collect();
+        let mut plan = Vec::new();
+        let scheme = scheme_of(&self.options.integrator, &self.model, &mut plan);
+        let observe = self.nodes.clone().unwrap_or_default();
+        let mut sorted = observe.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        let cols = integrate(
+            eq,
+            scheme,
+            &[0.0; 6],
+            &Request {
+                seeds: &seeds,
+                lengths: &[],
+                observe: &sorted,
+                load_node: None,
+                record_nodes: true,
+                stops: &[],
+            },
+        )?;
+        self.march = Some(March {
+            a: a.to_vec(),
+            nodes: cols.nodes.clone(),
+            lengths: cols.lengths.clone(),
+            residual: crate::solve::max_norm(cols.residual.as_slice()),
+            evaluations: cols.evaluations,
+        });
+        let to_matrix = |c: &[nalgebra::Vector6<f64>]| DMatrix::from_fn(6, nt + nc, |r, k| c[k][r]);
+        Ok(match &self.nodes {
+            None => Evaluation {
+                positions: vec![cols.tip_pose.0],
+                rotation: cols.tip_pose.1,
+                jacobian: Some(vec![to_matrix(&cols.tip)]),
+            },
+            Some(nodes) => {
+                let at = |i: usize| sorted.iter().position(|&x| x == i).unwrap_or(0);
+                let positions = nodes
+                    .iter()
+                    .map(|&i| crate::cosserat::equations::v3(&cols.nodes[i].y, 0))
+                    .collect();
+                let last = *nodes.last().unwrap_or(&0);
+                Evaluation {
+                    positions,
+                    rotation: cols.rotations[at(last)],
+                    jacobian: Some(
+                        nodes
+                            .iter()
+                            .map(|&i| to_matrix(&cols.poses[at(i)]))
+                            .collect(),
+                    ),
+                }
+            }
+        })
     }
 }
 
@@ -995,70 +1132,8 @@ impl Forward for CosseratForward {
     }
 
     fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation> {
-        let (nt, nc) = self.dims();
         if no_external_loads(&self.model) && jacobian {
-            // The actuated, unloaded rod: a zero base wrench, the base wrench does not move
-            // with the actuation; one march of the state and one column per actuator.
-            let (tensions, pressures) = (&a[..nt], &a[nt..]);
-            let act = self.actuation(a);
-            act.validate(nt, nc)?;
-            let eq = Equations {
-                model: &self.model,
-                tensions,
-                pressures,
-                load_factor: 1.0,
-                profile: None,
-            };
-            let seeds: Vec<Seed> = (0..nt)
-                .map(|i| Seed::Forced(Column::Tension(i)))
-                .chain((0..nc).map(|j| Seed::Forced(Column::Pressure(j))))
-                .collect();
-            let mut plan = Vec::new();
-            let scheme = scheme_of(&self.options.integrator, &self.model, &mut plan);
-            let observe = self.nodes.clone().unwrap_or_default();
-            let mut sorted = observe.clone();
-            sorted.sort_unstable();
-            sorted.dedup();
-            let cols = integrate(
-                eq,
-                scheme,
-                &[0.0; 6],
-                &Request {
-                    seeds: &seeds,
-                    lengths: &[],
-                    observe: &sorted,
-                    load_node: None,
-                    record_nodes: self.nodes.is_some(),
-                    stops: &[],
-                },
-            )?;
-            let to_matrix =
-                |c: &[nalgebra::Vector6<f64>]| DMatrix::from_fn(6, nt + nc, |r, k| c[k][r]);
-            return Ok(match &self.nodes {
-                None => Evaluation {
-                    positions: vec![cols.tip_pose.0],
-                    rotation: cols.tip_pose.1,
-                    jacobian: Some(vec![to_matrix(&cols.tip)]),
-                },
-                Some(nodes) => {
-                    let at = |i: usize| sorted.iter().position(|&x| x == i).unwrap_or(0);
-                    let positions = nodes
-                        .iter()
-                        .map(|&i| crate::cosserat::equations::v3(&cols.nodes[i].y, 0))
-                        .collect();
-                    let last = *nodes.last().unwrap_or(&0);
-                    Evaluation {
-                        positions,
-                        rotation: cols.rotations[at(last)],
-                        jacobian: Some(
-                            nodes
-                                .iter()
-                                .map(|&i| to_matrix(&cols.poses[at(i)]))
-                                .collect(),
-                        ),
-                    }
-                }
-            });
+            return self.unloaded(a);
         }
         let sol = self.solve(a)?;
         self.last = Some(sol.warm_start());

@@ -1,0 +1,70 @@
+//! Inverse statics of the two-segment NiTi tendon robot (default RK4 options): one forward
+//! evaluation with its actuation Jacobian, the inverse cold (from zero tensions) and warm
+//! (from the solution at a target 1 mm away).
+//!
+//! Run: `cargo bench -p softrod --bench inverse`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use softrod::nalgebra::Vector3;
+use softrod::{
+    inverse_statics, solve_statics, Actuation, CosseratForward, Forward, InverseOptions,
+    InverseWarmStart, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Target, Tendon,
+};
+
+fn niti() -> Arc<RobotModel> {
+    let rod = Rod::new(
+        0.4,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap();
+    let tendons = (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            let end = Some(if i < 3 { 0.2 } else { 0.4 });
+            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), Loads::default()).unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    let model = niti();
+    let o = SolveOptions::default();
+    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+    let tip = Vector3::from(
+        solve_statics(&model, &Actuation::tensions(&t), &o)
+            .unwrap()
+            .tip_position(),
+    );
+    let opts = InverseOptions::default();
+    let (first, _) = inverse_statics(&model, &Target::tip(tip), &opts, &o, None).unwrap();
+    let warm = InverseWarmStart::from(&first);
+    let moved = Target::tip(tip + Vector3::new(1e-3, 0.0, 0.0));
+    let mut g = c.benchmark_group("inverse_niti");
+    let mut fwd = CosseratForward::new(&model, &o, None).unwrap();
+    g.bench_function("evaluation_with_jacobian", |b| {
+        b.iter(|| fwd.evaluate(black_box(&t), true).unwrap());
+    });
+    g.bench_function("forward_solve", |b| {
+        b.iter(|| solve_statics(&model, &Actuation::tensions(black_box(&t)), &o).unwrap());
+    });
+    g.bench_function("cold", |b| {
+        b.iter(|| inverse_statics(&model, &Target::tip(tip), &opts, &o, None).unwrap());
+    });
+    g.bench_function("warm_1mm", |b| {
+        b.iter(|| inverse_statics(&model, &moved, &opts, &o, Some(&warm)).unwrap());
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30);
+    targets = bench
+}
+criterion_main!(benches);

@@ -1,0 +1,110 @@
+//! A fixed workload of the statics benches for instruction counts under callgrind: `COUNT`
+//! solves of one case, and the marches they took.
+//!
+//! Cases: `cold` / `warm` (the two-segment NiTi robot with a 0.05 N tip force, cold and
+//! warm-started after +2 % tension), `unloaded` (tendons only), `gravity` (the 1 m
+//! four-tendon robot under gravity, cold), `cantilever` (the soft cantilever, 0.02 N tip force).
+//!
+//! Run: `valgrind --tool=callgrind target/release/examples/loaded_solve cold 20`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::sync::Arc;
+
+use softrod::nalgebra::Vector3;
+use softrod::{
+    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Tendon,
+};
+
+fn niti(loads: Loads) -> Arc<RobotModel> {
+    let rod = Rod::new(
+        0.4,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap();
+    let tendons = (0..6)
+        .map(|i| {
+            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
+            let end = Some(if i < 3 { 0.2 } else { 0.4 });
+            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+}
+
+fn four_tendon_gravity() -> Arc<RobotModel> {
+    let rod = Rod::new(
+        1.0,
+        Section::circular(1e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_density(6450.0)
+    .unwrap();
+    let tendons = (0..4)
+        .map(|i| {
+            let a = (90.0 * i as f64).to_radians();
+            Tendon::constant([0.01 * a.cos(), 0.01 * a.sin()], None).unwrap()
+        })
+        .collect();
+    let g = Loads {
+        gravity: Vector3::new(-9.81, 0.0, 0.0),
+        ..Default::default()
+    };
+    RobotModel::new(rod, tendons, Vec::new(), g).unwrap()
+}
+
+fn main() {
+    let case = std::env::args().nth(1).unwrap_or("cold".into());
+    let count: usize = std::env::args()
+        .nth(2)
+        .map(|a| a.parse().unwrap())
+        .unwrap_or(20);
+    let opts = SolveOptions::default();
+    let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let changed = Actuation::tensions(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
+    let tip = Loads::tip_force(Vector3::new(0.05, 0.0, 0.0));
+    let (model, act, opts) = match case.as_str() {
+        "cold" => (niti(tip), act, opts),
+        "unloaded" => (niti(Loads::default()), act, opts),
+        "warm" => {
+            let model = niti(tip);
+            let prev = solve_statics(&model, &act, &opts).unwrap();
+            let warm = SolveOptions {
+                warm_start: Some(prev.warm_start()),
+                ..opts
+            };
+            (model, changed, warm)
+        }
+        "gravity" => (
+            four_tendon_gravity(),
+            Actuation::tensions(&[2.0, 0.0, 1.0, 0.0]),
+            opts,
+        ),
+        "cantilever" => {
+            let soft = Rod::new(
+                0.27,
+                Section::circular(0.01).unwrap(),
+                LinearElastic::new(110e3, 0.5).unwrap(),
+            )
+            .unwrap();
+            let m =
+                RobotModel::rod_only(soft, Loads::tip_force(Vector3::new(0.02, 0.0, 0.0))).unwrap();
+            (m, Actuation::default(), opts)
+        }
+        other => panic!("unknown case {other}"),
+    };
+    let mut last = None;
+    for _ in 0..count {
+        last = Some(solve_statics(&model, &act, &opts).unwrap());
+    }
+    let s = last.unwrap();
+    println!(
+        "{case}: iterations {}, load steps {}, rhs evaluations {}, stable {}, tip {:?}",
+        s.stats.iterations,
+        s.stats.load_steps,
+        s.stats.function_evaluations,
+        s.stable,
+        s.tip_position()
+    );
+}

@@ -1,0 +1,77 @@
+"""Tendon friction from Python: the path length along the tendons against the chord sum of the
+returned tendon path; a loaded load/unload path (hysteresis, balance)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import softrod
+
+
+def niti(mu: float, tip_force: list[float] | None = None) -> softrod.Robot:
+    base = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    spec = base.spec.model_dump(mode="python", exclude_none=True)
+    for t in spec["tendons"]:
+        t["friction"] = mu
+    if tip_force is not None:
+        spec["loads"] = {"tip_force": tip_force}
+    return softrod.Robot.from_dict(spec)
+
+
+def tendon_points(sol, offsets: np.ndarray) -> np.ndarray:
+    """World points of every tendon at every sample (N, n_tendons, 3): p + R [o; 0]."""
+    o = np.concatenate([offsets, np.zeros((len(offsets), 1))], axis=1)
+    return sol.position[:, None, :] + np.einsum("nab,tb->nta", sol.rotation, o)
+
+
+@pytest.mark.parametrize("tip_force", [None, [0.05, -0.02, 0.0]])
+def test_path_length_is_the_length_of_the_tendon_path(tip_force):
+    robot = niti(0.2, tip_force)
+    # 40 RK4 steps: 20 per segment, the break a node of the doubled spacing too.
+    sol = robot.solve([4.0, 0, 0, 0, 2.0, 0], steps=40)
+    length = sol.path_length
+    assert length.shape == sol.tendon_tension.shape
+    # Oracle: the chord sum of the tendon path through the returned poses converges to the
+    # path length at second order: on the uniform nodes (the mesh without the node just
+    # before the break), doubling the spacing quadruples the gap.
+    offsets = np.array([t.parameters["offset"] for t in robot.tendons])
+    pts = tendon_points(sol, offsets)
+    s = sol.s
+    h = s[1] - s[0]
+    uniform = np.flatnonzero(np.abs(s / h - np.round(s / h)) < 1e-9)
+
+    def chords(nodes: np.ndarray, i: int) -> float:
+        return float(np.sum(np.linalg.norm(np.diff(pts[nodes, i], axis=0), axis=1)))
+
+    for i, t in enumerate(robot.tendons):
+        end = t.end if t.end is not None else s[-1]
+        nodes = uniform[s[uniform] <= end + 1e-12]
+        assert len(nodes) % 2 == 1
+        total = length[nodes[-1], i]
+        gap_h = total - chords(nodes, i)
+        gap_2h = total - chords(nodes[::2], i)
+        assert gap_h > 0
+        assert 3.99 < gap_2h / gap_h < 4.01, f"tendon {i}: gap ratio {gap_2h / gap_h:.4f}"
+        # Richardson: the extrapolated chord sum is the path length (gaps ~1e-5 m).
+        richardson = gap_h - (gap_2h - gap_h) / 3.0
+        assert abs(richardson) < 1e-8, f"tendon {i}: {richardson:.3e} m"
+        # Beyond its termination the whole path length; at the tip the solution's length.
+        assert np.all(np.diff(length[:, i]) >= 0.0)
+        assert length[-1, i] == pytest.approx(sol.tendon_lengths[i], abs=1e-12)
+
+
+def test_frictionless_solve_has_no_path_length():
+    assert niti(0.0).solve([4.0, 0, 0, 0, 2.0, 0]).path_length is None
+
+
+def test_loaded_hysteresis_from_python():
+    robot = niti(0.2, [0.05, -0.02, 0.0])
+    path = softrod.solve_path(robot, [[t, 0, 0, 0, 2.0, 0] for t in (1.0, 3.0, 1.0)])
+    up, down = path[0], path[2]
+    # The same commanded tensions, loaded then unloaded: different shapes (friction), and
+    # the released tendon sticks or slides toward the tip near its base.
+    assert np.linalg.norm(up.tip_position - down.tip_position) > 1e-4
+    assert np.all(down.slip[1:5, 0] <= 0)
+    # Global balance of rod + tendons: the base wrench carries the tip force.
+    np.testing.assert_allclose(down.base_wrench[:3], [0.05, -0.02, 0.0], rtol=0, atol=1e-10)
