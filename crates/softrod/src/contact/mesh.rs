@@ -338,7 +338,9 @@ mod tests {
                     let (d, n) = m.distance(&p);
                     worst = worst.max((d - exact(p)).abs());
                     let h = 1e-7;
-                    if d.abs() > 1e-3 {
+                    // Outside the convex mesh the distance is differentiable (inside, not on
+                    // its medial axis).
+                    if d > 1e-3 {
                         for a in 0..3 {
                             let mut e = Vector3::zeros();
                             e[a] = h;
