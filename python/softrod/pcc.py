@@ -93,7 +93,7 @@ def inverse_statics(
         TargetUnreachableError: The target is out of reach (``throw=True``).
         ConvergenceError: The iteration did not converge (``throw=True``).
     """
-    from .inverse import InverseSolution, _warm_arguments
+    from .inverse import InverseSolution, _Deferred, _warm_arguments
 
     def _loads_key(v):
         return None if v is None else tuple(np.asarray(v, dtype=float).ravel())
@@ -118,12 +118,15 @@ def inverse_statics(
     a = np.asarray(out["actuation"])
     nt = out["n_tendons"]
     tensions, pressures = a[:nt].copy(), a[nt:].copy()
-    solution = solve(
-        robot,
-        tensions if nt else None,
-        pressures if len(pressures) else None,
-        tip_force=tip_force,
-        tip_moment=tip_moment,
+    # The PCC solution at the actuation found is solved when it is first read.
+    solution = _Deferred(
+        lambda: solve(
+            robot,
+            tensions if nt else None,
+            pressures if len(pressures) else None,
+            tip_force=tip_force,
+            tip_moment=tip_moment,
+        )
     )
     return InverseSolution(
         tensions=tensions,
