@@ -592,6 +592,12 @@ def _define_targets() -> None:
     t("Sphere")(lambda d: (sr.Sphere, dict(center=(0.0, 0.0, 0.1), radius=0.02)))
     t("Capsule")(lambda d: (sr.Capsule, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
     t("Cylinder")(lambda d: (sr.Cylinder, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
+    _tetra = dict(
+        vertices=[[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+        faces=[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    )
+    t("Mesh")(lambda d: (sr.Mesh, dict(_tetra)))
+    t("Mesh.from_file")(lambda d: (sr.Mesh.from_file, dict(path=_mesh_file(d, _tetra))))
     t("Clamp")(
         lambda d: (sr.Clamp, dict(pose=np.eye(4), held=[True, True, False, True, True, False]))
     )
@@ -1122,6 +1128,15 @@ def _photo_mask():
         grey = img.mean(axis=2) if img.ndim == 3 else img
         _CACHE["mask"] = grey > 0.5 * (grey.min() + grey.max())
     return _CACHE["mask"]
+
+
+def _mesh_file(d: Path, mesh: dict) -> str:
+    """A small OBJ file of ``mesh`` in ``d`` (what ``Mesh.from_file`` reads)."""
+    path = d / "tetra.obj"
+    lines = [f"v {x} {y} {z}" for x, y, z in mesh["vertices"]]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in mesh["faces"]]
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
 
 
 def _backbone_csv(d: Path) -> str:
