@@ -722,12 +722,8 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                 let mt = et.norm();
                 let ok = if near_phase {
                     // The change of the merit, summed without cancellation.
-                    let df: f64 = (0..n)
-                        .map(|i| {
-                            let d = trial[i] - a[i];
-                            bounds.weights[i] * d * (a[i] - bounds.centre[i] + 0.5 * d)
-                        })
-                        .sum();
+                    let df =
+                        objective_change(&bounds.weights, &bounds.centre, &a[..n], &trial[..n]);
                     let dphi = df + nu * (mt - merit);
                     let local = step_norm <= LOCAL_STEP * (1.0 + norm_a);
                     (local && mt <= near) || dphi <= 1e-4 * alpha * slope.min(0.0)
@@ -735,20 +731,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
                     mt <= (1.0 - 1e-4) * merit || (full && mt <= near)
                 };
                 if mt.is_finite() && ok {
-                    if full {
-                        radius = radius.max(2.0 * step_norm);
-                    } else {
-                        let ratio = if predicted > 0.0 {
-                            (merit - mt) / predicted
-                        } else {
-                            1.0
-                        };
-                        if ratio > 0.75 {
-                            radius = 4.0 * radius.max(step_norm);
-                        } else if ratio < 0.25 {
-                            radius = 0.5 * step_norm;
-                        }
-                    }
+                    radius = trust_radius(radius, full, step_norm, merit - mt, predicted);
                     last_step = if near_phase { step_norm } else { 0.0 };
                     accepted = Some((trial, t));
                     break;
@@ -1376,4 +1359,41 @@ fn curvature<F: Forward + ?Sized>(
     let h = &w + &z * (mz - zwz) * z.transpose();
     let h = (&h + h.transpose()) * 0.5;
     (Some(h), used)
+}
+
+/// Change of the objective `½ Σ w_i (a_i − c_i)²` from `a` to `trial` (same length as `w`).
+pub(crate) fn objective_change(w: &[f64], c: &[f64], a: &[f64], trial: &[f64]) -> f64 {
+    (0..a.len())
+        .map(|i| {
+            let d = trial[i] - a[i];
+            w[i] * d * (a[i] - c[i] + 0.5 * d)
+        })
+        .sum()
+}
+
+/// The trust radius after an accepted step of size `step_norm`: widened after a full
+/// (unclipped) step; otherwise by the ratio of the achieved merit decrease `achieved` to the
+/// `predicted` one (×4 above 0.75, halved step below 0.25).
+pub(crate) fn trust_radius(
+    radius: f64,
+    full: bool,
+    step_norm: f64,
+    achieved: f64,
+    predicted: f64,
+) -> f64 {
+    if full {
+        return radius.max(2.0 * step_norm);
+    }
+    let ratio = if predicted > 0.0 {
+        achieved / predicted
+    } else {
+        1.0
+    };
+    if ratio > 0.75 {
+        4.0 * radius.max(step_norm)
+    } else if ratio < 0.25 {
+        0.5 * step_norm
+    } else {
+        radius
+    }
 }

@@ -107,8 +107,9 @@ impl Forward for PccForward<'_> {
 use nalgebra::{DMatrix as Dm, Matrix3 as M3, Vector3 as V3};
 
 use super::{
-    check_options, check_target, solve_inverse, InverseOptions, InverseSolution, InverseWarmStart,
-    Target, FIRST_RADIUS, LEAST_SQUARES_REGULARISATION, LOCAL_STEP, NEAR_TARGET,
+    check_options, check_target, objective_change, solve_inverse, trust_radius, InverseOptions,
+    InverseSolution, InverseWarmStart, Target, FIRST_RADIUS, LEAST_SQUARES_REGULARISATION,
+    LOCAL_STEP, NEAR_TARGET,
 };
 use crate::math::linalg::DenseLu;
 use crate::pcc::statics::{seg_kin, SegKin};
@@ -689,32 +690,14 @@ fn closed_form(
             if next.eval(&aff, &trial) {
                 let mt = (target - next.p).norm();
                 let ok = if near_phase {
-                    let df: f64 = (0..n)
-                        .map(|i| {
-                            let d = trial[i] - a[i];
-                            bx.w[i] * d * (a[i] - bx.c[i] + 0.5 * d)
-                        })
-                        .sum();
+                    let df = objective_change(&bx.w, &bx.c, &a[..n], &trial[..n]);
                     let local = step_norm <= LOCAL_STEP * (1.0 + norm_a);
                     (local && mt <= near) || df + nu * (mt - merit) <= 1e-4 * alpha * slope.min(0.0)
                 } else {
                     mt <= (1.0 - 1e-4) * merit || (full && mt <= near)
                 };
                 if mt.is_finite() && ok {
-                    if full {
-                        radius = radius.max(2.0 * step_norm);
-                    } else {
-                        let ratio = if predicted > 0.0 {
-                            (merit - mt) / predicted
-                        } else {
-                            1.0
-                        };
-                        if ratio > 0.75 {
-                            radius = 4.0 * radius.max(step_norm);
-                        } else if ratio < 0.25 {
-                            radius = 0.5 * step_norm;
-                        }
-                    }
+                    radius = trust_radius(radius, full, step_norm, merit - mt, predicted);
                     accepted = true;
                     break;
                 }
