@@ -1,7 +1,7 @@
 //! Steady-state shape of a Cosserat rod with tendons, chambers and external loads, by shooting.
 //!
 //! [`solve_statics`] finds the total base wrench `(N(0), M(0))` (world frame) that meets the
-//! tip conditions ([`super::shooting`]). The actuation is always applied in full: with the
+//! tip conditions (`cosserat::shooting`). The actuation is always applied in full: with the
 //! total-wrench form a tendon or a chamber adds nothing to the base wrench, so the actuated,
 //! unloaded rod is solved exactly by a zero base wrench in one pass. The external loads are
 //! then applied along the load factor `λ` from 0 to 1: first directly, from the exact tangent

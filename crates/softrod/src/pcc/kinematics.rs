@@ -7,8 +7,8 @@
 //! * a robot-independent map, arc parameters ↔ pose ([`PccSegment::pose`], [`arc_pose`],
 //!   [`arc_frames`], [`arc_jacobian`], [`arc_from_tip`], [`arc_from_tip_with_length`]) and its
 //!   product over a chain ([`PccChain`], [`chain_pose`]);
-//! * robot-specific maps, actuation → arc parameters, for tendons ([`PccTendons`]: from
-//!   displacements or tensions) and pneumatic chambers ([`PccChambers`]: from pressures), with
+//! * robot-specific maps, actuation → arc parameters, for tendons ([`super::PccTendons`]: from
+//!   displacements or tensions) and pneumatic chambers ([`super::PccChambers`]: from pressures), with
 //!   their Jacobians.
 //!
 //! # Convention

@@ -329,7 +329,7 @@ pub struct PccEquilibrium {
     pub residual: DVector<f64>,
     /// Exact Jacobian `∂g/∂q` (3n × 3n, unsymmetric under a tip moment).
     pub jacobian: DMatrix<f64>,
-    /// Scaled residual (max norm), as compared with [`PccSolveOptions::tolerance`].
+    /// Scaled residual (max norm), as compared with the tolerance of [`PccSolveOptions::newton`].
     pub scaled_residual: f64,
 }
 
