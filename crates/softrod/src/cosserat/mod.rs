@@ -9,6 +9,7 @@ pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
 mod friction_march;
+mod guides;
 mod hyperelastic_local;
 pub mod sensitivity;
 pub(crate) mod shooting;
@@ -18,7 +19,8 @@ pub mod statics;
 pub use displacement::reference_lengths;
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 pub use friction::{
-    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
+    Slip,
 };
 pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,

@@ -778,6 +778,18 @@ fn check_inputs(
             ));
         }
     }
+    // A guided tendon loads the rod at its guides only (solve_frictional): its tension along
+    // the continuous channel would be another robot's answer.
+    let tensions = actuation.tension_values(model.tendons().len());
+    if let Some(i) =
+        (0..tensions.len()).find(|&i| model.tendons()[i].is_guided() && tensions[i] != 0.0)
+    {
+        return Err(Error::invalid(
+            format!("tendons[{i}].guides"),
+            format!("{} guides", model.tendons()[i].guides().len()),
+            "none here: a tendon routed through guides is solved by solve_frictional",
+        ));
+    }
     if let Some(w) = &options.warm_start {
         model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
     }
