@@ -8,7 +8,7 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{niti_rod, niti_tendons};
+use common::niti_model;
 use softrod::nalgebra::{DMatrix, DVector, Vector3};
 use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
 use softrod::pcc::{pcc_actuation_jacobian, ElasticSegment, PccTendons};
@@ -18,15 +18,7 @@ use softrod::{
 };
 
 fn niti(loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
-    let mut rod = niti_rod();
-    if let Some(d) = density {
-        rod = rod.with_density(d).unwrap();
-    }
-    let tendons = niti_tendons(&[0.0; 6])
-        .into_iter()
-        .map(|t| t.tendon)
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    niti_model(loads, density, 0.0)
 }
 
 struct Lcg(u64);
