@@ -140,7 +140,14 @@ def build_material(m: Any, errors: list[FieldError]) -> Any:
 def _tendon(t: Any) -> Tendon:
     if isinstance(t, rf.ConstantTendonSpec):
         offset = t.offset if t.offset is not None else _polar(t.distance, t.angle_deg)
-        return Tendon(offset, t.tension, t.end, friction=t.friction)
+        return Tendon(
+            offset,
+            t.tension,
+            t.end,
+            friction=t.friction,
+            guides=t.guides,
+            guide_friction=t.guide_friction,
+        )
     if isinstance(t, rf.RadiusProportionalTendonSpec):
         return Tendon.radius_proportional(
             t.ratio, math.radians(t.angle_deg), t.tension, t.end, friction=t.friction
@@ -457,6 +464,9 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
     if routing is None or p is None:
         return None
     if routing == "constant" and p.get("derivative") is None and not callable(p["offset"]):
+        if t.guides:
+            out["guides"] = [float(g) for g in t.guides]
+            out["guide_friction"] = [float(m) for m in t.guide_friction]
         return {**out, "offset": _floats(p["offset"])}
     if routing == "radius_proportional":
         return {

@@ -279,12 +279,18 @@ class _TendonBase(_Table):
 
 
 class ConstantTendonSpec(_TendonBase):
-    """A tendon at a constant body-frame offset."""
+    """A tendon at a constant body-frame offset (in a continuous channel, or through guides)."""
 
     routing: Literal["constant"] = "constant"
     offset: Vec2 | None = None
     distance: _num("distance from the backbone (m)", ge=0) | None = None
     angle_deg: _num("angle from body x toward body y (deg), with `distance`") | None = None
+    guides: list[Float] | None = Field(
+        None, description="arc lengths (m) of the disks the tendon runs through in chords"
+    )
+    guide_friction: Float | list[Float] | None = Field(
+        None, description="capstan coefficient at the guides (one, or one per guide)"
+    )
 
     @model_validator(mode="after")
     def _one_offset(self) -> ConstantTendonSpec:
