@@ -142,7 +142,7 @@ pub(crate) struct ContactData {
     pub contacts: Vec<softrod::Contact>,
     pub contact_force: Option<Vec<[f64; 3]>>,
     pub tip_reaction: Option<[f64; 6]>,
-    pub compliance: Option<softrod::nalgebra::Matrix6<f64>>,
+    pub compliance: softrod::ContactCompliance,
 }
 
 impl ContactData {
@@ -151,7 +151,7 @@ impl ContactData {
             contacts: sol.contacts.clone(),
             contact_force: Some(sol.contact_force.clone()),
             tip_reaction: sol.tip_reaction,
-            compliance: sol.compliance,
+            compliance: sol.compliance.clone(),
         }
     }
 

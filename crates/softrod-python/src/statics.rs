@@ -505,11 +505,12 @@ impl StaticsSolution {
     /// constraints (frictionless contacts hold the normal only), `[dp; dtheta]` of the tip
     /// (m, rad; world) per `[dF; dM]` of a dead tip load (N, N m; world), shape (6, 6); None
     /// without obstacles and tip constraint (then `tangent_compliance`, which treats contact
-    /// forces as dead loads, is the same) or when not converged.
+    /// forces as dead loads, is the same) or when not converged. Computed on first read.
     #[getter]
     fn contact_compliance<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
         self.contact
             .compliance
+            .get()
             .map(|m| Array::from_shape_fn((6, 6), |(i, j)| m[(i, j)]).into_pyarray(py))
     }
     /// Tension carried by each tendon (N), shape (n_tendons,): the input of a

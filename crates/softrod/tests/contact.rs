@@ -254,7 +254,7 @@ fn compliance_under_contact_is_the_constrained_derivative() {
     // Contact-free (F below the closing force): the constrained compliance is the tangent one.
     let free = solve(Vector3::new(-0.5 * closing, 0.0, 0.0));
     assert!(free.contacts.is_empty());
-    let c_free = free.compliance.unwrap();
+    let c_free = free.compliance.get().unwrap();
     let tangent =
         softrod::tangent_compliance(&free.solution, softrod::TendonControl::Tension, None)
             .unwrap()
@@ -266,7 +266,7 @@ fn compliance_under_contact_is_the_constrained_derivative() {
     let force = Vector3::new(-2.0 * closing, 0.0, 0.0);
     let pressed = solve(force);
     assert_eq!(pressed.contacts.len(), 1);
-    let c = pressed.compliance.unwrap();
+    let c = pressed.compliance.get().unwrap();
     let normal = (c[(0, 0)] / c_free[(0, 0)]).abs();
     println!(
         "normal compliance {:e} (contact-free {:e}, ratio {normal:e})",
@@ -326,7 +326,7 @@ fn compliance_under_an_interior_contact_is_the_constrained_derivative() {
     let sol = solve(base);
     assert_eq!(sol.contacts.len(), 1);
     assert!(sol.contacts[0].s < 0.99 * L, "an interior contact");
-    let cm = sol.compliance.unwrap();
+    let cm = sol.compliance.get().unwrap();
     let big = cm.amax();
     for k in 0..6 {
         let h = if k < 3 {

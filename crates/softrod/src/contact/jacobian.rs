@@ -186,10 +186,14 @@ impl Constrained<'_> {
         let tip_y = head(&y);
         let tip_k = nodes.last()?.interval;
         // The contact rows at the solution, and per contact the function of its node states.
-        let mut ev = Evaluator {
-            eq,
-            ws: &mut scratch,
-        };
+        let mut other = Workspace::new(nt);
+        let mut ev = [
+            Evaluator {
+                eq,
+                ws: &mut scratch,
+            },
+            Evaluator { eq, ws: &mut other },
+        ];
         let mut interior = 0;
         // (arc length, first and last node state + interval, scaled force, site index)
         let mut at = Vec::with_capacity(self.active.len());
@@ -310,9 +314,17 @@ impl Constrained<'_> {
                 };
                 eval(h, &mut buf);
                 let plus = buf.clone();
-                eval(-h, &mut buf);
-                for i in 0..size {
-                    j[n * c + row + i] = (plus[i] - buf[i]) / (2.0 * h);
+                if self.rough {
+                    // One-sided, from the rows at the point.
+                    let at = &rows[row..row + size];
+                    for i in 0..size {
+                        j[n * c + row + i] = (plus[i] - at[i]) / h;
+                    }
+                } else {
+                    eval(-h, &mut buf);
+                    for i in 0..size {
+                        j[n * c + row + i] = (plus[i] - buf[i]) / (2.0 * h);
+                    }
                 }
                 row += size;
             }
@@ -324,6 +336,7 @@ impl Constrained<'_> {
             key: self.key(x, mu),
             rows: rows.clone(),
             jacobian: Some((j.to_vec(), twists)),
+            marched: None,
         });
         Some(rows)
     }

@@ -16,6 +16,8 @@ mod obstacle;
 mod solve;
 mod stability;
 
+use std::sync::Arc;
+
 use nalgebra::Vector3;
 
 pub use constraint::TipConstraint;
@@ -79,8 +81,32 @@ pub struct ContactSolution {
     pub conjugate_points: Option<usize>,
     /// Tangent compliance of the tip with the active contacts and the tip constraint as
     /// constraints (frictionless contacts hold the normal only, the held tip directions
-    /// hold): `[δp; δθ]` of the tip (m, rad; world) per `[δF; δM]` of a dead tip load (N,
-    /// N m; world), 6×6 (`None` when not converged or singular). The compliance of
-    /// `solution` instead treats the contact forces as dead loads.
-    pub compliance: Option<nalgebra::Matrix6<f64>>,
+    /// hold): `compliance.get()` is `[δp; δθ]` of the tip (m, rad; world) per `[δF; δM]` of
+    /// a dead tip load (N, N m; world), 6×6 (`None` when not converged or singular),
+    /// computed on first read. The compliance of `solution` instead treats the contact
+    /// forces as dead loads.
+    pub compliance: ContactCompliance,
+}
+
+/// The tip compliance of a contact solution with its active contacts and tip constraint as
+/// constraints ([`ContactSolution::compliance`]), computed on first read (one march with the
+/// variational columns of every unknown) and kept; clones share it.
+#[derive(Debug, Clone, Default)]
+pub struct ContactCompliance {
+    inner: Option<Arc<solve::Frozen>>,
+}
+
+impl ContactCompliance {
+    /// `[δp; δθ]` of the tip (m, rad; world) per `[δF; δM]` of a dead tip load (N, N m;
+    /// world), 6×6; `None` when the solve did not converge or the constrained problem is
+    /// singular there.
+    pub fn get(&self) -> Option<nalgebra::Matrix6<f64>> {
+        self.inner.as_ref().and_then(|f| f.compliance())
+    }
+
+    pub(crate) fn of(frozen: Option<solve::Frozen>) -> Self {
+        Self {
+            inner: frozen.map(Arc::new),
+        }
+    }
 }

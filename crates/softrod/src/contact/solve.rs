@@ -8,11 +8,11 @@ use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 use super::constraint::TipConstraint;
 use super::obstacle::Obstacle;
 use super::stability::{conjugate_points, free_stiffness};
-use super::{obstacle_normal_basis, Contact, ContactSolution};
+use super::{obstacle_normal_basis, Contact, ContactCompliance, ContactSolution};
 use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL, STATE};
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
-    assemble, scaled, scaled_back, settings, solve_statics, Integrator, SolveOptions,
+    assemble, scaled, scaled_back, settings, solve_statics, stability_on, Integrator, SolveOptions,
     MAX_LINE_SEARCH_HALVINGS, MAX_LOAD_STEP_TURN,
 };
 use crate::cosserat::{tip_stability, Stability, NEUTRAL_MARGIN};
@@ -31,6 +31,77 @@ use crate::solve::{
 pub const MAX_ACTIVE_SET_ROUNDS: usize = 40;
 /// Relative step of the forward differences of the Jacobian columns with contacts.
 const DIFFERENCE_STEP: f64 = 1e-7;
+/// Ratio of the RK4 steps of a contact solve to those of its coarse mesh.
+const COARSE_RATIO: usize = 5;
+/// Fewest RK4 steps of the coarse mesh of a contact solve.
+const MIN_COARSE_STEPS: usize = 8;
+/// Newton tolerance on the coarse mesh (at least the one asked): below the difference of the
+/// two meshes' solutions, which Newton on the mesh asked removes.
+const COARSE_TOLERANCE: f64 = 1e-6;
+/// Stability margin on the coarse mesh beyond which its sign decides whether a contact
+/// solution is stable (closer to zero, the margin is computed on the mesh asked).
+const COARSE_MARGIN_GAP: f64 = 1e-2;
+
+/// What the compliance of a converged contact solution needs, owned (see
+/// [`ContactCompliance`]), and the compliance once computed.
+#[derive(Debug)]
+pub(crate) struct Frozen {
+    model: Arc<RobotModel>,
+    obstacles: Vec<Obstacle>,
+    tensions: Vec<f64>,
+    pressures: Vec<f64>,
+    integrator: Integrator,
+    tip: Option<TipConstraint>,
+    start: (Vector3<f64>, Matrix3<f64>),
+    active: Vec<Active>,
+    x: Vec<f64>,
+    value: std::sync::OnceLock<Option<Matrix6<f64>>>,
+}
+
+impl Frozen {
+    /// The problem `p` at full load at its solution `x`.
+    fn at(p: &Constrained<'_>, x: &[f64]) -> Self {
+        Self {
+            model: Arc::clone(p.shared),
+            obstacles: p.obstacles.to_vec(),
+            tensions: p.tensions.clone(),
+            pressures: p.pressures.clone(),
+            integrator: p.integrator,
+            tip: p.tip,
+            start: p.start,
+            active: p.active.clone(),
+            x: x.to_vec(),
+            value: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The constrained tip compliance (see [`Constrained::compliance`]), computed once.
+    pub(crate) fn compliance(&self) -> Option<Matrix6<f64>> {
+        *self.value.get_or_init(|| {
+            let mut p = Constrained {
+                model: &self.model,
+                shared: &self.model,
+                tensions: self.tensions.clone(),
+                pressures: self.pressures.clone(),
+                integrator: self.integrator,
+                tip: self.tip,
+                start: self.start,
+                obstacles: &self.obstacles,
+                active: self.active.clone(),
+                load: 1.0,
+                last: None,
+                reference: Vec::new(),
+                evaluations: 0,
+                coarse: None,
+                hint: None,
+                solved: None,
+                refine: true,
+                rough: false,
+            };
+            p.compliance(&self.x)
+        })
+    }
+}
 
 /// Where a contact acts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,6 +189,9 @@ pub(super) struct Pass {
     /// With an exact Jacobian: it (column-major) and the tip twist `[δp; δθ]` (m, rad;
     /// world) per scaled unknown.
     pub(super) jacobian: Option<(Vec<f64>, Vec<Vector6<f64>>)>,
+    /// Of a march of the state alone by `integrator`: the tendon path lengths (m) and
+    /// tensions (N) it left (what a solution is assembled from, with the nodes).
+    pub(super) marched: Option<(Integrator, Vec<f64>, Vec<f64>)>,
 }
 
 /// The unknowns, homotopy parameter, load factor, active set and tip constraint of an
@@ -145,6 +219,20 @@ pub(crate) struct Constrained<'m> {
     pub(super) last: Option<Pass>,
     pub(super) reference: Vec<Vector3<f64>>,
     pub(super) evaluations: usize,
+    /// The mesh the Jacobians are taken on when it is coarser than `integrator` (the rows
+    /// still come from `integrator`; see [`coarse_mesh`]).
+    pub(super) coarse: Option<Integrator>,
+    /// A Jacobian (column-major) to start the next Newton solve with, and the active set it
+    /// belongs to (used only with that active set).
+    pub(super) hint: Option<(Vec<Active>, Vec<f64>)>,
+    /// The (updated) Jacobian of the last converged Newton solve and its active set.
+    pub(super) solved: Option<(Vec<Active>, Vec<f64>)>,
+    /// Whether Newton continues past the tolerance toward round-off (not on the coarse
+    /// mesh, whose solution is only a start).
+    pub(super) refine: bool,
+    /// Whether the contact rows of a Jacobian are differenced one-sided (on the coarse
+    /// mesh, where the Jacobian only steers Newton) rather than centrally.
+    pub(super) rough: bool,
 }
 
 impl<'m> Constrained<'m> {
@@ -356,11 +444,17 @@ impl<'m> Constrained<'m> {
         };
         let l = self.model.length();
         let nt = model.tendons().len();
-        let mut scratch = Workspace::new(nt);
-        let mut ev = Evaluator {
-            eq: sh.eq,
-            ws: &mut scratch,
-        };
+        let (mut before, mut after) = (Workspace::new(nt), Workspace::new(nt));
+        let mut ev = [
+            Evaluator {
+                eq: sh.eq,
+                ws: &mut before,
+            },
+            Evaluator {
+                eq: sh.eq,
+                ws: &mut after,
+            },
+        ];
         for (a, o) in self.active.iter().zip(self.offsets()) {
             let (s, k) = match a.site {
                 Site::Tip => (l, o),
@@ -391,6 +485,13 @@ impl<'m> Constrained<'m> {
             key: self.key(x, mu),
             rows: rows.clone(),
             jacobian: None,
+            marched: (!full).then(|| {
+                (
+                    self.integrator,
+                    std::mem::take(&mut sh.lengths),
+                    std::mem::take(&mut sh.tensions),
+                )
+            }),
         });
         Some((rows, jac))
     }
@@ -399,12 +500,13 @@ impl<'m> Constrained<'m> {
     /// `f`, from the states (and intervals) of the first node at `s` (before the jump of the
     /// force) and the last (after it): the gap over `L` (relaxed by `mu` from its value when
     /// added), for a contact inside the rod the slope of the gap, and the force's two
-    /// components along the obstacle's surface. `ev` is a scratch evaluator of the contact
-    /// model.
+    /// components along the obstacle's surface. `ev` are scratch evaluators of the contact
+    /// model, one per side of the contact (so that each local solve starts from the last on
+    /// its side).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn contact_rows(
         &self,
-        ev: &mut Evaluator<'_, '_>,
+        ev: &mut [Evaluator<'_, '_>; 2],
         a: &Active,
         s: f64,
         first: (&[f64; STATE], usize),
@@ -429,7 +531,7 @@ impl<'m> Constrained<'m> {
                 [first, last]
             };
             let mut slope = 0.0;
-            for (y, interval) in sides {
+            for (ev, (y, interval)) in ev.iter_mut().zip(sides) {
                 ev.set_interval(interval);
                 let mut dy = [0.0; STATE];
                 ev.rhs_into::<STATE>(s, y, &mut dy);
@@ -549,6 +651,26 @@ impl Constrained<'_> {
                 return Evaluated::Residual;
             }
         }
+        if let (Some(j), Some(coarse)) = (jacobian.as_deref_mut(), self.coarse) {
+            // The Jacobian on the coarse mesh, the rows on the fine one.
+            let fine = std::mem::replace(&mut self.integrator, coarse);
+            self.coarse = None;
+            self.rough = true;
+            let mut rc = vec![0.0; n];
+            let got = self.evaluate_inner(x, lambda, Some(&mut *j), &mut rc);
+            self.integrator = fine;
+            self.coarse = Some(coarse);
+            self.rough = false;
+            self.last = None;
+            if got != Evaluated::Jacobian {
+                return Evaluated::Failed;
+            }
+            let Some((rows, _)) = self.run(x, lambda, false) else {
+                return Evaluated::Failed;
+            };
+            r.copy_from_slice(&rows);
+            return Evaluated::Jacobian;
+        }
         if let (Some(j), false) = (jacobian.as_deref_mut(), exact) {
             if let Some(rows) = self.exact(x, lambda, j) {
                 r.copy_from_slice(&rows);
@@ -641,10 +763,7 @@ fn exact_newton(
             return Some((x, norm));
         }
     }
-    if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
-        return None;
-    }
-    let mut exact = true;
+    let mut exact = start_jacobian(p, &x, residual_first, &mut j, &mut r)?;
     let mut norm = max_norm(&r);
     let (mut xt, mut rt) = (vec![0.0; n], vec![0.0; n]);
     if normal_first && predict(p, &mut x, &mut j, &mut r, effort) {
@@ -657,7 +776,8 @@ fn exact_newton(
     let (mut steps, mut retries) = (0, 0);
     while steps < opts.max_iterations && retries <= opts.max_iterations {
         if norm <= opts.tolerance {
-            if norm <= round_off(opts) || refined >= 2 {
+            if norm <= round_off(opts) || refined >= 2 || !p.refine {
+                p.solved = Some((p.active.clone(), j));
                 return Some((x, norm));
             }
             refined += 1;
@@ -724,7 +844,34 @@ fn exact_newton(
     if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
         return None;
     }
+    p.solved = Some((p.active.clone(), j));
     Some((x, norm))
+}
+
+/// The Jacobian `j` and residual `r` at `x` that Newton starts from: the one handed over in
+/// `p.hint` for the current active set (from the coarse mesh, or the solve that found `x`;
+/// `r` already evaluated if `residual_first`), else the exact one. Returns whether it is
+/// exact; `None` if the evaluation fails.
+fn start_jacobian(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    residual_first: bool,
+    j: &mut Vec<f64>,
+    r: &mut [f64],
+) -> Option<bool> {
+    let n = p.dim();
+    let hint = p
+        .hint
+        .take()
+        .filter(|(a, h)| *a == p.active && h.len() == n * n);
+    if let Some((_, h)) = hint {
+        if !residual_first && p.evaluate(x, 1.0, None, r) == Evaluated::Failed {
+            return None;
+        }
+        *j = h;
+        return Some(false);
+    }
+    (p.evaluate(x, 1.0, Some(j), r) == Evaluated::Jacobian).then_some(true)
 }
 
 /// The predictor of newly added contacts ([`normal_step`]) from `x` with the exact Jacobian
@@ -1115,7 +1262,7 @@ pub fn solve_constrained(
             contacts: Vec::new(),
             contact_force: vec![[0.0; 3]; n],
             conjugate_points: None,
-            compliance: None,
+            compliance: ContactCompliance::default(),
         });
     }
     let tensions = actuation.tension_values(model.tendons().len());
@@ -1134,25 +1281,110 @@ pub fn solve_constrained(
         last: None,
         reference: Vec::new(),
         evaluations: 0,
+        coarse: None,
+        hint: None,
+        solved: None,
+        refine: true,
+        rough: false,
     };
     // The actuated rod without loads: the target of the tip at load factor 0.
+    let mut effort = Effort::default();
+    // (Not with a triangle mesh: the curvature of its distance jumps between faces and
+    // edges, and Newton from the coarse solution may settle on another face.)
+    let smooth = !obstacles.iter().any(|o| matches!(o, Obstacle::Mesh(_)));
+    if let Some(coarse) = coarse_mesh(options.integrator).filter(|_| smooth) {
+        // The contacts and the nonlinear iterations on the coarse mesh; then Newton on the
+        // mesh asked from there, with the coarse Jacobian, and the active set checked there.
+        p.integrator = coarse;
+        (p.refine, p.rough) = (false, true);
+        let mut start = *options;
+        start.newton.tolerance = options.newton.tolerance.max(COARSE_TOLERANCE);
+        let reached = reach(&mut p, &start, &mut effort);
+        (p.refine, p.rough) = (true, false);
+        if let Reach::Done(xc) = reached {
+            p.integrator = options.integrator;
+            p.coarse = Some(coarse);
+            p.last = None;
+            p.load = 1.0;
+            p.hint = p.solved.take();
+            if let Some(x) = active_set(&mut p, &xc, &options.newton, &mut effort) {
+                return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
+            }
+        }
+        // Else the mesh asked from the start.
+        p.integrator = options.integrator;
+        p.coarse = None;
+        p.active.clear();
+        p.last = None;
+        p.load = 0.0;
+        p.reference.clear();
+        p.hint = None;
+        p.solved = None;
+    }
+    match reach(&mut p, options, &mut effort) {
+        Reach::Done(x) => {
+            p.load = 1.0;
+            finish(&mut p, model, actuation, options, &x, &effort, 1.0)
+        }
+        Reach::Stopped { lambda, why, .. } if options.newton.throw => {
+            fail(&p, &options.newton, &effort, lambda, why)
+        }
+        Reach::Stopped { x, lambda, .. } => {
+            p.load = 1.0;
+            finish(&mut p, model, actuation, options, &x, &effort, lambda)
+        }
+        Reach::Unintegrable => Err(Error::not_converged(
+            "constrained shooting: the actuated rod without external loads could not be \
+             integrated",
+            0,
+            f64::INFINITY,
+        )),
+    }
+}
+
+/// Steps of the coarse mesh of the contact solve with `integrator`: RK4 with a fifth of its
+/// steps (at least [`MIN_COARSE_STEPS`]); `None` (no coarse mesh) otherwise.
+fn coarse_mesh(integrator: Integrator) -> Option<Integrator> {
+    match integrator {
+        Integrator::Rk4 { steps } if steps >= COARSE_RATIO * MIN_COARSE_STEPS => {
+            Some(Integrator::Rk4 {
+                steps: steps / COARSE_RATIO,
+            })
+        }
+        _ => None,
+    }
+}
+
+/// What [`reach`] reached.
+enum Reach {
+    /// Converged at full load, the unknowns.
+    Done(Vec<f64>),
+    /// Stopped at load factor `lambda` (the active set as left, the unknowns reached).
+    Stopped {
+        x: Vec<f64>,
+        lambda: f64,
+        why: &'static str,
+    },
+    /// The actuated rod without loads could not be integrated.
+    Unintegrable,
+}
+
+/// The active set and the unknowns at full load from the unloaded rod (or the warm start):
+/// the contacts of the actuated rod at load factor 0, then the loads and the tip target
+/// stepped by continuation.
+fn reach(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Effort) -> Reach {
+    let model = p.model;
     let zero = vec![0.0; 6];
     let free_tip = p.tip.take();
     let unloaded = p.run(&zero, 1.0, false).map(|_| ());
     p.tip = free_tip;
     let start_node = p.last.as_ref().and_then(|l| l.nodes.last().copied());
     let (Some(()), Some(node)) = (unloaded, start_node) else {
-        return Err(Error::not_converged(
-            "constrained shooting: the actuated rod without external loads could not be \
-             integrated",
-            0,
-            f64::INFINITY,
-        ));
+        return Reach::Unintegrable;
     };
     p.start = (v3(&node.y, 0), rot(&node.y));
     p.commit();
     let opts = options.newton;
-    let mut effort = Effort::default();
     let mut x: Vec<f64> = match &options.warm_start {
         Some(w) => scaled(model, &w.base_wrench).to_vec(),
         None => zero.clone(),
@@ -1160,7 +1392,7 @@ pub fn solve_constrained(
     let mut reached = None;
     if options.warm_start.is_some() {
         p.load = 1.0;
-        if let Some(xs) = active_set(&mut p, &x, &opts, &mut effort) {
+        if let Some(xs) = active_set(p, &x, &opts, effort) {
             reached = Some(xs);
         } else {
             p.active.clear();
@@ -1170,36 +1402,29 @@ pub fn solve_constrained(
     }
     if reached.is_none() {
         // Load factor 0 (contacts of the actuated rod), then the loads and the target.
-        match active_set(&mut p, &x, &opts, &mut effort) {
+        match active_set(p, &x, &opts, effort) {
             Some(xs) => x = xs,
             None => {
-                let why = "no contact set at load factor 0";
-                if opts.throw {
-                    return fail(&p, &opts, &effort, 0.0, why);
-                }
                 // The last state reached (not converged), under the full loads.
                 p.active.clear();
-                p.load = 1.0;
-                return finish(&mut p, model, actuation, options, &x[..6], &effort, 0.0);
+                return Reach::Stopped {
+                    x: x[..6].to_vec(),
+                    lambda: 0.0,
+                    why: "no contact set at load factor 0",
+                };
             }
         }
         p.commit();
         if !(model.loads().is_unloaded() && p.tip.is_none()) {
             // (Otherwise nothing is stepped: load factor 0 is the problem.)
-            x = match step_loads(&mut p, x, &opts, &mut effort) {
+            x = match step_loads(p, x, &opts, effort) {
                 Ok(x) => x,
-                Err((lambda, _, x)) if !opts.throw => {
-                    p.load = 1.0;
-                    return finish(&mut p, model, actuation, options, &x, &effort, lambda);
-                }
-                Err((lambda, why, _)) => return fail(&p, &opts, &effort, lambda, why),
+                Err((lambda, why, x)) => return Reach::Stopped { x, lambda, why },
             };
         }
         reached = Some(x);
     }
-    let x = reached.unwrap_or_default();
-    p.load = 1.0;
-    finish(&mut p, model, actuation, options, &x, &effort, 1.0)
+    Reach::Done(reached.unwrap_or_default())
 }
 
 /// The error (or, without `throw`, nothing better to return) of a failed solve.
@@ -1228,6 +1453,7 @@ fn fail(
 /// result, whose residual is returned (`None` if it cannot be integrated).
 fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Option<(Vec<f64>, f64)> {
     let mut effort = Effort::default();
+    p.hint = p.solved.take();
     if let Some(out) = exact_newton(p, x, &options.newton, &mut effort, true, false) {
         return Some(out);
     }
@@ -1365,6 +1591,34 @@ fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) -> Option<Sta
     tip_stability(&y, &tw, p.model.length())
 }
 
+/// The shooting residual at the solution `x` and, with a held tip, the base-wrench columns,
+/// with the nodes in `sh`: those of the last pass when it marched the state alone at `x` on
+/// the mesh of `sh` (free tip), else from a new march.
+fn final_march(
+    p: &Constrained<'_>,
+    sh: &mut Shooting<'_>,
+    pass: Pass,
+    x: &[f64],
+) -> Result<(Vector6<f64>, Vec<Vector6<f64>>)> {
+    if let Some((mesh, lengths, tensions)) = pass.marched {
+        if p.tip.is_none() && mesh == sh.integrator && pass.key == p.key(x, 1.0) {
+            sh.nodes = pass.nodes;
+            sh.lengths = lengths;
+            sh.tensions = tensions;
+            return Ok((pass.residual, Vec::new()));
+        }
+    }
+    let marched = if p.tip.is_none() {
+        sh.pass::<STATE>(&x[..6], 1.0)
+    } else {
+        sh.pass::<FULL>(&x[..6], 1.0)
+    };
+    let (res, cols, _) = marched.map_err(|e| {
+        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
+    })?;
+    Ok((res, cols))
+}
+
 /// The solution at the converged unknowns `x`: the shape with its contact forces, the tip
 /// reaction, the contacts, the stability.
 fn finish(
@@ -1393,12 +1647,9 @@ fn finish(
     };
     let x: &[f64] = &polished;
     let forces = p.normal_forces(x);
-    // The compliance under the constraints (its march leaves the last pass at `x`).
-    let compliance = if residual <= options.newton.tolerance {
-        p.compliance(x)
-    } else {
-        None
-    };
+    // The compliance under the constraints, on first read.
+    let compliance =
+        ContactCompliance::of((residual <= options.newton.tolerance).then(|| Frozen::at(p, x)));
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
@@ -1416,14 +1667,7 @@ fn finish(
         profile: None,
     };
     let mut sh = Shooting::new(eq, options.integrator, plan);
-    let marched = if p.tip.is_none() {
-        sh.pass::<STATE>(&x[..6], 1.0)
-    } else {
-        sh.pass::<FULL>(&x[..6], 1.0)
-    };
-    let (res, cols, _) = marched.map_err(|e| {
-        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
-    })?;
+    let (res, cols) = final_march(p, &mut sh, pass, x)?;
     let tip_twist = sh.tip_twist;
     let stats = SolverStats {
         iterations: effort.iterations,
@@ -1454,6 +1698,14 @@ fn finish(
         let _ = sol.margin.set(margin);
     } else if let Some(st) = free_stability.filter(|_| sol.stats.converged) {
         let _ = sol.margin.set(st.margin);
+        sol.stable = st.stable;
+    } else if let Some(st) = coarse_mesh(options.integrator)
+        .filter(|_| sol.stats.converged)
+        .and_then(|mesh| stability_on(&sol, mesh))
+        .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
+    {
+        // Clear on the coarse mesh; the margin itself is computed on the mesh asked when
+        // read.
         sol.stable = st.stable;
     } else {
         sol.stable = sol.stats.converged && sol.stability_margin() > -NEUTRAL_MARGIN;

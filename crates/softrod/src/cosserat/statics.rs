@@ -267,6 +267,12 @@ impl StaticsSolution {
 
 /// The stability margin of a solution, from one march with the base-wrench columns.
 fn margin_of(sol: &StaticsSolution) -> Option<f64> {
+    stability_on(sol, sol.options.integrator).map(|s| s.margin)
+}
+
+/// The stability of a solution from one march with the base-wrench columns by `integrator`
+/// (e.g. a coarser mesh than it was solved on).
+pub(crate) fn stability_on(sol: &StaticsSolution, integrator: Integrator) -> Option<Stability> {
     let model = &*sol.model;
     let tensions = sol.tensions();
     let pressures = sol.pressures();
@@ -277,14 +283,14 @@ fn margin_of(sol: &StaticsSolution) -> Option<f64> {
         load_factor: 1.0,
         profile: sol.actuation.profile.as_deref(),
     };
-    let plan = match sol.options.integrator {
+    let plan = match integrator {
         Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
         Integrator::Adaptive(_) => Vec::new(),
     };
-    let mut p = Shooting::new(eq, sol.options.integrator, plan);
+    let mut p = Shooting::new(eq, integrator, plan);
     p.stops = interior(&sol.s_out, model.length());
     let x = scaled(model, &sol.base_wrench);
-    stability_at(&mut p, &x, None, false).map(|(s, _)| s.margin)
+    stability_at(&mut p, &x, None, false).map(|(s, _)| s)
 }
 
 /// The points of `s_out` strictly inside `(0, length)`.

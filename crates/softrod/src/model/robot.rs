@@ -77,13 +77,38 @@ impl RobotModel {
     ///
     /// # Errors
     /// As [`RobotModel::new`] for the loads.
+    /// The rod, tendons and chambers were validated with this model: only the loads are
+    /// checked, and what depends on them (breaks, `rho g`, force-free) is recomputed.
     pub fn with_loads(&self, loads: Loads) -> Result<Arc<Self>> {
-        Self::new(
-            self.rod.clone(),
-            self.tendons.clone(),
-            self.chambers.clone(),
+        let l = self.length();
+        loads.validate(l, self.rod.density())?;
+        check_load_limits(&loads, &self.rod, self.force_scale)?;
+        let mut breaks = vec![0.0, l];
+        breaks.extend_from_slice(&self.tendon_ends);
+        breaks.extend(loads.point_loads.iter().map(|p| p.s));
+        for &(start, end) in &self.chamber_extents {
+            breaks.extend([start, end]);
+        }
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup();
+        let mut model = Self {
+            rod: self.rod.clone(),
+            tendons: self.tendons.clone(),
+            chambers: self.chambers.clone(),
             loads,
-        )
+            tendon_ends: self.tendon_ends.clone(),
+            tendon_reach: self.tendon_reach.clone(),
+            chamber_area_max: self.chamber_area_max.clone(),
+            chamber_extents: self.chamber_extents.clone(),
+            breaks,
+            force_scale: self.force_scale,
+            rho_g: None,
+            force_free: false,
+            uniform_compliance: self.uniform_compliance,
+        };
+        model.rho_g = rho_g_of(&model.rod, &model.loads);
+        model.force_free = force_free_of(&model.loads);
+        Ok(Arc::new(model))
     }
 
     fn build(rod: Rod, tendons: Vec<Tendon>, chambers: Vec<Chamber>, loads: Loads) -> Result<Self> {
@@ -149,18 +174,8 @@ impl RobotModel {
                     .fold(0.0, f64::max)
             })
             .collect();
-        let rho_g = rod
-            .density()
-            .filter(|_| loads.gravity != Vector3::zeros())
-            .map(|rho| loads.gravity * rho);
-        let force_free = loads.distributed_force.is_none()
-            && loads.gravity == Vector3::zeros()
-            && loads.point_loads.iter().all(|p| {
-                p.force == Vector3::zeros()
-                    && (p.frame == Frame::World || p.moment == Vector3::zeros())
-            })
-            && (loads.tip_frame == Frame::World
-                || (loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros()));
+        let rho_g = rho_g_of(&rod, &loads);
+        let force_free = force_free_of(&loads);
         let uniform_compliance =
             (rod.section().is_uniform() && rod.material().is_linear()).then(|| {
                 rod.material()
@@ -280,6 +295,25 @@ impl RobotModel {
     pub fn uniform_compliance(&self) -> Option<&TangentCompliance> {
         self.uniform_compliance.as_ref()
     }
+}
+
+/// `rho g` (N/m³) of the rod under the loads, if gravity acts.
+fn rho_g_of(rod: &Rod, loads: &Loads) -> Option<Vector3<f64>> {
+    rod.density()
+        .filter(|_| loads.gravity != Vector3::zeros())
+        .map(|rho| loads.gravity * rho)
+}
+
+/// Whether no force acts along the rod under the loads (only world-frame tip loads and
+/// moments).
+fn force_free_of(loads: &Loads) -> bool {
+    loads.distributed_force.is_none()
+        && loads.gravity == Vector3::zeros()
+        && loads.point_loads.iter().all(|p| {
+            p.force == Vector3::zeros() && (p.frame == Frame::World || p.moment == Vector3::zeros())
+        })
+        && (loads.tip_frame == Frame::World
+            || (loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros()))
 }
 
 /// Checks tendon `i`'s routing on `[0, end]` at the check points: offset and derivative
