@@ -118,17 +118,7 @@ fn unloading_moves_a_slip_front() {
 
 /// The NiTi robot with friction `mu` on every tendon and a lateral tip force.
 fn niti(mu: f64, tip: Vector3<f64>) -> Arc<RobotModel> {
-    let tendons = common::niti_tendons(&[0.0; 6])
-        .into_iter()
-        .map(|t| t.tendon.with_friction(mu).unwrap())
-        .collect();
-    RobotModel::new(
-        common::niti_rod(),
-        tendons,
-        Vec::new(),
-        Loads::tip_force(tip),
-    )
-    .unwrap()
+    common::niti_model(Loads::tip_force(tip), None, mu)
 }
 
 /// With and without a tip force (the fixed point and the one march).
@@ -507,15 +497,7 @@ fn the_actuation_jacobian_of_a_frictional_equilibrium_is_refused_by_name() {
 
 /// The NiTi robot with friction `mu` on every tendon under `loads`.
 fn niti_loaded(mu: f64, loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
-    let tendons = common::niti_tendons(&[0.0; 6])
-        .into_iter()
-        .map(|t| t.tendon.with_friction(mu).unwrap())
-        .collect();
-    let mut rod = common::niti_rod();
-    if let Some(d) = density {
-        rod = rod.with_density(d).unwrap();
-    }
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    common::niti_model(loads, density, mu)
 }
 
 /// Loaded models (tip force, gravity, both): the one march per Newton iterate of the base

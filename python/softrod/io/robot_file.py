@@ -481,8 +481,47 @@ class CylinderSpec(_Table):
     radius: _num("radius (m)", gt=0)
 
 
+class MeshSpec(_Table):
+    """A triangle mesh: read from `file` (STL, OBJ, PLY, ... by trimesh; a relative path is
+    relative to the robot file) or given by `vertices` and `faces`; its vertices scaled by
+    `scale`, then rotated by `rotation` and moved by `position` (world)."""
+
+    type: Literal["mesh"]
+    file: Str | None = None
+    vertices: (
+        Annotated[list[Vec3], Field(min_length=3, description="vertices (m, mesh frame)")] | None
+    ) = None
+    faces: (
+        Annotated[
+            list[Annotated[list[Annotated[int, Field(ge=0)]], Field(min_length=3, max_length=3)]],
+            Field(min_length=1, description="vertex indices of each triangle"),
+        ]
+        | None
+    ) = None
+    scale: _num("factor from the mesh's units to m (1e-3 for a mesh in mm)", gt=0) = 1.0
+    position: _vec(3, "translation of the mesh frame (m, world)") | None = None
+    rotation: (
+        Annotated[
+            list[_vec(3, "row")],
+            Field(min_length=3, max_length=3, description="3x3 rotation rows (mesh -> world)"),
+        ]
+        | None
+    ) = None
+
+    @model_validator(mode="after")
+    def _one_source(self) -> MeshSpec:
+        _exclusive(self.__dict__, "file", "vertices", "a mesh file, or vertices and faces")
+        if self.vertices is not None and self.faces is None:
+            raise PydanticCustomError("needed", "needed with `vertices`", {"field": "faces"})
+        if self.vertices is None and self.faces is not None:
+            raise PydanticCustomError(
+                "with_vertices", "goes with `vertices`, not `file`", {"field": "faces"}
+            )
+        return self
+
+
 ObstacleSpec = Annotated[
-    PlaneSpec | SphereSpec | CapsuleSpec | CylinderSpec, Field(discriminator="type")
+    PlaneSpec | SphereSpec | CapsuleSpec | CylinderSpec | MeshSpec, Field(discriminator="type")
 ]
 
 

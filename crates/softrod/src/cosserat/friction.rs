@@ -1,6 +1,6 @@
 //! Capstan friction between the tendons and their channels, with stick and slip.
 //!
-//! A tendon with friction coefficient `μ` ([`Tendon::with_friction`]) carries a tension that
+//! A tendon with friction coefficient `μ` ([`crate::Tendon::with_friction`]) carries a tension that
 //! varies along its path: where it slides, `|dτ/dσ| = μ τ κ_path` (σ the path's arc length,
 //! `κ_path` its curvature), the tension decreasing away from the side it slides toward; where
 //! it sticks, `|dτ/dσ| <= μ τ κ_path`. Along the rod's arc length `s`, `κ_path dσ = |dt_i|` is
@@ -23,7 +23,7 @@
 //! tension because the tendon is taken inextensible (its own elasticity is not modelled).
 //!
 //! **Coupling with the rod.** The rod equations are in total-wrench form (see
-//! [`equations`](super::equations)): the friction force is internal to rod + tendons, so the
+//! `cosserat::equations`): the friction force is internal to rod + tendons, so the
 //! balance `N' = −f`, `M' = −p' × N − l` holds unchanged and only the tension profile enters
 //! the constitutive split `n = N − Σ τ_i(s) t_i`. The rod therefore receives from each tendon
 //! the distributed load `d(τ_i t_i)/ds = τ_i t_i' + τ_i' t_i` (normal load plus the friction

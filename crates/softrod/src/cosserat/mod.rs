@@ -1,5 +1,5 @@
 //! The Cosserat-rod model with tendons and chambers: the equations and their variational
-//! columns ([`equations`]), the constitutive local solve (linear and hyperelastic), the
+//! columns (`equations`), the constitutive local solve (linear and hyperelastic), the
 //! shooting problem, the statics entry point and its solution ([`statics`]), and the exact
 //! sensitivities of an equilibrium from the linearised boundary-value problem
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).

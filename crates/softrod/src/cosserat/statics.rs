@@ -1,7 +1,7 @@
 //! Steady-state shape of a Cosserat rod with tendons, chambers and external loads, by shooting.
 //!
 //! [`solve_statics`] finds the total base wrench `(N(0), M(0))` (world frame) that meets the
-//! tip conditions ([`super::shooting`]). The actuation is always applied in full: with the
+//! tip conditions (`cosserat::shooting`). The actuation is always applied in full: with the
 //! total-wrench form a tendon or a chamber adds nothing to the base wrench, so the actuated,
 //! unloaded rod is solved exactly by a zero base wrench in one pass. The external loads are
 //! then applied along the load factor `λ` from 0 to 1: first directly, from the exact tangent
@@ -251,9 +251,10 @@ impl StaticsSolution {
     /// The smallest eigenvalue of the symmetric part of the dimensionless tip tangent
     /// stiffness `D K D / (E I(0) / L)`, `K` the inverse of the tip tangent compliance
     /// (tendons at fixed tension, dead loads), `D = diag(L, L, L, 1, 1, 1)`: positive for a
-    /// stable equilibrium (see `docs/stability.md`). Computed during a loaded solve; for an
-    /// unloaded one (always stable) on first call, by one march with the six base-wrench
-    /// columns. NaN for a result that did not converge.
+    /// stable equilibrium (see `docs/stability.md`). Computed during a loaded solve when its
+    /// sign is in doubt; for an unloaded one (always stable) and a loaded one certified
+    /// stable by the exact columns of a nearby Newton iterate, on first call, by one march
+    /// with the six base-wrench columns. NaN for a result that did not converge.
     pub fn stability_margin(&self) -> f64 {
         *self.margin.get_or_init(|| {
             if !self.stats.converged {
@@ -516,6 +517,16 @@ fn stability_at(
     let length = p.eq.model.length();
     if let (true, Some(j), Some(tw)) = (fresh, jacobian, p.tip_twist) {
         return tip_stability(j, &tw, length).map(|s| (s, j.to_vec()));
+    }
+    if let Some((_, exact)) = p.certificate(x, 1.0) {
+        // Stable, certified by exact columns near x: the margin at x is computed when first
+        // read (NaN here).
+        let certified = Stability {
+            stable: true,
+            margin: f64::NAN,
+            mode: None,
+        };
+        return Some((certified, jacobian.map_or(exact.to_vec(), <[f64]>::to_vec)));
     }
     let (_, cols, _) = p.pass::<FULL>(x, 1.0).ok()?;
     let mut j = vec![0.0; 36];
@@ -901,7 +912,9 @@ fn solve_with(
     match stability {
         Some(s) => {
             sol.stable = s.stable;
-            let _ = sol.margin.set(s.margin);
+            if !s.margin.is_nan() {
+                let _ = sol.margin.set(s.margin);
+            }
         }
         None => sol.stable = !loaded && sol.stats.converged,
     }
