@@ -363,13 +363,6 @@ fn check_inputs(
         return Err(Error::invalid("friction.max_iterations", 0, ">= 1"));
     }
     model.check_actuation(actuation)?;
-    if let Some(i) = actuation.held().first() {
-        return Err(Error::invalid(
-            format!("tendons[{i}]"),
-            "displacement-controlled",
-            "tension-controlled (friction with displacement control is not modelled)",
-        ));
-    }
     Ok(())
 }
 
@@ -431,6 +424,9 @@ pub fn solve_frictional(
     previous: Option<&FrictionalSolution>,
 ) -> Result<FrictionalSolution> {
     check_inputs(model, actuation, options)?;
+    if actuation.has_held() {
+        return super::friction_held::solve_held_frictional(model, actuation, options, previous);
+    }
     if model.tendons().iter().any(Tendon::is_guided) {
         return super::guides::solve_guided(model, actuation, options, previous);
     }

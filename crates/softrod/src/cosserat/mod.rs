@@ -8,6 +8,7 @@ mod collapse;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
+mod friction_held;
 mod friction_march;
 mod guides;
 mod hyperelastic_local;

@@ -775,8 +775,14 @@ fn check_inputs(
     model.check_actuation(actuation)?;
     // A tendon with friction needs its tension profile (solve_frictional): a uniform tension
     // would be the frictionless answer, reported as if friction had been modelled.
+    // (A tendon at zero tension carries no friction: the zero actuation of the displacement
+    // reference is the frictionless one.)
+    let tensions = actuation.tension_values(model.tendons().len());
     if actuation.profile.is_none() {
-        if let Some(i) = model.tendons().iter().position(|t| t.friction() > 0.0) {
+        if let Some(i) = (0..tensions.len()).find(|&i| {
+            model.tendons()[i].friction() > 0.0
+                && (tensions[i] != 0.0 || actuation.tendons.get(i).is_some_and(|t| t.is_held()))
+        }) {
             return Err(Error::invalid(
                 format!("tendons[{i}].friction"),
                 model.tendons()[i].friction(),
@@ -786,7 +792,6 @@ fn check_inputs(
     }
     // A guided tendon loads the rod at its guides only (solve_frictional): its tension along
     // the continuous channel would be another robot's answer.
-    let tensions = actuation.tension_values(model.tendons().len());
     if let Some(i) =
         (0..tensions.len()).find(|&i| model.tendons()[i].is_guided() && tensions[i] != 0.0)
     {
