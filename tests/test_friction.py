@@ -124,3 +124,17 @@ def test_disk_guided_bad_input_names_the_parameter():
         softrod.Tendon((0.01, 0.0), 1.0, end=0.2, guides=[0.1], guide_friction=-0.1)
     with pytest.raises(softrod.ParameterError, match="guide_friction"):
         softrod.Tendon((0.01, 0.0), 1.0, end=0.2, guides=[0.05, 0.1], guide_friction=[0.1] * 3)
+
+
+def test_displacement_control_with_friction_round_trip():
+    robot = niti(0.2)
+    up = robot.solve([3.0, 0, 0, 0, 1.5, 0])
+    down = robot.solve([1.8, 0, 0, 0, 1.2, 0], previous=up)
+    zero = robot.solve([0.0] * 6)
+    for target, prev in [(up, None), (down, up)]:
+        shortening = zero.tendon_lengths - target.tendon_lengths
+        held = [shortening[0], None, None, None, shortening[4], None]
+        sol = robot.solve([0.0] * 6, displacements=held, previous=prev)
+        assert sol.frictional
+        np.testing.assert_allclose(sol.tendon_tension, target.tendon_tension, rtol=0, atol=3e-8)
+        np.testing.assert_allclose(sol.position, target.position, rtol=0, atol=1e-10)
