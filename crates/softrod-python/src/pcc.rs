@@ -93,6 +93,22 @@ fn renamed(e: softrod::Error, from: &str, to: &str) -> softrod::Error {
     }
 }
 
+/// A parameter error of entry `i` of an array argument: the parameter named `name[i]`.
+fn indexed(e: softrod::Error, i: usize) -> softrod::Error {
+    match e {
+        softrod::Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => softrod::Error::InvalidParameter {
+            name: format!("{name}[{i}]"),
+            value,
+            expected,
+        },
+        other => other,
+    }
+}
+
 fn vector3(v: Floats, name: &str) -> PyResult<Vector3<f64>> {
     let v = v.to_vec()?;
     if v.len() != 3 {
@@ -179,20 +195,8 @@ pub(crate) fn pcc_arc_poses<'py>(
         }
     }
     let at = |v: &[f64], i: usize| if v.len() == 1 { v[0] } else { v[i] };
-    let segment = |i: usize| {
-        PccSegment::checked(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| match e {
-            softrod::Error::InvalidParameter {
-                name,
-                value,
-                expected,
-            } => softrod::Error::InvalidParameter {
-                name: format!("{name}[{i}]"),
-                value,
-                expected,
-            },
-            other => other,
-        })
-    };
+    let segment =
+        |i: usize| PccSegment::checked(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| indexed(e, i));
     let mut flat = vec![0.0; 16 * n];
     let fill = |i: usize, out: &mut [f64]| -> softrod::Result<()> {
         let t = segment(i)?.pose();
@@ -640,18 +644,8 @@ impl PccRobot {
         };
         let bodies = (0..n)
             .map(|i| {
-                ElasticSegment::new(l0[i], ei[i], ea.as_ref().map(|a| a[i])).map_err(|e| match e {
-                    softrod::Error::InvalidParameter {
-                        name,
-                        value,
-                        expected,
-                    } => softrod::Error::InvalidParameter {
-                        name: format!("{name}[{i}]"),
-                        value,
-                        expected,
-                    },
-                    other => other,
-                })
+                ElasticSegment::new(l0[i], ei[i], ea.as_ref().map(|a| a[i]))
+                    .map_err(|e| indexed(e, i))
             })
             .collect::<softrod::Result<Vec<_>>>()
             .map_err(to_py_err)?;

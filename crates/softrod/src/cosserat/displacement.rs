@@ -59,7 +59,7 @@ pub fn reference_lengths(model: &Arc<RobotModel>, options: &SolveOptions) -> Res
 }
 
 /// One held tendon: its index, `ℓ_ref - δ` (m), compliance (m/N), slack scale (m).
-fn held_of(model: &RobotModel, actuation: &Actuation, reference: &[f64]) -> Vec<Held> {
+pub(super) fn held_of(model: &RobotModel, actuation: &Actuation, reference: &[f64]) -> Vec<Held> {
     actuation
         .tendons
         .iter()

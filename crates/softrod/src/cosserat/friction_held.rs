@@ -17,7 +17,9 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
+use super::displacement::held_of;
 use super::friction::{solve_frictional, FrictionOptions, FrictionalSolution};
+use super::shooting::Held;
 use crate::error::{Error, Result};
 use crate::model::{Actuation, RobotModel, TendonInput};
 
@@ -26,22 +28,6 @@ pub const HELD_MAX_ITERATIONS: usize = 60;
 
 /// Tolerance on the length residual `g` of the held tendons, relative to the rod length.
 pub const HELD_TOLERANCE: f64 = 1e-13;
-
-/// The held tendons: index, `ℓ_ref − δ` (m), compliance `1/k` (m/N).
-fn held_of(actuation: &Actuation, reference: &[f64]) -> Vec<(usize, f64, f64)> {
-    actuation
-        .tendons
-        .iter()
-        .enumerate()
-        .filter_map(|(i, t)| match *t {
-            TendonInput::Displacement {
-                displacement,
-                stiffness,
-            } => Some((i, reference[i] - displacement, 1.0 / stiffness)),
-            TendonInput::Tension(_) => None,
-        })
-        .collect()
-}
 
 /// A held tendon routed through guides is refused by name.
 fn check_guided(model: &RobotModel, actuation: &Actuation) -> Result<()> {
@@ -64,12 +50,15 @@ fn check_guided(model: &RobotModel, actuation: &Actuation) -> Result<()> {
 /// base tensions, or zero.
 fn first_tensions(
     actuation: &Actuation,
-    held: &[(usize, f64, f64)],
+    held: &[Held],
     previous: Option<&FrictionalSolution>,
 ) -> Vec<f64> {
     match (&actuation.tension_guess, previous) {
-        (Some(g), _) => held.iter().map(|h| g[h.0].max(0.0)).collect(),
-        (None, Some(p)) => held.iter().map(|h| p.tension[0][h.0].max(0.0)).collect(),
+        (Some(g), _) => held.iter().map(|h| g[h.tendon].max(0.0)).collect(),
+        (None, Some(p)) => held
+            .iter()
+            .map(|h| p.tension[0][h.tendon].max(0.0))
+            .collect(),
         (None, None) => vec![0.0; held.len()],
     }
 }
@@ -93,20 +82,20 @@ pub(super) fn solve_held_frictional(
         Some(r) => r.clone(),
         None => super::reference_lengths(model, &options.statics)?,
     };
-    let held = held_of(actuation, &reference);
+    let held = held_of(model, actuation, &reference);
     let mut tau = first_tensions(actuation, &held, previous);
     let base = actuation.tension_values(nt);
     let solve = |tau: &[f64]| -> Result<(FrictionalSolution, DVector<f64>)> {
         let mut t = base.clone();
         for (k, h) in held.iter().enumerate() {
-            t[h.0] = tau[k];
+            t[h.tendon] = tau[k];
         }
         let mut act = actuation.clone();
         act.tendons = t.iter().map(|&x| TendonInput::Tension(x)).collect();
         let sol = solve_frictional(model, &act, options, previous)?;
         let g = DVector::from_fn(held.len(), |k, _| {
-            let (i, target, c) = held[k];
-            target - sol.statics.tendon_lengths[i] + c * tau[k]
+            let h = &held[k];
+            h.target - sol.statics.tendon_lengths[h.tendon] + h.compliance * tau[k]
         });
         Ok((sol, g))
     };
