@@ -87,3 +87,42 @@ def test_a_robot_solves_with_a_mesh_and_names_it_when_described():
     _same(_solve(sr.Plane((X, 0, 0), (1, 0, 0))), robot.solve())
     with pytest.raises(sr.ParameterError, match="obstacles"):
         robot.spec  # noqa: B018 (a robot file cannot describe the mesh yet)
+
+
+def test_a_robot_file_reads_a_mesh_relative_to_itself(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    box = trimesh.creation.box(extents=(1.0, 4 * L, 4 * L))
+    box.apply_translation((X - 0.5, 0.0, 0.5 * L))
+    (tmp_path / "meshes").mkdir()
+    box.export(tmp_path / "meshes" / "box.stl")
+    face = float(sr.Mesh.from_file(tmp_path / "meshes" / "box.stl").vertices[:, 0].max())
+    text = f"""
+[rod]
+length = {L}
+
+[rod.section]
+type = "circular"
+radius = {R}
+
+[rod.material]
+youngs_modulus = {E}
+poisson_ratio = {NU}
+
+[loads]
+tip_force = [{-2 * CLOSING}, {0.3 * CLOSING}, 0.0]
+
+[solver]
+steps = 100
+
+[[obstacles]]
+type = "mesh"
+file = "meshes/box.stl"
+"""
+    (tmp_path / "robot.toml").write_text(text)
+    robot = sr.load_robot(tmp_path / "robot.toml")
+    assert isinstance(robot.obstacles[0], sr.Mesh)
+    _same(_solve(sr.Plane((face, 0, 0), (1, 0, 0))), robot.solve())
+    # A file that is not there is named at its table.
+    (tmp_path / "bad.toml").write_text(text.replace("meshes/box.stl", "meshes/none.stl"))
+    with pytest.raises(sr.ParameterError, match=r"obstacles\[0\]"):
+        sr.load_robot(tmp_path / "bad.toml")

@@ -225,21 +225,36 @@ def build(spec: rf.RobotFile, source: str | None = None) -> Parts:
     if errors:
         rf.raise_errors(errors, source)
     solver = spec.solver.options() if spec.solver is not None else {}
-    return Parts(
+    errors_after: list[FieldError] = []
+    parts = Parts(
         rod,
         tuple(tendons),
         tuple(chambers),
         loads,
         solver,
-        tuple(obstacle_of(o) for o in spec.obstacles),
+        tuple(
+            _attempt(errors_after, f"obstacles[{i}]", lambda o=o: obstacle_of(o, source))
+            for i, o in enumerate(spec.obstacles)
+        ),
         tip_constraint_of(spec.tip_constraint),
     )
+    if errors_after:
+        rf.raise_errors(errors_after, source)
+    return parts
 
 
-def obstacle_of(o: Any) -> Any:
-    """The obstacle dataclass of an ``[[obstacles]]`` table."""
-    from ..contact import Capsule, Cylinder, Plane, Sphere
+def obstacle_of(o: Any, source: str | None = None) -> Any:
+    """The obstacle dataclass of an ``[[obstacles]]`` table (a mesh file relative to the
+    robot file `source`, else to the working directory)."""
+    import os
 
+    from ..contact import Capsule, Cylinder, Mesh, Plane, Sphere
+
+    if isinstance(o, rf.MeshSpec):
+        path = o.file
+        if source is not None and not os.path.isabs(path):
+            path = os.path.join(os.path.dirname(os.path.abspath(source)), path)
+        return Mesh.from_file(path)
     if isinstance(o, rf.PlaneSpec):
         return Plane(tuple(o.point), tuple(o.normal))
     if isinstance(o, rf.SphereSpec):

@@ -475,8 +475,19 @@ class CylinderSpec(_Table):
     radius: _num("radius (m)", gt=0)
 
 
+class MeshSpec(_Table):
+    """A closed triangle mesh read with trimesh (STL, OBJ, PLY...; world frame, m)."""
+
+    type: Literal["mesh"]
+    file: Annotated[
+        str,
+        Strict(),
+        Field(min_length=1, description="mesh file, relative to the robot file"),
+    ]
+
+
 ObstacleSpec = Annotated[
-    PlaneSpec | SphereSpec | CapsuleSpec | CylinderSpec, Field(discriminator="type")
+    PlaneSpec | SphereSpec | CapsuleSpec | CylinderSpec | MeshSpec, Field(discriminator="type")
 ]
 
 
