@@ -1,6 +1,8 @@
 """Triangle-mesh obstacles from Python: a flat two-triangle mesh and a box read with trimesh
 give the plane's solution to round-off; bad meshes are named errors."""
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -78,51 +80,81 @@ def test_plot_rod_draws_a_mesh():
     assert [a.get_gid() for a in drawn] == ["obstacle-0"]
 
 
-def test_a_robot_solves_with_a_mesh_and_names_it_when_described():
+def test_a_robot_with_a_mesh_solves_and_writes_it_out():
     rod = sr.Rod(L, sr.CircularSection(R), sr.LinearElastic(E, NU))
     square = np.array([[X, -L, -L], [X, L, -L], [X, L, 2 * L], [X, -L, 2 * L]])
     mesh = sr.Mesh(square, [[0, 1, 2], [0, 2, 3]])
     loads = sr.Loads(tip_force=(-2 * CLOSING, 0.3 * CLOSING, 0))
     robot = sr.Robot(rod, loads=loads, obstacles=[mesh], solver={"steps": 100})
     _same(_solve(sr.Plane((X, 0, 0), (1, 0, 0))), robot.solve())
-    with pytest.raises(sr.ParameterError, match="obstacles"):
-        robot.spec  # noqa: B018 (a robot file cannot describe the mesh yet)
+    # Written out in full (vertices and faces), read back equal, solved identically.
+    again = sr.Robot.from_toml(robot.to_toml())
+    assert again.obstacles == (mesh,)
+    assert again == robot
+    np.testing.assert_array_equal(again.solve().position, robot.solve().position)
 
 
-def test_a_robot_file_reads_a_mesh_relative_to_itself(tmp_path):
-    trimesh = pytest.importorskip("trimesh")
-    box = trimesh.creation.box(extents=(1.0, 4 * L, 4 * L))
-    box.apply_translation((X - 0.5, 0.0, 0.5 * L))
-    (tmp_path / "meshes").mkdir()
-    box.export(tmp_path / "meshes" / "box.stl")
-    face = float(sr.Mesh.from_file(tmp_path / "meshes" / "box.stl").vertices[:, 0].max())
-    text = f"""
+ROBOT_WITH_MESH = """
 [rod]
-length = {L}
-
-[rod.section]
-type = "circular"
-radius = {R}
-
-[rod.material]
-youngs_modulus = {E}
-poisson_ratio = {NU}
+length = 1.0
+section = {{ type = "circular", radius = 1e-3 }}
+material = {{ type = "linear", youngs_modulus = 2e9, poisson_ratio = 0.3 }}
 
 [loads]
-tip_force = [{-2 * CLOSING}, {0.3 * CLOSING}, 0.0]
+tip_force = [{fx}, {fy}, 0.0]
 
 [solver]
 steps = 100
 
 [[obstacles]]
 type = "mesh"
-file = "meshes/box.stl"
+file = "meshes/square_mm.obj"
+scale = 1e-3
+# mesh z -> world x: the square's plane z = 0 becomes x = {x}
+rotation = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]
+position = [{x}, 0.0, 0.0]
 """
-    (tmp_path / "robot.toml").write_text(text)
-    robot = sr.load_robot(tmp_path / "robot.toml")
-    assert isinstance(robot.obstacles[0], sr.Mesh)
-    _same(_solve(sr.Plane((face, 0, 0), (1, 0, 0))), robot.solve())
-    # A file that is not there is named at its table.
-    (tmp_path / "bad.toml").write_text(text.replace("meshes/box.stl", "meshes/none.stl"))
-    with pytest.raises(sr.ParameterError, match=r"obstacles\[0\]"):
-        sr.load_robot(tmp_path / "bad.toml")
+
+
+def test_a_robot_file_reads_a_mesh_file_relative_to_itself_scaled_and_posed(tmp_path, monkeypatch):
+    # A 4 m square in mm in the mesh's xy-plane, normal +z (counter-clockwise seen from +z).
+    folder = tmp_path / "robots"
+    (folder / "meshes").mkdir(parents=True)
+    (folder / "meshes" / "square_mm.obj").write_text(
+        "v -2000 -2000 0\nv 2000 -2000 0\nv 2000 2000 0\nv -2000 2000 0\nf 1 2 3\nf 1 3 4\n"
+    )
+    path = folder / "arm.toml"
+    path.write_text(ROBOT_WITH_MESH.format(fx=-2 * CLOSING, fy=0.3 * CLOSING, x=X))
+    monkeypatch.chdir(tmp_path)  # not the robot file's folder
+    robot = sr.load_robot(path)
+    (mesh,) = robot.obstacles
+    # Rotated: world x = -(mesh z) ... the square lies in the plane x = X.
+    np.testing.assert_allclose(mesh.vertices[:, 0], X, atol=1e-15)
+    assert np.abs(mesh.vertices[:, 1:]).max() == pytest.approx(2.0)
+    _same(_solve(sr.Plane((X, 0, 0), (1, 0, 0))), robot.solve())
+    assert "square_mm.obj" in robot.to_toml()
+    # Pickled (to a worker that may not see the file): it travels with its vertices.
+    shipped = pickle.dumps(robot)
+    (folder / "meshes" / "square_mm.obj").unlink()
+    again = pickle.loads(shipped)
+    assert again.obstacles == robot.obstacles
+    np.testing.assert_array_equal(again.solve().position, robot.solve().position)
+
+
+def test_mesh_tables_name_their_errors(tmp_path):
+    base = "[rod]\nlength = 1.0\nsection = { type = 'circular', radius = 1e-3 }\n"
+    base += "material = { type = 'linear', youngs_modulus = 2e9, poisson_ratio = 0.3 }\n"
+    tri = "vertices = [[0.0,0,0],[1.0,0,0],[0.0,1,0]]\n"
+    cases = {
+        "[[obstacles]]\ntype = 'mesh'\n": "obstacles[0].mesh.file",
+        "[[obstacles]]\ntype = 'mesh'\nfile = 'a.stl'\n" + tri: "obstacles[0].mesh.file",
+        "[[obstacles]]\ntype = 'mesh'\n" + tri: "obstacles[0].mesh.faces",
+        "[[obstacles]]\ntype = 'mesh'\nfile = 'missing.stl'\n": "obstacles[0].mesh.file",
+        "[[obstacles]]\ntype = 'mesh'\nfile = 'a.stl'\nscale = -1.0\n": "obstacles[0].mesh.scale",
+    }
+    for table, where in cases.items():
+        path = tmp_path / "r.toml"
+        path.write_text(base + table)
+        with pytest.raises(sr.ParameterError) as info:
+            sr.load_robot(path)
+        assert info.value.parameter == where, (table, str(info.value))

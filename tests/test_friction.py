@@ -75,3 +75,66 @@ def test_loaded_hysteresis_from_python():
     assert np.all(down.slip[1:5, 0] <= 0)
     # Global balance of rod + tendons: the base wrench carries the tip force.
     np.testing.assert_allclose(down.base_wrench[:3], [0.05, -0.02, 0.0], rtol=0, atol=1e-10)
+
+
+def guided_niti(mu: float, per_segment: int = 8) -> softrod.Robot:
+    """The NiTi robot with its tendons through equally spaced disks (capstan `mu` at each)."""
+    base = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    spec = base.spec.model_dump(mode="python", exclude_none=True)
+    for t in spec["tendons"]:
+        end = t.get("end", 0.4)
+        n = round(per_segment * end / 0.2)
+        t["guides"] = [end * g / n for g in range(1, n)]
+        t["guide_friction"] = mu
+    return softrod.Robot.from_dict(spec)
+
+
+def test_disk_guided_tendons_follow_the_capstan_law_per_guide():
+    robot = guided_niti(0.3)
+    assert robot.tendons[0].guides[0] == pytest.approx(0.025)
+    # Small tensions: the guide fixed point converges where the tendon load is small against
+    # the rod's stiffness (docs/friction.md).
+    sol = robot.solve([0.02, 0, 0, 0, 0.01, 0])
+    assert sol.frictional
+    anchors = sol.guides[0]
+    assert [a["s"] for a in anchors][-1] == pytest.approx(0.2)
+    # Wrap angles from the returned guide points (independent of the reported wrap).
+    pts = np.array([a["point"] for a in anchors])
+    chords = np.diff(pts, axis=0)
+    chords /= np.linalg.norm(chords, axis=1)[:, None]
+    for g in range(1, len(anchors) - 1):
+        theta = np.arctan2(
+            np.linalg.norm(np.cross(chords[g - 1], chords[g])), chords[g - 1] @ chords[g]
+        )
+        a = anchors[g]
+        assert a["slip"] == 1
+        assert a["tension_out"] / a["tension_in"] == pytest.approx(np.exp(-0.3 * theta), rel=1e-9)
+    # Per sample, the tension of the chord the sample lies on.
+    j = int(np.searchsorted(sol.s, anchors[3]["s"]))
+    assert sol.tendon_tension[j, 0] == anchors[3]["tension_out"]
+    # The description round-trips with its guides.
+    again = softrod.Robot.from_dict(robot.spec.model_dump(mode="python", exclude_none=True))
+    assert again.tendons[4].guide_friction == robot.tendons[4].guide_friction
+
+
+def test_disk_guided_bad_input_names_the_parameter():
+    with pytest.raises(softrod.ParameterError, match="guides"):
+        softrod.Tendon((0.01, 0.0), 1.0, end=0.2, guides=[0.1, 0.05])
+    with pytest.raises(softrod.ParameterError, match="guide_friction"):
+        softrod.Tendon((0.01, 0.0), 1.0, end=0.2, guides=[0.1], guide_friction=-0.1)
+    with pytest.raises(softrod.ParameterError, match="guide_friction"):
+        softrod.Tendon((0.01, 0.0), 1.0, end=0.2, guides=[0.05, 0.1], guide_friction=[0.1] * 3)
+
+
+def test_displacement_control_with_friction_round_trip():
+    robot = niti(0.2)
+    up = robot.solve([3.0, 0, 0, 0, 1.5, 0])
+    down = robot.solve([1.8, 0, 0, 0, 1.2, 0], previous=up)
+    zero = robot.solve([0.0] * 6)
+    for target, prev in [(up, None), (down, up)]:
+        shortening = zero.tendon_lengths - target.tendon_lengths
+        held = [shortening[0], None, None, None, shortening[4], None]
+        sol = robot.solve([0.0] * 6, displacements=held, previous=prev)
+        assert sol.frictional
+        np.testing.assert_allclose(sol.tendon_tension, target.tendon_tension, rtol=0, atol=3e-8)
+        np.testing.assert_allclose(sol.position, target.position, rtol=0, atol=1e-10)

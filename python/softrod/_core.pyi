@@ -302,6 +302,8 @@ class Tendon:
         *,
         derivative: Callable[[float], Sequence[float]] | None = None,
         friction: float = 0.0,
+        guides: Sequence[float] | None = None,
+        guide_friction: float | Sequence[float] | None = None,
     ) -> None: ...
     @staticmethod
     def radius_proportional(
@@ -330,6 +332,12 @@ class Tendon:
     @property
     def friction(self) -> float:
         """Friction coefficient between the tendon and its channel (>= 0)."""
+    @property
+    def guides(self) -> list[float]:
+        """Arc lengths (m) of the guides the tendon runs through; empty: a continuous channel."""
+    @property
+    def guide_friction(self) -> list[float]:
+        """Capstan coefficient at each guide."""
     @property
     def routing(self) -> Literal["constant", "function", "radius_proportional", "helical"]: ...
     @property
@@ -424,6 +432,9 @@ class StaticsSolution:
         """+1 sliding toward the base, -1 toward the tip, 0 sticking; (N, n_tendons)."""
     @property
     def frictional(self) -> bool: ...
+    @property
+    def guides(self) -> list[list[dict[str, Any]]]:
+        """Per tendon through guides, the state at its anchors (base hole, guides, termination)."""
     @property
     def friction_iterations(self) -> int: ...
     @property

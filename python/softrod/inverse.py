@@ -104,8 +104,29 @@ def _warm_arguments(warm_start: Any, key: tuple) -> tuple[Any, dict[str, Any]]:
         and len(old) == len(key)
         and all(a is b or (isinstance(a, tuple) and a == b) for a, b in zip(old, key, strict=True))
     )
-    extra = {"warm_state": warm_start._warm_state, "same_model": same}
-    return warm_start.actuation, extra
+    state = warm_start._warm_state
+    if state is None:
+        return warm_start.actuation, {}
+    # The state carries the actuation: the extension takes it from there.
+    return None, {"warm_state": state, "same_model": same}
+
+
+def _from_core(out: dict, solution: Any, warm_state: Any, key: Any) -> InverseSolution:
+    """The :class:`InverseSolution` of an extension result ``out``, made without the
+    dataclass initialiser (its values are already of the field types)."""
+    obj = object.__new__(InverseSolution)
+    obj.__dict__.update(
+        tensions=out["tensions"],
+        pressures=out["pressures"],
+        _solution=solution,
+        position_error=out["position_error"],
+        rotation_error=out["rotation_error"],
+        iterations=out["iterations"],
+        converged=out["converged"],
+        _warm_state=warm_state,
+        _model_key=key,
+    )
+    return obj
 
 
 def _model_key(robot: Robot) -> tuple:
@@ -186,25 +207,15 @@ def inverse_statics(
         **{k: v for k, v in robot.solver.items() if k in ("integrator", "steps", "rtol", "atol")},
         **extra,
     )
-    a = np.asarray(out["actuation"])
-    nt = out["n_tendons"]
-    tensions, pressures = a[:nt].copy(), a[nt:].copy()
+    tensions, pressures = out["tensions"], out["pressures"]
     solution = _Deferred(
         lambda: robot.solve(
-            tensions if nt else None, pressures if len(pressures) else None, on_unstable="ignore"
+            tensions.copy() if len(tensions) else None,
+            pressures.copy() if len(pressures) else None,
+            on_unstable="ignore",
         )
     )
-    return InverseSolution(
-        tensions=tensions,
-        pressures=pressures,
-        solution=solution,
-        position_error=float(out["position_error"]),
-        rotation_error=float(out["rotation_error"]),
-        iterations=int(out["iterations"]),
-        converged=bool(out["converged"]),
-        _warm_state=None if target_s is not None else out["warm_state"],
-        _model_key=key,
-    )
+    return _from_core(out, solution, None if target_s is not None else out["warm_state"], key)
 
 
 @dataclass(frozen=True)

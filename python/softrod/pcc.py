@@ -51,6 +51,7 @@ from ._core import pcc_chain_pose as chain_pose
 from ._core import pcc_solve as solve
 from ._core import pcc_tendon_displacement_jacobian as tendon_displacement_jacobian
 from ._core import pcc_tendon_displacements as tendon_displacements
+from .inverse import _Deferred, _from_core, _warm_arguments
 
 
 def inverse_statics(
@@ -93,11 +94,6 @@ def inverse_statics(
         TargetUnreachableError: The target is out of reach (``throw=True``).
         ConvergenceError: The iteration did not converge (``throw=True``).
     """
-    from .inverse import InverseSolution, _Deferred, _warm_arguments
-
-    def _loads_key(v):
-        return None if v is None else tuple(np.asarray(v, dtype=float).ravel())
-
     key = (robot, (_loads_key(tip_force), _loads_key(tip_moment)))
     warm_start, extra = _warm_arguments(warm_start, key)
     out = _core._pcc_inverse_statics(
@@ -115,30 +111,22 @@ def inverse_statics(
         max_iterations=max_iterations,
         **extra,
     )
-    a = np.asarray(out["actuation"])
-    nt = out["n_tendons"]
-    tensions, pressures = a[:nt].copy(), a[nt:].copy()
+    tensions, pressures = out["tensions"], out["pressures"]
     # The PCC solution at the actuation found is solved when it is first read.
     solution = _Deferred(
         lambda: solve(
             robot,
-            tensions if nt else None,
-            pressures if len(pressures) else None,
+            tensions.copy() if len(tensions) else None,
+            pressures.copy() if len(pressures) else None,
             tip_force=tip_force,
             tip_moment=tip_moment,
         )
     )
-    return InverseSolution(
-        tensions=tensions,
-        pressures=pressures,
-        solution=solution,
-        position_error=float(out["position_error"]),
-        rotation_error=float(out["rotation_error"]),
-        iterations=int(out["iterations"]),
-        converged=bool(out["converged"]),
-        _warm_state=out["warm_state"],
-        _model_key=key,
-    )
+    return _from_core(out, solution, out["warm_state"], key)
+
+
+def _loads_key(v):
+    return None if v is None else tuple(np.asarray(v, dtype=float).ravel())
 
 
 # The names of the first release, kept: ``softrod.pcc.Robot`` is ``PccRobot``.

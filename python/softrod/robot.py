@@ -581,7 +581,9 @@ class Robot:
         )
 
     def __reduce__(self):
-        if self._tip_constraint is not None or (self._obstacles and self._spec is None):
+        # A mesh read from a file travels as its vertices (the file may not be there).
+        meshes = any(type(o).__name__ == "Mesh" for o in self._obstacles)
+        if self._tip_constraint is not None or (self._obstacles and (self._spec is None or meshes)):
             return (_rebuild, (self._parts(), self._obstacles, self._tip_constraint))
         if self._spec is not None:
             return (_from_pickled_spec, (self._spec,))

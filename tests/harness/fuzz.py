@@ -470,6 +470,18 @@ def _define_targets() -> None:
     t("Tendon(friction)")(
         lambda d: (sr.Tendon, dict(offset=(0.001, 0.0), tension=0.5, end=0.2, friction=0.2))
     )
+    t("Tendon(guides)")(
+        lambda d: (
+            sr.Tendon,
+            dict(
+                offset=(0.001, 0.0),
+                tension=0.5,
+                end=0.2,
+                guides=[0.05, 0.1, 0.15],
+                guide_friction=[0.1, 0.2, 0.3],
+            ),
+        )
+    )
     t("Tendon.radius_proportional(friction)")(
         lambda d: (
             sr.Tendon.radius_proportional,

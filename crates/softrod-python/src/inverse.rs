@@ -22,14 +22,21 @@ pub(crate) struct InverseWarmState {
     inner: InverseWarmStart,
 }
 
-/// The warm start of a call: `warm_state` (if its actuation is that of `warm_start`, and with
-/// its evaluation only when `same_model`), else the actuation of `warm_start` alone.
+/// The warm start of a call: `warm_state` (if its actuation is that of `warm_start`, or
+/// `warm_start` is not given; with its evaluation only when `same_model`), else the actuation
+/// of `warm_start` alone.
 fn merge_warm(
     warm: Option<InverseWarmStart>,
     state: Option<&Bound<'_, InverseWarmState>>,
     same_model: bool,
 ) -> Option<InverseWarmStart> {
-    let w = warm?;
+    let Some(w) = warm else {
+        let mut inner = state?.get().inner.clone();
+        if !same_model {
+            inner.evaluation = None;
+        }
+        return Some(inner);
+    };
     match state {
         Some(st) if st.get().inner.actuation == w.actuation => {
             let mut inner = st.get().inner.clone();
@@ -121,6 +128,8 @@ fn result_dict<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("actuation", inv.actuation.clone().into_pyarray(py))?;
+    d.set_item("tensions", inv.tensions().to_vec().into_pyarray(py))?;
+    d.set_item("pressures", inv.pressures().to_vec().into_pyarray(py))?;
     d.set_item("n_tendons", inv.n_tendons)?;
     d.set_item("position_error", inv.position_error)?;
     d.set_item("rotation_error", inv.rotation_error)?;
@@ -165,8 +174,8 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 
 /// Inverse statics of the robot `(rod, tendons, loads, chambers)` for a tip target (see
 /// `softrod.inverse_statics`). Returns a dict: `actuation` (tensions then pressures),
-/// `n_tendons`, `position_error` (m), `rotation_error` (rad), `iterations`, `evaluations`,
-/// `converged`, `reached`.
+/// `tensions`, `pressures`, `n_tendons`, `position_error` (m), `rotation_error` (rad),
+/// `iterations`, `evaluations`, `converged`, `reached`.
 #[pyfunction]
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
                     target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,

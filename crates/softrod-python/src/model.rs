@@ -295,8 +295,12 @@ fn check_tension(tension: f64) -> PyResult<f64> {
 impl Tendon {
     /// `offset`: `(x, y)` (m, body frame) or a function `s -> (x, y)`; `derivative`: the
     /// function's exact derivative `s -> (dx/ds, dy/ds)` (required with a function offset).
+    /// `guides`: arc lengths (m, increasing, in `(0, end)`) of the disks the tendon runs
+    /// through in straight chords (at its offset there), with the capstan coefficient
+    /// `guide_friction` (one value, or one per guide); `None`: a continuous channel.
     #[new]
-    #[pyo3(signature = (offset, tension, end=None, *, derivative=None, friction=0.0))]
+    #[pyo3(signature = (offset, tension, end=None, *, derivative=None, friction=0.0, guides=None, guide_friction=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         offset: &Bound<'_, PyAny>,
@@ -304,7 +308,33 @@ impl Tendon {
         #[pyo3(from_py_with = arg::end)] end: Option<f64>,
         derivative: Option<&Bound<'_, PyAny>>,
         #[pyo3(from_py_with = arg::friction)] friction: f64,
+        guides: Option<&Bound<'_, PyAny>>,
+        guide_friction: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let guides = guides.filter(|g| !g.is_none());
+        let guide_friction = guide_friction.filter(|g| !g.is_none());
+        let guide_list: Vec<f64> = match guides {
+            Some(g) => g
+                .extract()
+                .map_err(|_| type_err("guides", g, "a sequence of arc lengths (m)"))?,
+            None => Vec::new(),
+        };
+        let guide_mu: Vec<f64> = match guide_friction {
+            None => vec![0.0],
+            Some(g) => match g.extract::<f64>() {
+                Ok(v) => vec![v],
+                Err(_) => g
+                    .extract()
+                    .map_err(|_| type_err("guide_friction", g, "a coefficient or one per guide"))?,
+            },
+        };
+        if guides.is_none() && guide_friction.is_some() {
+            return Err(param_err(
+                "guide_friction",
+                "given",
+                "None without guides (a continuous channel takes friction=)",
+            ));
+        }
         let derivative = derivative.filter(|d| !d.is_none());
         let routing = match (offset.is_callable(), derivative) {
             (false, None) => softrod::Routing::Constant(pair(offset, "offset")?),
@@ -338,21 +368,31 @@ impl Tendon {
                     }
                 }
             }
-            softrod::Tendon::new(routing, end)?.with_friction(friction)
+            let t = softrod::Tendon::new(routing, end)?.with_friction(friction)?;
+            if guide_list.is_empty() && guides.is_some() {
+                return Err(softrod::Error::invalid(
+                    "guides",
+                    "an empty sequence",
+                    "at least one guide arc length, or None",
+                ));
+            }
+            t.with_guides(guide_list, &guide_mu)
         })?;
-        let args = Args::new(
-            py,
-            &[
-                ("offset", offset.clone().unbind()),
-                ("tension", obj(py, tension)?),
-                ("end", obj(py, end)?),
-                (
-                    "derivative",
-                    derivative.map_or_else(|| py.None(), |d| d.clone().unbind()),
-                ),
-                ("friction", obj(py, friction)?),
-            ],
-        )?;
+        let mut fields = vec![
+            ("offset", offset.clone().unbind()),
+            ("tension", obj(py, tension)?),
+            ("end", obj(py, end)?),
+            (
+                "derivative",
+                derivative.map_or_else(|| py.None(), |d| d.clone().unbind()),
+            ),
+            ("friction", obj(py, friction)?),
+        ];
+        if inner.is_guided() {
+            fields.push(("guides", obj(py, inner.guides().to_vec())?));
+            fields.push(("guide_friction", obj(py, inner.guide_friction().to_vec())?));
+        }
+        let args = Args::new(py, &fields)?;
         Ok(Self {
             inner,
             tension,
@@ -472,6 +512,16 @@ impl Tendon {
     fn friction(&self) -> f64 {
         self.inner.friction()
     }
+    /// Arc lengths (m) of the guides the tendon runs through; empty for a continuous channel.
+    #[getter]
+    fn guides(&self) -> Vec<f64> {
+        self.inner.guides().to_vec()
+    }
+    /// Capstan coefficient at each guide (dimensionless, one per guide).
+    #[getter]
+    fn guide_friction(&self) -> Vec<f64> {
+        self.inner.guide_friction().to_vec()
+    }
     /// Routing kind: "constant", "function", "radius_proportional" or "helical".
     #[getter]
     fn routing(&self) -> &'static str {
@@ -489,10 +539,17 @@ impl Tendon {
         self.args.0.bind(py).copy()
     }
     fn __repr__(&self) -> String {
-        let friction = match self.inner.friction() {
+        let mut friction = match self.inner.friction() {
             0.0 => String::new(),
             mu => format!(", friction={mu}"),
         };
+        if self.inner.is_guided() {
+            friction += &format!(
+                ", guides={:?}, guide_friction={:?}",
+                self.inner.guides(),
+                self.inner.guide_friction()
+            );
+        }
         format!(
             "Tendon({:?}, tension={}, end={:?}{friction})",
             self.inner.routing(),

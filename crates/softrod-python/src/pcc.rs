@@ -155,6 +155,9 @@ pub(crate) fn pcc_arc_pose(
     Ok(pose_array(py, &t))
 }
 
+/// Arcs from which [`pcc_arc_poses`] computes its poses on all cores.
+const PARALLEL_POSES: usize = 20_000;
+
 /// Tip poses (N, 4, 4) of N arcs: `curvature`, `plane_angle`, `length` are arrays of one
 /// length (a number is repeated); one call for any number of poses.
 #[pyfunction]
@@ -176,32 +179,53 @@ pub(crate) fn pcc_arc_poses<'py>(
         }
     }
     let at = |v: &[f64], i: usize| if v.len() == 1 { v[0] } else { v[i] };
-    let mut out = numpy::ndarray::Array3::<f64>::zeros((n, 4, 4));
-    let result = py.detach(|| -> softrod::Result<()> {
-        for i in 0..n {
-            let seg =
-                PccSegment::checked(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| match e {
-                    softrod::Error::InvalidParameter {
-                        name,
-                        value,
-                        expected,
-                    } => softrod::Error::InvalidParameter {
-                        name: format!("{name}[{i}]"),
-                        value,
-                        expected,
-                    },
-                    other => other,
-                })?;
-            let t = seg.pose();
-            for r in 0..4 {
-                for c in 0..4 {
-                    out[[i, r, c]] = t[(r, c)];
-                }
+    let segment = |i: usize| {
+        PccSegment::checked(at(&k, i), at(&p, i), at(&l, i)).map_err(|e| match e {
+            softrod::Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => softrod::Error::InvalidParameter {
+                name: format!("{name}[{i}]"),
+                value,
+                expected,
+            },
+            other => other,
+        })
+    };
+    let mut flat = vec![0.0; 16 * n];
+    let fill = |i: usize, out: &mut [f64]| -> softrod::Result<()> {
+        let t = segment(i)?.pose();
+        for r in 0..4 {
+            for c in 0..4 {
+                out[4 * r + c] = t[(r, c)];
             }
         }
         Ok(())
+    };
+    let result = py.detach(|| -> softrod::Result<()> {
+        if n < PARALLEL_POSES {
+            return flat
+                .chunks_exact_mut(16)
+                .enumerate()
+                .try_for_each(|(i, out)| fill(i, out));
+        }
+        use rayon::prelude::*;
+        let ok = flat
+            .par_chunks_exact_mut(16)
+            .enumerate()
+            .try_for_each(|(i, out)| fill(i, out))
+            .is_ok();
+        // The error of the first invalid arc, whichever thread met an invalid one first.
+        if ok {
+            Ok(())
+        } else {
+            (0..n).try_for_each(|i| segment(i).map(|_| ()))
+        }
     });
     result.map_err(blame(&["curvature", "plane_angle", "length"]))?;
+    let out = numpy::ndarray::Array3::from_shape_vec((n, 4, 4), flat)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
     Ok(out.into_pyarray(py))
 }
 

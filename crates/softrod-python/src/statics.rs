@@ -419,6 +419,39 @@ impl StaticsSolution {
         };
         a.into_pyarray(py)
     }
+    /// Per tendon, its anchors when it runs through guides (`Tendon(..., guides=...)`): a
+    /// list of dicts with `s` (m), `point` (m, world), `wrap` (rad), `friction`,
+    /// `tension_in` and `tension_out` (N, of the chords into and out of it), `slip` (+1, -1,
+    /// 0) and `force` (N, world, the tendon's force on the rod), from the base hole to the
+    /// termination; an empty list for a tendon in a continuous channel (or without friction
+    /// modelled).
+    #[getter]
+    fn guides<'py>(&self, py: Python<'py>) -> PyResult<Vec<Vec<Bound<'py, PyDict>>>> {
+        let nt = self.inner.model.tendons().len();
+        let Some(f) = &self.friction else {
+            return Ok(vec![Vec::new(); nt]);
+        };
+        f.guides
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|g| {
+                        let d = PyDict::new(py);
+                        d.set_item("s", g.s)?;
+                        d.set_item("point", g.point.to_vec())?;
+                        d.set_item("wrap", g.wrap)?;
+                        d.set_item("friction", g.friction)?;
+                        d.set_item("tension_in", g.tension_in)?;
+                        d.set_item("tension_out", g.tension_out)?;
+                        d.set_item("slip", g.slip.sign())?;
+                        d.set_item("force", g.force.to_vec())?;
+                        Ok(d)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Whether the solve modelled tendon friction (a tendon with `friction > 0` or a
     /// `previous` state).
     #[getter]
@@ -859,7 +892,11 @@ pub(crate) fn solve_statics<'py>(
         ));
     }
     let (model, act) = (&problem.model, &actuation);
-    let frictional = prev_state.is_some() || model.tendons().iter().any(|t| t.friction() > 0.0);
+    let frictional = prev_state.is_some()
+        || model
+            .tendons()
+            .iter()
+            .any(|t| t.friction() > 0.0 || t.is_guided());
     if frictional && !s_values.is_empty() {
         return Err(param_err(
             "s_out",

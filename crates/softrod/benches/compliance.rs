@@ -4,32 +4,20 @@
 //! Run: `CARGO_TARGET_DIR=... cargo bench -p softrod --bench compliance`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::batch::workspace::{workspace_map, DEFAULT_CHUNK};
 use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::nalgebra::Vector3;
-use softrod::{
-    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Tendon,
-};
+use softrod::{solve_statics, Actuation, Loads, RobotModel, SolveOptions};
 use std::hint::black_box;
 
 fn niti(loads: Loads) -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
-        })
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    robot::niti_model(loads, None, 0.0)
 }
 
 fn bench(c: &mut Criterion) {

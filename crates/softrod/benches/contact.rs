@@ -4,30 +4,20 @@
 //! Run: `cargo bench -p softrod --bench contact`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use std::hint::black_box;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::{
-    solve_constrained, solve_statics, Actuation, LinearElastic, Loads, Obstacle, RobotModel, Rod,
-    Section, SolveOptions, Tendon, TipConstraint,
+    solve_constrained, solve_statics, Actuation, Loads, Obstacle, RobotModel, SolveOptions,
+    TipConstraint,
 };
 
 fn niti() -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
-        })
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), Loads::default()).unwrap()
+    robot::niti_model(Loads::default(), None, 0.0)
 }
 
 fn bench(c: &mut Criterion) {

@@ -5,6 +5,9 @@
 //! Run: `cargo bench -p softrod --bench friction`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use std::hint::black_box;
 use std::sync::Arc;
 
@@ -12,7 +15,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::nalgebra::Vector3;
 use softrod::{
     friction_mesh, solve_frictional, solve_statics, solve_statics_at, Actuation, FrictionOptions,
-    Integrator, LinearElastic, Loads, RobotModel, Rod, Section, Tendon,
+    Integrator, Loads, RobotModel,
 };
 
 fn niti(mu: f64) -> Arc<RobotModel> {
@@ -20,23 +23,7 @@ fn niti(mu: f64) -> Arc<RobotModel> {
 }
 
 fn niti_with(mu: f64, loads: Loads) -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end)
-                .unwrap()
-                .with_friction(mu)
-                .unwrap()
-        })
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    robot::niti_model(loads, None, mu)
 }
 
 fn friction(c: &mut Criterion) {

@@ -5,55 +5,21 @@
 //! Run: `CARGO_TARGET_DIR=... cargo bench -p softrod --bench statics`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::nalgebra::Vector3;
 use softrod::{
-    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Tendon,
+    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions,
 };
 use std::hint::black_box;
 
 /// The two-segment NiTi robot under `loads`.
 fn niti(loads: Loads) -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
-        })
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
-}
-
-/// A 1 m NiTi rod (radius 1 mm, 6450 kg/m³) with four tendons at 10 mm, 90° apart, ending at
-/// the tip, horizontal base, under gravity.
-pub fn four_tendon_gravity() -> Arc<RobotModel> {
-    let rod = Rod::new(
-        1.0,
-        Section::circular(1e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap()
-    .with_density(6450.0)
-    .unwrap();
-    let tendons = (0..4)
-        .map(|i| {
-            let a = (90.0 * i as f64).to_radians();
-            Tendon::constant([0.01 * a.cos(), 0.01 * a.sin()], None).unwrap()
-        })
-        .collect();
-    let g = Loads {
-        gravity: Vector3::new(-9.81, 0.0, 0.0),
-        ..Default::default()
-    };
-    RobotModel::new(rod, tendons, Vec::new(), g).unwrap()
+    robot::niti_model(loads, None, 0.0)
 }
 
 fn statics(c: &mut Criterion) {
@@ -85,7 +51,7 @@ fn statics(c: &mut Criterion) {
     g.finish();
 
     let mut g = c.benchmark_group("statics_four_tendon_1m");
-    let model = four_tendon_gravity();
+    let model = robot::four_tendon_gravity();
     let act4 = Actuation::tensions(&[2.0, 0.0, 1.0, 0.0]);
     g.bench_function("gravity_cold", |b| {
         b.iter(|| solve_statics(&model, black_box(&act4), &opts).unwrap())

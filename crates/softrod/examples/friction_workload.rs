@@ -9,34 +9,19 @@
 //! solve is the difference of 11 and 1 solves divided by 10.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use std::hint::black_box;
 use std::sync::Arc;
 
 use softrod::nalgebra::Vector3;
 use softrod::{
-    solve_frictional, solve_statics, Actuation, FrictionOptions, Integrator, LinearElastic, Loads,
-    RobotModel, Rod, Section, Tendon,
+    solve_frictional, solve_statics, Actuation, FrictionOptions, Integrator, Loads, RobotModel,
 };
 
 fn niti(mu: f64) -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end)
-                .unwrap()
-                .with_friction(mu)
-                .unwrap()
-        })
-        .collect();
-    let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    robot::niti_model(Loads::tip_force(Vector3::new(0.05, -0.02, 0.0)), None, mu)
 }
 
 fn main() {

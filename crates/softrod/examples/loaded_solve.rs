@@ -8,50 +8,18 @@
 //! Run: `valgrind --tool=callgrind target/release/examples/loaded_solve cold 20`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use std::sync::Arc;
 
 use softrod::nalgebra::Vector3;
 use softrod::{
-    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Tendon,
+    solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions,
 };
 
 fn niti(loads: Loads) -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
-        })
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
-}
-
-fn four_tendon_gravity() -> Arc<RobotModel> {
-    let rod = Rod::new(
-        1.0,
-        Section::circular(1e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap()
-    .with_density(6450.0)
-    .unwrap();
-    let tendons = (0..4)
-        .map(|i| {
-            let a = (90.0 * i as f64).to_radians();
-            Tendon::constant([0.01 * a.cos(), 0.01 * a.sin()], None).unwrap()
-        })
-        .collect();
-    let g = Loads {
-        gravity: Vector3::new(-9.81, 0.0, 0.0),
-        ..Default::default()
-    };
-    RobotModel::new(rod, tendons, Vec::new(), g).unwrap()
+    robot::niti_model(loads, None, 0.0)
 }
 
 fn main() {
@@ -77,7 +45,7 @@ fn main() {
             (model, changed, warm)
         }
         "gravity" => (
-            four_tendon_gravity(),
+            robot::four_tendon_gravity(),
             Actuation::tensions(&[2.0, 0.0, 1.0, 0.0]),
             opts,
         ),

@@ -56,7 +56,8 @@ pub use contact::{
 };
 pub use cosserat::displacement::reference_lengths;
 pub use cosserat::friction::{
-    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
+    Slip,
 };
 pub use cosserat::sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,

@@ -8,7 +8,7 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{niti_rod, niti_tendons};
+use common::niti_model;
 use softrod::nalgebra::Vector3;
 use softrod::{
     reference_lengths, solve_statics, tangent_compliance, Actuation, Loads, RobotModel,
@@ -16,15 +16,7 @@ use softrod::{
 };
 
 fn niti(loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
-    let mut rod = niti_rod();
-    if let Some(d) = density {
-        rod = rod.with_density(d).unwrap();
-    }
-    let tendons = niti_tendons(&[0.0; 6])
-        .into_iter()
-        .map(|t| t.tendon)
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    niti_model(loads, density, 0.0)
 }
 
 fn options() -> SolveOptions {

@@ -118,17 +118,7 @@ fn unloading_moves_a_slip_front() {
 
 /// The NiTi robot with friction `mu` on every tendon and a lateral tip force.
 fn niti(mu: f64, tip: Vector3<f64>) -> Arc<RobotModel> {
-    let tendons = common::niti_tendons(&[0.0; 6])
-        .into_iter()
-        .map(|t| t.tendon.with_friction(mu).unwrap())
-        .collect();
-    RobotModel::new(
-        common::niti_rod(),
-        tendons,
-        Vec::new(),
-        Loads::tip_force(tip),
-    )
-    .unwrap()
+    common::niti_model(Loads::tip_force(tip), None, mu)
 }
 
 /// With and without a tip force (the fixed point and the one march).
@@ -507,15 +497,7 @@ fn the_actuation_jacobian_of_a_frictional_equilibrium_is_refused_by_name() {
 
 /// The NiTi robot with friction `mu` on every tendon under `loads`.
 fn niti_loaded(mu: f64, loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
-    let tendons = common::niti_tendons(&[0.0; 6])
-        .into_iter()
-        .map(|t| t.tendon.with_friction(mu).unwrap())
-        .collect();
-    let mut rod = common::niti_rod();
-    if let Some(d) = density {
-        rod = rod.with_density(d).unwrap();
-    }
-    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+    common::niti_model(loads, density, mu)
 }
 
 /// Loaded models (tip force, gravity, both): the one march per Newton iterate of the base
@@ -604,4 +586,70 @@ fn loaded_one_march_equals_the_fixed_point() {
             }
         }
     }
+}
+
+/// Displacement control with friction: the shortenings a tension-controlled path produces,
+/// held on the same history, give back its tensions and shapes; with μ = 0 it is the
+/// frictionless displacement solve.
+#[test]
+fn displacement_round_trip_with_friction() {
+    use softrod::{reference_lengths, TendonInput};
+    let opts = options(50);
+    for tip in [Vector3::zeros(), Vector3::new(0.03, -0.02, 0.0)] {
+        let model = niti(0.2, tip);
+        let reference = reference_lengths(&model, &opts.statics).unwrap();
+        let up = Actuation::tensions(&[3.0, 0.0, 0.0, 0.0, 1.5, 0.0]);
+        let down = Actuation::tensions(&[1.8, 0.0, 0.0, 0.0, 1.2, 0.0]);
+        let first = solve_frictional(&model, &up, &opts, None).unwrap();
+        let second = solve_frictional(&model, &down, &opts, Some(&first)).unwrap();
+        for (target, prev) in [(&first, None), (&second, Some(&first))] {
+            let mut act = Actuation::tensions(&[0.0; 6]);
+            for i in [0, 4] {
+                act.tendons[i] =
+                    TendonInput::displacement(reference[i] - target.statics.tendon_lengths[i]);
+            }
+            let held = solve_frictional(&model, &act, &opts, prev).unwrap();
+            let (mut dt, mut dp): (f64, f64) = (0.0, 0.0);
+            for (a, b) in held
+                .tension
+                .iter()
+                .flatten()
+                .zip(target.tension.iter().flatten())
+            {
+                dt = dt.max((a - b).abs() / 3.0);
+            }
+            for (a, b) in held.statics.position.iter().zip(&target.statics.position) {
+                for k in 0..3 {
+                    dp = dp.max((a[k] - b[k]).abs());
+                }
+            }
+            eprintln!(
+                "displacement round trip (tip {tip:?}, {}): tensions {dt:e} relative, shape \
+                 {dp:e} m",
+                if prev.is_some() {
+                    "unloading"
+                } else {
+                    "loading"
+                }
+            );
+            assert!(dt < 1e-8 && dp < 1e-10, "round trip: {dt:e}, {dp:e} m");
+            assert_eq!(held.slip, target.slip);
+        }
+    }
+    // μ = 0: the frictionless displacement solve.
+    let model = niti(0.0, Vector3::new(0.03, -0.02, 0.0));
+    let mut act = Actuation::tensions(&[0.0; 6]);
+    act.tendons[0] = TendonInput::displacement(0.004);
+    act.tendons[4] = TendonInput::displacement(0.002);
+    let fr = solve_frictional(&model, &act, &opts, None).unwrap();
+    let plain = solve_statics_at(&model, &act, &opts.statics, &fr.statics.s).unwrap();
+    let mut worst: f64 = 0.0;
+    for (a, b) in fr.statics.position.iter().zip(&plain.position) {
+        for k in 0..3 {
+            worst = worst.max((a[k] - b[k]).abs());
+        }
+    }
+    let dt = (fr.tension[0][0] - plain.tendon_tensions[0]).abs() / plain.tendon_tensions[0];
+    eprintln!("μ = 0 displacement control: {worst:e} m, tension {dt:e} relative");
+    assert!(worst < 1e-10 && dt < 1e-8, "{worst:e} m, {dt:e}");
 }

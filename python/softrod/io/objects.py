@@ -10,6 +10,7 @@ named in the error.
 from __future__ import annotations
 
 import math
+import os
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -139,7 +140,14 @@ def build_material(m: Any, errors: list[FieldError]) -> Any:
 def _tendon(t: Any) -> Tendon:
     if isinstance(t, rf.ConstantTendonSpec):
         offset = t.offset if t.offset is not None else _polar(t.distance, t.angle_deg)
-        return Tendon(offset, t.tension, t.end, friction=t.friction)
+        return Tendon(
+            offset,
+            t.tension,
+            t.end,
+            friction=t.friction,
+            guides=t.guides,
+            guide_friction=t.guide_friction,
+        )
     if isinstance(t, rf.RadiusProportionalTendonSpec):
         return Tendon.radius_proportional(
             t.ratio, math.radians(t.angle_deg), t.tension, t.end, friction=t.friction
@@ -222,39 +230,51 @@ def build(spec: rf.RobotFile, source: str | None = None) -> Parts:
         for i, c in enumerate(spec.chambers)
     ]
     loads = _loads(spec.loads, errors)
+    # A mesh file's relative path is relative to the robot file.
+    base = os.path.dirname(os.path.abspath(source)) if source else os.getcwd()
+    obstacles = [
+        _attempt(errors, f"obstacles[{i}].{o.type}", lambda o=o: obstacle_of(o, base))
+        for i, o in enumerate(spec.obstacles)
+    ]
     if errors:
         rf.raise_errors(errors, source)
     solver = spec.solver.options() if spec.solver is not None else {}
-    errors_after: list[FieldError] = []
-    parts = Parts(
+    return Parts(
         rod,
         tuple(tendons),
         tuple(chambers),
         loads,
         solver,
-        tuple(
-            _attempt(errors_after, f"obstacles[{i}]", lambda o=o: obstacle_of(o, source))
-            for i, o in enumerate(spec.obstacles)
-        ),
+        tuple(obstacles),
         tip_constraint_of(spec.tip_constraint),
     )
-    if errors_after:
-        rf.raise_errors(errors_after, source)
-    return parts
 
 
-def obstacle_of(o: Any, source: str | None = None) -> Any:
-    """The obstacle dataclass of an ``[[obstacles]]`` table (a mesh file relative to the
-    robot file `source`, else to the working directory)."""
-    import os
+def _mesh_of(o: Any, base: str) -> Any:
+    """The Mesh of a ``type = "mesh"`` table: read (relative to ``base``), scaled, posed."""
+    from ..contact import Mesh
 
-    from ..contact import Capsule, Cylinder, Mesh, Plane, Sphere
+    if o.file is not None:
+        path = o.file if os.path.isabs(o.file) else os.path.join(base, o.file)
+        mesh = Mesh.from_file(path)
+        vertices, faces = mesh.vertices, mesh.faces
+    else:
+        vertices, faces = np.asarray(o.vertices, dtype=float), np.asarray(o.faces)
+    vertices = o.scale * vertices
+    if o.rotation is not None:
+        vertices = vertices @ np.asarray(o.rotation, dtype=float).T
+    if o.position is not None:
+        vertices = vertices + np.asarray(o.position, dtype=float)
+    return Mesh(vertices, faces)
+
+
+def obstacle_of(o: Any, base: str | None = None) -> Any:
+    """The obstacle dataclass of an ``[[obstacles]]`` table (a mesh file's relative path is
+    taken from ``base``, default the working directory)."""
+    from ..contact import Capsule, Cylinder, Plane, Sphere
 
     if isinstance(o, rf.MeshSpec):
-        path = o.file
-        if source is not None and not os.path.isabs(path):
-            path = os.path.join(os.path.dirname(os.path.abspath(source)), path)
-        return Mesh.from_file(path)
+        return _mesh_of(o, base if base is not None else os.getcwd())
     if isinstance(o, rf.PlaneSpec):
         return Plane(tuple(o.point), tuple(o.normal))
     if isinstance(o, rf.SphereSpec):
@@ -319,24 +339,18 @@ def tip_constraint_spec(t: Any) -> dict[str, Any]:
     }
 
 
-def _mesh_not_described(o: Any) -> Exception:
-    from ..plot.obstacles import _field_error
-
-    return _field_error(
-        "obstacles",
-        f"Mesh({len(o.vertices)} vertices, {len(o.faces)} faces)",
-        "a robot (and its robot file) does not describe a Mesh yet: pass it as "
-        "solve_statics(..., obstacles=[mesh])",
-    )
-
-
 def obstacle_spec(o: Any) -> dict[str, Any]:
     """The ``[[obstacles]]`` table of an obstacle dataclass."""
     from ..plot.obstacles import as_obstacle
 
     o = as_obstacle(o)
     if type(o).__name__ == "Mesh":
-        raise _mesh_not_described(o)
+        # Written out in full: a robot file then stands on its own.
+        return {
+            "type": "mesh",
+            "vertices": [[float(x) for x in v] for v in o.vertices],
+            "faces": [[int(i) for i in f] for f in o.faces],
+        }
     kind = type(o).__name__.lower()
     fields = {k: getattr(o, k) for k in o.__dataclass_fields__}
     out: dict[str, Any] = {"type": kind}
@@ -450,6 +464,9 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
     if routing is None or p is None:
         return None
     if routing == "constant" and p.get("derivative") is None and not callable(p["offset"]):
+        if t.guides:
+            out["guides"] = [float(g) for g in t.guides]
+            out["guide_friction"] = [float(m) for m in t.guide_friction]
         return {**out, "offset": _floats(p["offset"])}
     if routing == "radius_proportional":
         return {

@@ -279,12 +279,18 @@ class _TendonBase(_Table):
 
 
 class ConstantTendonSpec(_TendonBase):
-    """A tendon at a constant body-frame offset."""
+    """A tendon at a constant body-frame offset (in a continuous channel, or through guides)."""
 
     routing: Literal["constant"] = "constant"
     offset: Vec2 | None = None
     distance: _num("distance from the backbone (m)", ge=0) | None = None
     angle_deg: _num("angle from body x toward body y (deg), with `distance`") | None = None
+    guides: list[Float] | None = Field(
+        None, description="arc lengths (m) of the disks the tendon runs through in chords"
+    )
+    guide_friction: Float | list[Float] | None = Field(
+        None, description="capstan coefficient at the guides (one, or one per guide)"
+    )
 
     @model_validator(mode="after")
     def _one_offset(self) -> ConstantTendonSpec:
@@ -476,14 +482,42 @@ class CylinderSpec(_Table):
 
 
 class MeshSpec(_Table):
-    """A closed triangle mesh read with trimesh (STL, OBJ, PLY...; world frame, m)."""
+    """A triangle mesh: read from `file` (STL, OBJ, PLY, ... by trimesh; a relative path is
+    relative to the robot file) or given by `vertices` and `faces`; its vertices scaled by
+    `scale`, then rotated by `rotation` and moved by `position` (world)."""
 
     type: Literal["mesh"]
-    file: Annotated[
-        str,
-        Strict(),
-        Field(min_length=1, description="mesh file, relative to the robot file"),
-    ]
+    file: Str | None = None
+    vertices: (
+        Annotated[list[Vec3], Field(min_length=3, description="vertices (m, mesh frame)")] | None
+    ) = None
+    faces: (
+        Annotated[
+            list[Annotated[list[Annotated[int, Field(ge=0)]], Field(min_length=3, max_length=3)]],
+            Field(min_length=1, description="vertex indices of each triangle"),
+        ]
+        | None
+    ) = None
+    scale: _num("factor from the mesh's units to m (1e-3 for a mesh in mm)", gt=0) = 1.0
+    position: _vec(3, "translation of the mesh frame (m, world)") | None = None
+    rotation: (
+        Annotated[
+            list[_vec(3, "row")],
+            Field(min_length=3, max_length=3, description="3x3 rotation rows (mesh -> world)"),
+        ]
+        | None
+    ) = None
+
+    @model_validator(mode="after")
+    def _one_source(self) -> MeshSpec:
+        _exclusive(self.__dict__, "file", "vertices", "a mesh file, or vertices and faces")
+        if self.vertices is not None and self.faces is None:
+            raise PydanticCustomError("needed", "needed with `vertices`", {"field": "faces"})
+        if self.vertices is None and self.faces is not None:
+            raise PydanticCustomError(
+                "with_vertices", "goes with `vertices`, not `file`", {"field": "faces"}
+            )
+        return self
 
 
 ObstacleSpec = Annotated[

@@ -144,6 +144,16 @@ class Mesh:
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
 
+    def __eq__(self, other: object) -> bool:
+        return (
+            isinstance(other, Mesh)
+            and np.array_equal(self.vertices, other.vertices)
+            and np.array_equal(self.faces, other.faces)
+        )
+
+    def __hash__(self) -> int:
+        return hash((self.vertices.tobytes(), self.faces.tobytes()))
+
     @classmethod
     def from_file(cls, path) -> Mesh:
         """A mesh read by trimesh from ``path`` (STL, OBJ, PLY, ...; coordinates in m)."""

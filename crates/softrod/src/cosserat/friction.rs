@@ -1,6 +1,6 @@
 //! Capstan friction between the tendons and their channels, with stick and slip.
 //!
-//! A tendon with friction coefficient `μ` ([`Tendon::with_friction`]) carries a tension that
+//! A tendon with friction coefficient `μ` ([`crate::Tendon::with_friction`]) carries a tension that
 //! varies along its path: where it slides, `|dτ/dσ| = μ τ κ_path` (σ the path's arc length,
 //! `κ_path` its curvature), the tension decreasing away from the side it slides toward; where
 //! it sticks, `|dτ/dσ| <= μ τ κ_path`. Along the rod's arc length `s`, `κ_path dσ = |dt_i|` is
@@ -23,7 +23,7 @@
 //! tension because the tendon is taken inextensible (its own elasticity is not modelled).
 //!
 //! **Coupling with the rod.** The rod equations are in total-wrench form (see
-//! [`equations`](super::equations)): the friction force is internal to rod + tendons, so the
+//! `cosserat::equations`): the friction force is internal to rod + tendons, so the
 //! balance `N' = −f`, `M' = −p' × N − l` holds unchanged and only the tension profile enters
 //! the constitutive split `n = N − Σ τ_i(s) t_i`. The rod therefore receives from each tendon
 //! the distributed load `d(τ_i t_i)/ds = τ_i t_i' + τ_i' t_i` (normal load plus the friction
@@ -42,6 +42,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 pub use super::friction_march::MAX_CELL_ATTEMPTS;
 use super::friction_march::{solve_marched, Setup};
+pub use super::guides::GuideState;
 use crate::cosserat::equations::{Equations, Evaluator, Workspace, STATE};
 use crate::cosserat::statics::{
     interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
@@ -49,6 +50,7 @@ use crate::cosserat::statics::{
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Scheme};
 use crate::model::actuation::TensionProfile;
+use crate::model::tendon::Tendon;
 use crate::model::{Actuation, RobotModel};
 
 /// Default relative tolerance of the fixed point on the tension profile.
@@ -138,8 +140,13 @@ pub struct FrictionalSolution {
     /// tendon being inextensible and anchored at its termination, its slip toward the base
     /// at a node between two states is the change of `path length − path_length[node]`.
     pub path_length: Vec<Vec<f64>>,
+    /// Per tendon, the states at its anchors (base hole, guides, termination) for a tendon
+    /// routed through guides ([`crate::Tendon::with_guides`]); empty for a tendon in a
+    /// continuous channel.
+    pub guides: Vec<Vec<GuideState>>,
     /// Marches: 1 for an unloaded model, one per quasi-Newton iterate of a loaded one; the
-    /// rod solves of the fixed point when it was used.
+    /// rod solves of the fixed point when it was used (summed over the rod solves of the
+    /// guide fixed point with guided tendons).
     pub iterations: usize,
     /// Integration steps over the cells of the friction mesh, all rod solves and repeated
     /// cells together (a rod solve without friction takes one per cell and Newton iteration).
@@ -356,13 +363,6 @@ fn check_inputs(
         return Err(Error::invalid("friction.max_iterations", 0, ">= 1"));
     }
     model.check_actuation(actuation)?;
-    if let Some(i) = actuation.held().first() {
-        return Err(Error::invalid(
-            format!("tendons[{i}]"),
-            "displacement-controlled",
-            "tension-controlled (friction with displacement control is not modelled)",
-        ));
-    }
     Ok(())
 }
 
@@ -424,6 +424,12 @@ pub fn solve_frictional(
     previous: Option<&FrictionalSolution>,
 ) -> Result<FrictionalSolution> {
     check_inputs(model, actuation, options)?;
+    if actuation.has_held() {
+        return super::friction_held::solve_held_frictional(model, actuation, options, previous);
+    }
+    if model.tendons().iter().any(Tendon::is_guided) {
+        return super::guides::solve_guided(model, actuation, options, previous);
+    }
     let nt = model.tendons().len();
     let base = actuation.tension_values(nt);
     let mesh = friction_mesh(model, &options.statics.integrator);
@@ -460,7 +466,7 @@ pub fn solve_frictional(
         statics_options.warm_start = Some(p.statics.warm_start());
     }
     let mut iterations = 0;
-    let mut anderson = Anderson::new();
+    let mut anderson = Anderson::new(true);
     loop {
         let mut act = actuation.clone();
         act.profile = Some(Arc::new(to_profile(model, &mesh, &tau)));
@@ -482,6 +488,7 @@ pub fn solve_frictional(
             let tangent = tangent_rows(&dirs);
             let path_length = node_path_lengths(model, &act, &statics_options, &mesh, &sol)?;
             return Ok(FrictionalSolution {
+                guides: vec![Vec::new(); nt],
                 path_length,
                 statics: sol,
                 tension: next,
@@ -566,39 +573,56 @@ fn node_path_lengths(
     Ok(out)
 }
 
-/// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of the fixed point `x = g(x)` on
-/// the tension profile: the next iterate combines the last images so as to minimise the
+/// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of a fixed point `x = g(x)` (the
+/// tension profile, or the guide points of `guides`): the next iterate combines the last images so as to minimise the
 /// linearised residual `g(x) - x` (Walker & Ni, SIAM J. Numer. Anal. 49(4), 2011). The rule
 /// is applied to the rod's shape at every iterate, so the accepted profile always satisfies
 /// the capstan bounds; the acceleration only chooses where the rod is solved next.
-struct Anderson {
-    /// Past residuals `f = g(x) - x` and images `g(x)` (flattened profiles).
+pub(super) struct Anderson {
+    /// Past residuals `f = g(x) - x` and images `g(x)` (flattened).
     f: Vec<Vec<f64>>,
     g: Vec<Vec<f64>>,
+    /// Whether the iterates are tensions (kept >= 0, zero where the image is zero).
+    tensions: bool,
+    /// Past iterates kept.
+    depth: usize,
 }
 
 /// Depth of the Anderson acceleration.
 const ANDERSON_DEPTH: usize = 3;
 
 impl Anderson {
-    fn new() -> Self {
+    /// An empty history; `tensions`: the iterates are tension profiles (kept >= 0, a tendon
+    /// absent at a node stays absent).
+    pub(super) fn new(tensions: bool) -> Self {
+        Self::with_depth(tensions, ANDERSON_DEPTH)
+    }
+
+    /// An empty history keeping `depth` past iterates.
+    pub(super) fn with_depth(tensions: bool, depth: usize) -> Self {
         Self {
             f: Vec::new(),
             g: Vec::new(),
+            tensions,
+            depth,
         }
     }
 
     /// The next iterate from the current `x` and its image `gx`.
     fn update(&mut self, x: &[Vec<f64>], gx: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let flat_x: Vec<f64> = x.iter().flatten().copied().collect();
         let flat_g: Vec<f64> = gx.iter().flatten().copied().collect();
-        let flat_f: Vec<f64> = flat_g
-            .iter()
-            .zip(x.iter().flatten())
-            .map(|(g, x)| g - x)
-            .collect();
+        let next = self.update_flat(&flat_x, flat_g);
+        let cols = gx.first().map_or(0, Vec::len);
+        next.chunks(cols.max(1)).map(<[f64]>::to_vec).collect()
+    }
+
+    /// The next iterate from the current `x` and its image `gx` (flattened).
+    pub(super) fn update_flat(&mut self, x: &[f64], gx: Vec<f64>) -> Vec<f64> {
+        let flat_f: Vec<f64> = gx.iter().zip(x).map(|(g, x)| g - x).collect();
         self.f.push(flat_f);
-        self.g.push(flat_g);
-        if self.f.len() > ANDERSON_DEPTH + 1 {
+        self.g.push(gx.clone());
+        if self.f.len() > self.depth + 1 {
             self.f.remove(0);
             self.g.remove(0);
         }
@@ -612,7 +636,7 @@ impl Anderson {
         let df = DMatrix::from_fn(n, m, |r, c| self.f[c + 1][r] - self.f[c][r]);
         let dg = DMatrix::from_fn(n, m, |r, c| self.g[c + 1][r] - self.g[c][r]);
         let rhs = DVector::from_column_slice(last);
-        let Ok(gamma) = df.clone().svd(true, true).solve(&rhs, 1e-12) else {
+        let Ok(gamma) = df.svd(true, true).solve(&rhs, 1e-12) else {
             return gx;
         };
         let next = DVector::from_column_slice(&self.g[m]) - dg * gamma;
@@ -621,16 +645,17 @@ impl Anderson {
             self.g.clear();
             return gx;
         }
-        let cols = gx.first().map_or(0, Vec::len);
-        next.as_slice()
-            .chunks(cols.max(1))
+        next.iter()
             .zip(&gx)
-            .map(|(row, g)| {
-                row.iter()
-                    .zip(g)
+            .map(|(&v, &g)| {
+                if !self.tensions {
+                    v
+                } else if g == 0.0 {
                     // A tendon absent at a node stays absent; tensions stay >= 0.
-                    .map(|(v, g)| if *g == 0.0 { 0.0 } else { v.max(0.0) })
-                    .collect()
+                    0.0
+                } else {
+                    v.max(0.0)
+                }
             })
             .collect()
     }

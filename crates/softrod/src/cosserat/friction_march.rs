@@ -551,6 +551,7 @@ fn finish(
     let tangent = tangent_rows(&m.dirs);
     let forces = friction_forces(mesh, &m.tau, &m.dirs);
     Ok(FrictionalSolution {
+        guides: vec![Vec::new(); setup.base.len()],
         statics: sol,
         tension: m.tau,
         slip: m.slip,

@@ -1,5 +1,5 @@
 //! The Cosserat-rod model with tendons and chambers: the equations and their variational
-//! columns ([`equations`]), the constitutive local solve (linear and hyperelastic), the
+//! columns (`equations`), the constitutive local solve (linear and hyperelastic), the
 //! shooting problem, the statics entry point and its solution ([`statics`]), and the exact
 //! sensitivities of an equilibrium from the linearised boundary-value problem
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
@@ -8,7 +8,9 @@ mod collapse;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
+mod friction_held;
 mod friction_march;
+mod guides;
 mod hyperelastic_local;
 pub mod sensitivity;
 pub(crate) mod shooting;
@@ -18,7 +20,8 @@ pub mod statics;
 pub use displacement::reference_lengths;
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 pub use friction::{
-    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, Slip,
+    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
+    Slip,
 };
 pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,

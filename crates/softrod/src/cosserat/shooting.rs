@@ -23,7 +23,7 @@ use super::equations::{
     STATE,
 };
 use super::sensitivity::{integrate, scheme_of, Request, Seed};
-use super::stability::tip_stability;
+use super::stability::{certifies, tip_stability, Stability};
 use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Scheme};
@@ -67,6 +67,16 @@ pub(crate) struct Held {
 /// A shape: arc length, position and rotation at the nodes of a pass.
 type Shape = Vec<(f64, Vector3<f64>, Matrix3<f64>)>;
 
+/// The unknowns, load factor and exact tip columns of a pass with columns, and the stability
+/// they give (computed when first asked).
+struct ExactPass {
+    x: [f64; 6],
+    lambda: f64,
+    jacobian: [f64; 36],
+    tip_twist: [Vector6<f64>; 6],
+    stability: Option<Option<Stability>>,
+}
+
 /// The shooting problem of one model and actuation, with its workspace and the nodes of the
 /// last pass.
 pub(crate) struct Shooting<'a> {
@@ -93,6 +103,8 @@ pub(crate) struct Shooting<'a> {
     pub require_stable: bool,
     /// Tendon path lengths of the last pass (m).
     pub lengths: Vec<f64>,
+    /// The exact columns of the last pass with them, the certificate's evidence.
+    exact: Option<ExactPass>,
     /// The shape of the committed state, the safeguard's reference.
     reference: Shape,
     /// Right-hand-side evaluations so far.
@@ -115,6 +127,7 @@ impl<'a> Shooting<'a> {
             columns: None,
             require_stable: false,
             lengths: Vec::new(),
+            exact: None,
             reference: Vec::new(),
             evaluations: 0,
         }
@@ -204,11 +217,19 @@ impl<'a> Shooting<'a> {
             }
             self.columns = Some(j);
             let rt = rot(&y);
-            self.tip_twist = Some(std::array::from_fn(|k| {
+            let tw = std::array::from_fn(|k| {
                 let b = STATE + COLUMN * k;
                 let (dp, w) = (v3(&y, b), rotation_variation(&rt, &col_rot(&y, b)));
                 Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
-            }));
+            });
+            self.tip_twist = Some(tw);
+            self.exact = Some(ExactPass {
+                x: std::array::from_fn(|k| x[k]),
+                lambda,
+                jacobian: j,
+                tip_twist: tw,
+                stability: None,
+            });
         }
         let chord = v3(&y, 0) - eq.model.rod().base_pose().position();
         Ok((r, cols, chord))
@@ -302,6 +323,21 @@ impl<'a> Shooting<'a> {
         } else {
             Evaluated::Failed
         }
+    }
+
+    /// The stability certified at `x` (load factor `lambda`) by the exact columns of the last
+    /// pass with them ([`certifies`]), and that pass's shooting Jacobian (column-major).
+    pub fn certificate(&mut self, x: &[f64], lambda: f64) -> Option<(Stability, [f64; 36])> {
+        if !self.held.is_empty() || x.len() != 6 {
+            return None;
+        }
+        let length = self.eq.model.length();
+        let e = self.exact.as_mut().filter(|e| e.lambda == lambda)?;
+        let s = (*e
+            .stability
+            .get_or_insert_with(|| tip_stability(&e.jacobian, &e.tip_twist, length)))?;
+        let distance = (0..6).map(|k| (x[k] - e.x[k]).abs()).fold(0.0, f64::max);
+        certifies(&s, distance).then_some((s, e.jacobian))
     }
 
     /// Arc lengths, positions and rotations at the nodes of the last pass.
@@ -481,6 +517,10 @@ impl Problem for Shooting<'_> {
         let dm = -(msum + mt) / fm;
         out.copy_from_slice(&[dn.x, dn.y, dn.z, dm.x, dm.y, dm.z]);
         out.iter().all(|v| v.is_finite())
+    }
+
+    fn certified(&mut self, x: &[f64], lambda: f64) -> bool {
+        self.certificate(x, lambda).is_some()
     }
 
     fn commit(&mut self) {

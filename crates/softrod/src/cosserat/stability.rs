@@ -51,6 +51,24 @@ pub const NEUTRAL_MARGIN: f64 = 1e-8;
 /// constraint (zero compliance to round-off), not as a degree of freedom.
 pub const CONSTRAINT_COMPLIANCE: f64 = 1e-9;
 
+/// Smallest stability margin at the last exact columns of a solve for which [`certifies`]
+/// vouches for the stability at the solution without evaluating its columns there.
+pub const CERTIFIED_MARGIN: f64 = 0.05;
+
+/// Assumed bound on the rate of change of the stability margin per scaled unit of the base
+/// wrench (max norm) between the last exact columns and the solution (see [`certifies`]).
+pub const MARGIN_RATE: f64 = 10.0;
+
+/// Whether the stability `s` from the exact columns at a point `distance` (max norm of the
+/// scaled base wrench) from a solution certifies that solution stable: `s` is stable with a
+/// margin of at least [`CERTIFIED_MARGIN`] and [`MARGIN_RATE`] `distance` more, so that a
+/// margin changing by at most [`MARGIN_RATE`] per unit stays above [`CERTIFIED_MARGIN`] at the
+/// solution. Never certifies an unstable, critical or nearly critical state: those are judged
+/// from the columns at the solution itself (see `docs/stability.md`).
+pub(crate) fn certifies(s: &Stability, distance: f64) -> bool {
+    s.stable && distance.is_finite() && s.margin >= CERTIFIED_MARGIN + MARGIN_RATE * distance
+}
+
 /// The stability of one equilibrium (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Stability {
@@ -159,5 +177,85 @@ mod tests {
         x[0][0] = -1.0;
         let s = tip_stability(&y, &x, 1.0).unwrap();
         assert!(!s.stable && s.margin < 0.0 && s.mode.is_some(), "{s:?}");
+    }
+
+    #[test]
+    fn certificate_needs_a_margin_that_outlasts_the_distance() {
+        let s = |margin: f64| Stability {
+            stable: margin > -NEUTRAL_MARGIN,
+            margin,
+            mode: None,
+        };
+        assert!(certifies(&s(0.8), 0.07) && !certifies(&s(0.8), 0.08));
+        assert!(certifies(&s(CERTIFIED_MARGIN), 0.0));
+        assert!(!certifies(&s(0.9 * CERTIFIED_MARGIN), 0.0));
+        assert!(!certifies(&s(-1.0), 0.0) && !certifies(&s(0.8), f64::NAN));
+    }
+
+    use std::sync::Arc;
+
+    use nalgebra::Vector3;
+
+    use crate::cosserat::statics::{solve_statics, SolveOptions};
+    use crate::model::loads::Loads;
+    use crate::model::material::LinearElastic;
+    use crate::model::rod::Rod;
+    use crate::model::section::Section;
+    use crate::model::{Actuation, RobotModel};
+
+    /// A steel cantilever column (L = 0.5 m, r = 1 mm) under a dead tip force: axial `ratio`
+    /// times Euler's critical load `π² E I / (4 L²)`, lateral `lateral` times `E I / L²`.
+    fn column(ratio: f64, lateral: f64) -> Arc<RobotModel> {
+        let (l, r, e): (f64, f64, f64) = (0.5, 1e-3, 200e9);
+        let ei = e * std::f64::consts::PI * r.powi(4) / 4.0;
+        let p_cr = std::f64::consts::PI.powi(2) * ei / (4.0 * l * l);
+        let rod = Rod::new(
+            l,
+            Section::circular(r).unwrap(),
+            LinearElastic::new(e, 0.3).unwrap(),
+        );
+        let f = Vector3::new(lateral * ei / (l * l), 0.0, -ratio * p_cr);
+        RobotModel::rod_only(rod.unwrap(), Loads::tip_force(f)).unwrap()
+    }
+
+    /// Near Euler's load the margin is small: the certificate refuses and the columns at the
+    /// solution decide (the margin is then known at once). Below the load the column is
+    /// stable, above it the straight column is not (Euler).
+    #[test]
+    fn near_the_euler_load_the_columns_at_the_solution_decide() {
+        let opts = SolveOptions {
+            seek_stable: false,
+            ..SolveOptions::default()
+        };
+        let none = Actuation::default();
+        let below = solve_statics(&column(0.97, 1e-3), &none, &opts).unwrap();
+        assert!(below.stats.converged && below.stable);
+        let m = *below
+            .margin
+            .get()
+            .expect("decided by the columns at the solution");
+        assert!(m > 0.0 && m < CERTIFIED_MARGIN, "margin {m}");
+        let above = solve_statics(&column(1.03, 0.0), &none, &opts).unwrap();
+        assert!(above.stats.converged && !above.stable);
+        assert!(above.margin.get().is_some_and(|m| *m < -NEUTRAL_MARGIN));
+    }
+
+    /// Far from critical, a solution certified stable by the exact columns of the predicted
+    /// point has its margin computed when read: it is at least the certificate's floor.
+    #[test]
+    fn a_certified_solution_is_stable_by_the_columns_at_the_solution() {
+        let sol = solve_statics(
+            &column(0.0, 0.3),
+            &Actuation::default(),
+            &SolveOptions::default(),
+        )
+        .unwrap();
+        assert!(sol.stats.converged && sol.stable);
+        assert!(
+            sol.margin.get().is_none(),
+            "certified: margin computed when read"
+        );
+        let m = sol.stability_margin();
+        assert!(m >= CERTIFIED_MARGIN, "margin {m}");
     }
 }

@@ -1,7 +1,7 @@
 //! Steady-state shape of a Cosserat rod with tendons, chambers and external loads, by shooting.
 //!
 //! [`solve_statics`] finds the total base wrench `(N(0), M(0))` (world frame) that meets the
-//! tip conditions ([`super::shooting`]). The actuation is always applied in full: with the
+//! tip conditions (`cosserat::shooting`). The actuation is always applied in full: with the
 //! total-wrench form a tendon or a chamber adds nothing to the base wrench, so the actuated,
 //! unloaded rod is solved exactly by a zero base wrench in one pass. The external loads are
 //! then applied along the load factor `λ` from 0 to 1: first directly, from the exact tangent
@@ -251,9 +251,10 @@ impl StaticsSolution {
     /// The smallest eigenvalue of the symmetric part of the dimensionless tip tangent
     /// stiffness `D K D / (E I(0) / L)`, `K` the inverse of the tip tangent compliance
     /// (tendons at fixed tension, dead loads), `D = diag(L, L, L, 1, 1, 1)`: positive for a
-    /// stable equilibrium (see `docs/stability.md`). Computed during a loaded solve; for an
-    /// unloaded one (always stable) on first call, by one march with the six base-wrench
-    /// columns. NaN for a result that did not converge.
+    /// stable equilibrium (see `docs/stability.md`). Computed during a loaded solve when its
+    /// sign is in doubt; for an unloaded one (always stable) and a loaded one certified
+    /// stable by the exact columns of a nearby Newton iterate, on first call, by one march
+    /// with the six base-wrench columns. NaN for a result that did not converge.
     pub fn stability_margin(&self) -> f64 {
         *self.margin.get_or_init(|| {
             if !self.stats.converged {
@@ -523,6 +524,16 @@ fn stability_at(
     if let (true, Some(j), Some(tw)) = (fresh, jacobian, p.tip_twist) {
         return tip_stability(j, &tw, length).map(|s| (s, j.to_vec()));
     }
+    if let Some((_, exact)) = p.certificate(x, 1.0) {
+        // Stable, certified by exact columns near x: the margin at x is computed when first
+        // read (NaN here).
+        let certified = Stability {
+            stable: true,
+            margin: f64::NAN,
+            mode: None,
+        };
+        return Some((certified, jacobian.map_or(exact.to_vec(), <[f64]>::to_vec)));
+    }
     let (_, cols, _) = p.pass::<FULL>(x, 1.0).ok()?;
     let mut j = vec![0.0; 36];
     for (c, col) in cols.iter().enumerate() {
@@ -764,14 +775,31 @@ fn check_inputs(
     model.check_actuation(actuation)?;
     // A tendon with friction needs its tension profile (solve_frictional): a uniform tension
     // would be the frictionless answer, reported as if friction had been modelled.
+    // (A tendon at zero tension carries no friction: the zero actuation of the displacement
+    // reference is the frictionless one.)
+    let tensions = actuation.tension_values(model.tendons().len());
     if actuation.profile.is_none() {
-        if let Some(i) = model.tendons().iter().position(|t| t.friction() > 0.0) {
+        if let Some(i) = (0..tensions.len()).find(|&i| {
+            model.tendons()[i].friction() > 0.0
+                && (tensions[i] != 0.0 || actuation.tendons.get(i).is_some_and(|t| t.is_held()))
+        }) {
             return Err(Error::invalid(
                 format!("tendons[{i}].friction"),
                 model.tendons()[i].friction(),
                 "0 here: a tendon with friction is solved by solve_frictional",
             ));
         }
+    }
+    // A guided tendon loads the rod at its guides only (solve_frictional): its tension along
+    // the continuous channel would be another robot's answer.
+    if let Some(i) =
+        (0..tensions.len()).find(|&i| model.tendons()[i].is_guided() && tensions[i] != 0.0)
+    {
+        return Err(Error::invalid(
+            format!("tendons[{i}].guides"),
+            format!("{} guides", model.tendons()[i].guides().len()),
+            "none here: a tendon routed through guides is solved by solve_frictional",
+        ));
     }
     if let Some(w) = &options.warm_start {
         model.check_wrench("warm_start.base_wrench", &w.base_wrench)?;
@@ -890,7 +918,9 @@ fn solve_with(
     match stability {
         Some(s) => {
             sol.stable = s.stable;
-            let _ = sol.margin.set(s.margin);
+            if !s.margin.is_nan() {
+                let _ = sol.margin.set(s.margin);
+            }
         }
         None => sol.stable = !loaded && sol.stats.converged,
     }

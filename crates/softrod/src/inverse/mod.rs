@@ -87,7 +87,7 @@ pub const LEAST_SQUARES_REGULARISATION: f64 = 1e-12;
 /// function cannot resolve smaller ones).
 pub const LOCAL_STEP: f64 = 1e-5;
 /// Ratio of successive steps near the target above which the curvature is made again.
-pub const STALLED: f64 = 0.1;
+pub const STALLED: f64 = 0.5;
 /// The first trust radius: the scaled actuation that moves the linearised pose by this
 /// fraction of the rod length.
 pub const FIRST_RADIUS: f64 = 1.0;
@@ -746,8 +746,9 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         iterations += 1;
         match accepted {
             Some((trial, t)) => {
-                // Near the target, the curvature met along the step refines the Hessian.
-                if near_phase && curved_for.is_some() {
+                // The curvature met along the step refines the Hessian (far from the target
+                // too: a warm start's first step is the longest secant it gets).
+                if curved_for.is_some() {
                     if let (Some(lambda), Some(jn)) =
                         (&lambda_k, error_rows(target, &t, rotation_weight).1)
                     {
@@ -1306,6 +1307,9 @@ fn curvature<F: Forward + ?Sized>(
         return (None, 0);
     }
     let d = cols.len();
+    if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
+        eprintln!("curvature: {d} null directions");
+    }
     let mut z = DMatrix::zeros(n, d);
     for (j, &c) in cols.iter().enumerate() {
         for (r, &i) in idx.iter().enumerate() {

@@ -127,6 +127,22 @@ impl RobotModel {
                 ));
             }
             tendon_reach.push(check_routing(i, t, &rod, end)?);
+            if let Some(g) = t.guides().iter().position(|&g| g >= end) {
+                return Err(Error::invalid(
+                    format!("tendons[{i}].guides[{g}]"),
+                    t.guides()[g],
+                    format!("in (0, end) = (0, {end}) m (the termination is the last anchor)"),
+                ));
+            }
+            if t.is_guided() && t.friction() > 0.0 {
+                return Err(Error::invalid(
+                    format!("tendons[{i}].friction"),
+                    t.friction(),
+                    "0 for a tendon routed through guides (its chords touch only the guides: \
+                     set guide_friction)",
+                ));
+            }
+            breaks.extend_from_slice(t.guides());
             breaks.push(end);
             tendon_ends.push(end);
         }

@@ -108,6 +108,8 @@ pub struct Tendon {
     routing: Routing,
     end: Option<f64>,
     friction: f64,
+    guides: Vec<f64>,
+    guide_friction: Vec<f64>,
 }
 
 impl Tendon {
@@ -159,6 +161,8 @@ impl Tendon {
             routing,
             end,
             friction: 0.0,
+            guides: Vec::new(),
+            guide_friction: Vec::new(),
         })
     }
 
@@ -177,6 +181,76 @@ impl Tendon {
     /// Friction coefficient of the tendon in its channel (dimensionless, >= 0).
     pub fn friction(&self) -> f64 {
         self.friction
+    }
+
+    /// The same tendon routed through discrete guides (spacer disks) at the arc lengths
+    /// `guides` (m, strictly increasing, in `(0, end)`; checked against the rod when the model
+    /// is built) with the Coulomb coefficient `friction[g]` (dimensionless, >= 0) at guide `g`
+    /// (one value for all, or one per guide). The tendon passes each guide at its routing
+    /// offset `r(s_g)`, runs in straight chords between the base hole (`s = 0`), the guides
+    /// and its termination, and at a guide of wrap angle `θ` (the angle between the chords)
+    /// obeys the capstan law `τ_out ∈ [τ_in e^(−μ_g θ), τ_in e^(+μ_g θ)]`
+    /// (see `cosserat::guides`). An empty `guides` is a tendon in a continuous channel.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `guides[g]` (not finite, <= 0 or not increasing) or
+    /// `guide_friction` (a length other than 1 or `guides.len()`, or a value not finite or
+    /// negative).
+    pub fn with_guides(mut self, guides: Vec<f64>, friction: &[f64]) -> Result<Self> {
+        for (g, &s) in guides.iter().enumerate() {
+            if !(s.is_finite() && s > 0.0) || (g > 0 && s <= guides[g - 1]) {
+                return Err(Error::invalid(
+                    format!("guides[{g}]"),
+                    s,
+                    "finite, > 0 m and strictly increasing",
+                ));
+            }
+        }
+        let per: Vec<f64> = match friction.len() {
+            1 => vec![friction[0]; guides.len()],
+            n if n == guides.len() => friction.to_vec(),
+            n => {
+                return Err(Error::invalid(
+                    "guide_friction",
+                    format!("{n} values"),
+                    format!("1 or one per guide ({})", guides.len()),
+                ))
+            }
+        };
+        for (g, &mu) in per.iter().enumerate() {
+            check_non_negative(&format!("guide_friction[{g}]"), mu, "")?;
+        }
+        self.guides = guides;
+        self.guide_friction = if self.guides.is_empty() {
+            Vec::new()
+        } else {
+            per
+        };
+        Ok(self)
+    }
+
+    /// Arc lengths (m) of the guides the tendon runs through; empty for a continuous channel.
+    pub fn guides(&self) -> &[f64] {
+        &self.guides
+    }
+
+    /// Friction coefficient at each guide (dimensionless, one per entry of [`Tendon::guides`]).
+    pub fn guide_friction(&self) -> &[f64] {
+        &self.guide_friction
+    }
+
+    /// The same tendon in a continuous channel (its guides dropped).
+    pub(crate) fn without_guides(&self) -> Self {
+        Self {
+            guides: Vec::new(),
+            guide_friction: Vec::new(),
+            ..self.clone()
+        }
+    }
+
+    /// Whether the tendon is routed through discrete guides (straight chords between them).
+    pub fn is_guided(&self) -> bool {
+        !self.guides.is_empty()
     }
 
     /// Tendon at the constant offset `(x, y)` (m).

@@ -7,8 +7,11 @@
 //! * a robot-independent map, arc parameters ↔ pose ([`PccSegment::pose`], [`arc_pose`],
 //!   [`arc_frames`], [`arc_jacobian`], [`arc_from_tip`], [`arc_from_tip_with_length`]) and its
 //!   product over a chain ([`PccChain`], [`chain_pose`]);
-//! * robot-specific maps, actuation → arc parameters, for tendons ([`PccTendons`]: from
-//!   displacements or tensions) and pneumatic chambers ([`PccChambers`]: from pressures), with
+//! * the same arc in the bending-vector coordinates `(θ_x, θ_y, ℓ)` of the PCC statics, with
+//!   first and second derivatives of its tip pose (`seg_kin`), from the one set of series-safe
+//!   arc functions ([`crate::math::series`]);
+//! * robot-specific maps, actuation → arc parameters, for tendons ([`super::PccTendons`]: from
+//!   displacements or tensions) and pneumatic chambers ([`super::PccChambers`]: from pressures), with
 //!   their Jacobians.
 //!
 //! # Convention
@@ -69,7 +72,7 @@ use nalgebra::{Matrix3, Matrix4, Matrix6x3, Matrix6xX, Vector3};
 use crate::error::{check_finite, Error, Result};
 use crate::limits::MAX_BENDING_ANGLE;
 use crate::math::samples::in_range;
-use crate::math::series::{arc_s1, arc_sb};
+use crate::math::series::{arc_fns, arc_s1, arc_sb};
 
 /// Samples of the bending angle over `[0, 2π]` that bracket the closest arc in
 /// [`arc_from_tip_with_length`] before it is refined.
@@ -777,4 +780,96 @@ pub fn chain_jacobian(
         }
     }
     j
+}
+
+// ---------------------------------------------------------------------------------------------
+// Segment kinematics in θ coordinates (θ_x, θ_y, ℓ) with first and second derivatives.
+// ---------------------------------------------------------------------------------------------
+
+/// One segment's tip pose (segment base frame) and its derivatives in `(θ_x, θ_y, ℓ)`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SegKin {
+    pub(crate) r: Matrix3<f64>,
+    pub(crate) p: Vector3<f64>,
+    /// `∂p/∂(θ_x, θ_y, ℓ)`.
+    pub(crate) dp: [Vector3<f64>; 3],
+    /// Spatial angular velocity per unit `θ_x`, `θ_y` (zero for `ℓ`).
+    pub(crate) w: [Vector3<f64>; 2],
+    /// `∂²p/∂q_k∂q_m`.
+    pub(crate) ddp: [[Vector3<f64>; 3]; 3],
+    /// `∂w_k/∂θ_m`.
+    pub(crate) dw: [[Vector3<f64>; 2]; 2],
+}
+
+/// One segment's kinematics at `(θ_x, θ_y, ℓ) = (a, b, l)`.
+#[inline]
+pub(crate) fn seg_kin(a: f64, b: f64, l: f64) -> SegKin {
+    let x = a * a + b * b;
+    let f = arc_fns(x);
+    let (ab, a2, b2) = (a * b, a * a, b * b);
+    let r = Matrix3::new(
+        1.0 - f.b * b2,
+        f.b * ab,
+        f.s * b,
+        f.b * ab,
+        1.0 - f.b * a2,
+        -f.s * a,
+        -f.s * b,
+        f.s * a,
+        1.0 - f.b * x,
+    );
+    // P = p/ℓ = (B b, -B a, S).
+    let pp = Vector3::new(f.b * b, -f.b * a, f.s);
+    let dpa = Vector3::new(2.0 * ab * f.b1, -2.0 * a2 * f.b1 - f.b, 2.0 * a * f.s1);
+    let dpb = Vector3::new(2.0 * b2 * f.b1 + f.b, -2.0 * ab * f.b1, 2.0 * b * f.s1);
+    let daa = Vector3::new(
+        2.0 * b * f.b1 + 4.0 * a2 * b * f.b2,
+        -6.0 * a * f.b1 - 4.0 * a2 * a * f.b2,
+        2.0 * f.s1 + 4.0 * a2 * f.s2,
+    );
+    let dab = Vector3::new(
+        2.0 * a * f.b1 + 4.0 * a * b2 * f.b2,
+        -2.0 * b * f.b1 - 4.0 * a2 * b * f.b2,
+        4.0 * ab * f.s2,
+    );
+    let dbb = Vector3::new(
+        6.0 * b * f.b1 + 4.0 * b2 * b * f.b2,
+        -2.0 * a * f.b1 - 4.0 * a * b2 * f.b2,
+        2.0 * f.s1 + 4.0 * b2 * f.s2,
+    );
+    let wa = Vector3::new(1.0 - f.c * b2, f.c * ab, -f.b * b);
+    let wb = Vector3::new(f.c * ab, 1.0 - f.c * a2, f.b * a);
+    let waa = Vector3::new(
+        -2.0 * a * b2 * f.c1,
+        2.0 * a2 * b * f.c1 + b * f.c,
+        -2.0 * ab * f.b1,
+    );
+    let wab = Vector3::new(
+        -2.0 * b2 * b * f.c1 - 2.0 * b * f.c,
+        2.0 * a * b2 * f.c1 + a * f.c,
+        -2.0 * b2 * f.b1 - f.b,
+    );
+    let wba = Vector3::new(
+        2.0 * a2 * b * f.c1 + b * f.c,
+        -2.0 * a2 * a * f.c1 - 2.0 * a * f.c,
+        2.0 * a2 * f.b1 + f.b,
+    );
+    let wbb = Vector3::new(
+        2.0 * a * b2 * f.c1 + a * f.c,
+        -2.0 * a2 * b * f.c1,
+        2.0 * ab * f.b1,
+    );
+    let z = Vector3::zeros();
+    SegKin {
+        r,
+        p: pp * l,
+        dp: [dpa * l, dpb * l, pp],
+        w: [wa, wb],
+        ddp: [
+            [daa * l, dab * l, dpa],
+            [dab * l, dbb * l, dpb],
+            [dpa, dpb, z],
+        ],
+        dw: [[waa, wab], [wba, wbb]],
+    }
 }

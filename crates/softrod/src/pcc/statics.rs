@@ -64,9 +64,9 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3};
 
 use crate::error::{check_finite, check_positive, Error, Result};
 use crate::limits::check_load;
-use crate::math::series::arc_fns;
 use crate::pcc::actuation::{ElasticSegment, PccChambers, PccTendons};
 use crate::pcc::kinematics::{chain_pose, PccChain, PccSegment};
+pub(crate) use crate::pcc::kinematics::{seg_kin, SegKin};
 use crate::solve::{
     continuation, newton, Armijo, ContinuationSettings, Evaluated, LineSearch, NewtonOptions,
     NewtonSettings, Problem, SolverStats,
@@ -329,100 +329,8 @@ pub struct PccEquilibrium {
     pub residual: DVector<f64>,
     /// Exact Jacobian `∂g/∂q` (3n × 3n, unsymmetric under a tip moment).
     pub jacobian: DMatrix<f64>,
-    /// Scaled residual (max norm), as compared with [`PccSolveOptions::tolerance`].
+    /// Scaled residual (max norm), as compared with the tolerance of [`PccSolveOptions::newton`].
     pub scaled_residual: f64,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Segment kinematics in θ coordinates (θ_x, θ_y, ℓ) with first and second derivatives.
-// ---------------------------------------------------------------------------------------------
-
-/// One segment's tip pose (segment base frame) and its derivatives in `(θ_x, θ_y, ℓ)`.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct SegKin {
-    pub(crate) r: Matrix3<f64>,
-    pub(crate) p: Vector3<f64>,
-    /// `∂p/∂(θ_x, θ_y, ℓ)`.
-    pub(crate) dp: [Vector3<f64>; 3],
-    /// Spatial angular velocity per unit `θ_x`, `θ_y` (zero for `ℓ`).
-    pub(crate) w: [Vector3<f64>; 2],
-    /// `∂²p/∂q_k∂q_m`.
-    pub(crate) ddp: [[Vector3<f64>; 3]; 3],
-    /// `∂w_k/∂θ_m`.
-    pub(crate) dw: [[Vector3<f64>; 2]; 2],
-}
-
-/// One segment's kinematics at `(θ_x, θ_y, ℓ) = (a, b, l)`.
-#[inline]
-pub(crate) fn seg_kin(a: f64, b: f64, l: f64) -> SegKin {
-    let x = a * a + b * b;
-    let f = arc_fns(x);
-    let (ab, a2, b2) = (a * b, a * a, b * b);
-    let r = Matrix3::new(
-        1.0 - f.b * b2,
-        f.b * ab,
-        f.s * b,
-        f.b * ab,
-        1.0 - f.b * a2,
-        -f.s * a,
-        -f.s * b,
-        f.s * a,
-        1.0 - f.b * x,
-    );
-    // P = p/ℓ = (B b, -B a, S).
-    let pp = Vector3::new(f.b * b, -f.b * a, f.s);
-    let dpa = Vector3::new(2.0 * ab * f.b1, -2.0 * a2 * f.b1 - f.b, 2.0 * a * f.s1);
-    let dpb = Vector3::new(2.0 * b2 * f.b1 + f.b, -2.0 * ab * f.b1, 2.0 * b * f.s1);
-    let daa = Vector3::new(
-        2.0 * b * f.b1 + 4.0 * a2 * b * f.b2,
-        -6.0 * a * f.b1 - 4.0 * a2 * a * f.b2,
-        2.0 * f.s1 + 4.0 * a2 * f.s2,
-    );
-    let dab = Vector3::new(
-        2.0 * a * f.b1 + 4.0 * a * b2 * f.b2,
-        -2.0 * b * f.b1 - 4.0 * a2 * b * f.b2,
-        4.0 * ab * f.s2,
-    );
-    let dbb = Vector3::new(
-        6.0 * b * f.b1 + 4.0 * b2 * b * f.b2,
-        -2.0 * a * f.b1 - 4.0 * a * b2 * f.b2,
-        2.0 * f.s1 + 4.0 * b2 * f.s2,
-    );
-    let wa = Vector3::new(1.0 - f.c * b2, f.c * ab, -f.b * b);
-    let wb = Vector3::new(f.c * ab, 1.0 - f.c * a2, f.b * a);
-    let waa = Vector3::new(
-        -2.0 * a * b2 * f.c1,
-        2.0 * a2 * b * f.c1 + b * f.c,
-        -2.0 * ab * f.b1,
-    );
-    let wab = Vector3::new(
-        -2.0 * b2 * b * f.c1 - 2.0 * b * f.c,
-        2.0 * a * b2 * f.c1 + a * f.c,
-        -2.0 * b2 * f.b1 - f.b,
-    );
-    let wba = Vector3::new(
-        2.0 * a2 * b * f.c1 + b * f.c,
-        -2.0 * a2 * a * f.c1 - 2.0 * a * f.c,
-        2.0 * a2 * f.b1 + f.b,
-    );
-    let wbb = Vector3::new(
-        2.0 * a * b2 * f.c1 + a * f.c,
-        -2.0 * a2 * b * f.c1,
-        2.0 * ab * f.b1,
-    );
-    let z = Vector3::zeros();
-    SegKin {
-        r,
-        p: pp * l,
-        dp: [dpa * l, dpb * l, pp],
-        w: [wa, wb],
-        ddp: [
-            [daa * l, dab * l, dpa],
-            [dab * l, dbb * l, dpb],
-            [dpa, dpb, z],
-        ],
-        dw: [[waa, wab], [wba, wbb]],
-    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -123,6 +123,14 @@ pub trait Problem {
     fn close(&self) -> bool {
         true
     }
+    /// Whether what the problem checks at a solution `x` at load factor `lambda` (the
+    /// stability of a rod) is already certified by an exact Jacobian evaluated near it, so
+    /// that [`NewtonSettings::exact_at_solution`] need not evaluate one at `x`; `false` by
+    /// default.
+    fn certified(&mut self, x: &[f64], lambda: f64) -> bool {
+        let _ = (x, lambda);
+        false
+    }
 }
 
 /// Max norm, infinite if any entry is not finite.

@@ -71,7 +71,7 @@ pub struct NewtonSettings<'a> {
     /// End on an exact Jacobian evaluated at the converged iterate (the problem's last
     /// evaluation then carries it, e.g. for a stability test): a Broyden step predicted to
     /// converge is taken with the Jacobian, and a converged iterate without one is evaluated
-    /// once more.
+    /// once more; neither where [`Problem::certified`] says the check needs no Jacobian there.
     pub exact_at_solution: bool,
 }
 
@@ -161,7 +161,7 @@ fn start<P: Problem + ?Sized>(
     if it.rn <= problem.tolerance(&it.x, options.tolerance) {
         out.converged = true;
         out.exact = ev == Evaluated::Jacobian;
-        if settings.exact_at_solution && !out.exact {
+        if settings.exact_at_solution && !out.exact && !problem.certified(&it.x, lambda) {
             let mut j = vec![0.0; n * n];
             if problem.evaluate(&it.x, lambda, Some(&mut j), &mut it.r) == Evaluated::Jacobian {
                 out.residual = problem.norm(&it.r);
@@ -368,6 +368,18 @@ fn jacobian_at_solution<P: Problem + ?Sized>(
     }
 }
 
+/// Whether the problem's check at the point `x + dx` a step predicted to converge reaches is
+/// certified without an exact Jacobian there ([`Problem::certified`]).
+fn certified_after<P: Problem + ?Sized>(
+    problem: &mut P,
+    x: &[f64],
+    dx: &[f64],
+    lambda: f64,
+) -> bool {
+    let next: Vec<f64> = x.iter().zip(dx).map(|(a, b)| a + b).collect();
+    problem.certified(&next, lambda)
+}
+
 /// Damped Newton on `problem` at load factor `lambda` from `x0`.
 #[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub fn newton<P: Problem + ?Sized>(
@@ -413,6 +425,7 @@ pub fn newton<P: Problem + ?Sized>(
             && !single_failed
             && r_prev.is_finite()
             && rn * (rn / r_prev) <= 10.0 * tol
+            && !certified_after(problem, &it.x, &dx, lambda)
         {
             if full_step(problem, &mut it, &dx, lambda, settings, options, &mut out) {
                 r_prev = rn;
@@ -477,7 +490,11 @@ pub fn newton<P: Problem + ?Sized>(
             break;
         }
     }
-    if out.converged && settings.exact_at_solution && !(it.exact && out.at_x) {
+    if out.converged
+        && settings.exact_at_solution
+        && !(it.exact && out.at_x)
+        && !problem.certified(&it.x, lambda)
+    {
         jacobian_at_solution(problem, &mut it, lambda, options, &mut out);
     }
     out.finish(it)

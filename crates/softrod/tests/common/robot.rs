@@ -1,7 +1,8 @@
 //! Robots as the tests write them: tendons with their tensions and chambers with their
 //! pressures, split into the model and the actuation by [`solve`]; and the one fixture of the
-//! two-segment NiTi tendon robot.
-#![allow(dead_code, missing_docs)]
+//! two-segment NiTi tendon robot (also used by the benches and examples, through
+//! `#[path = "../tests/common/robot.rs"]`).
+#![allow(dead_code, missing_docs, clippy::unwrap_used)]
 
 use std::sync::Arc;
 
@@ -132,6 +133,51 @@ pub fn niti_tendons(tensions: &[f64; 6]) -> Vec<Tensioned> {
             .expect("tendon")
         })
         .collect()
+}
+
+/// The two-segment NiTi robot as a model (its tendons, without tensions) under `loads`, with
+/// the rod's `density` (kg/m³) if given and the friction coefficient `friction` on every
+/// tendon (0: frictionless).
+pub fn niti_model(loads: Loads, density: Option<f64>, friction: f64) -> Arc<RobotModel> {
+    let mut rod = niti_rod();
+    if let Some(d) = density {
+        rod = rod.with_density(d).expect("density");
+    }
+    let tendons = niti_tendons(&[0.0; 6])
+        .into_iter()
+        .map(|t| {
+            if friction == 0.0 {
+                t.tendon
+            } else {
+                t.tendon.with_friction(friction).expect("friction")
+            }
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), loads).expect("model")
+}
+
+/// A 1 m NiTi rod (radius 1 mm, 6450 kg/m³) with four tendons at 10 mm, 90° apart, ending at
+/// the tip, horizontal base (gravity along -x), under its own weight.
+pub fn four_tendon_gravity() -> Arc<RobotModel> {
+    let rod = Rod::new(
+        1.0,
+        Section::circular(1e-3).expect("radius"),
+        LinearElastic::new(54e9, 0.3).expect("material"),
+    )
+    .expect("rod")
+    .with_density(6450.0)
+    .expect("density");
+    let tendons = (0..4)
+        .map(|i| {
+            let a = (90.0 * i as f64).to_radians();
+            Tendon::constant([0.01 * a.cos(), 0.01 * a.sin()], None).expect("tendon")
+        })
+        .collect();
+    let g = Loads {
+        gravity: softrod::nalgebra::Vector3::new(-9.81, 0.0, 0.0),
+        ..Default::default()
+    };
+    RobotModel::new(rod, tendons, Vec::new(), g).expect("model")
 }
 
 /// The beam of the contact and end-constraint tests: length 1 m (m), E = 2 GPa (Pa),

@@ -29,7 +29,7 @@ use crate::error::{Error, Result};
 /// These curves stiffen with strain, so unconstrained Mooney–Rivlin fits come out with
 /// `C01 < 0` and are stable only in tension or mild compression (stretch bounds in each
 /// entry); three-term Yeoh fits have `C30 < 0` and lose stability a little above `λ = 3.7`
-/// (Dragon Skin) or 4.4 (Ecoflex). Check [`UniaxialLaw::check_stable`] on the stretch range of
+/// (Dragon Skin) or 4.4 (Ecoflex). Check [`UniaxialLaw::check_stable`](super::hyperelastic::UniaxialLaw::check_stable) on the stretch range of
 /// the application; prefer Yeoh where a section is compressed (bending).
 ///
 /// The measured curves are vendored in `data/silicone-tensile/` (with their licence). Literature

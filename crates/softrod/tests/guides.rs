@@ -1,0 +1,274 @@
+//! Disk-guided tendons (straight chords between guides, capstan friction per guide): the
+//! capstan law per guide on a nearly rigid arc (loading and unloading, closed-form wrap
+//! angles), global balance of rod + tendons, the capstan law along the returned shape of a
+//! flexible robot, and the continuous channel as the limit of dense guides.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::sync::Arc;
+
+use softrod::nalgebra::{Matrix3, Vector3};
+use softrod::{
+    solve_frictional, solve_path, Actuation, FrictionOptions, FrictionalSolution, Integrator,
+    LinearElastic, Loads, Profile, RobotModel, Rod, Section, Slip, Tendon,
+};
+
+const KAPPA0: f64 = 5.0; // rest curvature (1/m)
+const LENGTH: f64 = 0.3; // rod length (m): wrap angle 1.5 rad
+const GUIDES: usize = 12; // chords (guides at L/12, ..., 11 L/12; termination at the tip)
+
+fn options(steps: usize) -> FrictionOptions {
+    let mut o = FrictionOptions::default();
+    o.statics.integrator = Integrator::Rk4 { steps };
+    o.statics.newton.tolerance = 1e-13;
+    o.tolerance = 1e-12;
+    o
+}
+
+/// The coefficient of guide `g` (0-based) on the arc: different at every guide.
+fn mu_of(g: usize) -> f64 {
+    0.1 + 0.04 * g as f64
+}
+
+/// A stiff precurved steel rod (the capstan test of the continuous channel) with one tendon
+/// on the inside of the curve through `GUIDES - 1` equally spaced guides.
+fn arc_model() -> Arc<RobotModel> {
+    let rod = Rod::new(
+        LENGTH,
+        Section::circular(0.005).unwrap(),
+        LinearElastic::new(2e11, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_inextensible(true)
+    .with_rest_curvature(Profile::Constant(Vector3::new(0.0, KAPPA0, 0.0)))
+    .unwrap();
+    let guides: Vec<f64> = (1..GUIDES)
+        .map(|g| LENGTH * g as f64 / GUIDES as f64)
+        .collect();
+    let mu: Vec<f64> = (0..GUIDES - 1).map(mu_of).collect();
+    let tendon = Tendon::constant([0.004, 0.0], None)
+        .unwrap()
+        .with_guides(guides, &mu)
+        .unwrap();
+    RobotModel::new(rod, vec![tendon], Vec::new(), Loads::default()).unwrap()
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Rod + tendons at the base: the rod's own wrench at `s = 0` plus every tendon's pull there
+/// (along its first chord or its path tangent) balances `force` (N) and `moment` (N m) about
+/// the base.
+fn base_balance(model: &RobotModel, sol: &FrictionalSolution) -> (Vector3<f64>, Vector3<f64>) {
+    let st = &sol.statics;
+    let props = model.rod().section_at(0.0);
+    let r0 = Matrix3::from_fn(|a, b| st.rotation[0][a][b]);
+    let mut force = Vector3::from(st.n_world[0]);
+    let mut moment = Vector3::from(st.m_world[0]);
+    for (i, t) in model.tendons().iter().enumerate() {
+        let (o, _) = t.routing().offset(0.0, &props);
+        let pull = Vector3::from(sol.tangent[0][i]) * sol.tension[0][i];
+        force += pull;
+        moment += (r0 * Vector3::new(o[0], o[1], 0.0)).cross(&pull);
+    }
+    (force, moment)
+}
+
+#[test]
+fn capstan_per_guide_on_a_rigid_arc() {
+    let model = arc_model();
+    let tau0 = 1e-4;
+    let opts = options(240);
+    let sol = solve_frictional(&model, &Actuation::tensions(&[tau0]), &opts, None).unwrap();
+    let tip = sol.tip_position();
+    let th = KAPPA0 * LENGTH;
+    let arc = [(1.0 - th.cos()) / KAPPA0, 0.0, th.sin() / KAPPA0];
+    let off = (0..3).map(|k| (tip[k] - arc[k]).abs()).fold(0.0, f64::max);
+    assert!(off < 1e-9, "tip off the arc by {off:e} m");
+    let guides = &sol.guides[0];
+    assert_eq!(guides.len(), GUIDES + 1);
+    // The chords of equally spaced points on a circle turn by the central angle κ0 Δs.
+    let wrap = KAPPA0 * LENGTH / GUIDES as f64;
+    let (mut worst, mut worst_wrap, mut expected): (f64, f64, f64) = (0.0, 0.0, tau0);
+    for (g, st) in guides.iter().enumerate().take(GUIDES).skip(1) {
+        let ratio = st.tension_out / st.tension_in;
+        worst = worst.max(rel(ratio, (-mu_of(g - 1) * wrap).exp()));
+        expected *= (-mu_of(g - 1) * wrap).exp();
+        worst = worst.max(rel(st.tension_out, expected));
+        worst_wrap = worst_wrap.max((st.wrap - wrap).abs());
+        assert_eq!(st.slip, Slip::Loading);
+    }
+    // Per node: the tension of the chord the node lies on.
+    for (j, &s) in sol.statics.s.iter().enumerate() {
+        let g = ((s / LENGTH * GUIDES as f64 + 1e-12).floor() as usize).min(GUIDES - 1);
+        assert_eq!(
+            sol.tension[j][0], guides[g].tension_out,
+            "node {j} at s = {s}"
+        );
+    }
+    let (force, moment) = base_balance(&model, &sol);
+    eprintln!(
+        "guided capstan: worst relative error {worst:e}, wrap angles off by {worst_wrap:e} rad, \
+         tip off the arc {off:e} m, base balance {:e} N, {:e} N m, {} marches",
+        force.amax(),
+        moment.amax(),
+        sol.iterations
+    );
+    assert!(
+        worst < 1e-8,
+        "guided capstan: worst relative error {worst:e}"
+    );
+    // (The base balance of this stiff rod is bounded by the shooting tolerance relative to
+    // its stiffness scale EI/L² ~ 1e3 N; it is checked on the NiTi robot below.)
+}
+
+#[test]
+fn guided_unloading_slides_back_up_to_a_front() {
+    let model = arc_model();
+    let (tau0, taur) = (1e-4, 0.6e-4);
+    let path = [Actuation::tensions(&[tau0]), Actuation::tensions(&[taur])];
+    let sols = solve_path(&model, &path, &options(240)).unwrap();
+    let wrap = KAPPA0 * LENGTH / GUIDES as f64;
+    // The loading tensions and, on unloading, the capstan rule with the closed-form wraps:
+    // sliding back (τ_out = τ_in e^(+μθ)) until that would exceed the loading tension.
+    let mut load = vec![tau0];
+    for g in 1..GUIDES {
+        load.push(load[g - 1] * (-mu_of(g - 1) * wrap).exp());
+    }
+    let mut tau = taur;
+    let mut worst: f64 = 0.0;
+    let (mut slid, mut stuck) = (0, 0);
+    for g in 1..GUIDES {
+        let hi = tau * (mu_of(g - 1) * wrap).exp();
+        let st = &sols[1].guides[0][g];
+        if hi < load[g] {
+            tau = hi;
+            assert_eq!(st.slip, Slip::Unloading, "guide {g}");
+            slid += 1;
+        } else {
+            tau = load[g];
+            assert_eq!(st.slip, Slip::Stick, "guide {g}");
+            stuck += 1;
+        }
+        worst = worst.max(rel(st.tension_out, tau));
+    }
+    eprintln!("guided unloading: {slid} guides slide back, {stuck} stick; worst {worst:e}");
+    assert!(slid > 0 && stuck > 0);
+    assert!(
+        worst < 1e-8,
+        "guided unloading: worst relative error {worst:e}"
+    );
+}
+
+/// A precurved steel rod of radius `radius` (m) with two tendons (inside the curve, and at
+/// 90° ending at 0.2 m) through `per` equally spaced guides per 0.1 m (coefficient `mu` at
+/// every guide) or, `per = 0`, in continuous channels with coefficient `mu`.
+fn flexible(radius: f64, per: usize, mu: f64, tip: Vector3<f64>) -> Arc<RobotModel> {
+    let rod = Rod::new(
+        LENGTH,
+        Section::circular(radius).unwrap(),
+        LinearElastic::new(2e11, 0.3).unwrap(),
+    )
+    .unwrap()
+    .with_rest_curvature(Profile::Constant(Vector3::new(0.0, KAPPA0, 0.0)))
+    .unwrap();
+    let tendons = [([0.004, 0.0], None), ([0.0, 0.004], Some(0.2))]
+        .into_iter()
+        .map(|(o, end)| {
+            let t = Tendon::constant(o, end).unwrap();
+            if per == 0 {
+                return t.with_friction(mu).unwrap();
+            }
+            let e: f64 = end.unwrap_or(LENGTH);
+            let n = (per as f64 * e / 0.1).round() as usize;
+            let guides = (1..n).map(|g| e * g as f64 / n as f64).collect();
+            t.with_guides(guides, &[mu]).unwrap()
+        })
+        .collect();
+    RobotModel::new(rod, tendons, Vec::new(), Loads::tip_force(tip)).unwrap()
+}
+
+#[test]
+fn guided_balance_and_capstan_law_on_the_returned_shape() {
+    let mu = 0.2;
+    let f_tip = Vector3::new(0.03, -0.02, 0.01);
+    let model = flexible(0.0015, 4, mu, f_tip);
+    let opts = options(60);
+    let up = solve_frictional(&model, &Actuation::tensions(&[1.0, 0.5]), &opts, None).unwrap();
+    let down = Actuation::tensions(&[0.6, 0.5]);
+    let back = solve_frictional(&model, &down, &opts, Some(&up)).unwrap();
+    let mut stuck = 0;
+    for sol in [&up, &back] {
+        let st = &sol.statics;
+        let n = st.s.len() - 1;
+        let (force, moment) = base_balance(&model, sol);
+        let (p0, pl) = (Vector3::from(st.position[0]), Vector3::from(st.position[n]));
+        let ef = (force - f_tip).amax() / f_tip.norm();
+        let em = (moment - (pl - p0).cross(&f_tip)).amax() / (f_tip.norm() * LENGTH);
+        eprintln!("guided flexible rod: base balance {ef:e} (force), {em:e} (moment), relative");
+        assert!(ef < 1e-10 && em < 1e-10, "balance {ef:e}, {em:e}");
+        // The wrap angles from the guide points on the returned shape.
+        for i in [0, 1] {
+            let a = &sol.guides[i];
+            for g in 1..a.len() - 1 {
+                let x = |h: usize| {
+                    let s = a[h].s;
+                    let j = st.s.iter().position(|&m| m == s).unwrap();
+                    let r = Matrix3::from_fn(|p, q| st.rotation[j][p][q]);
+                    let props = model.rod().section_at(s);
+                    let (o, _) = model.tendons()[i].routing().offset(s, &props);
+                    Vector3::from(st.position[j]) + r * Vector3::new(o[0], o[1], 0.0)
+                };
+                let (c0, c1) = ((x(g) - x(g - 1)).normalize(), (x(g + 1) - x(g)).normalize());
+                let theta = c0.cross(&c1).norm().atan2(c0.dot(&c1));
+                let dlog = (a[g].tension_out / a[g].tension_in).ln();
+                let tol = 1e-6 * mu * theta;
+                match a[g].slip {
+                    Slip::Loading => assert!((dlog + mu * theta).abs() <= tol, "{i} {g}"),
+                    Slip::Unloading => assert!((dlog - mu * theta).abs() <= tol, "{i} {g}"),
+                    Slip::Stick => {
+                        stuck += 1;
+                        assert!(dlog.abs() <= mu * theta + tol);
+                    }
+                    Slip::Absent => unreachable!(),
+                }
+            }
+        }
+    }
+    assert!(stuck > 0, "the partial unloading sticks at some guide");
+}
+
+/// Dense guides approach the continuous channel: the tip distance between the two falls as
+/// the square of the guide spacing (chords against arcs), frictionless and with friction.
+#[test]
+fn dense_guides_approach_the_continuous_channel() {
+    let act = Actuation::tensions(&[1.0, 0.5]);
+    let opts = options(96);
+    for mu in [0.0, 0.2] {
+        let cont = solve_frictional(
+            &flexible(0.0015, 0, mu, Vector3::zeros()),
+            &act,
+            &opts,
+            None,
+        )
+        .unwrap();
+        let tc = Vector3::from(cont.tip_position());
+        let mut errs = Vec::new();
+        for per in [2, 4, 8] {
+            let sol = solve_frictional(
+                &flexible(0.0015, per, mu, Vector3::zeros()),
+                &act,
+                &opts,
+                None,
+            )
+            .unwrap();
+            errs.push((Vector3::from(sol.tip_position()) - tc).norm());
+        }
+        let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        eprintln!("μ = {mu}: tip distance to the continuous channel {errs:?}, orders {orders:?}");
+        assert!(
+            orders.iter().all(|&p| (1.8..2.2).contains(&p)),
+            "μ = {mu}: orders {orders:?}"
+        );
+    }
+}
