@@ -1311,7 +1311,9 @@ pub fn solve_constrained(
                 return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
             }
         }
-        // Else the mesh asked from the start.
+        // Else the mesh asked from the start (its iterations and load steps are those
+        // reported; the evaluations count both).
+        effort = Effort::default();
         p.integrator = options.integrator;
         p.coarse = None;
         p.active.clear();
