@@ -543,7 +543,7 @@ fn stability_at(
     tip_stability(&j, &tw, length).map(|s| (s, j))
 }
 
-/// Size of the imperfection of [`seek_stable`]: a dead tip wrench of `IMPERFECTION` times the
+/// Size of the imperfection of `seek_stable` (see [`SolveOptions::seek_stable`]): a dead tip wrench of `IMPERFECTION` times the
 /// force scale `E I(0) / L²` (and `E I(0) / L` for its moment) along the unstable mode.
 pub const IMPERFECTION: f64 = 1e-1;
 
