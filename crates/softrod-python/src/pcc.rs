@@ -77,15 +77,15 @@ fn rows3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
     Ok(a.outer_iter().map(|r| [r[0], r[1], r[2]]).collect())
 }
 
-/// The name of a core error prefixed: `segments[0].curvature` as `warm_start[0].curvature`.
-fn renamed(e: softrod::Error, from: &str, to: &str) -> softrod::Error {
+/// A core error with its parameter name mapped by `f` (other errors unchanged).
+fn map_name(e: softrod::Error, f: impl FnOnce(String) -> String) -> softrod::Error {
     match e {
         softrod::Error::InvalidParameter {
             name,
             value,
             expected,
         } => softrod::Error::InvalidParameter {
-            name: name.replacen(from, to, 1),
+            name: f(name),
             value,
             expected,
         },
@@ -93,20 +93,14 @@ fn renamed(e: softrod::Error, from: &str, to: &str) -> softrod::Error {
     }
 }
 
+/// The name of a core error prefixed: `segments[0].curvature` as `warm_start[0].curvature`.
+fn renamed(e: softrod::Error, from: &str, to: &str) -> softrod::Error {
+    map_name(e, |name| name.replacen(from, to, 1))
+}
+
 /// A parameter error of entry `i` of an array argument: the parameter named `name[i]`.
 fn indexed(e: softrod::Error, i: usize) -> softrod::Error {
-    match e {
-        softrod::Error::InvalidParameter {
-            name,
-            value,
-            expected,
-        } => softrod::Error::InvalidParameter {
-            name: format!("{name}[{i}]"),
-            value,
-            expected,
-        },
-        other => other,
-    }
+    map_name(e, |name| format!("{name}[{i}]"))
 }
 
 fn vector3(v: Floats, name: &str) -> PyResult<Vector3<f64>> {
