@@ -25,12 +25,8 @@ fn niti() -> Arc<RobotModel> {
 fn bench(c: &mut Criterion) {
     let model = niti();
     let o = SolveOptions::default();
-    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
-    let tip = Vector3::from(
-        solve_statics(&model, &Actuation::tensions(&t), &o)
-            .unwrap()
-            .tip_position(),
-    );
+    let t = robot::NITI_REFERENCE_TENSIONS;
+    let tip = robot::niti_reference_tip(&model, &o);
     let opts = InverseOptions::default();
     let (first, _) = inverse_statics(&model, &Target::tip(tip), &opts, &o, None).unwrap();
     let warm = InverseWarmStart::from(&first);

@@ -9,27 +9,17 @@
 
 use std::sync::Arc;
 
+#[path = "../tests/common/robot.rs"]
+mod robot;
+
 use softrod::nalgebra::Vector3;
 use softrod::{
-    solve_inverse, solve_statics, Actuation, CosseratForward, Forward, InverseOptions,
-    InverseWarmStart, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions, Target, Tendon,
+    solve_inverse, CosseratForward, Forward, InverseOptions, InverseWarmStart, Loads, RobotModel,
+    SolveOptions, Target,
 };
 
 fn niti() -> Arc<RobotModel> {
-    let rod = Rod::new(
-        0.4,
-        Section::circular(0.7e-3).unwrap(),
-        LinearElastic::new(54e9, 0.3).unwrap(),
-    )
-    .unwrap();
-    let tendons = (0..6)
-        .map(|i| {
-            let ang = [90.0f64, -30.0, 210.0][i % 3].to_radians();
-            let end = Some(if i < 3 { 0.2 } else { 0.4 });
-            Tendon::constant([0.01 * ang.cos(), 0.01 * ang.sin()], end).unwrap()
-        })
-        .collect();
-    RobotModel::new(rod, tendons, Vec::new(), Loads::default()).unwrap()
+    robot::niti_model(Loads::default(), None, 0.0)
 }
 
 fn main() {
@@ -38,12 +28,8 @@ fn main() {
     let n: usize = args.get(2).map_or(10, |a| a.parse().unwrap());
     let model = niti();
     let o = SolveOptions::default();
-    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
-    let tip = Vector3::from(
-        solve_statics(&model, &Actuation::tensions(&t), &o)
-            .unwrap()
-            .tip_position(),
-    );
+    let t = robot::NITI_REFERENCE_TENSIONS;
+    let tip = robot::niti_reference_tip(&model, &o);
     let io = InverseOptions::default();
     let target = Target::tip(tip);
     let moved = Target::tip(tip + Vector3::new(1e-3, 0.0, 0.0));

@@ -179,7 +179,7 @@ fn a_target_out_of_reach_is_reported_with_its_distance() {
 fn a_shape_target_is_reached_from_its_backbone_points() {
     let model = niti(Loads::default(), None);
     let o = SolveOptions::default();
-    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+    let t = common::NITI_REFERENCE_TENSIONS;
     let sol = solve_statics(&model, &Actuation::tensions(&t), &o).unwrap();
     // Points at mesh nodes and between them.
     let n = sol.s.len();
@@ -220,7 +220,7 @@ fn a_shape_target_is_reached_from_its_backbone_points() {
 fn a_rotation_target_is_reached() {
     let model = niti(Loads::default(), None);
     let o = SolveOptions::default();
-    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+    let t = common::NITI_REFERENCE_TENSIONS;
     let sol = solve_statics(&model, &Actuation::tensions(&t), &o).unwrap();
     let r = sol.rotation[sol.s.len() - 1];
     let rot = softrod::nalgebra::Matrix3::new(
@@ -245,12 +245,7 @@ fn a_rotation_target_is_reached() {
 fn warm_started_tracking_takes_few_iterations() {
     let model = niti(Loads::default(), None);
     let o = SolveOptions::default();
-    let t = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
-    let tip = Vector3::from(
-        solve_statics(&model, &Actuation::tensions(&t), &o)
-            .unwrap()
-            .tip_position(),
-    );
+    let tip = common::niti_reference_tip(&model, &o);
     let (first, _) = inverse_statics(
         &model,
         &Target::tip(tip),

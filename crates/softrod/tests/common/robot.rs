@@ -156,6 +156,24 @@ pub fn niti_model(loads: Loads, density: Option<f64>, friction: f64) -> Arc<Robo
     RobotModel::new(rod, tendons, Vec::new(), loads).expect("model")
 }
 
+/// The tensions (N) of the inverse-statics reference pose of the NiTi robot: both segments
+/// bent, one tendon slack in each.
+pub const NITI_REFERENCE_TENSIONS: [f64; 6] = [3.0, 0.0, 1.0, 0.0, 2.0, 0.5];
+
+/// The tip position (m, world) of `model` at [`NITI_REFERENCE_TENSIONS`]: the target the
+/// inverse-statics tests, bench and example start from.
+pub fn niti_reference_tip(
+    model: &Arc<RobotModel>,
+    options: &SolveOptions,
+) -> softrod::nalgebra::Vector3<f64> {
+    let act = Actuation::tensions(&NITI_REFERENCE_TENSIONS);
+    softrod::nalgebra::Vector3::from(
+        solve_statics(model, &act, options)
+            .expect("reference solve")
+            .tip_position(),
+    )
+}
+
 /// A 1 m NiTi rod (radius 1 mm, 6450 kg/m³) with four tendons at 10 mm, 90° apart, ending at
 /// the tip, horizontal base (gravity along -x), under its own weight.
 pub fn four_tendon_gravity() -> Arc<RobotModel> {
