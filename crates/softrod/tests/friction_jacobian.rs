@@ -10,10 +10,11 @@ mod common;
 
 use std::sync::Arc;
 
-use softrod::nalgebra::{DMatrix, Vector3};
+use softrod::nalgebra::Vector3;
 use softrod::{
     actuation_jacobian, solve_frictional, solve_statics_at, tangent_compliance, Actuation,
-    FrictionOptions, FrictionalSolution, Integrator, Loads, RobotModel, TendonControl,
+    FrictionOptions, FrictionalSolution, Integrator, Loads, RobotModel, StaticsSolution,
+    TendonControl,
 };
 
 fn options(steps: usize) -> FrictionOptions {
@@ -48,21 +49,37 @@ fn cases(mu: f64) -> Vec<(&'static str, Arc<RobotModel>)> {
     ]
 }
 
-/// Largest entry of `a - b` relative to the largest entry of `b`.
-fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    (a - b).amax() / b.amax()
+/// Largest entry of `a - b` relative to the largest entry of `b` (entries of two matrices of
+/// the same shape, in storage order).
+fn rel(a: &[f64], b: &[f64]) -> f64 {
+    let diff = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    diff / b.iter().fold(0.0f64, |m, y| m.max(y.abs()))
+}
+
+/// For every load case with μ = 0: the frictional solve at [`TENSIONS`] and the
+/// frictionless solve on its nodes.
+fn zero_friction_pairs() -> Vec<(&'static str, FrictionalSolution, StaticsSolution)> {
+    let act = Actuation::tensions(&TENSIONS);
+    let opts = options(50);
+    cases(0.0)
+        .into_iter()
+        .map(|(name, model)| {
+            let fr = solve_frictional(&model, &act, &opts, None).unwrap();
+            let plain = solve_statics_at(&model, &act, &opts.statics, &fr.statics.s).unwrap();
+            (name, fr, plain)
+        })
+        .collect()
 }
 
 #[test]
 fn zero_friction_actuation_jacobian_is_the_frictionless_one() {
-    for (name, model) in cases(0.0) {
-        let act = Actuation::tensions(&TENSIONS);
-        let opts = options(50);
-        let fr = solve_frictional(&model, &act, &opts, None).unwrap();
-        let plain = solve_statics_at(&model, &act, &opts.statics, &fr.statics.s).unwrap();
+    for (name, fr, plain) in zero_friction_pairs() {
         let a = actuation_jacobian(&fr.statics, None).unwrap();
         let b = actuation_jacobian(&plain, None).unwrap();
-        let e = rel(&a, &b);
+        let e = rel(a.as_slice(), b.as_slice());
         eprintln!("μ = 0, {name}: actuation Jacobian {e:e} relative to the frictionless one");
         assert!(e < 1e-12, "{name}: {e:e}");
     }
@@ -70,14 +87,10 @@ fn zero_friction_actuation_jacobian_is_the_frictionless_one() {
 
 #[test]
 fn zero_friction_tangent_compliance_is_the_frictionless_one() {
-    for (name, model) in cases(0.0) {
-        let act = Actuation::tensions(&TENSIONS);
-        let opts = options(50);
-        let fr = solve_frictional(&model, &act, &opts, None).unwrap();
-        let plain = solve_statics_at(&model, &act, &opts.statics, &fr.statics.s).unwrap();
+    for (name, fr, plain) in zero_friction_pairs() {
         let a = tangent_compliance(&fr.statics, TendonControl::Tension, None).unwrap();
         let b = tangent_compliance(&plain, TendonControl::Tension, None).unwrap();
-        let e = (a.world - b.world).amax() / b.world.amax();
+        let e = rel(a.world.as_slice(), b.world.as_slice());
         eprintln!("μ = 0, {name}: tangent compliance {e:e} relative to the frictionless one");
         assert!(e < 1e-12, "{name}: {e:e}");
     }
