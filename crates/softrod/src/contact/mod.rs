@@ -15,6 +15,7 @@ mod mesh;
 mod obstacle;
 mod solve;
 mod stability;
+mod sweep;
 
 use std::sync::Arc;
 
