@@ -49,3 +49,29 @@ def test_the_rod_rests_on_a_wire_between_two_nodes(free, wire):
     assert _least_gap_on_chords(np.asarray(sol.position), capsule, radius) > -1e-9
     # The rod rests on the side of the wire facing the unactuated (straight) rod.
     assert np.asarray(c["normal"]) @ (np.array([0.0, 0.0, c["s"]]) - mid) > 0.0
+
+
+@pytest.mark.parametrize(
+    ("k", "frac", "wire"), [(20, 0.3, 0.5e-3), (30, 0.6, 3e-3), (40, 0.3, 0.5e-3)]
+)
+def test_a_wire_crossed_on_the_way_from_the_straight_rod_is_met(free, k, frac, wire):
+    """A wire between the straight rod and its bent contact-free shape: the contact-free shape
+    lies wholly beyond it (no point of it near the wire), and the rod must rest on the wire's
+    side facing the straight rod."""
+    robot, sol0 = free
+    p, s = np.asarray(sol0.position), np.asarray(sol0.s)
+    straight = np.array([0.0, 0.0, s[k]])
+    mid = (1 - frac) * straight + frac * p[k]
+    d = (p[k] - straight) / np.linalg.norm(p[k] - straight)
+    b = np.cross(d, [0.0, 0.0, 1.0])
+    b /= np.linalg.norm(b)
+    capsule = sr.Capsule(mid - 0.05 * b, mid + 0.05 * b, wire)
+    radius = robot.rod.section.radius
+    assert _least_gap_on_chords(p, capsule, radius) > 0.0
+    sol = sr.Robot(robot.rod, tendons=robot.tendons, obstacles=[capsule]).solve(ACTUATION)
+    assert sol.converged
+    assert len(sol.contacts) == 1
+    c = sol.contacts[0]
+    assert c["normal_force"] > 0.0
+    assert _least_gap_on_chords(np.asarray(sol.position), capsule, radius) > -1e-9
+    assert np.asarray(c["normal"]) @ (np.array([0.0, 0.0, c["s"]]) - mid) > 0.0

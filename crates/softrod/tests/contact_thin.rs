@@ -40,7 +40,9 @@ fn a_wire_between_two_nodes_props_the_cantilever() {
     let x = -(radius + delta + wire);
     let obstacles = [Obstacle::capsule([x, -0.05, c], [x, 0.05, c], wire).unwrap()];
     let closing = delta * 6.0 * ei / (c * c * (3.0 * L - c));
-    for factor in [0.8, 1.5, 2.0] {
+    // At 10 F_c the contact-free cantilever lies wholly beyond the wire (deflection 10 δ at
+    // c against δ + 2 R + 2 r_wire = 3.4 δ): the rod must meet it on its way.
+    for factor in [0.8, 1.5, 2.0, 10.0] {
         let force = Vector3::new(-factor * closing, 0.0, 0.0);
         let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
         let sol = solve_constrained(

@@ -13,6 +13,7 @@ mod constraint;
 mod jacobian;
 mod mesh;
 mod obstacle;
+mod ramp;
 mod solve;
 mod stability;
 mod sweep;

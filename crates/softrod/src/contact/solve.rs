@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 
 use super::constraint::TipConstraint;
 use super::obstacle::Obstacle;
+use super::ramp;
 use super::stability::{conjugate_points, free_stiffness};
 use super::sweep::{least_gap_in_cell, CellEnd};
 use super::{obstacle_normal_basis, Contact, ContactCompliance, ContactSolution};
@@ -415,7 +416,7 @@ impl<'m> Constrained<'m> {
 
     /// One march at `x`; with `full`, the six base-wrench columns too. Returns the residual
     /// rows, and with `full` the exact Jacobian of the tip rows along the base wrench.
-    fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<Rows> {
+    pub(super) fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<Rows> {
         let model = self.contact_model(x)?;
         let plan = match self.integrator {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
@@ -740,9 +741,9 @@ impl Constrained<'_> {
 
 /// Effort of a solve.
 #[derive(Default)]
-struct Effort {
-    iterations: usize,
-    load_steps: usize,
+pub(super) struct Effort {
+    pub(super) iterations: usize,
+    pub(super) load_steps: usize,
 }
 
 /// Newton at the full contact targets from `x`; the last pass left at the result.
@@ -1187,7 +1188,7 @@ fn add_contacts(
 /// previous load factor): Newton; release the contact pulling hardest; add one contact at
 /// each local minimum of a gap below `-penetration`, reached by relaxing its gap from the
 /// current value; until no contact pulls and nothing penetrates.
-fn active_set(
+pub(super) fn active_set(
     p: &mut Constrained<'_>,
     x: &[f64],
     opts: &NewtonOptions,
@@ -1370,6 +1371,10 @@ pub fn solve_constrained(
             p.load = 1.0;
             p.hint = p.solved.take();
             if let Some(x) = active_set(&mut p, &xc, &options.newton, &mut effort) {
+                let x = match not_crossed(&mut p, x, options, &mut effort) {
+                    Ok(x) => x,
+                    Err(why) => return fail(&p, &options.newton, &effort, 0.0, why),
+                };
                 return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
             }
         }
@@ -1388,6 +1393,10 @@ pub fn solve_constrained(
     match reach(&mut p, options, &mut effort) {
         Reach::Done(x) => {
             p.load = 1.0;
+            let x = match not_crossed(&mut p, x, options, &mut effort) {
+                Ok(x) => x,
+                Err(why) => return fail(&p, &options.newton, &effort, 0.0, why),
+            };
             finish(&mut p, model, actuation, options, &x, &effort, 1.0)
         }
         Reach::Stopped { lambda, why, .. } if options.newton.throw => {
@@ -1489,6 +1498,45 @@ fn reach(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Effort) -
         reached = Some(x);
     }
     Reach::Done(reached.unwrap_or_default())
+}
+
+/// The solution `x` (its pass the last of `p`) if no point of the rod crossed an obstacle on
+/// its way from the unactuated rod, else the solve again with the actuation and the loads
+/// stepped together ([`ramp`](super::ramp); free tip only).
+fn not_crossed(
+    p: &mut Constrained<'_>,
+    x: Vec<f64>,
+    options: &SolveOptions,
+    effort: &mut Effort,
+) -> std::result::Result<Vec<f64>, &'static str> {
+    if p.tip.is_some() || !ramp::any_checked(p) {
+        return Ok(x);
+    }
+    let (s, radius) = ramp::samples(p);
+    let Some(shape) = p.last.as_ref().map(|pass| ramp::positions_at(pass, &s)) else {
+        return Ok(x);
+    };
+    let last = p.last.take();
+    let Some(rest) = ramp::rest_shape(p, &s) else {
+        p.last = last;
+        return Ok(x);
+    };
+    let depth = 10.0 * options.newton.tolerance * p.model.length();
+    if !ramp::crossed(p, (&rest, &shape), &radius, depth) {
+        p.last = last;
+        return Ok(x);
+    }
+    // Stepped on the mesh asked.
+    (p.integrator, p.coarse, p.refine, p.rough) = (options.integrator, None, true, false);
+    let full = (p.tensions.clone(), p.pressures.clone());
+    let stepped = ramp::stepped(
+        p,
+        (&full.0, &full.1),
+        (&s, &radius, rest),
+        &options.newton,
+        effort,
+    );
+    stepped.ok_or("the rod crossed a thin obstacle on its way from the unactuated rod, and stepping the actuation with the loads past it failed")
 }
 
 /// The error (or, without `throw`, nothing better to return) of a failed solve.

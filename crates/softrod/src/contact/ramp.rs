@@ -1,0 +1,244 @@
+//! Thin obstacles crossed on the way: the actuation stepped with the loads.
+//!
+//! The contact solve applies the actuation in full (the actuated rod without loads is one
+//! march) and adds contacts where that shape penetrates. An obstacle the rod would meet on
+//! its way from the unactuated shape, but that the final shape lies wholly beyond (a wire
+//! between the straight and the bent robot), is then never seen. After a solve, every point
+//! of the rod (sampled more finely than the thinnest obstacle) is moved along the straight
+//! segment from its unactuated, unloaded position to its position in the solution; if one of
+//! these segments runs into an obstacle that both its ends are clear of, the rod may have
+//! crossed it, and the problem is solved again with the actuation and the loads stepped
+//! together from zero, each step checked the same way against the previous one (and halved
+//! if it crossed), so that the rod meets the obstacle on its side.
+
+use nalgebra::Vector3;
+
+use super::obstacle::Obstacle;
+use super::solve::{active_set, Constrained, Effort, Pass};
+use super::sweep::{least_gap_in_cell, CellEnd};
+use crate::cosserat::equations::{rot, v3};
+use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};
+
+/// Most sample points along the rod for the crossing check.
+const MAX_SAMPLES: usize = 4000;
+/// Largest step of the load factor when stepping.
+const MAX_STEP: f64 = 0.25;
+
+/// The thickness (m) an obstacle offers to a rod crossing it: `None` for a plane (a rod
+/// beyond it penetrates it).
+fn thickness(o: &Obstacle) -> Option<f64> {
+    match o {
+        Obstacle::Plane { .. } => None,
+        Obstacle::Sphere { radius, .. }
+        | Obstacle::Capsule { radius, .. }
+        | Obstacle::Cylinder { radius, .. } => Some(2.0 * radius),
+        Obstacle::Mesh(m) => {
+            let v = m.vertices();
+            let extent = (0..3)
+                .map(|k| {
+                    let (lo, hi) = v
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                            (a.min(p[k]), b.max(p[k]))
+                        });
+                    hi - lo
+                })
+                .fold(f64::INFINITY, f64::min);
+            Some(extent)
+        }
+    }
+}
+
+/// The arc lengths (m) the crossing check samples, and the rod's radius (m) at each; empty
+/// if no obstacle has a finite thickness.
+pub(super) fn samples(p: &Constrained<'_>) -> (Vec<f64>, Vec<f64>) {
+    let l = p.model.length();
+    let Some(thin) = p.obstacles.iter().filter_map(thickness).reduce(f64::min) else {
+        return (Vec::new(), Vec::new());
+    };
+    let rod = p.model.rod();
+    let r_min = [0.0, 0.5 * l, l]
+        .iter()
+        .map(|&s| rod.section_at(s).radius)
+        .fold(f64::INFINITY, f64::min);
+    let spacing = (0.5 * (thin + 2.0 * r_min)).max(l / MAX_SAMPLES as f64);
+    let n = ((l / spacing).ceil() as usize).max(1);
+    let s: Vec<f64> = (0..=n).map(|k| l * k as f64 / n as f64).collect();
+    let r = s.iter().map(|&s| rod.section_at(s).radius).collect();
+    (s, r)
+}
+
+/// The backbone of `pass` at the arc lengths `s` (sorted): the cubic Hermite arc through the
+/// two nodes around each (tangents `Δs R e₃`).
+pub(super) fn positions_at(pass: &Pass, s: &[f64]) -> Vec<Vector3<f64>> {
+    let nodes = &pass.nodes;
+    let mut j = 0;
+    s.iter()
+        .map(|&t| {
+            while j + 2 < nodes.len() && nodes[j + 1].s < t {
+                j += 1;
+            }
+            let (a, b) = (&nodes[j], &nodes[(j + 1).min(nodes.len() - 1)]);
+            let h = b.s - a.s;
+            if h <= 0.0 {
+                return v3(&b.y, 0);
+            }
+            let u = ((t - a.s) / h).clamp(0.0, 1.0);
+            let (pa, pb) = (v3(&a.y, 0), v3(&b.y, 0));
+            let (ta, tb) = (rot(&a.y) * Vector3::z() * h, rot(&b.y) * Vector3::z() * h);
+            let (u2, u3) = (u * u, u * u * u);
+            pa * (2.0 * u3 - 3.0 * u2 + 1.0)
+                + ta * (u3 - 2.0 * u2 + u)
+                + pb * (-2.0 * u3 + 3.0 * u2)
+                + tb * (u3 - u2)
+        })
+        .collect()
+}
+
+/// Whether a point of the rod moved from `from` to `to` (same samples, radii `radius`)
+/// along a segment that runs into an obstacle by more than `depth` (m) while both its ends
+/// are clear of it by `-depth`. Obstacles the rod touches in `p`'s active set are not
+/// checked: the rod met them (a rod wrapped around an obstacle it touches moves through it
+/// only on the straight segments).
+/// Whether obstacle `i` is checked for crossing: of finite thickness and not touched in
+/// `p`'s active set.
+fn checked(p: &Constrained<'_>, i: usize) -> bool {
+    thickness(&p.obstacles[i]).is_some() && !p.active.iter().any(|a| a.obstacle == i)
+}
+
+/// Whether any obstacle is to be checked for crossing ([`crossed`]).
+pub(super) fn any_checked(p: &Constrained<'_>) -> bool {
+    (0..p.obstacles.len()).any(|i| checked(p, i))
+}
+
+pub(super) fn crossed(
+    p: &Constrained<'_>,
+    (from, to): (&[Vector3<f64>], &[Vector3<f64>]),
+    radius: &[f64],
+    depth: f64,
+) -> bool {
+    (0..p.obstacles.len()).filter(|&i| checked(p, i)).any(|i| {
+        let o = &p.obstacles[i];
+        (0..from.len()).any(|k| {
+            let chord = to[k] - from[k];
+            let end = |point: Vector3<f64>| CellEnd {
+                point,
+                tangent: chord,
+                radius: radius[k],
+            };
+            let (a, b) = (end(from[k]), end(to[k]));
+            let ga = o.distance(&a.point).0 - a.radius;
+            let gb = o.distance(&b.point).0 - b.radius;
+            ga >= -depth
+                && gb >= -depth
+                && least_gap_in_cell(o, (&a, ga), (&b, gb), -depth).is_some()
+        })
+    })
+}
+
+/// Whether a point of the rod moved from `from` to `to` by more than half the thickness of
+/// an obstacle (plus the rod's diameter) it passed within that distance of: a step that may
+/// have carried it through the obstacle between two checks.
+fn too_far(
+    p: &Constrained<'_>,
+    (from, to): (&[Vector3<f64>], &[Vector3<f64>]),
+    radius: &[f64],
+) -> bool {
+    p.obstacles.iter().any(|o| {
+        let Some(t) = thickness(o) else {
+            return false;
+        };
+        (0..from.len()).any(|k| {
+            let chord = to[k] - from[k];
+            let limit = 0.5 * (t + 2.0 * radius[k]);
+            if chord.norm() <= limit {
+                return false;
+            }
+            let end = |point: Vector3<f64>| CellEnd {
+                point,
+                tangent: chord,
+                radius: radius[k],
+            };
+            let (a, b) = (end(from[k]), end(to[k]));
+            let ga = o.distance(&a.point).0 - a.radius;
+            let gb = o.distance(&b.point).0 - b.radius;
+            least_gap_in_cell(o, (&a, ga), (&b, gb), limit).is_some()
+        })
+    })
+}
+
+/// The rod's unactuated, unloaded backbone at the samples `s` (one march at zero unknowns),
+/// leaving `p` as it was but for its last pass.
+pub(super) fn rest_shape(p: &mut Constrained<'_>, s: &[f64]) -> Option<Vec<Vector3<f64>>> {
+    let saved = (
+        std::mem::take(&mut p.active),
+        p.tensions.clone(),
+        p.pressures.clone(),
+        p.load,
+        p.tip.take(),
+    );
+    p.tensions.iter_mut().for_each(|t| *t = 0.0);
+    p.pressures.iter_mut().for_each(|t| *t = 0.0);
+    p.load = 0.0;
+    p.last = None;
+    let ok = p.run(&[0.0; 6], 1.0, false).is_some();
+    let shape = p.last.as_ref().map(|pass| positions_at(pass, s));
+    (p.active, p.tensions, p.pressures, p.load, p.tip) = saved;
+    p.last = None;
+    if ok {
+        shape
+    } else {
+        None
+    }
+}
+
+/// The active-set solve with the actuation (`tensions`, `pressures`: the full ones) and the
+/// loads stepped together from zero, from the unactuated rod `rest` (at the samples `s`,
+/// radii `radius`), each step refused and halved if the rod crossed an obstacle on it.
+pub(super) fn stepped(
+    p: &mut Constrained<'_>,
+    (tensions, pressures): (&[f64], &[f64]),
+    (s, radius, rest): (&[f64], &[f64], Vec<Vector3<f64>>),
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let depth = 10.0 * opts.tolerance * p.model.length();
+    p.active.clear();
+    p.hint = None;
+    p.solved = None;
+    let mut x = vec![0.0; 6];
+    let mut previous = rest;
+    let (mut lambda, mut step) = (0.0, MAX_STEP);
+    while lambda < 1.0 {
+        let next = (lambda + step).min(1.0);
+        for (t, full) in p.tensions.iter_mut().zip(tensions) {
+            *t = next * full;
+        }
+        for (q, full) in p.pressures.iter_mut().zip(pressures) {
+            *q = next * full;
+        }
+        p.load = next;
+        p.last = None;
+        let saved = p.active.clone();
+        let shape = active_set(p, &x, opts, effort).and_then(|xn| {
+            let shape = positions_at(p.last.as_ref()?, s);
+            let moved = (&previous[..], &shape[..]);
+            (!too_far(p, moved, radius) && !crossed(p, moved, radius, depth)).then_some((xn, shape))
+        });
+        match shape {
+            Some((xn, shape)) => {
+                effort.load_steps += 1;
+                (x, previous, lambda) = (xn, shape, next);
+                step = (2.0 * step).min(MAX_STEP);
+            }
+            None => {
+                p.active = saved;
+                step *= 0.5;
+                if step < MIN_LOAD_INCREMENT {
+                    return None;
+                }
+            }
+        }
+    }
+    Some(x)
+}
