@@ -9,26 +9,14 @@ from __future__ import annotations
 
 import difflib
 import math
-import sys
 import typing
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Annotated, Any, Union
 
-from pydantic import (
-    BaseModel,
-    Discriminator,
-    Tag,
-    ValidationError,
-)
+from pydantic import BaseModel, Discriminator, Tag, ValidationError
 
 from .._core import ParameterError
-
-if sys.version_info >= (3, 11):
-    pass
-else:  # pragma: no cover - exercised on Python 3.10 only
-    pass
-
 from .robot_schema import (
     RobotFile,
     TableSectionSpec,

@@ -9,7 +9,6 @@ messages are made in :mod:`softrod.io.robot_errors`; reading and writing are in
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Mapping
 from typing import Annotated, Any, Literal, Union
 
@@ -26,12 +25,6 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from .._core import SILICONES
-
-if sys.version_info >= (3, 11):
-    pass
-else:  # pragma: no cover - exercised on Python 3.10 only
-    pass
-
 
 #: Largest integration steps, Newton iterations and load steps a file may ask for (named
 #: limits rather than an allocation that fails).
