@@ -215,28 +215,37 @@ pub(crate) fn solve_held(
     Ok(sol)
 }
 
-/// [`solve_held`] on the integration mesh.
-#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
-fn solve_held_on_mesh(
-    model: &Arc<RobotModel>,
-    actuation: &Actuation,
-    options: &SolveOptions,
-) -> Result<StaticsSolution> {
-    let (nt, nc) = (model.tendons().len(), model.chambers().len());
-    let reference = match &actuation.reference_lengths {
-        Some(r) => r.clone(),
-        None => reference_lengths(model, options)?,
-    };
-    let all_held = held_of(model, actuation, &reference);
-    let mut tensions = actuation.tension_values(nt);
-    let pressures = actuation.pressure_values(nc);
-    let plan = match options.integrator {
-        Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
-        Integrator::Adaptive(_) => Vec::new(),
-    };
+/// One displacement-controlled solve: the model, its actuation and options, the zero of the
+/// displacements and the held tendons.
+struct HeldProblem<'a> {
+    model: &'a Arc<RobotModel>,
+    actuation: &'a Actuation,
+    options: &'a SolveOptions,
+    /// Path lengths at zero actuation (m), the zero of the displacements.
+    reference: Vec<f64>,
+    /// Every displacement-controlled tendon.
+    all_held: Vec<Held>,
+}
+
+/// The state of the active set between rounds.
+struct HeldState {
+    /// Tensions of every tendon (N): the inputs, and the held ones as solved.
+    tensions: Vec<f64>,
+    /// Per held tendon, whether it is taut in the current guess.
+    taut: Vec<bool>,
+    /// The scaled base wrench of the last solve (the start of the next).
+    x0: [f64; 6],
+    /// Whether the next solve starts from a solved state.
+    warm: bool,
+    /// Accumulated solver statistics.
+    stats: SolverStats,
+}
+
+/// The scaled base wrench of `options`' warm start (zero without).
+fn scaled_base_wrench(model: &RobotModel, options: &SolveOptions) -> [f64; 6] {
     let f_ref = model.force_scale();
     let fm = f_ref * model.length();
-    let mut x0 = match &options.warm_start {
+    match &options.warm_start {
         Some(w) => {
             let b = &w.base_wrench;
             [
@@ -249,39 +258,196 @@ fn solve_held_on_mesh(
             ]
         }
         None => [0.0; 6],
-    };
-    let mut warm = options.warm_start.is_some();
-    // The first taut set.
-    let mut taut: Vec<bool> = match &actuation.tension_guess {
-        Some(g) => all_held
-            .iter()
-            .map(|h| {
-                tensions[h.tendon] = g[h.tendon].max(0.0);
-                g[h.tendon] > 0.0
-            })
-            .collect(),
-        None => {
-            let eq = super::equations::Equations {
-                model,
-                tensions: &tensions,
-                pressures: &pressures,
-                load_factor: 0.0,
-                profile: None,
-            };
-            let mut p = Shooting::new(eq, options.integrator, plan.clone());
-            let mut r = [0.0; 6];
-            if p.evaluate(&[0.0; 6], 0.0, None, &mut r) == Evaluated::Failed {
-                vec![true; all_held.len()]
-            } else {
-                all_held
-                    .iter()
-                    .map(|h| h.target - p.lengths[h.tendon] < 0.0)
-                    .collect()
+    }
+}
+
+impl HeldProblem<'_> {
+    /// The first taut set: the tendons of the tension guess that carry tension (their
+    /// guessed tensions into `tensions`), else those stretched when every held tendon carries
+    /// no tension (one march of the actuated, unloaded rod; all taut if it fails).
+    fn first_taut(&self, plan: &[usize], pressures: &[f64], tensions: &mut [f64]) -> Vec<bool> {
+        match &self.actuation.tension_guess {
+            Some(g) => self
+                .all_held
+                .iter()
+                .map(|h| {
+                    tensions[h.tendon] = g[h.tendon].max(0.0);
+                    g[h.tendon] > 0.0
+                })
+                .collect(),
+            None => {
+                let eq = super::equations::Equations {
+                    model: self.model,
+                    tensions,
+                    pressures,
+                    load_factor: 0.0,
+                    profile: None,
+                };
+                let mut p = Shooting::new(eq, self.options.integrator, plan.to_vec());
+                let mut r = [0.0; 6];
+                if p.evaluate(&[0.0; 6], 0.0, None, &mut r) == Evaluated::Failed {
+                    vec![true; self.all_held.len()]
+                } else {
+                    self.all_held
+                        .iter()
+                        .map(|h| h.target - p.lengths[h.tendon] < 0.0)
+                        .collect()
+                }
             }
         }
+    }
+
+    /// Solves the smooth problem of the current taut set (slack tendons at zero tension) from
+    /// the last state; the solved tensions and base wrench go into `st`.
+    fn round(&self, p: &mut Shooting<'_>, st: &mut HeldState) -> NewtonOutcome {
+        let f_ref = self.model.force_scale();
+        p.held = self
+            .all_held
+            .iter()
+            .zip(&st.taut)
+            .filter(|(_, t)| **t)
+            .map(|(h, _)| *h)
+            .collect();
+        for (h, t) in self.all_held.iter().zip(&st.taut) {
+            if !t {
+                st.tensions[h.tendon] = 0.0;
+            }
+        }
+        p.tensions.clone_from(&st.tensions);
+        let mut z0 = st.x0.to_vec();
+        z0.extend(p.held.iter().map(|h| st.tensions[h.tendon] / f_ref));
+        let mut round_stats = SolverStats::default();
+        let mut out = smooth(p, &z0, self.options, st.warm, &mut round_stats);
+        st.stats.iterations += round_stats.iterations;
+        st.stats.load_steps += round_stats.load_steps;
+        st.stats.load_factor = round_stats.load_factor;
+        if !out.at_x {
+            let mut r = vec![0.0; p.dim()];
+            if p.evaluate(&out.x, st.stats.load_factor, None, &mut r) != Evaluated::Failed
+                && !out.converged
+                && st.stats.load_factor >= 1.0
+            {
+                out.residual = max_norm(&r);
+            }
+        }
+        for (h, held) in p.held.iter().enumerate() {
+            st.tensions[held.tendon] = out.x[6 + h] * f_ref;
+        }
+        st.x0.copy_from_slice(&out.x[..6]);
+        st.warm = true;
+        out
+    }
+
+    /// Checks the guess of a converged round: a taut tendon with a negative tension (beyond
+    /// `eps` relative) is released, a slack one stretched is taken up. Returns whether any
+    /// changed.
+    fn update_taut(&self, p: &Shooting<'_>, st: &mut HeldState, eps: f64) -> bool {
+        let f_ref = self.model.force_scale();
+        let mut changed = false;
+        for (k, h) in self.all_held.iter().enumerate() {
+            let tau = st.tensions[h.tendon];
+            let slack = h.target - p.lengths[h.tendon] + h.compliance * tau;
+            if st.taut[k] && tau < -eps * f_ref {
+                st.taut[k] = false;
+                st.tensions[h.tendon] = 0.0;
+                changed = true;
+            } else if !st.taut[k] && slack < -eps * h.scale {
+                st.taut[k] = true;
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    /// The solution of the last round `out` (after `round + 1` rounds).
+    ///
+    /// # Errors
+    /// With `throw`, the material error met or [`Error::NotConverged`] naming the active set
+    /// or the shooting if not `settled`.
+    fn finish(
+        self,
+        p: &mut Shooting<'_>,
+        mut st: HeldState,
+        out: &NewtonOutcome,
+        settled: bool,
+        round: usize,
+    ) -> Result<StaticsSolution> {
+        st.stats.residual = out.residual;
+        st.stats.converged = settled;
+        st.stats.function_evaluations = p.evaluations;
+        if !settled && self.options.newton.throw {
+            if let Some(e) = p.ws.material_error.take() {
+                return Err(e);
+            }
+            let what = if out.converged {
+                format!(
+                    "active set of the displacement-controlled tendons ({} rounds)",
+                    round + 1
+                )
+            } else {
+                "shooting Newton (Cosserat rod statics, displacement control)".into()
+            };
+            return Err(Error::NotConverged {
+                what,
+                iterations: st.stats.iterations,
+                residual: out.residual,
+                load_factor: 1.0,
+            });
+        }
+        p.tensions.clone_from(&st.tensions);
+        let f_ref = self.model.force_scale();
+        let fm = f_ref * self.model.length();
+        let x0 = st.x0;
+        let base_wrench = [
+            x0[0] * f_ref,
+            x0[1] * f_ref,
+            x0[2] * f_ref,
+            x0[3] * fm,
+            x0[4] * fm,
+            x0[5] * fm,
+        ];
+        let mut sol = assemble(p, self.model, base_wrench, st.stats, &[]);
+        let mut act = self.actuation.clone();
+        act.reference_lengths = Some(self.reference);
+        sol.actuation = act;
+        sol.options = *self.options;
+        Ok(sol)
+    }
+}
+
+/// [`solve_held`] on the integration mesh: the rounds of the active set.
+fn solve_held_on_mesh(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+) -> Result<StaticsSolution> {
+    let (nt, nc) = (model.tendons().len(), model.chambers().len());
+    let reference = match &actuation.reference_lengths {
+        Some(r) => r.clone(),
+        None => reference_lengths(model, options)?,
     };
-    let mut stats = SolverStats::default();
-    let rounds = MAX_ACTIVE_SET_ROUNDS_PER_TENDON * all_held.len() + 4;
+    let all_held = held_of(model, actuation, &reference);
+    let hp = HeldProblem {
+        model,
+        actuation,
+        options,
+        reference,
+        all_held,
+    };
+    let pressures = actuation.pressure_values(nc);
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let mut st = HeldState {
+        tensions: actuation.tension_values(nt),
+        taut: Vec::new(),
+        x0: scaled_base_wrench(model, options),
+        warm: options.warm_start.is_some(),
+        stats: SolverStats::default(),
+    };
+    st.taut = hp.first_taut(&plan, &pressures, &mut st.tensions);
+    let rounds = MAX_ACTIVE_SET_ROUNDS_PER_TENDON * hp.all_held.len() + 4;
     let inputs = actuation.tension_values(nt);
     let eq = super::equations::Equations {
         model,
@@ -295,96 +461,14 @@ fn solve_held_on_mesh(
     let eps = 10.0 * options.newton.tolerance;
     let mut round = 0;
     loop {
-        p.held = all_held
-            .iter()
-            .zip(&taut)
-            .filter(|(_, t)| **t)
-            .map(|(h, _)| *h)
-            .collect();
-        for (h, t) in all_held.iter().zip(&taut) {
-            if !t {
-                tensions[h.tendon] = 0.0;
-            }
-        }
-        p.tensions.clone_from(&tensions);
-        let mut z0 = x0.to_vec();
-        z0.extend(p.held.iter().map(|h| tensions[h.tendon] / f_ref));
-        let mut round_stats = SolverStats::default();
-        let mut out = smooth(&mut p, &z0, options, warm, &mut round_stats);
-        stats.iterations += round_stats.iterations;
-        stats.load_steps += round_stats.load_steps;
-        stats.load_factor = round_stats.load_factor;
-        if !out.at_x {
-            let mut r = vec![0.0; p.dim()];
-            if p.evaluate(&out.x, stats.load_factor, None, &mut r) != Evaluated::Failed
-                && !out.converged
-                && stats.load_factor >= 1.0
-            {
-                out.residual = max_norm(&r);
-            }
-        }
-        for (h, held) in p.held.iter().enumerate() {
-            tensions[held.tendon] = out.x[6 + h] * f_ref;
-        }
-        x0.copy_from_slice(&out.x[..6]);
-        warm = true;
-        let mut changed = false;
-        if out.converged {
-            for (k, h) in all_held.iter().enumerate() {
-                let tau = tensions[h.tendon];
-                let slack = h.target - p.lengths[h.tendon] + h.compliance * tau;
-                if taut[k] && tau < -eps * f_ref {
-                    taut[k] = false;
-                    tensions[h.tendon] = 0.0;
-                    changed = true;
-                } else if !taut[k] && slack < -eps * h.scale {
-                    taut[k] = true;
-                    changed = true;
-                }
-            }
-        }
+        let out = hp.round(&mut p, &mut st);
+        let changed = out.converged && hp.update_taut(&p, &mut st, eps);
         let settled = out.converged && !changed;
-        for h in &all_held {
-            tensions[h.tendon] = tensions[h.tendon].max(0.0);
+        for h in &hp.all_held {
+            st.tensions[h.tendon] = st.tensions[h.tendon].max(0.0);
         }
         if settled || !out.converged || round + 1 >= rounds {
-            stats.residual = out.residual;
-            stats.converged = settled;
-            stats.function_evaluations = p.evaluations;
-            if !settled && options.newton.throw {
-                if let Some(e) = p.ws.material_error.take() {
-                    return Err(e);
-                }
-                let what = if out.converged {
-                    format!(
-                        "active set of the displacement-controlled tendons ({} rounds)",
-                        round + 1
-                    )
-                } else {
-                    "shooting Newton (Cosserat rod statics, displacement control)".into()
-                };
-                return Err(Error::NotConverged {
-                    what,
-                    iterations: stats.iterations,
-                    residual: out.residual,
-                    load_factor: 1.0,
-                });
-            }
-            p.tensions.clone_from(&tensions);
-            let base_wrench = [
-                x0[0] * f_ref,
-                x0[1] * f_ref,
-                x0[2] * f_ref,
-                x0[3] * fm,
-                x0[4] * fm,
-                x0[5] * fm,
-            ];
-            let mut sol = assemble(&mut p, model, base_wrench, stats, &[]);
-            let mut act = actuation.clone();
-            act.reference_lengths = Some(reference);
-            sol.actuation = act;
-            sol.options = *options;
-            return Ok(sol);
+            return hp.finish(&mut p, st, &out, settled, round);
         }
         round += 1;
     }

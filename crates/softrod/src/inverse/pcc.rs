@@ -321,22 +321,34 @@ impl Box_ {
     }
 }
 
+/// The parameters of a program of [`dual`]: the centre `c` of the norm, its factor `μ`, the
+/// penalty `ρ` of the constraint residual, the tolerance on the dual gradient (m).
+#[derive(Clone, Copy)]
+struct DualProgram<'c> {
+    centre: &'c [f64],
+    mu: f64,
+    rho: f64,
+    tol: f64,
+}
+
 /// `min ½ Σ μ w_i (y_i - c_i)² + ½ ρ |J y - b|²/ρ²`-type programs in the dual: the maximiser
 /// `λ` of `ψ(λ) = ½ μ |y - c|²_W - λᵀ (J y - b) - ½ ρ |λ|²` with `y(λ) = clamp(c + Jᵀλ / (μ w))`
 /// (Newton on the gradient `b - J y - ρ λ`, backtracking). `ρ = 0`: the minimum-norm point
 /// of the box meeting `J y = b` to `tol` (`None` if infeasible); `ρ = 1`: the bounded
 /// Levenberg–Marquardt point `min |J y - b|² + μ |y - c|²_W`. `y` is written; returns `λ`.
-#[allow(clippy::too_many_arguments)]
 fn dual(
     jac: &[V3<f64>],
     b: &V3<f64>,
     bx: &Box_,
-    centre: &[f64],
-    mu: f64,
-    rho: f64,
-    tol: f64,
+    program: &DualProgram<'_>,
     y: &mut [f64],
 ) -> Option<V3<f64>> {
+    let DualProgram {
+        centre,
+        mu,
+        rho,
+        tol,
+    } = *program;
     let n = jac.len();
     let y_of = |l: &V3<f64>, y: &mut [f64]| -> f64 {
         let mut psi = 0.0;
@@ -429,7 +441,13 @@ fn lm_step(jac: &[V3<f64>], e: &V3<f64>, a: &[f64], bx: &Box_, radius: f64) -> V
     let mut y = vec![0.0; n];
     let tol = 1e-15 * (e.amax() + b.amax());
     for _ in 0..60 {
-        if dual(jac, &b, bx, a, mu, 1.0, tol, &mut y).is_none() {
+        let program = DualProgram {
+            centre: a,
+            mu,
+            rho: 1.0,
+            tol,
+        };
+        if dual(jac, &b, bx, &program, &mut y).is_none() {
             break;
         }
         let d: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
@@ -556,93 +574,278 @@ fn curved_step(
     Some(d)
 }
 
+/// The state of the closed-form iteration: the affine map, the box, the target and the
+/// scales, the iterate and its chain, and the scratch of the steps.
+struct ClosedForm {
+    aff: Affine,
+    bx: Box_,
+    target: V3<f64>,
+    /// The rod length (m).
+    length: f64,
+    /// Pose error below which the iteration is in its near phase (m).
+    near: f64,
+    /// Tolerance of the minimum-norm program's constraint (m).
+    tol_qp: f64,
+    /// The actuation: tensions (N), then pressures (Pa).
+    a: Vec<f64>,
+    /// The chain at `a`, and at the trial actuation.
+    cur: Chain,
+    next: Chain,
+    /// The minimum-norm (or least-squares) point of the last program.
+    y: Vec<f64>,
+    /// The Hessian of the Lagrangian of the last curved step (n × n, row-major).
+    hess: Vec<f64>,
+    /// The trial actuation.
+    trial: Vec<f64>,
+    /// The trust radius (scaled actuation norm): NaN until the first Jacobian is known.
+    radius: f64,
+    /// The penalty of the pose error in the merit function.
+    nu: f64,
+    iterations: usize,
+    evaluations: usize,
+}
+
+impl ClosedForm {
+    /// The first iterate (the warm start's actuation or the reference, clamped); `None` if
+    /// the warm start does not fit or the chain cannot be evaluated there.
+    fn new(
+        robot: &PccRobot,
+        target: &V3<f64>,
+        options: &InverseOptions,
+        warm: Option<&InverseWarmStart>,
+    ) -> Option<Self> {
+        let aff = Affine::new(robot);
+        let (nt, n) = (robot.n_tendons(), aff.n);
+        let length: f64 = aff.rest.iter().sum();
+        let areas: Vec<f64> = robot
+            .chambers()
+            .iter()
+            .flat_map(|(_, c)| c.areas().to_vec())
+            .collect();
+        let w = match &options.weights {
+            Some(w) => w.clone(),
+            None => (0..n)
+                .map(|i| if i < nt { 1.0 } else { areas[i - nt].powi(2) })
+                .collect(),
+        };
+        let (tb, pb) = (options.tension_bounds, options.pressure_bounds);
+        let bx = Box_ {
+            lo: (0..n).map(|i| if i < nt { tb.0 } else { pb.0 }).collect(),
+            hi: (0..n).map(|i| if i < nt { tb.1 } else { pb.1 }).collect(),
+            w,
+            c: options.reference.clone().unwrap_or_else(|| vec![0.0; n]),
+        };
+        let mut a: Vec<f64> = match warm {
+            Some(w) if w.actuation.len() == n && w.actuation.iter().all(|v| v.is_finite()) => {
+                w.actuation.clone()
+            }
+            Some(_) => return None,
+            None => bx.c.clone(),
+        };
+        for (i, v) in a.iter_mut().enumerate() {
+            *v = bx.clamp(i, *v);
+        }
+        let mut cur = Chain::default();
+        if !cur.eval(&aff, &a) {
+            return None;
+        }
+        Some(Self {
+            aff,
+            bx,
+            target: *target,
+            length,
+            near: NEAR_TARGET * length,
+            tol_qp: 1e-3 * options.tolerance,
+            a,
+            cur,
+            next: Chain::default(),
+            y: vec![0.0; n],
+            hess: Vec::new(),
+            trial: vec![0.0; n],
+            radius: f64::NAN,
+            nu: 0.0,
+            iterations: 0,
+            evaluations: 1,
+        })
+    }
+
+    /// The step of the program at the iterate for the pose error `e`: the minimum-norm step
+    /// (the bounded least squares if the linearised target cannot be met inside the bounds),
+    /// curved near the target. Returns the step, the multipliers (`None`: least squares) and
+    /// whether the step is curved; `None` if the least squares fail.
+    fn program_step(
+        &mut self,
+        e: &V3<f64>,
+        merit: f64,
+    ) -> Option<(Vec<f64>, Option<V3<f64>>, bool)> {
+        let n = self.aff.n;
+        let (jac, bx) = (&self.cur.jac, &self.bx);
+        let mut b = *e;
+        for i in 0..n {
+            b += jac[i] * self.a[i];
+        }
+        let min_norm = DualProgram {
+            centre: &bx.c,
+            mu: 1.0,
+            rho: 0.0,
+            tol: self.tol_qp,
+        };
+        let lambda = dual(jac, &b, bx, &min_norm, &mut self.y);
+        if lambda.is_none() {
+            // The linearised target cannot be met inside the bounds: the bounded least
+            // squares, with the norm as a vanishing regularisation.
+            let jmax = jac.iter().fold(0.0f64, |m, j| m.max(j.amax()));
+            let wmax = bx.w.iter().fold(0.0f64, |m, v| m.max(*v));
+            let reg = (LEAST_SQUARES_REGULARISATION * jmax.powi(2).max(1e-300) / wmax).max(1e-300);
+            let least_squares = DualProgram {
+                mu: reg,
+                rho: 1.0,
+                ..min_norm
+            };
+            dual(jac, &b, bx, &least_squares, &mut self.y)?;
+        }
+        let mut step: Vec<f64> = (0..n).map(|i| self.y[i] - self.a[i]).collect();
+        let mut curved = false;
+        if merit <= self.near && lambda.is_some() {
+            let hess = &mut self.hess;
+            self.cur
+                .curvature(&self.aff, &lambda.unwrap_or_default(), hess);
+            for (k, v) in hess.iter_mut().enumerate() {
+                *v = -*v + if k % (n + 1) == 0 { bx.w[k / n] } else { 0.0 };
+            }
+            convexify(hess, jac, &self.y, bx);
+            if let Some(d) = curved_step(hess, jac, e, &self.a, &self.y, bx) {
+                step = d;
+                curved = true;
+            }
+        }
+        Some((step, lambda, curved))
+    }
+
+    /// The step search of `solve_inverse` (trust region far from the target, line search on
+    /// the merit function near it) from the iterate along `step`; the accepted actuation is
+    /// left in `trial` and its chain in `next`. Returns whether a step was accepted.
+    fn search(&mut self, e: &V3<f64>, merit: f64, mut step: Vec<f64>, norm_a: f64) -> bool {
+        let n = self.aff.n;
+        let near_phase = merit <= self.near;
+        let residual_after = |jac: &[V3<f64>], d: &[f64]| {
+            let mut r = *e;
+            for i in 0..n {
+                r -= jac[i] * d[i];
+            }
+            r.norm()
+        };
+        let bx = &self.bx;
+        let grad: f64 = (0..n)
+            .map(|i| bx.w[i] * (self.a[i] - bx.c[i]) * step[i])
+            .sum();
+        let slope = grad + self.nu * (residual_after(&self.cur.jac, &step) - merit);
+        let mut alpha = 1.0;
+        while self.radius > 1e-14 * (1.0 + norm_a) && alpha > 1e-10 {
+            let full = near_phase || bx.norm(&step) <= self.radius;
+            if !full {
+                step = lm_step(&self.cur.jac, e, &self.a, bx, self.radius);
+            }
+            let step_norm = bx.norm(&step) * alpha;
+            if step_norm <= 1e-15 * (1.0 + norm_a) {
+                break;
+            }
+            for i in 0..n {
+                self.trial[i] = bx.clamp(i, self.a[i] + alpha * step[i]);
+            }
+            self.evaluations += 1;
+            let predicted = merit - residual_after(&self.cur.jac, &step);
+            if self.next.eval(&self.aff, &self.trial) {
+                let mt = (self.target - self.next.p).norm();
+                let ok = if near_phase {
+                    let df = objective_change(&bx.w, &bx.c, &self.a[..n], &self.trial[..n]);
+                    let local = step_norm <= LOCAL_STEP * (1.0 + norm_a);
+                    (local && mt <= self.near)
+                        || df + self.nu * (mt - merit) <= 1e-4 * alpha * slope.min(0.0)
+                } else {
+                    mt <= (1.0 - 1e-4) * merit || (full && mt <= self.near)
+                };
+                if mt.is_finite() && ok {
+                    self.radius = trust_radius(self.radius, full, step_norm, merit - mt, predicted);
+                    return true;
+                }
+            }
+            if near_phase {
+                alpha *= 0.5;
+            } else {
+                self.radius = 0.25 * step_norm.min(self.radius);
+            }
+        }
+        false
+    }
+
+    /// The result at the iterate (reached): its pose, the pose Jacobian in the actuation
+    /// (position rows, then rotation rows `Ω M`) and the Hessian (`W` unless the last step
+    /// was curved).
+    fn solution(self, nt: usize, curved: bool) -> InverseSolution {
+        let (aff, cur, n) = (&self.aff, &self.cur, self.aff.n);
+        let dist = (self.target - cur.p).norm();
+        let ns = aff.rest.len();
+        let jac = Dm::from_fn(6, n, |r, k| {
+            if r < 3 {
+                cur.jac[k][r]
+            } else {
+                (0..ns)
+                    .map(|s| {
+                        (0..3)
+                            .map(|c| cur.oc[s][c][r - 3] * aff.cols[s * n + k][c])
+                            .sum::<f64>()
+                    })
+                    .sum()
+            }
+        });
+        let hessian = if curved {
+            Dm::from_row_slice(n, n, &self.hess)
+        } else {
+            Dm::from_fn(n, n, |r, c| if r == c { self.bx.w[r] } else { 0.0 })
+        };
+        InverseSolution {
+            actuation: self.a,
+            n_tendons: nt,
+            position_error: dist,
+            rotation_error: 0.0,
+            iterations: self.iterations,
+            evaluations: self.evaluations,
+            converged: true,
+            reached: true,
+            evaluation: Evaluation {
+                positions: vec![cur.p],
+                rotation: cur.r,
+                jacobian: Some(vec![jac]),
+            },
+            hessian,
+        }
+    }
+}
+
 /// The closed-form iteration for an unloaded robot and a tip position; `None` hands the
 /// problem to the generic iteration (a linearised target out of reach inside the bounds, a
 /// failed step, the iterations exhausted: the generic one decides and reports those cases).
-#[allow(clippy::too_many_lines)] // the steps of `solve_inverse`, in the same order
+/// The steps are those of `solve_inverse`, in the same order.
 fn closed_form(
     robot: &PccRobot,
     target: &V3<f64>,
     options: &InverseOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Option<InverseSolution> {
-    let aff = Affine::new(robot);
-    let (nt, n) = (robot.n_tendons(), aff.n);
-    let length: f64 = aff.rest.iter().sum();
-    let areas: Vec<f64> = robot
-        .chambers()
-        .iter()
-        .flat_map(|(_, c)| c.areas().to_vec())
-        .collect();
-    let w = match &options.weights {
-        Some(w) => w.clone(),
-        None => (0..n)
-            .map(|i| if i < nt { 1.0 } else { areas[i - nt].powi(2) })
-            .collect(),
-    };
-    let (tb, pb) = (options.tension_bounds, options.pressure_bounds);
-    let bx = Box_ {
-        lo: (0..n).map(|i| if i < nt { tb.0 } else { pb.0 }).collect(),
-        hi: (0..n).map(|i| if i < nt { tb.1 } else { pb.1 }).collect(),
-        w,
-        c: options.reference.clone().unwrap_or_else(|| vec![0.0; n]),
-    };
-    let mut a: Vec<f64> = match warm {
-        Some(w) if w.actuation.len() == n && w.actuation.iter().all(|v| v.is_finite()) => {
-            w.actuation.clone()
-        }
-        Some(_) => return None,
-        None => bx.c.clone(),
-    };
-    for (i, v) in a.iter_mut().enumerate() {
-        *v = bx.clamp(i, *v);
-    }
-    let (mut cur, mut next) = (Chain::default(), Chain::default());
-    if !cur.eval(&aff, &a) {
-        return None;
-    }
-    let mut evaluations = 1;
-    let near = NEAR_TARGET * length;
-    let tol_qp = 1e-3 * options.tolerance;
-    let (mut radius, mut iterations) = (f64::NAN, 0);
-    let (mut y, mut hess, mut trial) = (vec![0.0; n], Vec::new(), vec![0.0; n]);
+    let mut cf = ClosedForm::new(robot, target, options, warm)?;
     let mut curved;
-    let mut nu = 0.0f64;
     loop {
-        let e = target - cur.p;
+        let e = cf.target - cf.cur.p;
         let merit = e.norm();
         let reached = merit <= options.tolerance;
-        let mut b = e;
-        for i in 0..n {
-            b += cur.jac[i] * a[i];
-        }
-        let lambda = dual(&cur.jac, &b, &bx, &bx.c, 1.0, 0.0, tol_qp, &mut y);
-        if lambda.is_none() {
-            // The linearised target cannot be met inside the bounds: the bounded least
-            // squares, with the norm as a vanishing regularisation.
-            let jmax = cur.jac.iter().fold(0.0f64, |m, j| m.max(j.amax()));
-            let wmax = bx.w.iter().fold(0.0f64, |m, v| m.max(*v));
-            let reg = (LEAST_SQUARES_REGULARISATION * jmax.powi(2).max(1e-300) / wmax).max(1e-300);
-            dual(&cur.jac, &b, &bx, &bx.c, reg, 1.0, tol_qp, &mut y)?;
-        }
-        let mut step: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
-        curved = false;
-        if merit <= near && lambda.is_some() {
-            cur.curvature(&aff, &lambda.unwrap_or_default(), &mut hess);
-            for (k, v) in hess.iter_mut().enumerate() {
-                *v = -*v + if k % (n + 1) == 0 { bx.w[k / n] } else { 0.0 };
-            }
-            convexify(&mut hess, &cur.jac, &y, &bx);
-            if let Some(d) = curved_step(&hess, &cur.jac, &e, &a, &y, &bx) {
-                step = d;
-                curved = true;
-            }
-        }
+        let (step, lambda, c) = cf.program_step(&e, merit)?;
+        curved = c;
         if let Some(l) = &lambda {
-            nu = 1.5 * l.norm();
+            cf.nu = 1.5 * l.norm();
         }
-        let norm_a = bx.norm(&a);
-        let small = bx.norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
+        let norm_a = cf.bx.norm(&cf.a);
+        let small = cf.bx.norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
         if small && reached {
             break;
         }
@@ -650,108 +853,26 @@ fn closed_form(
             // Stationary short of the target: the generic iteration reports it.
             return None;
         }
-        if iterations >= options.max_iterations {
+        if cf.iterations >= options.max_iterations {
             return None;
         }
-        if radius.is_nan() {
-            let sigma = scaled_norm_of(&cur.jac, &bx.w);
-            radius = if sigma > 0.0 {
-                (FIRST_RADIUS * length / sigma).max(norm_a)
+        if cf.radius.is_nan() {
+            let sigma = scaled_norm_of(&cf.cur.jac, &cf.bx.w);
+            cf.radius = if sigma > 0.0 {
+                (FIRST_RADIUS * cf.length / sigma).max(norm_a)
             } else {
                 f64::INFINITY
             };
         }
-        let near_phase = merit <= near;
-        let residual_after = |d: &[f64]| {
-            let mut r = e;
-            for i in 0..n {
-                r -= cur.jac[i] * d[i];
-            }
-            r.norm()
-        };
-        let grad: f64 = (0..n).map(|i| bx.w[i] * (a[i] - bx.c[i]) * step[i]).sum();
-        let slope = grad + nu * (residual_after(&step) - merit);
-        let mut alpha = 1.0;
-        let mut accepted = false;
-        while radius > 1e-14 * (1.0 + norm_a) && alpha > 1e-10 {
-            let full = near_phase || bx.norm(&step) <= radius;
-            if !full {
-                step = lm_step(&cur.jac, &e, &a, &bx, radius);
-            }
-            let step_norm = bx.norm(&step) * alpha;
-            if step_norm <= 1e-15 * (1.0 + norm_a) {
-                break;
-            }
-            for i in 0..n {
-                trial[i] = bx.clamp(i, a[i] + alpha * step[i]);
-            }
-            evaluations += 1;
-            let predicted = merit - residual_after(&step);
-            if next.eval(&aff, &trial) {
-                let mt = (target - next.p).norm();
-                let ok = if near_phase {
-                    let df = objective_change(&bx.w, &bx.c, &a[..n], &trial[..n]);
-                    let local = step_norm <= LOCAL_STEP * (1.0 + norm_a);
-                    (local && mt <= near) || df + nu * (mt - merit) <= 1e-4 * alpha * slope.min(0.0)
-                } else {
-                    mt <= (1.0 - 1e-4) * merit || (full && mt <= near)
-                };
-                if mt.is_finite() && ok {
-                    radius = trust_radius(radius, full, step_norm, merit - mt, predicted);
-                    accepted = true;
-                    break;
-                }
-            }
-            if near_phase {
-                alpha *= 0.5;
-            } else {
-                radius = 0.25 * step_norm.min(radius);
-            }
-        }
-        iterations += 1;
+        let accepted = cf.search(&e, merit, step, norm_a);
+        cf.iterations += 1;
         if !accepted {
             return None;
         }
-        a.copy_from_slice(&trial);
-        std::mem::swap(&mut cur, &mut next);
+        cf.a.copy_from_slice(&cf.trial);
+        std::mem::swap(&mut cf.cur, &mut cf.next);
     }
-    let dist = (target - cur.p).norm();
-    // The pose Jacobian in the actuation: position rows, then rotation rows Ω M.
-    let ns = aff.rest.len();
-    let jac = Dm::from_fn(6, n, |r, k| {
-        if r < 3 {
-            cur.jac[k][r]
-        } else {
-            (0..ns)
-                .map(|s| {
-                    (0..3)
-                        .map(|c| cur.oc[s][c][r - 3] * aff.cols[s * n + k][c])
-                        .sum::<f64>()
-                })
-                .sum()
-        }
-    });
-    let hessian = if curved {
-        Dm::from_row_slice(n, n, &hess)
-    } else {
-        Dm::from_fn(n, n, |r, c| if r == c { bx.w[r] } else { 0.0 })
-    };
-    Some(InverseSolution {
-        actuation: a,
-        n_tendons: nt,
-        position_error: dist,
-        rotation_error: 0.0,
-        iterations,
-        evaluations,
-        converged: true,
-        reached: true,
-        evaluation: Evaluation {
-            positions: vec![cur.p],
-            rotation: cur.r,
-            jacobian: Some(vec![jac]),
-        },
-        hessian,
-    })
+    Some(cf.solution(robot.n_tendons(), curved))
 }
 
 /// The inverse statics of the PCC robot `robot` under the tip wrench of `loads` (its

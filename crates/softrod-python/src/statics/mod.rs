@@ -1,0 +1,404 @@
+//! Binding of the Cosserat statics: `solve_statics` and its solution.
+//!
+//! The Python signature keeps the objects a user builds (a rod, tendons with their tensions,
+//! chambers with their pressures, loads); the binding splits them into the core's immutable
+//! `RobotModel` and its `Actuation`. Options start from the core's `SolveOptions::default()`:
+//! an option not given keeps the core's default (stated once, in the core).
+//!
+//! The files: `options.rs` (the options, the core model and actuation of the user's objects,
+//! displacement control, actuator names in errors), `solution.rs` (the solution class).
+
+mod options;
+mod solution;
+
+use std::sync::Arc;
+
+use numpy::ndarray::Array;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+
+use crate::callbacks::run;
+use crate::convert::{arg, count};
+use crate::errors::{param_err, type_err, StabilityError, StabilityWarning};
+use crate::model::{Args, Chamber, Loads, Rod, Tendon};
+
+pub(crate) use options::{actuator_names, apply_displacements, solve_options, OptionArgs, Problem};
+pub(crate) use solution::{stats_dict, StaticsSolution};
+
+/// What to do when the equilibrium returned is unstable.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum OnUnstable {
+    Warn,
+    Raise,
+    Ignore,
+}
+
+fn on_unstable(v: Option<&str>) -> PyResult<OnUnstable> {
+    match v.unwrap_or("warn") {
+        "warn" => Ok(OnUnstable::Warn),
+        "raise" => Ok(OnUnstable::Raise),
+        "ignore" => Ok(OnUnstable::Ignore),
+        other => Err(param_err(
+            "on_unstable",
+            other,
+            "\"warn\", \"raise\" or \"ignore\"",
+        )),
+    }
+}
+
+/// Warns (`StabilityWarning`) or raises (`StabilityError`) for a converged, unstable
+/// solution, as asked.
+fn report_unstable(
+    py: Python<'_>,
+    sol: StaticsSolution,
+    mode: OnUnstable,
+) -> PyResult<StaticsSolution> {
+    let inner = &sol.inner;
+    if mode == OnUnstable::Ignore || inner.stable || !inner.stats.converged {
+        return Ok(sol);
+    }
+    let margin = inner.stability_margin();
+    let msg = format!(
+        "the equilibrium returned is unstable (stability margin {margin:.4e}: the tip \
+         tangent stiffness is not positive definite) and no stable equilibrium was found \
+         from it; see docs/stability.md"
+    );
+    if mode == OnUnstable::Warn {
+        let category = py.get_type::<StabilityWarning>();
+        PyErr::warn(py, &category, &std::ffi::CString::new(msg)?, 1)?;
+        return Ok(sol);
+    }
+    let err = StabilityError::new_err(msg);
+    let value = err.value(py);
+    value.setattr("stability_margin", margin)?;
+    value.setattr("solution", Py::new(py, sol)?)?;
+    Err(err)
+}
+
+/// Solves the statics of `rod` with `tendons`, `loads` and pneumatic `chambers` by shooting
+/// (see the docs). Options not given keep the core's defaults.
+///
+/// Tendon tensions (N) and chamber pressures (Pa) are the actuation; returns a
+/// `StaticsSolution` (SI units; at the arc lengths `s_out` (m) if given) or raises
+/// `ConvergenceError` (with iterations, residual, load_factor). An unstable equilibrium is
+/// replaced by a stable one when found (`seek_stable`), else reported (`on_unstable`).
+#[pyfunction]
+#[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, integrator=None, steps=None,
+                    rtol=None, atol=None, tolerance=None, max_iterations=None,
+                    continuation=None, max_load_steps=None, warm_start=None, throw=None,
+                    chambers=Vec::new(), s_out=None, seek_stable=None, on_unstable=None,
+                    previous=None, displacements=None, tendon_stiffness=None,
+                    obstacles=None, tip_constraint=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_statics<'py>(
+    py: Python<'py>,
+    #[pyo3(from_py_with = arg::rod)] rod: Bound<'py, Rod>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: Vec<Bound<'py, Tendon>>,
+    #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'py, Loads>>,
+    #[pyo3(from_py_with = arg::integrator)] integrator: Option<&'py str>,
+    #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
+    #[pyo3(from_py_with = arg::continuation)] continuation: Option<bool>,
+    #[pyo3(from_py_with = arg::max_load_steps)] max_load_steps: Option<i64>,
+    warm_start: Option<Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = arg::throw)] throw: Option<bool>,
+    #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
+    s_out: Option<Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
+    on_unstable: Option<&'py str>,
+    previous: Option<Bound<'py, PyAny>>,
+    displacements: Option<Bound<'py, PyAny>>,
+    tendon_stiffness: Option<Bound<'py, PyAny>>,
+    obstacles: Option<Bound<'py, PyAny>>,
+    tip_constraint: Option<Bound<'py, PyAny>>,
+) -> PyResult<StaticsSolution> {
+    let previous = previous.filter(|p| !p.is_none());
+    let prev_state: Option<Arc<softrod::FrictionalSolution>> = match &previous {
+        None => None,
+        Some(p) => {
+            let Ok(p) = p.cast::<StaticsSolution>() else {
+                return Err(type_err("previous", p, "a StaticsSolution (or None)"));
+            };
+            match &p.get().friction {
+                Some(f) => Some(Arc::clone(f)),
+                None => {
+                    return Err(param_err(
+                        "previous",
+                        "a frictionless solution",
+                        "a solution of a solve with friction (a tendon with friction > 0)",
+                    ))
+                }
+            }
+        }
+    };
+    let obstacle_list = crate::contact::obstacles(py, obstacles.as_ref())?;
+    let tip = crate::contact::tip_constraint(tip_constraint.as_ref())?;
+    let constrained = tip.is_some() || !obstacle_list.is_empty();
+    let warm_start = warm_start.filter(|w| !w.is_none());
+    let unstable = self::on_unstable(on_unstable)?;
+    let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
+    if constrained && !s_values.is_empty() {
+        return Err(crate::errors::param_err(
+            "s_out",
+            format!("{s_values:?}"),
+            "None with obstacles or a tip constraint (the solution is at the integration mesh)",
+        ));
+    }
+    let args = OptionArgs {
+        integrator,
+        steps,
+        rtol,
+        atol,
+        tolerance,
+        max_iterations,
+        continuation,
+        max_load_steps,
+        warm_start: warm_start.clone(),
+        throw,
+        seek_stable,
+    };
+    let options = solve_options(&args)?;
+    let problem = Problem::new(
+        rod.get(),
+        &tendons,
+        loads.as_ref().map(Bound::get),
+        &chambers,
+    )?;
+    let mut actuation = problem.actuation.clone();
+    apply_displacements(
+        &mut actuation,
+        problem.model.tendons().len(),
+        displacements.as_ref(),
+        tendon_stiffness.as_ref(),
+    )?;
+    if actuation.has_held() {
+        if let Some(w) = warm_start
+            .as_ref()
+            .and_then(|w| w.cast::<StaticsSolution>().ok())
+        {
+            let prev = &w.get().inner;
+            if prev.tendon_tensions.len() == problem.model.tendons().len()
+                && prev.tendon_tensions.iter().all(|t| t.is_finite())
+            {
+                actuation.tension_guess = Some(prev.tendon_tensions.clone());
+            }
+        }
+    }
+    if constrained && actuation.has_held() {
+        return Err(crate::errors::param_err(
+            "displacements",
+            "given",
+            "None with obstacles or a tip constraint (tension control only)",
+        ));
+    }
+    let (model, act) = (&problem.model, &actuation);
+    let frictional = prev_state.is_some()
+        || model
+            .tendons()
+            .iter()
+            .any(|t| t.friction() > 0.0 || t.is_guided());
+    if frictional && !s_values.is_empty() {
+        return Err(param_err(
+            "s_out",
+            format!("{} arc lengths", s_values.len()),
+            "None with friction (the solution is reported at the friction mesh)",
+        ));
+    }
+    if frictional && constrained {
+        return Err(param_err(
+            "obstacles",
+            "obstacles or a tip constraint with tendon friction",
+            "no obstacles and no tip constraint when a tendon has friction (not modelled together)",
+        ));
+    }
+    let (result, friction, contact) = if frictional {
+        let fo = softrod::FrictionOptions {
+            statics: options,
+            ..Default::default()
+        };
+        let f = run(py, "solve_statics", || {
+            softrod::solve_frictional(model, act, &fo, prev_state.as_deref())
+                .map_err(actuator_names)
+        })?;
+        (
+            f.statics.clone(),
+            Some(Arc::new(f)),
+            crate::contact::ContactData::default(),
+        )
+    } else {
+        let (r, c) = run(py, "solve_statics", || {
+            if constrained {
+                let c =
+                    softrod::solve_constrained(model, act, &options, tip.as_ref(), &obstacle_list)
+                        .map_err(actuator_names)?;
+                let data = crate::contact::ContactData::from_solution(&c);
+                Ok((c.solution, data))
+            } else {
+                softrod::compliance::solve_at_output(model, act, &options, &s_values)
+                    .map_err(actuator_names)
+                    .map(|r| (r, crate::contact::ContactData::default()))
+            }
+        })?;
+        (r, None, c)
+    };
+    let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
+    let call = Args::new(
+        py,
+        &[
+            ("rod", rod.clone().into_any().unbind()),
+            ("tendons", tendons.into_pyobject(py)?.into_any().unbind()),
+            ("loads", o(loads.map(|l| l.clone().into_any().unbind()))),
+            (
+                "integrator",
+                integrator.into_pyobject(py)?.into_any().unbind(),
+            ),
+            ("steps", steps.into_pyobject(py)?.into_any().unbind()),
+            ("rtol", rtol.into_pyobject(py)?.into_any().unbind()),
+            ("atol", atol.into_pyobject(py)?.into_any().unbind()),
+            (
+                "tolerance",
+                tolerance.into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "max_iterations",
+                max_iterations.into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "continuation",
+                continuation.into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "max_load_steps",
+                max_load_steps.into_pyobject(py)?.into_any().unbind(),
+            ),
+            ("warm_start", o(warm_start.map(Bound::unbind))),
+            ("throw", throw.into_pyobject(py)?.into_any().unbind()),
+            ("chambers", chambers.into_pyobject(py)?.into_any().unbind()),
+            (
+                "s_out",
+                s_values.clone().into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "seek_stable",
+                seek_stable.into_pyobject(py)?.into_any().unbind(),
+            ),
+            (
+                "on_unstable",
+                "ignore".into_pyobject(py)?.into_any().unbind(),
+            ),
+            ("previous", o(previous.map(Bound::unbind))),
+            ("displacements", o(displacements.map(Bound::unbind))),
+            ("tendon_stiffness", o(tendon_stiffness.map(Bound::unbind))),
+            ("obstacles", o(obstacles.map(Bound::unbind))),
+            ("tip_constraint", o(tip_constraint.map(Bound::unbind))),
+        ],
+    )?;
+    let sol = StaticsSolution {
+        inner: result,
+        friction,
+        cache: std::array::from_fn(|_| PyOnceLock::new()),
+        call,
+        contact,
+    };
+    report_unstable(py, sol, unstable)
+}
+
+/// The actuation Jacobian of a statics solution (Cosserat `StaticsSolution` or
+/// `PccSolution`): the derivative of the pose twist `[δp; δθ]` (m, rad; world frame, the
+/// robot's base frame for PCC) of node `node` (default -1: the tip; negative counts from the
+/// end; PCC: the tip only) with respect to each tendon tension (per N), then each chamber
+/// pressure (per Pa), every tendon at fixed tension; shape (6, n_tendons + n_chambers). Exact:
+/// from the linearised boundary-value problem (Cosserat) or the equilibrium Jacobian (PCC),
+/// no finite differences.
+#[pyfunction]
+#[pyo3(signature = (solution, node=-1))]
+pub(crate) fn actuation_jacobian<'py>(
+    py: Python<'py>,
+    solution: Bound<'py, PyAny>,
+    #[pyo3(from_py_with = arg::node)] node: i64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let to_array = |m: &softrod::nalgebra::DMatrix<f64>| {
+        Array::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
+    };
+    if let Ok(s) = solution.cast::<StaticsSolution>() {
+        let inner = &s.get().inner;
+        let n = inner.s.len() as i64;
+        let index = if node < 0 { n + node } else { node };
+        if !(0..n).contains(&index) {
+            return Err(param_err(
+                "node",
+                node,
+                &format!("a node index in [-{n}, {n})"),
+            ));
+        }
+        let j = run(py, "actuation_jacobian", || {
+            softrod::actuation_jacobian(inner, Some(index as usize))
+        })?;
+        return Ok(to_array(&j));
+    }
+    if let Ok(s) = solution.cast::<crate::pcc::PccSolution>() {
+        let sol = s.get();
+        if node != -1 {
+            return Err(param_err(
+                "node",
+                node,
+                "-1 (the tip: the PCC actuation Jacobian is at the tip)",
+            ));
+        }
+        let j = run(py, "actuation_jacobian", || {
+            softrod::pcc::pcc_actuation_jacobian(&sol.robot, &sol.loads, &sol.inner)
+        })?;
+        return Ok(to_array(&j));
+    }
+    Err(crate::errors::type_err(
+        "solution",
+        &solution,
+        "a StaticsSolution or a PccSolution",
+    ))
+}
+
+/// Benchmark hook: runs the same solve `repeats` times inside Rust and returns each call's
+/// wall time (s), so that the Python overhead of `solve_statics` can be measured.
+#[pyfunction]
+#[pyo3(signature = (rod, tendons=Vec::new(), loads=None, *, repeats=1000, integrator=None,
+                    steps=None, rtol=None, atol=None, tolerance=None, warm_start=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn _time_solve_statics<'py>(
+    py: Python<'py>,
+    #[pyo3(from_py_with = arg::rod)] rod: Bound<'py, Rod>,
+    #[pyo3(from_py_with = arg::tendons)] tendons: Vec<Bound<'py, Tendon>>,
+    #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'py, Loads>>,
+    #[pyo3(from_py_with = arg::repeats)] repeats: i64,
+    #[pyo3(from_py_with = arg::integrator)] integrator: Option<&'py str>,
+    #[pyo3(from_py_with = arg::steps)] steps: Option<i64>,
+    #[pyo3(from_py_with = arg::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: Option<f64>,
+    warm_start: Option<Bound<'py, PyAny>>,
+) -> PyResult<Vec<f64>> {
+    let repeats = count("repeats", repeats, 1, softrod::limits::MAX_SAMPLES)?;
+    let options = solve_options(&OptionArgs {
+        integrator,
+        steps,
+        rtol,
+        atol,
+        tolerance,
+        warm_start: warm_start.filter(|w| !w.is_none()),
+        ..Default::default()
+    })?;
+    let problem = Problem::new(rod.get(), &tendons, loads.as_ref().map(Bound::get), &[])?;
+    let (model, act) = (&problem.model, &problem.actuation);
+    run(py, "_time_solve_statics", || {
+        let mut times = Vec::with_capacity(repeats);
+        for _ in 0..repeats {
+            let t0 = std::time::Instant::now();
+            softrod::solve_statics(model, act, &options)?;
+            times.push(t0.elapsed().as_secs_f64());
+        }
+        Ok(times)
+    })
+}

@@ -1,0 +1,219 @@
+//! The actuators of an interval: the tendons (tensioned and passive) and chambers that pass
+//! through it, the tendon offsets and directions, and the tendon load sums with their
+//! Jacobian.
+
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+use super::Evaluator;
+use crate::math::so3::hat;
+use crate::model::section::SectionProperties;
+
+impl Evaluator<'_, '_> {
+    /// Selects the tendons and chambers active on interval `k`.
+    pub fn set_interval(&mut self, k: usize) {
+        let model = self.eq.model;
+        let breaks = model.breaks();
+        let (a, b) = (breaks[k], breaks[k + 1]);
+        let ws = &mut *self.ws;
+        ws.interval = k;
+        ws.active.clear();
+        ws.passive.clear();
+        for (i, &end) in model.tendon_ends().iter().enumerate() {
+            ws.tendon_speed[i] = 0.0;
+            if end >= b {
+                if self.eq.tensions[i] != 0.0 {
+                    ws.active.push(i);
+                } else {
+                    ws.passive.push(i);
+                }
+            }
+        }
+        ws.guess = None;
+        ws.last_lu = None;
+        ws.chambers.clear();
+        for (i, &(start, end)) in model.chamber_extents().iter().enumerate() {
+            if start <= a && end >= b && self.eq.pressures[i] != 0.0 {
+                ws.chambers.push(i);
+            }
+        }
+    }
+
+    /// Body-frame wrench carried by the fluid of the active chambers at `s` (zero without).
+    #[inline]
+    pub(crate) fn chamber_wrench(&self, s: f64) -> [f64; 6] {
+        let mut w = [0.0; 6];
+        let chambers = self.eq.model.chambers();
+        for &i in &self.ws.chambers {
+            let c = chambers[i].fluid_wrench(s, self.eq.pressures[i]);
+            for k in 0..6 {
+                w[k] += c[k];
+            }
+        }
+        w
+    }
+
+    /// Offsets `(r, r', τ)` of the active tendons at `s` into the workspace.
+    #[inline]
+    pub(crate) fn load_offsets(&mut self, s: f64, props: &SectionProperties) {
+        let tendons = self.eq.model.tendons();
+        self.ws.offsets.clear();
+        for &i in &self.ws.active {
+            let (r, rp) = tendons[i].routing().offset(s, props);
+            let tau = self
+                .eq
+                .profile
+                .and_then(|p| p.at(i, s))
+                .unwrap_or(self.eq.tensions[i]);
+            self.ws.offsets.push((
+                Vector3::new(r[0], r[1], 0.0),
+                Vector3::new(rp[0], rp[1], 0.0),
+                tau,
+            ));
+        }
+    }
+
+    /// Records `|p_i'|` of the tension-free tendons for the strains `(v, u)`.
+    #[inline]
+    pub(crate) fn passive_speeds(
+        &mut self,
+        s: f64,
+        props: &SectionProperties,
+        v: &Vector3<f64>,
+        u: &Vector3<f64>,
+    ) {
+        if !self.ws.track_lengths {
+            return;
+        }
+        let tendons = self.eq.model.tendons();
+        for &i in &self.ws.passive {
+            let (r, rp) = tendons[i].routing().offset(s, props);
+            let r = Vector3::new(r[0], r[1], 0.0);
+            let rp = Vector3::new(rp[0], rp[1], 0.0);
+            self.ws.tendon_speed[i] = (v + u.cross(&r) + rp).norm();
+        }
+    }
+
+    /// `(t, r × t)` of tendon `i` (body) at strains `(v, u)`.
+    pub(crate) fn tendon_direction(
+        &self,
+        i: usize,
+        s: f64,
+        props: &SectionProperties,
+        v: &Vector3<f64>,
+        u: &Vector3<f64>,
+    ) -> Vector6<f64> {
+        let (r, rp) = self.eq.model.tendons()[i].routing().offset(s, props);
+        let r = Vector3::new(r[0], r[1], 0.0);
+        let w = v + u.cross(&r) + Vector3::new(rp[0], rp[1], 0.0);
+        let t = w / w.norm();
+        let q = r.cross(&t);
+        Vector6::new(t.x, t.y, t.z, q.x, q.y, q.z)
+    }
+
+    /// Tendon load sums `(Σ τ t, Σ τ r × t)` at the strains `x = (v, u)` (the chord steps of
+    /// the local iteration: [`Self::tendon_sums`] without the Jacobian).
+    #[inline]
+    pub(crate) fn tendon_load(&self, x: &Vector6<f64>) -> Vector6<f64> {
+        let v = Vector3::new(x[0], x[1], x[2]);
+        let u = Vector3::new(x[3], x[4], x[5]);
+        let mut tf = Vector3::zeros();
+        let mut tm = Vector3::zeros();
+        for (r, rp, tau) in &self.ws.offsets {
+            let w = v + u.cross(r) + rp;
+            let t = w * (*tau / w.norm());
+            tf += t;
+            tm += r.cross(&t);
+        }
+        Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)
+    }
+
+    /// Tendon load sums `(Σ τ t, Σ τ r × t)` at the strains `x = (v, u)`, and, if `jac`, the
+    /// local Jacobian `I + C D` (see the module documentation).
+    ///
+    /// Per tendon, with `t = w/|w|`, `q = r × t`, `a = τ/|w|` and `A = a (I - t tᵀ)`:
+    /// `dT_F/dv = A`, `dT_F/du = -A r̂ = -a (r̂ + t qᵀ)`, `dT_M/dv = r̂ A = a (r̂ - q tᵀ)`,
+    /// `dT_M/du = -r̂ A r̂ = -a (r rᵀ - |r|² I + q qᵀ)`.
+    #[inline]
+    pub(crate) fn tendon_sums(
+        &self,
+        x: &Vector6<f64>,
+        c: &[f64; 6],
+        jac: bool,
+    ) -> (Vector6<f64>, Option<Matrix6<f64>>) {
+        self.tendon_sums_into(x, c, jac, None)
+    }
+
+    /// [`Self::tendon_sums`]; with `stiffness`, `D` itself goes there (rows) instead of
+    /// `I + C D`.
+    #[inline]
+    pub(crate) fn tendon_sums_into(
+        &self,
+        x: &Vector6<f64>,
+        c: &[f64; 6],
+        jac: bool,
+        stiffness: Option<&mut [[f64; 6]; 6]>,
+    ) -> (Vector6<f64>, Option<Matrix6<f64>>) {
+        let jac = jac || stiffness.is_some();
+        let v = Vector3::new(x[0], x[1], x[2]);
+        let u = Vector3::new(x[3], x[4], x[5]);
+        let mut tf = Vector3::zeros();
+        let mut tm = Vector3::zeros();
+        let mut sa = 0.0;
+        let mut sar = Vector3::zeros();
+        let mut ar2 = 0.0;
+        let mut tt = Matrix3::zeros();
+        let mut tq = Matrix3::zeros();
+        let mut qq = Matrix3::zeros();
+        let mut rr = Matrix3::zeros();
+        for (r, rp, tau) in &self.ws.offsets {
+            let w = v + u.cross(r) + rp;
+            let inv_len = 1.0 / w.norm();
+            let t = w * inv_len;
+            let q = r.cross(&t);
+            tf += t * *tau;
+            tm += q * *tau;
+            if jac {
+                let a = *tau * inv_len;
+                let at = t * a;
+                sa += a;
+                sar += r * a;
+                ar2 += a * r.norm_squared();
+                tt += at * t.transpose();
+                tq += at * q.transpose();
+                qq += q * (q * a).transpose();
+                rr += r * (r * a).transpose();
+            }
+        }
+        let sums = Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z);
+        if !jac {
+            return (sums, None);
+        }
+        let rh = hat(&sar);
+        let dfv = Matrix3::identity() * sa - tt;
+        let dfu = -(rh + tq);
+        let dmv = rh - tq.transpose();
+        let dmu = Matrix3::identity() * ar2 - rr - qq;
+        if let Some(out) = stiffness {
+            // D is symmetric: [[dfv, dfu], [dmv = dfuᵀ, dmu]].
+            for i in 0..3 {
+                for j in 0..3 {
+                    out[i][j] = dfv[(i, j)];
+                    out[i][j + 3] = dfu[(i, j)];
+                    out[i + 3][j] = dmv[(i, j)];
+                    out[i + 3][j + 3] = dmu[(i, j)];
+                }
+            }
+            return (sums, None);
+        }
+        let mut h = Matrix6::identity();
+        for i in 0..3 {
+            for j in 0..3 {
+                h[(i, j)] += c[i] * dfv[(i, j)];
+                h[(i, j + 3)] += c[i] * dfu[(i, j)];
+                h[(i + 3, j)] += c[i + 3] * dmv[(i, j)];
+                h[(i + 3, j + 3)] += c[i + 3] * dmu[(i, j)];
+            }
+        }
+        (sums, Some(h))
+    }
+}

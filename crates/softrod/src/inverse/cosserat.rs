@@ -1,0 +1,344 @@
+//! The Cosserat model as a forward model of the inverse statics: a statics solve and its
+//! exact actuation Jacobian per evaluation, or, for a robot without external loads, one march
+//! of the state with one column per actuator.
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, Matrix3, Vector3};
+
+use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
+use super::{InverseWarmStart, Target};
+use crate::cosserat::equations::{Column, Equations};
+use crate::cosserat::sensitivity::{
+    actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
+};
+use crate::cosserat::shooting::{Node, Shooting};
+use crate::cosserat::statics::{assemble, solve_statics, SolveOptions, StaticsSolution, WarmStart};
+use crate::error::{Error, Result};
+use crate::model::loads::{Frame, PointLoad};
+use crate::model::{Actuation, RobotModel};
+use crate::solve::SolverStats;
+
+/// Whether no external load acts (zero point loads only mark integration breaks).
+fn no_external_loads(model: &RobotModel) -> bool {
+    let l = model.loads();
+    l.tip_force == Vector3::zeros()
+        && l.tip_moment == Vector3::zeros()
+        && l.point_loads
+            .iter()
+            .all(|p| p.force == Vector3::zeros() && p.moment == Vector3::zeros())
+        && l.distributed_force.is_none()
+        && l.distributed_moment.is_none()
+        && model.rho_g().is_none()
+}
+
+/// The Cosserat model as a [`Forward`] model: a robot model, its solver options and the
+/// observed nodes; warm-started from its last solve.
+pub struct CosseratForward {
+    model: Arc<RobotModel>,
+    options: SolveOptions,
+    /// Node indices of the observed points; `None`: the tip.
+    nodes: Option<Vec<usize>>,
+    last: Option<WarmStart>,
+    /// The last solution (loaded robots only).
+    pub solution: Option<StaticsSolution>,
+    /// The last march of an unloaded robot: its actuation, nodes, tendon path lengths and
+    /// scaled tip residual (a statics solution is assembled from it without solving again).
+    march: Option<March>,
+}
+
+/// The state recorded along one march of an unloaded robot at the actuation `a`.
+struct March {
+    a: Vec<f64>,
+    nodes: Vec<Node>,
+    lengths: Vec<f64>,
+    residual: f64,
+    evaluations: usize,
+}
+
+impl CosseratForward {
+    /// The forward model of `model` solved with `options`, observing the tip, or the backbone
+    /// points at the undeformed arc lengths `s` (m; the model gets integration breaks there
+    /// unless they are mesh nodes already).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `target_s[k]` outside `(0, L]`, or the model's.
+    pub fn new(model: &Arc<RobotModel>, options: &SolveOptions, s: Option<&[f64]>) -> Result<Self> {
+        options.validate()?;
+        let mut me = Self {
+            model: Arc::clone(model),
+            options: *options,
+            nodes: None,
+            last: None,
+            solution: None,
+            march: None,
+        };
+        if let Some(s) = s {
+            let l = model.length();
+            for (k, &v) in s.iter().enumerate() {
+                if !(v.is_finite() && v > 0.0 && v <= l) {
+                    return Err(Error::invalid(
+                        format!("target_s[{k}]"),
+                        v,
+                        format!("in (0, length] = (0, {l}] m"),
+                    ));
+                }
+            }
+            let zero = Actuation::zero(model.tendons().len(), model.chambers().len());
+            let probe = solve_statics(model, &zero, options)?;
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * l;
+            let on_mesh = s.iter().all(|&v| probe.s.iter().any(|&x| close(x, v)));
+            if !on_mesh {
+                let mut loads = model.loads().clone();
+                for &v in s {
+                    if !model.breaks().iter().any(|&b| close(b, v)) {
+                        loads.point_loads.push(PointLoad {
+                            s: v,
+                            force: Vector3::zeros(),
+                            moment: Vector3::zeros(),
+                            frame: Frame::World,
+                        });
+                    }
+                }
+                me.model = model.with_loads(loads)?;
+            }
+            let probe = solve_statics(&me.model, &zero, options)?;
+            let nodes = s
+                .iter()
+                .map(|&v| {
+                    probe
+                        .s
+                        .iter()
+                        .rposition(|&x| close(x, v))
+                        .ok_or_else(|| Error::invalid("target_s", v, "a point of the mesh"))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            me.nodes = Some(nodes);
+        }
+        Ok(me)
+    }
+
+    /// The model solved (with breaks at the observed arc lengths).
+    pub fn model(&self) -> &Arc<RobotModel> {
+        &self.model
+    }
+
+    fn actuation(&self, a: &[f64]) -> Actuation {
+        let nt = self.model.tendons().len();
+        Actuation::tensions(&a[..nt]).with_pressures(&a[nt..])
+    }
+
+    /// The statics solution at the actuation `a` (m, N, Pa).
+    ///
+    /// # Errors
+    /// As [`solve_statics`].
+    pub fn solve(&self, a: &[f64]) -> Result<StaticsSolution> {
+        if let Some(sol) = self.assembled(a) {
+            return Ok(sol);
+        }
+        let opts = SolveOptions {
+            warm_start: self.last,
+            ..self.options
+        };
+        solve_statics(&self.model, &self.actuation(a), &opts)
+    }
+}
+
+impl CosseratForward {
+    /// The statics solution of an unloaded robot at `a` from the last march, if it was at `a`:
+    /// the zero base wrench, the nodes and path lengths of that march (the state integrated
+    /// there is the forward solve's, step for step); `None` otherwise.
+    fn assembled(&self, a: &[f64]) -> Option<StaticsSolution> {
+        let m = self.march.as_ref().filter(|m| m.a == a)?;
+        let model = &self.model;
+        let nt = model.tendons().len();
+        let (tensions, pressures) = (&a[..nt], &a[nt..]);
+        let eq = Equations {
+            model,
+            tensions,
+            pressures,
+            load_factor: 1.0,
+            profile: None,
+        };
+        let mut plan = Vec::new();
+        let _ = scheme_of(&self.options.integrator, model, &mut plan);
+        let mut p = Shooting::new(eq, self.options.integrator, plan);
+        p.nodes.clone_from(&m.nodes);
+        p.lengths.clone_from(&m.lengths);
+        let converged = m.residual <= self.options.newton.tolerance
+            && m.nodes.iter().all(|n| n.y.iter().all(|v| v.is_finite()));
+        let stats = SolverStats {
+            iterations: 0,
+            residual: m.residual,
+            function_evaluations: m.evaluations,
+            converged,
+            load_steps: 0,
+            load_factor: 1.0,
+        };
+        let mut sol = assemble(&mut p, model, [0.0; 6], stats, &[]);
+        if !converged || p.ws.material_error.is_some() {
+            return None;
+        }
+        sol.actuation = self.actuation(a);
+        sol.options = self.options;
+        sol.stable = true;
+        Some(sol)
+    }
+}
+
+impl CosseratForward {
+    /// The evaluation of an unloaded robot with its Jacobian: the base wrench is zero and does
+    /// not move with the actuation, so one march of the state with one column per actuator.
+    fn unloaded(&mut self, a: &[f64]) -> Result<Evaluation> {
+        let (nt, nc) = self.dims();
+        let (tensions, pressures) = (&a[..nt], &a[nt..]);
+        let act = self.actuation(a);
+        act.validate(nt, nc)?;
+        let eq = Equations {
+            model: &self.model,
+            tensions,
+            pressures,
+            load_factor: 1.0,
+            profile: None,
+        };
+        let seeds: Vec<Seed> = (0..nt)
+            .map(|i| Seed::Forced(Column::Tension(i)))
+            .chain((0..nc).map(|j| Seed::Forced(Column::Pressure(j))))
+            .collect();
+        let mut plan = Vec::new();
+        let scheme = scheme_of(&self.options.integrator, &self.model, &mut plan);
+        let observe = self.nodes.clone().unwrap_or_default();
+        let mut sorted = observe.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        let cols = integrate(
+            eq,
+            scheme,
+            &[0.0; 6],
+            &Request {
+                seeds: &seeds,
+                lengths: &[],
+                observe: &sorted,
+                load_node: None,
+                record_nodes: true,
+                stops: &[],
+            },
+        )?;
+        self.march = Some(March {
+            a: a.to_vec(),
+            nodes: cols.nodes.clone(),
+            lengths: cols.lengths.clone(),
+            residual: crate::solve::max_norm(cols.residual.as_slice()),
+            evaluations: cols.evaluations,
+        });
+        let to_matrix = |c: &[nalgebra::Vector6<f64>]| DMatrix::from_fn(6, nt + nc, |r, k| c[k][r]);
+        Ok(match &self.nodes {
+            None => Evaluation {
+                positions: vec![cols.tip_pose.0],
+                rotation: cols.tip_pose.1,
+                jacobian: Some(vec![to_matrix(&cols.tip)]),
+            },
+            Some(nodes) => {
+                let at = |i: usize| sorted.iter().position(|&x| x == i).unwrap_or(0);
+                let positions = nodes
+                    .iter()
+                    .map(|&i| crate::cosserat::equations::v3(&cols.nodes[i].y, 0))
+                    .collect();
+                let last = *nodes.last().unwrap_or(&0);
+                Evaluation {
+                    positions,
+                    rotation: cols.rotations[at(last)],
+                    jacobian: Some(
+                        nodes
+                            .iter()
+                            .map(|&i| to_matrix(&cols.poses[at(i)]))
+                            .collect(),
+                    ),
+                }
+            }
+        })
+    }
+}
+
+impl Forward for CosseratForward {
+    fn dims(&self) -> (usize, usize) {
+        (self.model.tendons().len(), self.model.chambers().len())
+    }
+
+    fn length(&self) -> f64 {
+        self.model.length()
+    }
+
+    fn chamber_areas(&self) -> Vec<f64> {
+        self.model
+            .chambers()
+            .iter()
+            .zip(self.model.chamber_extents())
+            .map(|(c, (start, _))| c.area_at(*start))
+            .collect()
+    }
+
+    fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation> {
+        if no_external_loads(&self.model) && jacobian {
+            return self.unloaded(a);
+        }
+        let sol = self.solve(a)?;
+        self.last = Some(sol.warm_start());
+        let n = sol.s.len();
+        let nodes = self.nodes.clone().unwrap_or_else(|| vec![n - 1]);
+        let rot = |i: usize| {
+            let r = sol.rotation[i];
+            Matrix3::new(
+                r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
+            )
+        };
+        let positions = nodes
+            .iter()
+            .map(|&i| Vector3::from(sol.position[i]))
+            .collect();
+        let last = *nodes.last().unwrap_or(&(n - 1));
+        let jac = if jacobian {
+            let mut sorted = nodes.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            let js = actuation_jacobians(&sol, &sorted, Linearisation::Tension)?;
+            Some(
+                nodes
+                    .iter()
+                    .map(|i| js[sorted.iter().position(|x| x == i).unwrap_or(0)].clone())
+                    .collect(),
+            )
+        } else {
+            None
+        };
+        let out = Evaluation {
+            positions,
+            rotation: rot(last),
+            jacobian: jac,
+        };
+        self.solution = Some(sol);
+        Ok(out)
+    }
+}
+
+/// The inverse statics of a Cosserat robot `model` (solved with `options`) for `target`
+/// (see the module documentation); returns the result and the statics solution at the
+/// actuation found.
+///
+/// # Errors
+/// As [`solve_inverse`]; the forward solve's errors.
+pub fn inverse_statics(
+    model: &Arc<RobotModel>,
+    target: &Target,
+    options: &InverseOptions,
+    solve: &SolveOptions,
+    warm: Option<&InverseWarmStart>,
+) -> Result<(InverseSolution, StaticsSolution)> {
+    let mut fwd = CosseratForward::new(model, solve, target.s.as_deref())?;
+    let out = solve_inverse(&mut fwd, target, options, warm)?;
+    let sol = match fwd.solution.take() {
+        Some(s) if s.tensions() == out.tensions() && s.pressures() == out.pressures() => s,
+        _ => fwd.solve(&out.actuation)?,
+    };
+    Ok((out, sol))
+}
