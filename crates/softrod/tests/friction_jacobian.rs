@@ -3,17 +3,20 @@
 //! compliance at the same nodes), and the one-sided finite differences of the nonlinear
 //! frictional solve continued from the solution (`previous` = the solution) show that the
 //! derivative of a frictional equilibrium is one-sided: pulling on (sliding) and releasing
-//! (sticking) a loaded tendon give different slopes.
+//! (sticking) a loaded tendon give different slopes. The one-sided actuation Jacobians
+//! (pull and release) equal those one-sided differences, and with a vanishing coefficient
+//! the frictional linearisation tends to the frictionless one.
 #![allow(clippy::unwrap_used, missing_docs)]
 
 mod common;
 
 use std::sync::Arc;
 
-use softrod::nalgebra::Vector3;
+use softrod::nalgebra::{Matrix3, Vector3, Vector6};
 use softrod::{
-    actuation_jacobian, solve_frictional, solve_statics_at, tangent_compliance, Actuation,
-    FrictionOptions, FrictionalSolution, Integrator, Loads, RobotModel, StaticsSolution,
+    actuation_jacobian, directional_actuation_jacobian, solve_frictional, solve_statics_at,
+    tangent_compliance, Actuation, Direction, FrictionOptions, FrictionalSolution, Integrator,
+    LinearElastic, Loads, Profile, RobotModel, Rod, Section, StaticsSolution, Tendon,
     TendonControl,
 };
 
@@ -143,5 +146,201 @@ fn the_derivative_of_a_frictional_equilibrium_is_one_sided() {
             cu < 1e-2 * side && cd < 1e-2 * side,
             "{name}: {cu:e} {cd:e}"
         );
+    }
+}
+
+/// A flexible precurved rod (NiTi, 0.2 m, radius 1 mm, rest curvature 5 /m about body y)
+/// with two tendons at 4 mm on either side of the curve, under a tip force.
+fn precurved(mu: f64) -> Arc<RobotModel> {
+    let rod = Rod::new(
+        0.2,
+        Section::circular(0.001).unwrap(),
+        LinearElastic::new(6e10, 0.33).unwrap(),
+    )
+    .unwrap()
+    .with_rest_curvature(Profile::Constant(Vector3::new(0.0, 5.0, 0.0)))
+    .unwrap();
+    let tendons = [[0.004, 0.0], [-0.004, 0.0]]
+        .into_iter()
+        .map(|o| {
+            Tendon::constant(o, None)
+                .unwrap()
+                .with_friction(mu)
+                .unwrap()
+        })
+        .collect();
+    let loads = Loads::tip_force(Vector3::new(0.0, 0.02, -0.05));
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+}
+
+/// A state to linearise: its name, model, tensions (N) and the equilibrium.
+struct State {
+    name: &'static str,
+    model: Arc<RobotModel>,
+    tensions: Vec<f64>,
+    solution: FrictionalSolution,
+}
+
+/// The states: the NiTi robot loaded from rest at [`TENSIONS`] (unloaded, tip force,
+/// gravity: every element sliding toward the base), the unloaded one then released to 2 N
+/// on tendon 1 (a slip front: sliding toward the tip near the base, sticking beyond), and the
+/// precurved rod with a tip force loaded from rest at [0.8, 0.3] N; μ = 0.2.
+fn states(opts: &FrictionOptions) -> Vec<State> {
+    let mut out: Vec<State> = cases(0.2)
+        .into_iter()
+        .map(|(name, model)| {
+            let solution =
+                solve_frictional(&model, &Actuation::tensions(&TENSIONS), opts, None).unwrap();
+            State {
+                name,
+                model,
+                tensions: TENSIONS.to_vec(),
+                solution,
+            }
+        })
+        .collect();
+    let model = out[0].model.clone();
+    let mut released = TENSIONS;
+    released[0] = 2.0;
+    let act = Actuation::tensions(&released);
+    let solution = solve_frictional(&model, &act, opts, Some(&out[0].solution)).unwrap();
+    out.push(State {
+        name: "unloaded, released",
+        model,
+        tensions: released.to_vec(),
+        solution,
+    });
+    let model = precurved(0.2);
+    let tensions = vec![0.8, 0.3];
+    let solution = solve_frictional(&model, &Actuation::tensions(&tensions), opts, None).unwrap();
+    out.push(State {
+        name: "precurved, tip force",
+        model,
+        tensions,
+        solution,
+    });
+    out
+}
+
+/// The tip pose change `[δp; δθ]` (world; m, rad) from `a` to `b`, `δθ` the axial vector of
+/// the skew part of `R_b R_aᵀ`.
+fn tip_change(a: &StaticsSolution, b: &StaticsSolution) -> Vector6<f64> {
+    let rot = |s: &StaticsSolution| {
+        let r = s.rotation.last().unwrap();
+        Matrix3::from_fn(|i, j| r[i][j])
+    };
+    let d = rot(b) * rot(a).transpose();
+    let dp =
+        Vector3::from(*b.position.last().unwrap()) - Vector3::from(*a.position.last().unwrap());
+    Vector6::new(
+        dp.x,
+        dp.y,
+        dp.z,
+        0.5 * (d[(2, 1)] - d[(1, 2)]),
+        0.5 * (d[(0, 2)] - d[(2, 0)]),
+        0.5 * (d[(1, 0)] - d[(0, 1)]),
+    )
+}
+
+/// The one-sided difference of the tip pose along the base tension of tendon `i` continued
+/// from `st` (its history): `(f(τ + h e_i) − f(τ)) / h`, `h` signed.
+fn difference(st: &State, i: usize, h: f64, opts: &FrictionOptions) -> Vector6<f64> {
+    let mut t = st.tensions.clone();
+    t[i] += h;
+    let next = solve_frictional(
+        &st.model,
+        &Actuation::tensions(&t),
+        opts,
+        Some(&st.solution),
+    )
+    .unwrap();
+    tip_change(&st.solution.statics, &next.statics) / h
+}
+
+/// Relative size of the difference of two vectors (to the second).
+fn rel6(a: &Vector6<f64>, b: &Vector6<f64>) -> f64 {
+    (a - b).norm() / b.norm()
+}
+
+/// The pull and release Jacobians at the tip against the one-sided differences continued
+/// from the solution, forward for pull and backward for release, with steps `h` and `h / 10`.
+/// On one slip branch the difference is smooth in `h` with an O(h) error: the `h / 10` one
+/// is ten times closer to the Jacobian, and their Richardson extrapolation
+/// `(10 D(h/10) − D(h)) / 9` (error O(h²), about 1e-10 here, plus the solves' round-off
+/// divided by `h`) agrees with it to 1e-6 relative per column.
+#[test]
+fn one_sided_jacobians_are_the_one_sided_differences() {
+    let opts = options(50);
+    let h = 1e-4;
+    for st in states(&opts) {
+        for direction in [Direction::Pull, Direction::Release] {
+            let j = directional_actuation_jacobian(&st.solution.statics, None, direction).unwrap();
+            let sign = direction.sign();
+            let (mut worst, mut worst_fine) = (0.0f64, 0.0f64);
+            for i in 0..st.tensions.len() {
+                let col = Vector6::from_fn(|r, _| j[(r, i)]);
+                if sign < 0.0 && st.tensions[i] == 0.0 {
+                    // A slack tendon cannot be released: its release column is zero.
+                    assert_eq!(col.norm(), 0.0, "{}: slack tendon {i}", st.name);
+                    continue;
+                }
+                let coarse = difference(&st, i, sign * h, &opts);
+                let fine = difference(&st, i, sign * h / 10.0, &opts);
+                let extrapolated = (fine * 10.0 - coarse) / 9.0;
+                let (e_coarse, e_fine) = (rel6(&coarse, &col), rel6(&fine, &col));
+                let e = rel6(&extrapolated, &col);
+                eprintln!(
+                    "{} {direction:?} tendon {i}: |J| = {:.3e}; difference h {e_coarse:.2e}, \
+                     h/10 {e_fine:.2e}, extrapolated {e:.2e} (relative)",
+                    st.name,
+                    col.norm()
+                );
+                worst = worst.max(e);
+                worst_fine = worst_fine.max(e_fine);
+                assert!(e <= 1e-6, "{} {direction:?} {i}: {e:e}", st.name);
+                assert!(
+                    e_fine < 0.3 * e_coarse,
+                    "{} {direction:?} {i}: not O(h): {e_coarse:e} {e_fine:e}",
+                    st.name
+                );
+            }
+            eprintln!(
+                "{} {direction:?}: worst {worst:.2e} relative to the extrapolated differences \
+                 ({worst_fine:.2e} to the h/10 ones)",
+                st.name
+            );
+        }
+    }
+}
+
+/// As the coefficient vanishes, the frictional linearisation (every element sliding, the
+/// tension profile varying with the shape) tends to the frictionless Jacobian of the same
+/// equilibrium at O(μ): at μ = 1e-9 they agree to 1e-8 relative.
+#[test]
+fn vanishing_friction_tends_to_the_frictionless_jacobian() {
+    let opts = options(50);
+    let act = Actuation::tensions(&TENSIONS);
+    for ((name, model), (_, plain_model)) in cases(1e-9).into_iter().zip(cases(0.0)) {
+        let fr = solve_frictional(&model, &act, &opts, None).unwrap();
+        let plain = solve_statics_at(&plain_model, &act, &opts.statics, &fr.statics.s).unwrap();
+        for direction in [Direction::Pull, Direction::Release] {
+            let a = directional_actuation_jacobian(&fr.statics, None, direction).unwrap();
+            let b = actuation_jacobian(&plain, None).unwrap();
+            // The release columns of the slack tendons are zero.
+            let cols: Vec<usize> = (0..TENSIONS.len())
+                .filter(|&i| direction == Direction::Pull || TENSIONS[i] > 0.0)
+                .collect();
+            let pick = |m: &softrod::nalgebra::DMatrix<f64>| -> Vec<f64> {
+                cols.iter()
+                    .flat_map(|&i| m.column(i).iter().copied().collect::<Vec<_>>())
+                    .collect()
+            };
+            let (a, b) = (pick(&a), pick(&b));
+            let e = rel(&a, &b);
+            eprintln!(
+                "μ = 1e-9, {name}, {direction:?}: {e:e} relative to the frictionless Jacobian"
+            );
+            assert!(e < 1e-8, "{name} {direction:?}: {e:e}");
+        }
     }
 }
