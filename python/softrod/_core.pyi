@@ -572,7 +572,7 @@ def _pcc_inverse_statics(
 def actuation_jacobian(
     solution: StaticsSolution | PccSolution,
     node: int = ...,
-    direction: int | Literal["pull", "release"] = ...,
+    direction: int | Literal["pull", "release"] | None = ...,
 ) -> NDArray[np.float64]:
     """d[δp; δθ] (world; m, rad) of node ``node`` / d(tensions (N), pressures (Pa)),
     shape (6, n_tendons + n_chambers); exact (linearised boundary-value problem).

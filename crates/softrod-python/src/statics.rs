@@ -1010,18 +1010,21 @@ pub(crate) fn solve_statics<'py>(
 /// pressure (per Pa), every tendon at fixed tension; shape (6, n_tendons + n_chambers). Exact:
 /// from the linearised boundary-value problem (Cosserat) or the equilibrium Jacobian (PCC),
 /// no finite differences. For a frictional equilibrium the derivative is one-sided:
-/// `direction` 1 (default, "pull": increasing inputs, continued from the solution) or -1
+/// `direction` 1 (default, None: the same; "pull": increasing inputs, continued from the solution) or -1
 /// ("release": decreasing inputs, the column `(f(a) - f(a - h e)) / h`); for any other
 /// solution the two agree.
 #[pyfunction]
-#[pyo3(signature = (solution, node=-1, direction=1))]
+#[pyo3(signature = (solution, node=-1, direction=None))]
 pub(crate) fn actuation_jacobian<'py>(
     py: Python<'py>,
     solution: Bound<'py, PyAny>,
     #[pyo3(from_py_with = arg::node)] node: i64,
-    direction: Bound<'py, PyAny>,
+    direction: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let direction = jacobian_direction(&direction)?;
+    let direction = match &direction {
+        Some(d) => jacobian_direction(d)?,
+        None => softrod::Direction::Pull,
+    };
     let to_array = |m: &softrod::nalgebra::DMatrix<f64>| {
         Array::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
     };
@@ -1064,7 +1067,9 @@ pub(crate) fn actuation_jacobian<'py>(
 
 /// The direction of a one-sided Jacobian: 1 or "pull", -1 or "release".
 fn jacobian_direction(value: &Bound<'_, PyAny>) -> PyResult<softrod::Direction> {
-    if let Ok(v) = value.extract::<i64>() {
+    if value.is_instance_of::<pyo3::types::PyBool>() {
+        // A bool is an int in Python: not a direction.
+    } else if let Ok(v) = value.extract::<i64>() {
         match v {
             1 => return Ok(softrod::Direction::Pull),
             -1 => return Ok(softrod::Direction::Release),
