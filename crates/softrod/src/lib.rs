@@ -59,7 +59,7 @@ pub use cosserat::friction::{
     friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
     Slip,
 };
-pub use cosserat::friction_linear::Direction;
+pub use cosserat::friction_linear::{frictional_tip_compliance, Direction};
 pub use cosserat::sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, directional_actuation_jacobian,
     sensitivities, Linearisation, Parameter, Sensitivities,

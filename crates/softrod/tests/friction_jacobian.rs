@@ -14,10 +14,10 @@ use std::sync::Arc;
 
 use softrod::nalgebra::{Matrix3, Vector3, Vector6};
 use softrod::{
-    actuation_jacobian, directional_actuation_jacobian, solve_frictional, solve_statics_at,
-    tangent_compliance, Actuation, Direction, FrictionOptions, FrictionalSolution, Integrator,
-    LinearElastic, Loads, Profile, RobotModel, Rod, Section, StaticsSolution, Tendon,
-    TendonControl,
+    actuation_jacobian, directional_actuation_jacobian, frictional_tip_compliance,
+    solve_frictional, solve_statics_at, tangent_compliance, Actuation, Direction, FrictionOptions,
+    FrictionalSolution, Integrator, LinearElastic, Loads, Profile, RobotModel, Rod, Section,
+    StaticsSolution, Tendon, TendonControl,
 };
 
 fn options(steps: usize) -> FrictionOptions {
@@ -365,6 +365,69 @@ fn vanishing_friction_tends_to_the_frictionless_jacobian() {
                 "μ = 1e-9, {name}, {direction:?}: {e:e} relative to the frictionless Jacobian"
             );
             assert!(e < 1e-8, "{name} {direction:?}: {e:e}");
+        }
+    }
+}
+
+/// The NiTi robot of `case` ([`cases`]) at μ with `extra` (N, N m; world) added to its tip
+/// wrench.
+fn with_tip_wrench(case: &str, mu: f64, extra: &Vector6<f64>) -> Arc<RobotModel> {
+    let (_, model) = cases(mu).into_iter().find(|(n, _)| *n == case).unwrap();
+    let mut loads = model.loads().clone();
+    loads.tip_force += Vector3::new(extra[0], extra[1], extra[2]);
+    loads.tip_moment += Vector3::new(extra[3], extra[4], extra[5]);
+    let density = (case == "gravity").then_some(6450.0);
+    common::niti_model(loads, density, mu)
+}
+
+/// The one-sided tip compliance of a frictional equilibrium (the tension profile following
+/// the stick/slip rule) against the one-sided differences of the solve continued from the
+/// solution under a small added tip force or moment, for increasing (pull) and decreasing
+/// (release) wrench components: the `h / 10` difference to 1e-6 relative per column, steps
+/// 1e-6 N and 1e-8 N m. The steps are small because a wrench change moves some elements'
+/// `δlo` close to zero, and such an element changes branch at a finite step: releasing the
+/// moment about y on the unloaded robot, the difference at 1e-7 N m is 2.9e-5 off (another
+/// branch), at 1e-8 N m 1.6e-7 (the derivative's); the forces' differences are O(h)
+/// (1.7e-5 at 1e-5 N, 1.7e-6 at 1e-6 N).
+#[test]
+fn one_sided_tip_compliance_is_the_one_sided_difference() {
+    let opts = options(50);
+    for st in states(&opts).into_iter().take(3) {
+        for direction in [Direction::Pull, Direction::Release] {
+            let c = frictional_tip_compliance(&st.solution.statics, direction).unwrap();
+            let sign = direction.sign();
+            let mut worst = 0.0f64;
+            for k in 0..6 {
+                let col = Vector6::from_fn(|r, _| c[(r, k)]);
+                let h = if k < 3 { 1e-6 } else { 1e-8 };
+                let diff = |step: f64| {
+                    let model = with_tip_wrench(st.name, 0.2, &(Vector6::ith(k, 1.0) * step));
+                    let act = Actuation::tensions(&st.tensions);
+                    let next = solve_frictional(&model, &act, &opts, Some(&st.solution)).unwrap();
+                    tip_change(&st.solution.statics, &next.statics) / step
+                };
+                let (coarse, fine) = (diff(sign * h), diff(sign * h / 10.0));
+                let extrapolated = (fine * 10.0 - coarse) / 9.0;
+                let (e_coarse, e_fine) = (rel6(&coarse, &col), rel6(&fine, &col));
+                let e = rel6(&extrapolated, &col);
+                eprintln!(
+                    "{} {direction:?} tip wrench {k}: |C| = {:.3e}; difference h {e_coarse:.2e}, \
+                     h/10 {e_fine:.2e}, extrapolated {e:.2e}",
+                    st.name,
+                    col.norm()
+                );
+                worst = worst.max(e_fine);
+                assert!(e_fine <= 1e-6, "{} {direction:?} {k}: {e_fine:e}", st.name);
+            }
+            // Against the compliance with the profile held fixed.
+            let fixed = tangent_compliance(&st.solution.statics, TendonControl::Tension, None)
+                .unwrap()
+                .world;
+            eprintln!(
+                "{} {direction:?}: worst {worst:.2e}; |C − C_fixed profile| / |C| = {:.2e}",
+                st.name,
+                (c - fixed).norm() / c.norm()
+            );
         }
     }
 }

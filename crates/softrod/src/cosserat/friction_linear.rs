@@ -115,6 +115,8 @@ impl Bounds {
 enum Input {
     Tendon(usize),
     Pressure(usize),
+    /// Component `k` of a dead world-frame wrench added at the tip (force, then moment).
+    TipWrench(usize),
 }
 
 /// The solution's data the variational march needs.
@@ -826,15 +828,23 @@ fn directional<const N: usize>(
             return Ok(p.poses.iter().map(|c| c[0] * sigma).collect());
         }
         let d = Matrix6::from_columns(&p.residual[1..7]);
-        let step = d
-            .lu()
-            .solve(&(-p.residual[0]))
-            .ok_or_else(|| Error::NotConverged {
-                what: "frictional linearisation: singular shooting Jacobian".into(),
-                iterations: pass + 1,
-                residual: f64::INFINITY,
-                load_factor: 1.0,
-            })?;
+        let mut r0 = p.residual[0];
+        if let Input::TipWrench(k) = input {
+            // The scaled tip residual `(N(L) − F) / f_ref`, `(M(L) − M) / (f_ref L)`.
+            let f_ref = fr.model.force_scale();
+            r0[k] -= sigma
+                / if k < 3 {
+                    f_ref
+                } else {
+                    f_ref * fr.model.length()
+                };
+        }
+        let step = d.lu().solve(&(-r0)).ok_or_else(|| Error::NotConverged {
+            what: "frictional linearisation: singular shooting Jacobian".into(),
+            iterations: pass + 1,
+            residual: f64::INFINITY,
+            load_factor: 1.0,
+        })?;
         if last.as_ref() == Some(&p.branches) {
             return Ok(p
                 .poses
@@ -954,6 +964,47 @@ pub(crate) fn frictional_actuation_jacobians(
         for (m, &node) in out.iter_mut().zip(nodes) {
             m.set_column(col, &poses[node]);
         }
+    }
+    Ok(out)
+}
+
+/// The one-sided tangent compliance of a frictional equilibrium `solution` at its tip: per
+/// column `k`, the derivative of the tip twist `[δp; δθ]` (world; m, rad) for a dead
+/// world-frame tip wrench `[f; m]` (N, N m) growing along `+e_k` ([`Direction::Pull`]) or
+/// along `−e_k` ([`Direction::Release`]; the column is then `(f(0) − f(−h e_k)) / h`), the
+/// tension profile following the same stick/slip rule as the actuation Jacobian (tendons at
+/// fixed base tension). The columns need not form a symmetric matrix: each is the derivative
+/// along its own direction.
+///
+/// # Errors
+/// [`Error::NotConverged`] if a constitutive solve fails or the slip branches do not settle.
+pub fn frictional_tip_compliance(
+    solution: &StaticsSolution,
+    direction: Direction,
+) -> Result<Matrix6<f64>> {
+    let model = &*solution.model;
+    let mus: Vec<f64> = model.tendons().iter().map(|t| t.friction()).collect();
+    let fr = Frozen {
+        model,
+        mesh: &solution.s,
+        tau: node_tensions(solution, &mus)?,
+        base: solution.tendon_tensions.clone(),
+        pressures: solution.pressures(),
+        mus: mus.clone(),
+        x: super::sensitivity::scaled_base_wrench(model, &solution.base_wrench),
+        integrator: solution.options.integrator,
+        nb: 6,
+    };
+    let need = 7 + mus.iter().filter(|&&m| m > 0.0).count();
+    let mut out = Matrix6::zeros();
+    for k in 0..6 {
+        let input = Input::TipWrench(k);
+        let poses = match need {
+            0..=12 => directional::<{ width(12) }>(&fr, input, direction)?,
+            13..=18 => directional::<{ width(18) }>(&fr, input, direction)?,
+            _ => directional::<{ width(24) }>(&fr, input, direction)?,
+        };
+        out.set_column(k, &poses[poses.len() - 1]);
     }
     Ok(out)
 }

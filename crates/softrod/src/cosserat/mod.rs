@@ -24,7 +24,7 @@ pub use friction::{
     friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
     Slip,
 };
-pub use friction_linear::Direction;
+pub use friction_linear::{frictional_tip_compliance, Direction};
 pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, directional_actuation_jacobian,
     sensitivities, Linearisation, Parameter, Sensitivities,
