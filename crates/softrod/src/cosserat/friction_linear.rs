@@ -497,13 +497,21 @@ fn pose_of(y: &[f64], c: usize) -> Vector6<f64> {
     Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
 }
 
-/// The variational march of the input `input` in the direction `sigma` (±1), the base
-/// wrench changed by `dx` (scaled) at the base; with the base-wrench columns if `fr.nb`.
+/// The variational march of the inputs `inputs` in the direction `sigma` (±1), one column
+/// each with its own slip branches; with the base-wrench columns if `fr.nb` (then one input,
+/// the base wrench changed by `dx` (scaled) at the base, the base-wrench columns on its
+/// branches).
 #[allow(clippy::too_many_lines)] // one sequential march
-fn march<const N: usize>(fr: &Frozen<'_>, input: Input, sigma: f64, dx: &[f64; 6]) -> Result<Pass> {
+fn march<const N: usize>(
+    fr: &Frozen<'_>,
+    inputs: &[Input],
+    sigma: f64,
+    dx: &[f64; 6],
+) -> Result<Pass> {
     let model = fr.model;
     let nt = fr.base.len();
-    let nm = 1 + fr.nb;
+    let n_in = inputs.len();
+    let nm = n_in + fr.nb;
     let breaks = model.breaks();
     let f_ref = model.force_scale();
     let fm = f_ref * model.length();
@@ -528,7 +536,7 @@ fn march<const N: usize>(fr: &Frozen<'_>, input: Input, sigma: f64, dx: &[f64; 6
         y[STATE + DM + k] = fm * dx[3 + k];
     }
     for k in 0..fr.nb {
-        let b0 = STATE + COLUMN * (1 + k);
+        let b0 = STATE + COLUMN * (n_in + k);
         if k < 3 {
             y[b0 + DN + k] = f_ref;
         } else {
@@ -537,12 +545,14 @@ fn march<const N: usize>(fr: &Frozen<'_>, input: Input, sigma: f64, dx: &[f64; 6
     }
     // δτ per main column and tendon at the current node.
     let mut dtau = vec![vec![0.0; nt]; nm];
-    let pressure_of = |c: usize| match input {
-        Input::Pressure(j) if c == 0 => Some((j, sigma)),
+    let pressure_of = |c: usize| match inputs.get(c) {
+        Some(Input::Pressure(j)) => Some((*j, sigma)),
         _ => None,
     };
-    if let Input::Tendon(k) = input {
-        dtau[0][k] = sigma;
+    for (c, input) in inputs.iter().enumerate() {
+        if let Input::Tendon(k) = input {
+            dtau[c][*k] = sigma;
+        }
     }
     let mut interval = 0;
     let (mut ta, mut dta) = {
@@ -724,12 +734,20 @@ fn march<const N: usize>(fr: &Frozen<'_>, input: Input, sigma: f64, dx: &[f64; 6
                 load_factor: 1.0,
             });
         }
-        let (br, z0) = rule.branches(&lo[0], &hi[0])?;
-        let mut zs = vec![z0];
-        for c in 1..nm {
-            zs.push(rule.solve(&br, &lo[c], &hi[c])?);
+        // Each input's column on its own branches, the base-wrench ones on the first's.
+        let mut zs = Vec::with_capacity(nm);
+        let mut first = Vec::new();
+        for c in 0..n_in {
+            let (br, z) = rule.branches(&lo[c], &hi[c])?;
+            if c == 0 {
+                first = br;
+            }
+            zs.push(z);
         }
-        branches.extend_from_slice(&br);
+        for c in n_in..nm {
+            zs.push(rule.solve(&first, &lo[c], &hi[c])?);
+        }
+        branches.extend_from_slice(&first);
         // The main columns with their distal tension changes.
         let mut y_next = y1;
         for (c, z) in zs.iter().enumerate() {
@@ -823,7 +841,7 @@ fn directional<const N: usize>(
     let mut dx = [0.0; 6];
     let mut last: Option<Vec<Branch>> = None;
     for pass in 0..MAX_BRANCH_PASSES {
-        let p = march::<N>(fr, input, sigma, &dx)?;
+        let p = march::<N>(fr, &[input], sigma, &dx)?;
         if fr.nb == 0 {
             return Ok(p.poses.iter().map(|c| c[0] * sigma).collect());
         }
@@ -946,15 +964,36 @@ pub(crate) fn frictional_actuation_jacobians(
     let frictional = mus.iter().filter(|&&m| m > 0.0).count();
     let need = 1 + nb + frictional;
     let mut out = vec![DMatrix::zeros(6, nt + nc); nodes.len()];
-    let inputs = (0..nt)
+    let inputs: Vec<(usize, Input)> = (0..nt)
         .map(Input::Tendon)
-        .chain((0..nc).map(Input::Pressure));
-    for (col, input) in inputs.enumerate() {
-        if let (Input::Tendon(k), Direction::Release) = (input, direction) {
-            if fr.base[k] == 0.0 {
-                continue;
+        .chain((0..nc).map(Input::Pressure))
+        .enumerate()
+        .filter(|(_, input)| match (input, direction) {
+            (Input::Tendon(k), Direction::Release) => fr.base[*k] != 0.0,
+            _ => true,
+        })
+        .collect();
+    if nb == 0 {
+        // No base-wrench change: every input's column in one march (as many as fit).
+        let per = (width(24) - STATE) / COLUMN - frictional;
+        for chunk in inputs.chunks(per.max(1)) {
+            let ins: Vec<Input> = chunk.iter().map(|(_, i)| *i).collect();
+            let sigma = direction.sign();
+            let p = match chunk.len() + frictional {
+                0..=6 => march::<{ width(6) }>(&fr, &ins, sigma, &[0.0; 6])?,
+                7..=12 => march::<{ width(12) }>(&fr, &ins, sigma, &[0.0; 6])?,
+                13..=18 => march::<{ width(18) }>(&fr, &ins, sigma, &[0.0; 6])?,
+                _ => march::<{ width(24) }>(&fr, &ins, sigma, &[0.0; 6])?,
+            };
+            for (c, (col, _)) in chunk.iter().enumerate() {
+                for (m, &node) in out.iter_mut().zip(nodes) {
+                    m.set_column(*col, &(p.poses[node][c] * sigma));
+                }
             }
         }
+        return Ok(out);
+    }
+    for (col, input) in inputs {
         let poses = match need {
             0..=6 => directional::<{ width(6) }>(&fr, input, direction)?,
             7..=12 => directional::<{ width(12) }>(&fr, input, direction)?,
