@@ -1,5 +1,7 @@
 """Benchmark of the frictional solve against the frictionless one on the two-segment NiTi robot;
-prints a table of medians and their ratio (both timed side by side in one run).
+prints a table of medians and their ratio (both timed side by side in one run). With
+``--jacobian``: the actuation Jacobian of the frictional equilibrium (pull and release) against
+the frictionless one instead.
 
 Run: ``python benchmarks/bench_friction.py`` (after ``pip install .``).
 """
@@ -47,8 +49,12 @@ def main() -> None:
     ap.add_argument(
         "--clock", choices=("wall", "cpu"), default="wall", help="wall time or process CPU time"
     )
+    ap.add_argument("--jacobian", action="store_true", help="time the actuation Jacobians")
     a = ap.parse_args()
     timer = median_time if a.clock == "wall" else median_cpu_time
+    if a.jacobian:
+        jacobians(timer, a.calls, a.repeats)
+        return
     release = [3.0, 0, 0, 0, 2.0, 0]
     head = f"{'case':<40} {'frictionless (us)':>18} {'frictional (us)':>16}"
     print(f"{head} {'ratio':>6} {'marches':>8}")
@@ -74,6 +80,31 @@ def main() -> None:
                 f"{label:<40} {base * 1e6:18.1f} {t * 1e6:16.1f} {t / base:6.2f} "
                 f"{sol.friction_iterations:8d}"
             )
+
+
+def jacobians(timer, calls: int, repeats: int) -> None:
+    """The actuation Jacobian at [3, 0, 0, 0, 1, 0] N loaded from rest: frictionless, and
+    frictional (pull, release) with the frictional solve beside it."""
+    tensions = [3.0, 0, 0, 0, 1.0, 0]
+    head = f"{'case':<28} {'frictionless J (us)':>20} {'pull J (us)':>12} {'release J (us)':>15}"
+    print(f"{head} {'frictional solve (us)':>22}")
+    for tip in (None, TIP_FORCE):
+        plain = robot(0.0, tip).solve(tensions)
+        r = robot(0.2, tip)
+        sol = r.solve(tensions)
+        times = [
+            timer(lambda s=plain: softrod.actuation_jacobian(s), calls=calls, repeats=repeats),
+            timer(lambda s=sol: softrod.actuation_jacobian(s), calls=calls, repeats=repeats),
+            timer(
+                lambda s=sol: softrod.actuation_jacobian(s, direction=-1),
+                calls=calls,
+                repeats=repeats,
+            ),
+            timer(lambda r=r: r.solve(tensions), calls=calls, repeats=repeats),
+        ]
+        label = "mu = 0.2, " + ("unloaded" if tip is None else "tip force")
+        t = [x * 1e6 for x in times]
+        print(f"{label:<28} {t[0]:20.1f} {t[1]:12.1f} {t[2]:15.1f} {t[3]:22.1f}")
 
 
 if __name__ == "__main__":

@@ -138,3 +138,53 @@ def test_displacement_control_with_friction_round_trip():
         assert sol.frictional
         np.testing.assert_allclose(sol.tendon_tension, target.tendon_tension, rtol=0, atol=3e-8)
         np.testing.assert_allclose(sol.position, target.position, rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("tip_force", [None, [0.05, -0.02, 0.0]])
+def test_one_sided_actuation_jacobian_is_the_one_sided_difference(tip_force):
+    # Oracle: the one-sided difference of the solve continued from the solution
+    # (previous=solution), forward for pull and backward for release, at steps h and h/10:
+    # O(h) apart from the Jacobian, their Richardson extrapolation O(h^2) plus the solve's
+    # resolution of the profile (1e-9 of the largest tension, 3e-9 N, by default) divided by
+    # h: about 2e-6 relative for pull, 1e-5 for release (its slope is 40 times smaller: the
+    # tendon sticks; the larger step keeps within the first cell's sticking range).
+    robot = niti(0.2, tip_force)
+    tensions = np.array([3.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+    sol = robot.solve(tensions, steps=40)
+    for direction, h, bound in ((1, 1e-3, 1e-5), (-1, 3e-3, 5e-5)):
+        jac = softrod.actuation_jacobian(sol, direction=direction)
+        assert jac.shape == (6, 6)
+        for i in (0, 1, 4):
+            if direction < 0 and tensions[i] == 0.0:
+                # A slack tendon cannot be released: its release column is zero.
+                assert np.all(jac[:, i] == 0.0)
+                continue
+            diff = []
+            for step in (h, h / 10):
+                t = tensions.copy()
+                t[i] += direction * step
+                nxt = robot.solve(t, steps=40, previous=sol)
+                diff.append((nxt.tip_position - sol.tip_position) / (direction * step))
+            extrapolated = (10.0 * diff[1] - diff[0]) / 9.0
+            col = jac[:3, i]
+            err = [np.linalg.norm(d - col) / np.linalg.norm(col) for d in diff]
+            e = np.linalg.norm(extrapolated - col) / np.linalg.norm(col)
+            assert err[1] < 0.3 * err[0], (direction, i, err)
+            assert e < bound, (direction, i, e, err)
+    # Pull and release differ (sliding against sticking); "pull"/"release" name them.
+    pull = softrod.actuation_jacobian(sol, node=-1, direction="pull")
+    release = softrod.actuation_jacobian(sol, direction="release")
+    assert np.array_equal(pull, softrod.actuation_jacobian(sol))
+    assert np.linalg.norm(pull[:3, 0] - release[:3, 0]) > 0.5 * np.linalg.norm(pull[:3, 0])
+
+
+def test_actuation_jacobian_direction_is_checked():
+    sol = niti(0.2).solve([3.0, 0, 0, 0, 1.0, 0], steps=40)
+    for bad in (0, 2, "push", True, 1.5):
+        with pytest.raises((ValueError, TypeError), match="direction"):
+            softrod.actuation_jacobian(sol, direction=bad)
+    # Without friction both directions are the frictionless Jacobian.
+    plain = niti(0.0).solve([3.0, 0, 0, 0, 1.0, 0], steps=40)
+    assert np.array_equal(
+        softrod.actuation_jacobian(plain, direction=-1), softrod.actuation_jacobian(plain)
+    )

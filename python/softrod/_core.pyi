@@ -572,9 +572,15 @@ def _pcc_inverse_statics(
 def actuation_jacobian(
     solution: StaticsSolution | PccSolution,
     node: int = ...,
+    direction: int | Literal["pull", "release"] | None = ...,
 ) -> NDArray[np.float64]:
     """d[δp; δθ] (world; m, rad) of node ``node`` / d(tensions (N), pressures (Pa)),
-    shape (6, n_tendons + n_chambers); exact (linearised boundary-value problem)."""
+    shape (6, n_tendons + n_chambers); exact (linearised boundary-value problem).
+
+    For a frictional equilibrium the derivative is one-sided: ``direction=1`` ("pull",
+    default) for increasing inputs continued from the solution (``previous=solution``),
+    ``-1`` ("release") for decreasing ones, the column ``(f(a) - f(a - h e)) / h``; the
+    release column of a slack tendon is zero. Other solutions: both directions agree."""
 
 # ----------------------------------------------------------------------------- materials
 

@@ -640,9 +640,11 @@ def _define_targets() -> None:
             ),
         )
     )
-    t("actuation_jacobian")(lambda d: (sr.actuation_jacobian, dict(solution=_solution(), node=10)))
+    t("actuation_jacobian")(
+        lambda d: (sr.actuation_jacobian, dict(solution=_solution(), node=10, direction=1))
+    )
     t("actuation_jacobian(pcc)")(
-        lambda d: (sr.actuation_jacobian, dict(solution=_pcc_solution(), node=-1))
+        lambda d: (sr.actuation_jacobian, dict(solution=_pcc_solution(), node=-1, direction=1))
     )
     t("inverse_statics")(
         lambda d: (

@@ -59,9 +59,10 @@ pub use cosserat::friction::{
     friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
     Slip,
 };
+pub use cosserat::friction_linear::{frictional_tip_compliance, Direction};
 pub use cosserat::sensitivity::{
-    actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
-    Parameter, Sensitivities,
+    actuation_jacobian, actuation_jacobians, actuation_parameters, directional_actuation_jacobian,
+    sensitivities, Linearisation, Parameter, Sensitivities,
 };
 pub use cosserat::statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,

@@ -481,18 +481,27 @@ fn cycle_dissipation_is_friction_force_times_slip() {
     }
 }
 
+/// The actuation Jacobian of a frictional equilibrium is the one-sided pull one
+/// (`friction_jacobian.rs` checks both directions against one-sided differences), at every
+/// node `actuation_jacobians` asks for.
 #[test]
-fn the_actuation_jacobian_of_a_frictional_equilibrium_is_refused_by_name() {
+fn the_actuation_jacobian_of_a_frictional_equilibrium_is_the_pull_one() {
+    use softrod::{actuation_jacobians, Direction, Linearisation};
     let model = niti(0.2, Vector3::zeros());
     let act = Actuation::tensions(&[3.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     let sol = solve_frictional(&model, &act, &options(50), None).unwrap();
-    let e = softrod::actuation_jacobian(&sol.statics, None).unwrap_err();
-    assert!(e.to_string().contains("solution"), "{e}");
-    assert!(e.to_string().contains("friction"), "{e}");
-    // Without friction the profile-free Jacobian is unchanged.
-    let plain = niti(0.0, Vector3::zeros());
-    let sol = solve_frictional(&plain, &act, &options(50), None).unwrap();
-    assert!(softrod::actuation_jacobian(&sol.statics, None).is_ok());
+    let pull = softrod::actuation_jacobian(&sol.statics, None).unwrap();
+    let same =
+        softrod::directional_actuation_jacobian(&sol.statics, None, Direction::Pull).unwrap();
+    let release =
+        softrod::directional_actuation_jacobian(&sol.statics, None, Direction::Release).unwrap();
+    assert_eq!(pull, same);
+    assert!((&pull - &release).amax() > 1e-2 * pull.amax());
+    let last = sol.statics.s.len() - 1;
+    let both = actuation_jacobians(&sol.statics, &[10, last], Linearisation::Tension).unwrap();
+    assert_eq!(both[1], pull);
+    let mid = softrod::directional_actuation_jacobian(&sol.statics, Some(10), Direction::Pull);
+    assert_eq!(both[0], mid.unwrap());
 }
 
 /// The NiTi robot with friction `mu` on every tendon under `loads`.

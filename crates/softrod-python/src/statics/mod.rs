@@ -313,14 +313,22 @@ pub(crate) fn solve_statics<'py>(
 /// end; PCC: the tip only) with respect to each tendon tension (per N), then each chamber
 /// pressure (per Pa), every tendon at fixed tension; shape (6, n_tendons + n_chambers). Exact:
 /// from the linearised boundary-value problem (Cosserat) or the equilibrium Jacobian (PCC),
-/// no finite differences.
+/// no finite differences. For a frictional equilibrium the derivative is one-sided:
+/// `direction` 1 (default, None: the same; "pull": increasing inputs, continued from the solution) or -1
+/// ("release": decreasing inputs, the column `(f(a) - f(a - h e)) / h`); for any other
+/// solution the two agree.
 #[pyfunction]
-#[pyo3(signature = (solution, node=-1))]
+#[pyo3(signature = (solution, node=-1, direction=None))]
 pub(crate) fn actuation_jacobian<'py>(
     py: Python<'py>,
     solution: Bound<'py, PyAny>,
     #[pyo3(from_py_with = arg::node)] node: i64,
+    direction: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let direction = match &direction {
+        Some(d) => jacobian_direction(d)?,
+        None => softrod::Direction::Pull,
+    };
     let to_array = |m: &softrod::nalgebra::DMatrix<f64>| {
         Array::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
     };
@@ -336,7 +344,7 @@ pub(crate) fn actuation_jacobian<'py>(
             ));
         }
         let j = run(py, "actuation_jacobian", || {
-            softrod::actuation_jacobian(inner, Some(index as usize))
+            softrod::directional_actuation_jacobian(inner, Some(index as usize), direction)
         })?;
         return Ok(to_array(&j));
     }
@@ -358,6 +366,32 @@ pub(crate) fn actuation_jacobian<'py>(
         "solution",
         &solution,
         "a StaticsSolution or a PccSolution",
+    ))
+}
+
+/// The direction of a one-sided Jacobian: 1 or "pull", -1 or "release".
+fn jacobian_direction(value: &Bound<'_, PyAny>) -> PyResult<softrod::Direction> {
+    if value.is_instance_of::<pyo3::types::PyBool>() {
+        // A bool is an int in Python: not a direction.
+    } else if let Ok(v) = value.extract::<i64>() {
+        match v {
+            1 => return Ok(softrod::Direction::Pull),
+            -1 => return Ok(softrod::Direction::Release),
+            _ => {}
+        }
+    } else if let Ok(v) = value.extract::<String>() {
+        match v.as_str() {
+            "pull" => return Ok(softrod::Direction::Pull),
+            "release" => return Ok(softrod::Direction::Release),
+            _ => {}
+        }
+    }
+    Err(param_err(
+        "direction",
+        value
+            .repr()
+            .map_or_else(|_| "?".to_string(), |r| r.to_string()),
+        "1 or 'pull' (increasing inputs), -1 or 'release' (decreasing inputs)",
     ))
 }
 

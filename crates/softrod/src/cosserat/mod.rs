@@ -9,6 +9,7 @@ pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
 mod friction_held;
+pub mod friction_linear;
 mod friction_march;
 mod guides;
 mod hyperelastic_local;
@@ -23,9 +24,10 @@ pub use friction::{
     friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideState,
     Slip,
 };
+pub use friction_linear::{frictional_tip_compliance, Direction};
 pub use sensitivity::{
-    actuation_jacobian, actuation_jacobians, actuation_parameters, sensitivities, Linearisation,
-    Parameter, Sensitivities,
+    actuation_jacobian, actuation_jacobians, actuation_parameters, directional_actuation_jacobian,
+    sensitivities, Linearisation, Parameter, Sensitivities,
 };
 pub(crate) use stability::{tip_stability, Stability};
 pub use stability::{CONSTRAINT_COMPLIANCE, NEUTRAL_MARGIN};

@@ -49,6 +49,7 @@ use super::equations::{
     col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, DM, DN,
     DR, STATE,
 };
+use super::friction_linear::{frictional_actuation_jacobians, Direction};
 use super::shooting::Node;
 use super::statics::{Integrator, StaticsSolution};
 use crate::error::{Error, Result};
@@ -937,7 +938,9 @@ pub fn sensitivities(
 /// The actuation Jacobian of `solution` at node `node` (default: the tip): the derivative of
 /// the node's pose twist `[δp; δθ]` (world frame; m and rad) with respect to each tendon
 /// tension (per N, every tendon at fixed tension), then each chamber pressure (per Pa);
-/// shape 6 × (n_tendons + n_chambers).
+/// shape 6 × (n_tendons + n_chambers). For a frictional equilibrium, the one-sided
+/// derivative for increasing inputs ([`directional_actuation_jacobian`] with
+/// [`Direction::Pull`]).
 ///
 /// # Errors
 /// As [`sensitivities`] (`node` out of range).
@@ -945,6 +948,50 @@ pub fn actuation_jacobian(solution: &StaticsSolution, node: Option<usize>) -> Re
     let node = node_or_tip(solution, node)?;
     let mut jac = actuation_jacobians(solution, &[node], Linearisation::Tension)?;
     Ok(jac.pop().unwrap_or_else(|| DMatrix::zeros(6, 0)))
+}
+
+/// The one-sided actuation Jacobian of `solution` at node `node` (default: the tip) in
+/// `direction`: for a frictional equilibrium (a [`crate::FrictionalSolution`]'s `statics`)
+/// the derivative for increasing inputs ([`Direction::Pull`], continued from the solution:
+/// sliding elements slide on when pushed further, the others stick) or for decreasing ones
+/// ([`Direction::Release`]), see `cosserat::friction_linear`; for any other solution
+/// [`actuation_jacobian`] (the two directions agree). Shape 6 × (n_tendons + n_chambers),
+/// per N and per Pa.
+///
+/// # Errors
+/// As [`sensitivities`] (`node` out of range); [`Error::NotConverged`] if the slip branches
+/// of the frictional linearisation do not settle.
+pub fn directional_actuation_jacobian(
+    solution: &StaticsSolution,
+    node: Option<usize>,
+    direction: Direction,
+) -> Result<DMatrix<f64>> {
+    let node = node_or_tip(solution, node)?;
+    let mut jac = match frictional(solution, &[node], Linearisation::Tension, direction) {
+        Some(j) => j?,
+        None => actuation_jacobians(solution, &[node], Linearisation::Tension)?,
+    };
+    Ok(jac.pop().unwrap_or_else(|| DMatrix::zeros(6, 0)))
+}
+
+/// The actuation Jacobians of a frictional equilibrium (`None` for any other solution).
+fn frictional(
+    solution: &StaticsSolution,
+    nodes: &[usize],
+    lin: Linearisation,
+    direction: Direction,
+) -> Option<Result<Vec<DMatrix<f64>>>> {
+    solution.actuation.profile.as_ref()?;
+    let model = &*solution.model;
+    model.tendons().iter().position(|t| t.friction() > 0.0)?;
+    // A frictional solve at fixed displacement reports the tension-controlled equilibrium
+    // it found (its actuation holds the base tensions): the derivative is at fixed base
+    // tensions either way.
+    let _ = lin;
+    Some(
+        check_nodes(solution, nodes)
+            .and_then(|observe| frictional_actuation_jacobians(solution, &observe, direction)),
+    )
 }
 
 /// The node index `node` or the tip.
@@ -985,21 +1032,9 @@ pub fn actuation_jacobians(
     nodes: &[usize],
     lin: Linearisation,
 ) -> Result<Vec<DMatrix<f64>>> {
-    // The Jacobian of a frictional equilibrium depends on its stick/slip state: not modelled
-    // (the linearisation would propagate a tension change along the whole tendon).
-    if solution.actuation.profile.is_some() {
-        if let Some(i) = solution
-            .model
-            .tendons()
-            .iter()
-            .position(|t| t.friction() > 0.0)
-        {
-            return Err(Error::invalid(
-                "solution",
-                format!("a frictional equilibrium (tendons[{i}].friction > 0)"),
-                "a frictionless solution (the actuation Jacobian with friction is not modelled)",
-            ));
-        }
+    // A frictional equilibrium: the one-sided derivative for increasing inputs.
+    if let Some(j) = frictional(solution, nodes, lin, Direction::Pull) {
+        return j;
     }
     let params = actuation_parameters(solution, lin);
     let observe = check_nodes(solution, nodes)?;
