@@ -10,6 +10,7 @@
 //! arc length, point, normal and force.
 
 mod constraint;
+mod friction;
 mod jacobian;
 mod mesh;
 mod obstacle;
@@ -37,6 +38,21 @@ pub(crate) fn obstacle_normal_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<
     (t1, n.cross(&t1))
 }
 
+/// How a contact's tangential force is determined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ContactState {
+    /// Frictionless obstacle: no tangential force.
+    Frictionless,
+    /// Coulomb friction, sticking: the contact point has not moved along the surface from
+    /// where it first touched (under the proportional load path of the solve), and the
+    /// tangential force is inside the cone, `|f_t| <= μ f_n`.
+    Stick,
+    /// Coulomb friction, sliding: the tangential force is on the cone, `|f_t| = μ f_n`,
+    /// opposite to the slip (the displacement of the contact point along the surface from
+    /// where it first touched).
+    Slide,
+}
+
 /// One active contact of a solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
@@ -55,8 +71,11 @@ pub struct Contact {
     pub normal: [f64; 3],
     /// Normal force on the rod (N, >= 0).
     pub normal_force: f64,
-    /// Tangential (friction) force on the rod (N, world); zero without friction.
+    /// Tangential (friction) force on the rod (N, world; normal to `normal`); zero without
+    /// friction.
     pub tangential_force: [f64; 3],
+    /// Frictionless, sticking or sliding.
+    pub state: ContactState,
 }
 
 /// A solution of [`solve_constrained`].
