@@ -453,6 +453,7 @@ class PlaneSpec(_Table):
     type: Literal["plane"]
     point: _vec(3, "a point of the plane (m, world)")
     normal: _vec(3, "outward normal (world; any nonzero length)")
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class SphereSpec(_Table):
@@ -461,6 +462,7 @@ class SphereSpec(_Table):
     type: Literal["sphere"]
     center: _vec(3, "centre (m, world)")
     radius: _num("radius (m)", gt=0)
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class CapsuleSpec(_Table):
@@ -470,6 +472,7 @@ class CapsuleSpec(_Table):
     a: _vec(3, "first end of the axis (m, world)")
     b: _vec(3, "second end of the axis (m, world)")
     radius: _num("radius (m)", gt=0)
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class CylinderSpec(_Table):
@@ -479,6 +482,7 @@ class CylinderSpec(_Table):
     a: _vec(3, "centre of the first cap (m, world)")
     b: _vec(3, "centre of the second cap (m, world)")
     radius: _num("radius (m)", gt=0)
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class MeshSpec(_Table):
@@ -507,6 +511,7 @@ class MeshSpec(_Table):
         ]
         | None
     ) = None
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
     @model_validator(mode="after")
     def _one_source(self) -> MeshSpec:
