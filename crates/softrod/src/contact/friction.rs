@@ -31,6 +31,8 @@ const CONE_SLACK: f64 = 1e-9;
 const MAX_TOUCH_ITERATIONS: usize = 16;
 /// Half-width (relative) of the bracket of load factors about a first touch searched again.
 const RETOUCH_SPAN: f64 = 1e-2;
+/// Newton tolerance (at most) of the solves of the first-touch search.
+const TOUCH_TOLERANCE: f64 = 1e-10;
 /// Gap (relative to the rod length) at which the first-touch search stops.
 const TOUCH_GAP: f64 = 1e-13;
 
@@ -67,8 +69,13 @@ impl Constrained<'_> {
         let mu = self.obstacles[a.obstacle].friction();
         let normal = f.dot(&n);
         let ft = f - n * normal;
-        let u = d - n * d.dot(&n);
-        let r = ft + u * (mu * normal / u.norm().max(SLIP_FLOOR * l));
+        let r = match a.direction {
+            Some(e) => ft + e * (mu * normal),
+            None => {
+                let u = d - n * d.dot(&n);
+                ft + u * (mu * normal / u.norm().max(SLIP_FLOOR * l))
+            }
+        };
         rows.push(r.dot(&t1));
         rows.push(r.dot(&t2));
     }
@@ -95,12 +102,19 @@ impl Constrained<'_> {
 
 /// The state a tip contact with friction turns to at the converged `x` (the last pass at
 /// it), if any: the first sticking contact whose tangential force is outside the cone
-/// slides, the first sliding contact whose slip is back below [`SLIP_FLOOR`] sticks.
+/// slides (with the slip direction its force opposes, to start from: at the sticking
+/// solution the slip is zero), the first sliding contact whose slip is back below
+/// [`SLIP_FLOOR`] sticks. Not on a coarse mesh, whose Newton tolerance leaves the held
+/// displacements errors that the rod's axial stiffness turns into spurious forces: its
+/// contacts stick, and the mesh asked decides.
 pub(super) fn switch(
     p: &Constrained<'_>,
     x: &[f64],
     opts: &NewtonOptions,
-) -> Option<(usize, ContactState)> {
+) -> Option<(usize, ContactState, Option<Vector3<f64>>)> {
+    if !p.refine {
+        return None;
+    }
     let y = p.last.as_ref()?.nodes.last()?.y;
     let l = p.model.length();
     let fs = p.model.force_scale();
@@ -111,20 +125,21 @@ pub(super) fn switch(
         let (pc, n, _) = p.tip_point(a, &y);
         let f = Vector3::new(x[o], x[o + 1], x[o + 2]) * fs;
         let normal = f.dot(&n);
-        let tangential = (f - n * normal).norm();
+        let ft = f - n * normal;
+        let tangential = ft.norm();
         let mu = p.obstacles[a.obstacle].friction();
         match a.state {
             ContactState::Stick => {
                 let slack = CONE_SLACK * normal.abs().max(opts.tolerance * fs);
                 if tangential > mu * normal + slack {
-                    return Some((i, ContactState::Slide));
+                    return Some((i, ContactState::Slide, Some(-ft / tangential)));
                 }
             }
             _ => {
                 let d = pc - a.reference;
                 let u = d - n * d.dot(&n);
                 if u.norm() < SLIP_FLOOR * l {
-                    return Some((i, ContactState::Stick));
+                    return Some((i, ContactState::Stick, None));
                 }
             }
         }
@@ -165,6 +180,12 @@ pub(super) fn first_touch(
     let l = p.model.length();
     let mut touch = here;
     let mut found = (target, false);
+    // The sticking rows hold the touch point along the rod too, where the rod is stiffest
+    // (E A / L): the touch is solved to round-off, also on a coarse mesh.
+    let refine = std::mem::replace(&mut p.refine, true);
+    let mut strict = *opts;
+    strict.tolerance = opts.tolerance.min(TOUCH_TOLERANCE);
+    let opts = &strict;
     p.load = from;
     if let Some(mut xs) = correct(p, x, opts, effort) {
         if let Some((start, g0)) = at(p) {
@@ -188,7 +209,8 @@ pub(super) fn first_touch(
                     break;
                 };
                 (touch, found) = (pc, (lambda, true));
-                if g.abs() <= TOUCH_GAP * l {
+                if g.abs() <= TOUCH_GAP * l || g == ga || g == gb {
+                    // Found, or the gap no longer moves (Newton within its tolerance).
                     break;
                 }
                 if g > 0.0 {
@@ -208,6 +230,7 @@ pub(super) fn first_touch(
         }
     }
     p.load = target;
+    p.refine = refine;
     Some((touch, found.0, found.1))
 }
 

@@ -133,6 +133,8 @@ pub(super) struct Active {
     pub(super) reference: Vector3<f64>,
     pub(super) touch: f64,
     pub(super) t0: [f64; 2],
+    /// A slip direction (unit, world) held while a contact turns from sticking to sliding.
+    pub(super) direction: Option<Vector3<f64>>,
 }
 
 impl Active {
@@ -147,6 +149,7 @@ impl Active {
             reference: Vector3::zeros(),
             touch: 0.0,
             t0: [0.0; 2],
+            direction: None,
         }
     }
 }
@@ -1200,8 +1203,14 @@ fn active_set(
             continue;
         }
         // Sticking outside the cone, or sliding back to where it touched.
-        if let Some((i, state)) = switch(p, &x, opts) {
+        if let Some((i, state, direction)) = switch(p, &x, opts) {
             p.active[i].state = state;
+            if direction.is_some() {
+                // First along the slip the sticking force pushed to, then free to turn.
+                p.active[i].direction = direction;
+                x = correct(p, &x, opts, effort)?;
+                p.active[i].direction = None;
+            }
             x = correct(p, &x, opts, effort)?;
             continue;
         }
