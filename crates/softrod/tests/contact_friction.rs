@@ -221,3 +221,26 @@ fn bad_friction_and_interior_friction_are_named_errors() {
     println!("{e}");
     assert!(e.to_string().contains("friction"), "{e}");
 }
+
+/// Compliance under a sticking tip contact: the tip is held along the normal and along the
+/// surface, so its translation per tip force is zero (≤ 1e-9 of the contact-free `L³/(3EI)`)
+/// in every direction, while a frictionless contact lets it slide along the plane
+/// (`C_yy = L³/(3EI)` to 1e-3).
+#[test]
+fn a_sticking_tip_contact_holds_the_tip_in_the_compliance() {
+    let (ei, fc) = constants();
+    let free = L.powi(3) / (3.0 * ei);
+    let force = Vector3::new(-2.0 * fc, 0.5 * fc, 0.0);
+    let stick = solve(force, &plane(0.5));
+    assert_eq!(stick.contacts[0].state, ContactState::Stick);
+    let c = stick.compliance.get().unwrap();
+    let worst = c.fixed_view::<3, 3>(0, 0).amax();
+    println!("sticking: largest translational compliance {worst:e} m/N (free {free:e})");
+    assert!(worst <= 1e-9 * free, "{c}");
+    let slide = solve(force, &plane(0.0)).compliance.get().unwrap();
+    println!(
+        "frictionless: C_yy = {:e} (L^3/3EI = {free:e})",
+        slide[(1, 1)]
+    );
+    assert!((slide[(1, 1)] / free - 1.0).abs() < 1e-3);
+}

@@ -1295,7 +1295,8 @@ fn step_loads(
 }
 
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
-/// the rod's surface kept out of `obstacles` by frictionless unilateral contact.
+/// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
+/// Coulomb friction at the tip: see [`Obstacle::with_friction`] and [`ContactState`]).
 ///
 /// The unknowns are the base wrench (as in [`solve_statics`]), the force of every active
 /// contact and, for a contact inside the rod, its arc length; the residual the tip
@@ -1309,7 +1310,9 @@ fn step_loads(
 /// continuation when the direct solve fails.
 ///
 /// # Errors
-/// As [`solve_statics`] for the model, actuation and options; [`Error::NotConverged`] (with
+/// As [`solve_statics`] for the model, actuation and options; [`Error::InvalidParameter`]
+/// naming `friction` when an obstacle with friction is touched inside the rod (friction is
+/// modelled at tip contacts only); [`Error::NotConverged`] (with
 /// the iterations, residual and load factor reached) when no equilibrium with a consistent
 /// active set is found and `options.newton.throw` is set.
 pub fn solve_constrained(
