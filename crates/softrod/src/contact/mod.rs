@@ -17,6 +17,7 @@ mod mesh;
 mod obstacle;
 mod solve;
 mod stability;
+mod sweep;
 
 use std::sync::Arc;
 

@@ -9,6 +9,7 @@ use super::constraint::TipConstraint;
 use super::friction::{first_touch, retouch, switch};
 use super::obstacle::Obstacle;
 use super::stability::{conjugate_points, free_stiffness};
+use super::sweep::{least_gap_in_cell, CellEnd};
 use super::{obstacle_normal_basis, Contact, ContactCompliance, ContactSolution, ContactState};
 use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL, STATE};
 use crate::cosserat::shooting::{Node, Shooting};
@@ -583,11 +584,11 @@ impl<'m> Constrained<'m> {
 
     /// The gap (m) and outward normal of obstacle `o` at every node of the last pass (first
     /// copy of a break).
-    fn gaps(&self, o: usize) -> Vec<(usize, f64, f64, Vector3<f64>)> {
+    fn gaps(&self, o: usize) -> Vec<GapSample> {
         let Some(pass) = &self.last else {
             return Vec::new();
         };
-        let mut out: Vec<(usize, f64, f64, Vector3<f64>)> = Vec::new();
+        let mut out: Vec<GapSample> = Vec::new();
         for (j, n) in pass.nodes.iter().enumerate() {
             if out.last().is_some_and(|l| l.1 == n.s) {
                 continue;
@@ -597,6 +598,32 @@ impl<'m> Constrained<'m> {
             out.push((j, n.s, d - r, normal));
         }
         out
+    }
+
+    /// The arc length (m) where the rod's surface runs deepest into obstacle `o` between two
+    /// consecutive nodes of the last pass whose own gaps `(j, s, gap, _)` do not show it (an
+    /// obstacle thinner than the node spacing), if it runs in by more than `penetration` and a
+    /// thousandth of the cell ([`sweep`](super::sweep)).
+    fn penetration_in_cell(
+        &self,
+        o: usize,
+        (a, b): (&GapSample, &GapSample),
+        penetration: f64,
+    ) -> Option<f64> {
+        let pass = self.last.as_ref()?;
+        let h = b.1 - a.1;
+        let end = |j: usize, s: f64| {
+            let y = &pass.nodes[j].y;
+            CellEnd {
+                point: v3(y, 0),
+                tangent: rot(y) * Vector3::z() * h,
+                radius: pass.model.rod().section_at(s).radius,
+            }
+        };
+        let threshold = -penetration.max(1e-3 * h);
+        let (ea, eb) = (end(a.0, a.1), end(b.0, b.1));
+        least_gap_in_cell(&self.obstacles[o], (&ea, a.2), (&eb, b.2), threshold)
+            .map(|(t, _)| a.1 + t * h)
     }
 
     /// The normal force (N, signed) and normal of each active contact at `x` (last pass).
@@ -1004,6 +1031,9 @@ fn normal_step(p: &Constrained<'_>, x: &[f64], j: &[f64], r: &[f64]) -> Option<V
     Some(dx)
 }
 
+/// The gap at a node of the last pass: `(node index, s (m), gap (m), outward normal)`.
+type GapSample = (usize, f64, f64, Vector3<f64>);
+
 /// Normal forces, normal, arc length and point of each active contact at `x`.
 pub(super) type Forces = Vec<(f64, Vector3<f64>, f64, Vector3<f64>)>;
 
@@ -1039,10 +1069,39 @@ fn candidates(p: &Constrained<'_>, forces: &Forces, penetration: f64) -> Vec<(us
     added
 }
 
+/// New contacts where the rod runs into an obstacle between two nodes whose own gaps do not
+/// show it (an obstacle thinner than the node spacing), away from the active contacts: the
+/// last check of the active set, once no node penetrates.
+fn cell_candidates(
+    p: &Constrained<'_>,
+    forces: &Forces,
+    penetration: f64,
+) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let mut added = Vec::new();
+    for o in 0..p.obstacles.len() {
+        let g = p.gaps(o);
+        for i in 1..g.len() {
+            let (s0, s1) = (g[i - 1].1, g[i].1);
+            let near = |s: f64| s >= s0 - 1e-12 * l && s <= s1 + 1e-12 * l;
+            let covered = forces.iter().zip(&p.active).any(|(f, a)| {
+                a.obstacle == o && (near(f.2) || (a.site == Site::Interval && s1 >= f.2))
+            });
+            if covered || g[i - 1].2 < -penetration || g[i].2 < -penetration {
+                continue;
+            }
+            if let Some(s) = p.penetration_in_cell(o, (&g[i - 1], &g[i]), penetration) {
+                added.push((o, Site::Interior, s));
+            }
+        }
+    }
+    added
+}
+
 /// The arc length of the least gap of the parabola through three consecutive samples
 /// `(_, s, gap, _)` whose middle one is a local minimum (its own arc length if the three are
 /// collinear): a new contact starts where the gap is least, not at the nearest node.
-fn parabola_minimum(g: &[(usize, f64, f64, Vector3<f64>)]) -> f64 {
+fn parabola_minimum(g: &[GapSample]) -> f64 {
     let ((_, s0, g0, _), (_, s1, g1, _), (_, s2, g2, _)) = (g[0], g[1], g[2]);
     let (h0, h1) = (s1 - s0, s2 - s1);
     let (d0, d1) = ((g1 - g0) / h0, (g2 - g1) / h1);
@@ -1214,7 +1273,10 @@ fn active_set(
             x = correct(p, &x, opts, effort)?;
             continue;
         }
-        let added = candidates(p, &forces, penetration);
+        let mut added = candidates(p, &forces, penetration);
+        if added.is_empty() {
+            added = cell_candidates(p, &forces, penetration);
+        }
         if let Some(&(o, _, _)) = added
             .iter()
             .find(|(o, site, _)| *site != Site::Tip && p.obstacles[*o].friction() > 0.0)

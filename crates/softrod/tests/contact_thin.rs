@@ -1,0 +1,94 @@
+//! Obstacles thinner than the integration mesh: a wire (a capsule of radius 0.2 mm) across a
+//! cantilever midway between two nodes of its RK4 mesh (5 mm apart, rod radius 1 mm). No
+//! node comes near the wire, so a check of the nodes alone lets the rod pass through it; the
+//! gap is also checked along the arc between the nodes, and the wire props the cantilever
+//! with the closed-form reaction `R = (F c² (3L - c) / (6 E I) - δ) 3 E I / c³`.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+mod common;
+
+use softrod::nalgebra::Vector3;
+use softrod::{solve_constrained, Actuation, Loads, Obstacle, RobotModel};
+
+use common::{beam as rod, rk4_options as options, BEAM_E as E, BEAM_LENGTH as L, BEAM_NU as NU};
+
+/// RK4 steps over the cantilever (nodes every `L / STEPS`).
+const STEPS: usize = 200;
+
+/// The least gap (m) between the rod's surface and `o` along the polyline of the nodes,
+/// sampled 64 times per cell (no node lies near the wire: this is what a node check misses).
+fn least_gap_on_chords(positions: &[[f64; 3]], o: &Obstacle, radius: f64) -> f64 {
+    let mut least = f64::INFINITY;
+    for w in positions.windows(2) {
+        let (a, b) = (Vector3::from(w[0]), Vector3::from(w[1]));
+        for k in 0..=64 {
+            let x = a + (b - a) * (f64::from(k) / 64.0);
+            least = least.min(o.distance(&x).0 - radius);
+        }
+    }
+    least
+}
+
+#[test]
+fn a_wire_between_two_nodes_props_the_cantilever() {
+    let radius = 1e-3;
+    let delta = 1e-3 * L;
+    let wire = 2e-4;
+    let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
+    // Midway between the nodes at 0.6 L and 0.6 L + L / STEPS.
+    let c = 0.6 * L + 0.5 * L / STEPS as f64;
+    let x = -(radius + delta + wire);
+    let obstacles = [Obstacle::capsule([x, -0.05, c], [x, 0.05, c], wire).unwrap()];
+    let closing = delta * 6.0 * ei / (c * c * (3.0 * L - c));
+    for factor in [0.8, 1.5, 2.0] {
+        let force = Vector3::new(-factor * closing, 0.0, 0.0);
+        let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
+        let sol = solve_constrained(
+            &model,
+            &Actuation::default(),
+            &options(STEPS),
+            None,
+            &obstacles,
+        )
+        .unwrap();
+        assert!(sol.solution.stats.converged);
+        let least = least_gap_on_chords(&sol.solution.position, &obstacles[0], radius);
+        println!("wire, F = {factor} F_c: least gap along the chords {least:e} m");
+        if factor < 1.0 {
+            assert!(sol.contacts.is_empty());
+            assert!(least > 0.0);
+            continue;
+        }
+        // The chords cut the arc by its sagitta (below 1e-10 m here), nothing more.
+        assert!(
+            least >= -1e-9,
+            "the rod passes through the wire: gap {least:e} m"
+        );
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        let k = sol.contacts[0];
+        assert!(
+            (k.s - c).abs() < 0.1 * L / STEPS as f64,
+            "contact at {}",
+            k.s
+        );
+        let f = factor * closing;
+        let exact = (f * c * c * (3.0 * L - c) / (6.0 * ei) - delta) * 3.0 * ei / c.powi(3);
+        let err = (k.normal_force / exact - 1.0).abs();
+        println!(
+            "wire contact at s = {:.6}: R = {:e}, propped cantilever {exact:e}, rel. error {err:e}",
+            k.s, k.normal_force
+        );
+        assert!(err < 1e-3, "R = {:e} vs {exact:e}", k.normal_force);
+        // Global balance: base force = tip force + contact force.
+        let b = sol.solution.base_wrench;
+        let fc = Vector3::from(k.normal) * k.normal_force;
+        for i in 0..3 {
+            let want = force[i] + fc[i];
+            assert!(
+                (b[i] - want).abs() <= 1e-10 * closing,
+                "force {i}: {} vs {want}",
+                b[i]
+            );
+        }
+    }
+}

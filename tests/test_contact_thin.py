@@ -1,0 +1,51 @@
+"""An obstacle thinner than the node spacing: a wire across the NiTi robot's backbone between
+two nodes. The gap is checked along the arc between the nodes, so the rod rests on the wire
+instead of passing through it (every node clear of it)."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+import softrod as sr
+
+ACTUATION = [3.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+
+
+@pytest.fixture(scope="module")
+def free():
+    robot = sr.load_robot(sr.examples.path("niti_two_segment"))
+    return robot, robot.solve(ACTUATION)
+
+
+def _least_gap_on_chords(position, capsule, radius):
+    a, b, r = (np.asarray(v, float) for v in (capsule.a, capsule.b, capsule.radius))
+    u = (b - a) / np.linalg.norm(b - a)
+    t = np.linspace(0.0, 1.0, 65)[:, None]
+    pts = np.concatenate([(1 - t) * p + t * q for p, q in itertools.pairwise(position)])
+    rel = pts - a
+    axial = np.clip(rel @ u, 0.0, np.linalg.norm(b - a))
+    return (np.linalg.norm(rel - axial[:, None] * u, axis=1) - r - radius).min()
+
+
+@pytest.mark.parametrize("wire", [0.5e-3, 2e-3])
+def test_the_rod_rests_on_a_wire_between_two_nodes(free, wire):
+    robot, sol0 = free
+    p = np.asarray(sol0.position)
+    k = 30  # the wire crosses the free shape midway between nodes 30 and 31
+    mid = 0.5 * (p[k] + p[k + 1])
+    t = (p[k + 1] - p[k]) / np.linalg.norm(p[k + 1] - p[k])
+    n = np.cross(t, [0.0, 1.0, 0.0])
+    b = np.cross(t, n / np.linalg.norm(n))
+    capsule = sr.Capsule(mid - 0.05 * b, mid + 0.05 * b, wire)
+    radius = robot.rod.section.radius
+    # Without the check between the nodes, the free shape is what a node check accepts.
+    assert _least_gap_on_chords(p, capsule, radius) < -wire
+    sol = sr.Robot(robot.rod, tendons=robot.tendons, obstacles=[capsule]).solve(ACTUATION)
+    assert sol.converged
+    assert len(sol.contacts) == 1
+    c = sol.contacts[0]
+    assert c["normal_force"] > 0.0
+    assert _least_gap_on_chords(np.asarray(sol.position), capsule, radius) > -1e-9
+    # The rod rests on the side of the wire facing the unactuated (straight) rod.
+    assert np.asarray(c["normal"]) @ (np.array([0.0, 0.0, c["s"]]) - mid) > 0.0
