@@ -302,6 +302,22 @@ mod tests {
         assert!((d - 0.05).abs() < 1e-15);
     }
 
+    /// Friction changes neither the geometry nor the distance; a second coefficient replaces
+    /// the first, and 0 gives back the frictionless obstacle.
+    #[test]
+    fn friction_keeps_the_geometry() {
+        let sphere = Obstacle::sphere([0.1, 0.0, 0.0], 0.05).unwrap();
+        let rough = sphere.clone().with_friction(0.4).unwrap();
+        assert_eq!(rough.friction(), 0.4);
+        assert_eq!(rough.shape(), &sphere);
+        let x = Vector3::new(0.0, 0.02, 0.03);
+        assert_eq!(rough.distance(&x), sphere.distance(&x));
+        let again = rough.clone().with_friction(0.2).unwrap();
+        assert_eq!((again.friction(), again.shape()), (0.2, &sphere));
+        assert_eq!(rough.with_friction(0.0).unwrap(), sphere);
+        assert_eq!(sphere.friction(), 0.0);
+    }
+
     #[test]
     fn bad_geometry_is_a_named_error() {
         assert!(Obstacle::sphere([0.0; 3], -1.0)
