@@ -144,3 +144,73 @@ def test_contact_compliance_holds_the_normal_and_slides_along_the_plane():
     assert abs(c[0, 0]) <= 1e-9 * c0[0, 0]
     assert c[1, 1] == pytest.approx(L**3 / (3 * EI), rel=1e-3)
     assert sr.solve_statics(_rod()).contact_compliance is None
+
+
+@pytest.mark.parametrize(("fx", "fy", "state"), [(2.0, 0.5, "stick"), (2.0, -2.0, "slide")])
+def test_tip_friction_sticks_and_slides_as_the_cantilever_closed_form(fx, fy, state):
+    # Proportional loading: first touch at lambda0 = F_c / Fx, normal reaction Fx - F_c;
+    # sticking (|Fy| <= mu Fx) holds the tip at lambda0 Fy L^3 / (3 EI) with the tangential
+    # reaction -(1 - lambda0) Fy, sliding puts the reaction on the cone against the slip.
+    mu = 0.5
+    plane = sr.Plane((-(R + DELTA), 0.0, 0.0), (1.0, 0.0, 0.0), friction=mu)
+    force = np.array([-fx * CLOSING, fy * CLOSING, 0.0])
+    sol = sr.solve_statics(_rod(), loads=sr.Loads(tip_force=force), obstacles=[plane], steps=100)
+    (c,) = sol.contacts
+    assert c["state"] == state
+    lambda0, normal, comp = 1 / fx, (fx - 1) * CLOSING, L**3 / (3 * EI)
+    if state == "stick":
+        ft, y = -(1 - lambda0) * force[1], lambda0 * force[1] * comp
+    else:
+        ft = -np.sign(force[1]) * mu * normal
+        y = (force[1] + ft) * comp
+    assert abs(c["normal_force"] / normal - 1) < 1e-4
+    assert abs(c["tangential_force"][1] / ft - 1) < 1e-4
+    assert abs(sol.position[-1, 1] / y - 1) < 1e-4
+    assert np.linalg.norm(c["tangential_force"]) <= mu * c["normal_force"] * (1 + 1e-9)
+    total = np.asarray(c["normal"]) * c["normal_force"] + np.asarray(c["tangential_force"])
+    np.testing.assert_allclose(sol.contact_force.sum(axis=0), total, rtol=0, atol=1e-12 * CLOSING)
+
+
+@pytest.mark.parametrize("bad", [-0.2, float("nan"), float("inf"), "rough"])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda mu: sr.Plane((0, 0, 0), (1, 0, 0), friction=mu),
+        lambda mu: sr.Sphere((0, 0, 0), 0.1, friction=mu),
+        lambda mu: sr.Capsule((0, 0, 0), (0, 0, 1), 0.1, friction=mu),
+        lambda mu: sr.Cylinder((0, 0, 0), (0, 0, 1), 0.1, friction=mu),
+        lambda mu: sr.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], friction=mu),
+    ],
+)
+def test_bad_friction_is_a_named_value_error(make, bad):
+    with pytest.raises(ValueError, match=r"friction.*>= 0") as err:
+        make(bad)
+    assert err.value.parameter == "friction"
+    assert repr(bad) in str(err.value)
+
+
+def test_friction_in_robot_files_and_inside_the_rod():
+    plane = sr.Plane((-(R + DELTA), 0.0, 0.0), (1.0, 0.0, 0.0), friction=0.4)
+    robot = sr.Robot(_rod(), loads=sr.Loads(tip_force=(-2 * CLOSING, 0, 0)), obstacles=[plane])
+    text = robot.to_toml()
+    assert "friction = 0.4" in text
+    back = sr.Robot.from_toml(text)
+    assert back.obstacles == (plane,)
+    assert back.solve().contacts[0]["state"] == "stick"
+    # Frictionless obstacles write no friction key (robot files as before).
+    assert "friction" not in sr.Robot(_rod(), obstacles=[PLANE]).to_toml()
+    data = {
+        "rod": {
+            "length": 1.0,
+            "section": {"radius": R},
+            "material": {"youngs_modulus": E, "poisson_ratio": NU},
+        },
+        "obstacles": [{"type": "plane", "point": [0, 0, 0], "normal": [1, 0, 0], "friction": -1}],
+    }
+    with pytest.raises(ValueError, match="friction"):
+        sr.Robot.from_dict(data)
+    # A frictional floor touched along the rod (a uniform load): refused, naming `friction`.
+    q = 72 * EI * DELTA / (0.5 * L) ** 4
+    loads = sr.Loads(distributed_force=(-q, 0.0, 0.0))
+    with pytest.raises(ValueError, match="friction"):
+        sr.solve_statics(_rod(), loads=loads, obstacles=[plane], steps=100)

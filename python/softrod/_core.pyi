@@ -444,7 +444,7 @@ class StaticsSolution:
     @property
     def contacts(self) -> list[dict[str, Any]]:
         """Active contacts: obstacle, s (m), length (m), point, normal, normal_force (N),
-        tangential_force (N)."""
+        tangential_force (N), state ("frictionless", "stick" or "slide")."""
     @property
     def contact_force(self) -> NDArray[np.float64]:
         """Contact force on the rod at every sample (N, world), shape (N, 3)."""

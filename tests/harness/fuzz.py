@@ -600,16 +600,30 @@ def _define_targets() -> None:
             ),
         )
     )
-    t("Plane")(lambda d: (sr.Plane, dict(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0))))
-    t("Sphere")(lambda d: (sr.Sphere, dict(center=(0.0, 0.0, 0.1), radius=0.02)))
-    t("Capsule")(lambda d: (sr.Capsule, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
-    t("Cylinder")(lambda d: (sr.Cylinder, dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01)))
+    t("Plane")(
+        lambda d: (sr.Plane, dict(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), friction=0.3))
+    )
+    t("Sphere")(lambda d: (sr.Sphere, dict(center=(0.0, 0.0, 0.1), radius=0.02, friction=0.3)))
+    t("Capsule")(
+        lambda d: (
+            sr.Capsule,
+            dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01, friction=0.3),
+        )
+    )
+    t("Cylinder")(
+        lambda d: (
+            sr.Cylinder,
+            dict(a=(0.0, 0.0, 0.0), b=(0.0, 0.1, 0.0), radius=0.01, friction=0.3),
+        )
+    )
     _tetra = dict(
         vertices=[[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
         faces=[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
     )
-    t("Mesh")(lambda d: (sr.Mesh, dict(_tetra)))
-    t("Mesh.from_file")(lambda d: (sr.Mesh.from_file, dict(path=_mesh_file(d, _tetra))))
+    t("Mesh")(lambda d: (sr.Mesh, dict(_tetra, friction=0.3)))
+    t("Mesh.from_file")(
+        lambda d: (sr.Mesh.from_file, dict(path=_mesh_file(d, _tetra), friction=0.3))
+    )
     t("Clamp")(
         lambda d: (sr.Clamp, dict(pose=np.eye(4), held=[True, True, False, True, True, False]))
     )

@@ -59,6 +59,14 @@ pub(crate) fn obstacles(
                 ))
             }
         };
+        // The Coulomb coefficient of the surface (0 when the object has none).
+        let friction = match o.getattr("friction") {
+            Ok(f) if !f.is_none() => f
+                .extract::<f64>()
+                .map_err(|_| type_err(&name("friction"), &f, "a number >= 0"))?,
+            _ => 0.0,
+        };
+        let made = made.and_then(|m| m.with_friction(friction));
         out.push(made.map_err(|e| match e {
             softrod::Error::InvalidParameter {
                 name: n,
@@ -167,6 +175,12 @@ impl ContactData {
             d.set_item("normal", c.normal.to_vec())?;
             d.set_item("normal_force", c.normal_force)?;
             d.set_item("tangential_force", c.tangential_force.to_vec())?;
+            let state = match c.state {
+                softrod::ContactState::Frictionless => "frictionless",
+                softrod::ContactState::Stick => "stick",
+                softrod::ContactState::Slide => "slide",
+            };
+            d.set_item("state", state)?;
             out.append(d)?;
         }
         Ok(out.into_any().unbind())

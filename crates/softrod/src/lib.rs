@@ -51,8 +51,8 @@ pub use compliance::{
     TendonControl,
 };
 pub use contact::{
-    solve_constrained, Contact, ContactCompliance, ContactSolution, Obstacle, TipConstraint,
-    TriangleMesh,
+    solve_constrained, Contact, ContactCompliance, ContactSolution, ContactState, Obstacle,
+    TipConstraint, TriangleMesh,
 };
 pub use cosserat::displacement::reference_lengths;
 pub use cosserat::friction::{

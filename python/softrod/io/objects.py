@@ -265,7 +265,7 @@ def _mesh_of(o: Any, base: str) -> Any:
         vertices = vertices @ np.asarray(o.rotation, dtype=float).T
     if o.position is not None:
         vertices = vertices + np.asarray(o.position, dtype=float)
-    return Mesh(vertices, faces)
+    return Mesh(vertices, faces, o.friction)
 
 
 def obstacle_of(o: Any, base: str | None = None) -> Any:
@@ -276,11 +276,11 @@ def obstacle_of(o: Any, base: str | None = None) -> Any:
     if isinstance(o, rf.MeshSpec):
         return _mesh_of(o, base if base is not None else os.getcwd())
     if isinstance(o, rf.PlaneSpec):
-        return Plane(tuple(o.point), tuple(o.normal))
+        return Plane(tuple(o.point), tuple(o.normal), o.friction)
     if isinstance(o, rf.SphereSpec):
-        return Sphere(tuple(o.center), o.radius)
+        return Sphere(tuple(o.center), o.radius, o.friction)
     kind = Capsule if isinstance(o, rf.CapsuleSpec) else Cylinder
-    return kind(tuple(o.a), tuple(o.b), o.radius)
+    return kind(tuple(o.a), tuple(o.b), o.radius, o.friction)
 
 
 def tip_constraint_of(t: Any) -> Any:
@@ -344,18 +344,24 @@ def obstacle_spec(o: Any) -> dict[str, Any]:
     from ..plot.obstacles import as_obstacle
 
     o = as_obstacle(o)
+    friction = float(getattr(o, "friction", 0.0))
     if type(o).__name__ == "Mesh":
         # Written out in full: a robot file then stands on its own.
-        return {
+        mesh: dict[str, Any] = {
             "type": "mesh",
             "vertices": [[float(x) for x in v] for v in o.vertices],
             "faces": [[int(i) for i in f] for f in o.faces],
         }
+        if friction > 0:
+            mesh["friction"] = friction
+        return mesh
     kind = type(o).__name__.lower()
-    fields = {k: getattr(o, k) for k in o.__dataclass_fields__}
+    fields = {k: getattr(o, k) for k in o.__dataclass_fields__ if k != "friction"}
     out: dict[str, Any] = {"type": kind}
     for k, v in fields.items():
         out[k] = float(v) if k == "radius" else [float(x) for x in v]
+    if friction > 0:
+        out["friction"] = friction
     return out
 
 

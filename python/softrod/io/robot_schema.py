@@ -421,6 +421,7 @@ class PlaneSpec(_Table):
     type: Literal["plane"]
     point: _vec(3, "a point of the plane (m, world)")
     normal: _vec(3, "outward normal (world; any nonzero length)")
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class SphereSpec(_Table):
@@ -429,6 +430,7 @@ class SphereSpec(_Table):
     type: Literal["sphere"]
     center: _vec(3, "centre (m, world)")
     radius: _num("radius (m)", gt=0)
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class CapsuleSpec(_Table):
@@ -438,6 +440,7 @@ class CapsuleSpec(_Table):
     a: _vec(3, "first end of the axis (m, world)")
     b: _vec(3, "second end of the axis (m, world)")
     radius: _num("radius (m)", gt=0)
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class CylinderSpec(_Table):
@@ -447,6 +450,7 @@ class CylinderSpec(_Table):
     a: _vec(3, "centre of the first cap (m, world)")
     b: _vec(3, "centre of the second cap (m, world)")
     radius: _num("radius (m)", gt=0)
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
 
 class MeshSpec(_Table):
@@ -459,6 +463,7 @@ class MeshSpec(_Table):
     vertices: (
         Annotated[list[Vec3], Field(min_length=3, description="vertices (m, mesh frame)")] | None
     ) = None
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
     faces: (
         Annotated[
             list[Annotated[list[Annotated[int, Field(ge=0)]], Field(min_length=3, max_length=3)]],

@@ -51,19 +51,36 @@ def _radius(value: object) -> float:
     return r
 
 
+def _friction(value: object) -> float:
+    why = "must be finite and >= 0 (Coulomb coefficient, dimensionless)"
+    if isinstance(value, bool):
+        raise _field_error("friction", value, why)
+    try:
+        mu = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise _field_error("friction", value, why) from None
+    if not (np.isfinite(mu) and mu >= 0):
+        raise _field_error("friction", value, why)
+    return mu
+
+
 def _check(obj, vectors: tuple[str, ...], radius: bool) -> None:
     for name in vectors:
         object.__setattr__(obj, name, _vector(name, getattr(obj, name)))
     if radius:
         object.__setattr__(obj, "radius", _radius(obj.radius))
+    object.__setattr__(obj, "friction", _friction(obj.friction))
 
 
 @dataclass(frozen=True)
 class Plane:
-    """A plane through ``point`` (m, world, shape (3,)) with unit ``normal`` (shape (3,))."""
+    """A plane through ``point`` (m, world, shape (3,)) with unit ``normal`` (shape (3,));
+    ``friction`` is the Coulomb coefficient of its surface (dimensionless, >= 0; friction
+    acts at tip contacts)."""
 
     point: tuple[float, float, float]
     normal: tuple[float, float, float]
+    friction: float = 0.0
 
     def __post_init__(self) -> None:
         _check(self, ("point", "normal"), False)
@@ -76,10 +93,12 @@ class Plane:
 
 @dataclass(frozen=True)
 class Sphere:
-    """A sphere of ``radius`` (m) about ``center`` (m, world, shape (3,))."""
+    """A sphere of ``radius`` (m) about ``center`` (m, world, shape (3,)); ``friction`` as
+    for :class:`Plane`."""
 
     center: tuple[float, float, float]
     radius: float
+    friction: float = 0.0
 
     def __post_init__(self) -> None:
         _check(self, ("center",), True)
@@ -87,11 +106,13 @@ class Sphere:
 
 @dataclass(frozen=True)
 class Capsule:
-    """Points within ``radius`` (m) of the segment from ``a`` to ``b`` (m, world, (3,) each)."""
+    """Points within ``radius`` (m) of the segment from ``a`` to ``b`` (m, world, (3,) each);
+    ``friction`` as for :class:`Plane`."""
 
     a: tuple[float, float, float]
     b: tuple[float, float, float]
     radius: float
+    friction: float = 0.0
 
     def __post_init__(self) -> None:
         _check(self, ("a", "b"), True)
@@ -101,11 +122,13 @@ class Capsule:
 
 @dataclass(frozen=True)
 class Cylinder:
-    """A closed cylinder of ``radius`` (m) with axis from ``a`` to ``b`` (m, world)."""
+    """A closed cylinder of ``radius`` (m) with axis from ``a`` to ``b`` (m, world);
+    ``friction`` as for :class:`Plane`."""
 
     a: tuple[float, float, float]
     b: tuple[float, float, float]
     radius: float
+    friction: float = 0.0
 
     def __post_init__(self) -> None:
         _check(self, ("a", "b"), True)
@@ -117,13 +140,16 @@ class Cylinder:
 class Mesh:
     """A triangle mesh: ``vertices`` (m, world, shape (N, 3)) and ``faces`` (vertex indices,
     shape (M, 3), counter-clockwise seen from outside). The gap is the signed distance to
-    its triangles (negative inside a closed mesh), computed in the Rust core.
+    its triangles (negative inside a closed mesh), computed in the Rust core. ``friction``
+    as for :class:`Plane`.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
+    friction: float = 0.0
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "friction", _friction(self.friction))
         try:
             v = np.array(self.vertices, dtype=float)
         except (TypeError, ValueError):
@@ -149,27 +175,34 @@ class Mesh:
             isinstance(other, Mesh)
             and np.array_equal(self.vertices, other.vertices)
             and np.array_equal(self.faces, other.faces)
+            and self.friction == other.friction
         )
 
     def __hash__(self) -> int:
-        return hash((self.vertices.tobytes(), self.faces.tobytes()))
+        return hash((self.vertices.tobytes(), self.faces.tobytes(), self.friction))
 
     @classmethod
-    def from_file(cls, path) -> Mesh:
-        """A mesh read by trimesh from ``path`` (STL, OBJ, PLY, ...; coordinates in m)."""
+    def from_file(cls, path, friction: float = 0.0) -> Mesh:
+        """A mesh read by trimesh from ``path`` (STL, OBJ, PLY, ...; coordinates in m), with
+        Coulomb coefficient ``friction``."""
         import trimesh
 
         try:
             m = trimesh.load_mesh(str(path), process=False)
         except (OSError, ValueError) as exc:
             raise _field_error("file", str(path), f"could not be read as a mesh ({exc})") from None
-        return cls(np.asarray(m.vertices, dtype=float), np.asarray(m.faces, dtype=np.int64))
+        return cls(
+            np.asarray(m.vertices, dtype=float),
+            np.asarray(m.faces, dtype=np.int64),
+            friction,
+        )
 
 
 def _mesh_of(fields: dict) -> Mesh:
+    friction = fields.get("friction", 0.0)
     if "file" in fields:
-        return Mesh.from_file(fields["file"])
-    return Mesh(fields.get("vertices"), fields.get("faces"))
+        return Mesh.from_file(fields["file"], friction)
+    return Mesh(fields.get("vertices"), fields.get("faces"), friction)
 
 
 _KINDS = {
@@ -205,13 +238,13 @@ def as_obstacle(obj, index: int = 0) -> Plane | Sphere | Capsule | Cylinder | Me
         except (TypeError, ParameterError) as exc:
             raise _bad(index, obj, str(exc)) from None
     elif hasattr(obj, "vertices") and hasattr(obj, "faces"):
-        out = Mesh(obj.vertices, obj.faces)
+        out = Mesh(obj.vertices, obj.faces, getattr(obj, "friction", 0.0))
     elif hasattr(obj, "normal") and hasattr(obj, "point"):
-        out = Plane(obj.point, obj.normal)
+        out = Plane(obj.point, obj.normal, getattr(obj, "friction", 0.0))
     elif hasattr(obj, "center") and hasattr(obj, "radius"):
-        out = Sphere(obj.center, obj.radius)
+        out = Sphere(obj.center, obj.radius, getattr(obj, "friction", 0.0))
     elif hasattr(obj, "a") and hasattr(obj, "b") and hasattr(obj, "radius"):
-        out = Capsule(obj.a, obj.b, obj.radius)
+        out = Capsule(obj.a, obj.b, obj.radius, getattr(obj, "friction", 0.0))
     else:
         raise _bad(index, obj, "must be a Plane, Sphere, Capsule, Cylinder or a dict with `type`")
     radius = getattr(out, "radius", 1.0)

@@ -239,7 +239,8 @@ impl StaticsSolution {
     /// The active contacts, one dict each: `obstacle` (index), `s` (m), `length` (m, 0 for a
     /// point contact; a contact interval on a plane otherwise), `point` (m, world, on the
     /// rod's surface), `normal` (the obstacle's outward unit normal), `normal_force` (N,
-    /// >= 0), `tangential_force` (N, world; zero without friction). Empty without obstacles.
+    /// >= 0), `tangential_force` (N, world; zero without friction), `state`
+    /// (`"frictionless"`, `"stick"` or `"slide"`). Empty without obstacles.
     #[getter]
     fn contacts(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         self.contact.contacts_py(py)

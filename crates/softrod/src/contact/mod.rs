@@ -3,13 +3,15 @@
 //! [`solve_constrained`] solves the statics of a robot whose tip is held by a
 //! [`TipConstraint`] (clamped at a pose, pinned at a point, sliding on a plane, or any held
 //! directions of a frame) and whose surface touches rigid [`Obstacle`]s (planes, spheres,
-//! capsules, cylinders) without friction. The constraints are exact: the held tip directions
+//! capsules, cylinders, triangle meshes), with Coulomb friction at tip contacts
+//! ([`ContactState`]). The constraints are exact: the held tip directions
 //! and the contact gaps are residual rows of the shooting problem, their reactions unknowns,
 //! solved by the crate's Newton and continuation (see `docs/contact.md`). The solution
 //! ([`ContactSolution`]) carries the reactions: the tip reaction wrench and, per contact, its
 //! arc length, point, normal and force.
 
 mod constraint;
+mod friction;
 mod jacobian;
 mod mesh;
 mod obstacle;
@@ -39,6 +41,21 @@ pub(crate) fn obstacle_normal_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<
     (t1, n.cross(&t1))
 }
 
+/// How a contact's tangential force is determined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ContactState {
+    /// Frictionless obstacle: no tangential force.
+    Frictionless,
+    /// Coulomb friction, sticking: the contact point has not moved along the surface from
+    /// where it first touched (under the proportional load path of the solve), and the
+    /// tangential force is inside the cone, `|f_t| <= μ f_n`.
+    Stick,
+    /// Coulomb friction, sliding: the tangential force is on the cone, `|f_t| = μ f_n`,
+    /// opposite to the slip (the displacement of the contact point along the surface from
+    /// where it first touched).
+    Slide,
+}
+
 /// One active contact of a solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
@@ -57,8 +74,11 @@ pub struct Contact {
     pub normal: [f64; 3],
     /// Normal force on the rod (N, >= 0).
     pub normal_force: f64,
-    /// Tangential (friction) force on the rod (N, world); zero without friction.
+    /// Tangential (friction) force on the rod (N, world; normal to `normal`); zero without
+    /// friction.
     pub tangential_force: [f64; 3],
+    /// Frictionless, sticking or sliding.
+    pub state: ContactState,
 }
 
 /// A solution of [`solve_constrained`].

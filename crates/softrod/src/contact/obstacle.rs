@@ -52,6 +52,15 @@ pub enum Obstacle {
     /// A triangle mesh ([`TriangleMesh`]; world frame, m): the signed distance to its
     /// triangles, negative inside a closed mesh (outward faces counter-clockwise).
     Mesh(Arc<TriangleMesh>),
+    /// The obstacle `shape` (any of the others) with Coulomb friction of coefficient
+    /// `friction` (> 0, dimensionless) at its surface; made by [`Obstacle::with_friction`].
+    Frictional {
+        /// The geometry (not itself `Frictional`).
+        shape: Box<Obstacle>,
+        /// Coulomb friction coefficient μ (> 0): the tangential force on a contact is at
+        /// most μ times its normal force.
+        friction: f64,
+    },
 }
 
 fn finite3(name: &str, v: [f64; 3]) -> Result<Vector3<f64>> {
@@ -163,6 +172,51 @@ impl Obstacle {
         Ok(Self::Mesh(Arc::new(TriangleMesh::new(vertices, faces)?)))
     }
 
+    /// The obstacle with Coulomb friction coefficient `mu` (dimensionless, finite, >= 0) at
+    /// its surface; `mu = 0` is the frictionless obstacle. Friction acts at contacts at the
+    /// tip (see [`super::ContactState`]); a frictional obstacle touched inside the rod is
+    /// refused by the solve.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `friction` if `mu` is negative or not finite.
+    pub fn with_friction(self, mu: f64) -> Result<Self> {
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(Error::invalid(
+                "friction",
+                mu,
+                "finite and >= 0 (Coulomb coefficient, dimensionless)",
+            ));
+        }
+        let shape = match self {
+            Self::Frictional { shape, .. } => *shape,
+            other => other,
+        };
+        Ok(if mu == 0.0 {
+            shape
+        } else {
+            Self::Frictional {
+                shape: Box::new(shape),
+                friction: mu,
+            }
+        })
+    }
+
+    /// The Coulomb friction coefficient of the surface (dimensionless; 0: frictionless).
+    pub fn friction(&self) -> f64 {
+        match self {
+            Self::Frictional { friction, .. } => *friction,
+            _ => 0.0,
+        }
+    }
+
+    /// The geometry of the obstacle (itself, or the shape of a frictional one).
+    pub fn shape(&self) -> &Obstacle {
+        match self {
+            Self::Frictional { shape, .. } => shape.shape(),
+            other => other,
+        }
+    }
+
     /// Signed distance (m; negative inside) of the point `x` (m) to the obstacle's surface,
     /// and the unit outward normal of the surface at the closest point (the gradient of the
     /// distance).
@@ -176,6 +230,7 @@ impl Obstacle {
             }
         };
         match *self {
+            Self::Frictional { ref shape, .. } => shape.distance(x),
             Self::Mesh(ref m) => m.distance(x),
             Self::Plane { point, normal } => (normal.dot(&(x - point)), normal),
             Self::Sphere { center, radius } => radial(x - center, radius, Vector3::z()),
@@ -245,6 +300,22 @@ mod tests {
         assert!((d + 0.01).abs() < 1e-15);
         let d = obstacles[3].distance(&Vector3::new(0.07, 0.0, 0.23)).0;
         assert!((d - 0.05).abs() < 1e-15);
+    }
+
+    /// Friction changes neither the geometry nor the distance; a second coefficient replaces
+    /// the first, and 0 gives back the frictionless obstacle.
+    #[test]
+    fn friction_keeps_the_geometry() {
+        let sphere = Obstacle::sphere([0.1, 0.0, 0.0], 0.05).unwrap();
+        let rough = sphere.clone().with_friction(0.4).unwrap();
+        assert_eq!(rough.friction(), 0.4);
+        assert_eq!(rough.shape(), &sphere);
+        let x = Vector3::new(0.0, 0.02, 0.03);
+        assert_eq!(rough.distance(&x), sphere.distance(&x));
+        let again = rough.clone().with_friction(0.2).unwrap();
+        assert_eq!((again.friction(), again.shape()), (0.2, &sphere));
+        assert_eq!(rough.with_friction(0.0).unwrap(), sphere);
+        assert_eq!(sphere.friction(), 0.0);
     }
 
     #[test]

@@ -6,11 +6,12 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 
 use super::constraint::TipConstraint;
+use super::friction::{first_touch, retouch, switch};
 use super::obstacle::Obstacle;
 use super::ramp;
 use super::stability::{conjugate_points, free_stiffness};
 use super::sweep::{least_gap_in_cell, CellEnd};
-use super::{obstacle_normal_basis, Contact, ContactCompliance, ContactSolution};
+use super::{obstacle_normal_basis, Contact, ContactCompliance, ContactSolution, ContactState};
 use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL, STATE};
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
@@ -99,6 +100,8 @@ impl Frozen {
                 solved: None,
                 refine: true,
                 rough: false,
+                from: 1.0,
+                refused: None,
             };
             p.compliance(&self.x)
         })
@@ -119,13 +122,38 @@ pub(super) enum Site {
 }
 
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
-/// was added, relaxed to zero as the problem's parameter goes from 0 to 1).
+/// was added, relaxed to zero as the problem's parameter goes from 0 to 1); with friction (a
+/// tip contact), its state, the contact point where it first touched (m, world) and the
+/// homotopy targets of its sticking rows (its tangential displacements from there, m).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Active {
     pub(super) obstacle: usize,
     pub(super) site: Site,
     pub(super) g0: f64,
     pub(super) dg0: f64,
+    pub(super) state: ContactState,
+    pub(super) reference: Vector3<f64>,
+    pub(super) touch: f64,
+    pub(super) t0: [f64; 2],
+    /// A slip direction (unit, world) held while a contact turns from sticking to sliding.
+    pub(super) direction: Option<Vector3<f64>>,
+}
+
+impl Active {
+    /// A frictionless contact on `obstacle` at `site`, its gap targets zero.
+    pub(super) fn frictionless(obstacle: usize, site: Site) -> Self {
+        Self {
+            obstacle,
+            site,
+            g0: 0.0,
+            dg0: 0.0,
+            state: ContactState::Frictionless,
+            reference: Vector3::zeros(),
+            touch: 0.0,
+            t0: [0.0; 2],
+            direction: None,
+        }
+    }
 }
 
 impl Active {
@@ -235,6 +263,10 @@ pub(crate) struct Constrained<'m> {
     /// Whether the contact rows of a Jacobian are differenced one-sided (on the coarse
     /// mesh, where the Jacobian only steers Newton) rather than centrally.
     pub(super) rough: bool,
+    /// Load factor of the last accepted load step (where a first touch is searched from).
+    pub(super) from: f64,
+    /// The friction coefficient of an obstacle touched inside the rod, when refused.
+    pub(super) refused: Option<f64>,
 }
 
 impl<'m> Constrained<'m> {
@@ -382,7 +414,7 @@ impl<'m> Constrained<'m> {
                 if s >= l {
                     return None;
                 }
-                let Obstacle::Plane { normal, .. } = self.obstacles[a.obstacle] else {
+                let Obstacle::Plane { normal, .. } = *self.obstacles[a.obstacle].shape() else {
                     return None;
                 };
                 // The reaction starts just after the break at `s` (its own break), so that
@@ -542,9 +574,13 @@ impl<'m> Constrained<'m> {
             let dg = slope - props.radius_rate;
             rows.push(dg - (1.0 - mu) * a.dg0);
         }
-        let (t1, t2) = obstacle_normal_basis(&n);
-        rows.push(f.dot(&t1));
-        rows.push(f.dot(&t2));
+        if a.state == ContactState::Frictionless {
+            let (t1, t2) = obstacle_normal_basis(&n);
+            rows.push(f.dot(&t1));
+            rows.push(f.dot(&t2));
+        } else {
+            self.friction_rows(a, first.0, f, mu, rows);
+        }
     }
 
     /// The gap (m) and outward normal of obstacle `o` at every node of the last pass (first
@@ -747,7 +783,7 @@ pub(super) struct Effort {
 }
 
 /// Newton at the full contact targets from `x`; the last pass left at the result.
-fn correct(
+pub(super) fn correct(
     p: &mut Constrained<'_>,
     x: &[f64],
     opts: &NewtonOptions,
@@ -1000,7 +1036,7 @@ fn normal_step(p: &Constrained<'_>, x: &[f64], j: &[f64], r: &[f64]) -> Option<V
 type GapSample = (usize, f64, f64, Vector3<f64>);
 
 /// Normal forces, normal, arc length and point of each active contact at `x`.
-type Forces = Vec<(f64, Vector3<f64>, f64, Vector3<f64>)>;
+pub(super) type Forces = Vec<(f64, Vector3<f64>, f64, Vector3<f64>)>;
 
 /// New contacts at the local minima of the gaps below `-penetration` (not at an existing
 /// contact, not inside an interval).
@@ -1089,7 +1125,7 @@ fn merge_plane(
 ) -> bool {
     let l = p.model.length();
     for &(o, _, s) in added {
-        if !matches!(p.obstacles[o], Obstacle::Plane { .. }) {
+        if !matches!(p.obstacles[o].shape(), Obstacle::Plane { .. }) {
             continue;
         }
         let offsets = p.offsets();
@@ -1111,12 +1147,7 @@ fn merge_plane(
             p.active.remove(i);
             x.drain(offsets[i]..offsets[i] + size);
         }
-        p.active.push(Active {
-            obstacle: o,
-            site: Site::Interval,
-            g0: 0.0,
-            dg0: 0.0,
-        });
+        p.active.push(Active::frictionless(o, Site::Interval));
         x.push(a / l);
         x.extend([0.0; 3]);
         return true;
@@ -1137,14 +1168,26 @@ fn add_contacts(
     for a in &mut p.active {
         a.g0 = 0.0;
         a.dg0 = 0.0;
+        a.t0 = [0.0; 2];
     }
-    for (o, site, s) in added {
-        p.active.push(Active {
-            obstacle: o,
-            site,
-            g0: 0.0,
-            dg0: 0.0,
+    // Where the new contacts with friction first touched, on the load path.
+    let mut touched = Vec::with_capacity(added.len());
+    for &(o, site, _) in &added {
+        let rough = site == Site::Tip && p.obstacles[o].friction() > 0.0;
+        touched.push(if rough {
+            Some(first_touch(p, &x, o, opts, effort)?)
+        } else {
+            None
         });
+    }
+    for ((o, site, s), touched) in added.into_iter().zip(touched) {
+        let mut a = Active::frictionless(o, site);
+        if let Some((reference, touch, _)) = touched {
+            a.state = ContactState::Stick;
+            a.reference = reference;
+            a.touch = touch;
+        }
+        p.active.push(a);
         if site != Site::Tip {
             x.push(s / l);
         }
@@ -1165,6 +1208,9 @@ fn add_contacts(
         if a.site != Site::Tip {
             a.dg0 = r[o + 1];
         }
+        if a.state == ContactState::Stick {
+            a.t0 = [r[o + 1] * l, r[o + 2] * l];
+        }
     }
     let start = ContinuationSettings {
         x0: &x,
@@ -1177,6 +1223,7 @@ fn add_contacts(
     for a in &mut p.active {
         a.g0 = 0.0;
         a.dg0 = 0.0;
+        a.t0 = [0.0; 2];
     }
     if !(c.outcome.converged && c.load_factor >= 1.0) {
         return None;
@@ -1215,9 +1262,29 @@ pub(super) fn active_set(
             x = correct(p, &x, opts, effort)?;
             continue;
         }
+        // Sticking outside the cone, or sliding back to where it touched.
+        if let Some((i, state, direction)) = switch(p, &x, opts) {
+            p.active[i].state = state;
+            if direction.is_some() {
+                // First along the slip the sticking force pushed to, then free to turn.
+                p.active[i].direction = direction;
+                x = correct(p, &x, opts, effort)?;
+                p.active[i].direction = None;
+            }
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
         let mut added = candidates(p, &forces, penetration);
         if added.is_empty() {
             added = cell_candidates(p, &forces, penetration);
+        }
+        if let Some(&(o, _, _)) = added
+            .iter()
+            .find(|(o, site, _)| *site != Site::Tip && p.obstacles[*o].friction() > 0.0)
+        {
+            // Friction inside the rod is not modelled: refused, not solved without it.
+            p.refused = Some(p.obstacles[o].friction());
+            return None;
         }
         if merge_plane(p, &mut x, &forces, &added) {
             x = correct(p, &x, opts, effort)?;
@@ -1266,6 +1333,7 @@ fn step_loads(
             Some(xs) if p.close() || !opts.continuation => {
                 x = xs;
                 lambda = target;
+                p.from = lambda;
                 p.commit();
                 dl = (dl * 2.0).min(1.0);
             }
@@ -1290,7 +1358,8 @@ fn step_loads(
 }
 
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
-/// the rod's surface kept out of `obstacles` by frictionless unilateral contact.
+/// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
+/// Coulomb friction at the tip: see [`Obstacle::with_friction`] and [`ContactState`]).
 ///
 /// The unknowns are the base wrench (as in [`solve_statics`]), the force of every active
 /// contact and, for a contact inside the rod, its arc length; the residual the tip
@@ -1304,7 +1373,9 @@ fn step_loads(
 /// continuation when the direct solve fails.
 ///
 /// # Errors
-/// As [`solve_statics`] for the model, actuation and options; [`Error::NotConverged`] (with
+/// As [`solve_statics`] for the model, actuation and options; [`Error::InvalidParameter`]
+/// naming `friction` when an obstacle with friction is touched inside the rod (friction is
+/// modelled at tip contacts only); [`Error::NotConverged`] (with
 /// the iterations, residual and load factor reached) when no equilibrium with a consistent
 /// active set is found and `options.newton.throw` is set.
 pub fn solve_constrained(
@@ -1349,12 +1420,16 @@ pub fn solve_constrained(
         solved: None,
         refine: true,
         rough: false,
+        from: 0.0,
+        refused: None,
     };
     // The actuated rod without loads: the target of the tip at load factor 0.
     let mut effort = Effort::default();
     // (Not with a triangle mesh: the curvature of its distance jumps between faces and
     // edges, and Newton from the coarse solution may settle on another face.)
-    let smooth = !obstacles.iter().any(|o| matches!(o, Obstacle::Mesh(_)));
+    let smooth = !obstacles
+        .iter()
+        .any(|o| matches!(o.shape(), Obstacle::Mesh(_)));
     if let Some(coarse) = coarse_mesh(options.integrator).filter(|_| smooth) {
         // The contacts and the nonlinear iterations on the coarse mesh; then Newton on the
         // mesh asked from there, with the coarse Jacobian, and the active set checked there.
@@ -1370,6 +1445,7 @@ pub fn solve_constrained(
             p.last = None;
             p.load = 1.0;
             p.hint = p.solved.take();
+            retouch(&mut p, &xc, &options.newton, &mut effort);
             if let Some(x) = active_set(&mut p, &xc, &options.newton, &mut effort) {
                 let x = match not_crossed(&mut p, x, options, &mut effort) {
                     Ok(x) => x,
@@ -1377,6 +1453,9 @@ pub fn solve_constrained(
                 };
                 return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
             }
+        }
+        if let Some(e) = refusal(&p) {
+            return Err(e);
         }
         // Else the mesh asked from the start (its iterations and load steps are those
         // reported; the evaluations count both).
@@ -1390,7 +1469,11 @@ pub fn solve_constrained(
         p.hint = None;
         p.solved = None;
     }
-    match reach(&mut p, options, &mut effort) {
+    let reached = reach(&mut p, options, &mut effort);
+    if let Some(e) = refusal(&p) {
+        return Err(e);
+    }
+    match reached {
         Reach::Done(x) => {
             p.load = 1.0;
             let x = match not_crossed(&mut p, x, options, &mut effort) {
@@ -1413,6 +1496,18 @@ pub fn solve_constrained(
             f64::INFINITY,
         )),
     }
+}
+
+/// The error of an obstacle with friction touched inside the rod, if one was.
+fn refusal(p: &Constrained<'_>) -> Option<Error> {
+    p.refused.map(|mu| {
+        Error::invalid(
+            "friction",
+            mu,
+            "0 for an obstacle touched inside the rod (Coulomb friction is modelled at tip \
+             contacts only)",
+        )
+    })
 }
 
 /// Steps of the coarse mesh of the contact solve with `integrator`: RK4 with a fifth of its
@@ -1578,6 +1673,7 @@ fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Option<
 fn report(
     active: &[Active],
     forces: &Forces,
+    tangential: &[Vector3<f64>],
     model: &RobotModel,
     cm: &RobotModel,
     sol: &crate::cosserat::StaticsSolution,
@@ -1585,7 +1681,7 @@ fn report(
     let l = model.length();
     let mut contact_force = vec![[0.0; 3]; sol.s.len()];
     let mut contacts = Vec::with_capacity(forces.len());
-    for ((fnorm, n, s, pc), a) in forces.iter().zip(active) {
+    for (((fnorm, n, s, pc), a), ft) in forces.iter().zip(active).zip(tangential) {
         let radius = model.rod().section_at(*s).radius;
         let point = pc - n * radius;
         contacts.push(Contact {
@@ -1595,11 +1691,12 @@ fn report(
             point: [point.x, point.y, point.z],
             normal: [n.x, n.y, n.z],
             normal_force: *fnorm,
-            tangential_force: [0.0; 3],
+            tangential_force: [ft.x, ft.y, ft.z],
+            state: a.state,
         });
         if let Some(j) = sol.s.iter().rposition(|v| v == s) {
             for k in 0..3 {
-                contact_force[j][k] += fnorm * n[k];
+                contact_force[j][k] += fnorm * n[k] + ft[k];
             }
         }
         if a.site == Site::Interval {
@@ -1649,6 +1746,7 @@ fn report(
                 normal: [n.x, n.y, n.z],
                 normal_force: total,
                 tangential_force: [0.0; 3],
+                state: a.state,
             });
         }
     }
@@ -1794,7 +1892,8 @@ fn finish(
     let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
     sol.actuation = actuation.clone();
     sol.options = *options;
-    let (contacts, contact_force) = report(&p.active, &forces, model, &cm, &sol);
+    let tangential = p.tangential_forces(x, &forces);
+    let (contacts, contact_force) = report(&p.active, &forces, &tangential, model, &cm, &sol);
     let tip_reaction = p.tip.as_ref().map(|_| {
         let f = res.fixed_rows::<3>(0) * fs;
         let m = res.fixed_rows::<3>(3) * (fs * l);

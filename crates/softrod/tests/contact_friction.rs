@@ -1,0 +1,246 @@
+//! Coulomb friction at a tip contact, against the small-deflection cantilever under
+//! proportional loading: a cantilever along z beside the plane x = -(R + δ) (normal +x) under
+//! the tip force (-Fx, Fy, 0), Fx above the force F_c = 3 E I δ / L³ that closes the gap.
+//!
+//! The tip touches the plane at the load fraction λ0 = F_c / Fx, where its tangential
+//! position is y_touch = λ0 Fy L³ / (3 E I); the normal reaction is then R = Fx - F_c. If it
+//! sticks it stays at y_touch and the tangential reaction is -(1 - λ0) Fy, inside the cone
+//! iff |Fy| ≤ μ Fx (the ratio of the reaction components is the same at every load fraction
+//! after the touch); otherwise it slides, the tangential reaction is -sign(Fy) μ R and the tip
+//! is at y = (Fy - sign(Fy) μ R) L³ / (3 E I).
+#![allow(clippy::unwrap_used, missing_docs)]
+
+mod common;
+
+use softrod::nalgebra::Vector3;
+use softrod::{
+    solve_constrained, Actuation, ContactSolution, ContactState, Error, Loads, Obstacle, RobotModel,
+};
+
+use common::{beam as rod, rk4_options as options, BEAM_E as E, BEAM_LENGTH as L, BEAM_NU as NU};
+
+/// Radius (m) of the cantilever.
+const RADIUS: f64 = 1e-3;
+/// Surface gap (m) to the plane.
+const DELTA: f64 = 1e-3 * L;
+
+/// `(E I, F_c)` of the cantilever.
+fn constants() -> (f64, f64) {
+    let (ei, _, _, _) = common::circular_constants(E, NU, RADIUS, 1.0);
+    (ei, 3.0 * ei * DELTA / L.powi(3))
+}
+
+fn plane(mu: f64) -> Obstacle {
+    Obstacle::plane([-(RADIUS + DELTA), 0.0, 0.0], [1.0, 0.0, 0.0])
+        .unwrap()
+        .with_friction(mu)
+        .unwrap()
+}
+
+fn solve(force: Vector3<f64>, obstacle: &Obstacle) -> ContactSolution {
+    let model = RobotModel::rod_only(rod(RADIUS), Loads::tip_force(force)).unwrap();
+    let sol = solve_constrained(
+        &model,
+        &Actuation::default(),
+        &options(100),
+        None,
+        std::slice::from_ref(obstacle),
+    )
+    .unwrap();
+    assert!(sol.solution.stats.converged);
+    sol
+}
+
+/// No node penetrates by more than 1e-9 m, the force is inside the cone and split into its
+/// normal and tangential parts, and the base wrench equals the applied tip force and the
+/// contact forces (about the base) to 1e-10 of `scale`.
+fn assert_balanced(sol: &ContactSolution, obstacle: &Obstacle, force: Vector3<f64>, scale: f64) {
+    for p in &sol.solution.position {
+        let g = obstacle.distance(&Vector3::from(*p)).0 - RADIUS;
+        assert!(g >= -1e-9, "penetration {g:e} at {p:?}");
+    }
+    let mu = obstacle.friction();
+    for c in &sol.contacts {
+        let n = Vector3::from(c.normal);
+        let t = Vector3::from(c.tangential_force);
+        assert!(c.normal_force >= 0.0);
+        assert!(t.dot(&n).abs() <= 1e-15 * scale, "tangential force along n");
+        assert!(
+            t.norm() <= mu * c.normal_force * (1.0 + 1e-9),
+            "outside the cone: |f_t| = {:e}, mu f_n = {:e}",
+            t.norm(),
+            mu * c.normal_force
+        );
+    }
+    let tip = Vector3::from(sol.solution.tip_position());
+    let (mut f, mut m) = (force, tip.cross(&force));
+    for (j, cf) in sol.contact_force.iter().enumerate() {
+        let cf = Vector3::from(*cf);
+        f += cf;
+        m += Vector3::from(sol.solution.position[j]).cross(&cf);
+    }
+    let by_contact: Vector3<f64> = sol
+        .contacts
+        .iter()
+        .map(|c| Vector3::from(c.normal) * c.normal_force + Vector3::from(c.tangential_force))
+        .sum();
+    let total: Vector3<f64> = sol.contact_force.iter().map(|v| Vector3::from(*v)).sum();
+    assert!((total - by_contact).norm() <= 1e-12 * scale);
+    let b = sol.solution.base_wrench;
+    for k in 0..3 {
+        assert!((b[k] - f[k]).abs() <= 1e-10 * scale, "force {k}");
+        assert!((b[3 + k] - m[k]).abs() <= 1e-10 * scale * L, "moment {k}");
+    }
+}
+
+/// Sticking and sliding at the tip: reactions, tip position and state against the
+/// proportional-loading closed form to 1e-4 relative.
+#[test]
+fn tip_friction_sticks_and_slides_as_the_cantilever_closed_form() {
+    let (ei, fc) = constants();
+    let c = L.powi(3) / (3.0 * ei);
+    let mu = 0.5;
+    let obstacle = plane(mu);
+    // (Fx / F_c, Fy / F_c): stick iff |Fy| <= mu Fx.
+    for (ax, ay) in [
+        (2.0, 0.5),
+        (2.0, -0.9),
+        (3.0, 1.2),
+        (2.0, 2.0),
+        (2.0, -1.5),
+        (4.0, 3.0),
+    ] {
+        let (fx, fy) = (ax * fc, ay * fc);
+        let force = Vector3::new(-fx, fy, 0.0);
+        let sol = solve(force, &obstacle);
+        assert_balanced(&sol, &obstacle, force, fx);
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        let k = sol.contacts[0];
+        assert_eq!(k.s, L);
+        let lambda0 = fc / fx;
+        let normal = fx - fc;
+        let stick = fy.abs() <= mu * fx;
+        let (ft, y) = if stick {
+            (-(1.0 - lambda0) * fy, lambda0 * fy * c)
+        } else {
+            let ft = -fy.signum() * mu * normal;
+            (ft, (fy + ft) * c)
+        };
+        let tip = sol.solution.tip_position();
+        let err_n = (k.normal_force / normal - 1.0).abs();
+        let err_t = (k.tangential_force[1] / ft - 1.0).abs();
+        let err_y = (tip[1] / y - 1.0).abs();
+        println!(
+            "Fx = {ax} F_c, Fy = {ay} F_c: {:?}; R = {:e} (err {err_n:e}), f_t = {:e} \
+             (closed form {ft:e}, err {err_t:e}), tip y = {:e} (closed form {y:e}, err {err_y:e})",
+            k.state, k.normal_force, k.tangential_force[1], tip[1]
+        );
+        let expected = if stick {
+            ContactState::Stick
+        } else {
+            ContactState::Slide
+        };
+        assert_eq!(k.state, expected, "Fx = {ax} F_c, Fy = {ay} F_c");
+        assert!(err_n < 1e-4, "normal reaction");
+        assert!(err_t < 1e-4, "tangential reaction");
+        assert!(err_y < 1e-4, "tip y");
+        // Along the rod: zero in the closed form. Sticking, the tip is held where it touched
+        // and the rod feels only the total tip force, so the reaction is -(1 - λ0) times
+        // the applied force in every component (here to the accuracy of the touch point
+        // times the axial stiffness E A / L); sliding, the slip has the axial shortening of
+        // the bent rod (second order in the deflection).
+        let axial = k.tangential_force[2].abs();
+        println!("  axial component {axial:e} N (F_c = {fc:e} N)");
+        assert!(k.tangential_force[0].abs() <= 1e-12 * fc);
+        assert!(axial <= if stick { 1e-6 * fc } else { 1e-2 * ft.abs() });
+        if !stick {
+            let ratio = Vector3::from(k.tangential_force).norm() / (mu * k.normal_force);
+            assert!(
+                (ratio - 1.0).abs() < 1e-10,
+                "sliding force off the cone: {ratio}"
+            );
+        }
+    }
+}
+
+/// μ = 0 and μ = 1e-12 reproduce the frictionless solve (tip position to 1e-12 m), and a
+/// frictionless obstacle reports frictionless contacts with no tangential force.
+#[test]
+fn vanishing_friction_is_the_frictionless_solve() {
+    let (_, fc) = constants();
+    let base = Obstacle::plane([-(RADIUS + DELTA), 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap();
+    assert_eq!(base.friction(), 0.0);
+    for (ax, ay) in [(2.0, 0.7), (3.0, -2.0)] {
+        let force = Vector3::new(-ax * fc, ay * fc, 0.0);
+        let free = solve(force, &base);
+        assert_eq!(free.contacts[0].state, ContactState::Frictionless);
+        assert_eq!(free.contacts[0].tangential_force, [0.0; 3]);
+        for mu in [0.0, 1e-12] {
+            let sol = solve(force, &plane(mu));
+            assert_balanced(&sol, &plane(mu), force, ax * fc);
+            let (a, b) = (sol.solution.tip_position(), free.solution.tip_position());
+            let d = (Vector3::from(a) - Vector3::from(b)).norm();
+            println!("Fx = {ax} F_c, Fy = {ay} F_c, mu = {mu:e}: tip vs frictionless {d:e} m");
+            assert!(d <= 1e-12, "mu = {mu}: {d:e} m");
+            let want = if mu == 0.0 {
+                ContactState::Frictionless
+            } else {
+                ContactState::Slide
+            };
+            assert_eq!(sol.contacts[0].state, want);
+        }
+    }
+}
+
+/// A friction coefficient must be finite and >= 0; an obstacle with friction touched inside
+/// the rod is refused with an error naming `friction` (tip contacts only).
+#[test]
+fn bad_friction_and_interior_friction_are_named_errors() {
+    let p = Obstacle::plane([0.0; 3], [1.0, 0.0, 0.0]).unwrap();
+    for mu in [-0.1, f64::NAN, f64::INFINITY] {
+        let e = p.clone().with_friction(mu).unwrap_err();
+        assert!(matches!(e, Error::InvalidParameter { ref name, .. } if name == "friction"));
+    }
+    assert_eq!(p.with_friction(0.3).unwrap().friction(), 0.3);
+    // A uniform load on a floor at the gap δ touches it inside the rod.
+    let (ei, _) = constants();
+    let q = 72.0 * ei * DELTA / (0.5 * L).powi(4);
+    let loads = Loads {
+        distributed_force: Some(softrod::Profile::Constant(Vector3::new(-q, 0.0, 0.0))),
+        ..Loads::default()
+    };
+    let model = RobotModel::rod_only(rod(RADIUS), loads).unwrap();
+    let e = solve_constrained(
+        &model,
+        &Actuation::default(),
+        &options(100),
+        None,
+        &[plane(0.3)],
+    )
+    .unwrap_err();
+    println!("{e}");
+    assert!(e.to_string().contains("friction"), "{e}");
+}
+
+/// Compliance under a sticking tip contact: the tip is held along the normal and along the
+/// surface, so its translation per tip force is zero (≤ 1e-9 of the contact-free `L³/(3EI)`)
+/// in every direction, while a frictionless contact lets it slide along the plane
+/// (`C_yy = L³/(3EI)` to 1e-3).
+#[test]
+fn a_sticking_tip_contact_holds_the_tip_in_the_compliance() {
+    let (ei, fc) = constants();
+    let free = L.powi(3) / (3.0 * ei);
+    let force = Vector3::new(-2.0 * fc, 0.5 * fc, 0.0);
+    let stick = solve(force, &plane(0.5));
+    assert_eq!(stick.contacts[0].state, ContactState::Stick);
+    let c = stick.compliance.get().unwrap();
+    let worst = c.fixed_view::<3, 3>(0, 0).amax();
+    println!("sticking: largest translational compliance {worst:e} m/N (free {free:e})");
+    assert!(worst <= 1e-9 * free, "{c}");
+    let slide = solve(force, &plane(0.0)).compliance.get().unwrap();
+    println!(
+        "frictionless: C_yy = {:e} (L^3/3EI = {free:e})",
+        slide[(1, 1)]
+    );
+    assert!((slide[(1, 1)] / free - 1.0).abs() < 1e-3);
+}
