@@ -27,8 +27,8 @@ const MAX_STEP: f64 = 0.25;
 /// The thickness (m) an obstacle offers to a rod crossing it: `None` for a plane (a rod
 /// beyond it penetrates it).
 fn thickness(o: &Obstacle) -> Option<f64> {
-    match o {
-        Obstacle::Plane { .. } => None,
+    match o.shape() {
+        Obstacle::Plane { .. } | Obstacle::Frictional { .. } => None,
         Obstacle::Sphere { radius, .. }
         | Obstacle::Capsule { radius, .. }
         | Obstacle::Cylinder { radius, .. } => Some(2.0 * radius),

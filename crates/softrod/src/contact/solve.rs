@@ -1447,11 +1447,7 @@ pub fn solve_constrained(
             p.hint = p.solved.take();
             retouch(&mut p, &xc, &options.newton, &mut effort);
             if let Some(x) = active_set(&mut p, &xc, &options.newton, &mut effort) {
-                let x = match not_crossed(&mut p, x, options, &mut effort) {
-                    Ok(x) => x,
-                    Err(why) => return fail(&p, &options.newton, &effort, 0.0, why),
-                };
-                return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
+                return finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort);
             }
         }
         if let Some(e) = refusal(&p) {
@@ -1476,11 +1472,7 @@ pub fn solve_constrained(
     match reached {
         Reach::Done(x) => {
             p.load = 1.0;
-            let x = match not_crossed(&mut p, x, options, &mut effort) {
-                Ok(x) => x,
-                Err(why) => return fail(&p, &options.newton, &effort, 0.0, why),
-            };
-            finish(&mut p, model, actuation, options, &x, &effort, 1.0)
+            finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort)
         }
         Reach::Stopped { lambda, why, .. } if options.newton.throw => {
             fail(&p, &options.newton, &effort, lambda, why)
@@ -1593,6 +1585,21 @@ fn reach(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Effort) -
         reached = Some(x);
     }
     Reach::Done(reached.unwrap_or_default())
+}
+
+/// The solution at `x` ([`finish`]) once checked for obstacles crossed on the way
+/// ([`not_crossed`]).
+fn finish_unless_crossed(
+    p: &mut Constrained<'_>,
+    (model, actuation): (&Arc<RobotModel>, &Actuation),
+    options: &SolveOptions,
+    x: Vec<f64>,
+    effort: &mut Effort,
+) -> Result<ContactSolution> {
+    match not_crossed(p, x, options, effort) {
+        Ok(x) => finish(p, model, actuation, options, &x, effort, 1.0),
+        Err(why) => fail(p, &options.newton, effort, 0.0, why),
+    }
 }
 
 /// The solution `x` (its pass the last of `p`) if no point of the rod crossed an obstacle on

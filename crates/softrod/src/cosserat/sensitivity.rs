@@ -11,7 +11,7 @@
 //! ```
 //!
 //! where every column `y_c = ∂y/∂c` is a solution of the variational equations of
-//! `cosserat/equations.rs` integrated with the state: the six base-wrench columns start from a
+//! `cosserat/equations/` integrated with the state: the six base-wrench columns start from a
 //! unit base wrench, a parameter's column from zero (or from its change of the base pose) and
 //! is forced along the rod by the parameter's change of the constitutive balance at fixed
 //! strains, `e -= ∂(T + W_c + n_el)/∂p` in the body wrench of the local solve (`T` the
