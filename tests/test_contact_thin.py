@@ -28,6 +28,19 @@ def _least_gap_on_chords(position, capsule, radius):
     return (np.linalg.norm(rel - axial[:, None] * u, axis=1) - r - radius).min()
 
 
+def _assert_rests_on_the_straight_side(robot, capsule, mid):
+    """One pushing contact with the wire, no penetration along the chords, and the rod on the
+    side of the wire facing the unactuated (straight) rod."""
+    radius = robot.rod.section.radius
+    sol = sr.Robot(robot.rod, tendons=robot.tendons, obstacles=[capsule]).solve(ACTUATION)
+    assert sol.converged
+    assert len(sol.contacts) == 1
+    c = sol.contacts[0]
+    assert c["normal_force"] > 0.0
+    assert _least_gap_on_chords(np.asarray(sol.position), capsule, radius) > -1e-9
+    assert np.asarray(c["normal"]) @ (np.array([0.0, 0.0, c["s"]]) - mid) > 0.0
+
+
 @pytest.mark.parametrize("wire", [0.5e-3, 2e-3])
 def test_the_rod_rests_on_a_wire_between_two_nodes(free, wire):
     robot, sol0 = free
@@ -41,14 +54,7 @@ def test_the_rod_rests_on_a_wire_between_two_nodes(free, wire):
     radius = robot.rod.section.radius
     # Without the check between the nodes, the free shape is what a node check accepts.
     assert _least_gap_on_chords(p, capsule, radius) < -wire
-    sol = sr.Robot(robot.rod, tendons=robot.tendons, obstacles=[capsule]).solve(ACTUATION)
-    assert sol.converged
-    assert len(sol.contacts) == 1
-    c = sol.contacts[0]
-    assert c["normal_force"] > 0.0
-    assert _least_gap_on_chords(np.asarray(sol.position), capsule, radius) > -1e-9
-    # The rod rests on the side of the wire facing the unactuated (straight) rod.
-    assert np.asarray(c["normal"]) @ (np.array([0.0, 0.0, c["s"]]) - mid) > 0.0
+    _assert_rests_on_the_straight_side(robot, capsule, mid)
 
 
 @pytest.mark.parametrize(
@@ -68,10 +74,4 @@ def test_a_wire_crossed_on_the_way_from_the_straight_rod_is_met(free, k, frac, w
     capsule = sr.Capsule(mid - 0.05 * b, mid + 0.05 * b, wire)
     radius = robot.rod.section.radius
     assert _least_gap_on_chords(p, capsule, radius) > 0.0
-    sol = sr.Robot(robot.rod, tendons=robot.tendons, obstacles=[capsule]).solve(ACTUATION)
-    assert sol.converged
-    assert len(sol.contacts) == 1
-    c = sol.contacts[0]
-    assert c["normal_force"] > 0.0
-    assert _least_gap_on_chords(np.asarray(sol.position), capsule, radius) > -1e-9
-    assert np.asarray(c["normal"]) @ (np.array([0.0, 0.0, c["s"]]) - mid) > 0.0
+    _assert_rests_on_the_straight_side(robot, capsule, mid)

@@ -463,7 +463,6 @@ class MeshSpec(_Table):
     vertices: (
         Annotated[list[Vec3], Field(min_length=3, description="vertices (m, mesh frame)")] | None
     ) = None
-    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
     faces: (
         Annotated[
             list[Annotated[list[Annotated[int, Field(ge=0)]], Field(min_length=3, max_length=3)]],
@@ -480,6 +479,7 @@ class MeshSpec(_Table):
         ]
         | None
     ) = None
+    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
 
     @model_validator(mode="after")
     def _one_source(self) -> MeshSpec:

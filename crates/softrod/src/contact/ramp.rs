@@ -95,11 +95,6 @@ pub(super) fn positions_at(pass: &Pass, s: &[f64]) -> Vec<Vector3<f64>> {
         .collect()
 }
 
-/// Whether a point of the rod moved from `from` to `to` (same samples, radii `radius`)
-/// along a segment that runs into an obstacle by more than `depth` (m) while both its ends
-/// are clear of it by `-depth`. Obstacles the rod touches in `p`'s active set are not
-/// checked: the rod met them (a rod wrapped around an obstacle it touches moves through it
-/// only on the straight segments).
 /// Whether obstacle `i` is checked for crossing: of finite thickness and not touched in
 /// `p`'s active set.
 fn checked(p: &Constrained<'_>, i: usize) -> bool {
@@ -111,6 +106,32 @@ pub(super) fn any_checked(p: &Constrained<'_>) -> bool {
     (0..p.obstacles.len()).any(|i| checked(p, i))
 }
 
+/// The gaps (m) of `o` at the two ends of the straight segment from `a` to `b` (a point of the
+/// rod of radius `r` moving), and whether the gap along it falls below `threshold` (m).
+fn segment_gap(
+    o: &Obstacle,
+    a: Vector3<f64>,
+    b: Vector3<f64>,
+    r: f64,
+    threshold: f64,
+) -> (f64, f64, bool) {
+    let end = |point: Vector3<f64>| CellEnd {
+        point,
+        tangent: b - a,
+        radius: r,
+    };
+    let (ea, eb) = (end(a), end(b));
+    let ga = o.distance(&a).0 - r;
+    let gb = o.distance(&b).0 - r;
+    let below = least_gap_in_cell(o, (&ea, ga), (&eb, gb), threshold).is_some();
+    (ga, gb, below)
+}
+
+/// Whether a point of the rod moved from `from` to `to` (same samples, radii `radius`)
+/// along a segment that runs into an obstacle by more than `depth` (m) while both its ends
+/// are clear of it by `-depth`. Obstacles the rod touches in `p`'s active set are not
+/// checked: the rod met them (a rod wrapped around an obstacle it touches moves through it
+/// only on the straight segments).
 pub(super) fn crossed(
     p: &Constrained<'_>,
     (from, to): (&[Vector3<f64>], &[Vector3<f64>]),
@@ -118,20 +139,9 @@ pub(super) fn crossed(
     depth: f64,
 ) -> bool {
     (0..p.obstacles.len()).filter(|&i| checked(p, i)).any(|i| {
-        let o = &p.obstacles[i];
         (0..from.len()).any(|k| {
-            let chord = to[k] - from[k];
-            let end = |point: Vector3<f64>| CellEnd {
-                point,
-                tangent: chord,
-                radius: radius[k],
-            };
-            let (a, b) = (end(from[k]), end(to[k]));
-            let ga = o.distance(&a.point).0 - a.radius;
-            let gb = o.distance(&b.point).0 - b.radius;
-            ga >= -depth
-                && gb >= -depth
-                && least_gap_in_cell(o, (&a, ga), (&b, gb), -depth).is_some()
+            let (ga, gb, below) = segment_gap(&p.obstacles[i], from[k], to[k], radius[k], -depth);
+            ga >= -depth && gb >= -depth && below
         })
     })
 }
@@ -149,20 +159,8 @@ fn too_far(
             return false;
         };
         (0..from.len()).any(|k| {
-            let chord = to[k] - from[k];
             let limit = 0.5 * (t + 2.0 * radius[k]);
-            if chord.norm() <= limit {
-                return false;
-            }
-            let end = |point: Vector3<f64>| CellEnd {
-                point,
-                tangent: chord,
-                radius: radius[k],
-            };
-            let (a, b) = (end(from[k]), end(to[k]));
-            let ga = o.distance(&a.point).0 - a.radius;
-            let gb = o.distance(&b.point).0 - b.radius;
-            least_gap_in_cell(o, (&a, ga), (&b, gb), limit).is_some()
+            (to[k] - from[k]).norm() > limit && segment_gap(o, from[k], to[k], radius[k], limit).2
         })
     })
 }
