@@ -221,8 +221,6 @@ def test_one_sided_tip_compliance_is_the_one_sided_difference(tip_force, directi
     opts = {**robot.solver, "tolerance": 1e-14}
     sol = robot.solve(tolerance=1e-14)
     f0, m0 = np.array(robot.loads.tip_force), np.array(robot.loads.tip_moment)
-    fixed = softrod.tangent_compliance(sol, node=len(sol.s) - 2).world  # profile held fixed
-    assert fixed.shape == (6, 6)
     for direction in directions:
         tc = softrod.tangent_compliance(sol, direction=direction)
         c = tc.world
