@@ -1013,6 +1013,7 @@ def tangent_compliance(
     ("release" or "unload") for each decreasing, the column ``(f(0) - f(-h e_k)) / h``. At
     another node or with tendons="length" the profile is held fixed (``direction`` must be
     None). Other solutions: both directions agree."""
+
 def eigenscrews(
     matrix: NDArray[np.float64], kind: Literal["stiffness", "compliance"] = "stiffness"
 ) -> Eigenscrews: ...
