@@ -295,3 +295,8 @@ def test_tangent_compliance_direction_is_checked():
     plain = niti(0.0).solve([3.0, 0, 0, 0, 1.0, 0], steps=40)
     with pytest.raises(ValueError, match="direction"):
         softrod.tangent_compliance(plain, direction="push")
+    # A disk-guided solution holds its guide forces fixed: no one-sided compliance.
+    guided = guided_niti(0.3).solve([0.02, 0, 0, 0, 0.01, 0])
+    with pytest.raises(ValueError, match=r"direction.*disk-guided"):
+        softrod.tangent_compliance(guided, direction=1)
+    assert np.all(np.isfinite(softrod.tangent_compliance(guided).world))

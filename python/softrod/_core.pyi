@@ -1011,8 +1011,9 @@ def tangent_compliance(
     tension profile following the stick/slip rule continued from the solution:
     ``direction=1`` ("pull" or "load", default) for each wrench component increasing, ``-1``
     ("release" or "unload") for each decreasing, the column ``(f(0) - f(-h e_k)) / h``. At
-    another node or with tendons="length" the profile is held fixed (``direction`` must be
-    None). Other solutions: both directions agree."""
+    another node or with tendons="length" the profile is held fixed, on a disk-guided
+    solution the guide forces (``direction`` must be None there). Frictionless solutions:
+    both directions agree."""
 
 def eigenscrews(
     matrix: NDArray[np.float64], kind: Literal["stiffness", "compliance"] = "stiffness"

@@ -306,7 +306,8 @@ impl TangentCompliance {
 /// None: the same; each wrench component increasing) or -1, "release" or "unload" (each
 /// decreasing, the column `(f(0) - f(-h e_k)) / h`). Elsewhere on a frictional equilibrium
 /// (another node, tendons at fixed length; `direction` must then be None) the profile is held
-/// fixed. For any other solution `direction` is checked and the two directions agree.
+/// fixed, as on a disk-guided solution (its guide forces held fixed; `direction` must be None).
+/// For a frictionless solution `direction` is checked and the two directions agree.
 #[pyfunction]
 #[pyo3(signature = (solution, tendons="tension", *, held=None, node=None, direction=None))]
 pub(crate) fn tangent_compliance<'py>(
@@ -370,7 +371,7 @@ pub(crate) fn tangent_compliance<'py>(
     };
     let sol = &solution.inner;
     let tip = node.is_none_or(|k| k + 1 == sol.s.len());
-    let result = match frictional_kind(sol) {
+    let result = match frictional_kind(solution) {
         Frictional::Channel if tendons == "tension" && tip => {
             let d = one_sided.map_or(softrod::Direction::Pull, |(d, _)| d);
             run(py, "tangent_compliance", || one_sided_tip(sol, d))?
@@ -418,10 +419,14 @@ enum Frictional {
     Guided,
 }
 
-fn frictional_kind(sol: &softrod::StaticsSolution) -> Frictional {
-    if sol.model.tendons().iter().any(softrod::Tendon::is_guided) {
+fn frictional_kind(solution: &StaticsSolution) -> Frictional {
+    let guided = solution
+        .friction
+        .as_ref()
+        .is_some_and(|f| f.guides.iter().any(|g| !g.is_empty()));
+    if guided {
         Frictional::Guided
-    } else if sol.actuation.profile.is_some() {
+    } else if solution.inner.actuation.profile.is_some() {
         Frictional::Channel
     } else {
         Frictional::No
