@@ -188,3 +188,115 @@ def test_actuation_jacobian_direction_is_checked():
     assert np.array_equal(
         softrod.actuation_jacobian(plain, direction=-1), softrod.actuation_jacobian(plain)
     )
+
+
+def tip_twist(a, b) -> np.ndarray:
+    """The tip twist [dp; dtheta] (world) from solution a to solution b (rotation vector of
+    R_b R_a^T)."""
+    dp = b.tip_position - a.tip_position
+    m = np.asarray(b.rotation[-1]) @ np.asarray(a.rotation[-1]).T
+    w = 0.5 * np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+    s = np.linalg.norm(w)
+    if s > 0.0:
+        w *= np.arcsin(s) / s
+    return np.concatenate([dp, w])
+
+
+@pytest.mark.parametrize(
+    ("tip_force", "directions", "steps"),
+    [([0.05, -0.02, 0.01], (1, -1), (1e-6, 1e-8)), (None, (1,), (1e-5, 1e-6))],
+)
+def test_one_sided_tip_compliance_is_the_one_sided_difference(tip_force, directions, steps):
+    # Oracle: per column k, the one-sided difference of the solve continued from the solution
+    # (previous=solution) under a small dead tip force or moment added along +e_k (pull) or
+    # -e_k (release), at steps h and h/10 (h = 1e-6 N, 1e-8 N m with a tip force; 1e-5 N,
+    # 1e-6 N m without external loads), against the returned column: the h/10 difference to
+    # 1e-5 relative, and the force columns' error O(h). Without external loads the base
+    # state is one march and the perturbed (loaded) solve a quasi-Newton iteration: the two
+    # resolve the tension profile to the friction tolerance (1e-9 of the largest tension)
+    # differently, which limits the steps from below (6.5e-6 relative at 1e-7 N). There the
+    # release column of the moment about y is left to the Rust test (tolerance 1e-14): an
+    # element changes branch above 1e-8 N m, and at 1e-8 N m that resolution gives 2.4e-5.
+    robot = niti(0.2, tip_force).with_tensions([3.0, 0, 0, 0, 1.0, 0])
+    opts = {**robot.solver, "tolerance": 1e-14}
+    sol = robot.solve(tolerance=1e-14)
+    f0, m0 = np.array(robot.loads.tip_force), np.array(robot.loads.tip_moment)
+    for direction in directions:
+        tc = softrod.tangent_compliance(sol, direction=direction)
+        c = tc.world
+        assert tc.node == len(sol.s) - 1 and np.all(tc.tension_rate == 0.0)
+        for k in range(6):
+            col = c[:, k]
+            h = steps[0] if k < 3 else steps[1]
+            err = []
+            for step in (h, h / 10):
+                w = np.zeros(6)
+                w[k] = direction * step
+                loads = softrod.Loads(tip_force=f0 + w[:3], tip_moment=m0 + w[3:])
+                nxt = softrod.solve_statics(robot.rod, robot.tendons, loads, previous=sol, **opts)
+                diff = tip_twist(sol, nxt) / (direction * step)
+                err.append(np.linalg.norm(diff - col) / np.linalg.norm(col))
+            assert err[1] <= 1e-5, (direction, k, err)
+            if k < 3:
+                assert err[1] < 0.3 * err[0], (direction, k, err)
+    # The default is the pull direction; pull and release differ (sliding against sticking
+    # of the elements the wrench unloads); the body form is the world form in tip axes.
+    pull = softrod.tangent_compliance(sol, direction="pull")
+    assert np.array_equal(softrod.tangent_compliance(sol).world, pull.world)
+    r = np.asarray(sol.rotation[-1])
+    rt = np.kron(np.eye(2), r.T)
+    np.testing.assert_allclose(
+        pull.body, rt @ pull.world @ rt.T, rtol=0, atol=1e-12 * np.abs(pull.world).max()
+    )
+    np.testing.assert_allclose(pull.stiffness_world @ pull.world, np.eye(6), atol=1e-9)
+    if -1 in directions:
+        release = softrod.tangent_compliance(sol, direction="release")
+        assert np.abs(release.world - pull.world).max() > 1e-3 * np.abs(pull.world).max()
+
+
+@pytest.mark.parametrize("tip_force", [None, [0.05, -0.02, 0.01]])
+def test_one_sided_tip_compliance_without_friction_is_the_tangent_compliance(tip_force):
+    # A frictional solve with mu = 0 (continued from a mu = 0.2 state, so it carries a
+    # tension profile) against the frictionless solve at the same nodes: the one-sided tip
+    # compliance (the frictional linearisation) equals the frictionless tangent compliance.
+    t = [3.0, 0, 0, 0, 1.0, 0]
+    start = niti(0.2, tip_force).solve(t, tolerance=1e-14)
+    fr = niti(0.0, tip_force).solve(t, tolerance=1e-14, previous=start)
+    plain = niti(0.0, tip_force).solve(t, tolerance=1e-14, s_out=fr.s)
+    assert fr.frictional and not plain.frictional and np.array_equal(fr.s, plain.s)
+    ref = softrod.tangent_compliance(plain)
+    for direction in (1, -1, None):
+        c = softrod.tangent_compliance(fr, direction=direction)
+        for a, b in ((c.world, ref.world), (c.body, ref.body)):
+            assert np.abs(a - b).max() <= 1e-12 * np.abs(b).max()
+    # Without friction the direction is checked and changes nothing (bit for bit).
+    for direction in (1, -1, "load", "unload"):
+        other = softrod.tangent_compliance(plain, direction=direction)
+        assert np.array_equal(other.world, ref.world)
+    held = softrod.tangent_compliance(plain, "length", node=10)
+    assert np.array_equal(
+        softrod.tangent_compliance(plain, "length", node=10, direction=-1).world, held.world
+    )
+
+
+def test_tangent_compliance_direction_is_checked():
+    sol = niti(0.2).solve([3.0, 0, 0, 0, 1.0, 0], steps=40)
+    for bad in (0, 2, "push", True, 1.5):
+        with pytest.raises((ValueError, TypeError), match="direction") as info:
+            softrod.tangent_compliance(sol, direction=bad)
+        if isinstance(bad, str):
+            assert "push" in str(info.value) and "release" in str(info.value)
+    # The one-sided compliance is that of the tip at fixed base tensions.
+    for kwargs in ({"node": 10}, {"tendons": "length"}):
+        with pytest.raises(ValueError, match="direction"):
+            softrod.tangent_compliance(sol, direction=1, **kwargs)
+        # Without a direction, there the tension profile is held fixed (as documented).
+        assert softrod.tangent_compliance(sol, **kwargs).world.shape == (6, 6)
+    plain = niti(0.0).solve([3.0, 0, 0, 0, 1.0, 0], steps=40)
+    with pytest.raises(ValueError, match="direction"):
+        softrod.tangent_compliance(plain, direction="push")
+    # A disk-guided solution holds its guide forces fixed: no one-sided compliance.
+    guided = guided_niti(0.3).solve([0.02, 0, 0, 0, 0.01, 0])
+    with pytest.raises(ValueError, match=r"direction.*disk-guided"):
+        softrod.tangent_compliance(guided, direction=1)
+    assert np.all(np.isfinite(softrod.tangent_compliance(guided).world))

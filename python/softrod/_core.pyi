@@ -572,14 +572,14 @@ def _pcc_inverse_statics(
 def actuation_jacobian(
     solution: StaticsSolution | PccSolution,
     node: int = ...,
-    direction: int | Literal["pull", "release"] | None = ...,
+    direction: int | Literal["pull", "load", "release", "unload"] | None = ...,
 ) -> NDArray[np.float64]:
     """d[δp; δθ] (world; m, rad) of node ``node`` / d(tensions (N), pressures (Pa)),
     shape (6, n_tendons + n_chambers); exact (linearised boundary-value problem).
 
-    For a frictional equilibrium the derivative is one-sided: ``direction=1`` ("pull",
-    default) for increasing inputs continued from the solution (``previous=solution``),
-    ``-1`` ("release") for decreasing ones, the column ``(f(a) - f(a - h e)) / h``; the
+    For a frictional equilibrium the derivative is one-sided: ``direction=1`` ("pull" or
+    "load", default) for increasing inputs continued from the solution (``previous=solution``),
+    ``-1`` ("release" or "unload") for decreasing ones, the column ``(f(a) - f(a - h e)) / h``; the
     release column of a slack tendon is zero. Other solutions: both directions agree."""
 
 # ----------------------------------------------------------------------------- materials
@@ -1003,7 +1003,18 @@ def tangent_compliance(
     *,
     held: Sequence[int] | None = None,
     node: int | None = None,
-) -> TangentCompliance: ...
+    direction: int | Literal["pull", "load", "release", "unload"] | None = None,
+) -> TangentCompliance:
+    """d[δp; δθ]/d[f; m] at ``node`` (default the tip), tendons at fixed "tension" or "length".
+
+    For a frictional equilibrium the tip compliance at fixed base tensions is one-sided, the
+    tension profile following the stick/slip rule continued from the solution:
+    ``direction=1`` ("pull" or "load", default) for each wrench component increasing, ``-1``
+    ("release" or "unload") for each decreasing, the column ``(f(0) - f(-h e_k)) / h``. At
+    another node or with tendons="length" the profile is held fixed, on a disk-guided
+    solution the guide forces (``direction`` must be None there). Frictionless solutions:
+    both directions agree."""
+
 def eigenscrews(
     matrix: NDArray[np.float64], kind: Literal["stiffness", "compliance"] = "stiffness"
 ) -> Eigenscrews: ...

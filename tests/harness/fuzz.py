@@ -732,7 +732,7 @@ def _define_targets() -> None:
     t("tangent_compliance")(
         lambda d: (
             sr.tangent_compliance,
-            dict(solution=_solution(), tendons="length", held=[0], node=10),
+            dict(solution=_solution(), tendons="length", held=[0], node=10, direction=1),
         )
     )
     t("eigenscrews")(lambda d: (sr.eigenscrews, dict(matrix=_spd(), kind="stiffness")))

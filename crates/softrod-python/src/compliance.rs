@@ -300,16 +300,25 @@ impl TangentCompliance {
 /// the tendons at fixed "tension" or fixed "length" (all, or the indices `held`).
 ///
 /// Any number of tendons can be held; returns a `TangentCompliance` (6x6, m/N, 1/N, rad/(N m)
-/// blocks).
+/// blocks). For a frictional equilibrium (tendons in continuous channels) the tip compliance
+/// with the tendons at fixed base tension is one-sided, the tension profile following the
+/// stick/slip rule continued from the solution: `direction` 1, "pull" or "load" (default,
+/// None: the same; each wrench component increasing) or -1, "release" or "unload" (each
+/// decreasing, the column `(f(0) - f(-h e_k)) / h`). Elsewhere on a frictional equilibrium
+/// (another node, tendons at fixed length; `direction` must then be None) the profile is held
+/// fixed, as on a disk-guided solution (its guide forces held fixed; `direction` must be None).
+/// For a frictionless solution `direction` is checked and the two directions agree.
 #[pyfunction]
-#[pyo3(signature = (solution, tendons="tension", *, held=None, node=None))]
+#[pyo3(signature = (solution, tendons="tension", *, held=None, node=None, direction=None))]
 pub(crate) fn tangent_compliance<'py>(
     py: Python<'py>,
     #[pyo3(from_py_with = arg::solution)] solution: Bound<'py, StaticsSolution>,
     #[pyo3(from_py_with = arg::tendons)] tendons: &str,
     #[pyo3(from_py_with = arg::held)] held: Option<Vec<i64>>,
     #[pyo3(from_py_with = arg::node)] node: Option<i64>,
+    direction: Option<Bound<'py, PyAny>>,
 ) -> PyResult<TangentCompliance> {
+    let direction = direction.filter(|d| !d.is_none());
     let call = Args::new(
         py,
         &[
@@ -317,8 +326,16 @@ pub(crate) fn tangent_compliance<'py>(
             ("tendons", tendons.into_pyobject(py)?.into_any().unbind()),
             ("held", held.clone().into_pyobject(py)?.into_any().unbind()),
             ("node", node.into_pyobject(py)?.into_any().unbind()),
+            (
+                "direction",
+                direction.clone().map_or_else(|| py.None(), Bound::unbind),
+            ),
         ],
     )?;
+    let one_sided = match &direction {
+        Some(d) => Some((crate::statics::jacobian_direction(d)?, d)),
+        None => None,
+    };
     let solution = solution.get();
     let nt = solution.inner.model.tendons().len();
     let held: Vec<usize> = match (tendons, held) {
@@ -353,13 +370,94 @@ pub(crate) fn tangent_compliance<'py>(
         Some(k) => return Err(param_err("node", k, "in [-N, N)")),
     };
     let sol = &solution.inner;
-    let result = run(py, "tangent_compliance", || {
-        softrod::compliance::tangent_compliance_held(sol, &held, node)
-    })?;
+    let tip = node.is_none_or(|k| k + 1 == sol.s.len());
+    let result = match frictional_kind(solution) {
+        Frictional::Channel if tendons == "tension" && tip => {
+            let d = one_sided.map_or(softrod::Direction::Pull, |(d, _)| d);
+            run(py, "tangent_compliance", || one_sided_tip(sol, d))?
+        }
+        kind => {
+            if let (Some((_, value)), false) = (one_sided, kind == Frictional::No) {
+                return Err(param_err(
+                    "direction",
+                    value
+                        .repr()
+                        .map_or_else(|_| "?".to_string(), |r| r.to_string()),
+                    match kind {
+                        Frictional::Guided => {
+                            "None for a disk-guided solution (its tangent compliance holds \
+                             the guide forces fixed)"
+                        }
+                        _ => {
+                            "None unless tendons=\"tension\" at the tip (node None or -1): \
+                             the one-sided compliance of a frictional equilibrium is that of \
+                             the tip at fixed base tensions"
+                        }
+                    },
+                ));
+            }
+            run(py, "tangent_compliance", || {
+                softrod::compliance::tangent_compliance_held(sol, &held, node)
+            })?
+        }
+    };
     Ok(TangentCompliance {
         inner: result,
         tendons: tendons.to_string(),
         call,
+    })
+}
+
+/// Which friction a statics solution carries.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Frictional {
+    /// None: a frictionless solve.
+    No,
+    /// Tendons in continuous channels (a tension profile along them).
+    Channel,
+    /// A disk-guided tendon (the rod under the converged guide forces).
+    Guided,
+}
+
+fn frictional_kind(solution: &StaticsSolution) -> Frictional {
+    let guided = solution
+        .friction
+        .as_ref()
+        .is_some_and(|f| f.guides.iter().any(|g| !g.is_empty()));
+    if guided {
+        Frictional::Guided
+    } else if solution.inner.actuation.profile.is_some() {
+        Frictional::Channel
+    } else {
+        Frictional::No
+    }
+}
+
+/// The one-sided tip compliance of a frictional equilibrium (`softrod::frictional_tip_compliance`)
+/// with its body-frame form, inverses and condition number; the tension rates are zero (the
+/// tendons at fixed base tension).
+fn one_sided_tip(
+    sol: &softrod::StaticsSolution,
+    direction: softrod::Direction,
+) -> softrod::Result<softrod::compliance::TangentCompliance> {
+    use softrod::math::{linalg::invert_general, se3::rotation_adjoint};
+    let world = softrod::frictional_tip_compliance(sol, direction)?;
+    let node = sol.s.len() - 1;
+    let r = sol.rotation[node];
+    let rt = rotation_adjoint(&softrod::nalgebra::Matrix3::from_fn(|i, j| r[j][i]));
+    let body = rt * world * rt.transpose();
+    let (stiffness_world, condition) = invert_general(&world);
+    let (stiffness_body, _) = invert_general(&body);
+    Ok(softrod::compliance::TangentCompliance {
+        node,
+        s: sol.s[node],
+        world,
+        body,
+        stiffness_world,
+        stiffness_body,
+        condition,
+        symmetric: (world - world.transpose()).amax() <= 1e-6 * world.amax(),
+        tension_rate: vec![[0.0; 6]; sol.model.tendons().len()],
     })
 }
 

@@ -314,8 +314,9 @@ pub(crate) fn solve_statics<'py>(
 /// pressure (per Pa), every tendon at fixed tension; shape (6, n_tendons + n_chambers). Exact:
 /// from the linearised boundary-value problem (Cosserat) or the equilibrium Jacobian (PCC),
 /// no finite differences. For a frictional equilibrium the derivative is one-sided:
-/// `direction` 1 (default, None: the same; "pull": increasing inputs, continued from the solution) or -1
-/// ("release": decreasing inputs, the column `(f(a) - f(a - h e)) / h`); for any other
+/// `direction` 1 (default, None: the same; "pull" or "load": increasing inputs, continued from the
+/// solution) or -1 ("release" or "unload": decreasing inputs, the column
+/// `(f(a) - f(a - h e)) / h`); for any other
 /// solution the two agree.
 #[pyfunction]
 #[pyo3(signature = (solution, node=-1, direction=None))]
@@ -369,8 +370,10 @@ pub(crate) fn actuation_jacobian<'py>(
     ))
 }
 
-/// The direction of a one-sided Jacobian: 1 or "pull", -1 or "release".
-fn jacobian_direction(value: &Bound<'_, PyAny>) -> PyResult<softrod::Direction> {
+/// The direction of a one-sided derivative of a frictional equilibrium (the actuation
+/// Jacobian, the tangent compliance): 1, "pull" or "load" (increasing inputs), -1, "release"
+/// or "unload" (decreasing inputs).
+pub(crate) fn jacobian_direction(value: &Bound<'_, PyAny>) -> PyResult<softrod::Direction> {
     if value.is_instance_of::<pyo3::types::PyBool>() {
         // A bool is an int in Python: not a direction.
     } else if let Ok(v) = value.extract::<i64>() {
@@ -381,8 +384,8 @@ fn jacobian_direction(value: &Bound<'_, PyAny>) -> PyResult<softrod::Direction> 
         }
     } else if let Ok(v) = value.extract::<String>() {
         match v.as_str() {
-            "pull" => return Ok(softrod::Direction::Pull),
-            "release" => return Ok(softrod::Direction::Release),
+            "pull" | "load" => return Ok(softrod::Direction::Pull),
+            "release" | "unload" => return Ok(softrod::Direction::Release),
             _ => {}
         }
     }
@@ -391,7 +394,7 @@ fn jacobian_direction(value: &Bound<'_, PyAny>) -> PyResult<softrod::Direction> 
         value
             .repr()
             .map_or_else(|_| "?".to_string(), |r| r.to_string()),
-        "1 or 'pull' (increasing inputs), -1 or 'release' (decreasing inputs)",
+        "1, 'pull' or 'load' (increasing inputs), -1, 'release' or 'unload' (decreasing inputs)",
     ))
 }
 
