@@ -134,7 +134,24 @@ struct Frozen<'a> {
     nb: usize,
 }
 
-impl Frozen<'_> {
+impl<'a> Frozen<'a> {
+    /// The frozen state of `solution` (friction coefficients `mus`), with the six
+    /// base-wrench columns.
+    fn of(solution: &'a StaticsSolution, mus: &[f64]) -> Result<Self> {
+        let model = &*solution.model;
+        Ok(Self {
+            model,
+            mesh: &solution.s,
+            tau: node_tensions(solution, mus)?,
+            base: solution.tendon_tensions.clone(),
+            pressures: solution.pressures(),
+            mus: mus.to_vec(),
+            x: super::sensitivity::scaled_base_wrench(model, &solution.base_wrench),
+            integrator: solution.options.integrator,
+            nb: 6,
+        })
+    }
+
     fn present(&self, i: usize, s: f64) -> bool {
         let (ends, l) = (self.model.tendon_ends(), self.model.length());
         s < ends[i] || (ends[i] == l && s == l)
@@ -944,23 +961,11 @@ pub(crate) fn frictional_actuation_jacobians(
     let nt = model.tendons().len();
     let nc = model.chambers().len();
     let mus: Vec<f64> = model.tendons().iter().map(|t| t.friction()).collect();
-    let x = super::sensitivity::scaled_base_wrench(model, &solution.base_wrench);
-    let nb = if x[..3].iter().all(|v| *v == 0.0) && model.force_free() {
-        0
-    } else {
-        6
-    };
-    let fr = Frozen {
-        model,
-        mesh: &solution.s,
-        tau: node_tensions(solution, &mus)?,
-        base: solution.tendon_tensions.clone(),
-        pressures: solution.pressures(),
-        mus: mus.clone(),
-        x,
-        integrator: solution.options.integrator,
-        nb,
-    };
+    let mut fr = Frozen::of(solution, &mus)?;
+    if fr.x[..3].iter().all(|v| *v == 0.0) && model.force_free() {
+        fr.nb = 0;
+    }
+    let nb = fr.nb;
     let frictional = mus.iter().filter(|&&m| m > 0.0).count();
     let need = 1 + nb + frictional;
     let mut out = vec![DMatrix::zeros(6, nt + nc); nodes.len()];
@@ -1023,17 +1028,7 @@ pub fn frictional_tip_compliance(
 ) -> Result<Matrix6<f64>> {
     let model = &*solution.model;
     let mus: Vec<f64> = model.tendons().iter().map(|t| t.friction()).collect();
-    let fr = Frozen {
-        model,
-        mesh: &solution.s,
-        tau: node_tensions(solution, &mus)?,
-        base: solution.tendon_tensions.clone(),
-        pressures: solution.pressures(),
-        mus: mus.clone(),
-        x: super::sensitivity::scaled_base_wrench(model, &solution.base_wrench),
-        integrator: solution.options.integrator,
-        nb: 6,
-    };
+    let fr = Frozen::of(solution, &mus)?;
     let need = 7 + mus.iter().filter(|&&m| m > 0.0).count();
     let mut out = Matrix6::zeros();
     for k in 0..6 {
