@@ -87,6 +87,14 @@ pub(crate) fn pcc_arc_from_tendon_displacements_jacobian<'py>(
     #[pyo3(from_py_with = arg::extensible)] extensible: bool,
     #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const NAMES: &[&str] = &[
+        "displacements",
+        "distances",
+        "angles",
+        "rest_length",
+        "extensible",
+        "coordinates",
+    ];
     let c = coordinates_from(coordinates)?;
     let t = tendons_from(distances, angles)?;
     let j = pcc::arc_from_tendon_displacements_jacobian(
@@ -96,25 +104,8 @@ pub(crate) fn pcc_arc_from_tendon_displacements_jacobian<'py>(
         extensible,
         c,
     )
-    .map_err(blame(&[
-        "displacements",
-        "distances",
-        "angles",
-        "rest_length",
-        "extensible",
-        "coordinates",
-    ]))?;
-    finite_result(
-        j.iter(),
-        &[
-            "displacements",
-            "distances",
-            "angles",
-            "rest_length",
-            "extensible",
-            "coordinates",
-        ],
-    )?;
+    .map_err(blame(NAMES))?;
+    finite_result(j.iter(), NAMES)?;
     Ok(matrix_array(py, &j))
 }
 
@@ -171,32 +162,21 @@ pub(crate) fn pcc_arc_from_tendon_tensions_jacobian<'py>(
     #[pyo3(from_py_with = arg::axial_stiffness)] axial_stiffness: Option<f64>,
     #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const NAMES: &[&str] = &[
+        "tensions",
+        "distances",
+        "angles",
+        "rest_length",
+        "bending_stiffness",
+        "axial_stiffness",
+        "coordinates",
+    ];
     let c = coordinates_from(coordinates)?;
     let t = tendons_from(distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c).map_err(
-        blame(&[
-            "tensions",
-            "distances",
-            "angles",
-            "rest_length",
-            "bending_stiffness",
-            "axial_stiffness",
-            "coordinates",
-        ]),
-    )?;
-    finite_result(
-        j.iter(),
-        &[
-            "tensions",
-            "distances",
-            "angles",
-            "rest_length",
-            "bending_stiffness",
-            "axial_stiffness",
-            "coordinates",
-        ],
-    )?;
+    let j = pcc::arc_from_tendon_tensions_jacobian(&tensions.to_vec()?, &t, &body, c)
+        .map_err(blame(NAMES))?;
+    finite_result(j.iter(), NAMES)?;
     Ok(matrix_array(py, &j))
 }
 
@@ -244,16 +224,18 @@ pub(crate) fn pcc_arc_from_pressures_jacobian<'py>(
     let c = coordinates_from(coordinates)?;
     let ch = chambers_from(areas, distances, angles)?;
     let body = body_from(rest_length, bending_stiffness, axial_stiffness)?;
-    let j =
-        pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c).map_err(blame(&[
-            "pressures",
-            "areas",
-            "distances",
-            "angles",
-            "rest_length",
-            "bending_stiffness",
-            "axial_stiffness",
-            "coordinates",
-        ]))?;
+    const NAMES: &[&str] = &[
+        "pressures",
+        "areas",
+        "distances",
+        "angles",
+        "rest_length",
+        "bending_stiffness",
+        "axial_stiffness",
+        "coordinates",
+    ];
+    let j = pcc::arc_from_pressures_jacobian(&pressures.to_vec()?, &ch, &body, c)
+        .map_err(blame(NAMES))?;
+    finite_result(j.iter(), NAMES)?;
     Ok(matrix_array(py, &j))
 }

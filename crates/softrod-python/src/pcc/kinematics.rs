@@ -18,12 +18,9 @@ pub(crate) fn pcc_arc_pose(
     #[pyo3(from_py_with = arg::plane_angle)] plane_angle: f64,
     #[pyo3(from_py_with = arg::length)] length: f64,
 ) -> PyResult<Bound<'_, PyArray2<f64>>> {
-    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(blame(&[
-        "curvature",
-        "plane_angle",
-        "length",
-    ]))?;
-    finite_result(t.iter(), &["curvature", "plane_angle", "length"])?;
+    const NAMES: &[&str] = &["curvature", "plane_angle", "length"];
+    let t = pcc::arc_pose(curvature, plane_angle, length).map_err(blame(NAMES))?;
+    finite_result(t.iter(), NAMES)?;
     Ok(pose_array(py, &t))
 }
 
@@ -98,17 +95,10 @@ pub(crate) fn pcc_arc_frames<'py>(
     #[pyo3(from_py_with = arg::length)] length: f64,
     #[pyo3(from_py_with = arg::s)] s: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    const NAMES: &[&str] = &["curvature", "plane_angle", "length", "s"];
     let s = s.to_vec()?;
-    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(blame(&[
-        "curvature",
-        "plane_angle",
-        "length",
-        "s",
-    ]))?;
-    finite_result(
-        ts.iter().flat_map(|m| m.iter()),
-        &["curvature", "plane_angle", "length", "s"],
-    )?;
+    let ts = pcc::arc_frames(curvature, plane_angle, length, &s).map_err(blame(NAMES))?;
+    finite_result(ts.iter().flat_map(|m| m.iter()), NAMES)?;
     Ok(poses_array(py, &ts))
 }
 
@@ -123,18 +113,10 @@ pub(crate) fn pcc_arc_jacobian<'py>(
     #[pyo3(from_py_with = arg::frame)] frame: &str,
     #[pyo3(from_py_with = arg::coordinates)] coordinates: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const NAMES: &[&str] = &["curvature", "plane_angle", "length", "frame", "coordinates"];
     let (f, c) = (frame_from(frame)?, coordinates_from(coordinates)?);
-    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(blame(&[
-        "curvature",
-        "plane_angle",
-        "length",
-        "frame",
-        "coordinates",
-    ]))?;
-    finite_result(
-        j.iter(),
-        &["curvature", "plane_angle", "length", "frame", "coordinates"],
-    )?;
+    let j = pcc::arc_jacobian(curvature, plane_angle, length, f, c).map_err(blame(NAMES))?;
+    finite_result(j.iter(), NAMES)?;
     Ok(matrix_array(py, &j))
 }
 
@@ -155,11 +137,12 @@ pub(crate) fn pcc_chain_frames<'py>(
     segments: &Bound<'py, PyAny>,
     #[pyo3(from_py_with = arg::s)] s: Floats,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(blame(&["segments", "s"]))?;
+    const NAMES: &[&str] = &["segments", "s"];
+    let chain = pcc::PccChain::new(segments_from(segments)?).map_err(blame(NAMES))?;
     let ts = chain
         .backbone(&s.to_vec()?)
         .map_err(blame(&["segments", "s"]))?;
-    finite_result(ts.iter().flat_map(|m| m.iter()), &["segments", "s"])?;
+    finite_result(ts.iter().flat_map(|m| m.iter()), NAMES)?;
     Ok(poses_array(py, &ts))
 }
 
