@@ -15,8 +15,8 @@ use nalgebra::Vector3;
 
 use super::obstacle::Obstacle;
 use super::solve::{active_set, Constrained, Effort, Pass};
-use super::sweep::{least_gap_in_cell, CellEnd};
-use crate::cosserat::equations::{rot, v3};
+use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
+use crate::cosserat::equations::v3;
 use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};
 
 /// Most sample points along the rod for the crossing check.
@@ -84,13 +84,11 @@ pub(super) fn positions_at(pass: &Pass, s: &[f64]) -> Vec<Vector3<f64>> {
                 return v3(&b.y, 0);
             }
             let u = ((t - a.s) / h).clamp(0.0, 1.0);
-            let (pa, pb) = (v3(&a.y, 0), v3(&b.y, 0));
-            let (ta, tb) = (rot(&a.y) * Vector3::z() * h, rot(&b.y) * Vector3::z() * h);
-            let (u2, u3) = (u * u, u * u * u);
-            pa * (2.0 * u3 - 3.0 * u2 + 1.0)
-                + ta * (u3 - 2.0 * u2 + u)
-                + pb * (-2.0 * u3 + 3.0 * u2)
-                + tb * (u3 - u2)
+            arc_point(
+                &CellEnd::at_node(&a.y, h, 0.0),
+                &CellEnd::at_node(&b.y, h, 0.0),
+                u,
+            )
         })
         .collect()
 }

@@ -614,12 +614,7 @@ impl<'m> Constrained<'m> {
         let pass = self.last.as_ref()?;
         let h = b.1 - a.1;
         let end = |j: usize, s: f64| {
-            let y = &pass.nodes[j].y;
-            CellEnd {
-                point: v3(y, 0),
-                tangent: rot(y) * Vector3::z() * h,
-                radius: pass.model.rod().section_at(s).radius,
-            }
+            CellEnd::at_node(&pass.nodes[j].y, h, pass.model.rod().section_at(s).radius)
         };
         let threshold = -penetration.max(1e-3 * h);
         let (ea, eb) = (end(a.0, a.1), end(b.0, b.1));

@@ -13,6 +13,7 @@
 use nalgebra::Vector3;
 
 use super::obstacle::Obstacle;
+use crate::cosserat::equations::{rot, v3};
 
 /// Most gap evaluations per cell.
 const MAX_EVALUATIONS: usize = 200;
@@ -26,6 +27,40 @@ pub(super) struct CellEnd {
     pub radius: f64,
 }
 
+impl CellEnd {
+    /// The end of a cell of length `h` (m) at a node of state `y` (position, then rotation
+    /// rows), the rod's radius there `radius` (m): tangent `h R e₃`.
+    pub fn at_node(y: &[f64], h: f64, radius: f64) -> Self {
+        Self {
+            point: v3(y, 0),
+            tangent: rot(y) * Vector3::z() * h,
+            radius,
+        }
+    }
+}
+
+/// The point at fraction `t ∈ [0, 1]` of the cubic Hermite arc from `a` to `b` (its
+/// Bézier control points `q`).
+fn bezier(q: &[Vector3<f64>; 4], t: f64) -> Vector3<f64> {
+    let s = 1.0 - t;
+    q[0] * (s * s * s) + q[1] * (3.0 * s * s * t) + q[2] * (3.0 * s * t * t) + q[3] * (t * t * t)
+}
+
+/// The Bézier control points of the cubic Hermite arc from `a` to `b`.
+fn control_points(a: &CellEnd, b: &CellEnd) -> [Vector3<f64>; 4] {
+    [
+        a.point,
+        a.point + a.tangent / 3.0,
+        b.point - b.tangent / 3.0,
+        b.point,
+    ]
+}
+
+/// The point at fraction `t ∈ [0, 1]` of the cubic Hermite arc from `a` to `b` (m).
+pub(super) fn arc_point(a: &CellEnd, b: &CellEnd, t: f64) -> Vector3<f64> {
+    bezier(&control_points(a, b), t)
+}
+
 /// The least gap (m) of `obstacle` along the arc from `a` to `b` if it falls below
 /// `threshold` (m, negative), as `(t, gap)` with `t ∈ [0, 1]` the fraction of the cell;
 /// `None` if the gap stays above `threshold` everywhere on the arc (`ga`, `gb`: the gaps at
@@ -36,22 +71,10 @@ pub(super) fn least_gap_in_cell(
     (b, gb): (&CellEnd, f64),
     threshold: f64,
 ) -> Option<(f64, f64)> {
-    let q = [
-        a.point,
-        a.point + a.tangent / 3.0,
-        b.point - b.tangent / 3.0,
-        b.point,
-    ];
+    let q = control_points(a, b);
     let speed = 3.0 * (0..3).map(|k| (q[k + 1] - q[k]).norm()).fold(0.0, f64::max);
     let lipschitz = speed + (b.radius - a.radius).abs();
-    let gap = |t: f64| {
-        let s = 1.0 - t;
-        let c = q[0] * (s * s * s)
-            + q[1] * (3.0 * s * s * t)
-            + q[2] * (3.0 * s * t * t)
-            + q[3] * (t * t * t);
-        obstacle.distance(&c).0 - (a.radius + (b.radius - a.radius) * t)
-    };
+    let gap = |t: f64| obstacle.distance(&bezier(&q, t)).0 - (a.radius + (b.radius - a.radius) * t);
     let bound = |t0: f64, g0: f64, t1: f64, g1: f64| 0.5 * (g0 + g1 - lipschitz * (t1 - t0));
     let mut best = if ga <= gb { (0.0, ga) } else { (1.0, gb) };
     // Intervals (t0, g0, t1, g1, bound): refined best first (least bound), until no interval
