@@ -374,7 +374,9 @@ pub(crate) fn tangent_compliance<'py>(
     let result = match frictional_kind(solution) {
         Frictional::Channel if tendons == "tension" && tip => {
             let d = one_sided.map_or(softrod::Direction::Pull, |(d, _)| d);
-            run(py, "tangent_compliance", || one_sided_tip(sol, d))?
+            run(py, "tangent_compliance", || {
+                softrod::compliance::frictional_tangent_compliance(sol, d)
+            })?
         }
         kind => {
             if let (Some((_, value)), false) = (one_sided, kind == Frictional::No) {
@@ -431,34 +433,6 @@ fn frictional_kind(solution: &StaticsSolution) -> Frictional {
     } else {
         Frictional::No
     }
-}
-
-/// The one-sided tip compliance of a frictional equilibrium (`softrod::frictional_tip_compliance`)
-/// with its body-frame form, inverses and condition number; the tension rates are zero (the
-/// tendons at fixed base tension).
-fn one_sided_tip(
-    sol: &softrod::StaticsSolution,
-    direction: softrod::Direction,
-) -> softrod::Result<softrod::compliance::TangentCompliance> {
-    use softrod::math::{linalg::invert_general, se3::rotation_adjoint};
-    let world = softrod::frictional_tip_compliance(sol, direction)?;
-    let node = sol.s.len() - 1;
-    let r = sol.rotation[node];
-    let rt = rotation_adjoint(&softrod::nalgebra::Matrix3::from_fn(|i, j| r[j][i]));
-    let body = rt * world * rt.transpose();
-    let (stiffness_world, condition) = invert_general(&world);
-    let (stiffness_body, _) = invert_general(&body);
-    Ok(softrod::compliance::TangentCompliance {
-        node,
-        s: sol.s[node],
-        world,
-        body,
-        stiffness_world,
-        stiffness_body,
-        condition,
-        symmetric: (world - world.transpose()).amax() <= 1e-6 * world.amax(),
-        tension_rate: vec![[0.0; 6]; sol.model.tendons().len()],
-    })
 }
 
 /// Eigenscrew decomposition of a 6x6 stiffness or compliance, with the compliance ellipsoids.

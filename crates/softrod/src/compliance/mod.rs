@@ -13,5 +13,6 @@ pub use refine::{
     rk4_rotation_error, solve_at_output, MESH_ROTATION_TARGET, OUTPUT_ROTATION_TARGET,
 };
 pub use tangent::{
-    tangent_compliance, tangent_compliance_held, TangentCompliance, TendonControl, COLUMNS_PER_PASS,
+    frictional_tangent_compliance, tangent_compliance, tangent_compliance_held, TangentCompliance,
+    TendonControl, COLUMNS_PER_PASS,
 };

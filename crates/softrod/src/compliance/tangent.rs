@@ -14,8 +14,9 @@
 //! K. Oliver-Butler, J. Till, C. Rucker, "Continuum robot stiffness under external loads and
 //! prescribed tendon displacements", IEEE Trans. Robotics 35(2), 2019.
 
-use nalgebra::Matrix6;
+use nalgebra::{Matrix3, Matrix6};
 
+use crate::cosserat::friction_linear::{frictional_tip_compliance, Direction};
 pub use crate::cosserat::sensitivity::COLUMNS_PER_PASS;
 use crate::cosserat::sensitivity::{held_rows, linearise, HeldRow, Seed};
 use crate::cosserat::statics::StaticsSolution;
@@ -192,22 +193,63 @@ fn tangent_on_mesh(
             tension_rate[row.tendon][i] = linear.tensions[i][h];
         }
     }
-    let r_node = linear.rotations[0];
-    let rt = rotation_adjoint(&r_node.transpose());
-    let body = rt * world * rt.transpose();
-    let asym = (world - world.transpose()).amax();
-    let symmetric = asym <= 1e-6 * world.amax();
-    let (kw, condition) = invert_general(&world);
-    let (kb, _) = invert_general(&body);
-    Ok(TangentCompliance {
-        node,
-        s: target,
+    Ok(TangentCompliance::from_world(
+        (node, target),
         world,
-        body,
-        stiffness_world: kw,
-        stiffness_body: kb,
-        condition,
-        symmetric,
+        &linear.rotations[0],
         tension_rate,
-    })
+    ))
+}
+
+impl TangentCompliance {
+    /// The compliance at `node` (arc length `s`, m) from its world-frame matrix: the body
+    /// frame through the node's rotation `r` (body -> world), the stiffnesses, the condition
+    /// number and the symmetry test (asymmetry ≤ 1e-6 of the largest entry).
+    fn from_world(
+        (node, s): (usize, f64),
+        world: Matrix6<f64>,
+        r: &Matrix3<f64>,
+        tension_rate: Vec<[f64; 6]>,
+    ) -> Self {
+        let rt = rotation_adjoint(&r.transpose());
+        let body = rt * world * rt.transpose();
+        let asym = (world - world.transpose()).amax();
+        let symmetric = asym <= 1e-6 * world.amax();
+        let (stiffness_world, condition) = invert_general(&world);
+        let (stiffness_body, _) = invert_general(&body);
+        Self {
+            node,
+            s,
+            world,
+            body,
+            stiffness_world,
+            stiffness_body,
+            condition,
+            symmetric,
+            tension_rate,
+        }
+    }
+}
+
+/// The one-sided tip compliance of a frictional equilibrium
+/// ([`frictional_tip_compliance`](crate::frictional_tip_compliance): the tension profile
+/// following the stick/slip rule, tendons at fixed base tension) as a [`TangentCompliance`]
+/// at the tip; the tension rates are zero.
+///
+/// # Errors
+/// As [`frictional_tip_compliance`](crate::frictional_tip_compliance).
+pub fn frictional_tangent_compliance(
+    solution: &StaticsSolution,
+    direction: Direction,
+) -> Result<TangentCompliance> {
+    let world = frictional_tip_compliance(solution, direction)?;
+    let node = solution.s.len() - 1;
+    let r = Matrix3::from_fn(|i, j| solution.rotation[node][i][j]);
+    let nt = solution.model.tendons().len();
+    Ok(TangentCompliance::from_world(
+        (node, solution.s[node]),
+        world,
+        &r,
+        vec![[0.0; 6]; nt],
+    ))
 }
