@@ -300,3 +300,54 @@ def test_study_runs_outside_the_repository(tmp_path, monkeypatch, capsys):
     data = json.loads((tmp_path / "s.json").read_text())
     assert set(data) == {"hyperelastic", "linear"}
     assert len(list((tmp_path / "figs").glob("*.png"))) == 4
+
+
+def _digest(path):
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.mark.parametrize(
+    "argv, option",
+    [
+        (["planar", "-t", "1", "--plot", "{f}.png"], "--plot"),
+        (["planar", "-t", "1", "--csv", "{f}.csv"], "--csv"),
+        (["solve", "niti_two_segment", "--json", "{f}.json"], "--json"),
+        (["schema", "-o", "{f}.json"], "--output"),
+        (["demo", "--plot", "{f}.png"], "--plot"),
+    ],
+)
+def test_an_existing_file_is_never_overwritten_without_overwrite(argv, option, tmp_path, capsys):
+    # A file the user has (here: text under the output name) survives every command that
+    # would write there; --overwrite replaces it.
+    argv = [a.replace("{f}", str(tmp_path / "mine")) for a in argv]
+    target = next(tmp_path / a.rsplit("/", 1)[-1] for a in argv if "mine" in a)
+    target.write_text("my data\n")
+    before = _digest(target)
+    status, _, err = _run(argv, capsys)
+    line = _one_error_line(err)
+    assert status == 2 and option in line and "exists (pass --overwrite" in line
+    assert _digest(target) == before
+    status, _, _ = _run([*argv, "--overwrite"], capsys)
+    assert status == 0 and _digest(target) != before
+
+
+def test_demo_replaces_its_own_figure_and_no_other_file(tmp_path, monkeypatch, capsys):
+    # The demo run twice in one folder replaces the figure it wrote (marked in the PNG's
+    # metadata); a PNG of the same name that the demo did not write is refused.
+    from PIL import Image
+
+    from softrod.cli._common import DEMO_MARK
+
+    monkeypatch.chdir(tmp_path)
+    png = tmp_path / "softrod-demo.png"
+    assert _run(["demo"], capsys)[0] == 0
+    with Image.open(png) as im:
+        assert im.info.get("Source") == DEMO_MARK
+    assert _run(["demo"], capsys)[0] == 0
+    Image.new("RGB", (4, 4)).save(png)
+    before = _digest(png)
+    status, _, err = _run(["demo"], capsys)
+    assert status == 2 and "exists (pass --overwrite" in _one_error_line(err)
+    assert _digest(png) == before

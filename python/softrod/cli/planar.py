@@ -123,7 +123,7 @@ def register(sub) -> None:
         help="figure of backbones and profiles (default: %(default)s)",
     )
     files(d, outputs=("plot",), figures=("plot",))
-    d.set_defaults(func=_cmd_demo)
+    d.set_defaults(func=_cmd_demo, _demo=True)
     add_figure_options(d, "plot")
     pl = sub.add_parser(
         "planar", help="planar tapered cable-driven arm (closed form or final-value ODE)"
