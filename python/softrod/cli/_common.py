@@ -85,10 +85,9 @@ def resolve_robot(arg: str) -> str:
     if looks_like_path:
         raise FileNotFoundError(2, "No such file or directory", arg)
     try:
-        examples.path(arg)
+        return str(examples.path(arg))  # an earlier name of an example
     except ParameterError as exc:
         raise bad("ROBOT", arg, f"no such file, and {str(exc).split(': ', 1)[1]}") from None
-    raise AssertionError("unreachable")
 
 
 def _same(a: str, b: str) -> bool:
