@@ -14,7 +14,8 @@
 
 use nalgebra::Vector3;
 
-use super::solve::{equations, Constrained, Pass, Site};
+use super::problem::{equations, Constrained, Pass, Site};
+use super::rows::AtContact;
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
 };
@@ -214,7 +215,12 @@ impl Constrained<'_> {
                 }
             };
             let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
-            self.contact_rows(&mut ev, a, s, (&yf, kf), (&yl, kl), &f, mu, &mut rows);
+            let held = AtContact {
+                s,
+                first: (&yf, kf),
+                last: (&yl, kl),
+            };
+            self.contact_rows(&mut ev, a, held, &f, mu, &mut rows);
             at.push((s, yf, kf, yl, kl, f, site, o));
         }
         if rows.len() != n || !rows.iter().all(|v| v.is_finite()) {
@@ -310,7 +316,12 @@ impl Constrained<'_> {
                     }
                     buf.clear();
                     let f2 = f + df * t;
-                    self.contact_rows(&mut ev, a, s + ds * t, (&yf2, kf), (&yl2, kl), &f2, mu, buf);
+                    let moved = AtContact {
+                        s: s + ds * t,
+                        first: (&yf2, kf),
+                        last: (&yl2, kl),
+                    };
+                    self.contact_rows(&mut ev, a, moved, &f2, mu, buf);
                 };
                 eval(h, &mut buf);
                 let plus = buf.clone();

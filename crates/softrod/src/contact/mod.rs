@@ -10,12 +10,17 @@
 //! ([`ContactSolution`]) carries the reactions: the tip reaction wrench and, per contact, its
 //! arc length, point, normal and force.
 
+mod active_set;
 mod constraint;
+mod finish;
 mod friction;
 mod jacobian;
 mod mesh;
+mod newton;
 mod obstacle;
+mod problem;
 mod ramp;
+mod rows;
 mod solve;
 mod stability;
 mod sweep;
@@ -24,9 +29,10 @@ use std::sync::Arc;
 
 use nalgebra::Vector3;
 
+pub use active_set::MAX_ACTIVE_SET_ROUNDS;
 pub use constraint::TipConstraint;
 pub use obstacle::{Obstacle, TriangleMesh};
-pub use solve::{solve_constrained, MAX_ACTIVE_SET_ROUNDS};
+pub use solve::solve_constrained;
 
 use crate::cosserat::StaticsSolution;
 
@@ -115,7 +121,7 @@ pub struct ContactSolution {
 /// variational columns of every unknown) and kept; clones share it.
 #[derive(Debug, Clone, Default)]
 pub struct ContactCompliance {
-    inner: Option<Arc<solve::Frozen>>,
+    inner: Option<Arc<finish::Frozen>>,
 }
 
 impl ContactCompliance {
@@ -126,7 +132,7 @@ impl ContactCompliance {
         self.inner.as_ref().and_then(|f| f.compliance())
     }
 
-    pub(crate) fn of(frozen: Option<solve::Frozen>) -> Self {
+    pub(crate) fn of(frozen: Option<finish::Frozen>) -> Self {
         Self {
             inner: frozen.map(Arc::new),
         }
