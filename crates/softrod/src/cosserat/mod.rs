@@ -5,6 +5,7 @@
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
 
 mod collapse;
+mod columns;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
