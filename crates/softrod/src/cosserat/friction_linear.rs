@@ -37,16 +37,17 @@
 //! repeated from the new `δx` until the branches of two successive marches agree (then the
 //! last solve is exact on them).
 
-use nalgebra::{DMatrix, Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{DMatrix, Matrix6, Vector3, Vector6};
 
 use super::equations::{
-    col_rot, mul_hat, project, rot, rotation_variation, v3, Column, Equations, Evaluator, Tangent,
-    Workspace, COLUMN, DM, DN, DR, STATE,
+    col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, DM, DN,
+    STATE,
 };
 use super::friction::angle;
+use super::friction_cell::{angle_variation, Bounds, Branch, CellRule, CellSystem, NodeLin};
 use super::statics::{Integrator, StaticsSolution};
 use crate::error::{Error, Result};
-use crate::integrate::{adaptive, fixed, System, DP5, RK4};
+use crate::integrate::{adaptive, fixed, DP5, RK4};
 use crate::model::actuation::TensionProfile;
 use crate::model::RobotModel;
 
@@ -79,37 +80,6 @@ impl Direction {
     }
 }
 
-/// The branch an element takes under the change.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Branch {
-    /// Slides on at the lower bound: `δτ_k+1 = δlo`.
-    Lower,
-    /// Slides on at the upper bound: `δτ_k+1 = δhi`.
-    Upper,
-    /// Sticks: `δτ_k+1 = 0`.
-    Stick,
-}
-
-/// Which bounds an element's tension is at.
-#[derive(Debug, Clone, Copy)]
-struct Bounds {
-    lower: bool,
-    upper: bool,
-}
-
-impl Bounds {
-    /// The branch the values `δlo`, `δhi` give.
-    fn branch(self, dlo: f64, dhi: f64) -> Branch {
-        if self.lower && dlo > 0.0 {
-            Branch::Lower
-        } else if self.upper && dhi < 0.0 {
-            Branch::Upper
-        } else {
-            Branch::Stick
-        }
-    }
-}
-
 /// What the actuation column differentiates with respect to.
 #[derive(Debug, Clone, Copy)]
 enum Input {
@@ -120,18 +90,18 @@ enum Input {
 }
 
 /// The solution's data the variational march needs.
-struct Frozen<'a> {
-    model: &'a RobotModel,
-    mesh: &'a [f64],
+pub(super) struct Frozen<'a> {
+    pub(super) model: &'a RobotModel,
+    pub(super) mesh: &'a [f64],
     /// Tension per node and tendon (N; 0 where the tendon is not).
-    tau: Vec<Vec<f64>>,
-    base: Vec<f64>,
-    pressures: Vec<f64>,
-    mus: Vec<f64>,
-    x: [f64; 6],
-    integrator: Integrator,
+    pub(super) tau: Vec<Vec<f64>>,
+    pub(super) base: Vec<f64>,
+    pub(super) pressures: Vec<f64>,
+    pub(super) mus: Vec<f64>,
+    pub(super) x: [f64; 6],
+    pub(super) integrator: Integrator,
     /// Base-wrench columns (0 when the base wrench cannot change: no internal force).
-    nb: usize,
+    pub(super) nb: usize,
 }
 
 impl<'a> Frozen<'a> {
@@ -152,348 +122,9 @@ impl<'a> Frozen<'a> {
         })
     }
 
-    fn present(&self, i: usize, s: f64) -> bool {
+    pub(super) fn present(&self, i: usize, s: f64) -> bool {
         let (ends, l) = (self.model.tendon_ends(), self.model.length());
         s < ends[i] || (ends[i] == l && s == l)
-    }
-}
-
-/// One cell step of the state and the columns: the [`Evaluator`] plus, per column, the
-/// variation of the tension profile over the cell (and of a pressure).
-struct CellSystem<'e, 'w, 'c> {
-    ev: Evaluator<'e, 'w>,
-    a: f64,
-    b: f64,
-    /// Per tendon, the tensions at the cell's ends (N) and whether it carries a profile.
-    ends: &'c [[f64; 2]],
-    profiled: &'c [bool],
-    /// Per column and tendon, `(δτ_k, δτ_k+1)`.
-    dtau: &'c [Vec<[f64; 2]>],
-    /// Per column, a chamber's pressure change (per Pa).
-    pressure: &'c [Option<(usize, f64)>],
-    dirs: Vec<Option<Vector6<f64>>>,
-}
-
-impl CellSystem<'_, '_, '_> {
-    /// `δτ_i(s)` of the interpolated profile at the cell fraction `w` (`TensionProfile::at`:
-    /// geometric between two positive tensions, linear otherwise).
-    fn rate(&self, i: usize, w: f64, [da, db]: [f64; 2]) -> f64 {
-        let [ta, tb] = self.ends[i];
-        if self.profiled[i] && ta == 0.0 && tb == 0.0 && da != 0.0 && db / da > 0.0 {
-            // A slack tendon taken up: the profile `h c_a^(1−w) c_b^w` of a small tension
-            // `h` (geometric) per unit `h`.
-            return da * (db / da).powf(w);
-        }
-        if self.profiled[i] && ta > 0.0 && tb > 0.0 {
-            let (la, lb) = (ta.ln(), tb.ln());
-            let t = (la + (lb - la) * w).exp();
-            t * ((1.0 - w) * da / ta + w * db / tb)
-        } else {
-            (1.0 - w) * da + w * db
-        }
-    }
-}
-
-/// Adds to a column's rates (starting at `b0` of `out`) the effect of the body-wrench
-/// forcing `f` (subtracted from the constitutive balance): `δ(v, u) = −T f`.
-fn add_forcing(
-    out: &mut [f64],
-    b0: usize,
-    tangent: &Tangent,
-    f: &Vector6<f64>,
-    r: &Matrix3<f64>,
-    nw: &Vector3<f64>,
-) {
-    let d = tangent.apply(&[f[0], f[1], f[2], f[3], f[4], f[5]]);
-    let dv = -Vector3::new(d[0], d[1], d[2]);
-    let du = -Vector3::new(d[3], d[4], d[5]);
-    let dpd = r * dv;
-    let mut h = [0.0; 9];
-    mul_hat(r, &du, &mut h);
-    let dmd = -dpd.cross(nw);
-    for k in 0..3 {
-        out[b0 + k] += dpd[k];
-        out[b0 + DM + k] += dmd[k];
-    }
-    for k in 0..9 {
-        out[b0 + DR + k] += h[k];
-    }
-}
-
-impl<const N: usize> System<N> for CellSystem<'_, '_, '_> {
-    fn rhs(&mut self, s: f64, y: &[f64; N], out: &mut [f64; N]) {
-        let loc = self.ev.rhs_into(s, y, out);
-        let ncol = self.dtau.len().min((N - STATE) / COLUMN);
-        let model = self.ev.eq.model;
-        let props = model.rod().section_at(s);
-        let w = ((s - self.a) / (self.b - self.a)).clamp(0.0, 1.0);
-        let ends = model.tendon_ends();
-        let b_end = model.breaks()[self.ev.ws.interval + 1];
-        let (r, nw) = (rot(y), v3(y, 12));
-        let tangent = self.ev.ws.tangent;
-        self.dirs.iter_mut().for_each(|d| *d = None);
-        for c in 0..ncol {
-            let mut f = Vector6::zeros();
-            let mut any = false;
-            for i in 0..ends.len() {
-                let d = self.dtau[c][i];
-                if (d[0] == 0.0 && d[1] == 0.0) || ends[i] < b_end {
-                    continue;
-                }
-                let dir = match self.dirs[i] {
-                    Some(dir) => dir,
-                    None => {
-                        let dir = self.ev.tendon_direction(i, s, &props, &loc.v, &loc.u);
-                        self.dirs[i] = Some(dir);
-                        dir
-                    }
-                };
-                f += dir * self.rate(i, w, d);
-                any = true;
-            }
-            if let Some((j, coef)) = self.pressure[c] {
-                let (fw, _) = self.ev.forcing(
-                    Column::Pressure(j),
-                    s,
-                    &props,
-                    &loc.v,
-                    &loc.u,
-                    &Vector6::zeros(),
-                );
-                f += Vector6::from(fw) * coef;
-                any = true;
-            }
-            if any {
-                add_forcing(out, STATE + COLUMN * c, &tangent, &f, &r, &nw);
-            }
-        }
-    }
-
-    fn stage_evaluated(&mut self, stage: usize) {
-        <Evaluator<'_, '_> as System<N>>::stage_evaluated(&mut self.ev, stage);
-    }
-
-    fn step_accepted(&mut self, weights: &[f64], fsal: bool) {
-        <Evaluator<'_, '_> as System<N>>::step_accepted(&mut self.ev, weights, fsal);
-    }
-
-    fn project(&mut self, y: &mut [f64; N]) {
-        project(y);
-    }
-}
-
-/// The linearisation at a node: strains, the constitutive tangent and, per tendon there,
-/// its body direction `(t, r × t)`, the vector `w = v + u × r + r'` and its offset `r`.
-struct NodeLin {
-    r: Matrix3<f64>,
-    nw: Vector3<f64>,
-    mw: Vector3<f64>,
-    tangent: Tangent,
-    dirs: Vec<Option<Vector6<f64>>>,
-    w: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
-    /// Per chamber, its fluid wrench per Pa at the node (body).
-    fluid: Vec<Vector6<f64>>,
-}
-
-impl NodeLin {
-    /// At node `s` of state `y` (the evaluator on the node's interval).
-    fn at(fr: &Frozen<'_>, ev: &mut Evaluator<'_, '_>, s: f64, y: &[f64]) -> Result<Self> {
-        let model = fr.model;
-        let props = model.rod().section_at(s);
-        let (r, nw, mw) = (rot(y), v3(y, 12), v3(y, 15));
-        let loc = ev.local(s, &props, &r.tr_mul(&nw), &r.tr_mul(&mw), true);
-        if !(loc.v.iter().chain(loc.u.iter()).all(|c| c.is_finite())) {
-            return Err(ev.ws.material_error.take().unwrap_or(Error::NotConverged {
-                what: format!(
-                    "frictional linearisation: the constitutive solve failed at s = {s} m"
-                ),
-                iterations: 0,
-                residual: f64::INFINITY,
-                load_factor: 1.0,
-            }));
-        }
-        let nt = fr.base.len();
-        let mut dirs = vec![None; nt];
-        let mut w = vec![None; nt];
-        for i in 0..nt {
-            if fr.present(i, s) {
-                dirs[i] = Some(ev.tendon_direction(i, s, &props, &loc.v, &loc.u));
-                let (o, op) = model.tendons()[i].routing().offset(s, &props);
-                let o = Vector3::new(o[0], o[1], 0.0);
-                let wi = loc.v + loc.u.cross(&o) + Vector3::new(op[0], op[1], 0.0);
-                w[i] = Some((wi, o));
-            }
-        }
-        let fluid = (0..model.chambers().len())
-            .map(|j| {
-                let (f, _) = ev.forcing(
-                    Column::Pressure(j),
-                    s,
-                    &props,
-                    &loc.v,
-                    &loc.u,
-                    &Vector6::zeros(),
-                );
-                Vector6::from(f)
-            })
-            .collect();
-        Ok(Self {
-            r,
-            nw,
-            mw,
-            tangent: ev.ws.tangent,
-            dirs,
-            w,
-            fluid,
-        })
-    }
-
-    /// The unit path tangents (world) per tendon.
-    fn tangents(&self) -> Vec<Option<Vector3<f64>>> {
-        self.w
-            .iter()
-            .map(|w| w.map(|(w, _)| (self.r * w).normalize()))
-            .collect()
-    }
-
-    /// The change of the path tangents (world) of the column at `b0` of `y` with the
-    /// tension changes `dtau` at the node (and a pressure change).
-    fn variation(
-        &self,
-        y: &[f64],
-        b0: usize,
-        dtau: &[f64],
-        pressure: Option<(usize, f64)>,
-    ) -> Vec<Option<Vector3<f64>>> {
-        let dr = col_rot(y, b0);
-        let (dn, dm) = (v3(y, b0 + DN), v3(y, b0 + DM));
-        let dnb = dr.tr_mul(&self.nw) + self.r.tr_mul(&dn);
-        let dmb = dr.tr_mul(&self.mw) + self.r.tr_mul(&dm);
-        let mut e = Vector6::new(dnb.x, dnb.y, dnb.z, dmb.x, dmb.y, dmb.z);
-        for (i, d) in self.dirs.iter().enumerate() {
-            if let Some(d) = d {
-                e -= d * dtau[i];
-            }
-        }
-        if let Some((j, coef)) = pressure {
-            e -= self.fluid[j] * coef;
-        }
-        let d = self.tangent.apply(&[e[0], e[1], e[2], e[3], e[4], e[5]]);
-        let (dv, du) = (
-            Vector3::new(d[0], d[1], d[2]),
-            Vector3::new(d[3], d[4], d[5]),
-        );
-        self.w
-            .iter()
-            .map(|w| {
-                w.map(|(w, o)| {
-                    let big = self.r * w;
-                    let len = big.norm();
-                    let t = big / len;
-                    let dbig = dr * w + self.r * (dv + du.cross(&o));
-                    (dbig - t * t.dot(&dbig)) / len
-                })
-            })
-            .collect()
-    }
-}
-
-/// The change of the angle between the unit vectors `a` and `b` for their changes `da`,
-/// `db` (0 where they are parallel: the angle is not differentiable there).
-fn angle_variation(
-    a: &Vector3<f64>,
-    b: &Vector3<f64>,
-    da: &Vector3<f64>,
-    db: &Vector3<f64>,
-) -> f64 {
-    let c = a.cross(b);
-    let (sin, cos) = (c.norm(), a.dot(b));
-    if sin < 1e-12 {
-        return 0.0;
-    }
-    let dsin = (c / sin).dot(&(da.cross(b) + a.cross(db)));
-    let dcos = da.dot(b) + a.dot(db);
-    (cos * dsin - sin * dcos) / (sin * sin + cos * cos)
-}
-
-/// The piecewise-linear rule of one cell: per unknown distal tension `p`, the affine
-/// `δlo_p = lo[p] + L[p]·z`, `δhi_p = hi[p] + H[p]·z`, and which bounds it is at.
-struct CellRule {
-    bounds: Vec<Bounds>,
-    l: DMatrix<f64>,
-    h: DMatrix<f64>,
-}
-
-impl CellRule {
-    /// The distal tension changes `z` on the branches `branches` for the constant parts
-    /// `lo`, `hi`.
-    fn solve(&self, branches: &[Branch], lo: &[f64], hi: &[f64]) -> Result<Vec<f64>> {
-        let n = branches.len();
-        if n == 0 {
-            return Ok(Vec::new());
-        }
-        let mut a = DMatrix::identity(n, n);
-        let mut rhs = nalgebra::DVector::zeros(n);
-        for (p, br) in branches.iter().enumerate() {
-            match br {
-                Branch::Lower => {
-                    for q in 0..n {
-                        a[(p, q)] -= self.l[(p, q)];
-                    }
-                    rhs[p] = lo[p];
-                }
-                Branch::Upper => {
-                    for q in 0..n {
-                        a[(p, q)] -= self.h[(p, q)];
-                    }
-                    rhs[p] = hi[p];
-                }
-                Branch::Stick => {}
-            }
-        }
-        a.lu()
-            .solve(&rhs)
-            .map(|z| z.iter().copied().collect())
-            .ok_or_else(|| Error::NotConverged {
-                what: "frictional linearisation: singular cell rule".into(),
-                iterations: 0,
-                residual: f64::INFINITY,
-                load_factor: 1.0,
-            })
-    }
-
-    /// The branches consistent with their own solution, from the bounds' natural branches.
-    fn branches(&self, lo: &[f64], hi: &[f64]) -> Result<(Vec<Branch>, Vec<f64>)> {
-        let n = lo.len();
-        let mut br: Vec<Branch> = self
-            .bounds
-            .iter()
-            .map(|b| match (b.lower, b.upper) {
-                (true, _) => Branch::Lower,
-                (false, true) => Branch::Upper,
-                _ => Branch::Stick,
-            })
-            .collect();
-        for _ in 0..2 * n + 2 {
-            let z = self.solve(&br, lo, hi)?;
-            let next: Vec<Branch> = (0..n)
-                .map(|p| {
-                    let dlo = lo[p] + (0..n).map(|q| self.l[(p, q)] * z[q]).sum::<f64>();
-                    let dhi = hi[p] + (0..n).map(|q| self.h[(p, q)] * z[q]).sum::<f64>();
-                    self.bounds[p].branch(dlo, dhi)
-                })
-                .collect();
-            if next == br {
-                return Ok((br, z));
-            }
-            br = next;
-        }
-        Err(Error::NotConverged {
-            what: "frictional linearisation: the slip branches of a cell do not settle".into(),
-            iterations: 2 * n + 2,
-            residual: f64::INFINITY,
-            load_factor: 1.0,
-        })
     }
 }
 
@@ -518,99 +149,274 @@ fn pose_of(y: &[f64], c: usize) -> Vector6<f64> {
 /// each with its own slip branches; with the base-wrench columns if `fr.nb` (then one input,
 /// the base wrench changed by `dx` (scaled) at the base, the base-wrench columns on its
 /// branches).
-#[allow(clippy::too_many_lines)] // one sequential march
 fn march<const N: usize>(
     fr: &Frozen<'_>,
     inputs: &[Input],
     sigma: f64,
     dx: &[f64; 6],
 ) -> Result<Pass> {
-    let model = fr.model;
     let nt = fr.base.len();
-    let n_in = inputs.len();
-    let nm = n_in + fr.nb;
-    let breaks = model.breaks();
-    let f_ref = model.force_scale();
-    let fm = f_ref * model.length();
+    let ctx = Marcher {
+        fr,
+        inputs,
+        sigma,
+        nt,
+        nm: inputs.len() + fr.nb,
+        profiled: fr.mus.iter().map(|&m| m > 0.0).collect(),
+    };
+    let breaks = fr.model.breaks();
     let mut cell = TensionProfile::new(
         (0..nt)
             .map(|i| (fr.mus[i] > 0.0).then(|| (vec![0.0, 1.0], vec![fr.base[i]; 2])))
             .collect(),
     );
-    let profiled: Vec<bool> = fr.mus.iter().map(|&m| m > 0.0).collect();
-    let eq = Equations {
-        model,
-        tensions: &fr.base,
-        pressures: &fr.pressures,
-        load_factor: 1.0,
-        profile: None,
-    };
     let mut ws = Workspace::new(nt);
-    let mut y: [f64; N] = eq.initial(&fr.x);
-    y[STATE..].fill(0.0);
-    for k in 0..3 {
-        y[STATE + DN + k] = f_ref * dx[k];
-        y[STATE + DM + k] = fm * dx[3 + k];
-    }
-    for k in 0..fr.nb {
-        let b0 = STATE + COLUMN * (n_in + k);
-        if k < 3 {
-            y[b0 + DN + k] = f_ref;
-        } else {
-            y[b0 + DM + k - 3] = fm;
-        }
-    }
-    // δτ per main column and tendon at the current node.
-    let mut dtau = vec![vec![0.0; nt]; nm];
-    let pressure_of = |c: usize| match inputs.get(c) {
-        Some(Input::Pressure(j)) => Some((*j, sigma)),
-        _ => None,
-    };
-    for (c, input) in inputs.iter().enumerate() {
-        if let Input::Tendon(k) = input {
-            dtau[c][*k] = sigma;
-        }
-    }
+    let mut at = ctx.start::<N>(&cell, &mut ws, dx)?;
+    let n = fr.mesh.len();
+    let mut poses = Vec::with_capacity(n);
+    poses.push((0..ctx.nm).map(|c| pose_of(&at.y, c)).collect::<Vec<_>>());
+    let mut branches = Vec::new();
     let mut interval = 0;
-    let (mut ta, mut dta) = {
+    for j in 0..n - 1 {
+        let (a, b) = (fr.mesh[j], fr.mesh[j + 1]);
+        let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
+        let c = Cell {
+            j,
+            a,
+            b,
+            interval,
+            crosses,
+        };
+        let first = ctx.cell(&mut cell, &mut ws, &mut at, c)?;
+        branches.extend_from_slice(&first);
+        poses.push((0..ctx.nm).map(|c| pose_of(&at.y, c)).collect());
+        interval += usize::from(crosses);
+    }
+    let (_, residual) = ctx.eq().residual(&at.y, ctx.nm);
+    Ok(Pass {
+        poses,
+        residual,
+        branches,
+    })
+}
+
+/// Cell `j` of the mesh, `[a, b]`, the integration interval it lies in and whether `b` is a
+/// break into the next one.
+#[derive(Clone, Copy)]
+struct Cell {
+    j: usize,
+    a: f64,
+    b: f64,
+    interval: usize,
+    crosses: bool,
+}
+
+/// What the variational march carries from node to node: the state with its main columns,
+/// per main column and tendon `δτ`, the tendons' path tangents and, per main column, their
+/// variations.
+struct At<const N: usize> {
+    y: [f64; N],
+    dtau: Vec<Vec<f64>>,
+    ta: Vec<Option<Vector3<f64>>>,
+    dta: Vec<Vec<Option<Vector3<f64>>>>,
+}
+
+/// The distal tension changes of one cell: the frictional tendons whose distal change is an
+/// unknown of the cell rule, and per tendon the ratio of a slack tendon's distal to its
+/// proximal change (1 for the others).
+struct Distal {
+    unknown: Vec<usize>,
+    ratio: Vec<f64>,
+}
+
+/// The fixed data of one variational march: the frozen solution, the inputs and their
+/// direction, the number of tendons and of main columns (the inputs', then the base-wrench
+/// ones), and which tendons carry a tension profile.
+struct Marcher<'f, 'a, 'i> {
+    fr: &'f Frozen<'a>,
+    inputs: &'i [Input],
+    sigma: f64,
+    nt: usize,
+    nm: usize,
+    profiled: Vec<bool>,
+}
+
+impl Marcher<'_, '_, '_> {
+    /// The equations at the solution's base tensions (no profile).
+    fn eq(&self) -> Equations<'_> {
+        Equations {
+            model: self.fr.model,
+            tensions: &self.fr.base,
+            pressures: &self.fr.pressures,
+            load_factor: 1.0,
+            profile: None,
+        }
+    }
+
+    /// A chamber's pressure change (per Pa) along column `c`.
+    fn pressure_of(&self, c: usize) -> Option<(usize, f64)> {
+        match self.inputs.get(c) {
+            Some(Input::Pressure(j)) => Some((*j, self.sigma)),
+            _ => None,
+        }
+    }
+
+    /// The state at the base: the base wrench changed by `dx` along the input's column, the
+    /// base-wrench columns seeded, the inputs' tension changes and the tangents there.
+    fn start<const N: usize>(
+        &self,
+        cell: &TensionProfile,
+        ws: &mut Workspace,
+        dx: &[f64; 6],
+    ) -> Result<At<N>> {
+        let (fr, nt, nm) = (self.fr, self.nt, self.nm);
+        let f_ref = fr.model.force_scale();
+        let fm = f_ref * fr.model.length();
+        let eq = self.eq();
+        let mut y: [f64; N] = eq.initial(&fr.x);
+        y[STATE..].fill(0.0);
+        for k in 0..3 {
+            y[STATE + DN + k] = f_ref * dx[k];
+            y[STATE + DM + k] = fm * dx[3 + k];
+        }
+        for k in 0..fr.nb {
+            let b0 = STATE + COLUMN * (self.inputs.len() + k);
+            if k < 3 {
+                y[b0 + DN + k] = f_ref;
+            } else {
+                y[b0 + DM + k - 3] = fm;
+            }
+        }
+        // δτ per main column and tendon at the current node.
+        let mut dtau = vec![vec![0.0; nt]; nm];
+        for (c, input) in self.inputs.iter().enumerate() {
+            if let Input::Tendon(k) = input {
+                dtau[c][*k] = self.sigma;
+            }
+        }
         let mut ev = Evaluator {
             eq: Equations {
-                profile: Some(&cell),
+                profile: Some(cell),
                 ..eq
             },
-            ws: &mut ws,
+            ws,
         };
         ev.set_interval(0);
         let node = NodeLin::at(fr, &mut ev, 0.0, &y)?;
         let dta: Vec<_> = (0..nm)
-            .map(|c| node.variation(&y, STATE + COLUMN * c, &dtau[c], pressure_of(c)))
+            .map(|c| node.variation(&y, STATE + COLUMN * c, &dtau[c], self.pressure_of(c)))
             .collect();
-        (node.tangents(), dta)
-    };
-    let n = fr.mesh.len();
-    let mut poses = Vec::with_capacity(n);
-    poses.push((0..nm).map(|c| pose_of(&y, c)).collect::<Vec<_>>());
-    let mut branches = Vec::new();
-    let width = (N - STATE) / COLUMN;
-    for j in 0..n - 1 {
-        let (a, b) = (fr.mesh[j], fr.mesh[j + 1]);
-        let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
-        let mut ends = vec![[0.0; 2]; nt];
-        for i in 0..nt {
-            let distal = if fr.present(i, b) {
+        Ok(At {
+            y,
+            dtau,
+            ta: node.tangents(),
+            dta,
+        })
+    }
+
+    /// Steps `at` over the cell `c`: the tension profile over the cell, the cell step of the
+    /// state with the main columns and one column per unknown distal change, the cell rule,
+    /// and the main columns with their distal changes on their branches. Returns the
+    /// branches of the first input's column.
+    fn cell<const N: usize>(
+        &self,
+        cell: &mut TensionProfile,
+        ws: &mut Workspace,
+        at: &mut At<N>,
+        c: Cell,
+    ) -> Result<Vec<Branch>> {
+        let ends = self.ends(cell, c);
+        let distal = self.distal(cell, ws, at, c)?;
+        let nq = distal.unknown.len();
+        let ncols = self.nm + nq;
+        let width = (N - STATE) / COLUMN;
+        if ncols > width {
+            return Err(Error::invalid(
+                "tendons",
+                format!("{nq} frictional tendons"),
+                format!("at most {} frictional tendons", width - self.nm),
+            ));
+        }
+        let coef = self.coefficients(&at.dtau, &distal);
+        let (y1, node) = self.step(cell, ws, at, c, &ends, &coef)?;
+        let tb = node.tangents();
+        let at_node = |col: usize| -> Vec<f64> {
+            (0..self.nt)
+                .map(|i| {
+                    if !self.fr.present(i, c.b) {
+                        0.0
+                    } else if col >= self.nm {
+                        f64::from(u8::from(distal.unknown[col - self.nm] == i))
+                    } else {
+                        coef[col][i][1]
+                    }
+                })
+                .collect()
+        };
+        let mut dtb: Vec<Vec<Option<Vector3<f64>>>> = (0..ncols)
+            .map(|col| {
+                node.variation(
+                    &y1,
+                    STATE + COLUMN * col,
+                    &at_node(col),
+                    self.pressure_of(col),
+                )
+            })
+            .collect();
+        let (rule, lo, hi) = self.rule(at, (&tb, &dtb), &ends, &distal.unknown, c.b)?;
+        // Each input's column on its own branches, the base-wrench ones on the first's.
+        let n_in = self.inputs.len();
+        let mut zs = Vec::with_capacity(self.nm);
+        let mut first = Vec::new();
+        for col in 0..n_in {
+            let (br, z) = rule.branches(&lo[col], &hi[col])?;
+            if col == 0 {
+                first = br;
+            }
+            zs.push(z);
+        }
+        for col in n_in..self.nm {
+            zs.push(rule.solve(&first, &lo[col], &hi[col])?);
+        }
+        self.advance(at, &y1, &zs, &mut dtb, &distal, c.b);
+        dtb.truncate(self.nm);
+        at.dta = dtb;
+        at.ta = tb;
+        Ok(first)
+    }
+
+    /// Per tendon, its tensions at the ends of cell `c` (N), set as the cell of the profile
+    /// of the frictional ones.
+    fn ends(&self, cell: &mut TensionProfile, c: Cell) -> Vec<[f64; 2]> {
+        let (fr, j) = (self.fr, c.j);
+        let mut ends = vec![[0.0; 2]; self.nt];
+        for i in 0..self.nt {
+            let distal = if fr.present(i, c.b) {
                 fr.tau[j + 1][i]
             } else {
                 fr.tau[j][i]
             };
             ends[i] = [fr.tau[j][i], distal];
             if fr.mus[i] > 0.0 {
-                cell.set_cell(i, [a, b], ends[i]);
+                cell.set_cell(i, [c.a, c.b], ends[i]);
             }
         }
-        // A slack tendon (zero tension at both nodes) keeps the ratio e^(−μΔθ) of its
-        // distal to its proximal tension change (the term in δΔθ vanishes with τ): its Δθ
-        // from the state stepped alone; the others' distal changes are unknowns.
-        let slack: Vec<usize> = (0..nt)
+        ends
+    }
+
+    /// The unknown distal changes of cell `c`. A slack tendon (zero tension at both nodes)
+    /// keeps the ratio e^(−μΔθ) of its distal to its proximal tension change (the term in
+    /// δΔθ vanishes with τ): its Δθ from the state stepped alone; the others' distal
+    /// changes are unknowns.
+    fn distal<const N: usize>(
+        &self,
+        cell: &TensionProfile,
+        ws: &mut Workspace,
+        at: &At<N>,
+        c: Cell,
+    ) -> Result<Distal> {
+        let (fr, j, b) = (self.fr, c.j, c.b);
+        let slack: Vec<usize> = (0..self.nt)
             .filter(|&i| {
                 fr.mus[i] > 0.0
                     && fr.present(i, b)
@@ -619,93 +425,102 @@ fn march<const N: usize>(
             })
             .collect();
         let ratio = if slack.is_empty() {
-            vec![1.0; nt]
+            vec![1.0; self.nt]
         } else {
-            slack_ratios(fr, &mut ws, &cell, &y, [a, b], interval, crosses, &ta)?
+            slack_ratios(fr, ws, cell, &at.y, c, &at.ta)?
         };
-        let unknown: Vec<usize> = (0..nt)
+        let unknown: Vec<usize> = (0..self.nt)
             .filter(|&i| fr.mus[i] > 0.0 && fr.present(i, b) && !slack.contains(&i))
             .collect();
-        let nq = unknown.len();
-        let ncols = nm + nq;
-        if ncols > width {
-            return Err(Error::invalid(
-                "tendons",
-                format!("{nq} frictional tendons"),
-                format!("at most {} frictional tendons", width - nm),
-            ));
-        }
-        let mut coef = vec![vec![[0.0; 2]; nt]; ncols];
+        Ok(Distal { unknown, ratio })
+    }
+
+    /// Per column (the main ones, then one per unknown distal change) and tendon, its
+    /// proximal and distal tension changes `(δτ_k, δτ_k+1)` over the cell (an unknown's
+    /// distal change 0 in the main columns, 1 in its own).
+    fn coefficients(&self, dtau: &[Vec<f64>], distal: &Distal) -> Vec<Vec<[f64; 2]>> {
+        let (nm, nt) = (self.nm, self.nt);
+        let mut coef = vec![vec![[0.0; 2]; nt]; nm + distal.unknown.len()];
         for c in 0..nm {
             for i in 0..nt {
                 let d = dtau[c][i];
                 coef[c][i] = [
                     d,
-                    if unknown.contains(&i) {
+                    if distal.unknown.contains(&i) {
                         0.0
                     } else {
-                        d * ratio[i]
+                        d * distal.ratio[i]
                     },
                 ];
             }
         }
-        for (q, &i) in unknown.iter().enumerate() {
+        for (q, &i) in distal.unknown.iter().enumerate() {
             coef[nm + q][i] = [0.0, 1.0];
         }
-        let pressure: Vec<_> = (0..ncols).map(pressure_of).collect();
-        y[STATE + COLUMN * nm..].fill(0.0);
+        coef
+    }
+
+    /// The cell step of the state and the columns `coef` over cell `c` (the jump at a break
+    /// applied), and the linearisation at its end.
+    fn step<const N: usize>(
+        &self,
+        cell: &TensionProfile,
+        ws: &mut Workspace,
+        at: &mut At<N>,
+        c: Cell,
+        ends: &[[f64; 2]],
+        coef: &[Vec<[f64; 2]>],
+    ) -> Result<([f64; N], NodeLin)> {
+        let ncols = coef.len();
+        let pressure: Vec<_> = (0..ncols).map(|col| self.pressure_of(col)).collect();
+        at.y[STATE + COLUMN * self.nm..].fill(0.0);
         ws.set_columns(&vec![Column::Free; ncols], &[]);
-        let (y1, node) = {
-            let mut sys = CellSystem {
-                ev: Evaluator {
-                    eq: Equations {
-                        profile: Some(&cell),
-                        ..eq
-                    },
-                    ws: &mut ws,
+        let mut sys = CellSystem {
+            ev: Evaluator {
+                eq: Equations {
+                    profile: Some(cell),
+                    ..self.eq()
                 },
-                a,
-                b,
-                ends: &ends,
-                profiled: &profiled,
-                dtau: &coef,
-                pressure: &pressure,
-                dirs: vec![None; nt],
-            };
-            if sys.ev.ws.interval != interval {
-                sys.ev.set_interval(interval);
-            }
-            let mut y1 = match fr.integrator {
-                Integrator::Rk4 { .. } => fixed(&RK4, &mut sys, a, y, b, 1, |_, _, _| {})?,
-                Integrator::Adaptive(o) => {
-                    adaptive(&DP5, &mut sys, [a, b], y, &o, STATE, |_, _, _| {})?.0
-                }
-            };
-            if crosses {
-                sys.ev.eq.jump(b, &mut y1, ncols);
-                sys.ev.set_interval(interval + 1);
-            }
-            let node = NodeLin::at(fr, &mut sys.ev, b, &y1)?;
-            (y1, node)
+                ws,
+            },
+            a: c.a,
+            b: c.b,
+            ends,
+            profiled: &self.profiled,
+            dtau: coef,
+            pressure: &pressure,
+            dirs: vec![None; self.nt],
         };
-        let tb = node.tangents();
-        let at_node = |c: usize| -> Vec<f64> {
-            (0..nt)
-                .map(|i| {
-                    if !fr.present(i, b) {
-                        0.0
-                    } else if c >= nm {
-                        f64::from(u8::from(unknown[c - nm] == i))
-                    } else {
-                        coef[c][i][1]
-                    }
-                })
-                .collect()
+        if sys.ev.ws.interval != c.interval {
+            sys.ev.set_interval(c.interval);
+        }
+        let (a, b, y) = (c.a, c.b, at.y);
+        let mut y1 = match self.fr.integrator {
+            Integrator::Rk4 { .. } => fixed(&RK4, &mut sys, a, y, b, 1, |_, _, _| {})?,
+            Integrator::Adaptive(o) => {
+                adaptive(&DP5, &mut sys, [a, b], y, &o, STATE, |_, _, _| {})?.0
+            }
         };
-        let mut dtb: Vec<Vec<Option<Vector3<f64>>>> = (0..ncols)
-            .map(|c| node.variation(&y1, STATE + COLUMN * c, &at_node(c), pressure_of(c)))
-            .collect();
-        // The cell rule, affine in the distal changes z.
+        if c.crosses {
+            sys.ev.eq.jump(b, &mut y1, ncols);
+            sys.ev.set_interval(c.interval + 1);
+        }
+        let node = NodeLin::at(self.fr, &mut sys.ev, b, &y1)?;
+        Ok((y1, node))
+    }
+
+    /// The cell rule, affine in the distal changes z, from the tangents and their variations
+    /// at both ends of the cell (`at` and `(tb, dtb)` at `b`), and per main column its
+    /// constant parts `lo`, `hi`.
+    fn rule<const N: usize>(
+        &self,
+        at: &At<N>,
+        (tb, dtb): (&[Option<Vector3<f64>>], &[Vec<Option<Vector3<f64>>>]),
+        ends: &[[f64; 2]],
+        unknown: &[usize],
+        b: f64,
+    ) -> Result<(CellRule, Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+        let (fr, nm, nq) = (self.fr, self.nm, unknown.len());
         let mut rule = CellRule {
             bounds: Vec::with_capacity(nq),
             l: DMatrix::zeros(nq, nq),
@@ -714,7 +529,7 @@ fn march<const N: usize>(
         let mut lo = vec![vec![0.0; nq]; nm];
         let mut hi = vec![vec![0.0; nq]; nm];
         for (p, &i) in unknown.iter().enumerate() {
-            let (Some(a_t), Some(b_t)) = (ta[i], tb[i]) else {
+            let (Some(a_t), Some(b_t)) = (at.ta[i], tb[i]) else {
                 continue;
             };
             let theta = angle(&a_t, &b_t);
@@ -728,11 +543,11 @@ fn march<const N: usize>(
             });
             let zero = Vector3::zeros();
             for c in 0..nm {
-                let da = dta[c][i].unwrap_or(zero);
+                let da = at.dta[c][i].unwrap_or(zero);
                 let db = dtb[c][i].unwrap_or(zero);
                 let dth = angle_variation(&a_t, &b_t, &da, &db);
-                lo[c][p] = (dtau[c][i] - mu * t0 * dth) / g;
-                hi[c][p] = g * (dtau[c][i] + mu * t0 * dth);
+                lo[c][p] = (at.dtau[c][i] - mu * t0 * dth) / g;
+                hi[c][p] = g * (at.dtau[c][i] + mu * t0 * dth);
             }
             for q in 0..nq {
                 let db = dtb[nm + q][i].unwrap_or(zero);
@@ -751,22 +566,23 @@ fn march<const N: usize>(
                 load_factor: 1.0,
             });
         }
-        // Each input's column on its own branches, the base-wrench ones on the first's.
-        let mut zs = Vec::with_capacity(nm);
-        let mut first = Vec::new();
-        for c in 0..n_in {
-            let (br, z) = rule.branches(&lo[c], &hi[c])?;
-            if c == 0 {
-                first = br;
-            }
-            zs.push(z);
-        }
-        for c in n_in..nm {
-            zs.push(rule.solve(&first, &lo[c], &hi[c])?);
-        }
-        branches.extend_from_slice(&first);
-        // The main columns with their distal tension changes.
-        let mut y_next = y1;
+        Ok((rule, lo, hi))
+    }
+
+    /// The main columns at the end `b` of the cell (state `y1`) with their distal tension
+    /// changes `zs`: the unknowns' columns added, the tangent variations `dtb` and the
+    /// tension changes `δτ` of `at` updated.
+    fn advance<const N: usize>(
+        &self,
+        at: &mut At<N>,
+        y1: &[f64; N],
+        zs: &[Vec<f64>],
+        dtb: &mut [Vec<Option<Vector3<f64>>>],
+        distal: &Distal,
+        b: f64,
+    ) {
+        let (nm, nt) = (self.nm, self.nt);
+        let mut y_next = *y1;
         for (c, z) in zs.iter().enumerate() {
             let b0 = STATE + COLUMN * c;
             for (q, zq) in z.iter().enumerate() {
@@ -781,41 +597,34 @@ fn march<const N: usize>(
                 }
             }
             for i in 0..nt {
-                dtau[c][i] = match unknown.iter().position(|&u| u == i) {
+                at.dtau[c][i] = match distal.unknown.iter().position(|&u| u == i) {
                     Some(p) => z[p],
-                    None if fr.present(i, b) => dtau[c][i] * ratio[i],
+                    None if self.fr.present(i, b) => at.dtau[c][i] * distal.ratio[i],
                     None => 0.0,
                 };
             }
         }
-        y = y_next;
-        poses.push((0..nm).map(|c| pose_of(&y, c)).collect());
-        dtb.truncate(nm);
-        dta = dtb;
-        ta = tb;
-        interval += usize::from(crosses);
+        at.y = y_next;
     }
-    let (_, residual) = eq.residual(&y, nm);
-    Ok(Pass {
-        poses,
-        residual,
-        branches,
-    })
 }
 
-/// Per tendon, `e^(−μΔθ)` over the cell `[a, b]` from the state `y` (stepped alone, the
-/// path tangents `ta` at `a`); 1 for the tendons without friction.
-#[allow(clippy::too_many_arguments)] // the march's state at one cell
+/// Per tendon, `e^(−μΔθ)` over the cell `c` from the state `y` (stepped alone, the path
+/// tangents `ta` at its start); 1 for the tendons without friction.
 fn slack_ratios<const N: usize>(
     fr: &Frozen<'_>,
     ws: &mut Workspace,
     cell: &TensionProfile,
     y: &[f64; N],
-    [a, b]: [f64; 2],
-    interval: usize,
-    crosses: bool,
+    c: Cell,
     ta: &[Option<Vector3<f64>>],
 ) -> Result<Vec<f64>> {
+    let Cell {
+        a,
+        b,
+        interval,
+        crosses,
+        ..
+    } = c;
     let eq = Equations {
         model: fr.model,
         tensions: &fr.base,

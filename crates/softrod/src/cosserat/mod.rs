@@ -5,9 +5,11 @@
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
 
 mod collapse;
+mod columns;
 pub mod displacement;
 pub(crate) mod equations;
 pub mod friction;
+mod friction_cell;
 mod friction_held;
 pub mod friction_linear;
 mod friction_march;

@@ -43,20 +43,15 @@
 //! prescribed tendon displacements", IEEE Trans. Robotics 35(2), 2019 (the linearised
 //! boundary-value problem).
 
-use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
+use nalgebra::{DMatrix, Matrix3, Vector6};
 
-use super::equations::{
-    col_rot, rot, rotation_variation, v3, Column, Equations, Evaluator, Workspace, COLUMN, DM, DN,
-    DR, STATE,
-};
+pub(crate) use super::columns::{integrate, scheme_of, Integrated, Request, Seed};
+use super::equations::{Column, Equations};
 use super::friction_linear::{frictional_actuation_jacobians, Direction};
-use super::shooting::Node;
-use super::statics::{Integrator, StaticsSolution};
+use super::statics::StaticsSolution;
 use crate::error::{Error, Result};
-use crate::integrate::march::{march, rk4_plan, Scheme};
+use crate::integrate::march::Scheme;
 use crate::math::linalg::DenseLu;
-use crate::math::so3::hat;
-use crate::model::section::SectionProperties;
 use crate::model::{RobotModel, TendonInput};
 
 /// Most sensitivity columns integrated in one march (more are integrated in further marches
@@ -133,329 +128,6 @@ pub struct Sensitivities {
     pub tendon_lengths: DMatrix<f64>,
 }
 
-/// What a column of a pass is.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Seed {
-    /// Component `k` of the scaled base wrench (seeded at the base).
-    Base(usize),
-    /// Component `k` of a dead wrench applied at the load node (seeded there).
-    Load(usize),
-    /// A column forced along the rod, from zero at the base.
-    Forced(Column),
-    /// A translation of the base along world axis `k`.
-    BaseTranslation(usize),
-    /// A rotation of the base about world axis `k`.
-    BaseRotation(usize),
-}
-
-/// What to integrate in one request.
-pub(crate) struct Request<'r> {
-    pub seeds: &'r [Seed],
-    /// Tendons whose path-length sensitivities are integrated.
-    pub lengths: &'r [usize],
-    /// Node indices (increasing) whose pose derivatives are recorded.
-    pub observe: &'r [usize],
-    /// Node index where the [`Seed::Load`] columns are seeded.
-    pub load_node: Option<usize>,
-    /// Whether to record the nodes of the march.
-    pub record_nodes: bool,
-    /// Arc lengths inside the rod where the march puts a node (a solution's `s_out`).
-    pub stops: &'r [f64],
-}
-
-/// The result of integrating the columns of a [`Request`].
-pub(crate) struct Integrated {
-    /// Scaled tip residual at the end of the march.
-    pub residual: Vector6<f64>,
-    /// Tendon path lengths (m, quadrature on the stages).
-    pub lengths: Vec<f64>,
-    /// Per column, the derivative of the scaled residual.
-    pub d_residual: Vec<Vector6<f64>>,
-    /// Per column, the path-length sensitivities of the requested tendons.
-    pub d_lengths: Vec<Vec<f64>>,
-    /// Per observed node, per column, `(δp, R w)` (world).
-    pub poses: Vec<Vec<Vector6<f64>>>,
-    /// Per observed node, its rotation.
-    pub rotations: Vec<Matrix3<f64>>,
-    /// The nodes (if recorded).
-    pub nodes: Vec<Node>,
-    /// Per column, `(δp, R w)` at the tip.
-    pub tip: Vec<Vector6<f64>>,
-    /// Tip position (m) and rotation.
-    pub tip_pose: (Vector3<f64>, Matrix3<f64>),
-    /// Right-hand-side evaluations.
-    pub evaluations: usize,
-}
-
-/// The integration scheme of `integrator` on the breaks of `model` (`plan` keeps the RK4
-/// plan alive).
-pub(crate) fn scheme_of<'p>(
-    integrator: &Integrator,
-    model: &RobotModel,
-    plan: &'p mut Vec<usize>,
-) -> Scheme<'p> {
-    match *integrator {
-        Integrator::Rk4 { steps } => {
-            *plan = rk4_plan(model.breaks(), steps);
-            Scheme::Rk4(plan)
-        }
-        Integrator::Adaptive(options) => Scheme::Adaptive {
-            options,
-            controlled: STATE,
-        },
-    }
-}
-
-#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
-fn pass<const N: usize>(
-    eq: Equations<'_>,
-    scheme: Scheme<'_>,
-    x: &[f64; 6],
-    req: &Request<'_>,
-    seeds: &[Seed],
-    record: bool,
-) -> Result<Integrated> {
-    let model = eq.model;
-    let nt = model.tendons().len();
-    let mut ws = Workspace::new(nt);
-    let columns: Vec<Column> = seeds
-        .iter()
-        .map(|s| match s {
-            Seed::Forced(c) => *c,
-            _ => Column::Free,
-        })
-        .collect();
-    ws.set_columns(&columns, req.lengths);
-    ws.track_lengths = true;
-    let mut y0: [f64; N] = eq.initial(x);
-    y0[STATE..].fill(0.0);
-    let f_ref = model.force_scale();
-    let fm = f_ref * model.length();
-    let r0 = model.rod().base_pose().rotation();
-    for (c, s) in seeds.iter().enumerate() {
-        let b = STATE + COLUMN * c;
-        match *s {
-            Seed::Base(k) if k < 3 => y0[b + DN + k] = f_ref,
-            Seed::Base(k) => y0[b + DM + k - 3] = fm,
-            Seed::BaseTranslation(k) => y0[b + k] = 1.0,
-            Seed::BaseRotation(k) => {
-                // δR(0) = δθ̂ R(0) for a world rotation δθ = e_k.
-                let dr = hat(&Vector3::ith(k, 1.0)) * r0;
-                y0[b + DR..b + DR + 9].copy_from_slice(dr.as_slice());
-            }
-            Seed::Load(_) | Seed::Forced(_) => {}
-        }
-    }
-    let mut ev = Evaluator { eq, ws: &mut ws };
-    let mut poses = Vec::with_capacity(req.observe.len());
-    let mut rotations = Vec::with_capacity(req.observe.len());
-    let mut nodes = Vec::new();
-    let mut index = 0usize;
-    let mut next = 0usize;
-    let y = march(
-        &mut ev,
-        model.breaks(),
-        req.stops,
-        y0,
-        scheme,
-        |_, s, interval, y| {
-            if record {
-                let mut h = [0.0; STATE];
-                h.copy_from_slice(&y[..STATE]);
-                nodes.push(Node { s, interval, y: h });
-            }
-            if req.observe.get(next) == Some(&index) {
-                let r = rot(y);
-                poses.push(
-                    (0..seeds.len())
-                        .map(|c| {
-                            let b = STATE + COLUMN * c;
-                            let (dp, w) = (v3(y, b), rotation_variation(&r, &col_rot(y, b)));
-                            Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
-                        })
-                        .collect(),
-                );
-                rotations.push(r);
-                while req.observe.get(next) == Some(&index) {
-                    next += 1;
-                }
-            }
-            if req.load_node == Some(index) {
-                for (c, seed) in seeds.iter().enumerate() {
-                    if let Seed::Load(k) = seed {
-                        let b = STATE + COLUMN * c + if *k < 3 { DN + k } else { DM + k - 3 };
-                        y[b] = -1.0;
-                    }
-                }
-            }
-            index += 1;
-        },
-    )?;
-    let evaluations = ws.evaluations;
-    if !y[..STATE].iter().all(|v| v.is_finite()) {
-        return Err(Error::NotConverged {
-            what: "rod integration: non-finite state".into(),
-            iterations: 0,
-            residual: f64::INFINITY,
-            load_factor: 1.0,
-        });
-    }
-    if next < req.observe.len() {
-        return Err(Error::invalid(
-            "node",
-            req.observe[next],
-            format!("a node of the solution's mesh (< {index})"),
-        ));
-    }
-    let (residual, d_residual) = eq.residual(&y, seeds.len());
-    let r_tip = rot(&y);
-    let tip = (0..seeds.len())
-        .map(|c| {
-            let b = STATE + COLUMN * c;
-            let (dp, w) = (v3(&y, b), rotation_variation(&r_tip, &col_rot(&y, b)));
-            Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
-        })
-        .collect();
-    let nl = req.lengths.len();
-    let d_lengths = (0..seeds.len())
-        .map(|c| ws.integral[nt + c * nl..nt + (c + 1) * nl].to_vec())
-        .collect();
-    Ok(Integrated {
-        residual,
-        lengths: ws.integral[..nt].to_vec(),
-        d_residual,
-        d_lengths,
-        poses,
-        rotations,
-        nodes,
-        tip,
-        tip_pose: (v3(&y, 0), r_tip),
-        evaluations,
-    })
-}
-
-/// State length of a pass with `c` columns.
-const fn width(c: usize) -> usize {
-    STATE + COLUMN * c
-}
-
-/// Integrates every column of `req` ([`COLUMNS_PER_PASS`] per march) with the state from the
-/// scaled base wrench `x`.
-///
-/// # Errors
-/// [`Error::NotConverged`] if the integration fails; [`Error::InvalidParameter`] naming `node`
-/// for an observed node that is not on the mesh.
-pub(crate) fn integrate(
-    eq: Equations<'_>,
-    scheme: Scheme<'_>,
-    x: &[f64; 6],
-    req: &Request<'_>,
-) -> Result<Integrated> {
-    if req.seeds.is_empty() {
-        return pass::<STATE>(eq, scheme, x, req, &[], req.record_nodes);
-    }
-    let mut all: Option<Integrated> = None;
-    for chunk in req.seeds.chunks(COLUMNS_PER_PASS) {
-        let record = req.record_nodes && all.is_none();
-        let p = match chunk.len() {
-            0..=6 => pass::<{ width(6) }>(eq, scheme, x, req, chunk, record)?,
-            7..=12 => pass::<{ width(12) }>(eq, scheme, x, req, chunk, record)?,
-            13..=18 => pass::<{ width(18) }>(eq, scheme, x, req, chunk, record)?,
-            _ => pass::<{ width(COLUMNS_PER_PASS) }>(eq, scheme, x, req, chunk, record)?,
-        };
-        match &mut all {
-            None => all = Some(p),
-            Some(a) => {
-                a.d_residual.extend(p.d_residual);
-                a.d_lengths.extend(p.d_lengths);
-                for (mine, theirs) in a.poses.iter_mut().zip(p.poses) {
-                    mine.extend(theirs);
-                }
-                a.tip.extend(p.tip);
-                a.evaluations += p.evaluations;
-            }
-        }
-    }
-    all.ok_or_else(|| Error::invalid("seeds", 0, "at least one"))
-}
-
-impl Evaluator<'_, '_> {
-    /// The body-wrench forcing of `column` at `s` (strains `v`, `u`; rod's elastic wrench
-    /// `n_el`), and the rate `(tendon, t·δw)` of the path length of the tendon whose offset it
-    /// changes. The tendon directions of the evaluation are in `ws.dirs`.
-    pub(crate) fn forcing(
-        &self,
-        column: Column,
-        s: f64,
-        props: &SectionProperties,
-        v: &Vector3<f64>,
-        u: &Vector3<f64>,
-        n_el: &Vector6<f64>,
-    ) -> ([f64; 6], Option<(usize, f64)>) {
-        let model = self.eq.model;
-        let breaks = model.breaks();
-        let k = self.ws.interval;
-        let fills = |j: usize| {
-            let (start, end) = model.chamber_extents()[j];
-            start <= breaks[k] && end >= breaks[k + 1]
-        };
-        let dirs = &self.ws.dirs;
-        let z = [0.0; 6];
-        match column {
-            Column::Free => (z, None),
-            Column::Tension(i) => (dirs[i].map_or(z, Into::into), None),
-            Column::Pressure(j) if fills(j) => (model.chambers()[j].fluid_wrench(s, 1.0), None),
-            Column::ChamberAreaScale(j) if fills(j) => (
-                model.chambers()[j].fluid_wrench(s, self.eq.pressures[j]),
-                None,
-            ),
-            Column::Pressure(_) | Column::ChamberAreaScale(_) => (z, None),
-            Column::TensionScale => {
-                let mut f = Vector6::zeros();
-                for (i, d) in dirs.iter().enumerate() {
-                    if let Some(d) = d {
-                        f += d * self.eq.tensions[i];
-                    }
-                }
-                (f.into(), None)
-            }
-            Column::StiffnessScale => ((*n_el).into(), None),
-            Column::TendonOffsetScale(i) | Column::TendonOffsetShift(i, _) => {
-                if dirs[i].is_none() {
-                    return (z, None);
-                }
-                let (r, rp) = model.tendons()[i].routing().offset(s, props);
-                let r = Vector3::new(r[0], r[1], 0.0);
-                let rp = Vector3::new(rp[0], rp[1], 0.0);
-                let (dr, drp) = match column {
-                    Column::TendonOffsetShift(_, d) => {
-                        (Vector3::new(d[0], d[1], 0.0), Vector3::zeros())
-                    }
-                    _ => (r, rp),
-                };
-                let w = v + u.cross(&r) + rp;
-                let len = w.norm();
-                let t = w / len;
-                let dw = u.cross(&dr) + drp;
-                let dt = (dw - t * t.dot(&dw)) / len;
-                let dq = dr.cross(&t) + r.cross(&dt);
-                let tau = self.eq.tensions[i];
-                (
-                    [
-                        tau * dt.x,
-                        tau * dt.y,
-                        tau * dt.z,
-                        tau * dq.x,
-                        tau * dq.y,
-                        tau * dq.z,
-                    ],
-                    Some((i, t.dot(&dw))),
-                )
-            }
-        }
-    }
-}
-
 /// A displacement-controlled tendon held taut, as a row and an unknown of the linearised
 /// problem.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -524,7 +196,6 @@ pub(crate) struct Linear {
 /// tendons' displacements, the unit right-hand sides in `displaced`: indices into `held`),
 /// observing the nodes `observe` (increasing) and the path lengths of `lengths`.
 /// Right-hand sides are ordered: `seeds`, then `displaced`.
-#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub(crate) fn linearise(
     solution: &StaticsSolution,
     held: &[HeldRow],
@@ -563,43 +234,15 @@ pub(crate) fn linearise(
     let mut plan = Vec::new();
     let stops = super::statics::interior(&solution.s_out, model.length());
     let scheme = scheme_of(&solution.options.integrator, model, &mut plan);
-    // A solution reported at `s_out` keeps some nodes of its march: map its node indices to
-    // the march's (the last node at each arc length, as the solution reports).
-    let (observe, load_node) = if solution.s_out.is_empty() {
-        (observe.to_vec(), load_node)
-    } else {
-        let nodes = integrate(
-            eq,
-            scheme,
-            &x,
-            &Request {
-                seeds: &[],
-                lengths: &[],
-                observe: &[],
-                load_node: None,
-                record_nodes: true,
-                stops: &stops,
-            },
-        )?
-        .nodes;
-        let map = |i: usize| -> Result<usize> {
-            let s = *solution
-                .s
-                .get(i)
-                .ok_or_else(|| Error::invalid("node", i, "a node of the solution"))?;
-            nodes
-                .iter()
-                .rposition(|n| n.s == s)
-                .ok_or_else(|| Error::invalid("node", i, "a node of the solution"))
-        };
-        (
-            observe
-                .iter()
-                .map(|&i| map(i))
-                .collect::<Result<Vec<_>>>()?,
-            load_node.map(map).transpose()?,
-        )
+    let march = Request {
+        seeds: &[],
+        lengths: &[],
+        observe,
+        load_node,
+        record_nodes: true,
+        stops: &stops,
     };
+    let (observe, load_node) = march_indices(solution, eq, scheme, &x, &march)?;
     let observe = &observe[..];
     let cols = integrate(
         eq,
@@ -614,41 +257,8 @@ pub(crate) fn linearise(
             stops: &stops,
         },
     )?;
-    // Unknowns z = [δx (nb); δτ_H / f_ref (nh)]; rows: tip residual (nb), held slack / scale.
-    let f_ref = model.force_scale();
-    let dim = nb + nh;
-    let row_scale: Vec<f64> = held
-        .iter()
-        .map(|h| 1.0 / slack_scale(model, h.tendon, h.compliance))
-        .collect();
-    let entry = |c: usize, row: usize| -> f64 {
-        if row < nb {
-            cols.d_residual[c][row]
-        } else {
-            let h = row - nb;
-            -cols.d_lengths[c][h] * row_scale[h]
-        }
-    };
-    let mut a = vec![0.0; dim * dim];
-    for c in 0..dim {
-        let unit = if c < nb { 1.0 } else { f_ref };
-        for row in 0..dim {
-            a[c * dim + row] = entry(c, row) * unit;
-        }
-        if c >= nb {
-            let h = c - nb;
-            a[c * dim + c] += held[h].compliance * f_ref * row_scale[h];
-        }
-    }
-    let mut lu = DenseLu::default();
-    if dim > 0 && !lu.factor(dim, &a) {
-        return Err(Error::NotConverged {
-            what: "linearised equilibrium: singular problem".into(),
-            iterations: 0,
-            residual: f64::INFINITY,
-            load_factor: 1.0,
-        });
-    }
+    let system = System::new(model, held, &cols, nb);
+    let mut lu = system.factor(held)?;
     let nrhs = seeds.len() + displaced.len();
     let mut out = Linear {
         pose: Vec::with_capacity(nrhs),
@@ -657,30 +267,170 @@ pub(crate) fn linearise(
         lengths: Vec::with_capacity(nrhs),
         rotations: cols.rotations.clone(),
     };
-    let nl = len_tendons.len();
     for q in 0..nrhs {
         // Right-hand side: -(column's rows), or the unit displacement of a held tendon.
-        let column = (q < seeds.len()).then_some(dim + q);
+        let column = (q < seeds.len()).then_some(system.dim + q);
+        let moved = column.is_none().then(|| displaced[q - seeds.len()]);
+        let z = system.solve(&mut lu, column, moved)?;
+        system.record(&mut out, column, &z, (observe.len(), len_tendons.len()));
+    }
+    // Lengths ordered as `len_tendons`: reorder to `lengths`.
+    for l in &mut out.lengths {
+        let reordered = lengths
+            .iter()
+            .map(|i| {
+                let h = len_tendons.iter().position(|j| j == i).unwrap_or(0);
+                l[h]
+            })
+            .collect();
+        *l = reordered;
+    }
+    Ok(out)
+}
+
+/// The march's node indices of the solution's nodes `req.observe` and `req.load_node`: the
+/// same without `s_out`; a solution reported at `s_out` keeps some nodes of its march, so
+/// its indices are mapped to the march's (the last node at each arc length, as the solution
+/// reports) by one march of the state recording its nodes (`req`, no columns).
+fn march_indices(
+    solution: &StaticsSolution,
+    eq: Equations<'_>,
+    scheme: Scheme<'_>,
+    x: &[f64; 6],
+    req: &Request<'_>,
+) -> Result<(Vec<usize>, Option<usize>)> {
+    if solution.s_out.is_empty() {
+        return Ok((req.observe.to_vec(), req.load_node));
+    }
+    let nodes = integrate(
+        eq,
+        scheme,
+        x,
+        &Request {
+            observe: &[],
+            load_node: None,
+            ..*req
+        },
+    )?
+    .nodes;
+    let map = |i: usize| -> Result<usize> {
+        let s = *solution
+            .s
+            .get(i)
+            .ok_or_else(|| Error::invalid("node", i, "a node of the solution"))?;
+        nodes
+            .iter()
+            .rposition(|n| n.s == s)
+            .ok_or_else(|| Error::invalid("node", i, "a node of the solution"))
+    };
+    Ok((
+        req.observe
+            .iter()
+            .map(|&i| map(i))
+            .collect::<Result<Vec<_>>>()?,
+        req.load_node.map(map).transpose()?,
+    ))
+}
+
+/// The linear system of the linearised problem: unknowns `z = [δx (nb); δτ_H / f_ref
+/// (nh)]`, rows the tip residual (nb) and the held tendons' slack over its scale.
+struct System<'c> {
+    cols: &'c Integrated,
+    nb: usize,
+    dim: usize,
+    f_ref: f64,
+    row_scale: Vec<f64>,
+}
+
+/// The error of a singular linearised problem.
+fn singular() -> Error {
+    Error::NotConverged {
+        what: "linearised equilibrium: singular problem".into(),
+        iterations: 0,
+        residual: f64::INFINITY,
+        load_factor: 1.0,
+    }
+}
+
+impl<'c> System<'c> {
+    fn new(model: &RobotModel, held: &[HeldRow], cols: &'c Integrated, nb: usize) -> Self {
+        Self {
+            cols,
+            nb,
+            dim: nb + held.len(),
+            f_ref: model.force_scale(),
+            row_scale: held
+                .iter()
+                .map(|h| 1.0 / slack_scale(model, h.tendon, h.compliance))
+                .collect(),
+        }
+    }
+
+    /// Row `row` of march column `c`.
+    fn entry(&self, c: usize, row: usize) -> f64 {
+        if row < self.nb {
+            self.cols.d_residual[c][row]
+        } else {
+            let h = row - self.nb;
+            -self.cols.d_lengths[c][h] * self.row_scale[h]
+        }
+    }
+
+    /// The factored matrix (the held tendons' compliance on the diagonal of their rows).
+    fn factor(&self, held: &[HeldRow]) -> Result<DenseLu> {
+        let (nb, dim, f_ref) = (self.nb, self.dim, self.f_ref);
+        let mut a = vec![0.0; dim * dim];
+        for c in 0..dim {
+            let unit = if c < nb { 1.0 } else { f_ref };
+            for row in 0..dim {
+                a[c * dim + row] = self.entry(c, row) * unit;
+            }
+            if c >= nb {
+                let h = c - nb;
+                a[c * dim + c] += held[h].compliance * f_ref * self.row_scale[h];
+            }
+        }
+        let mut lu = DenseLu::default();
+        if dim > 0 && !lu.factor(dim, &a) {
+            return Err(singular());
+        }
+        Ok(lu)
+    }
+
+    /// The unknowns for the right-hand side of march column `column`, or else of the unit
+    /// displacement of the held tendon `displaced` (an index into the held rows).
+    fn solve(
+        &self,
+        lu: &mut DenseLu,
+        column: Option<usize>,
+        displaced: Option<usize>,
+    ) -> Result<Vec<f64>> {
+        let dim = self.dim;
         let mut z = vec![0.0; dim];
-        match column {
-            Some(c) => {
-                for row in 0..dim {
-                    z[row] = -entry(c, row);
-                }
+        if let Some(c) = column {
+            for row in 0..dim {
+                z[row] = -self.entry(c, row);
             }
-            None => {
-                let h = displaced[q - seeds.len()];
-                z[nb + h] = row_scale[h];
-            }
+        } else if let Some(h) = displaced {
+            z[self.nb + h] = self.row_scale[h];
         }
         if dim > 0 && !lu.solve_in_place(&mut z) {
-            return Err(Error::NotConverged {
-                what: "linearised equilibrium: singular problem".into(),
-                iterations: 0,
-                residual: f64::INFINITY,
-                load_factor: 1.0,
-            });
+            return Err(singular());
         }
+        Ok(z)
+    }
+
+    /// Appends to `out` the pose derivatives at the `observed` nodes, the base-wrench and
+    /// held-tension changes and the changes of the `nl` tendon lengths of the unknowns `z` of
+    /// march column `column` (none: a held tendon's displacement).
+    fn record(
+        &self,
+        out: &mut Linear,
+        column: Option<usize>,
+        z: &[f64],
+        (observed, nl): (usize, usize),
+    ) {
+        let (nb, f_ref, cols) = (self.nb, self.f_ref, self.cols);
         let combine = |get: &dyn Fn(usize) -> Vector6<f64>| -> Vector6<f64> {
             let mut t = column.map_or(Vector6::zeros(), get);
             for (k, zk) in z.iter().enumerate() {
@@ -690,7 +440,7 @@ pub(crate) fn linearise(
             t
         };
         out.pose.push(
-            (0..observe.len())
+            (0..observed)
                 .map(|o| combine(&|c| cols.poses[o][c]))
                 .collect(),
         );
@@ -712,18 +462,6 @@ pub(crate) fn linearise(
                 .collect(),
         );
     }
-    // Lengths ordered as `len_tendons`: reorder to `lengths`.
-    for l in &mut out.lengths {
-        let reordered = lengths
-            .iter()
-            .map(|i| {
-                let h = len_tendons.iter().position(|j| j == i).unwrap_or(0);
-                l[h]
-            })
-            .collect();
-        *l = reordered;
-    }
-    Ok(out)
 }
 
 /// The length scale (m) of the slack of tendon `i` per force scale: `(|r_i(0)|² + I/A) / L`
