@@ -272,3 +272,51 @@ fn dense_guides_approach_the_continuous_channel() {
         );
     }
 }
+
+#[path = "common/robot.rs"]
+mod robot;
+
+/// The two-segment NiTi robot with its tendons through `per_segment` equally spaced disks per
+/// 0.2 m (coefficient `mu` at each), as the Python tests build it.
+fn guided_niti(mu: f64, per_segment: usize) -> Arc<RobotModel> {
+    let tendons = robot::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let end = if i < 3 { 0.2 } else { 0.4 };
+            let n = (per_segment as f64 * end / 0.2).round() as usize;
+            let guides = (1..n).map(|g| end * g as f64 / n as f64).collect();
+            t.tendon.with_guides(guides, &[mu]).unwrap()
+        })
+        .collect();
+    RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap()
+}
+
+#[test]
+fn experiment_niti() {
+    let tau: f64 = std::env::var("TAU")
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(0.3);
+    let mu: f64 = std::env::var("MU")
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(0.0);
+    let model = guided_niti(mu, 8);
+    let mut opts = FrictionOptions::default();
+    if std::env::var("NEWTON").is_ok() {
+        opts.guide_method = softrod::GuideMethod::Newton;
+    }
+    let t0 = std::time::Instant::now();
+    let r = solve_frictional(
+        &model,
+        &Actuation::tensions(&[tau, 0.0, 0.0, 0.0, tau / 2.0, 0.0]),
+        &opts,
+        None,
+    );
+    eprintln!(
+        "{:?} {:?}",
+        t0.elapsed(),
+        r.as_ref()
+            .map(|s| s.tip_position())
+            .map_err(|e| e.to_string())
+    );
+}
