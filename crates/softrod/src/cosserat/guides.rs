@@ -13,12 +13,28 @@
 //! The tendon touches the rod only at its guides and its termination: it loads guide `g` with
 //! the point force `F_g = τ_g c_g − τ_{g−1} c_{g−1}` (the termination with `−τ_{G−1} c_{G−1}`)
 //! applied at `X_g`, that is the force `F_g` and the moment `(X_g − p(s_g)) × F_g` at the
-//! backbone. These are solved with the shape by a fixed point on the guide points: the rod is
-//! solved under the point loads of the current points (with any other tendons, frictional or
-//! not, as usual), the points are read from the new shape, until they move by less than
-//! [`FrictionOptions::tolerance`] times the rod length (Anderson-accelerated). The reported
-//! tensions, chords and guide forces are those the converged rod was solved with, so the
-//! balance of rod + tendons holds to rounding.
+//! backbone. These are solved with the shape ([`GuideMethod`]):
+//!
+//! - a fixed point on the guide points: the rod is solved under the point loads of the current
+//!   points (follower loads in the guides' frames of the last shape), the points are read from
+//!   the new shape, until they move by less than [`FrictionOptions::tolerance`] times the rod
+//!   length (Anderson-accelerated). Its gain is about `τ L²/EI` (the chords' geometric
+//!   stiffness against the rod's bending compliance): it converges only where that is ≲ 1.
+//! - Newton on the guide forces: the unknowns `z` are the body-frame forces at the anchors of
+//!   the pulled guided tendons, the map `z ↦ z'` solves the rod under `z` (follower point
+//!   loads at the guides' offsets) and reads the capstan forces `z'` of the points on the new
+//!   shape in its frames; `F(z) = z' − z = 0` is solved by Newton with a forward-difference
+//!   Jacobian (one warm rod solve per unknown, reused while steps contract the residual by
+//!   4), a backtracking line search, and, if the full step from the start fails,
+//!   continuation in the tensions from `previous` (or from zero). It ends at a residual of
+//!   [`GUIDE_FORCE_TOLERANCE`] times the largest tension. Unlike the points, the forces in
+//!   the guides' frames determine the rod solve alone, so `z ↦ z'` is a function and its
+//!   Jacobian exists.
+//!
+//! The default ([`GuideMethod::Auto`]) tries the fixed point for
+//! [`GUIDE_FIXED_POINT_BUDGET`] rod solves, then Newton. The reported tensions, chords and
+//! wraps are those of the points on the returned shape, the guide forces those the returned
+//! rod was solved with, so the balance of rod + tendons holds to the residual.
 
 use std::sync::Arc;
 
