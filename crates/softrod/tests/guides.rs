@@ -358,8 +358,10 @@ fn distance(a: &FrictionalSolution, b: &FrictionalSolution) -> (f64, f64) {
 /// Newton on the guide forces finds the same equilibrium.
 #[test]
 fn newton_agrees_with_the_fixed_point_where_it_converges() {
-    let mut niti_opts = FrictionOptions::default();
-    niti_opts.tolerance = 1e-12;
+    let mut niti_opts = FrictionOptions {
+        tolerance: 1e-12,
+        ..Default::default()
+    };
     niti_opts.statics.newton.tolerance = 1e-13;
     let cases = [
         (

@@ -759,8 +759,7 @@ impl<'a> Guided<'a> {
             .chain(&from)
             .fold(0.0, |m: f64, t| m.max(*t))
             .max(f64::MIN_POSITIVE);
-        let done = |z: Vec<f64>, e: Evaluation, c: &Counters| {
-            let _ = z;
+        let done = |e: Evaluation, c: &Counters| {
             let rel = e.norm / scale;
             finish(
                 self.model,
@@ -775,12 +774,11 @@ impl<'a> Guided<'a> {
         let x0 = points_on(self.model, &self.guided, start);
         let st0 = self.states_at(&x0, &target);
         let z0 = self.body_forces(&st0, start, &active);
-        let first = match self.newton(&target, &active, z0, start, c) {
-            Ok((z, e)) => return Ok(done(z, e, c)),
+        match self.newton(&target, &active, z0, start, c) {
+            Ok((_, e)) => return Ok(done(e, c)),
             Err(Error::NotConverged { .. }) => (),
             Err(e) => return Err(e),
-        };
-        let _ = first;
+        }
         // Continuation from λ = 0: `previous` with its forces, or the rod without the guided
         // tendons' loads.
         let mut z = match self.previous {
@@ -801,7 +799,7 @@ impl<'a> Guided<'a> {
             match self.newton(&at(next), &active, z.clone(), &warm, c) {
                 Ok((zn, e)) => {
                     if next >= 1.0 {
-                        return Ok(done(zn, e, c));
+                        return Ok(done(e, c));
                     }
                     lam = next;
                     z = zn;
