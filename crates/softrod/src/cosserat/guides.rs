@@ -287,7 +287,7 @@ fn split<'x>(model: &RobotModel, guided: &[usize], x: &'x [f64]) -> Vec<&'x [f64
 pub enum GuideMethod {
     /// The fixed point on the guide points first (a few rod solves where the tendon load is
     /// small against the rod's stiffness), Newton on the guide forces if it has not settled
-    /// in [`GUIDE_FIXED_POINT_BUDGET`] rod solves.
+    /// in [`GUIDE_FIXED_POINT_BUDGET`] rod solves or diverges.
     #[default]
     Auto,
     /// The fixed point on the guide points only (up to [`FrictionOptions::max_iterations`]
@@ -300,6 +300,10 @@ pub enum GuideMethod {
 
 /// Rod solves the fixed point gets before Newton takes over ([`GuideMethod::Auto`]).
 pub const GUIDE_FIXED_POINT_BUDGET: usize = 16;
+
+/// Growth of the fixed point's change over its smallest value taken as a divergence
+/// ([`GuideMethod::Auto`] then turns to Newton).
+const GUIDE_FIXED_POINT_GROWTH: f64 = 10.0;
 
 /// Residual of the guide forces (largest component, relative to the largest base tension)
 /// that ends Newton; a stall below [`FrictionOptions::tolerance`] is accepted.
@@ -348,7 +352,7 @@ struct Guided<'a> {
     actuation: &'a Actuation,
     /// The rod's actuation: the guided tendons at tension 0 (they load it by point loads).
     act: Actuation,
-    /// The history of the other tendons.
+    /// The history of the other tendons (`None` if none has friction).
     inner_prev: Option<FrictionalSolution>,
     previous: Option<&'a FrictionalSolution>,
     options: &'a FrictionOptions,
@@ -371,7 +375,11 @@ impl<'a> Guided<'a> {
         for &i in &guided {
             act.tendons[i] = TendonInput::Tension(0.0);
         }
-        let inner_prev = previous.map(|p| {
+        // The history of the other tendons, if any has friction (a previous solution also
+        // sets the rod solve's warm start, replaced by the current shape's in `rod_solve`).
+        let others =
+            (0..nt).any(|i| !model.tendons()[i].is_guided() && model.tendons()[i].friction() > 0.0);
+        let inner_prev = previous.filter(|_| others).map(|p| {
             let mut q = p.clone();
             for &i in &guided {
                 for row in &mut q.tension {
@@ -421,7 +429,13 @@ impl<'a> Guided<'a> {
         // forces held in the guides' frames) is no reason to leave the branch.
         inner.statics.seek_stable = false;
         inner.statics.warm_start = Some(warm.statics.warm_start());
-        let sol = solve_frictional(m, &self.act, &inner, self.inner_prev.as_ref())?;
+        let prev = self.inner_prev.as_ref().map(|p| {
+            let mut q = p.clone();
+            q.statics.base_wrench = warm.statics.base_wrench;
+            q.statics.jacobian = warm.statics.jacobian;
+            q
+        });
+        let sol = solve_frictional(m, &self.act, &inner, prev.as_ref())?;
         c.iterations += sol.iterations;
         c.cell_steps += sol.cell_steps;
         c.rod_solves += 1;
@@ -443,13 +457,16 @@ impl<'a> Guided<'a> {
         }
     }
 
-    /// The fixed point on the guide points from `sol`, up to `budget` rod solves: the rod is
+    /// The fixed point on the guide points from `sol`, up to `budget` rod solves (`bounded`:
+    /// also stopping once the change grows [`GUIDE_FIXED_POINT_GROWTH`]-fold over its
+    /// smallest value, a divergence): the rod is
     /// solved under the follower loads of the current points (the moment arms and frames
     /// read on the last shape), the points are read on the new shape.
     fn fixed_point(
         &self,
         mut sol: FrictionalSolution,
         budget: usize,
+        bounded: bool,
         c: &mut Counters,
     ) -> Result<FrictionalSolution> {
         let model = self.model;
@@ -458,6 +475,7 @@ impl<'a> Guided<'a> {
         let mut x = points_on(model, &self.guided, &sol);
         let mut anderson = Anderson::with_depth(false, GUIDE_ANDERSON_DEPTH);
         let mut solves = 0;
+        let mut best = f64::INFINITY;
         loop {
             let st = self.states_at(&x, &base);
             let m = loaded_model(model, &self.guided, Some(&st), Some(&sol))?;
@@ -488,7 +506,8 @@ impl<'a> Guided<'a> {
                     delta,
                 ));
             }
-            if solves >= budget {
+            best = best.min(delta);
+            if solves >= budget || (bounded && delta > GUIDE_FIXED_POINT_GROWTH * best) {
                 return Err(Error::NotConverged {
                     what: format!(
                         "guides: the guide points did not settle in {solves} rod solves of the \
@@ -855,11 +874,13 @@ pub(super) fn solve_guided(
     let mut c = Counters::default();
     let start = problem.start(&mut c)?;
     match options.guide_method {
-        GuideMethod::FixedPoint => problem.fixed_point(start, options.max_iterations, &mut c),
+        GuideMethod::FixedPoint => {
+            problem.fixed_point(start, options.max_iterations, false, &mut c)
+        }
         GuideMethod::Newton => problem.newton_solve(&start, &mut c),
         GuideMethod::Auto => {
             let budget = GUIDE_FIXED_POINT_BUDGET.min(options.max_iterations);
-            match problem.fixed_point(start.clone(), budget, &mut c) {
+            match problem.fixed_point(start.clone(), budget, true, &mut c) {
                 Err(Error::NotConverged { .. }) => problem.newton_solve(&start, &mut c),
                 other => other,
             }
