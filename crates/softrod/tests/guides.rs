@@ -455,6 +455,50 @@ fn guided_niti_at_working_tensions() {
     }
 }
 
+/// Guided and channel tendons on one robot at working tensions: the first segment's tendons
+/// through disks, the second's in frictional channels (μ = 0.1), loaded then partly unloaded
+/// (the history of both kinds carried by `previous`): balance and the capstan law per guide.
+#[test]
+fn guided_and_channel_tendons_mixed_at_working_tensions() {
+    let tendons = robot::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            if i < 3 {
+                let guides = (1..8).map(|g| 0.2 * g as f64 / 8.0).collect();
+                t.tendon.with_guides(guides, &[0.2]).unwrap()
+            } else {
+                t.tendon.with_friction(0.1).unwrap()
+            }
+        })
+        .collect();
+    let model = RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap();
+    let path: Vec<Actuation> = [3.0, 2.85]
+        .iter()
+        .map(|&tau| Actuation::tensions(&[tau, 0.0, 0.3 * tau, 0.0, 0.5 * tau, 0.1 * tau]))
+        .collect();
+    let sols = solve_path(&model, &path, &FrictionOptions::default()).unwrap();
+    for (k, sol) in sols.iter().enumerate() {
+        let (force, moment) = base_balance(&model, sol);
+        let stuck = check_capstan_on_shape(&model, sol);
+        let channel_stick = sol.slip.iter().filter(|row| row[4] == Slip::Stick).count();
+        eprintln!(
+            "mixed guided + channel, step {k}: balance {:e} N, {:e} N m, {stuck} guides and \
+             {channel_stick} channel nodes of tendon 4 stick, {} marches",
+            force.amax(),
+            moment.amax(),
+            sol.iterations
+        );
+        assert!(force.amax() <= 1e-10 && moment.amax() <= 1e-10);
+        if k == 1 {
+            assert!(
+                stuck > 0 && channel_stick > 0,
+                "the partial unloading sticks"
+            );
+        }
+    }
+}
+
 /// Dense guides approach the continuous channel at a working tension (1 N on the NiTi
 /// robot, where the guide fixed point diverges): order 2 in the guide spacing without
 /// friction (chords against arcs). With friction the chords leave out the wrap of half a
