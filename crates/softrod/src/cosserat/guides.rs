@@ -163,59 +163,6 @@ fn states(
     out
 }
 
-/// The model with its guided tendons as plain ones (tension 0 in the rod's actuation) under
-/// its own loads plus the point loads of the guided tendons in `states` (`None`: zero loads
-/// at their anchors, which keeps the same breaks), the moment arms read on `sol`.
-fn loaded_model(
-    model: &RobotModel,
-    guided: &[usize],
-    states: Option<&[Vec<GuideState>]>,
-    sol: Option<&FrictionalSolution>,
-) -> Result<Arc<RobotModel>> {
-    let mut loads = model.loads().clone();
-    for (k, &i) in guided.iter().enumerate() {
-        match states {
-            Some(st) => {
-                for g in st[k].iter().skip(1) {
-                    // A follower load: the force in the guide's frame on the last shape, at
-                    // the guide's offset (a dead load of the tendon's pull would buckle a
-                    // rod that its tendon only bends).
-                    let (f, o) = match sol {
-                        Some(sol) => {
-                            let j = node_at(&sol.statics.s, g.s);
-                            let r = Matrix3::from_fn(|a, b| sol.statics.rotation[j][a][b]);
-                            let props = model.rod().section_at(g.s);
-                            let (o, _) = model.tendons()[i].routing().offset(g.s, &props);
-                            (
-                                r.transpose() * Vector3::from(g.force),
-                                Vector3::new(o[0], o[1], 0.0),
-                            )
-                        }
-                        None => (Vector3::zeros(), Vector3::zeros()),
-                    };
-                    loads
-                        .point_loads
-                        .push(PointLoad::new(g.s, f, o.cross(&f), Frame::Body)?);
-                }
-            }
-            None => {
-                for s in anchors(model, i).into_iter().skip(1) {
-                    loads
-                        .point_loads
-                        .push(PointLoad::force(s, Vector3::zeros()));
-                }
-            }
-        }
-    }
-    let tendons = model.tendons().iter().map(Tendon::without_guides).collect();
-    RobotModel::new(
-        model.rod().clone(),
-        tendons,
-        model.chambers().to_vec(),
-        loads,
-    )
-}
-
 /// The model with its guided tendons in continuous channels of their mean guide coefficient
 /// (and zero loads at their anchors, which keeps the same breaks).
 fn channel_model(model: &RobotModel, guided: &[usize]) -> Result<Arc<RobotModel>> {
@@ -478,7 +425,10 @@ impl<'a> Guided<'a> {
         let mut best = f64::INFINITY;
         loop {
             let st = self.states_at(&x, &base);
-            let m = loaded_model(model, &self.guided, Some(&st), Some(&sol))?;
+            // Follower loads: the forces in the guides' frames on the last shape (a dead
+            // load of the tendon's pull would buckle a rod that its tendon only bends).
+            let all = vec![true; self.guided.len()];
+            let m = self.forces_model(&self.body_forces(&st, &sol, &all), &all)?;
             sol = self.rod_solve(&m, &sol, c)?;
             solves += 1;
             let next = points_on(model, &self.guided, &sol);
