@@ -1,7 +1,9 @@
 """Benchmark of the frictional solve against the frictionless one on the two-segment NiTi robot;
 prints a table of medians and their ratio (both timed side by side in one run). With
 ``--jacobian``: the actuation Jacobian of the frictional equilibrium (pull and release) against
-the frictionless one instead.
+the frictionless one instead. With ``--guides``: the two-segment NiTi robot with its tendons
+through 8 disks per segment at working tensions against the same tendons in continuous
+channels.
 
 Run: ``python benchmarks/bench_friction.py`` (after ``pip install .``).
 """
@@ -50,8 +52,12 @@ def main() -> None:
         "--clock", choices=("wall", "cpu"), default="wall", help="wall time or process CPU time"
     )
     ap.add_argument("--jacobian", action="store_true", help="time the actuation Jacobians")
+    ap.add_argument("--guides", action="store_true", help="time disk-guided tendons")
     a = ap.parse_args()
     timer = median_time if a.clock == "wall" else median_cpu_time
+    if a.guides:
+        guides(timer, a.calls, a.repeats)
+        return
     if a.jacobian:
         jacobians(timer, a.calls, a.repeats)
         return
@@ -105,6 +111,37 @@ def jacobians(timer, calls: int, repeats: int) -> None:
         label = "mu = 0.2, " + ("unloaded" if tip is None else "tip force")
         t = [x * 1e6 for x in times]
         print(f"{label:<28} {t[0]:20.1f} {t[1]:12.1f} {t[2]:15.1f} {t[3]:22.1f}")
+
+
+def guided(mu: float, per_segment: int = 8) -> softrod.Robot:
+    """The NiTi robot with its tendons through equally spaced disks (coefficient ``mu``)."""
+    base = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    spec = base.spec.model_dump(mode="python", exclude_none=True)
+    for t in spec["tendons"]:
+        end = t.get("end", 0.4)
+        n = round(per_segment * end / 0.2)
+        t["guides"] = [end * g / n for g in range(1, n)]
+        t["guide_friction"] = mu
+    return softrod.Robot.from_dict(spec)
+
+
+def guides(timer, calls: int, repeats: int) -> None:
+    """Disk-guided tendons (8 disks per segment) at tensions ``tau * [1, 0, 0.3, 0, 0.5, 0.1]``
+    from rest, against the same tendons in continuous channels (coefficient ``mu``)."""
+    head = f"{'case':<28} {'channel (us)':>14} {'guided (us)':>14}"
+    print(f"{head} {'ratio':>7} {'marches':>8}")
+    for mu in (0.0, 0.2):
+        chan, disk = robot(mu), guided(mu)
+        for tau in (0.02, 0.3, 1.0, 2.0, 4.0):
+            act = [tau, 0, 0.3 * tau, 0, 0.5 * tau, 0.1 * tau]
+            sol = disk.solve(act)
+            base = timer(lambda r=chan, a=act: r.solve(a), calls=calls, repeats=repeats)
+            t = timer(lambda r=disk, a=act: r.solve(a), calls=calls, repeats=repeats)
+            label = f"mu = {mu}, tau = {tau} N"
+            print(
+                f"{label:<28} {base * 1e6:14.1f} {t * 1e6:14.1f} {t / base:7.1f} "
+                f"{sol.friction_iterations:8d}"
+            )
 
 
 if __name__ == "__main__":

@@ -8,8 +8,8 @@ use std::sync::Arc;
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::{
-    solve_frictional, solve_path, Actuation, FrictionOptions, FrictionalSolution, Integrator,
-    LinearElastic, Loads, Profile, RobotModel, Rod, Section, Slip, Tendon,
+    solve_frictional, solve_path, Actuation, FrictionOptions, FrictionalSolution, GuideMethod,
+    Integrator, LinearElastic, Loads, Profile, RobotModel, Rod, Section, Slip, Tendon,
 };
 
 const KAPPA0: f64 = 5.0; // rest curvature (1/m)
@@ -271,4 +271,327 @@ fn dense_guides_approach_the_continuous_channel() {
             "μ = {mu}: orders {orders:?}"
         );
     }
+}
+
+#[path = "common/robot.rs"]
+mod robot;
+
+/// The two-segment NiTi robot with its tendons through `per_segment` equally spaced disks per
+/// 0.2 m (coefficient `mu` at each), as the Python tests build it.
+fn guided_niti(mu: f64, per_segment: usize) -> Arc<RobotModel> {
+    let tendons = robot::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let end = if i < 3 { 0.2 } else { 0.4 };
+            let n = (per_segment as f64 * end / 0.2).round() as usize;
+            let guides = (1..n).map(|g| end * g as f64 / n as f64).collect();
+            t.tendon.with_guides(guides, &[mu]).unwrap()
+        })
+        .collect();
+    RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap()
+}
+
+/// The capstan law at every interior guide of every guided tendon of `sol`, with the wrap
+/// angles from the guide points on the returned shape (position and rotation at the anchor's
+/// node and the tendon's offset), not the reported ones: sliding `Δ ln τ = ∓μθ`, sticking
+/// inside. Returns the number of sticking guides.
+fn check_capstan_on_shape(model: &RobotModel, sol: &FrictionalSolution) -> usize {
+    let st = &sol.statics;
+    let mut stuck = 0;
+    for (i, a) in sol.guides.iter().enumerate() {
+        if a.is_empty() || a[0].tension_out == 0.0 {
+            continue;
+        }
+        let x = |h: usize| {
+            let s = a[h].s;
+            let j = st.s.iter().position(|&m| m == s).unwrap();
+            let r = Matrix3::from_fn(|p, q| st.rotation[j][p][q]);
+            let props = model.rod().section_at(s);
+            let (o, _) = model.tendons()[i].routing().offset(s, &props);
+            Vector3::from(st.position[j]) + r * Vector3::new(o[0], o[1], 0.0)
+        };
+        for g in 1..a.len() - 1 {
+            let (c0, c1) = ((x(g) - x(g - 1)).normalize(), (x(g + 1) - x(g)).normalize());
+            let theta = c0.cross(&c1).norm().atan2(c0.dot(&c1));
+            let mu = a[g].friction;
+            let dlog = (a[g].tension_out / a[g].tension_in).ln();
+            let tol = 1e-6 * (mu * theta).max(1e-12);
+            match a[g].slip {
+                Slip::Loading => assert!((dlog + mu * theta).abs() <= tol, "tendon {i} guide {g}"),
+                Slip::Unloading => {
+                    assert!((dlog - mu * theta).abs() <= tol, "tendon {i} guide {g}")
+                }
+                Slip::Stick => {
+                    stuck += 1;
+                    assert!(dlog.abs() <= mu * theta + tol, "tendon {i} guide {g}");
+                }
+                Slip::Absent => unreachable!(),
+            }
+        }
+    }
+    stuck
+}
+
+fn with_method(mut o: FrictionOptions, method: GuideMethod) -> FrictionOptions {
+    o.guide_method = method;
+    o
+}
+
+/// The largest distance (m) between the tips and between the guide points of two solutions
+/// of one model, and the largest relative difference of their guide tensions.
+fn distance(a: &FrictionalSolution, b: &FrictionalSolution) -> (f64, f64) {
+    let mut d = (Vector3::from(a.tip_position()) - Vector3::from(b.tip_position())).amax();
+    let mut t: f64 = 0.0;
+    for (ga, gb) in a.guides.iter().zip(&b.guides) {
+        for (x, y) in ga.iter().zip(gb) {
+            d = d.max((Vector3::from(x.point) - Vector3::from(y.point)).amax());
+            if y.tension_out > 0.0 {
+                t = t.max(rel(x.tension_out, y.tension_out));
+            }
+        }
+    }
+    (d, t)
+}
+
+/// Where the guide fixed point converges (a steel rod at 1 N, the NiTi robot at 0.02 N),
+/// Newton on the guide forces finds the same equilibrium.
+#[test]
+fn newton_agrees_with_the_fixed_point_where_it_converges() {
+    let mut niti_opts = FrictionOptions {
+        tolerance: 1e-12,
+        ..Default::default()
+    };
+    niti_opts.statics.newton.tolerance = 1e-13;
+    let cases = [
+        (
+            "steel rod, 1 N",
+            flexible(0.0015, 4, 0.2, Vector3::new(0.03, -0.02, 0.01)),
+            Actuation::tensions(&[1.0, 0.5]),
+            options(60),
+        ),
+        (
+            "NiTi robot, 0.02 N",
+            guided_niti(0.3, 8),
+            Actuation::tensions(&[0.02, 0.0, 0.0, 0.0, 0.01, 0.0]),
+            niti_opts,
+        ),
+    ];
+    for (name, model, act, opts) in cases {
+        let fp = solve_frictional(
+            &model,
+            &act,
+            &with_method(opts, GuideMethod::FixedPoint),
+            None,
+        )
+        .unwrap();
+        let nw =
+            solve_frictional(&model, &act, &with_method(opts, GuideMethod::Newton), None).unwrap();
+        let auto = solve_frictional(&model, &act, &opts, None).unwrap();
+        let (d, t) = distance(&nw, &fp);
+        let (da, _) = distance(&auto, &fp);
+        eprintln!(
+            "{name}: Newton vs fixed point: points {d:e} m, tensions {t:e} relative \
+             ({} vs {} marches); default vs fixed point {da:e} m",
+            nw.iterations, fp.iterations
+        );
+        assert!(d < 1e-10 && t < 1e-10, "{name}: {d:e} m, {t:e}");
+        assert!(da < 1e-10, "{name}: default {da:e} m");
+    }
+}
+
+/// The NiTi robot with disks at working tensions (where the guide fixed point diverges),
+/// frictionless and with guide friction, loading then unloading: global balance of rod +
+/// tendon chords (no external load: the base wrench of the rod plus the tendons' pulls at
+/// the base vanishes) and the capstan law per guide on the returned shape.
+#[test]
+fn guided_niti_at_working_tensions() {
+    let opts = FrictionOptions::default();
+    let levels = [0.3, 1.0, 2.0, 4.0, 3.6];
+    let path: Vec<Actuation> = levels
+        .iter()
+        .map(|&tau| Actuation::tensions(&[tau, 0.0, 0.3 * tau, 0.0, 0.5 * tau, 0.1 * tau]))
+        .collect();
+    for mu in [0.0, 0.2] {
+        let model = guided_niti(mu, 8);
+        // Each level from rest, and the load/unload path (each step from the last).
+        let path_sols = solve_path(&model, &path, &opts).unwrap();
+        for (k, act) in path.iter().enumerate() {
+            let rest = solve_frictional(&model, act, &opts, None).unwrap();
+            for (how, sol) in [("from rest", &rest), ("on the path", &path_sols[k])] {
+                let (force, moment) = base_balance(&model, sol);
+                let stuck = check_capstan_on_shape(&model, sol);
+                eprintln!(
+                    "guided NiTi μ = {mu}, τ = {} N {how}: tip {:.6?} m, balance {:e} N, \
+                     {:e} N m, {stuck} guides stick, {} marches",
+                    levels[k],
+                    sol.tip_position(),
+                    force.amax(),
+                    moment.amax(),
+                    sol.iterations
+                );
+                assert!(force.amax() <= 1e-10 && moment.amax() <= 1e-10);
+                if mu > 0.0 && k == levels.len() - 1 && how == "on the path" {
+                    assert!(stuck > 0, "the partial unloading sticks at some guide");
+                }
+            }
+        }
+        // Frictionless, the path and the solve from rest agree; with friction, unloading
+        // and loading from rest to the same tensions differ (hysteresis).
+        let last = levels.len() - 1;
+        let rest = solve_frictional(&model, &path[last], &opts, None).unwrap();
+        let d = (Vector3::from(rest.tip_position())
+            - Vector3::from(path_sols[last].tip_position()))
+        .norm();
+        eprintln!(
+            "μ = {mu}: tip at {} N from rest vs unloaded {d:e} m",
+            levels[last]
+        );
+        if mu == 0.0 {
+            assert!(d < 1e-10, "{d:e}");
+        } else {
+            assert!(d > 1e-4, "{d:e}");
+        }
+    }
+}
+
+/// Guided and channel tendons on one robot at working tensions: the first segment's tendons
+/// through disks, the second's in frictional channels (μ = 0.1), loaded then partly unloaded
+/// (the history of both kinds carried by `previous`): balance and the capstan law per guide.
+#[test]
+fn guided_and_channel_tendons_mixed_at_working_tensions() {
+    let tendons = robot::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            if i < 3 {
+                let guides = (1..8).map(|g| 0.2 * g as f64 / 8.0).collect();
+                t.tendon.with_guides(guides, &[0.2]).unwrap()
+            } else {
+                t.tendon.with_friction(0.1).unwrap()
+            }
+        })
+        .collect();
+    let model = RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap();
+    let path: Vec<Actuation> = [3.0, 2.85]
+        .iter()
+        .map(|&tau| Actuation::tensions(&[tau, 0.0, 0.3 * tau, 0.0, 0.5 * tau, 0.1 * tau]))
+        .collect();
+    let sols = solve_path(&model, &path, &FrictionOptions::default()).unwrap();
+    for (k, sol) in sols.iter().enumerate() {
+        let (force, moment) = base_balance(&model, sol);
+        let stuck = check_capstan_on_shape(&model, sol);
+        let channel_stick = sol.slip.iter().filter(|row| row[4] == Slip::Stick).count();
+        eprintln!(
+            "mixed guided + channel, step {k}: balance {:e} N, {:e} N m, {stuck} guides and \
+             {channel_stick} channel nodes of tendon 4 stick, {} marches",
+            force.amax(),
+            moment.amax(),
+            sol.iterations
+        );
+        assert!(force.amax() <= 1e-10 && moment.amax() <= 1e-10);
+        if k == 1 {
+            assert!(
+                stuck > 0 && channel_stick > 0,
+                "the partial unloading sticks"
+            );
+        }
+    }
+}
+
+/// Dense guides approach the continuous channel at a working tension (1 N on the NiTi
+/// robot, where the guide fixed point diverges): order 2 in the guide spacing without
+/// friction (chords against arcs). With friction the chords leave out the wrap of half a
+/// spacing at the base hole and at the termination (no guide there), a first-order term
+/// `μ κ h / 2` in the tensions: the distance falls with an order between 1 and 2.
+#[test]
+fn dense_guides_approach_the_channel_at_a_working_tension() {
+    let act = Actuation::tensions(&[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]);
+    let mut opts = FrictionOptions::default();
+    opts.statics.integrator = Integrator::Rk4 { steps: 128 };
+    for mu in [0.0, 0.2] {
+        let cont = solve_frictional(
+            &robot::niti_model(Loads::default(), None, mu),
+            &act,
+            &opts,
+            None,
+        )
+        .unwrap();
+        let tc = Vector3::from(cont.tip_position());
+        let mut errs = Vec::new();
+        for per in [4, 8, 16] {
+            let sol = solve_frictional(&guided_niti(mu, per), &act, &opts, None).unwrap();
+            errs.push((Vector3::from(sol.tip_position()) - tc).norm());
+        }
+        let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        eprintln!("NiTi 1 N, μ = {mu}: tip distance to the channel {errs:?}, orders {orders:?}");
+        let range = if mu == 0.0 { 1.9..2.1 } else { 1.0..2.0 };
+        assert!(
+            orders.iter().all(|p| range.contains(p)),
+            "μ = {mu}: orders {orders:?}"
+        );
+    }
+}
+
+/// Random tensions (0–4 N on each of the six tendons) and guide coefficients (0–0.3) on the
+/// guided NiTi robot, from rest and then one step of the load path to other random tensions:
+/// at least 99 % converge (balanced, the capstan law per guide), every failure a named error.
+fn random_sweep(samples: usize) {
+    let mut seed: u64 = 0x5eed_1234_abcd_0001;
+    let mut uniform = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let opts = FrictionOptions::default();
+    let mut failures = Vec::new();
+    let mut solves = 0;
+    for k in 0..samples {
+        let mu = 0.3 * uniform();
+        let model = guided_niti(mu, 8);
+        // From rest, then a step of the load path to other random tensions from there.
+        let mut previous: Option<FrictionalSolution> = None;
+        for step in 0..2 {
+            let t: Vec<f64> = (0..6).map(|_| 4.0 * uniform()).collect();
+            solves += 1;
+            match solve_frictional(&model, &Actuation::tensions(&t), &opts, previous.as_ref()) {
+                Ok(sol) => {
+                    let (force, moment) = base_balance(&model, &sol);
+                    assert!(
+                        force.amax() <= 1e-10 && moment.amax() <= 1e-10,
+                        "sample {k} step {step}: {force:?} {moment:?}"
+                    );
+                    check_capstan_on_shape(&model, &sol);
+                    previous = Some(sol);
+                }
+                Err(e @ softrod::Error::NotConverged { .. }) => {
+                    failures.push((k, step, mu, t, e));
+                    break;
+                }
+                Err(e) => panic!("sample {k} step {step}: unexpected error {e}"),
+            }
+        }
+    }
+    for f in &failures {
+        eprintln!("failed: {f:?}");
+    }
+    let rate = 1.0 - failures.len() as f64 / solves as f64;
+    eprintln!(
+        "random guided NiTi: {} of {solves} solves converge ({:.1} %)",
+        solves - failures.len(),
+        100.0 * rate
+    );
+    assert!(rate >= 0.99, "{rate}");
+}
+
+#[test]
+fn random_tensions_on_the_guided_niti_robot_bounded() {
+    random_sweep(6);
+}
+
+#[test]
+#[ignore = "long sweep: cargo test --release -p softrod --test guides -- --ignored"]
+fn random_tensions_on_the_guided_niti_robot() {
+    random_sweep(200);
 }

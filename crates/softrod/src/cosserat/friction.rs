@@ -42,7 +42,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 pub use super::friction_march::MAX_CELL_ATTEMPTS;
 use super::friction_march::{solve_marched, Setup};
-pub use super::guides::GuideState;
+pub use super::guides::{GuideMethod, GuideState, GUIDE_FIXED_POINT_BUDGET, GUIDE_FORCE_TOLERANCE};
 use crate::cosserat::equations::{Equations, Evaluator, Workspace, STATE};
 use crate::cosserat::statics::{
     interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
@@ -82,6 +82,9 @@ pub struct FrictionOptions {
     /// iteration fails); `false`: by the fixed point on the profile (the same discrete
     /// equations, an independent solve of them).
     pub single_march: bool,
+    /// How disk-guided tendons are solved (default [`GuideMethod::Auto`]: the guide fixed
+    /// point first, Newton on the guide forces if it does not settle).
+    pub guide_method: GuideMethod,
 }
 
 impl Default for FrictionOptions {
@@ -91,6 +94,7 @@ impl Default for FrictionOptions {
             tolerance: DEFAULT_FRICTION_TOLERANCE,
             max_iterations: DEFAULT_FRICTION_ITERATIONS,
             single_march: true,
+            guide_method: GuideMethod::Auto,
         }
     }
 }

@@ -13,16 +13,32 @@
 //! The tendon touches the rod only at its guides and its termination: it loads guide `g` with
 //! the point force `F_g = τ_g c_g − τ_{g−1} c_{g−1}` (the termination with `−τ_{G−1} c_{G−1}`)
 //! applied at `X_g`, that is the force `F_g` and the moment `(X_g − p(s_g)) × F_g` at the
-//! backbone. These are solved with the shape by a fixed point on the guide points: the rod is
-//! solved under the point loads of the current points (with any other tendons, frictional or
-//! not, as usual), the points are read from the new shape, until they move by less than
-//! [`FrictionOptions::tolerance`] times the rod length (Anderson-accelerated). The reported
-//! tensions, chords and guide forces are those the converged rod was solved with, so the
-//! balance of rod + tendons holds to rounding.
+//! backbone. These are solved with the shape ([`GuideMethod`]):
+//!
+//! - a fixed point on the guide points: the rod is solved under the point loads of the current
+//!   points (follower loads in the guides' frames of the last shape), the points are read from
+//!   the new shape, until they move by less than [`FrictionOptions::tolerance`] times the rod
+//!   length (Anderson-accelerated). Its gain is about `τ L²/EI` (the chords' geometric
+//!   stiffness against the rod's bending compliance): it converges only where that is ≲ 1.
+//! - Newton on the guide forces: the unknowns `z` are the body-frame forces at the anchors of
+//!   the pulled guided tendons, the map `z ↦ z'` solves the rod under `z` (follower point
+//!   loads at the guides' offsets) and reads the capstan forces `z'` of the points on the new
+//!   shape in its frames; `F(z) = z' − z = 0` is solved by Newton with a forward-difference
+//!   Jacobian (one warm rod solve per unknown, reused while steps contract the residual by
+//!   4), a backtracking line search, and, if the full step from the start fails,
+//!   continuation in the tensions from `previous` (or from zero). It ends at a residual of
+//!   [`GUIDE_FORCE_TOLERANCE`] times the largest tension. Unlike the points, the forces in
+//!   the guides' frames determine the rod solve alone, so `z ↦ z'` is a function and its
+//!   Jacobian exists.
+//!
+//! The default ([`GuideMethod::Auto`]) tries the fixed point for
+//! [`GUIDE_FIXED_POINT_BUDGET`] rod solves, then Newton. The reported tensions, chords and
+//! wraps are those of the points on the returned shape, the guide forces those the returned
+//! rod was solved with, so the balance of rod + tendons holds to the residual.
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::friction::{
     angle, base_slip, cell_rule, solve_frictional, Anderson, FrictionOptions, FrictionalSolution,
@@ -147,59 +163,6 @@ fn states(
     out
 }
 
-/// The model with its guided tendons as plain ones (tension 0 in the rod's actuation) under
-/// its own loads plus the point loads of the guided tendons in `states` (`None`: zero loads
-/// at their anchors, which keeps the same breaks), the moment arms read on `sol`.
-fn loaded_model(
-    model: &RobotModel,
-    guided: &[usize],
-    states: Option<&[Vec<GuideState>]>,
-    sol: Option<&FrictionalSolution>,
-) -> Result<Arc<RobotModel>> {
-    let mut loads = model.loads().clone();
-    for (k, &i) in guided.iter().enumerate() {
-        match states {
-            Some(st) => {
-                for g in st[k].iter().skip(1) {
-                    // A follower load: the force in the guide's frame on the last shape, at
-                    // the guide's offset (a dead load of the tendon's pull would buckle a
-                    // rod that its tendon only bends).
-                    let (f, o) = match sol {
-                        Some(sol) => {
-                            let j = node_at(&sol.statics.s, g.s);
-                            let r = Matrix3::from_fn(|a, b| sol.statics.rotation[j][a][b]);
-                            let props = model.rod().section_at(g.s);
-                            let (o, _) = model.tendons()[i].routing().offset(g.s, &props);
-                            (
-                                r.transpose() * Vector3::from(g.force),
-                                Vector3::new(o[0], o[1], 0.0),
-                            )
-                        }
-                        None => (Vector3::zeros(), Vector3::zeros()),
-                    };
-                    loads
-                        .point_loads
-                        .push(PointLoad::new(g.s, f, o.cross(&f), Frame::Body)?);
-                }
-            }
-            None => {
-                for s in anchors(model, i).into_iter().skip(1) {
-                    loads
-                        .point_loads
-                        .push(PointLoad::force(s, Vector3::zeros()));
-                }
-            }
-        }
-    }
-    let tendons = model.tendons().iter().map(Tendon::without_guides).collect();
-    RobotModel::new(
-        model.rod().clone(),
-        tendons,
-        model.chambers().to_vec(),
-        loads,
-    )
-}
-
 /// The model with its guided tendons in continuous channels of their mean guide coefficient
 /// (and zero loads at their anchors, which keeps the same breaks).
 fn channel_model(model: &RobotModel, guided: &[usize]) -> Result<Arc<RobotModel>> {
@@ -265,112 +228,613 @@ fn split<'x>(model: &RobotModel, guided: &[usize], x: &'x [f64]) -> Vec<&'x [f64
     out
 }
 
+/// How [`solve_frictional`] solves a robot with disk-guided tendons
+/// ([`FrictionOptions::guide_method`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GuideMethod {
+    /// The fixed point on the guide points first (a few rod solves where the tendon load is
+    /// small against the rod's stiffness), Newton on the guide forces if it has not settled
+    /// in [`GUIDE_FIXED_POINT_BUDGET`] rod solves or diverges.
+    #[default]
+    Auto,
+    /// The fixed point on the guide points only (up to [`FrictionOptions::max_iterations`]
+    /// rod solves); converges only where `τ L²/EI ≲ 1`.
+    FixedPoint,
+    /// Newton on the guide forces only (with continuation in the tensions if a full step
+    /// fails).
+    Newton,
+}
+
+/// Rod solves the fixed point gets before Newton takes over ([`GuideMethod::Auto`]).
+pub const GUIDE_FIXED_POINT_BUDGET: usize = 16;
+
+/// Growth of the fixed point's change over its smallest value taken as a divergence
+/// ([`GuideMethod::Auto`] then turns to Newton).
+const GUIDE_FIXED_POINT_GROWTH: f64 = 10.0;
+
+/// Residual of the guide forces (largest component, relative to the largest base tension)
+/// that ends Newton; a stall below [`FrictionOptions::tolerance`] is accepted.
+pub const GUIDE_FORCE_TOLERANCE: f64 = 1e-12;
+
+/// Step of the finite-difference Jacobian of the guide forces, relative to the largest base
+/// tension.
+const GUIDE_FD_STEP: f64 = 1e-6;
+
+/// Newton iterations per tension level.
+const GUIDE_NEWTON_ITERATIONS: usize = 25;
+
+/// Smallest line-search step of Newton.
+const GUIDE_MIN_STEP: f64 = 1.0 / 64.0;
+
+/// A step that reuses the last Jacobian is accepted while the residual falls by at least
+/// this factor; otherwise the Jacobian is rebuilt.
+const GUIDE_CHORD_CONTRACTION: f64 = 0.25;
+
+/// First and smallest step of the continuation in the tensions (fraction of the change).
+const GUIDE_CONTINUATION_STEP: (f64, f64) = (0.25, 1.0 / 256.0);
+
+/// Rod solves, marches and cell steps spent.
+#[derive(Debug, Default)]
+struct Counters {
+    rod_solves: usize,
+    iterations: usize,
+    cell_steps: usize,
+}
+
+/// The rod solved under body-frame guide forces `z`: its solution, the capstan states read on
+/// it (tensions, chords, wraps from its points; forces those applied) and the residual
+/// `z' − z` (N) of the guide forces `z'` of those states in the guides' frames.
+struct Evaluation {
+    sol: FrictionalSolution,
+    states: Vec<Vec<GuideState>>,
+    residual: Vec<f64>,
+    /// Largest component of the residual (N).
+    norm: f64,
+}
+
+/// One guided solve: the model, its guided tendons, the rod's own actuation and history.
+struct Guided<'a> {
+    model: &'a Arc<RobotModel>,
+    guided: Vec<usize>,
+    actuation: &'a Actuation,
+    /// The rod's actuation: the guided tendons at tension 0 (they load it by point loads).
+    act: Actuation,
+    /// The history of the other tendons (`None` if none has friction).
+    inner_prev: Option<FrictionalSolution>,
+    previous: Option<&'a FrictionalSolution>,
+    options: &'a FrictionOptions,
+}
+
+impl<'a> Guided<'a> {
+    fn new(
+        model: &'a Arc<RobotModel>,
+        actuation: &'a Actuation,
+        options: &'a FrictionOptions,
+        previous: Option<&'a FrictionalSolution>,
+    ) -> Result<Self> {
+        let nt = model.tendons().len();
+        let guided: Vec<usize> = (0..nt)
+            .filter(|&i| model.tendons()[i].is_guided())
+            .collect();
+        check_previous(model, &guided, previous)?;
+        let mut act = actuation.clone();
+        act.tendons.resize(nt, TendonInput::Tension(0.0));
+        for &i in &guided {
+            act.tendons[i] = TendonInput::Tension(0.0);
+        }
+        // The history of the other tendons, if any has friction (a previous solution also
+        // sets the rod solve's warm start, replaced by the current shape's in `rod_solve`).
+        let others =
+            (0..nt).any(|i| !model.tendons()[i].is_guided() && model.tendons()[i].friction() > 0.0);
+        let inner_prev = previous.filter(|_| others).map(|p| {
+            let mut q = p.clone();
+            for &i in &guided {
+                for row in &mut q.tension {
+                    row[i] = 0.0;
+                }
+            }
+            q
+        });
+        Ok(Self {
+            model,
+            guided,
+            actuation,
+            act,
+            inner_prev,
+            previous,
+            options,
+        })
+    }
+
+    fn prev_states(&self, k: usize) -> Option<&'a [GuideState]> {
+        self.previous.map(|p| p.guides[self.guided[k]].as_slice())
+    }
+
+    /// The capstan states of every guided tendon through the points `x` at base tensions
+    /// `base` (N, per tendon of the model).
+    fn states_at(&self, x: &[f64], base: &[f64]) -> Vec<Vec<GuideState>> {
+        split(self.model, &self.guided, x)
+            .into_iter()
+            .enumerate()
+            .map(|(k, xk)| {
+                let i = self.guided[k];
+                states(self.model, i, xk, base[i], self.prev_states(k))
+            })
+            .collect()
+    }
+
+    /// The rod solve of model `m` from the base wrench of `warm`.
+    fn rod_solve(
+        &self,
+        m: &Arc<RobotModel>,
+        warm: &FrictionalSolution,
+        c: &mut Counters,
+    ) -> Result<FrictionalSolution> {
+        let mut inner = *self.options;
+        inner.single_march = false;
+        // The rod under frozen guide forces is not the guided robot: its stability (the
+        // forces held in the guides' frames) is no reason to leave the branch.
+        inner.statics.seek_stable = false;
+        inner.statics.warm_start = Some(warm.statics.warm_start());
+        let prev = self.inner_prev.as_ref().map(|p| {
+            let mut q = p.clone();
+            q.statics.base_wrench = warm.statics.base_wrench;
+            q.statics.jacobian = warm.statics.jacobian;
+            q
+        });
+        let sol = solve_frictional(m, &self.act, &inner, prev.as_ref())?;
+        c.iterations += sol.iterations;
+        c.cell_steps += sol.cell_steps;
+        c.rod_solves += 1;
+        Ok(sol)
+    }
+
+    /// The first shape: `previous`, or the tendons in continuous channels of their mean
+    /// guide coefficient (which the chords approach as the guides get dense).
+    fn start(&self, c: &mut Counters) -> Result<FrictionalSolution> {
+        match self.previous {
+            Some(p) => Ok(p.clone()),
+            None => {
+                let m = channel_model(self.model, &self.guided)?;
+                let sol = solve_frictional(&m, self.actuation, self.options, None)?;
+                c.iterations += sol.iterations;
+                c.cell_steps += sol.cell_steps;
+                Ok(sol)
+            }
+        }
+    }
+
+    /// The fixed point on the guide points from `sol`, up to `budget` rod solves (`bounded`:
+    /// also stopping once the change grows [`GUIDE_FIXED_POINT_GROWTH`]-fold over its
+    /// smallest value, a divergence): the rod is
+    /// solved under the follower loads of the current points (the moment arms and frames
+    /// read on the last shape), the points are read on the new shape.
+    fn fixed_point(
+        &self,
+        mut sol: FrictionalSolution,
+        budget: usize,
+        bounded: bool,
+        c: &mut Counters,
+    ) -> Result<FrictionalSolution> {
+        let model = self.model;
+        let base = self.actuation.tension_values(model.tendons().len());
+        let l = model.length();
+        let mut x = points_on(model, &self.guided, &sol);
+        let mut anderson = Anderson::with_depth(false, GUIDE_ANDERSON_DEPTH);
+        let mut solves = 0;
+        let mut best = f64::INFINITY;
+        loop {
+            let st = self.states_at(&x, &base);
+            // Follower loads: the forces in the guides' frames on the last shape (a dead
+            // load of the tendon's pull would buckle a rod that its tendon only bends).
+            let all = vec![true; self.guided.len()];
+            let m = self.forces_model(&self.body_forces(&st, &sol, &all), &all)?;
+            sol = self.rod_solve(&m, &sol, c)?;
+            solves += 1;
+            let next = points_on(model, &self.guided, &sol);
+            let delta = next
+                .iter()
+                .zip(&x)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+                / l;
+            if !delta.is_finite() {
+                return Err(Error::NotConverged {
+                    what: "guides: the guide points became non-finite".into(),
+                    iterations: c.rod_solves,
+                    residual: delta,
+                    load_factor: sol.statics.stats.load_factor,
+                });
+            }
+            if delta <= self.options.tolerance {
+                return Ok(finish(
+                    model,
+                    &self.guided,
+                    sol,
+                    st,
+                    (c.iterations, c.cell_steps),
+                    delta,
+                ));
+            }
+            best = best.min(delta);
+            if solves >= budget || (bounded && delta > GUIDE_FIXED_POINT_GROWTH * best) {
+                return Err(Error::NotConverged {
+                    what: format!(
+                        "guides: the guide points did not settle in {solves} rod solves of the \
+                         fixed point (relative change {delta:e} > tolerance {:e})",
+                        self.options.tolerance
+                    ),
+                    iterations: c.rod_solves,
+                    residual: delta,
+                    load_factor: sol.statics.stats.load_factor,
+                });
+            }
+            x = anderson.update_flat(&x, next);
+        }
+    }
+
+    /// The guided tendons whose forces are unknowns: those pulled at `base` or `from`.
+    fn active(&self, base: &[f64], from: &[f64]) -> Vec<bool> {
+        self.guided
+            .iter()
+            .map(|&i| base[i] > 0.0 || from[i] > 0.0)
+            .collect()
+    }
+
+    /// The model under the body-frame guide forces `z` (3 per anchor after the base hole of
+    /// every active guided tendon) applied at the guides' offsets; zero loads at the other
+    /// anchors (the same breaks).
+    fn forces_model(&self, z: &[f64], active: &[bool]) -> Result<Arc<RobotModel>> {
+        let model = self.model;
+        let mut loads = model.loads().clone();
+        let mut q = 0;
+        for (k, &i) in self.guided.iter().enumerate() {
+            for s in anchors(model, i).into_iter().skip(1) {
+                if active[k] {
+                    let props = model.rod().section_at(s);
+                    let (o, _) = model.tendons()[i].routing().offset(s, &props);
+                    let o = Vector3::new(o[0], o[1], 0.0);
+                    let f = Vector3::new(z[q], z[q + 1], z[q + 2]);
+                    q += 3;
+                    loads
+                        .point_loads
+                        .push(PointLoad::new(s, f, o.cross(&f), Frame::Body)?);
+                } else {
+                    loads
+                        .point_loads
+                        .push(PointLoad::force(s, Vector3::zeros()));
+                }
+            }
+        }
+        let tendons = model.tendons().iter().map(Tendon::without_guides).collect();
+        RobotModel::new(
+            model.rod().clone(),
+            tendons,
+            model.chambers().to_vec(),
+            loads,
+        )
+    }
+
+    /// The forces of `states` at the anchors of the active tendons in the frames of `sol`
+    /// (N, body), flattened as the unknowns.
+    fn body_forces(
+        &self,
+        states: &[Vec<GuideState>],
+        sol: &FrictionalSolution,
+        active: &[bool],
+    ) -> Vec<f64> {
+        let mut z = Vec::new();
+        for (k, st) in states.iter().enumerate() {
+            if !active[k] {
+                continue;
+            }
+            for g in st.iter().skip(1) {
+                let j = node_at(&sol.statics.s, g.s);
+                let r = Matrix3::from_fn(|a, b| sol.statics.rotation[j][a][b]);
+                z.extend_from_slice((r.transpose() * Vector3::from(g.force)).as_slice());
+            }
+        }
+        z
+    }
+
+    /// The rod under the guide forces `z` at base tensions `base`, from `warm`.
+    fn evaluate(
+        &self,
+        z: &[f64],
+        base: &[f64],
+        active: &[bool],
+        warm: &FrictionalSolution,
+        c: &mut Counters,
+    ) -> Result<Evaluation> {
+        let m = self.forces_model(z, active)?;
+        let sol = self.rod_solve(&m, warm, c)?;
+        let x = points_on(self.model, &self.guided, &sol);
+        let mut states = self.states_at(&x, base);
+        let next = self.body_forces(&states, &sol, active);
+        let residual: Vec<f64> = next.iter().zip(z).map(|(a, b)| a - b).collect();
+        let norm = residual.iter().fold(0.0, |m: f64, r| m.max(r.abs()));
+        if !norm.is_finite() {
+            return Err(Error::NotConverged {
+                what: "guides: the guide forces became non-finite".into(),
+                iterations: c.rod_solves,
+                residual: norm,
+                load_factor: 1.0,
+            });
+        }
+        // Report the forces the rod carries (those of the points to the residual).
+        let mut q = 0;
+        for (k, st) in states.iter_mut().enumerate() {
+            if !active[k] {
+                continue;
+            }
+            for g in st.iter_mut().skip(1) {
+                let j = node_at(&sol.statics.s, g.s);
+                let r = Matrix3::from_fn(|a, b| sol.statics.rotation[j][a][b]);
+                g.force = (r * Vector3::new(z[q], z[q + 1], z[q + 2])).into();
+                q += 3;
+            }
+        }
+        Ok(Evaluation {
+            sol,
+            states,
+            residual,
+            norm,
+        })
+    }
+
+    /// The forward-difference Jacobian of the residual at `z` (evaluated in `cur`).
+    fn jacobian(
+        &self,
+        z: &[f64],
+        cur: &Evaluation,
+        base: &[f64],
+        active: &[bool],
+        h: f64,
+        c: &mut Counters,
+    ) -> Result<DMatrix<f64>> {
+        let n = z.len();
+        let mut jac = DMatrix::zeros(n, n);
+        let mut zk = z.to_vec();
+        for k in 0..n {
+            zk[k] = z[k] + h;
+            let e = self.evaluate(&zk, base, active, &cur.sol, c)?;
+            zk[k] = z[k];
+            for r in 0..n {
+                jac[(r, k)] = (e.residual[r] - cur.residual[r]) / h;
+            }
+        }
+        Ok(jac)
+    }
+
+    /// Newton with a backtracking line search on the guide forces at base tensions `base`
+    /// from the forces `z` on the shape `warm`; the Jacobian is rebuilt when a step reusing
+    /// it does not contract the residual by [`GUIDE_CHORD_CONTRACTION`].
+    fn newton(
+        &self,
+        base: &[f64],
+        active: &[bool],
+        mut z: Vec<f64>,
+        warm: &FrictionalSolution,
+        c: &mut Counters,
+    ) -> Result<(Vec<f64>, Evaluation)> {
+        let scale = base
+            .iter()
+            .fold(0.0, |m: f64, t| m.max(*t))
+            .max(f64::MIN_POSITIVE);
+        let mut cur = self.evaluate(&z, base, active, warm, c)?;
+        let mut lu = None;
+        let mut fresh = false;
+        for _ in 0..GUIDE_NEWTON_ITERATIONS {
+            if cur.norm <= GUIDE_FORCE_TOLERANCE * scale || z.is_empty() {
+                return Ok((z, cur));
+            }
+            if lu.is_none() {
+                let h = GUIDE_FD_STEP * scale;
+                lu = Some(self.jacobian(&z, &cur, base, active, h, c)?.lu());
+                fresh = true;
+            }
+            let rhs = -DVector::from_column_slice(&cur.residual);
+            let step = lu.as_ref().and_then(|lu| lu.solve(&rhs));
+            let mut accepted = None;
+            if let Some(step) = step {
+                let mut alpha = 1.0;
+                while alpha >= GUIDE_MIN_STEP {
+                    let trial: Vec<f64> = z
+                        .iter()
+                        .zip(step.iter())
+                        .map(|(a, d)| a + alpha * d)
+                        .collect();
+                    match self.evaluate(&trial, base, active, &cur.sol, c) {
+                        Ok(e) if e.norm < (1.0 - 1e-4 * alpha) * cur.norm => {
+                            accepted = Some((trial, e, alpha));
+                            break;
+                        }
+                        Ok(_) | Err(Error::NotConverged { .. }) => alpha *= 0.5,
+                        Err(e) => return Err(e),
+                    }
+                }
+            }
+            match accepted {
+                Some((trial, e, alpha)) => {
+                    if alpha < 1.0 || e.norm > GUIDE_CHORD_CONTRACTION * cur.norm {
+                        lu = None;
+                    }
+                    fresh = false;
+                    z = trial;
+                    cur = e;
+                }
+                None if !fresh => lu = None,
+                None if cur.norm <= self.options.tolerance * scale => return Ok((z, cur)),
+                None => {
+                    return Err(Error::NotConverged {
+                        what: format!(
+                            "guides: Newton on the guide forces found no descent step \
+                             (relative residual {:e})",
+                            cur.norm / scale
+                        ),
+                        iterations: c.rod_solves,
+                        residual: cur.norm / scale,
+                        load_factor: 1.0,
+                    })
+                }
+            }
+        }
+        if cur.norm <= self.options.tolerance * scale {
+            return Ok((z, cur));
+        }
+        Err(Error::NotConverged {
+            what: format!(
+                "guides: Newton on the guide forces did not converge in \
+                 {GUIDE_NEWTON_ITERATIONS} iterations (relative residual {:e})",
+                cur.norm / scale
+            ),
+            iterations: c.rod_solves,
+            residual: cur.norm / scale,
+            load_factor: 1.0,
+        })
+    }
+
+    /// Newton on the guide forces: first at the full tensions from `start`, then, if that
+    /// fails, by continuation in the tensions from `previous` (or from zero) with steps halved
+    /// on failure.
+    fn newton_solve(
+        &self,
+        start: &FrictionalSolution,
+        c: &mut Counters,
+    ) -> Result<FrictionalSolution> {
+        let nt = self.model.tendons().len();
+        let target = self.actuation.tension_values(nt);
+        let from = match self.previous {
+            Some(p) => p.statics.tendon_tensions.clone(),
+            None => vec![0.0; nt],
+        };
+        let from: Vec<f64> = (0..nt)
+            .map(|i| from.get(i).copied().unwrap_or(0.0))
+            .collect();
+        let active = self.active(&target, &from);
+        let at = |lam: f64| -> Vec<f64> {
+            (0..nt)
+                .map(|i| {
+                    if self.guided.contains(&i) {
+                        from[i] + lam * (target[i] - from[i])
+                    } else {
+                        target[i]
+                    }
+                })
+                .collect()
+        };
+        let scale = target
+            .iter()
+            .chain(&from)
+            .fold(0.0, |m: f64, t| m.max(*t))
+            .max(f64::MIN_POSITIVE);
+        let done = |e: Evaluation, c: &Counters| {
+            let rel = e.norm / scale;
+            finish(
+                self.model,
+                &self.guided,
+                e.sol,
+                e.states,
+                (c.iterations, c.cell_steps),
+                rel,
+            )
+        };
+        // The full step from the start's points.
+        let x0 = points_on(self.model, &self.guided, start);
+        let st0 = self.states_at(&x0, &target);
+        let z0 = self.body_forces(&st0, start, &active);
+        match self.newton(&target, &active, z0, start, c) {
+            Ok((_, e)) => return Ok(done(e, c)),
+            Err(Error::NotConverged { .. }) => (),
+            Err(e) => return Err(e),
+        }
+        // Continuation from λ = 0: `previous` with its forces, or the rod without the guided
+        // tendons' loads.
+        let mut z = match self.previous {
+            Some(p) => {
+                let st: Vec<Vec<GuideState>> =
+                    self.guided.iter().map(|&i| p.guides[i].clone()).collect();
+                self.body_forces(&st, p, &active)
+            }
+            None => vec![0.0; z_len(self.model, &self.guided, &active)],
+        };
+        let mut warm = match self.previous {
+            Some(p) => p.clone(),
+            None => self.evaluate(&z, &at(0.0), &active, start, c)?.sol,
+        };
+        let (mut lam, mut step) = (0.0, GUIDE_CONTINUATION_STEP.0);
+        loop {
+            let next = (lam + step).min(1.0);
+            match self.newton(&at(next), &active, z.clone(), &warm, c) {
+                Ok((zn, e)) => {
+                    if next >= 1.0 {
+                        return Ok(done(e, c));
+                    }
+                    lam = next;
+                    z = zn;
+                    warm = e.sol;
+                    step = (2.0 * step).min(1.0 - lam);
+                }
+                Err(Error::NotConverged { residual, .. }) => {
+                    step *= 0.5;
+                    if step < GUIDE_CONTINUATION_STEP.1 {
+                        return Err(Error::NotConverged {
+                            what: format!(
+                                "guides: the continuation in the tensions stalled at load \
+                                 factor {lam} (step {step:e}, Newton on the guide forces \
+                                 from there ended at relative residual {residual:e})"
+                            ),
+                            iterations: c.rod_solves,
+                            residual,
+                            load_factor: lam,
+                        });
+                    }
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+}
+
+/// Number of guide-force unknowns: 3 per anchor after the base hole of every active tendon.
+fn z_len(model: &RobotModel, guided: &[usize], active: &[bool]) -> usize {
+    guided
+        .iter()
+        .zip(active)
+        .filter(|(_, &a)| a)
+        .map(|(&i, _)| 3 * (anchors(model, i).len() - 1))
+        .sum()
+}
+
 /// Solves the statics of a model with tendons routed through guides (see the module
-/// documentation), from the state `previous` or from rest.
+/// documentation), from the state `previous` or from rest, by
+/// [`FrictionOptions::guide_method`].
 ///
 /// # Errors
 /// What [`solve_frictional`] reports for the rod solves; [`Error::NotConverged`] if the guide
-/// points do not settle in [`FrictionOptions::max_iterations`] rod solves.
+/// points do not settle (the fixed point in [`FrictionOptions::max_iterations`] rod solves,
+/// Newton down to the smallest continuation step).
 pub(super) fn solve_guided(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
     options: &FrictionOptions,
     previous: Option<&FrictionalSolution>,
 ) -> Result<FrictionalSolution> {
-    let nt = model.tendons().len();
-    let guided: Vec<usize> = (0..nt)
-        .filter(|&i| model.tendons()[i].is_guided())
-        .collect();
-    let base = actuation.tension_values(nt);
-    // The rod's own actuation: the guided tendons load it through the point loads only.
-    let mut act = actuation.clone();
-    act.tendons.resize(nt, TendonInput::Tension(0.0));
-    for &i in &guided {
-        act.tendons[i] = TendonInput::Tension(0.0);
-    }
-    // The history of the other tendons (the guided ones carry none along the rod).
-    let inner_prev = previous.map(|p| {
-        let mut q = p.clone();
-        for &i in &guided {
-            for row in &mut q.tension {
-                row[i] = 0.0;
+    let problem = Guided::new(model, actuation, options, previous)?;
+    let mut c = Counters::default();
+    let start = problem.start(&mut c)?;
+    match options.guide_method {
+        GuideMethod::FixedPoint => {
+            problem.fixed_point(start, options.max_iterations, false, &mut c)
+        }
+        GuideMethod::Newton => problem.newton_solve(&start, &mut c),
+        GuideMethod::Auto => {
+            let budget = GUIDE_FIXED_POINT_BUDGET.min(options.max_iterations);
+            match problem.fixed_point(start.clone(), budget, true, &mut c) {
+                Err(Error::NotConverged { .. }) => problem.newton_solve(&start, &mut c),
+                other => other,
             }
         }
-        q
-    });
-    check_previous(model, &guided, previous)?;
-    let prev_states = |k: usize| previous.map(|p| p.guides[guided[k]].as_slice());
-    let mut sol = match previous {
-        Some(p) => p.clone(),
-        None => {
-            // The first guide points: the tendons in continuous channels (their mean guide
-            // coefficient), which the chords approach as the guides get dense.
-            let m = channel_model(model, &guided)?;
-            solve_frictional(&m, actuation, options, None)?
-        }
-    };
-    let l = model.length();
-    let mut x = points_on(model, &guided, &sol);
-    let mut anderson = Anderson::with_depth(false, GUIDE_ANDERSON_DEPTH);
-    let mut iterations = sol.iterations;
-    let mut cell_steps = sol.cell_steps;
-    let mut rod_solves = 0;
-    loop {
-        let st: Vec<Vec<GuideState>> = split(model, &guided, &x)
-            .into_iter()
-            .enumerate()
-            .map(|(k, xk)| states(model, guided[k], xk, base[guided[k]], prev_states(k)))
-            .collect();
-        let m = loaded_model(model, &guided, Some(&st), Some(&sol))?;
-        // The moment arms were read on the last shape; the points on the new shape are
-        // the same to the tolerance at convergence.
-        // The rod solve from the last iterate's base wrench (the fixed point of the profile
-        // takes it; a start from the unloaded rod would cross the whole load path again).
-        let mut inner = *options;
-        inner.single_march = false;
-        inner.statics.warm_start = Some(sol.statics.warm_start());
-        sol = solve_frictional(&m, &act, &inner, inner_prev.as_ref())?;
-        iterations += sol.iterations;
-        cell_steps += sol.cell_steps;
-        rod_solves += 1;
-        let next = points_on(model, &guided, &sol);
-        let delta = next
-            .iter()
-            .zip(&x)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
-            / l;
-        if !delta.is_finite() {
-            return Err(Error::NotConverged {
-                what: "guides: the guide points became non-finite".into(),
-                iterations: rod_solves,
-                residual: delta,
-                load_factor: sol.statics.stats.load_factor,
-            });
-        }
-        if delta <= options.tolerance {
-            return Ok(finish(
-                model,
-                &guided,
-                sol,
-                st,
-                (iterations, cell_steps),
-                delta,
-            ));
-        }
-        if rod_solves >= options.max_iterations {
-            return Err(Error::NotConverged {
-                what: format!(
-                    "guides: the guide points did not settle in {rod_solves} rod solves \
-                     (relative change {delta:e} > tolerance {:e})",
-                    options.tolerance
-                ),
-                iterations: rod_solves,
-                residual: delta,
-                load_factor: sol.statics.stats.load_factor,
-            });
-        }
-        x = anderson.update_flat(&x, next);
     }
 }
 
