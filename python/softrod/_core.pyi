@@ -464,11 +464,13 @@ class StaticsSolution:
     @property
     def base_wrench(self) -> NDArray[np.float64]: ...
     @property
-    def stable(self) -> bool:
-        """Whether the equilibrium is stable (tip tangent stiffness positive definite)."""
+    def stable(self) -> bool | None:
+        """Whether the equilibrium is stable (tip tangent stiffness positive definite); None:
+        not assessed (a tendon pulling through disk guides)."""
     @property
     def stability_margin(self) -> float:
-        """Smallest eigenvalue of the scaled tip tangent stiffness (> 0: stable)."""
+        """Smallest eigenvalue of the scaled tip tangent stiffness (> 0: stable; NaN: not
+        converged or not assessed)."""
     @property
     def tensions(self) -> NDArray[np.float64]:
         """Tendon tensions it was solved for (N), shape (n_tendons,)."""

@@ -55,7 +55,11 @@ fn report_unstable(
     mode: OnUnstable,
 ) -> PyResult<StaticsSolution> {
     let inner = &sol.inner;
-    if mode == OnUnstable::Ignore || inner.stable || !inner.stats.converged {
+    if mode == OnUnstable::Ignore
+        || inner.stable
+        || !inner.stats.converged
+        || sol.pulled_through_guides()
+    {
         return Ok(sol);
     }
     let margin = inner.stability_margin();

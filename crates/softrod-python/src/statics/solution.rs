@@ -36,6 +36,17 @@ fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
 }
 
 impl StaticsSolution {
+    /// Whether a tendon pulls through discrete guides: the stability of such an equilibrium
+    /// is not assessed (the rod is solved under the guide forces held in the guides' frames,
+    /// which leaves out the chords' own stiffness; docs/friction.md).
+    pub(crate) fn pulled_through_guides(&self) -> bool {
+        self.friction.as_ref().is_some_and(|f| {
+            f.guides
+                .iter()
+                .any(|row| row.first().is_some_and(|g| g.tension_in > 0.0))
+        })
+    }
+
     fn cached(
         &self,
         py: Python<'_>,
@@ -346,16 +357,21 @@ impl StaticsSolution {
     }
     /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
     /// tension, dead loads) is positive definite; always True without external loads,
-    /// False for a result that did not converge (docs/stability.md).
+    /// False for a result that did not converge; None (not assessed) when a tendon pulls
+    /// through disk guides (docs/stability.md).
     #[getter]
-    fn stable(&self) -> bool {
-        self.inner.stable
+    fn stable(&self) -> Option<bool> {
+        (!self.pulled_through_guides()).then_some(self.inner.stable)
     }
     /// Smallest eigenvalue of the symmetric part of the dimensionless tip tangent stiffness
     /// D K D / (EI(0)/L), D = diag(L, L, L, 1, 1, 1): > 0 for a stable equilibrium; NaN if
-    /// not converged (docs/stability.md).
+    /// not converged or not assessed (a tendon pulling through disk guides;
+    /// docs/stability.md).
     #[getter]
     fn stability_margin(&self, py: Python<'_>) -> f64 {
+        if self.pulled_through_guides() {
+            return f64::NAN;
+        }
         py.detach(|| self.inner.stability_margin())
     }
     /// Solver statistics: iterations, residual, function_evaluations, load_steps, load_factor,
