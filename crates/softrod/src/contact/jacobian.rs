@@ -14,13 +14,15 @@
 
 use nalgebra::Vector3;
 
-use super::problem::{equations, Constrained, Pass, Site};
+use super::problem::{equations, Active, Constrained, Pass, Site};
 use super::rows::AtContact;
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
 };
+use crate::cosserat::shooting::Node;
 use crate::cosserat::statics::Integrator;
 use crate::integrate::march::{march, rk4_plan, Scheme};
+use crate::model::RobotModel;
 use crate::solve::Problem;
 
 /// State length of a march with `c` columns.
@@ -52,6 +54,105 @@ fn head(y: &[f64]) -> [f64; STATE] {
     h
 }
 
+impl Site2 {
+    /// At a node of the march at `s` (on `interval`, state and columns `y`) where the
+    /// contact sits: at its first copy, the state before the jump; at the second, the
+    /// right-hand sides on both sides of the jump (`side` evaluates them), the columns of
+    /// the contact's arc length (`δy(s⁺) = y'(s⁻) - y'(s⁺)` per unit of `s / L`) and force
+    /// (`δN(s⁺) = -e_k f_ref`) seeded, and the state after it. `(l, fs)`: the rod's length
+    /// (m) and force scale (N).
+    fn record<const N: usize>(
+        &mut self,
+        side: &mut Evaluator<'_, '_>,
+        s: f64,
+        interval: usize,
+        y: &mut [f64; N],
+        (l, fs): (f64, f64),
+    ) {
+        if self.before.is_none() {
+            self.before = Some((y.to_vec(), interval));
+            return;
+        }
+        if self.after.is_some() {
+            return;
+        }
+        let Some((pre, k0)) = self.before.as_ref().map(|b| (head(&b.0), b.1)) else {
+            return;
+        };
+        let post = head(y);
+        side.set_interval(k0);
+        let mut a = [0.0; STATE];
+        side.rhs_into::<STATE>(s, &pre, &mut a);
+        side.set_interval(interval);
+        let mut b = [0.0; STATE];
+        side.rhs_into::<STATE>(self.post_at, &post, &mut b);
+        self.rate = [a, b];
+        let c = STATE + COLUMN * self.column;
+        for i in 0..STATE {
+            y[c + i] = (a[i] - b[i]) * l;
+        }
+        for q in 0..3 {
+            y[STATE + COLUMN * (self.column + 1 + q) + DN + q] = -fs;
+        }
+        self.after = Some((y.to_vec(), interval));
+    }
+}
+
+/// What the rows of one active contact are a function of: the contact, its arc length (m),
+/// the states and intervals of its first and last nodes, its scaled force, its index among
+/// the contacts inside the rod (none at the tip) and its first unknown.
+struct RowsOf {
+    active: Active,
+    s: f64,
+    first: ([f64; STATE], usize),
+    last: ([f64; STATE], usize),
+    f: Vector3<f64>,
+    site: Option<usize>,
+    o: usize,
+}
+
+/// The march's result that the Jacobian columns are read from: the end state with its
+/// columns, the residual's derivative per column, the tip rotation, the march column of each
+/// unknown, the unknowns' offsets, the contacts inside the rod, the contacts' row functions,
+/// the rows at the point, the homotopy parameter and the dimension.
+struct Linear<'a> {
+    y: &'a [f64],
+    dres: &'a [nalgebra::Vector6<f64>],
+    r_tip: nalgebra::Matrix3<f64>,
+    mcol: &'a [Option<usize>],
+    offsets: &'a [usize],
+    sites: &'a [Site2],
+    at: &'a [RowsOf],
+    rows: &'a [f64],
+    mu: f64,
+    n: usize,
+}
+
+/// The state part of march column `m` of `y` (zero for none).
+fn column_of(y: &[f64], m: Option<usize>) -> [f64; STATE] {
+    let mut d = [0.0; STATE];
+    if let Some(m) = m {
+        let b = STATE + COLUMN * m;
+        d.copy_from_slice(&y[b..b + STATE]);
+    }
+    d
+}
+
+/// The size of a state change `d` in the rod's scales (length `l`, force scale `fs`): the
+/// largest of its position over `l`, rotation, force over `fs` and moment over `fs l`.
+fn scale(d: &[f64; STATE], l: f64, fs: f64) -> f64 {
+    let mut v: f64 = 0.0;
+    for i in 0..3 {
+        v = v.max(d[i].abs() / l);
+        v = v.max(d[DN + i].abs() / fs);
+        v = v.max(d[DN + 3 + i].abs() / (fs * l));
+    }
+    for i in 3..12 {
+        v = v.max(d[i].abs());
+    }
+    v
+}
+
 impl Constrained<'_> {
     /// The residual rows at `x` and the exact Jacobian (column-major, `dim × dim`, into `j`)
     /// from one march; `None` if the march fails or the columns do not fit in one march (the
@@ -68,21 +169,75 @@ impl Constrained<'_> {
         }
     }
 
-    #[allow(clippy::too_many_lines)] // one march and its chain rule, documented above
+    /// [`Self::exact`] with the state and `(N - STATE) / COLUMN` columns in one march: the
+    /// march of the columns, the rows at its end, then the Jacobian column by column.
     fn wide<const N: usize>(&mut self, x: &[f64], mu: f64, j: &mut [f64]) -> Option<Vec<f64>> {
         let model = self.contact_model(x)?;
-        let l = self.model.length();
-        let fs = self.model.force_scale();
         let n = self.dim();
         let offsets = self.offsets();
-        // The march column of every unknown (none for a tip contact's force).
-        let mut mcol: Vec<Option<usize>> = vec![None; n];
+        let (mcol, mut sites, ncol) = self.march_columns_of(x);
+        let nt = model.tendons().len();
+        let mut scratch = Workspace::new(nt);
+        let (y, nodes) = self.march_with_columns::<N>(&model, x, &mut sites, ncol, &mut scratch)?;
+        let eq = equations(&model, &self.tensions, &self.pressures);
+        let (res, dres) = eq.residual(&y, ncol);
+        let (p_tip, r_tip) = (v3(&y, 0), rot(&y));
+        let mut rows = self.tip_rows(&res, &p_tip, &r_tip).to_vec();
+        let tip = (head(&y), nodes.last()?.interval);
+        // The contact rows at the solution, and per contact the function of its node states.
+        let mut other = Workspace::new(nt);
+        let mut ev = [
+            Evaluator {
+                eq,
+                ws: &mut scratch,
+            },
+            Evaluator { eq, ws: &mut other },
+        ];
+        let at = self.contact_rows_at(&mut ev, x, mu, tip, &sites, &mut rows)?;
+        if rows.len() != n || !rows.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let lin = Linear {
+            y: &y,
+            dres: &dres,
+            r_tip,
+            mcol: &mcol,
+            offsets: &offsets,
+            sites: &sites,
+            at: &at,
+            rows: &rows,
+            mu,
+            n,
+        };
+        let mut buf = Vec::with_capacity(4);
+        let mut twists = Vec::with_capacity(n);
+        for c in 0..n {
+            twists.push(self.jacobian_column(&mut ev, &lin, c, j, &mut buf)?);
+        }
+        self.last = Some(Pass {
+            model: std::sync::Arc::clone(&model),
+            nodes,
+            residual: res,
+            key: self.key(x, mu),
+            rows: rows.clone(),
+            jacobian: Some((j.to_vec(), twists)),
+            marched: None,
+        });
+        Some(rows)
+    }
+
+    /// The march column of every unknown at `x` (none for a tip contact's force: six for the
+    /// base wrench, then four per contact inside the rod, its arc length and force), those
+    /// contacts, and the number of march columns.
+    fn march_columns_of(&self, x: &[f64]) -> (Vec<Option<usize>>, Vec<Site2>, usize) {
+        let l = self.model.length();
+        let mut mcol: Vec<Option<usize>> = vec![None; self.dim()];
         for (k, m) in mcol.iter_mut().enumerate().take(6) {
             *m = Some(k);
         }
         let mut sites: Vec<Site2> = Vec::new();
         let mut next = 6;
-        for (a, &o) in self.active.iter().zip(&offsets) {
+        for (a, &o) in self.active.iter().zip(&self.offsets()) {
             if a.site == Site::Tip {
                 continue;
             }
@@ -105,7 +260,23 @@ impl Constrained<'_> {
             });
             next += 4;
         }
-        let ncol = next;
+        (mcol, sites, next)
+    }
+
+    /// One march at `x` of the state with `ncol` columns on the contact model `model`, the
+    /// contacts inside the rod recorded and their columns seeded in `sites` (`scratch`
+    /// evaluates the sides of their jumps). Returns the end state and the nodes; `None` if
+    /// the march fails or does not reach every contact.
+    fn march_with_columns<const N: usize>(
+        &mut self,
+        model: &RobotModel,
+        x: &[f64],
+        sites: &mut [Site2],
+        ncol: usize,
+        scratch: &mut Workspace,
+    ) -> Option<([f64; N], Vec<Node>)> {
+        let l = self.model.length();
+        let fs = self.model.force_scale();
         let plan = match self.integrator {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
             Integrator::Adaptive(_) => Vec::new(),
@@ -117,21 +288,16 @@ impl Constrained<'_> {
                 controlled: STATE,
             },
         };
-        let eq = equations(&model, &self.tensions, &self.pressures);
-        let nt = model.tendons().len();
-        let mut ws = Workspace::new(nt);
+        let eq = equations(model, &self.tensions, &self.pressures);
+        let mut ws = Workspace::new(model.tendons().len());
         ws.set_columns(&vec![Column::Free; ncol], &[]);
-        let mut scratch = Workspace::new(nt);
         let y0: [f64; N] = eq.initial(&x[..6]);
         let mut nodes = Vec::new();
         let y = {
             let mut ev = Evaluator { eq, ws: &mut ws };
-            let mut side = Evaluator {
-                eq,
-                ws: &mut scratch,
-            };
-            let sites = &mut sites;
+            let mut side = Evaluator { eq, ws: scratch };
             let nodes = &mut nodes;
+            let sites = &mut *sites;
             march(
                 &mut ev,
                 model.breaks(),
@@ -140,35 +306,9 @@ impl Constrained<'_> {
                 scheme,
                 |_, s, interval, y: &mut [f64; N]| {
                     for site in sites.iter_mut().filter(|c| c.s == s) {
-                        if site.before.is_none() {
-                            site.before = Some((y.to_vec(), interval));
-                            continue;
-                        }
-                        if site.after.is_some() {
-                            continue;
-                        }
-                        let Some((pre, k0)) = site.before.as_ref().map(|b| (head(&b.0), b.1))
-                        else {
-                            continue;
-                        };
-                        let post = head(y);
-                        side.set_interval(k0);
-                        let mut a = [0.0; STATE];
-                        side.rhs_into::<STATE>(s, &pre, &mut a);
-                        side.set_interval(interval);
-                        let mut b = [0.0; STATE];
-                        side.rhs_into::<STATE>(site.post_at, &post, &mut b);
-                        site.rate = [a, b];
-                        let c = STATE + COLUMN * site.column;
-                        for i in 0..STATE {
-                            y[c + i] = (a[i] - b[i]) * l;
-                        }
-                        for q in 0..3 {
-                            y[STATE + COLUMN * (site.column + 1 + q) + DN + q] = -fs;
-                        }
-                        site.after = Some((y.to_vec(), interval));
+                        site.record(&mut side, s, interval, y, (l, fs));
                     }
-                    nodes.push(crate::cosserat::shooting::Node {
+                    nodes.push(Node {
                         s,
                         interval,
                         y: head(y),
@@ -181,24 +321,25 @@ impl Constrained<'_> {
         if !y[..STATE].iter().all(|v| v.is_finite()) || sites.iter().any(|c| c.after.is_none()) {
             return None;
         }
-        let (res, dres) = eq.residual(&y, ncol);
-        let (p_tip, r_tip) = (v3(&y, 0), rot(&y));
-        let mut rows = self.tip_rows(&res, &p_tip, &r_tip).to_vec();
-        let tip_y = head(&y);
-        let tip_k = nodes.last()?.interval;
-        // The contact rows at the solution, and per contact the function of its node states.
-        let mut other = Workspace::new(nt);
-        let mut ev = [
-            Evaluator {
-                eq,
-                ws: &mut scratch,
-            },
-            Evaluator { eq, ws: &mut other },
-        ];
+        Some((y, nodes))
+    }
+
+    /// Appends to `rows` the rows of every active contact from its node states (the tip's
+    /// `tip` state and interval for a tip contact; the recorded sides of `sites` inside the
+    /// rod), and returns per contact what they are a function of.
+    fn contact_rows_at(
+        &self,
+        ev: &mut [Evaluator<'_, '_>; 2],
+        x: &[f64],
+        mu: f64,
+        (tip_y, tip_k): ([f64; STATE], usize),
+        sites: &[Site2],
+        rows: &mut Vec<f64>,
+    ) -> Option<Vec<RowsOf>> {
+        let l = self.model.length();
         let mut interior = 0;
-        // (arc length, first and last node state + interval, scaled force, site index)
         let mut at = Vec::with_capacity(self.active.len());
-        for (a, &o) in self.active.iter().zip(&offsets) {
+        for (a, o) in self.active.iter().zip(self.offsets()) {
             let (s, k, site) = match a.site {
                 Site::Tip => (l, o, None),
                 _ => {
@@ -220,136 +361,143 @@ impl Constrained<'_> {
                 first: (&yf, kf),
                 last: (&yl, kl),
             };
-            self.contact_rows(&mut ev, a, held, &f, mu, &mut rows);
-            at.push((s, yf, kf, yl, kl, f, site, o));
+            self.contact_rows(ev, a, held, &f, mu, rows);
+            at.push(RowsOf {
+                active: *a,
+                s,
+                first: (yf, kf),
+                last: (yl, kl),
+                f,
+                site,
+                o,
+            });
         }
-        if rows.len() != n || !rows.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        // The Jacobian, column by column.
-        let column_of = |y: &[f64], m: Option<usize>| -> [f64; STATE] {
-            let mut d = [0.0; STATE];
-            if let Some(m) = m {
+        Some(at)
+    }
+
+    /// Column `c` of the Jacobian into `j` (the tip rows from the tip columns, the contact
+    /// rows by central differences along the column); returns the tip twist of the column.
+    fn jacobian_column(
+        &self,
+        ev: &mut [Evaluator<'_, '_>; 2],
+        lin: &Linear<'_>,
+        c: usize,
+        j: &mut [f64],
+        buf: &mut Vec<f64>,
+    ) -> Option<nalgebra::Vector6<f64>> {
+        let n = lin.n;
+        let (dres_c, dp, w) = match lin.mcol[c] {
+            Some(m) => {
                 let b = STATE + COLUMN * m;
-                d.copy_from_slice(&y[b..b + STATE]);
+                (
+                    lin.dres[m],
+                    v3(lin.y, b),
+                    rotation_variation(&lin.r_tip, &col_rot(lin.y, b)),
+                )
             }
-            d
+            None => {
+                // A tip contact's force: the tip balance alone.
+                let mut d = nalgebra::Vector6::zeros();
+                let q = (c - lin.offsets.iter().rev().find(|o| **o <= c).copied()?) % 3;
+                d[q] = -1.0;
+                (d, Vector3::zeros(), Vector3::zeros())
+            }
         };
-        let scale = |d: &[f64; STATE]| -> f64 {
-            let mut v: f64 = 0.0;
-            for i in 0..3 {
-                v = v.max(d[i].abs() / l);
-                v = v.max(d[DN + i].abs() / fs);
-                v = v.max(d[DN + 3 + i].abs() / (fs * l));
+        let tip = self.tip_rows_dot(&dres_c, &dp, &w, &lin.r_tip);
+        j[n * c..n * c + 6].copy_from_slice(&tip);
+        let mut row = 6;
+        for held in lin.at {
+            let size = held.active.size();
+            let out = &mut j[n * c + row..n * c + row + size];
+            self.contact_entries(ev, lin, held, (c, row), out, buf)?;
+            row += size;
+        }
+        Some(nalgebra::Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z))
+    }
+
+    /// The derivatives `out` of the rows (from row `row`) of the contact `held` along column
+    /// `c`: its node states moved along the column (and, for its own arc length, along the
+    /// rod; for its own force, the force), by central differences (one-sided when `rough`).
+    fn contact_entries(
+        &self,
+        ev: &mut [Evaluator<'_, '_>; 2],
+        lin: &Linear<'_>,
+        held: &RowsOf,
+        (c, row): (usize, usize),
+        out: &mut [f64],
+        buf: &mut Vec<f64>,
+    ) -> Option<()> {
+        let l = self.model.length();
+        let fs = self.model.force_scale();
+        let (s, f, o) = (held.s, held.f, held.o);
+        let ((yf, kf), (yl, kl)) = (held.first, held.last);
+        let (mut ds, mut df) = (0.0, Vector3::zeros());
+        let (mut dyf, mut dyl) = match held.site {
+            None => {
+                let d = column_of(lin.y, lin.mcol[c]);
+                (d, d)
             }
-            for i in 3..12 {
-                v = v.max(d[i].abs());
-            }
-            v
+            Some(i) => (
+                column_of(&lin.sites[i].before.as_ref()?.0, lin.mcol[c]),
+                column_of(&lin.sites[i].after.as_ref()?.0, lin.mcol[c]),
+            ),
         };
-        let mut buf = Vec::with_capacity(4);
-        let mut twists = Vec::with_capacity(n);
-        for c in 0..n {
-            let (dres_c, dp, w) = match mcol[c] {
-                Some(m) => {
-                    let b = STATE + COLUMN * m;
-                    (
-                        dres[m],
-                        v3(&y, b),
-                        rotation_variation(&r_tip, &col_rot(&y, b)),
-                    )
-                }
-                None => {
-                    // A tip contact's force: the tip balance alone.
-                    let mut d = nalgebra::Vector6::zeros();
-                    let q = (c - offsets.iter().rev().find(|o| **o <= c).copied()?) % 3;
-                    d[q] = -1.0;
-                    (d, Vector3::zeros(), Vector3::zeros())
-                }
-            };
-            twists.push(nalgebra::Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z));
-            let tip = self.tip_rows_dot(&dres_c, &dp, &w, &r_tip);
-            j[n * c..n * c + 6].copy_from_slice(&tip);
-            let mut row = 6;
-            for (a, &(s, yf, kf, yl, kl, f, site, o)) in self.active.iter().zip(&at) {
-                let size = a.size();
-                let (mut ds, mut df) = (0.0, Vector3::zeros());
-                let (mut dyf, mut dyl) = match site {
-                    None => {
-                        let d = column_of(&y, mcol[c]);
-                        (d, d)
-                    }
-                    Some(i) => (
-                        column_of(&sites[i].before.as_ref()?.0, mcol[c]),
-                        column_of(&sites[i].after.as_ref()?.0, mcol[c]),
-                    ),
-                };
-                let first_force = if site.is_some() { o + 1 } else { o };
-                if site.is_some() && c == o {
-                    // The contact's own arc length: both sides move with the state before
-                    // the jump.
-                    let i = site?;
-                    ds = l;
-                    for k in 0..STATE {
-                        dyf[k] += sites[i].rate[0][k] * l;
-                        dyl[k] += sites[i].rate[1][k] * l;
-                    }
-                }
-                if (first_force..first_force + 3).contains(&c) {
-                    df[c - first_force] = 1.0;
-                }
-                let nu = scale(&dyf).max(scale(&dyl)).max(ds / l).max(df.amax());
-                if nu == 0.0 {
-                    for i in 0..size {
-                        j[n * c + row + i] = 0.0;
-                    }
-                    row += size;
-                    continue;
-                }
-                let h = ROW_STEP / nu;
-                let mut eval = |t: f64, buf: &mut Vec<f64>| {
-                    let mut yf2 = yf;
-                    let mut yl2 = yl;
-                    for k in 0..STATE {
-                        yf2[k] += t * dyf[k];
-                        yl2[k] += t * dyl[k];
-                    }
-                    buf.clear();
-                    let f2 = f + df * t;
-                    let moved = AtContact {
-                        s: s + ds * t,
-                        first: (&yf2, kf),
-                        last: (&yl2, kl),
-                    };
-                    self.contact_rows(&mut ev, a, moved, &f2, mu, buf);
-                };
-                eval(h, &mut buf);
-                let plus = buf.clone();
-                if self.rough {
-                    // One-sided, from the rows at the point.
-                    let at = &rows[row..row + size];
-                    for i in 0..size {
-                        j[n * c + row + i] = (plus[i] - at[i]) / h;
-                    }
-                } else {
-                    eval(-h, &mut buf);
-                    for i in 0..size {
-                        j[n * c + row + i] = (plus[i] - buf[i]) / (2.0 * h);
-                    }
-                }
-                row += size;
+        let first_force = if held.site.is_some() { o + 1 } else { o };
+        if held.site.is_some() && c == o {
+            // The contact's own arc length: both sides move with the state before
+            // the jump.
+            let i = held.site?;
+            ds = l;
+            for k in 0..STATE {
+                dyf[k] += lin.sites[i].rate[0][k] * l;
+                dyl[k] += lin.sites[i].rate[1][k] * l;
             }
         }
-        self.last = Some(Pass {
-            model: std::sync::Arc::clone(&model),
-            nodes,
-            residual: res,
-            key: self.key(x, mu),
-            rows: rows.clone(),
-            jacobian: Some((j.to_vec(), twists)),
-            marched: None,
-        });
-        Some(rows)
+        if (first_force..first_force + 3).contains(&c) {
+            df[c - first_force] = 1.0;
+        }
+        let nu = scale(&dyf, l, fs)
+            .max(scale(&dyl, l, fs))
+            .max(ds / l)
+            .max(df.amax());
+        if nu == 0.0 {
+            out.fill(0.0);
+            return Some(());
+        }
+        let h = ROW_STEP / nu;
+        let a = &held.active;
+        let mut eval = |t: f64, buf: &mut Vec<f64>| {
+            let mut yf2 = yf;
+            let mut yl2 = yl;
+            for k in 0..STATE {
+                yf2[k] += t * dyf[k];
+                yl2[k] += t * dyl[k];
+            }
+            buf.clear();
+            let f2 = f + df * t;
+            let moved = AtContact {
+                s: s + ds * t,
+                first: (&yf2, kf),
+                last: (&yl2, kl),
+            };
+            self.contact_rows(ev, a, moved, &f2, lin.mu, buf);
+        };
+        eval(h, buf);
+        let plus = buf.clone();
+        let size = out.len();
+        if self.rough {
+            // One-sided, from the rows at the point.
+            let at = &lin.rows[row..row + size];
+            for i in 0..size {
+                out[i] = (plus[i] - at[i]) / h;
+            }
+        } else {
+            eval(-h, buf);
+            for i in 0..size {
+                out[i] = (plus[i] - buf[i]) / (2.0 * h);
+            }
+        }
+        Some(())
     }
 
     /// The tip compliance at the converged `x` with the active contacts and the tip

@@ -221,6 +221,10 @@ struct At<const N: usize> {
     dta: Vec<Vec<Option<Vector3<f64>>>>,
 }
 
+/// The cell rule of one cell and, per main column, the constant parts `lo`, `hi` of its
+/// bounds.
+type RuleParts = (CellRule, Vec<Vec<f64>>, Vec<Vec<f64>>);
+
 /// The distal tension changes of one cell: the frictional tendons whose distal change is an
 /// unknown of the cell rule, and per tendon the ratio of a slack tendon's distal to its
 /// proximal change (1 for the others).
@@ -363,7 +367,7 @@ impl Marcher<'_, '_, '_> {
                 )
             })
             .collect();
-        let (rule, lo, hi) = self.rule(at, (&tb, &dtb), &ends, &distal.unknown, c.b)?;
+        let (rule, lo, hi) = self.rule(at, &tb, &dtb, &ends, &distal.unknown, c.b)?;
         // Each input's column on its own branches, the base-wrench ones on the first's.
         let n_in = self.inputs.len();
         let mut zs = Vec::with_capacity(self.nm);
@@ -510,16 +514,17 @@ impl Marcher<'_, '_, '_> {
     }
 
     /// The cell rule, affine in the distal changes z, from the tangents and their variations
-    /// at both ends of the cell (`at` and `(tb, dtb)` at `b`), and per main column its
+    /// at both ends of the cell (`at`, and `tb`, `dtb` at `b`), and per main column its
     /// constant parts `lo`, `hi`.
     fn rule<const N: usize>(
         &self,
         at: &At<N>,
-        (tb, dtb): (&[Option<Vector3<f64>>], &[Vec<Option<Vector3<f64>>>]),
+        tb: &[Option<Vector3<f64>>],
+        dtb: &[Vec<Option<Vector3<f64>>>],
         ends: &[[f64; 2]],
         unknown: &[usize],
         b: f64,
-    ) -> Result<(CellRule, Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+    ) -> Result<RuleParts> {
         let (fr, nm, nq) = (self.fr, self.nm, unknown.len());
         let mut rule = CellRule {
             bounds: Vec::with_capacity(nq),

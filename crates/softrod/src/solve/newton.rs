@@ -381,7 +381,6 @@ fn certified_after<P: Problem + ?Sized>(
 }
 
 /// Damped Newton on `problem` at load factor `lambda` from `x0`.
-#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 pub fn newton<P: Problem + ?Sized>(
     problem: &mut P,
     x0: &[f64],
@@ -391,113 +390,227 @@ pub fn newton<P: Problem + ?Sized>(
 ) -> NewtonOutcome {
     let n = problem.dim();
     let mut out = NewtonOutcome::unsolved(x0);
-    let Some(mut it) = start(problem, x0, lambda, options, settings, &mut out) else {
+    let Some(it) = start(problem, x0, lambda, options, settings, &mut out) else {
         return out;
+    };
+    let mut run = Run {
+        problem,
+        lambda,
+        options,
+        settings,
+        it,
+        out,
+        r_prev: f64::INFINITY,
+        refresh: false,
+        single_failed: false,
     };
     let mut lu = DenseLu::default();
     let mut dx = vec![0.0; n];
-    let mut r_prev = f64::INFINITY;
-    let mut refresh = false;
-    let mut single_failed = false;
-    while out.iterations < options.max_iterations {
-        if refresh && !it.exact && !exact_jacobian(problem, &mut it, lambda, &mut out) {
-            break;
-        }
-        refresh = false;
-        if !lu.factor(n, &it.jac) {
-            break;
-        }
-        dx.iter_mut().zip(&it.r).for_each(|(d, r)| *d = -r);
-        if !lu.solve_in_place(&mut dx) {
-            break;
-        }
-        if let Some(limit) = settings.first_step_limit {
-            if out.iterations == 0 && max_norm(&dx) > limit {
-                out.first_step = max_norm(&dx);
+    while run.out.iterations < options.max_iterations {
+        match run.iteration(&mut lu, &mut dx) {
+            Turn::Next | Turn::Through => {}
+            Turn::Converged => {
+                run.out.converged = true;
                 break;
             }
+            Turn::Stop => break,
         }
-        let tol = problem.tolerance(&it.x, options.tolerance);
+    }
+    run.finish()
+}
+
+/// What a stage of a Newton iteration leaves the loop to do.
+enum Turn {
+    /// The next iteration.
+    Next,
+    /// Stop: converged.
+    Converged,
+    /// Stop: failed.
+    Stop,
+    /// The next stage of this iteration.
+    Through,
+}
+
+/// A damped Newton solve in progress: the problem at its load factor, the iterate, the
+/// outcome so far, and the loop's memory (the previous residual norm, whether the exact
+/// Jacobian is to be evaluated before the next step, whether the full step predicted to
+/// converge failed).
+struct Run<'a, 's, P: Problem + ?Sized> {
+    problem: &'a mut P,
+    lambda: f64,
+    options: &'a NewtonOptions,
+    settings: &'a NewtonSettings<'s>,
+    it: Iterate,
+    out: NewtonOutcome,
+    r_prev: f64,
+    refresh: bool,
+    single_failed: bool,
+}
+
+impl<P: Problem + ?Sized> Run<'_, '_, P> {
+    /// One iteration: the Newton direction `dx` (factored in `lu`), then the full step
+    /// predicted to converge, a Broyden step or a last step, else the line search.
+    fn iteration(&mut self, lu: &mut DenseLu, dx: &mut [f64]) -> Turn {
+        if !self.direction(lu, dx) {
+            return Turn::Stop;
+        }
+        let tol = self.problem.tolerance(&self.it.x, self.options.tolerance);
         // Under superlinear convergence the next residual is about rn² / r_prev: a step
         // predicted to converge is taken with the Jacobian when the solve must end on one.
-        let rn = it.rn;
-        if settings.exact_at_solution
-            && !single_failed
-            && r_prev.is_finite()
-            && rn * (rn / r_prev) <= 10.0 * tol
-            && !certified_after(problem, &it.x, &dx, lambda)
+        let rn = self.it.rn;
+        match self.predicted(dx, rn, tol) {
+            Turn::Through => {}
+            turn => return turn,
+        }
+        self.single_failed = false;
+        match self.quick(dx, rn, tol) {
+            Turn::Through => {}
+            turn => return turn,
+        }
+        self.r_prev = self.it.rn;
+        self.out.at_x = false;
+        let (problem, it) = (&mut *self.problem, &mut self.it);
+        if !line_search(problem, it, dx, self.lambda, self.settings, self.options) {
+            return Turn::Stop;
+        }
+        self.out.at_x = true;
+        self.out.iterations += 1;
+        self.converged_or_next()
+    }
+
+    /// [`Turn::Converged`] if the iterate is within the tolerance, else [`Turn::Next`].
+    fn converged_or_next(&self) -> Turn {
+        if self.it.rn <= self.problem.tolerance(&self.it.x, self.options.tolerance) {
+            Turn::Converged
+        } else {
+            Turn::Next
+        }
+    }
+
+    /// The Newton direction `dx` of the iterate (the exact Jacobian first if a refresh is
+    /// due); `false` if it cannot be evaluated or factored, or a first step is beyond the
+    /// limit of the settings.
+    fn direction(&mut self, lu: &mut DenseLu, dx: &mut [f64]) -> bool {
+        if self.refresh
+            && !self.it.exact
+            && !exact_jacobian(&mut *self.problem, &mut self.it, self.lambda, &mut self.out)
         {
-            if full_step(problem, &mut it, &dx, lambda, settings, options, &mut out) {
-                r_prev = rn;
-                if it.rn <= problem.tolerance(&it.x, options.tolerance) {
-                    out.converged = true;
-                    break;
-                }
-                continue;
-            }
-            // The full step failed: search along the exact Newton direction of the iterate.
-            single_failed = true;
-            if !it.exact {
-                refresh = true;
-                continue;
+            return false;
+        }
+        self.refresh = false;
+        if !lu.factor(dx.len(), &self.it.jac) {
+            return false;
+        }
+        dx.iter_mut().zip(&self.it.r).for_each(|(d, r)| *d = -r);
+        if !lu.solve_in_place(dx) {
+            return false;
+        }
+        if let Some(limit) = self.settings.first_step_limit {
+            if self.out.iterations == 0 && max_norm(dx) > limit {
+                self.out.first_step = max_norm(dx);
+                return false;
             }
         }
-        single_failed = false;
-        if settings.broyden || !it.exact {
-            let was_exact = it.exact;
-            out.at_x = false;
-            match broyden_step(problem, &mut it, &dx, lambda, settings, tol) {
+        true
+    }
+
+    /// When the solve must end on an exact Jacobian, the full step `dx` predicted to
+    /// converge (residual `rn` now, tolerance `tol`), taken with the Jacobian; if it fails,
+    /// the exact direction of the iterate next.
+    fn predicted(&mut self, dx: &[f64], rn: f64, tol: f64) -> Turn {
+        if !(self.settings.exact_at_solution
+            && !self.single_failed
+            && self.r_prev.is_finite()
+            && rn * (rn / self.r_prev) <= 10.0 * tol
+            && !certified_after(&mut *self.problem, &self.it.x, dx, self.lambda))
+        {
+            return Turn::Through;
+        }
+        let (problem, it, out) = (&mut *self.problem, &mut self.it, &mut self.out);
+        if full_step(
+            problem,
+            it,
+            dx,
+            self.lambda,
+            self.settings,
+            self.options,
+            out,
+        ) {
+            self.r_prev = rn;
+            return self.converged_or_next();
+        }
+        // The full step failed: search along the exact Newton direction of the iterate.
+        self.single_failed = true;
+        if !self.it.exact {
+            self.refresh = true;
+            return Turn::Next;
+        }
+        Turn::Through
+    }
+
+    /// A Broyden step along `dx` (with Broyden's updates, or an updated Jacobian), or the
+    /// last step of a solve converging fast enough to end without a line search.
+    fn quick(&mut self, dx: &[f64], rn: f64, tol: f64) -> Turn {
+        if self.settings.broyden || !self.it.exact {
+            let was_exact = self.it.exact;
+            self.out.at_x = false;
+            let (problem, it) = (&mut *self.problem, &mut self.it);
+            match broyden_step(problem, it, dx, self.lambda, self.settings, tol) {
                 Broyden::Accepted(slow) => {
-                    r_prev = rn;
-                    refresh = slow;
-                    out.at_x = true;
-                    out.iterations += 1;
-                    if it.rn <= problem.tolerance(&it.x, options.tolerance) {
-                        out.converged = true;
-                        break;
-                    }
-                    continue;
+                    self.r_prev = rn;
+                    self.refresh = slow;
+                    self.out.at_x = true;
+                    self.out.iterations += 1;
+                    return self.converged_or_next();
                 }
                 Broyden::Refused if !was_exact => {
                     // The updated Jacobian failed: evaluate the exact one and retry.
-                    refresh = true;
-                    continue;
+                    self.refresh = true;
+                    return Turn::Next;
                 }
                 Broyden::Refused => {}
             }
-        } else if !settings.exact_at_solution
-            && r_prev.is_finite()
-            && it.rn < 0.1 * r_prev
-            && it.rn * (it.rn / r_prev).powi(2) < 0.5 * tol
+        } else if !self.settings.exact_at_solution
+            && self.r_prev.is_finite()
+            && self.it.rn < 0.1 * self.r_prev
+            && self.it.rn * (self.it.rn / self.r_prev).powi(2) < 0.5 * tol
         {
-            out.at_x = false;
-            if last_step(problem, &mut it, &dx, lambda, options) {
-                out.iterations += 1;
-                out.at_x = true;
-                out.converged = true;
-                break;
+            self.out.at_x = false;
+            if last_step(
+                &mut *self.problem,
+                &mut self.it,
+                dx,
+                self.lambda,
+                self.options,
+            ) {
+                self.out.iterations += 1;
+                self.out.at_x = true;
+                return Turn::Converged;
             }
         }
-        r_prev = it.rn;
-        out.at_x = false;
-        if !line_search(problem, &mut it, &dx, lambda, settings, options) {
-            break;
-        }
-        out.at_x = true;
-        out.iterations += 1;
-        if it.rn <= problem.tolerance(&it.x, options.tolerance) {
-            out.converged = true;
-            break;
-        }
+        Turn::Through
     }
-    if out.converged
-        && settings.exact_at_solution
-        && !(it.exact && out.at_x)
-        && !problem.certified(&it.x, lambda)
-    {
-        jacobian_at_solution(problem, &mut it, lambda, options, &mut out);
+
+    /// The outcome, with the exact Jacobian at the solution when the settings ask for one.
+    fn finish(self) -> NewtonOutcome {
+        let Self {
+            problem,
+            lambda,
+            options,
+            settings,
+            mut it,
+            mut out,
+            ..
+        } = self;
+        if out.converged
+            && settings.exact_at_solution
+            && !(it.exact && out.at_x)
+            && !problem.certified(&it.x, lambda)
+        {
+            jacobian_at_solution(problem, &mut it, lambda, options, &mut out);
+        }
+        out.finish(it)
     }
-    out.finish(it)
 }
 
 impl NewtonOutcome {
