@@ -36,27 +36,30 @@ fn main() {
     let mut fwd = CosseratForward::new(&model, &o, None).unwrap();
     let cold = solve_inverse(&mut fwd, &target, &io, None).unwrap();
     eprintln!(
-        "cold: iterations {} evaluations {} a {:?}",
-        cold.iterations, cold.evaluations, cold.actuation
+        "cold: iterations {} evaluations {} probes {} a {:?}",
+        cold.iterations, cold.evaluations, cold.probes, cold.actuation
     );
     let w = InverseWarmStart::from(&cold);
     let warm = solve_inverse(&mut fwd, &moved, &io, Some(&w)).unwrap();
     eprintln!(
-        "warm: iterations {} evaluations {} a {:?} error {:e}",
-        warm.iterations, warm.evaluations, warm.actuation, warm.position_error
+        "warm: iterations {} evaluations {} probes {} a {:?} error {:e}",
+        warm.iterations, warm.evaluations, warm.probes, warm.actuation, warm.position_error
     );
     // Ten 1 mm steps of a tracked path (as the warm-tracking test of `tests/inverse.rs`).
     let mut w10 = w.clone();
     let mut total = 0u32;
+    let mut probes = 0u32;
     for k in 1..=10 {
         let p = Target::tip(tip + Vector3::new(1e-3 * f64::from(k), 0.0, 0.0));
         let r = solve_inverse(&mut fwd, &p, &io, Some(&w10)).unwrap();
         total += u32::try_from(r.evaluations).unwrap();
+        probes += u32::try_from(r.probes).unwrap();
         w10 = InverseWarmStart::from(&r);
     }
     eprintln!(
-        "tracking: {:.1} evaluations per 1 mm step",
-        f64::from(total) / 10.0
+        "tracking: {:.1} evaluations and {:.1} probes per 1 mm step",
+        f64::from(total) / 10.0,
+        f64::from(probes) / 10.0
     );
     let mut acc = 0.0;
     for _ in 0..n {

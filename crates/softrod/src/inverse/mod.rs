@@ -96,6 +96,14 @@ pub const STALLED: f64 = 0.5;
 pub const FIRST_RADIUS: f64 = 1.0;
 /// Most halvings of a step.
 pub const MAX_STEP_HALVINGS: usize = 30;
+/// Relative length (scaled actuation, relative to `1 + |a|_W`) of the probes of the
+/// curvature made from second differences of the poses.
+pub const PROBE_STEP: f64 = 1e-4;
+/// Most directions (range step and null directions) of the curvature made from probes: `k`
+/// directions take `k (k + 1) / 2` probes.
+pub const MAX_PROBE_DIRECTIONS: usize = 3;
+/// Steps (relative to the stopping test's) above which the curvature is probed again.
+pub const PROBE_FROM: f64 = 100.0;
 
 /// What the inverse statics aims at.
 #[derive(Debug, Clone, PartialEq)]
@@ -186,6 +194,20 @@ pub trait Forward {
     /// # Errors
     /// When the forward solve fails.
     fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation>;
+    /// Whether the model has a pass without the Jacobian several times cheaper than
+    /// [`Forward::evaluate`] with it (for an unloaded Cosserat robot, one march of the state
+    /// alone): the iteration then makes its curvature from second differences of the poses
+    /// ([`PROBE_STEP`]).
+    fn has_probes(&self) -> bool {
+        false
+    }
+    /// The observed poses at `a` without the Jacobian.
+    ///
+    /// # Errors
+    /// When the forward solve fails.
+    fn probe(&mut self, a: &[f64]) -> Result<Evaluation> {
+        self.evaluate(a, false)
+    }
     /// A length scale (m): the rod length.
     fn length(&self) -> f64;
     /// The areas (m²) of the chambers, for the default weights.
@@ -205,8 +227,10 @@ pub struct InverseSolution {
     pub rotation_error: f64,
     /// Iterations (SQP steps taken).
     pub iterations: usize,
-    /// Forward evaluations.
+    /// Forward evaluations (with the Jacobian).
     pub evaluations: usize,
+    /// Forward passes without the Jacobian (probes of the curvature, [`Forward::probe`]).
+    pub probes: usize,
     /// Whether the iteration converged: the target reached within the tolerances (for a
     /// shape target: the least-squares fit found) with the minimum-norm actuation.
     pub converged: bool,

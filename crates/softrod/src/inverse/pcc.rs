@@ -811,6 +811,7 @@ impl ClosedForm {
             rotation_error: 0.0,
             iterations: self.iterations,
             evaluations: self.evaluations,
+            probes: 0,
             converged: true,
             reached: true,
             evaluation: Evaluation {

@@ -6,13 +6,14 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::problem::{PoseError, Program};
+use super::qp;
 use super::steps::{
-    bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change,
+    bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change, probed_curvature,
     scaled_jacobian_norm, solve_qp, trust_radius, QpStep,
 };
 use super::{
     Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target, FIRST_RADIUS,
-    LOCAL_STEP, STALLED,
+    LOCAL_STEP, PROBE_FROM, STALLED,
 };
 use crate::error::{Error, Result};
 
@@ -38,6 +39,10 @@ struct Iterate {
     iterations: usize,
     /// Forward evaluations.
     evaluations: usize,
+    /// Probes (poses without the Jacobian).
+    probes: usize,
+    /// Whether the forward model has probes ([`Forward::probe`]).
+    probes_available: bool,
 }
 
 impl Iterate {
@@ -50,6 +55,7 @@ impl Iterate {
             rotation_error: lin.rot,
             iterations: self.iterations,
             evaluations: self.evaluations,
+            probes: self.probes,
             converged,
             reached: lin.reached,
             evaluation: self.ev,
@@ -102,8 +108,10 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         let small = p.scaled_norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
         if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
             eprintln!(
-                "it {}: dist {:.3e} rot {:.3e} ls {least_squares} |step| {:.3e} radius {:.3e} a {:?}",
+                "it {} ({} evaluations, {} probes): dist {:.3e} rot {:.3e} ls {least_squares} |step| {:.3e} radius {:.3e} a {:?}",
                 it.iterations,
+                it.evaluations,
+                it.probes,
                 lin.dist,
                 lin.rot,
                 p.scaled_norm(&step),
@@ -183,6 +191,7 @@ fn start<F: Forward + ?Sized>(
             forward.evaluate(&a, true)?
         }
     };
+    let probes_available = forward.has_probes();
     let mut hess = DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights));
     let mut curved_for: Option<Vec<bool>> = None;
     if let Some(h) = warm.and_then(|w| w.hessian.as_ref()) {
@@ -201,6 +210,8 @@ fn start<F: Forward + ?Sized>(
         radius: f64::NAN,
         iterations: 0,
         evaluations,
+        probes: 0,
+        probes_available,
     })
 }
 
@@ -255,8 +266,38 @@ fn program_step<F: Forward + ?Sized>(
     if !solved.least_squares && lin.merit <= p.near {
         let free = free_set(solved.y.as_slice(), &p.bounds);
         let d: Vec<f64> = (0..n).map(|i| solved.y[i] - it.a[i]).collect();
-        let stalled = it.last_step > 0.0 && p.scaled_norm(&d) > STALLED * it.last_step;
-        if stalled || it.curved_for.as_ref() != Some(&free) {
+        let d_norm = p.scaled_norm(&d);
+        let stalled = it.last_step > 0.0 && d_norm > STALLED * it.last_step;
+        // With cheap probes the curvature is made again at every step that is not already
+        // within reach of the stopping test: the step is then Newton's.
+        let tol_step = p.options.optimality_tolerance * (1.0 + p.scaled_norm(&it.a));
+        let probing = it.probes_available && p.target.rotation.is_none() && !p.shape;
+        let mut probed = false;
+        if probing && d_norm > PROBE_FROM * tol_step {
+            if let Some(lambda) = &solved.lambda {
+                // The range step of the program with W (its part off the null space).
+                let (yw, _) = qp::min_norm(&lin.jac, &lin.b, &p.bounds, p.tol_qp)
+                    .unwrap_or_else(|| (solved.y.clone(), lambda.clone()));
+                let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
+                let free_w = free_set(yw.as_slice(), &p.bounds);
+                let base = if it.curved_for.is_some() {
+                    it.hess.clone()
+                } else {
+                    DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights))
+                };
+                let (h, used) = probed_curvature(
+                    forward, p, &it.a, &lin.e, &lin.jac, lambda, &free_w, &v, &base,
+                );
+                it.probes += used;
+                if let Some(h) = h {
+                    it.hess = h;
+                    it.curved_for = Some(free_w);
+                    solved = solve_qp(p, &lin.jac, &lin.b, &it.a, &it.hess, true);
+                    probed = true;
+                }
+            }
+        }
+        if !probed && (stalled || it.curved_for.as_ref() != Some(&free)) {
             if let Some(lambda) = &solved.lambda {
                 let (h, used) = curvature(forward, p, &it.a, &lin.jac, lambda, &free);
                 it.evaluations += used;
