@@ -494,14 +494,22 @@ fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_) {
                 }
             }
             let hm = Dm::from_row_slice(n, n, h);
-            let mz = z.tr_mul(&(&hm * &z));
-            let mz = (&mz + mz.transpose()) * 0.5;
-            let e = mz.symmetric_eigen();
-            let vals = e.eigenvalues.map(|v| v.max(1e-3));
-            let mz = &e.eigenvectors * Dm::from_diagonal(&vals) * e.eigenvectors.transpose();
-            let zwz = z.tr_mul(&(&w * &z));
-            out = &w + &z * (mz - zwz) * z.transpose();
-            out = (&out + out.transpose()) * 0.5;
+            let hm = (&hm + hm.transpose()) * 0.5;
+            let zhz = z.tr_mul(&(&hm * &z));
+            let zhz = (&zhz + zhz.transpose()) * 0.5;
+            let e = zhz.clone().symmetric_eigen();
+            if e.eigenvalues.iter().all(|&v| v >= 1e-3) {
+                // Positive definite on Z already: the exact Hessian, cross terms included
+                // (the step is Newton's).
+                out = hm;
+            } else {
+                let vals = e.eigenvalues.map(|v| v.max(1e-3));
+                let mz = &e.eigenvectors * Dm::from_diagonal(&vals) * e.eigenvectors.transpose();
+                // Only `Zᵀ H Z` raised (`Zᵀ W Z = I`): the rest of the exact Hessian kept.
+                let wz = &w * &z;
+                out = &hm + &wz * (mz - zhz) * wz.transpose();
+                out = (&out + out.transpose()) * 0.5;
+            }
         }
     }
     for r in 0..n {
@@ -847,6 +855,7 @@ fn closed_form(
         }
         let norm_a = cf.bx.norm(&cf.a);
         let small = cf.bx.norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
+
         if small && reached {
             break;
         }

@@ -6,7 +6,6 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::problem::{PoseError, Program};
-use super::qp;
 use super::steps::{
     bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change, probed_curvature,
     scaled_jacobian_norm, solve_qp, trust_radius, QpStep,
@@ -274,12 +273,13 @@ fn program_step<F: Forward + ?Sized>(
         let probing = it.probes_available && p.target.rotation.is_none() && !p.shape;
         let mut probed = false;
         if probing && d_norm > PROBE_FROM * tol_step {
-            if let Some(lambda) = &solved.lambda {
-                // The range step of the program with W (its part off the null space).
-                let (yw, _) = qp::min_norm(&lin.jac, &lin.b, &p.bounds, p.tol_qp)
-                    .unwrap_or_else(|| (solved.y.clone(), lambda.clone()));
+            if let (Some(lambda), Some(yw)) = (&solved.lambda, &solved.y_min_norm) {
+                // The range step: that of the program with W (its part off the null space).
                 let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
                 let free_w = free_set(yw.as_slice(), &p.bounds);
+                if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
+                    eprintln!("probe: |v| {:.3e} |d| {:.3e}", p.scaled_norm(&v), d_norm);
+                }
                 let base = if it.curved_for.is_some() {
                     it.hess.clone()
                 } else {

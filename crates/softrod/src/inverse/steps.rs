@@ -138,6 +138,8 @@ pub(super) struct QpStep {
     pub lambda: Option<DVector<f64>>,
     /// Whether the target could not be met inside the bounds (the bounded least squares).
     pub least_squares: bool,
+    /// The minimum-norm point (the program with `W`), if feasible.
+    pub y_min_norm: Option<DVector<f64>>,
 }
 
 /// The program of one iteration at `a`: `min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ` (or `½ |y - c|²_W`
@@ -165,14 +167,16 @@ pub(super) fn solve_qp(
             let q = wd - hess * &av;
             // The multipliers of the program with W (those of the target at a solution).
             let r = qp::active_set_qp(hess, &q, jac, bounds, &y_w);
-            let y = r.map_or(y_w, |(y, _)| y);
+            let y = r.map_or_else(|| y_w.clone(), |(y, _)| y);
             QpStep {
                 y,
                 lambda: Some(l_w),
                 least_squares: false,
+                y_min_norm: Some(y_w),
             }
         }
         Some((y, l)) => QpStep {
+            y_min_norm: Some(y.clone()),
             y,
             lambda: Some(l),
             least_squares: false,
@@ -181,6 +185,7 @@ pub(super) fn solve_qp(
             y: qp::bounded_least_squares(jac, b, bounds, ls_regularisation(jac, bounds)),
             lambda: None,
             least_squares: true,
+            y_min_norm: None,
         },
     }
 }
