@@ -211,7 +211,7 @@ impl CosseratForward {
         let mut sorted = observe.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        let cols = integrate(
+        let mut cols = integrate(
             eq,
             scheme,
             &[0.0; 6],
@@ -224,15 +224,8 @@ impl CosseratForward {
                 stops: &[],
             },
         )?;
-        self.march = Some(March {
-            a: a.to_vec(),
-            nodes: cols.nodes.clone(),
-            lengths: cols.lengths.clone(),
-            residual: crate::solve::max_norm(cols.residual.as_slice()),
-            evaluations: cols.evaluations,
-        });
         let to_matrix = |c: &[nalgebra::Vector6<f64>]| DMatrix::from_fn(6, nt + nc, |r, k| c[k][r]);
-        Ok(match &self.nodes {
+        let out = match &self.nodes {
             None => Evaluation {
                 positions: vec![cols.tip_pose.0],
                 rotation: cols.tip_pose.1,
@@ -256,7 +249,16 @@ impl CosseratForward {
                     ),
                 }
             }
-        })
+        };
+        // The nodes move into the record of the march (after the positions are read).
+        self.march = Some(March {
+            a: a.to_vec(),
+            nodes: std::mem::take(&mut cols.nodes),
+            lengths: std::mem::take(&mut cols.lengths),
+            residual: crate::solve::max_norm(cols.residual.as_slice()),
+            evaluations: cols.evaluations,
+        });
+        Ok(out)
     }
 }
 

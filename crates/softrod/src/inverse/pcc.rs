@@ -99,7 +99,9 @@ impl Forward for PccForward<'_> {
 // (`seg_kin`), so the actuation Jacobian is `J = J_θ M` and the Hessian of the Lagrangian
 // `½|a - c|²_W - λᵀ p(a)` is `W - Mᵀ (Σ λ_k ∇²_θ p_k) M`, exact. The iteration is that of
 // `solve_inverse` (the same two phases, steps, merit function and stopping test) with the
-// exact Hessian near the target instead of directional differences, on stack-sized dense
+// exact Hessian near the target instead of directional differences (kept whole, cross terms
+// included, unless `Zᵀ H Z` must be raised to be positive definite: the step is Newton's and
+// a warm 1 mm move takes three iterations), on stack-sized dense
 // algebra: the minimum-norm step and the Levenberg–Marquardt step are solved in the dual
 // (three multipliers), the curved step by the KKT system of its free variables.
 // ---------------------------------------------------------------------------------------------
@@ -467,10 +469,12 @@ fn lm_step(jac: &[V3<f64>], e: &V3<f64>, a: &[f64], bx: &Box_, radius: f64) -> V
     best
 }
 
-/// The Hessian `h` (n × n, row-major) made what the generic iteration uses: `W` off the
-/// null space `Z` of the free columns of `J` (those free in `y_w`), and `Zᵀ h Z` with its
-/// eigenvalues floored at `1e-3` (scaled variables `W^{1/2} a`) on it, so that the curved
-/// step is a descent step toward a minimum, never a saddle. Without a null space: `W`.
+/// The Hessian `h` (n × n, row-major) made positive definite on the null space `Z` of the
+/// free columns of `J` (those free in `y_w`, scaled variables `W^{1/2} a`): kept exact when
+/// `Zᵀ h Z` has its eigenvalues above `1e-3` (the cross terms `Zᵀ h Y` make the curved step
+/// Newton's), otherwise only `Zᵀ h Z` raised to that floor, so that the curved step is a
+/// descent step toward a minimum, never a saddle. Without a null space: `W` (the step is
+/// then the constraints' alone).
 fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_) {
     let n = y_w.len();
     let idx: Vec<usize> = (0..n)
