@@ -42,6 +42,8 @@ struct Iterate {
     probes: usize,
     /// Whether the forward model has probes ([`Forward::probe`]).
     probes_available: bool,
+    /// How many times actuators were put on their bounds at the end.
+    snapped: usize,
 }
 
 impl Iterate {
@@ -101,10 +103,28 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         let solved = program_step(forward, &p, &mut it, &lin);
         let least_squares = solved.least_squares;
         let lambda_k = solved.lambda;
-        let y = solved.y;
-        let step: Vec<f64> = (0..n).map(|i| y[i] - it.a[i]).collect();
+        let mut y = solved.y;
         let norm_a = p.scaled_norm(&it.a);
-        let small = p.scaled_norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
+        let tol_step = options.optimality_tolerance * (1.0 + norm_a);
+        let mut step: Vec<f64> = (0..n).map(|i| y[i] - it.a[i]).collect();
+        let small = p.scaled_norm(&step) <= tol_step;
+        if small && lin.reached && it.snapped < 3 {
+            // An actuator left within the step tolerance of its bound (a degenerate optimum:
+            // on the bound and on the target at once) is put on it; the next evaluation
+            // checks the target there (a few times at most).
+            let mut snap = false;
+            for i in 0..n {
+                let reach = tol_step / p.bounds.weights[i].sqrt();
+                for bound in [p.bounds.lo[i], p.bounds.hi[i]] {
+                    if y[i] != bound && (y[i] - bound).abs() <= reach {
+                        y[i] = bound;
+                        step[i] = bound - it.a[i];
+                        snap = true;
+                    }
+                }
+            }
+            it.snapped += usize::from(snap);
+        }
         if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
             eprintln!(
                 "it {} ({} evaluations, {} probes): dist {:.3e} rot {:.3e} ls {least_squares} |step| {:.3e} radius {:.3e} a {:?}",
@@ -211,6 +231,7 @@ fn start<F: Forward + ?Sized>(
         evaluations,
         probes: 0,
         probes_available,
+        snapped: 0,
     })
 }
 
