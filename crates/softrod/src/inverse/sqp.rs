@@ -288,12 +288,16 @@ fn program_step<F: Forward + ?Sized>(
         let d: Vec<f64> = (0..n).map(|i| solved.y[i] - it.a[i]).collect();
         let d_norm = p.scaled_norm(&d);
         let stalled = it.last_step > 0.0 && d_norm > STALLED * it.last_step;
-        // With cheap probes the curvature is made again at every step that is not already
-        // within reach of the stopping test: the step is then Newton's.
+        // Where the curvature is stale (the free set changed, the steps stopped contracting)
+        // and the model has cheap probes, it is made from them (range step and null space:
+        // the next step is Newton's); otherwise from directional differences of the Jacobian.
         let tol_step = p.options.optimality_tolerance * (1.0 + p.scaled_norm(&it.a));
         let probing = it.probes_available && p.target.rotation.is_none() && !p.shape;
         let mut probed = false;
-        if probing && d_norm > PROBE_FROM * tol_step {
+        if probing
+            && d_norm > PROBE_FROM * tol_step
+            && (stalled || it.curved_for.as_ref() != Some(&free))
+        {
             if let (Some(lambda), Some(yw)) = (&solved.lambda, &solved.y_min_norm) {
                 // The range step: that of the program with W (its part off the null space).
                 let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
