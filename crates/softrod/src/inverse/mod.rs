@@ -41,16 +41,16 @@
 //!   norm.
 //! * A model with probes ([`Forward::has_probes`]: an unloaded Cosserat robot, whose poses
 //!   alone take one march of the state, about a quarter of an evaluation with its Jacobian)
-//!   makes `H` again at every near step that is not within [`PROBE_FROM`] of the stopping
-//!   test, from second differences of the poses ([`PROBE_STEP`]) on the span of the range
-//!   step `v` (the minimum-norm step off the null space) and `Z`: `Zᵀ H Z` and the cross term
-//!   `Zᵀ H v`, which is all the SQP step uses of `H`, so the step is Newton's on the KKT
-//!   conditions and converges quadratically (three probes for one null direction). Without
-//!   the cross term (the directional differences above, or a secant) the steps contract only
-//!   linearly, by about ten per step: a position error along the stiff axis of the rod asks
-//!   for large range steps, and their coupling into the null space is first order. For a
-//!   1 mm move of a warm-started tip this takes three evaluations with the Jacobian and six
-//!   probes instead of five or six evaluations.
+//!   makes that curvature from second differences of the poses instead ([`PROBE_STEP`]), on
+//!   the span of the range step `v` (the minimum-norm step off the null space) and `Z`:
+//!   `Zᵀ H Z` and the cross term `Zᵀ H v`, which is all the SQP step uses of `H`, so the
+//!   next step is Newton's on the KKT conditions (three probes for one null direction, not
+//!   within [`PROBE_FROM`] of the stopping test). Without the cross term (the directional
+//!   differences above, or a secant) the steps contract only linearly, by about ten per
+//!   step: a position error along the stiff axis of the rod asks for large range steps,
+//!   and their coupling into the null space is first order. Probing at every near step
+//!   converges quadratically (three evaluations and six probes for a warm 1 mm move) but
+//!   costs more instructions along a tracked path than probing where the curvature is stale.
 //!
 //! When the linearised target cannot be met inside the bounds, the bounded least squares
 //! `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the same norm as a
