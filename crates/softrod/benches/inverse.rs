@@ -1,6 +1,7 @@
 //! Inverse statics of the two-segment NiTi tendon robot (default RK4 options): one forward
-//! evaluation with its actuation Jacobian, the inverse cold (from zero tensions) and warm
-//! (from the solution at a target 1 mm away).
+//! evaluation with its actuation Jacobian, one probe (the march of the state alone, for the
+//! curvature), the inverse cold (from zero tensions) and warm (from the solution at a target
+//! 1 mm away).
 //!
 //! Run: `cargo bench -p softrod --bench inverse`.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -35,6 +36,9 @@ fn bench(c: &mut Criterion) {
     let mut fwd = CosseratForward::new(&model, &o, None).unwrap();
     g.bench_function("evaluation_with_jacobian", |b| {
         b.iter(|| fwd.evaluate(black_box(&t), true).unwrap());
+    });
+    g.bench_function("probe", |b| {
+        b.iter(|| fwd.probe(black_box(&t)).unwrap());
     });
     g.bench_function("forward_solve", |b| {
         b.iter(|| solve_statics(&model, &Actuation::tensions(black_box(&t)), &o).unwrap());

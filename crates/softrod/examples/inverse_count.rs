@@ -1,7 +1,9 @@
 //! Instruction-count harness (`valgrind --tool=callgrind`): N inverse statics of the
 //! two-segment NiTi tendon robot (default RK4 options), cold from zero tensions (mode 0), warm
 //! from the solution at a target 1 mm away (mode 1), or N forward evaluations with the
-//! actuation Jacobian (mode 2). Prints the iterations and evaluations of each case on stderr.
+//! actuation Jacobian (mode 2); the PCC inverse of the same robot (two arcs) cold (mode 3)
+//! and warm, target moved 1 mm (mode 4). Prints the iterations and evaluations of each case
+//! on stderr.
 //!
 //! Run: `cargo build --release -p softrod --example inverse_count` then
 //! `valgrind --tool=callgrind target/release/examples/inverse_count MODE N`.
@@ -13,13 +15,28 @@ use std::sync::Arc;
 mod robot;
 
 use softrod::nalgebra::Vector3;
+use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
+use softrod::pcc::{ElasticSegment, PccTendons};
 use softrod::{
-    solve_inverse, CosseratForward, Forward, InverseOptions, InverseWarmStart, Loads, RobotModel,
-    SolveOptions, Target,
+    pcc_inverse_statics, solve_inverse, CosseratForward, Forward, InverseOptions, InverseWarmStart,
+    Loads, RobotModel, SolveOptions, Target,
 };
 
 fn niti() -> Arc<RobotModel> {
     robot::niti_model(Loads::default(), None, 0.0)
+}
+
+/// The two-segment NiTi robot as two PCC arcs (as in `tests/inverse.rs`).
+fn pcc_niti() -> PccRobot {
+    let ang = [90.0f64, -30.0, 210.0].map(f64::to_radians);
+    let tendons = PccTendons::new(&[0.01; 3], &ang).unwrap();
+    let seg = || ElasticSegment::solid_circle(0.2, 0.7e-3, 54e9, true).unwrap();
+    PccRobot::new(vec![seg(), seg()])
+        .unwrap()
+        .with_segment_tendons(0, &tendons)
+        .unwrap()
+        .with_segment_tendons(1, &tendons)
+        .unwrap()
 }
 
 fn main() {
@@ -36,27 +53,58 @@ fn main() {
     let mut fwd = CosseratForward::new(&model, &o, None).unwrap();
     let cold = solve_inverse(&mut fwd, &target, &io, None).unwrap();
     eprintln!(
-        "cold: iterations {} evaluations {} a {:?}",
-        cold.iterations, cold.evaluations, cold.actuation
+        "cold: iterations {} evaluations {} probes {} a {:?}",
+        cold.iterations, cold.evaluations, cold.probes, cold.actuation
     );
     let w = InverseWarmStart::from(&cold);
     let warm = solve_inverse(&mut fwd, &moved, &io, Some(&w)).unwrap();
     eprintln!(
-        "warm: iterations {} evaluations {} a {:?} error {:e}",
-        warm.iterations, warm.evaluations, warm.actuation, warm.position_error
+        "warm: iterations {} evaluations {} probes {} a {:?} error {:e}",
+        warm.iterations, warm.evaluations, warm.probes, warm.actuation, warm.position_error
     );
     // Ten 1 mm steps of a tracked path (as the warm-tracking test of `tests/inverse.rs`).
     let mut w10 = w.clone();
     let mut total = 0u32;
+    let mut probes = 0u32;
     for k in 1..=10 {
         let p = Target::tip(tip + Vector3::new(1e-3 * f64::from(k), 0.0, 0.0));
         let r = solve_inverse(&mut fwd, &p, &io, Some(&w10)).unwrap();
         total += u32::try_from(r.evaluations).unwrap();
+        probes += u32::try_from(r.probes).unwrap();
         w10 = InverseWarmStart::from(&r);
     }
     eprintln!(
-        "tracking: {:.1} evaluations per 1 mm step",
-        f64::from(total) / 10.0
+        "tracking: {:.1} evaluations and {:.1} probes per 1 mm step",
+        f64::from(total) / 10.0,
+        f64::from(probes) / 10.0
+    );
+    // The PCC inverse (its closed-form iteration) to the PCC tip at the same tensions.
+    let pcc = pcc_niti();
+    let po = PccSolveOptions::default();
+    let pl = PccLoads::default();
+    let ptip = solve_pcc_statics(
+        &pcc,
+        &PccLoads {
+            tensions: t.to_vec(),
+            ..Default::default()
+        },
+        &po,
+    )
+    .unwrap()
+    .tip_pose;
+    let ptip = Vector3::new(ptip[(0, 3)], ptip[(1, 3)], ptip[(2, 3)]);
+    let ptarget = Target::tip(ptip);
+    let pmoved = Target::tip(ptip + Vector3::new(1e-3, 0.0, 0.0));
+    let pcold = pcc_inverse_statics(&pcc, &pl, &ptarget, &io, &po, None).unwrap();
+    let pw = InverseWarmStart::from(&pcold);
+    let pwarm = pcc_inverse_statics(&pcc, &pl, &pmoved, &io, &po, Some(&pw)).unwrap();
+    eprintln!(
+        "pcc: cold iterations {} evaluations {}; warm iterations {} evaluations {} error {:e}",
+        pcold.iterations,
+        pcold.evaluations,
+        pwarm.iterations,
+        pwarm.evaluations,
+        pwarm.position_error
     );
     let mut acc = 0.0;
     for _ in 0..n {
@@ -68,6 +116,16 @@ fn main() {
             }
             1 => {
                 solve_inverse(&mut fwd, &moved, &io, Some(&w))
+                    .unwrap()
+                    .actuation[0]
+            }
+            3 => {
+                pcc_inverse_statics(&pcc, &pl, &ptarget, &io, &po, None)
+                    .unwrap()
+                    .actuation[0]
+            }
+            4 => {
+                pcc_inverse_statics(&pcc, &pl, &pmoved, &io, &po, Some(&pw))
                     .unwrap()
                     .actuation[0]
             }

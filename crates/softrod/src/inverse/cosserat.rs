@@ -211,7 +211,7 @@ impl CosseratForward {
         let mut sorted = observe.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        let cols = integrate(
+        let mut cols = integrate(
             eq,
             scheme,
             &[0.0; 6],
@@ -224,15 +224,8 @@ impl CosseratForward {
                 stops: &[],
             },
         )?;
-        self.march = Some(March {
-            a: a.to_vec(),
-            nodes: cols.nodes.clone(),
-            lengths: cols.lengths.clone(),
-            residual: crate::solve::max_norm(cols.residual.as_slice()),
-            evaluations: cols.evaluations,
-        });
         let to_matrix = |c: &[nalgebra::Vector6<f64>]| DMatrix::from_fn(6, nt + nc, |r, k| c[k][r]);
-        Ok(match &self.nodes {
+        let out = match &self.nodes {
             None => Evaluation {
                 positions: vec![cols.tip_pose.0],
                 rotation: cols.tip_pose.1,
@@ -256,11 +249,87 @@ impl CosseratForward {
                     ),
                 }
             }
+        };
+        // The nodes move into the record of the march (after the positions are read).
+        self.march = Some(March {
+            a: a.to_vec(),
+            nodes: std::mem::take(&mut cols.nodes),
+            lengths: std::mem::take(&mut cols.lengths),
+            residual: crate::solve::max_norm(cols.residual.as_slice()),
+            evaluations: cols.evaluations,
+        });
+        Ok(out)
+    }
+}
+
+impl CosseratForward {
+    /// The observed poses of an unloaded robot at `a` from one march of the state alone (no
+    /// columns); the march recorded for [`CosseratForward::solve`] is kept.
+    fn unloaded_poses(&self, a: &[f64]) -> Result<Evaluation> {
+        let (nt, nc) = self.dims();
+        let act = self.actuation(a);
+        act.validate(nt, nc)?;
+        let eq = Equations {
+            model: &self.model,
+            tensions: &a[..nt],
+            pressures: &a[nt..],
+            load_factor: 1.0,
+            profile: None,
+        };
+        let mut plan = Vec::new();
+        let scheme = scheme_of(&self.options.integrator, &self.model, &mut plan);
+        let observe = self.nodes.clone().unwrap_or_default();
+        let mut sorted = observe.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        let cols = integrate(
+            eq,
+            scheme,
+            &[0.0; 6],
+            &Request {
+                seeds: &[],
+                lengths: &[],
+                observe: &sorted,
+                load_node: None,
+                record_nodes: self.nodes.is_some(),
+                stops: &[],
+            },
+        )?;
+        Ok(match &self.nodes {
+            None => Evaluation {
+                positions: vec![cols.tip_pose.0],
+                rotation: cols.tip_pose.1,
+                jacobian: None,
+            },
+            Some(nodes) => {
+                let at = |i: usize| sorted.iter().position(|&x| x == i).unwrap_or(0);
+                let last = *nodes.last().unwrap_or(&0);
+                Evaluation {
+                    positions: nodes
+                        .iter()
+                        .map(|&i| crate::cosserat::equations::v3(&cols.nodes[i].y, 0))
+                        .collect(),
+                    rotation: cols.rotations[at(last)],
+                    jacobian: None,
+                }
+            }
         })
     }
 }
 
 impl Forward for CosseratForward {
+    fn has_probes(&self) -> bool {
+        // A loaded robot solves a boundary-value problem (several marches): no cheaper pass.
+        no_external_loads(&self.model)
+    }
+
+    fn probe(&mut self, a: &[f64]) -> Result<Evaluation> {
+        if no_external_loads(&self.model) {
+            return self.unloaded_poses(a);
+        }
+        self.evaluate(a, false)
+    }
+
     fn dims(&self) -> (usize, usize) {
         (self.model.tendons().len(), self.model.chambers().len())
     }

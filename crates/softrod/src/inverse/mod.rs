@@ -39,6 +39,18 @@
 //!   set changes or the steps stop contracting ([`STALLED`]). With `H = W` alone the
 //!   iteration oscillates where the curvature of the target manifold exceeds that of the
 //!   norm.
+//! * A model with probes ([`Forward::has_probes`]: an unloaded Cosserat robot, whose poses
+//!   alone take one march of the state, about a quarter of an evaluation with its Jacobian)
+//!   makes that curvature from second differences of the poses instead ([`PROBE_STEP`]), on
+//!   the span of the range step `v` (the minimum-norm step off the null space) and `Z`:
+//!   `Zᵀ H Z` and the cross term `Zᵀ H v`, which is all the SQP step uses of `H`, so the
+//!   next step is Newton's on the KKT conditions (three probes for one null direction, not
+//!   within [`PROBE_FROM`] of the stopping test). Without the cross term (the directional
+//!   differences above, or a secant) the steps contract only linearly, by about ten per
+//!   step: a position error along the stiff axis of the rod asks for large range steps,
+//!   and their coupling into the null space is first order. Probing at every near step
+//!   converges quadratically (three evaluations and six probes for a warm 1 mm move) but
+//!   costs more instructions along a tracked path than probing where the curvature is stale.
 //!
 //! When the linearised target cannot be met inside the bounds, the bounded least squares
 //! `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the same norm as a
@@ -96,6 +108,14 @@ pub const STALLED: f64 = 0.5;
 pub const FIRST_RADIUS: f64 = 1.0;
 /// Most halvings of a step.
 pub const MAX_STEP_HALVINGS: usize = 30;
+/// Relative length (scaled actuation, relative to `1 + |a|_W`) of the probes of the
+/// curvature made from second differences of the poses.
+pub const PROBE_STEP: f64 = 1e-4;
+/// Most directions (range step and null directions) of the curvature made from probes: `k`
+/// directions take `k (k + 1) / 2` probes.
+pub const MAX_PROBE_DIRECTIONS: usize = 3;
+/// Steps (relative to the stopping test's) above which the curvature is probed again.
+pub const PROBE_FROM: f64 = 100.0;
 
 /// What the inverse statics aims at.
 #[derive(Debug, Clone, PartialEq)]
@@ -186,6 +206,20 @@ pub trait Forward {
     /// # Errors
     /// When the forward solve fails.
     fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation>;
+    /// Whether the model has a pass without the Jacobian several times cheaper than
+    /// [`Forward::evaluate`] with it (for an unloaded Cosserat robot, one march of the state
+    /// alone): the iteration then makes its curvature from second differences of the poses
+    /// ([`PROBE_STEP`]).
+    fn has_probes(&self) -> bool {
+        false
+    }
+    /// The observed poses at `a` without the Jacobian.
+    ///
+    /// # Errors
+    /// When the forward solve fails.
+    fn probe(&mut self, a: &[f64]) -> Result<Evaluation> {
+        self.evaluate(a, false)
+    }
     /// A length scale (m): the rod length.
     fn length(&self) -> f64;
     /// The areas (m²) of the chambers, for the default weights.
@@ -205,8 +239,10 @@ pub struct InverseSolution {
     pub rotation_error: f64,
     /// Iterations (SQP steps taken).
     pub iterations: usize,
-    /// Forward evaluations.
+    /// Forward evaluations (with the Jacobian).
     pub evaluations: usize,
+    /// Forward passes without the Jacobian (probes of the curvature, [`Forward::probe`]).
+    pub probes: usize,
     /// Whether the iteration converged: the target reached within the tolerances (for a
     /// shape target: the least-squares fit found) with the minimum-norm actuation.
     pub converged: bool,

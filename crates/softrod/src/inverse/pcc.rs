@@ -99,7 +99,9 @@ impl Forward for PccForward<'_> {
 // (`seg_kin`), so the actuation Jacobian is `J = J_θ M` and the Hessian of the Lagrangian
 // `½|a - c|²_W - λᵀ p(a)` is `W - Mᵀ (Σ λ_k ∇²_θ p_k) M`, exact. The iteration is that of
 // `solve_inverse` (the same two phases, steps, merit function and stopping test) with the
-// exact Hessian near the target instead of directional differences, on stack-sized dense
+// exact Hessian near the target instead of directional differences (kept whole, cross terms
+// included, unless `Zᵀ H Z` must be raised to be positive definite: the step is Newton's and
+// a warm 1 mm move takes three iterations), on stack-sized dense
 // algebra: the minimum-norm step and the Levenberg–Marquardt step are solved in the dual
 // (three multipliers), the curved step by the KKT system of its free variables.
 // ---------------------------------------------------------------------------------------------
@@ -467,10 +469,12 @@ fn lm_step(jac: &[V3<f64>], e: &V3<f64>, a: &[f64], bx: &Box_, radius: f64) -> V
     best
 }
 
-/// The Hessian `h` (n × n, row-major) made what the generic iteration uses: `W` off the
-/// null space `Z` of the free columns of `J` (those free in `y_w`), and `Zᵀ h Z` with its
-/// eigenvalues floored at `1e-3` (scaled variables `W^{1/2} a`) on it, so that the curved
-/// step is a descent step toward a minimum, never a saddle. Without a null space: `W`.
+/// The Hessian `h` (n × n, row-major) made positive definite on the null space `Z` of the
+/// free columns of `J` (those free in `y_w`, scaled variables `W^{1/2} a`): kept exact when
+/// `Zᵀ h Z` has its eigenvalues above `1e-3` (the cross terms `Zᵀ h Y` make the curved step
+/// Newton's), otherwise only `Zᵀ h Z` raised to that floor, so that the curved step is a
+/// descent step toward a minimum, never a saddle. Without a null space: `W` (the step is
+/// then the constraints' alone).
 fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_) {
     let n = y_w.len();
     let idx: Vec<usize> = (0..n)
@@ -494,14 +498,22 @@ fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_) {
                 }
             }
             let hm = Dm::from_row_slice(n, n, h);
-            let mz = z.tr_mul(&(&hm * &z));
-            let mz = (&mz + mz.transpose()) * 0.5;
-            let e = mz.symmetric_eigen();
-            let vals = e.eigenvalues.map(|v| v.max(1e-3));
-            let mz = &e.eigenvectors * Dm::from_diagonal(&vals) * e.eigenvectors.transpose();
-            let zwz = z.tr_mul(&(&w * &z));
-            out = &w + &z * (mz - zwz) * z.transpose();
-            out = (&out + out.transpose()) * 0.5;
+            let hm = (&hm + hm.transpose()) * 0.5;
+            let zhz = z.tr_mul(&(&hm * &z));
+            let zhz = (&zhz + zhz.transpose()) * 0.5;
+            let e = zhz.clone().symmetric_eigen();
+            if e.eigenvalues.iter().all(|&v| v >= 1e-3) {
+                // Positive definite on Z already: the exact Hessian, cross terms included
+                // (the step is Newton's).
+                out = hm;
+            } else {
+                let vals = e.eigenvalues.map(|v| v.max(1e-3));
+                let mz = &e.eigenvectors * Dm::from_diagonal(&vals) * e.eigenvectors.transpose();
+                // Only `Zᵀ H Z` raised (`Zᵀ W Z = I`): the rest of the exact Hessian kept.
+                let wz = &w * &z;
+                out = &hm + &wz * (mz - zhz) * wz.transpose();
+                out = (&out + out.transpose()) * 0.5;
+            }
         }
     }
     for r in 0..n {
@@ -811,6 +823,7 @@ impl ClosedForm {
             rotation_error: 0.0,
             iterations: self.iterations,
             evaluations: self.evaluations,
+            probes: 0,
             converged: true,
             reached: true,
             evaluation: Evaluation {
@@ -846,6 +859,7 @@ fn closed_form(
         }
         let norm_a = cf.bx.norm(&cf.a);
         let small = cf.bx.norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
+
         if small && reached {
             break;
         }

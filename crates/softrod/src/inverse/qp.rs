@@ -109,7 +109,14 @@ pub fn min_norm(
             let trial = &lambda + &d * alpha;
             let (yt, ft) = y_of(&trial);
             let pt = dual(&trial, &yt);
-            if pt >= psi + 1e-4 * alpha * slope || (pt - psi).abs() <= 1e-15 * psi.abs() {
+            // On an unchanged free set the dual is a concave quadratic and the step a
+            // (regularised) Newton step: a smaller residual is progress even where the dual's
+            // value is lost in round-off (large multipliers of a nearly singular target).
+            let same_free = ft == free && (b - a * &yt).amax() < g.amax();
+            if pt >= psi + 1e-4 * alpha * slope
+                || (pt - psi).abs() <= 1e-15 * psi.abs()
+                || same_free
+            {
                 lambda = trial;
                 y = yt;
                 free = ft;

@@ -7,12 +7,12 @@ use nalgebra::{DMatrix, DVector};
 
 use super::problem::{PoseError, Program};
 use super::steps::{
-    bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change,
+    bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change, probed_curvature,
     scaled_jacobian_norm, solve_qp, trust_radius, QpStep,
 };
 use super::{
     Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target, FIRST_RADIUS,
-    LOCAL_STEP, STALLED,
+    LOCAL_STEP, PROBE_FROM, STALLED,
 };
 use crate::error::{Error, Result};
 
@@ -38,6 +38,12 @@ struct Iterate {
     iterations: usize,
     /// Forward evaluations.
     evaluations: usize,
+    /// Probes (poses without the Jacobian).
+    probes: usize,
+    /// Whether the forward model has probes ([`Forward::probe`]).
+    probes_available: bool,
+    /// How many times actuators were put on their bounds at the end.
+    snapped: usize,
 }
 
 impl Iterate {
@@ -50,6 +56,7 @@ impl Iterate {
             rotation_error: lin.rot,
             iterations: self.iterations,
             evaluations: self.evaluations,
+            probes: self.probes,
             converged,
             reached: lin.reached,
             evaluation: self.ev,
@@ -96,14 +103,34 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         let solved = program_step(forward, &p, &mut it, &lin);
         let least_squares = solved.least_squares;
         let lambda_k = solved.lambda;
-        let y = solved.y;
-        let step: Vec<f64> = (0..n).map(|i| y[i] - it.a[i]).collect();
+        let mut y = solved.y;
         let norm_a = p.scaled_norm(&it.a);
-        let small = p.scaled_norm(&step) <= options.optimality_tolerance * (1.0 + norm_a);
+        let tol_step = options.optimality_tolerance * (1.0 + norm_a);
+        let mut step: Vec<f64> = (0..n).map(|i| y[i] - it.a[i]).collect();
+        let small = p.scaled_norm(&step) <= tol_step;
+        if small && lin.reached && it.snapped < 3 {
+            // An actuator left within the step tolerance of its bound (a degenerate optimum:
+            // on the bound and on the target at once) is put on it; the next evaluation
+            // checks the target there (a few times at most).
+            let mut snap = false;
+            for i in 0..n {
+                let reach = tol_step / p.bounds.weights[i].sqrt();
+                for bound in [p.bounds.lo[i], p.bounds.hi[i]] {
+                    if y[i] != bound && (y[i] - bound).abs() <= reach {
+                        y[i] = bound;
+                        step[i] = bound - it.a[i];
+                        snap = true;
+                    }
+                }
+            }
+            it.snapped += usize::from(snap);
+        }
         if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
             eprintln!(
-                "it {}: dist {:.3e} rot {:.3e} ls {least_squares} |step| {:.3e} radius {:.3e} a {:?}",
+                "it {} ({} evaluations, {} probes): dist {:.3e} rot {:.3e} ls {least_squares} |step| {:.3e} radius {:.3e} a {:?}",
                 it.iterations,
+                it.evaluations,
+                it.probes,
                 lin.dist,
                 lin.rot,
                 p.scaled_norm(&step),
@@ -183,6 +210,7 @@ fn start<F: Forward + ?Sized>(
             forward.evaluate(&a, true)?
         }
     };
+    let probes_available = forward.has_probes();
     let mut hess = DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights));
     let mut curved_for: Option<Vec<bool>> = None;
     if let Some(h) = warm.and_then(|w| w.hessian.as_ref()) {
@@ -201,6 +229,9 @@ fn start<F: Forward + ?Sized>(
         radius: f64::NAN,
         iterations: 0,
         evaluations,
+        probes: 0,
+        probes_available,
+        snapped: 0,
     })
 }
 
@@ -255,8 +286,43 @@ fn program_step<F: Forward + ?Sized>(
     if !solved.least_squares && lin.merit <= p.near {
         let free = free_set(solved.y.as_slice(), &p.bounds);
         let d: Vec<f64> = (0..n).map(|i| solved.y[i] - it.a[i]).collect();
-        let stalled = it.last_step > 0.0 && p.scaled_norm(&d) > STALLED * it.last_step;
-        if stalled || it.curved_for.as_ref() != Some(&free) {
+        let d_norm = p.scaled_norm(&d);
+        let stalled = it.last_step > 0.0 && d_norm > STALLED * it.last_step;
+        // Where the curvature is stale (the free set changed, the steps stopped contracting)
+        // and the model has cheap probes, it is made from them (range step and null space:
+        // the next step is Newton's); otherwise from directional differences of the Jacobian.
+        let tol_step = p.options.optimality_tolerance * (1.0 + p.scaled_norm(&it.a));
+        let probing = it.probes_available && p.target.rotation.is_none() && !p.shape;
+        let mut probed = false;
+        if probing
+            && d_norm > PROBE_FROM * tol_step
+            && (stalled || it.curved_for.as_ref() != Some(&free))
+        {
+            if let (Some(lambda), Some(yw)) = (&solved.lambda, &solved.y_min_norm) {
+                // The range step: that of the program with W (its part off the null space).
+                let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
+                let free_w = free_set(yw.as_slice(), &p.bounds);
+                if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
+                    eprintln!("probe: |v| {:.3e} |d| {:.3e}", p.scaled_norm(&v), d_norm);
+                }
+                let base = if it.curved_for.is_some() {
+                    it.hess.clone()
+                } else {
+                    DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights))
+                };
+                let (h, used) = probed_curvature(
+                    forward, p, &it.a, &lin.e, &lin.jac, lambda, &free_w, &v, &base,
+                );
+                it.probes += used;
+                if let Some(h) = h {
+                    it.hess = h;
+                    it.curved_for = Some(free_w);
+                    solved = solve_qp(p, &lin.jac, &lin.b, &it.a, &it.hess, true);
+                    probed = true;
+                }
+            }
+        }
+        if !probed && (stalled || it.curved_for.as_ref() != Some(&free)) {
             if let Some(lambda) = &solved.lambda {
                 let (h, used) = curvature(forward, p, &it.a, &lin.jac, lambda, &free);
                 it.evaluations += used;

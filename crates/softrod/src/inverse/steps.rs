@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::problem::Program;
 use super::qp::{self, Bounds};
-use super::{Forward, LEAST_SQUARES_REGULARISATION};
+use super::{Forward, LEAST_SQUARES_REGULARISATION, MAX_PROBE_DIRECTIONS, PROBE_STEP};
 
 /// The damped BFGS update (Powell) of the Lagrangian Hessian `h` for the step `a0 → a1`, with
 /// the Jacobians (scaled rows) `j0`, `j1` and the multipliers `lambda`: `s = a1 - a0`,
@@ -138,6 +138,8 @@ pub(super) struct QpStep {
     pub lambda: Option<DVector<f64>>,
     /// Whether the target could not be met inside the bounds (the bounded least squares).
     pub least_squares: bool,
+    /// The minimum-norm point (the program with `W`), if feasible.
+    pub y_min_norm: Option<DVector<f64>>,
 }
 
 /// The program of one iteration at `a`: `min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ` (or `½ |y - c|²_W`
@@ -165,14 +167,16 @@ pub(super) fn solve_qp(
             let q = wd - hess * &av;
             // The multipliers of the program with W (those of the target at a solution).
             let r = qp::active_set_qp(hess, &q, jac, bounds, &y_w);
-            let y = r.map_or(y_w, |(y, _)| y);
+            let y = r.map_or_else(|| y_w.clone(), |(y, _)| y);
             QpStep {
                 y,
                 lambda: Some(l_w),
                 least_squares: false,
+                y_min_norm: Some(y_w),
             }
         }
         Some((y, l)) => QpStep {
+            y_min_norm: Some(y.clone()),
             y,
             lambda: Some(l),
             least_squares: false,
@@ -181,6 +185,7 @@ pub(super) fn solve_qp(
             y: qp::bounded_least_squares(jac, b, bounds, ls_regularisation(jac, bounds)),
             lambda: None,
             least_squares: true,
+            y_min_norm: None,
         },
     }
 }
@@ -202,35 +207,13 @@ pub(super) fn curvature<F: Forward + ?Sized>(
 ) -> (Option<DMatrix<f64>>, usize) {
     let n = a.len();
     let bounds = &p.bounds;
-    let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
-    let k = idx.len();
-    let m = jac.nrows();
     let w = DMatrix::from_diagonal(&DVector::from_column_slice(&bounds.weights));
-    if k <= m {
+    let Some(z) = null_space(jac, &bounds.weights, free) else {
         return (None, 0);
-    }
-    // Null space of the free columns, in the scaled variables W^{1/2} a.
-    let jf = DMatrix::from_fn(m, k, |r, c| {
-        jac[(r, idx[c])] / bounds.weights[idx[c]].sqrt()
-    });
-    let g = jf.tr_mul(&jf);
-    let eig = g.symmetric_eigen();
-    let top = eig.eigenvalues.iter().fold(0.0f64, |x, v| x.max(v.abs()));
-    let cols: Vec<usize> = (0..k)
-        .filter(|&c| eig.eigenvalues[c].abs() <= 1e-10 * top)
-        .collect();
-    if cols.is_empty() {
-        return (None, 0);
-    }
-    let d = cols.len();
+    };
+    let d = z.ncols();
     if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
         eprintln!("curvature: {d} null directions");
-    }
-    let mut z = DMatrix::zeros(n, d);
-    for (j, &c) in cols.iter().enumerate() {
-        for (r, &i) in idx.iter().enumerate() {
-            z[(i, j)] = eig.eigenvectors[(r, c)] / bounds.weights[i].sqrt();
-        }
     }
     let scale = 1.0
         + a.iter()
@@ -279,6 +262,155 @@ pub(super) fn curvature<F: Forward + ?Sized>(
     let h = &w + &z * (mz - zwz) * z.transpose();
     let h = (&h + h.transpose()) * 0.5;
     (Some(h), used)
+}
+
+/// A basis `Z` (n × d, `Zᵀ W Z = I`, zero on the fixed variables) of the null space of the
+/// free columns of `jac`; `None` if it is empty.
+fn null_space(jac: &DMatrix<f64>, weights: &[f64], free: &[bool]) -> Option<DMatrix<f64>> {
+    let n = weights.len();
+    let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+    let k = idx.len();
+    let m = jac.nrows();
+    if k <= m {
+        return None;
+    }
+    // Null space of the free columns, in the scaled variables W^{1/2} a.
+    let jf = DMatrix::from_fn(m, k, |r, c| jac[(r, idx[c])] / weights[idx[c]].sqrt());
+    let g = jf.tr_mul(&jf);
+    let eig = g.symmetric_eigen();
+    let top = eig.eigenvalues.iter().fold(0.0f64, |x, v| x.max(v.abs()));
+    let cols: Vec<usize> = (0..k)
+        .filter(|&c| eig.eigenvalues[c].abs() <= 1e-10 * top)
+        .collect();
+    if cols.is_empty() {
+        return None;
+    }
+    let mut z = DMatrix::zeros(n, cols.len());
+    for (j, &c) in cols.iter().enumerate() {
+        for (r, &i) in idx.iter().enumerate() {
+            z[(i, j)] = eig.eigenvectors[(r, c)] / weights[i].sqrt();
+        }
+    }
+    Some(z)
+}
+
+/// `m` with its eigenvalues raised to `floor` (positive definite).
+fn floored(m: &DMatrix<f64>, floor: f64) -> DMatrix<f64> {
+    let m = (m + m.transpose()) * 0.5;
+    let e = m.symmetric_eigen();
+    let vals = e.eigenvalues.map(|v| v.max(floor));
+    &e.eigenvectors * DMatrix::from_diagonal(&vals) * e.eigenvectors.transpose()
+}
+
+/// The Hessian of the Lagrangian `½|a - c|²_W - λᵀ p(a)` on the span `S` of the range step
+/// `v` (its part `W`-orthogonal to the null space, dropped when negligible) and the null
+/// space `Z` of the free columns of `J`, from second differences of the poses alone
+/// ([`Forward::probe`]): for unit directions `u`, `w` of `S`,
+/// `λᵀ p''[u, u] = 2 λᵀ (p(a + h u) - p(a) - h J u) / h²` (`h` = [`PROBE_STEP`] relative, one
+/// probe each; `p''[u, w]` by polarisation from one more probe at `a + h (u + w)`). That is
+/// the part of the Hessian an SQP step uses — `Zᵀ H Z` and `Zᵀ H v` — so the step is
+/// Newton's. Returns `base` corrected on `S` (`base + P (H_S - Sᵀ base S) Pᵀ`,
+/// `Sᵀ P = I`, with `Zᵀ H Z` floored positive definite), or `W` corrected so if that is not
+/// positive definite; `None` without probes, more than [`MAX_PROBE_DIRECTIONS`] directions,
+/// a probe outside the bounds or failed. Also returns the probes used.
+#[allow(clippy::too_many_arguments)] // the iterate, its linearisation and the step
+pub(super) fn probed_curvature<F: Forward + ?Sized>(
+    forward: &mut F,
+    p: &Program<'_>,
+    a: &[f64],
+    e0: &DVector<f64>,
+    jac: &DMatrix<f64>,
+    lambda: &DVector<f64>,
+    free: &[bool],
+    v: &[f64],
+    base: &DMatrix<f64>,
+) -> (Option<DMatrix<f64>>, usize) {
+    let n = a.len();
+    let bounds = &p.bounds;
+    let Some(z) = null_space(jac, &bounds.weights, free) else {
+        return (None, 0);
+    };
+    let d = z.ncols();
+    let w = DMatrix::from_diagonal(&DVector::from_column_slice(&bounds.weights));
+    let scale = 1.0 + p.scaled_norm(a);
+    // The range part of v, W-orthogonal to Z, in unit W-norm (if not negligible).
+    let mut vr = DVector::from_column_slice(v);
+    let zw = z.tr_mul(&(&w * &vr));
+    vr -= &z * zw;
+    let vn = p.scaled_norm(vr.as_slice());
+    let with_v = vn > 1e-12 * scale;
+    let k = d + usize::from(with_v);
+    if k > MAX_PROBE_DIRECTIONS {
+        return (None, 0);
+    }
+    let mut s = DMatrix::zeros(n, k);
+    if with_v {
+        s.set_column(0, &(vr / vn));
+    }
+    for j in 0..d {
+        s.set_column(k - d + j, &z.column(j));
+    }
+    let h = PROBE_STEP * scale;
+    let mut used = 0;
+    // λᵀ p''[u, u] along the direction u (scaled length 1 or √2), ±h inside the bounds.
+    let mut second = |u: &DVector<f64>, used: &mut usize| -> Option<f64> {
+        let inside = |t: f64| {
+            (0..n).all(|i| {
+                let x = a[i] + t * u[i];
+                x >= bounds.lo[i] && x <= bounds.hi[i]
+            })
+        };
+        let t = [h, -h].into_iter().find(|&t| inside(t))?;
+        let trial: Vec<f64> = (0..n).map(|i| a[i] + t * u[i]).collect();
+        *used += 1;
+        let ev = forward.probe(&trial).ok()?;
+        let e1 = p.error(&ev).e;
+        if e1.len() != e0.len() {
+            return None;
+        }
+        // e = target - p: p(a + t u) - p(a) - t J u = -(e1 - e0) - t J u.
+        let dp = -(e1 - e0) - jac * u * t;
+        let q = 2.0 * lambda.dot(&dp) / (t * t);
+        q.is_finite().then_some(q)
+    };
+    let mut lpp = DMatrix::zeros(k, k);
+    for i in 0..k {
+        let Some(q) = second(&s.column(i).into_owned(), &mut used) else {
+            return (None, used);
+        };
+        lpp[(i, i)] = q;
+    }
+    for i in 0..k {
+        for j in i + 1..k {
+            let u = s.column(i) + s.column(j);
+            let Some(q) = second(&u, &mut used) else {
+                return (None, used);
+            };
+            let c = 0.5 * (q - lpp[(i, i)] - lpp[(j, j)]);
+            lpp[(i, j)] = c;
+            lpp[(j, i)] = c;
+        }
+    }
+    let mut hs = s.tr_mul(&(&w * &s)) - lpp;
+    // Positive definite on Z (a strict local minimum has it; clamp otherwise).
+    let zz = hs.view((k - d, k - d), (d, d)).into_owned();
+    hs.view_mut((k - d, k - d), (d, d))
+        .copy_from(&floored(&zz, 1e-3));
+    let Some(sts) = s.tr_mul(&s).try_inverse() else {
+        return (None, used);
+    };
+    let pm = &s * sts;
+    let corrected = |b: &DMatrix<f64>| {
+        let h = b + &pm * (&hs - s.tr_mul(&(b * &s))) * pm.transpose();
+        (&h + h.transpose()) * 0.5
+    };
+    for b in [base, &w] {
+        let h = corrected(b);
+        if h.clone().cholesky().is_some() {
+            return (Some(h), used);
+        }
+    }
+    (None, used)
 }
 
 /// Change of the objective `½ Σ w_i (a_i − c_i)²` from `a` to `trial` (same length as `w`).
