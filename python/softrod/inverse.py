@@ -139,6 +139,32 @@ def _model_key(robot: Robot) -> tuple:
     )
 
 
+def _refuse_unsupported(robot: Robot, obstacles_supported: bool = False) -> None:
+    """Raises ``ParameterError`` naming ``robot`` for what the inverse statics does not model
+    (rather than solving without it and reporting the forward solution with it)."""
+    why = None
+    if robot.tip_constraint is not None:
+        why = (
+            f"a tip constraint ({type(robot.tip_constraint).__name__}): the inverse statics "
+            "moves a free tip; solve the held robot with robot.solve"
+        )
+    elif any(t.friction > 0 or len(t.guides) > 0 for t in robot.tendons):
+        i = next(k for k, t in enumerate(robot.tendons) if t.friction > 0 or len(t.guides))
+        why = (
+            f"tendon friction or disk guides (tendons[{i}]): the inverse statics is "
+            "frictionless; give the tendons friction 0 and no guides"
+        )
+    elif robot.obstacles and not obstacles_supported:
+        why = (
+            "obstacles: the inverse statics is contact-free here; remove the obstacles or "
+            "aim at the tip"
+        )
+    if why is not None:
+        err = _core.ParameterError(f"invalid parameter `robot` = {robot.name!r}: {why}")
+        err.parameter = "robot"
+        raise err
+
+
 def inverse_statics(
     robot: Robot,
     target_position: Sequence[float] | np.ndarray,
@@ -185,6 +211,7 @@ def inverse_statics(
         )
         err.parameter = "robot"
         raise err
+    _refuse_unsupported(robot, obstacles_supported=False)
     key = _model_key(robot)
     warm_start, extra = _warm_arguments(warm_start, key)
     if target_s is not None:

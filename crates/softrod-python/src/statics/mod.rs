@@ -335,6 +335,14 @@ pub(crate) fn actuation_jacobian<'py>(
     };
     if let Ok(s) = solution.cast::<StaticsSolution>() {
         let inner = &s.get().inner;
+        if s.get().contact.constrained() {
+            return Err(param_err(
+                "solution",
+                "a solution with active contacts or a tip constraint",
+                "a solution without active contacts or tip constraint (the actuation Jacobian \
+                 under contact is not computed: it would hold the contact forces as dead loads)",
+            ));
+        }
         let n = inner.s.len() as i64;
         let index = if node < 0 { n + node } else { node };
         if !(0..n).contains(&index) {
