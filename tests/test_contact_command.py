@@ -90,9 +90,65 @@ def test_sensitivities_of_a_contact_solution_are_refused_by_name():
     assert err.value.parameter == "solution"
 
 
-def test_actuation_jacobian_of_a_contact_solution_is_refused_by_name():
-    robot = _niti(obstacles=[SPHERE])
-    _, sol = _pressing(robot, np.random.default_rng(1))
-    with pytest.raises(softrod.ParameterError, match="contact") as err:
+# ------------------------------------------------------------------ actuation Jacobian
+
+TENSIONS = np.array([2.48047599, 2.6565608, 1.98106614, 0.7366568, 2.305551, 0.63502423])
+PLANE = softrod.Plane((0.135, 0.0, 0.0), (-1.0, 0.0, 0.0))
+
+
+def _rotation_difference(rp, rm):
+    d = np.asarray(rp) @ np.asarray(rm).T
+    return 0.5 * np.array([d[2, 1] - d[1, 2], d[0, 2] - d[2, 0], d[1, 0] - d[0, 1]])
+
+
+def _differences(robot, tensions, node, h=1e-5):
+    """(6, n) central differences of the twist of `node` per tension (N), the active set of
+    the perturbed solves that of the solution."""
+    base = [c["obstacle"] for c in robot.solve(tensions, tolerance=1e-14).contacts]
+    cols = []
+    for i in range(len(tensions)):
+        up, down = tensions.copy(), tensions.copy()
+        up[i] += h
+        down[i] -= h
+        sp, sm = robot.solve(up, tolerance=1e-14), robot.solve(down, tolerance=1e-14)
+        assert [c["obstacle"] for c in sp.contacts] == base
+        assert [c["obstacle"] for c in sm.contacts] == base
+        dp = (sp.position[node] - sm.position[node]) / (2 * h)
+        dth = _rotation_difference(sp.rotation[node], sm.rotation[node]) / (2 * h)
+        cols.append(np.concatenate([dp, dth]))
+    return np.array(cols).T
+
+
+def test_actuation_jacobian_under_contact_matches_central_differences():
+    """Pressing the sphere (a contact inside the rod) with the tip on the plane (a tip
+    contact), every tendon taut."""
+    robot = _niti(obstacles=[SPHERE, PLANE])
+    sol = robot.solve(TENSIONS, tolerance=1e-14)
+    assert sorted((c["obstacle"], c["s"] == 0.4) for c in sol.contacts) == [(0, False), (1, True)]
+    end1 = int(np.flatnonzero(np.isclose(sol.s, 0.2))[-1])
+    for node in (-1, 10, end1):
+        j = softrod.actuation_jacobian(sol, node=node)
+        fd = _differences(robot, TENSIONS, node)
+        assert np.abs(j - fd).max() <= 1e-6 * np.abs(fd).max(), node
+    # Holding the contact forces as dead loads would be another answer.
+    free = softrod.actuation_jacobian(_niti().solve(TENSIONS, tolerance=1e-14))
+    assert np.abs(free - _differences(robot, TENSIONS, -1)).max() > 0.1 * np.abs(free).max()
+
+
+def test_actuation_jacobian_with_a_pinned_tip_holds_the_tip():
+    tip = _niti().solve(TENSIONS).tip_position - np.array([0.01, 0.0, 0.0])
+    robot = _niti(tip_constraint=softrod.Pin(tip))
+    sol = robot.solve(TENSIONS, tolerance=1e-14)
+    j = softrod.actuation_jacobian(sol)
+    fd = _differences(robot, TENSIONS, -1)
+    assert np.abs(j - fd).max() <= 1e-6 * np.abs(fd).max()
+    assert np.abs(j[:3]).max() <= 1e-10 * np.abs(j).max()
+
+
+def test_actuation_jacobian_with_friction_at_a_contact_is_refused_by_name():
+    robot = _niti(obstacles=[softrod.Plane((0.135, 0.0, 0.0), (-1.0, 0.0, 0.0), friction=0.3)])
+    sol = robot.solve(TENSIONS)
+    assert sol.contacts and sol.contacts[0]["state"] != "frictionless"
+    with pytest.raises(softrod.ParameterError, match="friction") as err:
         softrod.actuation_jacobian(sol)
     assert err.value.parameter == "solution"

@@ -317,7 +317,9 @@ pub(crate) fn solve_statics<'py>(
 /// `direction` 1 (default, None: the same; "pull" or "load": increasing inputs, continued from the
 /// solution) or -1 ("release" or "unload": decreasing inputs, the column
 /// `(f(a) - f(a - h e)) / h`); for any other
-/// solution the two agree.
+/// solution the two agree. With active contacts or a tip constraint, the contacts and the
+/// held tip directions are constraints (`ContactCompliance::actuation_jacobian`; friction at
+/// a contact is refused naming `solution`).
 #[pyfunction]
 #[pyo3(signature = (solution, node=-1, direction=None))]
 pub(crate) fn actuation_jacobian<'py>(
@@ -335,14 +337,6 @@ pub(crate) fn actuation_jacobian<'py>(
     };
     if let Ok(s) = solution.cast::<StaticsSolution>() {
         let inner = &s.get().inner;
-        if s.get().contact.constrained() {
-            return Err(param_err(
-                "solution",
-                "a solution with active contacts or a tip constraint",
-                "a solution without active contacts or tip constraint (the actuation Jacobian \
-                 under contact is not computed: it would hold the contact forces as dead loads)",
-            ));
-        }
         let n = inner.s.len() as i64;
         let index = if node < 0 { n + node } else { node };
         if !(0..n).contains(&index) {
@@ -352,9 +346,20 @@ pub(crate) fn actuation_jacobian<'py>(
                 &format!("a node index in [-{n}, {n})"),
             ));
         }
-        let j = run(py, "actuation_jacobian", || {
-            softrod::directional_actuation_jacobian(inner, Some(index as usize), direction)
-        })?;
+        let contact = &s.get().contact;
+        let j = if contact.constrained() {
+            // The active contacts and the held tip directions as constraints (their
+            // reactions move with the actuation).
+            run(py, "actuation_jacobian", || {
+                contact
+                    .compliance
+                    .actuation_jacobian(inner, Some(index as usize))
+            })?
+        } else {
+            run(py, "actuation_jacobian", || {
+                softrod::directional_actuation_jacobian(inner, Some(index as usize), direction)
+            })?
+        };
         return Ok(to_array(&j));
     }
     if let Ok(s) = solution.cast::<crate::pcc::PccSolution>() {

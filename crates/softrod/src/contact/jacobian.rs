@@ -11,8 +11,14 @@
 //! along each column are taken by central differences of those few evaluations (no march);
 //! the tip rows use the tip columns. One march replaces the `6 + 4 n_c` marches of forward
 //! differences.
+//!
+//! For the actuation Jacobian the same march carries one forced column per actuator (tension,
+//! then pressure, as in the contact-free sensitivities) and keeps the columns at one observed
+//! node: the rows' derivatives at fixed unknowns along those columns (the contact rows
+//! differenced with the actuator changed in the equations too, since their slope row
+//! evaluates the right-hand side) and the node's twist per unknown and per actuator.
 
-use nalgebra::Vector3;
+use nalgebra::{Vector3, Vector6};
 
 use super::solve::{equations, Constrained, Pass, Site};
 use crate::cosserat::equations::{
@@ -51,24 +57,72 @@ fn head(y: &[f64]) -> [f64; STATE] {
     h
 }
 
+/// What the actuator columns of a march left (see [`Constrained::exact_actuated`]).
+pub(super) struct Actuated {
+    /// Per actuator (tensions, then pressures), the derivative of the residual rows at fixed
+    /// unknowns (per N, per Pa).
+    pub(super) rows: Vec<Vec<f64>>,
+    /// Per actuator, the twist `[δp; δθ]` (m, rad; world) of the observed node at fixed
+    /// unknowns.
+    pub(super) twist: Vec<Vector6<f64>>,
+    /// Per scaled unknown, the twist of the observed node.
+    pub(super) node: Vec<Vector6<f64>>,
+    /// Position of the observed node (m, world).
+    pub(super) position: Vector3<f64>,
+}
+
 impl Constrained<'_> {
     /// The residual rows at `x` and the exact Jacobian (column-major, `dim × dim`, into `j`)
     /// from one march; `None` if the march fails or the columns do not fit in one march (the
     /// caller then differences).
     pub(super) fn exact(&mut self, x: &[f64], mu: f64, j: &mut [f64]) -> Option<Vec<f64>> {
+        self.dispatch(x, mu, j, None).map(|(rows, _)| rows)
+    }
+
+    /// As [`Self::exact`], with the actuator columns and the columns at the node of index
+    /// `observe` (in the order of the march's nodes, those of a solution).
+    pub(super) fn exact_actuated(
+        &mut self,
+        x: &[f64],
+        j: &mut [f64],
+        observe: usize,
+    ) -> Option<(Vec<f64>, Actuated)> {
+        let (rows, act) = self.dispatch(x, 1.0, j, Some(observe))?;
+        Some((rows, act?))
+    }
+
+    fn dispatch(
+        &mut self,
+        x: &[f64],
+        mu: f64,
+        j: &mut [f64],
+        observe: Option<usize>,
+    ) -> Option<(Vec<f64>, Option<Actuated>)> {
         let interior = self.active.iter().filter(|a| a.site != Site::Tip).count();
-        match 6 + 4 * interior {
-            0..=6 => self.wide::<{ width(6) }>(x, mu, j),
-            7..=10 => self.wide::<{ width(10) }>(x, mu, j),
-            11..=14 => self.wide::<{ width(14) }>(x, mu, j),
-            15..=18 => self.wide::<{ width(18) }>(x, mu, j),
-            19..=26 => self.wide::<{ width(26) }>(x, mu, j),
+        let actuators = if observe.is_some() {
+            self.tensions.len() + self.pressures.len()
+        } else {
+            0
+        };
+        match 6 + 4 * interior + actuators {
+            0..=6 => self.wide::<{ width(6) }>(x, mu, j, observe),
+            7..=10 => self.wide::<{ width(10) }>(x, mu, j, observe),
+            11..=14 => self.wide::<{ width(14) }>(x, mu, j, observe),
+            15..=18 => self.wide::<{ width(18) }>(x, mu, j, observe),
+            19..=26 => self.wide::<{ width(26) }>(x, mu, j, observe),
+            27..=34 if observe.is_some() => self.wide::<{ width(34) }>(x, mu, j, observe),
             _ => None,
         }
     }
 
     #[allow(clippy::too_many_lines)] // one march and its chain rule, documented above
-    fn wide<const N: usize>(&mut self, x: &[f64], mu: f64, j: &mut [f64]) -> Option<Vec<f64>> {
+    fn wide<const N: usize>(
+        &mut self,
+        x: &[f64],
+        mu: f64,
+        j: &mut [f64],
+        observe: Option<usize>,
+    ) -> Option<(Vec<f64>, Option<Actuated>)> {
         let model = self.contact_model(x)?;
         let l = self.model.length();
         let fs = self.model.force_scale();
@@ -105,6 +159,18 @@ impl Constrained<'_> {
             next += 4;
         }
         let ncol = next;
+        // The actuator columns follow the unknowns' (only with an observed node).
+        let (nt, nc) = (self.tensions.len(), self.pressures.len());
+        let actuators: Vec<Column> = if observe.is_some() {
+            (0..nt)
+                .map(Column::Tension)
+                .chain((0..nc).map(Column::Pressure))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut columns = vec![Column::Free; ncol];
+        columns.extend_from_slice(&actuators);
         let plan = match self.integrator {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
             Integrator::Adaptive(_) => Vec::new(),
@@ -119,10 +185,11 @@ impl Constrained<'_> {
         let eq = equations(&model, &self.tensions, &self.pressures);
         let nt = model.tendons().len();
         let mut ws = Workspace::new(nt);
-        ws.set_columns(&vec![Column::Free; ncol], &[]);
+        ws.set_columns(&columns, &[]);
         let mut scratch = Workspace::new(nt);
         let y0: [f64; N] = eq.initial(&x[..6]);
         let mut nodes = Vec::new();
+        let mut observed: Option<Vec<f64>> = None;
         let y = {
             let mut ev = Evaluator { eq, ws: &mut ws };
             let mut side = Evaluator {
@@ -167,6 +234,9 @@ impl Constrained<'_> {
                         }
                         site.after = Some((y.to_vec(), interval));
                     }
+                    if observe == Some(nodes.len()) {
+                        observed = Some(y.to_vec());
+                    }
                     nodes.push(crate::cosserat::shooting::Node {
                         s,
                         interval,
@@ -180,7 +250,7 @@ impl Constrained<'_> {
         if !y[..STATE].iter().all(|v| v.is_finite()) || sites.iter().any(|c| c.after.is_none()) {
             return None;
         }
-        let (res, dres) = eq.residual(&y, ncol);
+        let (res, dres) = eq.residual(&y, columns.len());
         let (p_tip, r_tip) = (v3(&y, 0), rot(&y));
         let mut rows = self.tip_rows(&res, &p_tip, &r_tip).to_vec();
         let tip_y = head(&y);
@@ -329,6 +399,101 @@ impl Constrained<'_> {
                 row += size;
             }
         }
+        let actuated = match &observed {
+            None => None,
+            Some(yo) => {
+                let twist_of = |y: &[f64], m: Option<usize>| -> Vector6<f64> {
+                    let Some(m) = m else {
+                        return Vector6::zeros();
+                    };
+                    let b = STATE + COLUMN * m;
+                    let (dp, w) = (v3(y, b), rotation_variation(&rot(y), &col_rot(y, b)));
+                    Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
+                };
+                let node = (0..n).map(|c| twist_of(yo, mcol[c])).collect();
+                let mut out = Actuated {
+                    rows: Vec::with_capacity(actuators.len()),
+                    twist: Vec::with_capacity(actuators.len()),
+                    node,
+                    position: v3(yo, 0),
+                };
+                for (k, col) in actuators.iter().enumerate() {
+                    let m = ncol + k;
+                    let b = STATE + COLUMN * m;
+                    let (dp, w) = (v3(&y, b), rotation_variation(&r_tip, &col_rot(&y, b)));
+                    let mut d = self.tip_rows_dot(&dres[m], &dp, &w, &r_tip).to_vec();
+                    // The actuator's size: the force scale, or the pressure that makes it.
+                    let unit = match *col {
+                        Column::Pressure(q) => {
+                            let (start, _) = model.chamber_extents()[q];
+                            fs / model.chambers()[q].area_at(start)
+                        }
+                        _ => fs,
+                    };
+                    for (a, &(s, yf, kf, yl, kl, f, site, _)) in self.active.iter().zip(&at) {
+                        let (dyf, dyl) = match site {
+                            None => {
+                                let d = column_of(&y, Some(m));
+                                (d, d)
+                            }
+                            Some(i) => (
+                                column_of(&sites[i].before.as_ref()?.0, Some(m)),
+                                column_of(&sites[i].after.as_ref()?.0, Some(m)),
+                            ),
+                        };
+                        let h = ROW_STEP / scale(&dyf).max(scale(&dyl)).max(1.0 / unit);
+                        let side = |t: f64| -> Vec<f64> {
+                            let (mut tp, mut pp) = (self.tensions.clone(), self.pressures.clone());
+                            match *col {
+                                Column::Tension(i) => tp[i] += t,
+                                Column::Pressure(q) => pp[q] += t,
+                                _ => {}
+                            }
+                            let eq2 = equations(&model, &tp, &pp);
+                            let (mut w1, mut w2) = (Workspace::new(nt), Workspace::new(nt));
+                            let mut ev2 = [
+                                Evaluator {
+                                    eq: eq2,
+                                    ws: &mut w1,
+                                },
+                                Evaluator {
+                                    eq: eq2,
+                                    ws: &mut w2,
+                                },
+                            ];
+                            let (mut yf2, mut yl2) = (yf, yl);
+                            for i in 0..STATE {
+                                yf2[i] += t * dyf[i];
+                                yl2[i] += t * dyl[i];
+                            }
+                            let mut buf = Vec::with_capacity(4);
+                            self.contact_rows(
+                                &mut ev2,
+                                a,
+                                s,
+                                (&yf2, kf),
+                                (&yl2, kl),
+                                &f,
+                                1.0,
+                                &mut buf,
+                            );
+                            buf
+                        };
+                        let (plus, minus) = (side(h), side(-h));
+                        d.extend(plus.iter().zip(&minus).map(|(p, q)| (p - q) / (2.0 * h)));
+                    }
+                    if d.len() != n || !d.iter().all(|v| v.is_finite()) {
+                        return None;
+                    }
+                    out.rows.push(d);
+                    out.twist.push(twist_of(yo, Some(m)));
+                }
+                Some(out)
+            }
+        };
+        if observe.is_some() && actuated.is_none() {
+            return None;
+        }
         self.last = Some(Pass {
             model: std::sync::Arc::clone(&model),
             nodes,
@@ -338,7 +503,7 @@ impl Constrained<'_> {
             jacobian: Some((j.to_vec(), twists)),
             marched: None,
         });
-        Some(rows)
+        Some((rows, actuated))
     }
 
     /// The tip compliance at the converged `x` with the active contacts and the tip
