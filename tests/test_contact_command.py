@@ -152,3 +152,123 @@ def test_actuation_jacobian_with_friction_at_a_contact_is_refused_by_name():
     with pytest.raises(softrod.ParameterError, match="friction") as err:
         softrod.actuation_jacobian(sol)
     assert err.value.parameter == "solution"
+
+
+# ------------------------------------------------------------------ inverse statics with obstacles
+
+
+def _admissible(rng):
+    """Random tensions: each segment pulled by at most two of its tendons (N)."""
+    t = np.zeros(6)
+    for seg in range(2):
+        o = rng.integers(3)
+        t[3 * seg + o] = rng.random() * 3.0
+        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
+    return t
+
+
+def _check_contact_solution(sol, obstacles, radius=0.7e-3):
+    """No penetration beyond 1e-9 m and no pulling contact force."""
+    for c in sol.contacts:
+        assert c["normal_force"] >= 0.0
+    for o in obstacles:
+        if isinstance(o, softrod.Sphere):
+            gap = np.linalg.norm(sol.position - np.asarray(o.center), axis=1) - o.radius
+        else:
+            gap = (sol.position - np.asarray(o.point)) @ np.asarray(o.normal)
+        assert (gap - radius).min() >= -1e-9
+
+
+def test_inverse_reaches_a_target_pressed_on_the_sphere_at_a_kkt_point():
+    """The target of a forward contact solve; at the inverse's answer the contact is active,
+    and the tensions solve the minimum-norm program linearised with a finite-difference
+    Jacobian of the contact solve (SciPy's SLSQP): the KKT conditions, checked independently."""
+    scipy_optimize = pytest.importorskip("scipy.optimize")
+    robot = _niti(obstacles=[SPHERE])
+    target = robot.solve(TENSIONS).tip_position
+    inv = softrod.inverse_statics(robot, target)
+    sol = inv.solution
+    assert inv.converged and np.linalg.norm(sol.tip_position - target) <= 1e-9
+    assert np.all(inv.tensions >= 0.0)
+    assert sol.contacts and sol.contacts[0]["normal_force"] > 1e-3
+    _check_contact_solution(sol, [SPHERE])
+    # The Jacobian of the tip position by differences of the contact solve (one-sided for a
+    # tension at its bound).
+    t = inv.tensions
+    h = 1e-6
+    cols = []
+    for i in range(6):
+        up = t.copy()
+        up[i] += h
+        p_up = robot.solve(up, tolerance=1e-14).tip_position
+        if t[i] > h:
+            down = t.copy()
+            down[i] -= h
+            cols.append((p_up - robot.solve(down, tolerance=1e-14).tip_position) / (2 * h))
+        else:
+            cols.append((p_up - robot.solve(t, tolerance=1e-14).tip_position) / h)
+    j = np.array(cols).T
+    b = j @ t
+    qp = scipy_optimize.minimize(
+        lambda x: 0.5 * x @ x,
+        np.ones(6),
+        jac=lambda x: x,
+        constraints=[{"type": "eq", "fun": lambda x: j @ x - b, "jac": lambda x: j}],
+        bounds=[(0.0, None)] * 6,
+        method="SLSQP",
+        options={"ftol": 1e-16, "maxiter": 500},
+    )
+    assert qp.success
+    np.testing.assert_allclose(t, qp.x, rtol=0, atol=1e-6)
+    # Stationarity directly: the free tensions are in the row space of the free columns.
+    free = t > 1e-12
+    lam = np.linalg.lstsq(j[:, free].T, t[free], rcond=None)[0]
+    assert np.linalg.norm(t[free] - j[:, free].T @ lam) <= 1e-6 * np.linalg.norm(t)
+    assert np.all(-(j[:, ~free].T @ lam) >= -1e-6)  # bound multipliers >= 0
+
+
+def _round_trip(robot, obstacles, count, seed):
+    rng = np.random.default_rng(seed)
+    touching, misses = 0, []
+    while touching < count:
+        fwd = robot.solve(_admissible(rng))
+        if not fwd.contacts:
+            continue
+        touching += 1
+        target = fwd.tip_position
+        inv = softrod.inverse_statics(robot, target, throw=False)
+        err = np.linalg.norm(inv.solution.tip_position - target)
+        if not (inv.converged and err <= 1e-9 and np.all(inv.tensions >= 0.0)):
+            misses.append((touching, err, inv.converged))
+            continue
+        _check_contact_solution(inv.solution, obstacles)
+    return misses
+
+
+def test_round_trip_of_targets_resting_on_a_plane():
+    plane = softrod.Plane((0.05, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    misses = _round_trip(_niti(obstacles=[plane]), [plane], 12, 3)
+    assert not misses, misses
+
+
+@pytest.mark.slow
+def test_round_trip_of_many_targets_resting_on_a_plane():
+    plane = softrod.Plane((0.05, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    misses = _round_trip(_niti(obstacles=[plane]), [plane], 300, 4)
+    assert len(misses) <= 3, misses
+
+
+def test_a_path_with_obstacles_is_tracked_and_errors_are_named():
+    robot = _niti(obstacles=[SPHERE])
+    target = robot.solve(TENSIONS).tip_position
+    targets = np.array([target, target + np.array([0.0, 0.0, 1e-3])])
+    path = softrod.inverse_statics_path(robot, targets)
+    assert path.converged.all()
+    assert np.abs(path.tip_position - targets).max() <= 1e-9
+    rough = _niti(obstacles=[softrod.Sphere((0.06, 0.0, 0.3), 0.04, friction=0.2)])
+    with pytest.raises(softrod.ParameterError, match=r"obstacles\[0\]") as err:
+        softrod.inverse_statics(rough, target)
+    assert err.value.parameter == "robot"
+    with pytest.raises(softrod.TargetUnreachableError) as err:
+        softrod.inverse_statics(robot, (0.3, 0.3, 0.0))
+    assert err.value.distance > 0.05

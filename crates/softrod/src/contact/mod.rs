@@ -13,6 +13,7 @@
 mod actuation;
 mod constraint;
 mod friction;
+mod inverse;
 mod jacobian;
 mod mesh;
 mod obstacle;
@@ -26,6 +27,7 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 
 pub use constraint::TipConstraint;
+pub use inverse::{contact_inverse_statics, solve_contact_inverse, ContactForward};
 pub use obstacle::{Obstacle, TriangleMesh};
 pub use solve::{solve_constrained, MAX_ACTIVE_SET_ROUNDS};
 
