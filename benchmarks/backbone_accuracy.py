@@ -23,7 +23,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
-from arm_photos import SIZES, centreline_errors, render_seed_arm, thin_radius  # noqa: E402
+from arm_photos import SIZES, centreline_errors, render_published_arm, thin_radius  # noqa: E402
 
 import softrod  # noqa: E402
 
@@ -47,7 +47,7 @@ def main() -> None:
     for size in SIZES:
         for background in ("dark", "light"):
             for tension in (0.5, 1.0, 2.0, 3.0, 4.0):
-                photo = render_seed_arm(tension, size, background=background, seed=11)
+                photo = render_published_arm(tension, size, background=background, seed=11)
                 bb = softrod.extract_backbone(
                     photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
                 )
@@ -56,7 +56,7 @@ def main() -> None:
     print(f"worst of the 20 cases: {worst}")
     for size in SIZES:
         for background in ("dark", "light"):
-            photo = render_seed_arm(1.0, size, background=background, clamp=0.04, seed=8)
+            photo = render_published_arm(1.0, size, background=background, clamp=0.04, seed=8)
             bb = softrod.extract_backbone(
                 photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
             )
@@ -67,25 +67,27 @@ def main() -> None:
                 keep=(0.0, 0.975),
             )
     for background in ("dark", "light"):
-        photo = render_seed_arm(2.0, "1MP", background=background, touching=True, seed=9)
+        photo = render_published_arm(2.0, "1MP", background=background, touching=True, seed=9)
         bb = softrod.extract_backbone(
             photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
         )
         _row(f"1MP, {background} floor, float touching the arm", photo, bb)
     scale = SIZES["0.3MP"][1]
     for background in ("dark", "light"):
-        photo = render_seed_arm(
+        photo = render_published_arm(
             2.0, radius=lambda s: thin_radius(s, scale), background=background, blur=1.0, seed=3
         )
         bb = softrod.extract_backbone(photo.image, base=photo.base)
         _row(f"thin arm (5 to 3 px wide), {background} floor", photo, bb)
     for background in ("dark", "light"):
-        photo = render_seed_arm(3.0, "1MP", background=background, blur=2.0, noise=0.05, seed=7)
+        photo = render_published_arm(
+            3.0, "1MP", background=background, blur=2.0, noise=0.05, seed=7
+        )
         bb = softrod.extract_backbone(photo.image, base=photo.base)
         _row(f"1MP, {background} floor, blur 2 px, noise 5 %", photo, bb)
 
     # The docs' sample photo, saved as a camera would (JPEG), and what comes out of it.
-    photo = render_seed_arm(2.0, "0.3MP", seed=11)
+    photo = render_published_arm(2.0, "0.3MP", seed=11)
     out = ROOT / "python" / "softrod" / "examples" / "data" / "photos" / "cable-arm-2N.jpg"
     out.parent.mkdir(exist_ok=True)
     iio.imwrite(out, photo.image, quality=90)
@@ -99,7 +101,7 @@ def main() -> None:
     )
 
     # The figure: a photo with a clamp over the base and a float on the arm.
-    photo = render_seed_arm(3.0, "0.3MP", clamp=0.04, touching=True, seed=9)
+    photo = render_published_arm(3.0, "0.3MP", clamp=0.04, touching=True, seed=9)
     bb = softrod.extract_backbone(
         photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
     )

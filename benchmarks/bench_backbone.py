@@ -18,7 +18,7 @@ from _timing import median_time
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-from arm_photos import centreline_errors, render_seed_arm
+from arm_photos import centreline_errors, render_published_arm
 from scipy import ndimage
 from skimage.filters import threshold_otsu
 
@@ -53,7 +53,7 @@ def main() -> None:
         ("1MP", 4.0, {"background": "light"}),
         ("1MP", 1.0, {"clamp": 0.04}),
     ]:
-        photo = render_seed_arm(tension, size, seed=1, **kw)
+        photo = render_published_arm(tension, size, seed=1, **kw)
         h, w = photo.image.shape
         label = f"{size} ({w}x{h}), T = {tension:g} N" + "".join(
             f", {k} {v}" for k, v in kw.items()

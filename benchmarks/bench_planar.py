@@ -1,4 +1,4 @@
-"""Benchmark of the seed-000 planar arm from Python; prints a table of medians.
+"""Benchmark of the planar cable-arm paper's arm from Python; prints a table of medians.
 
 Run: ``python benchmarks/bench_planar.py`` (after ``pip install .``). The Rust-side numbers
 come from ``cargo bench -p softrod --bench planar``.
@@ -21,7 +21,7 @@ def main() -> None:
     args = p.parse_args()
     reps = 3 if args.quick else args.repeats
 
-    arm = softrod.PlanarCableArm.seed_arm()
+    arm = softrod.PlanarCableArm.published_arm()
     tensions = np.linspace(0.0, 5.0, 10_000)
     rows: list[tuple[str, float, str]] = []
 

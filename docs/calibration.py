@@ -23,17 +23,17 @@ import numpy as np
 import softrod
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
-from arm_photos import render_seed_arm
+from arm_photos import render_published_arm
 
 TENSIONS = (1.0, 2.0, 3.0)  # N
-TRUE = {"youngs_modulus": 110e3, "offset_ratio": 1 / 3}  # the rendered arm (seed_arm)
+TRUE = {"youngs_modulus": 110e3, "offset_ratio": 1 / 3}  # the rendered arm (published_arm)
 START = softrod.PlanarCableArm(0.27, 0.015, 0.0074, 0.25, 70e3)  # a guessed model
 
 
 def photographs(seed: int = 0):
     photos, backbones = [], []
     for i, t in enumerate(TENSIONS):
-        photo = render_seed_arm(t, seed=seed + i)
+        photo = render_published_arm(t, seed=seed + i)
         bb = softrod.extract_backbone(
             photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
         )

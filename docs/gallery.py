@@ -34,14 +34,14 @@ def main(out: Path) -> list[Path]:
         written.append(path)
 
     niti = softrod.load_robot(ROBOTS / "niti_two_segment.toml")
-    pneu = softrod.load_robot(ROBOTS / "seed001_pneumatic_arm.toml")
-    arm = softrod.load_robot(ROBOTS / "seed000_arm.toml")
+    pneu = softrod.load_robot(ROBOTS / "pneumatic_arm.toml")
+    arm = softrod.load_robot(ROBOTS / "tapered_cable_arm.toml")
     niti_sol, pneu_sol = niti.solve(), pneu.solve()
 
     save(plot.plot_robot(niti, niti_sol, projections=True), "robot_niti.png")
     save(plot.plot_robot(pneu, pneu_sol, projections=True), "robot_pneumatic.png")
     save(plot.plot_planar_rod(arm.solve(), robot=arm), "planar_rod_arm.png")
-    planar = softrod.PlanarCableArm.seed_arm()
+    planar = softrod.PlanarCableArm.published_arm()
     save(plot.plot_planar(planar, [planar.solve(t) for t in (0.5, 1, 2, 4)]), "planar_arm.png")
     obstacles = [{"type": "sphere", "center": [0.08, 0.16, 0.25], "radius": 0.03}]
     save(plot.plot_robot(niti, niti_sol, obstacles=obstacles), "robot_obstacle.png")

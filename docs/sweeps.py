@@ -28,7 +28,7 @@ TENSION = np.linspace(0.0, 4.0, 81)  # N
 
 
 def run(scheduler=None):
-    arm = softrod.examples.load("seed000_arm")
+    arm = softrod.examples.load("tapered_cable_arm")
     return softrod.sweep(
         arm,
         design={"rod.section.tip_radius": TAPER * BASE_RADIUS, "tendons[0].ratio": OFFSET},

@@ -59,7 +59,7 @@ fig.savefig("docs/figures/compliance_workspace_tangent.png", dpi=110)
 
 # The compliance-methodology paper's Fig. 1e in kind: the pneumatic arm with pairs 1 and 2
 # pressurised together.
-arm = softrod.examples.load("seed001_pneumatic_arm")
+arm = softrod.examples.load("pneumatic_arm")
 pressures = [0, 10, 20, 30, 40]
 comps = []
 for p in pressures:

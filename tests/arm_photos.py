@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 
 import softrod
 
-ARM = softrod.PlanarCableArm.seed_arm()
+ARM = softrod.PlanarCableArm.published_arm()
 
 #: Image sizes of the accuracy tests: ~0.3 MP and ~1 MP, with the scale that fits every
 #: tension of the planar cable-arm paper's arm in the frame (m per pixel).
@@ -281,7 +281,7 @@ def render_backbone(
     )
 
 
-def render_seed_arm(
+def render_published_arm(
     tension: float,
     size: str = "0.3MP",
     *,
@@ -290,7 +290,7 @@ def render_seed_arm(
     radius=None,
     **kwargs,
 ) -> Photo:
-    """A photo of the planar cable-arm paper's arm (``PlanarCableArm.seed_arm()``) at a cable
+    """A photo of the planar cable-arm paper's arm (``PlanarCableArm.published_arm()``) at a cable
     tension (N): ``size`` picks the image shape and scale (or give ``shape`` and ``scale``),
     ``radius(s)`` (m) replaces the arm's taper, and the other keywords go to
     :func:`render_backbone`."""

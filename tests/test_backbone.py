@@ -4,7 +4,7 @@ import pickle
 
 import numpy as np
 import pytest
-from arm_photos import ARM, SIZES, centreline_errors, render_seed_arm, thin_radius
+from arm_photos import ARM, SIZES, centreline_errors, render_published_arm, thin_radius
 
 import softrod
 from softrod import ParameterError
@@ -27,7 +27,7 @@ def _extract(photo, **kwargs):
 @pytest.mark.parametrize("background", ["dark", "light"])
 @pytest.mark.parametrize("tension", TENSIONS)
 def test_centreline_within_issue_tolerances(tension, background, size):
-    photo = render_seed_arm(tension, size, background=background, seed=11)
+    photo = render_published_arm(tension, size, background=background, seed=11)
     bb = _extract(photo)
     err = centreline_errors(photo, bb.pixels, keep=(0.025, 0.975))
     assert err["rms"] <= RMS_MAX and err["max"] <= MAX_MAX and err["tip"] <= TIP_MAX, err
@@ -62,7 +62,7 @@ def test_metric_frame_straight_arm_along_known_direction():
     d = np.array([np.cos(ang), -np.sin(ang)])  # up and to the right on the image
     scale = SIZES["0.3MP"][1]
     base = np.array([70.0, 400.0])
-    photo = render_seed_arm(0.0, "0.3MP", base=base, direction=d, seed=2)
+    photo = render_published_arm(0.0, "0.3MP", base=base, direction=d, seed=2)
     bb = softrod.extract_backbone(photo.image, scale=scale, base=base, direction=d)
     assert bb.unit == "m" and bb.quality.direction_source == "given"
     np.testing.assert_allclose(bb.points[0], [0.0, 0.0], atol=0.5 * scale)
@@ -87,7 +87,7 @@ def test_metric_y_is_turned_plus_90_degrees_as_seen_on_the_image(direction, side
     # it curls to the side the frame's definition names (top of the image for rightward).
     scale = 0.27 / 420
     base = {"up": (60, 420), "right": (150, 60), "down": (540, 180), "left": (450, 540)}[side]
-    photo = render_seed_arm(
+    photo = render_published_arm(
         2.0,
         shape=(600, 600),
         scale=scale,
@@ -109,13 +109,13 @@ def test_ordering_without_base_border_and_wider_end():
     shape, scale = SIZES["0.3MP"]
     # The arm enters from the left border: that end is the base.
     base = np.array([-15.0, shape[0] - 1 - 0.04 / scale])
-    photo = render_seed_arm(2.0, "0.3MP", base=base, seed=5)
+    photo = render_published_arm(2.0, "0.3MP", base=base, seed=5)
     bb = softrod.extract_backbone(photo.image)
     assert bb.unit == "px" and bb.quality.base_source == "border"
     assert abs(bb.pixels[0, 0] + 0.5) < 0.5  # on the image's left edge
     assert np.hypot(*(bb.pixels[-1] - photo.tip)) <= TIP_MAX
     # A free flat base inside the image: the wider end is the base, in any orientation.
-    photo = render_seed_arm(3.0, "0.3MP", seed=6)
+    photo = render_published_arm(3.0, "0.3MP", seed=6)
     for k in range(4):
         img = np.rot90(photo.image, k)
         bb = softrod.extract_backbone(img)
@@ -136,7 +136,7 @@ def _rot90_point(p, k, shape):
 @pytest.mark.parametrize("background", ["dark", "light"])
 @pytest.mark.parametrize("size", list(SIZES))
 def test_occluded_base_is_extrapolated_to_the_given_base(background, size):
-    photo = render_seed_arm(1.0, size, background=background, clamp=0.04, seed=8)
+    photo = render_published_arm(1.0, size, background=background, clamp=0.04, seed=8)
     bb = _extract(photo)
     q = bb.quality
     assert q.base_extrapolated and q.extrapolated_length > 0
@@ -152,7 +152,7 @@ def test_occluded_base_is_extrapolated_to_the_given_base(background, size):
 
 @pytest.mark.parametrize("background", ["dark", "light"])
 def test_distractor_touching_the_arm(background):
-    photo = render_seed_arm(2.0, "1MP", background=background, touching=True, seed=9)
+    photo = render_published_arm(2.0, "1MP", background=background, touching=True, seed=9)
     bb = _extract(photo)
     err = centreline_errors(photo, bb.pixels)
     assert err["rms"] <= RMS_MAX and err["max"] <= MAX_MAX and err["tip"] <= TIP_MAX, err
@@ -163,7 +163,7 @@ def test_distractor_touching_the_arm(background):
 def test_thin_arm_of_a_few_pixels():
     scale = SIZES["0.3MP"][1]
     for background in ("dark", "light"):
-        photo = render_seed_arm(
+        photo = render_published_arm(
             2.0, radius=lambda s: thin_radius(s, scale), background=background, blur=1.0, seed=3
         )
         bb = softrod.extract_backbone(photo.image, base=photo.base)
@@ -175,7 +175,7 @@ def test_thin_arm_of_a_few_pixels():
 def test_input_types_agree(tmp_path):
     from skimage import io
 
-    photo = render_seed_arm(1.0, "0.3MP", seed=12)
+    photo = render_published_arm(1.0, "0.3MP", seed=12)
     ref = softrod.extract_backbone(photo.image)
     path = tmp_path / "photo.png"
     io.imsave(path, photo.image, check_contrast=False)
@@ -199,7 +199,7 @@ def test_input_types_agree(tmp_path):
 
 
 def test_rgb_photo():
-    photo = render_seed_arm(3.0, "0.3MP", rgb=True, seed=13)
+    photo = render_published_arm(3.0, "0.3MP", rgb=True, seed=13)
     assert photo.image.shape[2] == 3
     bb = _extract(photo)
     err = centreline_errors(photo, bb.pixels)
@@ -207,9 +207,9 @@ def test_rgb_photo():
 
 
 def test_mask_overrides_segmentation():
-    photo = render_seed_arm(2.0, "0.3MP", seed=14)
+    photo = render_published_arm(2.0, "0.3MP", seed=14)
     # The true silhouette, rendered without blur, noise or distractors: a mask from elsewhere.
-    clean = render_seed_arm(2.0, "0.3MP", blur=1e-3, noise=0.0, n_blobs=0, seed=14)
+    clean = render_published_arm(2.0, "0.3MP", blur=1e-3, noise=0.0, n_blobs=0, seed=14)
     mask = clean.image > 0.5 * (int(clean.image.max()) + int(clean.image.min()))
     bb = softrod.extract_backbone(np.zeros_like(photo.image), mask=mask, base=photo.base)
     assert bb.quality.polarity == "mask"
@@ -218,7 +218,7 @@ def test_mask_overrides_segmentation():
 
 
 def test_tip_leaving_the_image_is_reported():
-    photo = render_seed_arm(0.5, "0.3MP", seed=15)
+    photo = render_published_arm(0.5, "0.3MP", seed=15)
     cut = photo.image[:, :420]  # the tip is near column 530
     bb = softrod.extract_backbone(cut, base=photo.base)
     assert bb.quality.tip_source == "border"
@@ -231,7 +231,7 @@ def test_tip_leaving_the_image_is_reported():
 
 @pytest.fixture(scope="module")
 def backbone():
-    photo = render_seed_arm(2.0, "0.3MP", seed=16)
+    photo = render_published_arm(2.0, "0.3MP", seed=16)
     return _extract(photo), photo
 
 

@@ -13,7 +13,7 @@ import softrod
 from softrod.analysis import calibration as cal
 
 TRUTH = softrod.PlanarCableArm(0.27, 0.015, 0.0074, 0.3, 140e3)
-START = softrod.PlanarCableArm.seed_arm()  # E 110 kPa, a 1/3
+START = softrod.PlanarCableArm.published_arm()  # E 110 kPa, a 1/3
 TENSIONS = (0.5, 1.0, 2.0)
 
 
@@ -152,11 +152,11 @@ def test_standard_errors_match_the_scatter_of_noisy_fits():
 
 
 def test_three_rendered_photos_give_e_within_1_percent_and_a_within_2_percent():
-    from arm_photos import render_seed_arm
+    from arm_photos import render_published_arm
 
     data = []
     for i, t in enumerate((1.0, 2.0, 3.0)):
-        photo = render_seed_arm(t, seed=100 + i)
+        photo = render_published_arm(t, seed=100 + i)
         bb = softrod.extract_backbone(
             photo.image, scale=photo.scale, base=photo.base, direction=photo.direction
         )
@@ -177,9 +177,9 @@ def test_observations_with_separate_actuations_and_backbones_in_pixels():
     points, tensions = [p for _, p in data], [t for t, _ in data]
     c = softrod.calibrate(start, points, ["E"], actuations=tensions, bounds={"E": (1e4, 1e6)})
     assert rel(c.values["youngs_modulus"], 140e3) < 1e-6
-    from arm_photos import render_seed_arm
+    from arm_photos import render_published_arm
 
-    photo = render_seed_arm(1.0)
+    photo = render_published_arm(1.0)
     bb = softrod.extract_backbone(photo.image)
     with pytest.raises(softrod.ParameterError, match="pixels"):
         softrod.calibrate(START, [(1.0, bb)], ["E"])

@@ -24,7 +24,7 @@ from softrod import (
 )
 
 ROOT = Path(__file__).resolve().parents[1]
-ARM = softrod.examples.path("seed001_pneumatic_arm")
+ARM = softrod.examples.path("pneumatic_arm")
 
 
 def test_chamber_fields_and_repr():

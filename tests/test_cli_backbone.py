@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from arm_photos import render_seed_arm
+from arm_photos import render_published_arm
 from skimage import io
 
 import softrod
@@ -15,7 +15,7 @@ from softrod.cli import main
 
 @pytest.fixture(scope="module")
 def photo(tmp_path_factory):
-    shot = render_seed_arm(2.0, "0.3MP", seed=21)
+    shot = render_published_arm(2.0, "0.3MP", seed=21)
     path = tmp_path_factory.mktemp("photos") / "arm.png"
     io.imsave(path, shot.image, check_contrast=False)
     return shot, path

@@ -152,10 +152,10 @@ def test_sweep_options_are_named(argv, option, capsys):
 
 def test_pressures_beside_tensions(capsys):
     p = ["--pressures", *["10e3"] * 6]
-    status, out, _ = _run(["solve", "seed001_pneumatic_arm", *p], capsys)
-    expected = softrod.examples.load("seed001_pneumatic_arm").solve(pressures=[10e3] * 6)
+    status, out, _ = _run(["solve", "pneumatic_arm", *p], capsys)
+    expected = softrod.examples.load("pneumatic_arm").solve(pressures=[10e3] * 6)
     assert status == 0 and f"{expected.tip_position[0]: .9f}" in out
-    status, _, err = _run(["solve", "seed001_pneumatic_arm", "--pressures", "1"], capsys)
+    status, _, err = _run(["solve", "pneumatic_arm", "--pressures", "1"], capsys)
     assert status == 2 and "pressures" in _one_error_line(err)
     for command in ("compliance", "compare", "solve"):
         assert "--pressures" in _options(command) and "--tensions" in _options(command)
@@ -225,7 +225,7 @@ def test_workspace_refuses_an_all_nan_map(tmp_path, capsys):
 
 def test_workspace_of_a_chamber_only_robot_says_it_has_no_tendons(capsys):
     # A tendon-plus-chamber robot is mapped with its chambers (test_trust_defects.py).
-    argv = ["workspace", "seed001_pneumatic_arm", "--sweep", "0:1"]
+    argv = ["workspace", "pneumatic_arm", "--sweep", "0:1"]
     status, _, err = _run(argv, capsys)
     line = _one_error_line(err)
     assert status == 2 and "no tendons" in line and "chambers" in line
@@ -300,3 +300,68 @@ def test_study_runs_outside_the_repository(tmp_path, monkeypatch, capsys):
     data = json.loads((tmp_path / "s.json").read_text())
     assert set(data) == {"hyperelastic", "linear"}
     assert len(list((tmp_path / "figs").glob("*.png"))) == 4
+
+
+def _digest(path):
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.mark.parametrize(
+    "argv, option",
+    [
+        (["planar", "-t", "1", "--plot", "{f}.png"], "--plot"),
+        (["planar", "-t", "1", "--csv", "{f}.csv"], "--csv"),
+        (["solve", "niti_two_segment", "--json", "{f}.json"], "--json"),
+        (["schema", "-o", "{f}.json"], "--output"),
+        (["demo", "--plot", "{f}.png"], "--plot"),
+    ],
+)
+def test_an_existing_file_is_never_overwritten_without_overwrite(argv, option, tmp_path, capsys):
+    # A file the user has (here: text under the output name) survives every command that
+    # would write there; --overwrite replaces it.
+    argv = [a.replace("{f}", str(tmp_path / "mine")) for a in argv]
+    target = next(tmp_path / a.rsplit("/", 1)[-1] for a in argv if "mine" in a)
+    target.write_text("my data\n")
+    before = _digest(target)
+    status, _, err = _run(argv, capsys)
+    line = _one_error_line(err)
+    assert status == 2 and option in line and "exists (pass --overwrite" in line
+    assert _digest(target) == before
+    status, _, _ = _run([*argv, "--overwrite"], capsys)
+    assert status == 0 and _digest(target) != before
+
+
+def test_demo_replaces_its_own_figure_and_no_other_file(tmp_path, monkeypatch, capsys):
+    # The demo run twice in one folder replaces the figure it wrote (marked in the PNG's
+    # metadata); a PNG of the same name that the demo did not write is refused.
+    from PIL import Image
+
+    from softrod.cli._common import DEMO_MARK
+
+    monkeypatch.chdir(tmp_path)
+    png = tmp_path / "softrod-demo.png"
+    assert _run(["demo"], capsys)[0] == 0
+    with Image.open(png) as im:
+        assert im.info.get("Source") == DEMO_MARK
+    assert _run(["demo"], capsys)[0] == 0
+    Image.new("RGB", (4, 4)).save(png)
+    before = _digest(png)
+    status, _, err = _run(["demo"], capsys)
+    assert status == 2 and "exists (pass --overwrite" in _one_error_line(err)
+    assert _digest(png) == before
+
+
+def test_earlier_names_of_the_examples_and_the_published_arm_keep_working(capsys):
+    # The example robots and the planar arm were renamed after the papers; the earlier names
+    # give the same objects.
+    from softrod.examples import ALIASES
+
+    for old, new in ALIASES.items():
+        assert softrod.examples.path(old) == softrod.examples.path(new)
+        assert old not in softrod.examples.names() and new in softrod.examples.names()
+    assert _run(["solve", "seed000_arm"], capsys)[0] == 0
+    a, b = softrod.PlanarCableArm.seed_arm(), softrod.PlanarCableArm.published_arm()
+    assert np.array_equal(a.solve(2.0).x, b.solve(2.0).x)
+    assert softrod.analysis.seed001_study is softrod.analysis.compliance_study

@@ -111,7 +111,7 @@ def _argv(rng: random.Random, tmp: Path, inputs: list[Path]) -> tuple[list[str],
         robot = str(robot_file)
     else:
         robot = rng.choice(
-            ["niti_two_segment", "seed000_arm", "seed001_pneumatic_arm", "nope", "x/y.toml"]
+            ["niti_two_segment", "tapered_cable_arm", "pneumatic_arm", "nope", "x/y.toml"]
         )
     argv = [command]
     if command in ("solve", "compliance", "workspace", "compare", "inverse"):

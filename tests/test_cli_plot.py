@@ -23,7 +23,7 @@ def test_planar_prints_a_table(capsys):
 def test_planar_json_matches_the_api(capsys):
     assert main(["planar", "-t", "1.5", "-n", "11", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    sol = PlanarCableArm.seed_arm().solve(1.5, 11)
+    sol = PlanarCableArm.published_arm().solve(1.5, 11)
     got = data["solutions"][0]
     assert got["tip"] == pytest.approx(list(sol.tip), abs=0, rel=0)
     assert len(got["x"]) == 11 and data["arm"]["length"] == 0.27
@@ -78,7 +78,7 @@ def test_demo_prints_table_and_writes_png(tmp_path, capsys):
 
 
 def test_plot_draws_one_backbone_per_solution():
-    arm = PlanarCableArm.seed_arm()
+    arm = PlanarCableArm.published_arm()
     sols = [arm.solve(t) for t in (0.5, 1.0, 2.0)]
     fig = plot_planar(arm, sols)
     ax = fig.axes[0]

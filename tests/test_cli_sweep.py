@@ -72,7 +72,7 @@ def test_sweep_writes_the_api_result(tmp_path, capsys, monkeypatch):
 
 
 def test_sweep_on_a_local_cluster_equals_in_process(tmp_path, capsys):
-    argv = ["sweep", "seed001_pneumatic_arm", "--pressures", "0=0:3e4:3", "--pressures", "2=0,1e4"]
+    argv = ["sweep", "pneumatic_arm", "--pressures", "0=0:3e4:3", "--pressures", "2=0,1e4"]
     assert _run([*argv, "--out", tmp_path / "a.nc"], capsys)[0] == 0
     status, _, err = _run([*argv, "--scheduler", "local:2", "--out", tmp_path / "b.nc"], capsys)
     assert status == 0, err

@@ -108,7 +108,7 @@ def test_actuation_jacobian_at_an_interior_node_matches_central_differences():
 
 
 def test_pneumatic_actuation_jacobian_matches_central_differences():
-    robot = softrod.load_robot(softrod.examples.path("seed001_pneumatic_arm"))
+    robot = softrod.load_robot(softrod.examples.path("pneumatic_arm"))
     base = np.array([30e3, 30e3, 15e3, 15e3, 5e3, 5e3])
 
     def solve(p):

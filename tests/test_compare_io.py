@@ -7,7 +7,7 @@ from softrod import ParameterError, PlanarCableArm, backbone_distance, read_back
 
 
 def test_distance_of_a_backbone_to_itself_resampled_is_tiny():
-    sol = PlanarCableArm.seed_arm().solve(2.0, 401)
+    sol = PlanarCableArm.published_arm().solve(2.0, 401)
     fine = np.column_stack((sol.x, sol.y))
     coarse = fine[::8]  # 51 points, as if digitised
     d = backbone_distance(fine, coarse)
@@ -18,7 +18,7 @@ def test_distance_of_a_backbone_to_itself_resampled_is_tiny():
 
 
 def test_distance_between_tensions_is_largest_at_the_tip():
-    arm = PlanarCableArm.seed_arm()
+    arm = PlanarCableArm.published_arm()
     a, b = arm.solve(1.0), arm.solve(1.2)
     d = backbone_distance(np.column_stack((a.x, a.y)), np.column_stack((b.x, b.y)), n_index=101)
     assert d.argmax_index == 1.0

@@ -9,7 +9,7 @@ from softrod.plot import plot_models
 
 ROBOTS = softrod.examples.ROBOTS
 NITI = ROBOTS / "niti_two_segment.toml"
-SEED000 = ROBOTS / "seed000_arm.toml"
+TAPERED_ARM = ROBOTS / "tapered_cable_arm.toml"
 
 
 def _loaded_rod(tip_force):
@@ -42,8 +42,8 @@ def test_niti_robot_pcc_applies_and_is_exact_planar_does_not():
         comp["nope"]
 
 
-def test_seed000_arm_planar_applies_pcc_does_not():
-    comp = softrod.compare_models(softrod.load_robot(SEED000), repeats=2)
+def test_tapered_cable_arm_planar_applies_pcc_does_not():
+    comp = softrod.compare_models(softrod.load_robot(TAPERED_ARM), repeats=2)
     pl = comp["planar"]
     assert pl.applies and pl.tip_rotation is None and "anchor=0.27)" in pl.note
     assert 0 < pl.tip_error < 0.05 and 0 < pl.angle_error < 0.5
@@ -79,7 +79,7 @@ def test_bad_arguments_raise_parameter_error():
 
 
 def test_table_lists_models_and_reasons():
-    text = softrod.compare_models(SEED000, repeats=1).table()
+    text = softrod.compare_models(TAPERED_ARM, repeats=1).table()
     lines = text.splitlines()
     assert lines[0].split()[0] == "model" and "time (ms)" in lines[0]
     assert lines[2].startswith("cosserat") and lines[3].startswith("planar")
@@ -95,12 +95,12 @@ def test_cli_prints_table_writes_plot_and_exits(tmp_path, capsys):
     assert png.read_bytes()[:4] == b"\x89PNG" and png.stat().st_size > 10_000
     assert main(["compare", str(NITI), "--tensions", "1", "2"]) == 2
     assert main(["compare", str(tmp_path / "missing.toml")]) == 1
-    assert main(["compare", str(SEED000), "--tensions", "1", "--repeats", "1"]) == 0
+    assert main(["compare", str(TAPERED_ARM), "--tensions", "1", "--repeats", "1"]) == 0
     assert "\nplanar " in capsys.readouterr().out
 
 
 def test_plot_models_draws_every_applicable_model():
-    fig = plot_models(softrod.compare_models(SEED000, repeats=1))
+    fig = plot_models(softrod.compare_models(TAPERED_ARM, repeats=1))
     ax = fig.axes[0]
     labels = [ln.get_label() for ln in ax.get_lines()]
     assert labels[0] == "cosserat" and labels[1].startswith("planar (tip")
@@ -147,7 +147,7 @@ def test_mappings_follow_the_base_pose_and_chambers_split_segments():
 
 
 def test_planar_anchor_is_the_tendon_end():
-    robot = softrod.load_robot(SEED000)
+    robot = softrod.load_robot(TAPERED_ARM)
     data = {**robot.source, "tendons": [{**robot.source["tendons"][0], "end": 0.2}]}
     comp = softrod.compare_models(softrod.Robot.from_dict(data), repeats=1)
     pl = comp["planar"]
@@ -155,5 +155,5 @@ def test_planar_anchor_is_the_tendon_end():
     # Both arms run straight beyond the anchor; they differ by millimetres, as at full length.
     assert (
         0 < pl.tip_error < 0.05
-        and pl.tip_error < softrod.compare_models(SEED000)["planar"].tip_error
+        and pl.tip_error < softrod.compare_models(TAPERED_ARM)["planar"].tip_error
     )

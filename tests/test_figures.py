@@ -21,8 +21,8 @@ from softrod.plot import (
 
 ROBOTS = Path(__file__).resolve().parent.parent / "examples" / "robots"
 NITI = ROBOTS / "niti_two_segment.toml"
-PNEU = ROBOTS / "seed001_pneumatic_arm.toml"
-ARM = ROBOTS / "seed000_arm.toml"
+PNEU = ROBOTS / "pneumatic_arm.toml"
+ARM = ROBOTS / "tapered_cable_arm.toml"
 
 
 def _by_gid(ax, prefix):

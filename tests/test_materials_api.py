@@ -481,15 +481,15 @@ def test_plot_fit_draws_data_fits_and_residuals():
 def test_study_command_runs_both_materials_and_writes_figures(tmp_path, capsys):
 
     from softrod.cli import main
-    from softrod.study import seed001_study
+    from softrod.study import compliance_study
 
-    robot = softrod.examples.path("seed001_pneumatic_arm")
-    res = seed001_study(robot, levels=2, max_pressure=30e3, out_dir=tmp_path, log=None)
+    robot = softrod.examples.path("pneumatic_arm")
+    res = compliance_study(robot, levels=2, max_pressure=30e3, out_dir=tmp_path, log=None)
     assert set(res) == {"hyperelastic", "linear"}
     for r in res.values():
         assert r.pressures.shape == (8, 3) and np.all(np.isfinite(r.max_compliance))
         assert r.gamma_c_tip.shape == (5, 3) and r.centre_periphery_ratio > 0
-    assert len(list(tmp_path.glob("seed001_*.png"))) == 4
+    assert len(list(tmp_path.glob("pneumatic_*.png"))) == 4
     assert (
         main(
             [

@@ -137,7 +137,7 @@ def test_pcc_and_planar_types_pickle():
     )
     np.testing.assert_array_equal(round_trip(sol).frames, sol.frames)
     assert pcc.Robot is pcc.PccRobot
-    arm = softrod.PlanarCableArm.seed_arm()
+    arm = softrod.PlanarCableArm.published_arm()
     p = arm.solve(1.0, method="ode")
     np.testing.assert_array_equal(round_trip(p).x, p.x)
     batch = arm.solve_many([0.5, 1.0], n_points=11)

@@ -6,14 +6,14 @@ import pytest
 import softrod
 from softrod import ConvergenceError, ParameterError, PlanarCableArm
 
-SEED = dict(
+ARM = dict(
     length=0.27, base_radius=0.015, tip_radius=0.0074, offset_ratio=1 / 3, youngs_modulus=110e3
 )
 
 
-def test_constructor_keywords_and_seed_arm_agree():
-    a = PlanarCableArm(**SEED)
-    b = PlanarCableArm.seed_arm()
+def test_constructor_keywords_and_published_arm_agree():
+    a = PlanarCableArm(**ARM)
+    b = PlanarCableArm.published_arm()
     assert a.anchor == pytest.approx(a.length)
     for name in ("length", "base_radius", "tip_radius", "offset_ratio", "youngs_modulus"):
         assert getattr(a, name) == pytest.approx(getattr(b, name))
@@ -21,7 +21,7 @@ def test_constructor_keywords_and_seed_arm_agree():
 
 
 def test_solve_returns_arrays_of_the_requested_length():
-    arm = PlanarCableArm(**SEED)
+    arm = PlanarCableArm(**ARM)
     sol = arm.solve(1.0)
     for name in ("s", "curvature", "strain", "angle", "x", "y"):
         arr = getattr(sol, name)
@@ -35,7 +35,7 @@ def test_solve_returns_arrays_of_the_requested_length():
 
 
 def test_ode_method_and_tolerances():
-    arm = PlanarCableArm(**SEED)
+    arm = PlanarCableArm(**ARM)
     cf = arm.solve(2.0)
     ode = arm.solve(2.0, method="ode", rtol=1e-10, atol=1e-12)
     assert ode.method == "ode" and ode.stats["accepted_steps"] > 0
@@ -43,7 +43,7 @@ def test_ode_method_and_tolerances():
 
 
 def test_strided_arrays_are_accepted():
-    arm = PlanarCableArm(**SEED)
+    arm = PlanarCableArm(**ARM)
     tensions = np.linspace(0.0, 3.0, 12)
     strided = arm.solve_many(tensions[::3], n_points=5)
     np.testing.assert_array_equal(strided.x, arm.solve_many(tensions[::3].copy(), n_points=5).x)
@@ -52,7 +52,7 @@ def test_strided_arrays_are_accepted():
 
 
 def test_custom_samples():
-    arm = PlanarCableArm(**SEED)
+    arm = PlanarCableArm(**ARM)
     s = np.array([0.0, 0.1, 0.2])
     sol = arm.solve(1.0, s=s)
     np.testing.assert_array_equal(sol.s, s)
@@ -61,7 +61,7 @@ def test_custom_samples():
 
 
 def test_solve_many_is_vectorised_and_matches_solve():
-    arm = PlanarCableArm(**SEED)
+    arm = PlanarCableArm(**ARM)
     tensions = np.linspace(0, 3, 7)
     batch = arm.solve_many(tensions, n_points=51)
     assert len(batch) == 7
@@ -78,15 +78,15 @@ def test_solve_many_is_vectorised_and_matches_solve():
 @pytest.mark.parametrize(
     ("kwargs", "name"),
     [
-        (dict(SEED, length=0.0), "length"),
-        (dict(SEED, length=float("nan")), "length"),
-        (dict(SEED, base_radius=-0.01), "base_radius"),
-        (dict(SEED, tip_radius=0.0), "tip_radius"),
-        (dict(SEED, offset_ratio=1.0), "offset_ratio"),
-        (dict(SEED, offset_ratio=-0.2), "offset_ratio"),
-        (dict(SEED, youngs_modulus=0.0), "youngs_modulus"),
-        (dict(SEED, anchor=0.0), "anchor"),
-        (dict(SEED, anchor=0.5), "anchor"),
+        (dict(ARM, length=0.0), "length"),
+        (dict(ARM, length=float("nan")), "length"),
+        (dict(ARM, base_radius=-0.01), "base_radius"),
+        (dict(ARM, tip_radius=0.0), "tip_radius"),
+        (dict(ARM, offset_ratio=1.0), "offset_ratio"),
+        (dict(ARM, offset_ratio=-0.2), "offset_ratio"),
+        (dict(ARM, youngs_modulus=0.0), "youngs_modulus"),
+        (dict(ARM, anchor=0.0), "anchor"),
+        (dict(ARM, anchor=0.5), "anchor"),
     ],
 )
 def test_bad_parameters_raise_value_error_naming_them(kwargs, name):
@@ -114,12 +114,12 @@ def test_bad_parameters_raise_value_error_naming_them(kwargs, name):
 )
 def test_bad_solve_arguments_raise_value_error_naming_them(call, name):
     with pytest.raises(ParameterError) as info:
-        call(PlanarCableArm(**SEED))
+        call(PlanarCableArm(**ARM))
     assert info.value.parameter == name
 
 
 def test_non_convergence_raises_with_iterations_and_residual():
-    arm = PlanarCableArm(**SEED)
+    arm = PlanarCableArm(**ARM)
     with pytest.raises(ConvergenceError) as info:
         arm.solve(1.0, method="ode", rtol=1e-10, atol=1e-12, max_steps=5)
     assert info.value.iterations == 5

@@ -18,7 +18,7 @@ def niti():
 
 
 def test_examples_are_reachable_by_name():
-    assert EXAMPLES == ("niti_two_segment", "seed000_arm", "seed001_pneumatic_arm")
+    assert EXAMPLES == ("niti_two_segment", "pneumatic_arm", "tapered_cable_arm")
     assert softrod.examples.path("niti_two_segment.toml").is_file()
     with pytest.raises(softrod.ParameterError) as info:
         softrod.examples.path("niti_two_segmnt")
@@ -69,7 +69,7 @@ def test_actuation_is_an_input(niti):
     with pytest.raises(softrod.ParameterError) as info:
         niti.solve(tensions=[1.0])
     assert info.value.parameter == "tensions"
-    arm = softrod.examples.load("seed001_pneumatic_arm")
+    arm = softrod.examples.load("pneumatic_arm")
     p = [10e3, 10e3, 0, 0, 0, 0]
     np.testing.assert_array_equal(
         arm.solve(pressures=p).position, arm.with_pressures(p).solve().position
@@ -129,7 +129,7 @@ def test_parameters_by_file_path(niti):
 
 
 def test_with_parameters_returns_a_new_validated_robot(niti):
-    arm = softrod.examples.load("seed000_arm")
+    arm = softrod.examples.load("tapered_cable_arm")
     new = arm.with_parameters({"rod.section.tip_radius": 0.008, "rod.material.youngs_modulus": 2e5})
     assert new.parameter("rod.section.tip_radius") == 0.008
     assert arm.parameter("rod.section.tip_radius") == 0.0074
@@ -141,7 +141,7 @@ def test_with_parameters_returns_a_new_validated_robot(niti):
         "distance = 0.01\nangle_deg = 210.0\n", "distance = 0.012\nangle_deg = 210.0\n", 1
     )
     assert Robot.from_toml(text) == moved
-    pneumatic = softrod.examples.load("seed001_pneumatic_arm")
+    pneumatic = softrod.examples.load("pneumatic_arm")
     assert pneumatic.with_parameters({"chambers[1].pressure": 5e3}).chambers[1].pressure == 5e3
     loaded = niti.with_parameters({"loads.tip_force": np.array([0.0, 0.01, 0.0])})
     assert loaded.parameter("loads.tip_force") == [0.0, 0.01, 0.0]

@@ -162,7 +162,7 @@ def test_package_layout_and_earlier_module_paths():
     import softrod.study
     import softrod.workspace
 
-    assert softrod.study.seed001_study is softrod.analysis.study.seed001_study
+    assert softrod.study.compliance_study is softrod.analysis.study.compliance_study
     assert softrod.workspace.workspace_map is softrod.workspace_map
     assert callable(softrod.cli.main) and callable(softrod.plot.plot_rod)
     assert softrod.io.read_backbone_csv is softrod.read_backbone_csv

@@ -58,7 +58,7 @@ def test_grid_sweep_equals_single_solves_under_the_warm_start_rule():
 
 
 def test_chambers_and_pressures_are_swept_like_tendons():
-    robot = softrod.examples.load("seed001_pneumatic_arm")
+    robot = softrod.examples.load("pneumatic_arm")
     p = np.linspace(0.0, 3e4, 3)
     ds = softrod.sweep(
         robot,
@@ -137,7 +137,7 @@ def test_values_at_arc_lengths_are_the_compliance_at_the_mesh_nodes():
 
 
 def test_infeasible_designs_complete_and_are_marked():
-    arm = softrod.examples.load("seed000_arm").with_parameters(
+    arm = softrod.examples.load("tapered_cable_arm").with_parameters(
         {"solver": {"integrator": "rk4", "steps": 30}}
     )
     ds = softrod.sweep(
@@ -161,7 +161,7 @@ def test_infeasible_designs_complete_and_are_marked():
 
 def test_failed_samples_are_recorded_not_dropped():
     # A thin, strongly tapered arm curls into itself at high tension: the solver reports it.
-    arm = softrod.examples.load("seed000_arm").with_parameters(
+    arm = softrod.examples.load("tapered_cable_arm").with_parameters(
         {
             "solver": {"integrator": "rk4", "steps": 40},
             "rod.section.tip_radius": 0.004,
@@ -272,7 +272,7 @@ def test_killing_a_dask_worker_loses_no_sample():
     import time
 
     distributed = pytest.importorskip("distributed")
-    arm = softrod.examples.load("seed000_arm")
+    arm = softrod.examples.load("tapered_cable_arm")
     kw = dict(
         actuation={"tendons[0].tension": np.linspace(0.0, 2.0, 1024)},
         design={"tendons[0].ratio": np.linspace(0.1, 0.5, 24)},

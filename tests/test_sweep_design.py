@@ -77,7 +77,7 @@ def test_design_summary_over_a_synthetic_sweep():
 
 
 def test_design_summary_of_a_real_sweep():
-    arm = softrod.examples.load("seed000_arm").with_parameters(
+    arm = softrod.examples.load("tapered_cable_arm").with_parameters(
         {"solver": {"integrator": "rk4", "steps": 30}}
     )
     ds = softrod.sweep(

@@ -280,12 +280,12 @@ def test_yeoh_stress_overflow():
 
 
 def test_planar_radius_of_nan():
-    _finite_or_named(lambda: softrod.PlanarCableArm.seed_arm().radius([math.nan]), "s")
+    _finite_or_named(lambda: softrod.PlanarCableArm.published_arm().radius([math.nan]), "s")
 
 
 def test_planar_radius_beyond_the_arm_is_a_named_error():
     with pytest.raises(ValueError) as e:
-        softrod.PlanarCableArm.seed_arm().radius([1e3])
+        softrod.PlanarCableArm.published_arm().radius([1e3])
     assert _named(e.value, "s")
 
 

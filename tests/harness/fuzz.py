@@ -347,24 +347,26 @@ def _define_targets() -> None:
         )
     )
     t("PlanarCableArm.radius")(
-        lambda d: (sr.PlanarCableArm.seed_arm().radius, dict(s=[0.0, 0.1, 0.27]))
+        lambda d: (sr.PlanarCableArm.published_arm().radius, dict(s=[0.0, 0.1, 0.27]))
     )
-    t("PlanarCableArm.radius(scalar)")(lambda d: (sr.PlanarCableArm.seed_arm().radius, dict(s=0.1)))
+    t("PlanarCableArm.radius(scalar)")(
+        lambda d: (sr.PlanarCableArm.published_arm().radius, dict(s=0.1))
+    )
     t("PlanarCableArm.solve")(
         lambda d: (
-            sr.PlanarCableArm.seed_arm().solve,
+            sr.PlanarCableArm.published_arm().solve,
             dict(tension=1.0, n_points=21, method="ode", rtol=1e-8, atol=1e-10, max_steps=100000),
         )
     )
     t("PlanarCableArm.solve(s)")(
         lambda d: (
-            sr.PlanarCableArm.seed_arm().solve,
+            sr.PlanarCableArm.published_arm().solve,
             dict(tension=1.0, s=[0.0, 0.1, 0.2], method="closed-form"),
         )
     )
     t("PlanarCableArm.solve_many")(
         lambda d: (
-            sr.PlanarCableArm.seed_arm().solve_many,
+            sr.PlanarCableArm.published_arm().solve_many,
             dict(
                 tensions=[0.5, 1.0],
                 n_points=21,
@@ -377,7 +379,7 @@ def _define_targets() -> None:
     )
     t("PlanarCableArm.solve_many(s)")(
         lambda d: (
-            sr.PlanarCableArm.seed_arm().solve_many,
+            sr.PlanarCableArm.published_arm().solve_many,
             dict(tensions=[0.5, 1.0], s=[0.0, 0.1, 0.2]),
         )
     )
@@ -386,7 +388,7 @@ def _define_targets() -> None:
             sr.write_samples_csv,
             dict(
                 path=str(d / "samples.csv"),
-                solutions=[sr.PlanarCableArm.seed_arm().solve(1.0, n_points=11)],
+                solutions=[sr.PlanarCableArm.published_arm().solve(1.0, n_points=11)],
             ),
         )
     )
@@ -829,6 +831,7 @@ def _define_targets() -> None:
         lambda d: (sr.Robot.from_spec, dict(spec=_niti().spec, name="r", source="file.toml"))
     )
     t("Robot.to_toml")(lambda d: (_niti().to_toml, {}))
+    t("PlanarCableArm.published_arm")(lambda d: (sr.PlanarCableArm.published_arm, {}))
     t("PlanarCableArm.seed_arm")(lambda d: (sr.PlanarCableArm.seed_arm, {}))
     t("TensileCurve.initial_slope")(lambda d: (sr.TensileCurve(*_curve_data()).initial_slope, {}))
     t("Robot.from_dict")(lambda d: (sr.Robot.from_dict, dict(data=_robot_dict(), name="r")))
@@ -873,13 +876,13 @@ def _define_targets() -> None:
         )
     )
     t("PlanarCableArm.sensitivities")(
-        lambda d: (sr.PlanarCableArm.seed_arm().sensitivities, dict(tension=1.0, s=[0.0, 0.1]))
+        lambda d: (sr.PlanarCableArm.published_arm().sensitivities, dict(tension=1.0, s=[0.0, 0.1]))
     )
     t("calibrate")(
         lambda d: (
             sr.calibrate,
             dict(
-                robot=sr.PlanarCableArm.seed_arm(),
+                robot=sr.PlanarCableArm.published_arm(),
                 measurements=_planar_shapes(),
                 parameters=["youngs_modulus", "offset_ratio"],
                 bounds={"youngs_modulus": (1e4, 1e6)},
@@ -896,7 +899,7 @@ def _define_targets() -> None:
         lambda d: (
             sr.calibrate,
             dict(
-                robot=sr.PlanarCableArm.seed_arm(),
+                robot=sr.PlanarCableArm.published_arm(),
                 measurements=[p for _, p in _planar_shapes()],
                 parameters=["E"],
                 metric="nearest",
@@ -906,7 +909,7 @@ def _define_targets() -> None:
     )
     t("Calibration.interval")(
         lambda d: (
-            sr.calibrate(sr.PlanarCableArm.seed_arm(), _planar_shapes(), ["E", "a"]).interval,
+            sr.calibrate(sr.PlanarCableArm.published_arm(), _planar_shapes(), ["E", "a"]).interval,
             dict(level=0.9),
         )
     )

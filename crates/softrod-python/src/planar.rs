@@ -217,10 +217,16 @@ impl PlanarCableArm {
 
     /// The paper's experimental arm (L 270 mm, R0 15 mm, RL 7.4 mm, a 1/3, E 110 kPa).
     #[staticmethod]
-    fn seed_arm() -> Self {
+    fn published_arm() -> Self {
         Self {
-            inner: softrod::PlanarCableArm::seed_arm(),
+            inner: softrod::PlanarCableArm::published_arm(),
         }
+    }
+
+    /// The same arm as `published_arm()` (its earlier name, kept working).
+    #[staticmethod]
+    fn seed_arm() -> Self {
+        Self::published_arm()
     }
 
     #[getter]

@@ -9,9 +9,9 @@ use softrod::{solve_planar, solve_planar_many, uniform_samples, PlanarCableArm, 
 use std::hint::black_box;
 
 fn planar(c: &mut Criterion) {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 201).unwrap();
-    let mut g = c.benchmark_group("planar_seed_arm_201_samples");
+    let mut g = c.benchmark_group("planar_published_arm_201_samples");
     for t in [1.0, 5.0] {
         g.bench_function(format!("closed_form_T{t}"), |b| {
             b.iter(|| solve_planar(&arm, black_box(t), &s, PlanarMethod::ClosedForm).unwrap())

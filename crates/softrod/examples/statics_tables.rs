@@ -31,7 +31,7 @@ fn tight() -> SolveOptions {
 
 fn main() {
     // The planar cable-arm paper: L = 0.27 m, R0 = 15 mm, RL = 7.4 mm, a = 1/3, E = 110 kPa, cable at the tip.
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let rod = Rod::new(
         arm.length(),
         Section::tapered_circular(arm.base_radius(), arm.tip_radius()).unwrap(),

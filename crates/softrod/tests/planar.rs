@@ -45,7 +45,7 @@ fn rk4_reference(arm: &PlanarCableArm, t: f64, s_out: f64, n: usize) -> (f64, f6
 
 #[test]
 fn ode_path_matches_closed_form_to_1e_8() {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 201).unwrap();
     for t in TENSIONS {
         let cf = solve_planar(&arm, t, &s, PlanarMethod::ClosedForm).unwrap();
@@ -66,7 +66,7 @@ fn ode_path_matches_closed_form_to_1e_8() {
 #[test]
 fn published_ode_is_the_derivative_of_the_closed_form() {
     // Central difference of the closed form vs the printed right-hand side.
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     for t in TENSIONS {
         for i in 1..20 {
             let s = arm.length() * i as f64 / 20.0;
@@ -90,7 +90,7 @@ fn published_ode_is_the_derivative_of_the_closed_form() {
 
 #[test]
 fn zero_tension_is_straight_with_length_l() {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 11).unwrap();
     for m in [PlanarMethod::ClosedForm, ode(1e-8, 1e-10)] {
         let sol = solve_planar(&arm, 0.0, &s, m).unwrap();
@@ -151,7 +151,7 @@ fn untapered_arm_is_an_exact_circular_arc() {
 
 #[test]
 fn backbone_is_accurate_to_1e_9_m_at_201_samples() {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 201).unwrap();
     for t in TENSIONS {
         let sol = solve_planar(&arm, t, &s, PlanarMethod::ClosedForm).unwrap();
@@ -175,7 +175,7 @@ fn coarse_sampling_does_not_lose_accuracy() {
     // The panels are set by the curvature and the taper, not by the output spacing: with 2,
     // 3 or 11 samples the tip is as accurate as with 201, at low tension (slowly turning,
     // strongly tapered) as at high tension, for both evaluation paths.
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     for t in [0.001, 0.01, 0.05, 0.1, 0.5, 1.0, 5.0, 20.0] {
         let r = rk4_reference(&arm, t, arm.length(), 1 << 15);
         for n in [2, 3, 11] {
@@ -212,7 +212,7 @@ fn anchor_before_tip_leaves_a_straight_distal_part() {
 
 #[test]
 fn scaling_lengths_by_lambda_and_tension_by_lambda_squared_gives_a_similar_shape() {
-    let base = PlanarCableArm::seed_arm();
+    let base = PlanarCableArm::published_arm();
     let s = uniform_samples(base.length(), 101).unwrap();
     let a = solve_planar(&base, 1.5, &s, PlanarMethod::ClosedForm).unwrap();
     for lam in [0.1, 3.0] {
@@ -238,7 +238,7 @@ fn scaling_lengths_by_lambda_and_tension_by_lambda_squared_gives_a_similar_shape
 
 #[test]
 fn tip_angle_grows_monotonically_with_tension() {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 2).unwrap();
     let tensions: Vec<f64> = (0..=100).map(|i| 5.0 * i as f64 / 100.0).collect();
     let b = solve_planar_many(&arm, &tensions, &s, PlanarMethod::ClosedForm).unwrap();
@@ -259,7 +259,7 @@ fn tip_angle_grows_monotonically_with_tension() {
 
 #[test]
 fn batch_equals_individual_solves() {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 33).unwrap();
     let tensions: Vec<f64> = (0..300).map(|i| 0.01 * i as f64).collect();
     for m in [PlanarMethod::ClosedForm, ode(1e-8, 1e-10)] {
@@ -305,7 +305,7 @@ fn bad_input_names_the_parameter() {
         let e = PlanarCableArm::new(p[0], p[1], p[2], p[3], p[4], anchor).unwrap_err();
         assert_eq!(name_of(e), name);
     }
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 5).unwrap();
     for t in [-1.0, f64::NAN, f64::INFINITY, 1e6] {
         let e = solve_planar(&arm, t, &s, PlanarMethod::ClosedForm).unwrap_err();
@@ -322,7 +322,7 @@ fn bad_input_names_the_parameter() {
 
 #[test]
 fn ode_non_convergence_reports_iterations() {
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let s = uniform_samples(arm.length(), 5).unwrap();
     let m = PlanarMethod::Ode(AdaptiveOptions {
         rtol: 1e-10,

@@ -406,14 +406,14 @@ fn helical_tendon_bends_out_of_plane_with_its_handedness() {
 }
 
 #[test]
-fn seed_000_arm_agrees_to_the_order_of_its_linearisation() {
+fn published_arm_agrees_to_the_order_of_its_linearisation() {
     use softrod::{solve_planar, PlanarCableArm, PlanarMethod, Routing};
     // The paper's planar model takes the cable moment as T d (1 - d k) per *deformed* length and
     // neglects shear; the 3-D rod uses the exact tendon direction per *undeformed* length.
     // Their relative difference is of the order of the terms the paper linearises, |q| + d k
     // (both O(T)); with the rod made shear-rigid like the paper, it must stay below their
     // maximum along the arm, and shrink linearly with T.
-    let arm = PlanarCableArm::seed_arm();
+    let arm = PlanarCableArm::published_arm();
     let rod = Rod::new(
         arm.length(),
         Section::tapered_circular(arm.base_radius(), arm.tip_radius()).unwrap(),

@@ -8,7 +8,7 @@ from .compare import BackboneDistance, backbone_distance
 from .design import Pareto, design_summary
 from .materials import TensileCurve, read_tensile_csv
 from .models import ModelComparison, ModelResult, compare_models
-from .study import seed001_study
+from .study import compliance_study, seed001_study
 from .sweep import SampleTable, samples, sweep
 from .workspace import WorkspaceMap, tension_grid, workspace_map
 
@@ -25,6 +25,7 @@ __all__ = [
     "backbone_distance",
     "calibrate",
     "compare_models",
+    "compliance_study",
     "design_summary",
     "read_tensile_csv",
     "samples",

@@ -270,7 +270,7 @@ def _rot(phi: float) -> np.ndarray:
 
 
 class _PlanarModel:
-    """The seed-000 planar arm: core columns (E, a, T, R0, RL) of ``sensitivities``."""
+    """The planar cable-arm paper's arm: core columns (E, a, T, R0, RL) of ``sensitivities``."""
 
     dim = 2
     PARAMETERS: ClassVar[dict[str, str]] = {

@@ -4,11 +4,12 @@ Stiffness over the workspace and ``gamma_c`` vs pressure.
 
 For a robot with three chamber pairs (pressures P1, P2, P3 on chambers 0-1, 2-3, 4-5), solved
 twice — with its hyperelastic material and with the linear material of the same small-strain
-modulus — :func:`seed001_study` sweeps the pair pressures over a grid, takes the tip compliance
-of every configuration (seed eq. 6), decomposes it into eigenscrews and maps the largest
-translational compliance (the translational ellipsoid's largest semi-axis) over the workspace
-(seed Fig. 1d); then it computes ``gamma_c(s)`` along the arm as P1 and P2 rise together
-(seed Fig. 1e). ``softrod study ROBOT.toml`` runs it from the command line.
+modulus — :func:`compliance_study` sweeps the pair pressures over a grid, takes the tip
+compliance of every configuration (the compliance-methodology paper's eq. 6), decomposes it
+into eigenscrews and maps the largest translational compliance (the translational
+ellipsoid's largest semi-axis) over the workspace (its Fig. 1d); then it computes
+``gamma_c(s)`` along the arm as P1 and P2 rise together (its Fig. 1e). ``softrod study
+ROBOT.toml`` runs it from the command line.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from .._core import ConvergenceError, ParameterError, UniaxialLaw
 from ..io.objects import build_material
 from ..robot import Robot, load_robot
 
-__all__ = ["StudyResult", "seed001_study"]
+__all__ = ["StudyResult", "compliance_study", "seed001_study"]
 
 
 @dataclass
@@ -123,7 +124,7 @@ def _run(
     )
 
 
-def seed001_study(
+def compliance_study(
     robot_path: str | os.PathLike[str] | Robot,
     *,
     levels: int = 13,
@@ -132,6 +133,7 @@ def seed001_study(
     out_dir: str | os.PathLike[str] | None = None,
     log: TextIO | Literal["stdout"] | None = "stdout",
     progress: bool | None = False,
+    overwrite: bool = False,
 ) -> dict[str, StudyResult]:
     """Runs the compliance-methodology paper's study (hyperelastic and linear).
 
@@ -144,8 +146,10 @@ def seed001_study(
             per material).
         max_pressure: Largest pair pressure (Pa).
         gamma_pressures: P1 = P2 pressures (Pa) of the ``gamma_c(s)`` curves.
-        out_dir: Folder for the figures (``seed001_workspace_<material>.png``,
-            ``seed001_gamma_c_<material>.png``); ``None`` draws nothing.
+        out_dir: Folder for the figures (``pneumatic_workspace_<material>.png``,
+            ``pneumatic_gamma_c_<material>.png``); ``None`` draws nothing.
+        overwrite: Replace figures of those names already in ``out_dir`` (default: refuse,
+            before any work).
         progress: Progress bars (tqdm) on stderr: True, False, or None for only when stderr
             is a terminal.
         log: Where the summary is printed: ``"stdout"`` (the current ``sys.stdout``, the
@@ -156,6 +160,7 @@ def seed001_study(
 
     Raises:
         ParameterError: A robot without exactly six chambers, or bad arguments.
+        FileExistsError: A figure exists in ``out_dir`` and ``overwrite`` is false.
     """
     if isinstance(log, str) and log == "stdout":
         log = sys.stdout
@@ -165,6 +170,10 @@ def seed001_study(
         raise ParameterError(
             f"invalid parameter `max_pressure` = {max_pressure}: must be finite and > 0 Pa"
         )
+    if out_dir is not None and not overwrite:
+        for path in _figure_paths(out_dir):
+            if os.path.exists(path):
+                raise FileExistsError(17, "exists (pass overwrite=True to replace it)", path)
     robot = robot_path if isinstance(robot_path, Robot) else load_robot(robot_path)
     if len(robot.chambers) != 6:
         raise ParameterError(
@@ -205,6 +214,15 @@ def seed001_study(
     return out
 
 
+def _figure_paths(out_dir) -> list[str]:
+    """The figures the study writes in ``out_dir``, per material: workspace map, gamma_c."""
+    return [
+        os.path.join(out_dir, f"pneumatic_{kind}_{material}.png")
+        for material in ("hyperelastic", "linear")
+        for kind in ("workspace", "gamma_c")
+    ]
+
+
 def _equal_ratio(res: StudyResult, grid: np.ndarray) -> float:
     base = np.flatnonzero(np.all(res.pressures == 0.0, axis=1))[0]
     top = np.flatnonzero(np.all(res.pressures == grid[-1], axis=1))[0]
@@ -232,7 +250,7 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
             title=f"{material}: largest translational tip compliance (m/N), "
             f"P1, P2, P3 in 0-{grid[-1] / 1e3:.0f} kPa",
         )
-        p1 = os.path.join(out_dir, f"seed001_workspace_{material}.png")
+        p1 = os.path.join(out_dir, f"pneumatic_workspace_{material}.png")
         f1.savefig(p1, dpi=110)
         plt.close(f1)
         f2 = plot_gamma_c(
@@ -240,8 +258,12 @@ def _figures(out: dict[str, StudyResult], grid, out_dir, log) -> None:
             labels=[f"P1 = P2 = {p / 1e3:.0f} kPa" for p in res.gamma_c_pressures],
             title=f"{material}: dimensionless flexural compliance along the arm",
         )
-        p2 = os.path.join(out_dir, f"seed001_gamma_c_{material}.png")
+        p2 = os.path.join(out_dir, f"pneumatic_gamma_c_{material}.png")
         f2.savefig(p2, dpi=110)
         plt.close(f2)
         if log is not None:
             print(f"wrote {p1}\nwrote {p2}", file=log)
+
+
+#: The earlier name of :func:`compliance_study`, kept working.
+seed001_study = compliance_study

@@ -2,9 +2,11 @@
 
 Each subcommand declares its file arguments with :func:`files`: ``inputs`` (read), ``outputs``
 (written) and, among them, ``figures`` (written by matplotlib). :func:`check_files` runs on
-them before any work: an output equal to an input or to another output, a figure with an
-extension matplotlib cannot write, or an output in a folder that does not exist is refused
-with a named error.
+them before any work: an output equal to an input or to another output, an existing file
+without ``--overwrite`` (every command with outputs has it), a figure with an extension
+matplotlib cannot write, or an output in a folder that does not exist is refused with a named
+error. The one exception is the figure of ``softrod demo``: a PNG that an earlier demo wrote
+(it carries :data:`DEMO_MARK` in its metadata) is replaced, any other file is not.
 """
 
 from __future__ import annotations
@@ -43,7 +45,14 @@ def files(
     parser: argparse.ArgumentParser, *, inputs=(), outputs=(), figures=(), folders=("out",)
 ) -> None:
     """Declares which destinations of ``parser`` are input and output files (``folders``:
-    the outputs that are folders, by default ``out``)."""
+    the outputs that are folders, by default ``out``) and, for a command with output files,
+    adds ``--overwrite`` (unless the command declared it already)."""
+    if any(d not in folders for d in outputs) and "--overwrite" not in getattr(
+        parser, "_option_string_actions", {}
+    ):
+        parser.add_argument(
+            "--overwrite", action="store_true", help="replace existing output files"
+        )
     parser.set_defaults(
         _inputs=tuple(inputs),
         _outputs=tuple(outputs),
@@ -76,10 +85,9 @@ def resolve_robot(arg: str) -> str:
     if looks_like_path:
         raise FileNotFoundError(2, "No such file or directory", arg)
     try:
-        examples.path(arg)
+        return str(examples.path(arg))  # an earlier name of an example
     except ParameterError as exc:
         raise bad("ROBOT", arg, f"no such file, and {str(exc).split(': ', 1)[1]}") from None
-    raise AssertionError("unreachable")
 
 
 def _same(a: str, b: str) -> bool:
@@ -91,13 +99,31 @@ def _same(a: str, b: str) -> bool:
     return os.path.realpath(a) == os.path.realpath(b)
 
 
+#: PNG metadata (key ``Source``) of the figure ``softrod demo`` writes: the demo replaces a
+#: file carrying it, and refuses any other existing file without ``--overwrite``.
+DEMO_MARK = "softrod demo figure"
+
+
+def written_by_demo(path: str) -> bool:
+    """Whether ``path`` is a PNG that ``softrod demo`` wrote (its ``Source`` metadata)."""
+    try:
+        from PIL import Image
+
+        with Image.open(path) as im:
+            return im.format == "PNG" and im.info.get("Source") == DEMO_MARK
+    except Exception:  # not an image, unreadable, or no Pillow: not the demo's
+        return False
+
+
 def check_files(args: argparse.Namespace) -> None:
-    """Refuses, before any work, outputs that would destroy an input or another output.
+    """Refuses, before any work, outputs that would destroy an input, another output or an
+    existing file.
 
     Raises:
         ParameterError: Naming the option: an output equal to an input file or to another
-            output, a figure extension matplotlib cannot write, an output that is a folder or
-            whose folder does not exist.
+            output, an existing file without ``--overwrite`` (except the demo's own figure),
+            a figure extension matplotlib cannot write, an output that is a folder or whose
+            folder does not exist.
     """
     inputs = [(d, getattr(args, d)) for d in getattr(args, "_inputs", ()) if getattr(args, d, None)]
     outputs = [
@@ -119,6 +145,13 @@ def check_files(args: argparse.Namespace) -> None:
                 raise bad(name, path, f"is also the output of {option_name(other)}")
         if os.path.isdir(path) and dest not in folders:
             raise bad(name, path, "is a folder (give a file name)")
+        if (
+            dest not in folders
+            and os.path.exists(path)
+            and not getattr(args, "overwrite", False)
+            and not (getattr(args, "_demo", False) and written_by_demo(path))
+        ):
+            raise bad(name, path, "exists (pass --overwrite to replace it)")
         if dest in folders:
             if os.path.exists(path) and not os.path.isdir(path):
                 raise bad(name, path, "is a file (give a folder)")
@@ -139,12 +172,17 @@ DEFAULT_DPI = 130
 
 def save_figure(fig, path: str, dpi: float | None = DEFAULT_DPI, args=None) -> None:
     """Writes ``fig`` to ``path`` (format from the extension: png, pdf, svg) and says so on
-    stderr; ``args`` with ``--dpi`` overrides ``dpi``."""
+    stderr; ``args`` with ``--dpi`` overrides ``dpi``; the demo's PNG carries
+    :data:`DEMO_MARK`."""
     from ..plot import save_figure as _save
 
     if args is not None and getattr(args, "dpi", None) is not None:
         dpi = args.dpi
-    _save(fig, path, dpi=dpi)
+    demo = args is not None and getattr(args, "_demo", False)
+    if demo and os.fspath(path).lower().endswith(".png"):
+        fig.savefig(path, format="png", dpi=dpi, metadata={"Source": DEMO_MARK})
+    else:
+        _save(fig, path, dpi=dpi)
     print(f"wrote {path}", file=sys.stderr)
 
 

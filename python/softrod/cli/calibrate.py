@@ -8,7 +8,7 @@ import warnings
 
 from ._common import bad, files, resolve_robot, write_json
 
-PLANAR = ("planar", "seed-arm")
+PLANAR = ("planar", "published-arm", "seed-arm")
 
 
 def _pairs(items, option: str, count: int | None = None) -> dict[str, tuple[float, ...]]:
@@ -70,7 +70,7 @@ def _cmd_calibrate(args) -> int:
                 f"--{flag.replace('_', '-')}", path, "exists (pass --overwrite to replace it)"
             )
     planar = args.robot in PLANAR
-    robot = PlanarCableArm.seed_arm() if planar else load_robot(args.robot_file)
+    robot = PlanarCableArm.published_arm() if planar else load_robot(args.robot_file)
     if planar and args.write_robot:
         raise bad("--write-robot", args.write_robot, "needs a robot file (not the planar arm)")
     data = _measurements(args.measurements, args.unit_scale, 2 if planar else 3)

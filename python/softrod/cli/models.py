@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from ._common import (
@@ -22,18 +24,24 @@ from ._common import (
 
 
 def _cmd_study(args) -> int:
-    from ..analysis.study import seed001_study
+    from ..analysis.study import compliance_study
     from ..robot import load_robot
 
     if args.levels < 2:
         raise bad("--levels", args.levels, "must be >= 2")
+    from ..analysis.study import _figure_paths
+
+    for path in _figure_paths(args.out):
+        if os.path.exists(path) and not args.overwrite:
+            raise bad("--out", args.out, f"holds {path!r} (pass --overwrite to replace it)")
     robot = load_robot(args.robot)
-    results = seed001_study(
+    results = compliance_study(
         robot,
         levels=args.levels,
         max_pressure=args.max_pressure,
         out_dir=args.out,
         progress=True if args.progress else None,
+        overwrite=args.overwrite,
     )
     if args.csv:
         header = ["material", "p1", "p2", "p3", "x", "y", "z", "max_translational_compliance"]
@@ -132,7 +140,7 @@ def register(sub) -> None:
     st.add_argument(
         "robot",
         nargs="?",
-        default="seed001_pneumatic_arm",
+        default="pneumatic_arm",
         metavar="ROBOT",
         help="robot with three chamber pairs, a file or a shipped example (default: %(default)s)",
     )

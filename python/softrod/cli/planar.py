@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from .._core import PlanarCableArm, PlanarSolution
 from ._common import _positive_int, add_figure_options, figure_options, files, save_figure
 
-SEED = PlanarCableArm.seed_arm()
+ARM = PlanarCableArm.published_arm()
 DEMO_TENSIONS = (0.5, 1.0, 2.0, 3.0, 4.0)
 
 
@@ -91,7 +91,7 @@ def _cmd_planar(args) -> int:
 
 
 def _cmd_demo(args) -> int:
-    arm = SEED
+    arm = ARM
     args.method, args.rtol, args.atol, args.n_points = "closed-form", 1e-8, 1e-10, 201
     args.json, args.csv = False, None
     sols = _solve_all(arm, DEMO_TENSIONS, args)
@@ -123,21 +123,21 @@ def register(sub) -> None:
         help="figure of backbones and profiles (default: %(default)s)",
     )
     files(d, outputs=("plot",), figures=("plot",))
-    d.set_defaults(func=_cmd_demo)
+    d.set_defaults(func=_cmd_demo, _demo=True)
     add_figure_options(d, "plot")
     pl = sub.add_parser(
         "planar", help="planar tapered cable-driven arm (closed form or final-value ODE)"
     )
-    pl.add_argument("--length", type=float, default=SEED.length, help="arm length L (m)")
-    pl.add_argument("--base-radius", type=float, default=SEED.base_radius, help="R0 (m)")
-    pl.add_argument("--tip-radius", type=float, default=SEED.tip_radius, help="RL (m)")
+    pl.add_argument("--length", type=float, default=ARM.length, help="arm length L (m)")
+    pl.add_argument("--base-radius", type=float, default=ARM.base_radius, help="R0 (m)")
+    pl.add_argument("--tip-radius", type=float, default=ARM.tip_radius, help="RL (m)")
     pl.add_argument(
         "--offset-ratio",
         type=float,
-        default=SEED.offset_ratio,
+        default=ARM.offset_ratio,
         help="cable offset ratio a in [0, 1)",
     )
-    pl.add_argument("--youngs-modulus", type=float, default=SEED.youngs_modulus, help="E (Pa)")
+    pl.add_argument("--youngs-modulus", type=float, default=ARM.youngs_modulus, help="E (Pa)")
     pl.add_argument(
         "--anchor", type=float, default=None, help="cable anchor arc length (m), default the tip"
     )

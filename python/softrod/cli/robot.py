@@ -86,9 +86,9 @@ def _cmd_compliance(args) -> int:
     tip = fmt_vector(sol.tip_position, scale=1e3, unit="mm", digits=6)
     print(f"robot: {robot.name} ({args.robot}); tip at {tip}")
     print("twist [dp; dtheta] = C [f; m], wrench applied at the tip (SI units)")
-    print("integrated tip compliance, world frame (seed eq. 6):")
+    print("integrated tip compliance, world frame (compliance-methodology paper, eq. 6):")
     print(_fmt6(comp.tip_world))
-    print("integrated tip compliance, body frame (seed eq. 7):")
+    print("integrated tip compliance, body frame (compliance-methodology paper, eq. 7):")
     print(_fmt6(comp.tip_body))
     print(f"condition number (1-norm): {comp.tip_condition:.3e}")
     g = comp.gamma_c[-1]

@@ -9,7 +9,7 @@ and ``data/silicone-tensile`` point here.
 Example:
     >>> import softrod
     >>> softrod.examples.names()
-    ('niti_two_segment', 'seed000_arm', 'seed001_pneumatic_arm')
+    ('niti_two_segment', 'pneumatic_arm', 'tapered_cable_arm')
     >>> robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
 """
 
@@ -21,6 +21,9 @@ from pathlib import Path
 from .._core import ParameterError
 
 __all__ = ["data_path", "load", "names", "path", "tensile_curves"]
+
+#: Earlier names of the example robots, still accepted by :func:`path` and :func:`load`.
+ALIASES = {"seed000_arm": "tapered_cable_arm", "seed001_pneumatic_arm": "pneumatic_arm"}
 
 _HERE = Path(__file__).resolve().parent
 ROBOTS = _HERE / "robots"
@@ -36,13 +39,15 @@ def path(name: str) -> Path:
     """The file of an example robot.
 
     Args:
-        name: Its name, with or without ``.toml`` (see :func:`names`).
+        name: Its name, with or without ``.toml`` (see :func:`names`; the earlier names in
+            :data:`ALIASES` work too).
 
     Raises:
         ParameterError: No example of that name (the message lists the names and the
             closest one).
     """
     stem = str(name).removesuffix(".toml")
+    stem = ALIASES.get(stem, stem)
     if stem in names():
         return ROBOTS / f"{stem}.toml"
     close = difflib.get_close_matches(stem, names(), n=1)

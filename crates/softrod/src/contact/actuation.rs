@@ -14,7 +14,7 @@
 
 use nalgebra::{DMatrix, Vector6};
 
-use super::solve::Constrained;
+use super::problem::Constrained;
 use crate::math::linalg::DenseLu;
 use crate::solve::Problem;
 

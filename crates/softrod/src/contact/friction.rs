@@ -15,8 +15,10 @@
 
 use nalgebra::Vector3;
 
+use super::newton::{correct, Effort};
 use super::obstacle_normal_basis;
-use super::solve::{correct, Active, Constrained, Effort, Forces, Site};
+use super::problem::{Active, Constrained, Site};
+use super::rows::Forces;
 use super::ContactState;
 use crate::cosserat::equations::{v3, STATE};
 use crate::solve::{Evaluated, NewtonOptions, Problem};

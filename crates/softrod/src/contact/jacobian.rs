@@ -20,7 +20,8 @@
 
 use nalgebra::{Vector3, Vector6};
 
-use super::solve::{equations, Constrained, Pass, Site};
+use super::problem::{equations, Constrained, Pass, Site};
+use super::rows::AtContact;
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
 };
@@ -284,7 +285,12 @@ impl Constrained<'_> {
                 }
             };
             let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
-            self.contact_rows(&mut ev, a, s, (&yf, kf), (&yl, kl), &f, mu, &mut rows);
+            let held = AtContact {
+                s,
+                first: (&yf, kf),
+                last: (&yl, kl),
+            };
+            self.contact_rows(&mut ev, a, held, &f, mu, &mut rows);
             at.push((s, yf, kf, yl, kl, f, site, o));
         }
         if rows.len() != n || !rows.iter().all(|v| v.is_finite()) {
@@ -380,7 +386,12 @@ impl Constrained<'_> {
                     }
                     buf.clear();
                     let f2 = f + df * t;
-                    self.contact_rows(&mut ev, a, s + ds * t, (&yf2, kf), (&yl2, kl), &f2, mu, buf);
+                    let moved = AtContact {
+                        s: s + ds * t,
+                        first: (&yf2, kf),
+                        last: (&yl2, kl),
+                    };
+                    self.contact_rows(&mut ev, a, moved, &f2, mu, buf);
                 };
                 eval(h, &mut buf);
                 let plus = buf.clone();
@@ -467,16 +478,12 @@ impl Constrained<'_> {
                                 yl2[i] += t * dyl[i];
                             }
                             let mut buf = Vec::with_capacity(4);
-                            self.contact_rows(
-                                &mut ev2,
-                                a,
+                            let here = AtContact {
                                 s,
-                                (&yf2, kf),
-                                (&yl2, kl),
-                                &f,
-                                1.0,
-                                &mut buf,
-                            );
+                                first: (&yf2, kf),
+                                last: (&yl2, kl),
+                            };
+                            self.contact_rows(&mut ev2, a, here, &f, mu, &mut buf);
                             buf
                         };
                         let (plus, minus) = (side(h), side(-h));

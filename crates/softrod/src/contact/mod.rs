@@ -10,14 +10,19 @@
 //! ([`ContactSolution`]) carries the reactions: the tip reaction wrench and, per contact, its
 //! arc length, point, normal and force.
 
+mod active_set;
 mod actuation;
 mod constraint;
+mod finish;
 mod friction;
 mod inverse;
 mod jacobian;
 mod mesh;
+mod newton;
 mod obstacle;
+mod problem;
 mod ramp;
+mod rows;
 mod solve;
 mod stability;
 mod sweep;
@@ -26,10 +31,11 @@ use std::sync::Arc;
 
 use nalgebra::Vector3;
 
+pub use active_set::MAX_ACTIVE_SET_ROUNDS;
 pub use constraint::TipConstraint;
 pub use inverse::{contact_inverse_statics, solve_contact_inverse, ContactForward};
 pub use obstacle::{Obstacle, TriangleMesh};
-pub use solve::{solve_constrained, MAX_ACTIVE_SET_ROUNDS};
+pub use solve::solve_constrained;
 
 use crate::cosserat::StaticsSolution;
 
@@ -118,7 +124,7 @@ pub struct ContactSolution {
 /// variational columns of every unknown) and kept; clones share it.
 #[derive(Debug, Clone, Default)]
 pub struct ContactCompliance {
-    inner: Option<Arc<solve::Frozen>>,
+    inner: Option<Arc<finish::Frozen>>,
 }
 
 impl ContactCompliance {
@@ -193,7 +199,7 @@ impl ContactCompliance {
         Ok(j)
     }
 
-    pub(crate) fn of(frozen: Option<solve::Frozen>) -> Self {
+    pub(crate) fn of(frozen: Option<finish::Frozen>) -> Self {
         Self {
             inner: frozen.map(Arc::new),
         }

@@ -13,8 +13,10 @@
 
 use nalgebra::Vector3;
 
+use super::active_set::active_set;
+use super::newton::Effort;
 use super::obstacle::Obstacle;
-use super::solve::{active_set, Constrained, Effort, Pass};
+use super::problem::{Constrained, Pass};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
 use crate::cosserat::equations::v3;
 use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};

@@ -183,9 +183,10 @@ impl PlanarCableArm {
         })
     }
 
-    /// The paper's experimental arm: `L = 270 mm`, `R0 = 15 mm`, `RL = 7.4 mm`, `a = 1/3`,
+    /// The experimental arm of *Planar steady-state physical model for a soft cable-driven
+    /// octopus-like arm manipulator*: `L = 270 mm`, `R0 = 15 mm`, `RL = 7.4 mm`, `a = 1/3`,
     /// `E = 110 kPa`, cable anchored at the tip.
-    pub fn seed_arm() -> Self {
+    pub fn published_arm() -> Self {
         Self {
             length: 0.270,
             base_radius: 0.015,
@@ -195,6 +196,11 @@ impl PlanarCableArm {
             anchor: 0.270,
             taper: (0.0074 - 0.015) / 0.270,
         }
+    }
+
+    /// The same arm as [`Self::published_arm`] (its earlier name, kept working).
+    pub fn seed_arm() -> Self {
+        Self::published_arm()
     }
 
     /// Arm length `L` (m).

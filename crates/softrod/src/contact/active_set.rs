@@ -1,0 +1,336 @@
+//! The active set of contacts: contacts released when they pull, added at the local minima
+//! of the gaps (or inside a cell, for thin obstacles), merged into intervals on a plane, and
+//! the load steps of the external loads and the tip target.
+
+use super::friction::{first_touch, switch};
+use super::newton::{correct, exact_newton, Effort};
+use super::obstacle::Obstacle;
+use super::problem::{Active, Constrained, Site};
+use super::rows::{Forces, GapSample};
+use super::ContactState;
+use crate::cosserat::statics::settings;
+use crate::solve::{
+    continuation, ContinuationSettings, Evaluated, NewtonOptions, Problem, MIN_LOAD_INCREMENT,
+};
+
+/// Most rounds of the active-set loop (contacts added or released) per load step.
+pub const MAX_ACTIVE_SET_ROUNDS: usize = 40;
+
+/// New contacts at the local minima of the gaps below `-penetration` (not at an existing
+/// contact, not inside an interval).
+fn candidates(p: &Constrained<'_>, forces: &Forces, penetration: f64) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let mut added = Vec::new();
+    for o in 0..p.obstacles.len() {
+        let g = p.gaps(o);
+        for i in 1..g.len() {
+            let (_, s, gi, _) = g[i];
+            let at_tip = i + 1 == g.len();
+            let minimum = gi < -penetration && gi <= g[i - 1].2 && (at_tip || gi <= g[i + 1].2);
+            let taken = forces
+                .iter()
+                .zip(&p.active)
+                .any(|(f, a)| a.obstacle == o && (f.2 - s).abs() <= 1e-12 * l);
+            let inside = p
+                .active
+                .iter()
+                .zip(forces)
+                .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
+            if minimum && !taken && !inside {
+                if at_tip {
+                    added.push((o, Site::Tip, s));
+                } else {
+                    added.push((o, Site::Interior, parabola_minimum(&g[i - 1..=i + 1])));
+                }
+            }
+        }
+    }
+    added
+}
+
+/// New contacts where the rod runs into an obstacle between two nodes whose own gaps do not
+/// show it (an obstacle thinner than the node spacing), away from the active contacts: the
+/// last check of the active set, once no node penetrates.
+fn cell_candidates(
+    p: &Constrained<'_>,
+    forces: &Forces,
+    penetration: f64,
+) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let mut added = Vec::new();
+    for o in 0..p.obstacles.len() {
+        let g = p.gaps(o);
+        for i in 1..g.len() {
+            let (s0, s1) = (g[i - 1].1, g[i].1);
+            let near = |s: f64| s >= s0 - 1e-12 * l && s <= s1 + 1e-12 * l;
+            let covered = forces.iter().zip(&p.active).any(|(f, a)| {
+                a.obstacle == o && (near(f.2) || (a.site == Site::Interval && s1 >= f.2))
+            });
+            if covered || g[i - 1].2 < -penetration || g[i].2 < -penetration {
+                continue;
+            }
+            if let Some(s) = p.penetration_in_cell(o, (&g[i - 1], &g[i]), penetration) {
+                added.push((o, Site::Interior, s));
+            }
+        }
+    }
+    added
+}
+
+/// The arc length of the least gap of the parabola through three consecutive samples
+/// `(_, s, gap, _)` whose middle one is a local minimum (its own arc length if the three are
+/// collinear): a new contact starts where the gap is least, not at the nearest node.
+fn parabola_minimum(g: &[GapSample]) -> f64 {
+    let ((_, s0, g0, _), (_, s1, g1, _), (_, s2, g2, _)) = (g[0], g[1], g[2]);
+    let (h0, h1) = (s1 - s0, s2 - s1);
+    let (d0, d1) = ((g1 - g0) / h0, (g2 - g1) / h1);
+    let curvature = 2.0 * (d1 - d0) / (h0 + h1);
+    if !(curvature > 0.0 && h0 > 0.0 && h1 > 0.0) {
+        return s1;
+    }
+    // The slope at s1 of the parabola, and its zero.
+    let slope = (d0 * h1 + d1 * h0) / (h0 + h1);
+    (s1 - slope / curvature).clamp(s0, s2)
+}
+
+/// A plane touched twice (or an interval touched before its edge) becomes one interval from
+/// the first contact to the tip; `true` if a merge was made.
+fn merge_plane(
+    p: &mut Constrained<'_>,
+    x: &mut Vec<f64>,
+    forces: &Forces,
+    added: &[(usize, Site, f64)],
+) -> bool {
+    let l = p.model.length();
+    for &(o, _, s) in added {
+        if !matches!(p.obstacles[o].shape(), Obstacle::Plane { .. }) {
+            continue;
+        }
+        let offsets = p.offsets();
+        let on: Vec<usize> = (0..p.active.len())
+            .filter(|i| p.active[*i].obstacle == o)
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        let mut a = s;
+        for &i in &on {
+            a = a.min(forces[i].2);
+        }
+        if a >= l {
+            continue;
+        }
+        for &i in on.iter().rev() {
+            let size = p.active[i].size();
+            p.active.remove(i);
+            x.drain(offsets[i]..offsets[i] + size);
+        }
+        p.active.push(Active::frictionless(o, Site::Interval));
+        x.push(a / l);
+        x.extend([0.0; 3]);
+        return true;
+    }
+    false
+}
+
+/// Adds the contacts `added` at zero force and relaxes their gaps from the values found to
+/// zero by continuation; the state at full contact targets.
+fn add_contacts(
+    p: &mut Constrained<'_>,
+    mut x: Vec<f64>,
+    added: Vec<(usize, Site, f64)>,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+        a.t0 = [0.0; 2];
+    }
+    // Where the new contacts with friction first touched, on the load path.
+    let mut touched = Vec::with_capacity(added.len());
+    for &(o, site, _) in &added {
+        let rough = site == Site::Tip && p.obstacles[o].friction() > 0.0;
+        touched.push(if rough {
+            Some(first_touch(p, &x, o, opts, effort)?)
+        } else {
+            None
+        });
+    }
+    for ((o, site, s), touched) in added.into_iter().zip(touched) {
+        let mut a = Active::frictionless(o, site);
+        if let Some((reference, touch, _)) = touched {
+            a.state = ContactState::Stick;
+            a.reference = reference;
+            a.touch = touch;
+        }
+        p.active.push(a);
+        if site != Site::Tip {
+            x.push(s / l);
+        }
+        x.extend([0.0; 3]);
+    }
+    // Straight to the contact (one exact Newton solve), else by relaxing the gaps.
+    if let Some((xs, _)) = exact_newton(p, &x, opts, effort, false, true) {
+        return Some(xs);
+    }
+    // The gap targets of the new contacts: their rows at zero force.
+    let mut r = vec![0.0; p.dim()];
+    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
+        return None;
+    }
+    let offsets = p.offsets();
+    for (a, o) in p.active.iter_mut().zip(offsets) {
+        a.g0 = r[o] * l;
+        if a.site != Site::Tip {
+            a.dg0 = r[o + 1];
+        }
+        if a.state == ContactState::Stick {
+            a.t0 = [r[o + 1] * l, r[o + 2] * l];
+        }
+    }
+    let start = ContinuationSettings {
+        x0: &x,
+        jacobian0: None,
+        first_increment: 1.0,
+        max_increment: 1.0,
+    };
+    let c = continuation(p, &start, opts, &settings(true, None, false));
+    effort.iterations += c.iterations;
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+        a.t0 = [0.0; 2];
+    }
+    if !(c.outcome.converged && c.load_factor >= 1.0) {
+        return None;
+    }
+    correct(p, &c.outcome.x, opts, effort)
+}
+
+/// The active-set loop at the current load factor from the state `x` (converged at the
+/// previous load factor): Newton; release the contact pulling hardest; add one contact at
+/// each local minimum of a gap below `-penetration`, reached by relaxing its gap from the
+/// current value; until no contact pulls and nothing penetrates.
+pub(super) fn active_set(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
+    let fs = p.model.force_scale();
+    let penetration = 10.0 * opts.tolerance * l;
+    let mut x = correct(p, x, opts, effort)?;
+    for _ in 0..MAX_ACTIVE_SET_ROUNDS {
+        // Release the most negative contact force.
+        let forces = p.normal_forces(&x);
+        let worst = forces
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.0 < -opts.tolerance * fs)
+            .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+            .map(|(i, _)| i);
+        if let Some(i) = worst {
+            let o = p.offsets()[i];
+            let size = p.active[i].size();
+            p.active.remove(i);
+            x.drain(o..o + size);
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        // Sticking outside the cone, or sliding back to where it touched.
+        if let Some((i, state, direction)) = switch(p, &x, opts) {
+            p.active[i].state = state;
+            if direction.is_some() {
+                // First along the slip the sticking force pushed to, then free to turn.
+                p.active[i].direction = direction;
+                x = correct(p, &x, opts, effort)?;
+                p.active[i].direction = None;
+            }
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        let mut added = candidates(p, &forces, penetration);
+        if added.is_empty() {
+            added = cell_candidates(p, &forces, penetration);
+        }
+        if let Some(&(o, _, _)) = added
+            .iter()
+            .find(|(o, site, _)| *site != Site::Tip && p.obstacles[*o].friction() > 0.0)
+        {
+            // Friction inside the rod is not modelled: refused, not solved without it.
+            p.refused = Some(p.obstacles[o].friction());
+            return None;
+        }
+        if merge_plane(p, &mut x, &forces, &added) {
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        // An interval whose segment lifts off the plane is only its edge contact.
+        let lifted = p.active.iter().enumerate().position(|(i, a)| {
+            a.site == Site::Interval
+                && p.gaps(a.obstacle)
+                    .iter()
+                    .any(|g| g.1 > forces[i].2 && g.2 > penetration)
+        });
+        if let Some(i) = lifted {
+            p.active[i].site = Site::Interior;
+            x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        if added.is_empty() {
+            return Some(x);
+        }
+        x = add_contacts(p, x, added, opts, effort)?;
+    }
+    None
+}
+
+/// Steps the load factor (external loads and tip target) from 0 to 1 from the state `x`
+/// at load factor 0, halving a step whose active-set loop fails or moves the shape too far;
+/// on failure, the load factor reached and why.
+pub(super) fn step_loads(
+    p: &mut Constrained<'_>,
+    mut x: Vec<f64>,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> std::result::Result<Vec<f64>, (f64, &'static str, Vec<f64>)> {
+    let mut lambda = 0.0;
+    let mut dl: f64 = 1.0;
+    while lambda < 1.0 {
+        if effort.load_steps >= opts.max_load_steps {
+            return Err((lambda, "the load steps ran out", x));
+        }
+        let target = (lambda + dl).min(1.0);
+        let saved = (x.clone(), p.active.clone());
+        p.load = target;
+        effort.load_steps += 1;
+        match active_set(p, &x, opts, effort) {
+            Some(xs) if p.close() || !opts.continuation => {
+                x = xs;
+                lambda = target;
+                p.from = lambda;
+                p.commit();
+                dl = (dl * 2.0).min(1.0);
+            }
+            _ => {
+                (x, p.active) = saved;
+                p.load = lambda;
+                if !opts.continuation {
+                    return Err((lambda, "the direct solve failed", x));
+                }
+                dl *= 0.5;
+                if dl < MIN_LOAD_INCREMENT {
+                    return Err((
+                        lambda,
+                        "no load step converged (load increment underflow)",
+                        x,
+                    ));
+                }
+            }
+        }
+    }
+    Ok(x)
+}

@@ -1,0 +1,416 @@
+//! The solution at the converged unknowns: the polished shape with its contact forces, the
+//! tip reaction, the contacts, the stability, and what its compliance needs.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+use super::constraint::TipConstraint;
+use super::newton::{exact_newton, Effort};
+use super::obstacle::Obstacle;
+use super::problem::{Active, Constrained, Pass, Site};
+use super::rows::Forces;
+use super::solve::coarse_mesh;
+use super::stability::{conjugate_points, free_stiffness};
+use super::{Contact, ContactCompliance, ContactSolution, ContactState};
+use crate::cosserat::equations::{Equations, FULL, STATE};
+use crate::cosserat::shooting::Shooting;
+use crate::cosserat::statics::{assemble, scaled_back, stability_on, Integrator, SolveOptions};
+use crate::cosserat::{tip_stability, Stability, NEUTRAL_MARGIN};
+use crate::error::{Error, Result};
+use crate::integrate::march::rk4_plan;
+use crate::model::{Actuation, RobotModel};
+use crate::solve::{max_norm, Evaluated, NewtonOptions, Problem, SolverStats};
+
+/// Stability margin on the coarse mesh beyond which its sign decides whether a contact
+/// solution is stable (closer to zero, the margin is computed on the mesh asked).
+const COARSE_MARGIN_GAP: f64 = 1e-2;
+
+/// What the compliance of a converged contact solution needs, owned (see
+/// [`ContactCompliance`]), and the compliance once computed.
+#[derive(Debug)]
+pub(crate) struct Frozen {
+    model: Arc<RobotModel>,
+    obstacles: Vec<Obstacle>,
+    tensions: Vec<f64>,
+    pressures: Vec<f64>,
+    integrator: Integrator,
+    tip: Option<TipConstraint>,
+    start: (Vector3<f64>, Matrix3<f64>),
+    active: Vec<Active>,
+    x: Vec<f64>,
+    value: std::sync::OnceLock<Option<Matrix6<f64>>>,
+}
+
+impl Frozen {
+    /// The problem `p` at full load at its solution `x`.
+    fn at(p: &Constrained<'_>, x: &[f64]) -> Self {
+        Self {
+            model: Arc::clone(p.shared),
+            obstacles: p.obstacles.to_vec(),
+            tensions: p.tensions.clone(),
+            pressures: p.pressures.clone(),
+            integrator: p.integrator,
+            tip: p.tip,
+            start: p.start,
+            active: p.active.clone(),
+            x: x.to_vec(),
+            value: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The problem at full load with the active set of the solution.
+    fn problem(&self) -> Constrained<'_> {
+        Constrained {
+            model: &self.model,
+            shared: &self.model,
+            tensions: self.tensions.clone(),
+            pressures: self.pressures.clone(),
+            integrator: self.integrator,
+            tip: self.tip,
+            start: self.start,
+            obstacles: &self.obstacles,
+            active: self.active.clone(),
+            load: 1.0,
+            last: None,
+            reference: Vec::new(),
+            evaluations: 0,
+            coarse: None,
+            hint: None,
+            solved: None,
+            refine: true,
+            rough: false,
+            from: 1.0,
+            refused: None,
+        }
+    }
+
+    /// The constrained tip compliance (see [`Constrained::compliance`]), computed once.
+    pub(crate) fn compliance(&self) -> Option<Matrix6<f64>> {
+        *self
+            .value
+            .get_or_init(|| self.problem().compliance(&self.x))
+    }
+
+    /// Whether an active contact has friction (sticking or sliding).
+    pub(crate) fn frictional(&self) -> bool {
+        self.active
+            .iter()
+            .any(|a| a.state != ContactState::Frictionless)
+    }
+
+    /// The constrained actuation Jacobian of node `node` and its position (see
+    /// [`Constrained::actuation_jacobian`]).
+    pub(crate) fn actuation_jacobian(
+        &self,
+        node: usize,
+    ) -> Option<(nalgebra::DMatrix<f64>, Vector3<f64>)> {
+        self.problem().actuation_jacobian(&self.x, node)
+    }
+}
+
+/// The error (or, without `throw`, nothing better to return) of a failed solve.
+pub(super) fn fail(
+    p: &Constrained<'_>,
+    opts: &NewtonOptions,
+    effort: &Effort,
+    lambda: f64,
+    why: &str,
+) -> Result<ContactSolution> {
+    let _ = opts;
+    Err(Error::NotConverged {
+        what: format!("constrained shooting (tip constraint, contact): {why}"),
+        iterations: effort.iterations,
+        residual: p
+            .last
+            .as_ref()
+            .map_or(f64::INFINITY, |l| max_norm(l.residual.as_slice())),
+        load_factor: lambda,
+    })
+}
+
+/// Exact Newton steps from the converged `x` toward round-off (see [`exact_newton`]), so
+/// that the balance of the reactions holds to the digits of the loads, not only of the
+/// tolerance; `x` itself if they do not lower the residual. The last pass is left at the
+/// result, whose residual is returned (`None` if it cannot be integrated).
+fn polish(p: &mut Constrained<'_>, x: &[f64], options: &SolveOptions) -> Option<(Vec<f64>, f64)> {
+    let mut effort = Effort::default();
+    p.hint = p.solved.take();
+    if let Some(out) = exact_newton(p, x, &options.newton, &mut effort, true, false) {
+        return Some(out);
+    }
+    let mut r = vec![0.0; p.dim()];
+    (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
+}
+
+/// The contacts of a solution and the contact force at its samples (an interval's
+/// distributed reaction lumped by the trapezoid rule).
+fn report(
+    active: &[Active],
+    forces: &Forces,
+    tangential: &[Vector3<f64>],
+    model: &RobotModel,
+    cm: &RobotModel,
+    sol: &crate::cosserat::StaticsSolution,
+) -> (Vec<Contact>, Vec<[f64; 3]>) {
+    let l = model.length();
+    let mut contact_force = vec![[0.0; 3]; sol.s.len()];
+    let mut contacts = Vec::with_capacity(forces.len());
+    for (((fnorm, n, s, pc), a), ft) in forces.iter().zip(active).zip(tangential) {
+        let radius = model.rod().section_at(*s).radius;
+        let point = pc - n * radius;
+        contacts.push(Contact {
+            obstacle: a.obstacle,
+            s: *s,
+            length: 0.0,
+            point: [point.x, point.y, point.z],
+            normal: [n.x, n.y, n.z],
+            normal_force: *fnorm,
+            tangential_force: [ft.x, ft.y, ft.z],
+            state: a.state,
+        });
+        if let Some(j) = sol.s.iter().rposition(|v| v == s) {
+            for k in 0..3 {
+                contact_force[j][k] += fnorm * n[k] + ft[k];
+            }
+        }
+        if a.site == Site::Interval {
+            // The distributed reaction on (a, L], lumped at the samples by the trapezoid rule.
+            let after = f64::from_bits(s.to_bits() + 1);
+            let density = |t: f64| {
+                let mut f = cm
+                    .loads()
+                    .distributed_force
+                    .as_ref()
+                    .map_or(Vector3::zeros(), |p| p.at(t));
+                // The model's distributed force already carries the reaction: take it alone.
+                if let Some(g) = cm.rho_g() {
+                    f += g * cm.rod().section_at(t).area;
+                }
+                f
+            };
+            let base = model.loads().distributed_force.as_ref();
+            let mut total = 0.0;
+            let idx: Vec<usize> = (0..sol.s.len()).filter(|j| sol.s[*j] >= after).collect();
+            for w in idx.windows(2) {
+                let (j0, j1) = (w[0], w[1]);
+                let h = sol.s[j1] - sol.s[j0];
+                if h <= 0.0 {
+                    continue;
+                }
+                for j in [j0, j1] {
+                    let t = sol.s[j];
+                    let applied = base.map_or(Vector3::zeros(), |p| p.at(t));
+                    let reaction = density(t)
+                        - applied
+                        - cm.rho_g()
+                            .map_or(Vector3::zeros(), |g| g * cm.rod().section_at(t).area);
+                    let lump = reaction * (0.5 * h);
+                    total += lump.dot(n);
+                    for k in 0..3 {
+                        contact_force[j][k] += lump[k];
+                    }
+                }
+            }
+            let tip = Vector3::from(sol.tip_position()) - n * radius;
+            contacts.push(Contact {
+                obstacle: a.obstacle,
+                s: after,
+                length: l - after,
+                point: [tip.x, tip.y, tip.z],
+                normal: [n.x, n.y, n.z],
+                normal_force: total,
+                tangential_force: [0.0; 3],
+                state: a.state,
+            });
+        }
+    }
+    (contacts, contact_force)
+}
+
+/// The stability of a rod with a held tip (see [`super::stability`]): whether stable, the
+/// margin (the free directions' smallest stiffness; `+inf` for a full clamp, minus the
+/// number of conjugate points when there are some) and the conjugate points.
+fn held_stability(
+    sh: &mut Shooting<'_>,
+    x: &[f64],
+    c: &TipConstraint,
+    cols: &[Vector6<f64>],
+    tw: &[Vector6<f64>; 6],
+) -> (bool, f64, Option<usize>) {
+    let l = sh.eq.model.length();
+    let mut y = Matrix6::zeros();
+    let mut xt = Matrix6::zeros();
+    for k in 0..6 {
+        for i in 0..6 {
+            y[(i, k)] = cols[k][i];
+            xt[(i, k)] = tw[k][i] / if i < 3 { l } else { 1.0 };
+        }
+    }
+    let count = conjugate_points(sh, x).map(|c| c.0);
+    let free: Vec<usize> = (0..6).filter(|k| !c.held[*k]).collect();
+    let stiff = free_stiffness(&y, &xt, &c.pose.rotation(), &free);
+    let (stable, margin) = match (count, stiff) {
+        (Some(0), Some((m, neg))) => (neg == 0 && m > -NEUTRAL_MARGIN, m),
+        (Some(0), None) if free.is_empty() => (true, f64::INFINITY),
+        (Some(n), _) if n > 0 => (false, -(n as f64)),
+        _ => (false, 0.0),
+    };
+    (stable, margin, count)
+}
+
+/// With a free tip, the stability of the contacts as dead loads from the exact Jacobian of
+/// the pass at `x` (its base-wrench block and tip columns, as the compliance left it), so
+/// that no march with the columns is needed again; `None` otherwise.
+fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) -> Option<Stability> {
+    let (j, twists) = pass.jacobian.as_ref()?;
+    if p.tip.is_some() || pass.key != p.key(x, 1.0) || twists.len() < 6 {
+        return None;
+    }
+    let n = p.dim();
+    let mut y = [0.0; 36];
+    for c in 0..6 {
+        y[6 * c..6 * c + 6].copy_from_slice(&j[n * c..n * c + 6]);
+    }
+    let tw: [Vector6<f64>; 6] = std::array::from_fn(|k| twists[k]);
+    tip_stability(&y, &tw, p.model.length())
+}
+
+/// The shooting residual at the solution `x` and, with a held tip, the base-wrench columns,
+/// with the nodes in `sh`: those of the last pass when it marched the state alone at `x` on
+/// the mesh of `sh` (free tip), else from a new march.
+fn final_march(
+    p: &Constrained<'_>,
+    sh: &mut Shooting<'_>,
+    pass: Pass,
+    x: &[f64],
+) -> Result<(Vector6<f64>, Vec<Vector6<f64>>)> {
+    if let Some((mesh, lengths, tensions)) = pass.marched {
+        if p.tip.is_none() && mesh == sh.integrator && pass.key == p.key(x, 1.0) {
+            sh.nodes = pass.nodes;
+            sh.lengths = lengths;
+            sh.tensions = tensions;
+            return Ok((pass.residual, Vec::new()));
+        }
+    }
+    let marched = if p.tip.is_none() {
+        sh.pass::<STATE>(&x[..6], 1.0)
+    } else {
+        sh.pass::<FULL>(&x[..6], 1.0)
+    };
+    let (res, cols, _) = marched.map_err(|e| {
+        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
+    })?;
+    Ok((res, cols))
+}
+
+/// The solution at the converged unknowns `x`: the shape with its contact forces, the tip
+/// reaction, the contacts, the stability.
+pub(super) fn finish(
+    p: &mut Constrained<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    x: &[f64],
+    effort: &Effort,
+    load_factor: f64,
+) -> Result<ContactSolution> {
+    let reached = if load_factor >= 1.0 {
+        polish(p, x, options)
+    } else {
+        let mut r = vec![0.0; p.dim()];
+        (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
+    };
+    let Some((polished, residual)) = reached else {
+        return fail(
+            p,
+            &options.newton,
+            effort,
+            1.0,
+            "the solution could not be integrated",
+        );
+    };
+    let x: &[f64] = &polished;
+    let forces = p.normal_forces(x);
+    // The compliance under the constraints, on first read.
+    let compliance =
+        ContactCompliance::of((residual <= options.newton.tolerance).then(|| Frozen::at(p, x)));
+    let Some(pass) = p.last.take() else {
+        return fail(p, &options.newton, effort, 1.0, "no pass");
+    };
+    let free_stability = jacobian_stability(p, &pass, x);
+    let cm = Arc::clone(&pass.model);
+    let plan = match options.integrator {
+        Integrator::Rk4 { steps } => rk4_plan(cm.breaks(), steps),
+        Integrator::Adaptive(_) => Vec::new(),
+    };
+    let eq = Equations {
+        model: &cm,
+        tensions: &p.tensions,
+        pressures: &p.pressures,
+        load_factor: 1.0,
+        profile: None,
+    };
+    let mut sh = Shooting::new(eq, options.integrator, plan);
+    let (res, cols) = final_march(p, &mut sh, pass, x)?;
+    let tip_twist = sh.tip_twist;
+    let stats = SolverStats {
+        iterations: effort.iterations,
+        residual,
+        function_evaluations: p.evaluations + sh.evaluations,
+        converged: residual <= options.newton.tolerance && load_factor >= 1.0,
+        load_steps: effort.load_steps,
+        load_factor,
+    };
+    let fs = model.force_scale();
+    let l = model.length();
+    let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
+    sol.actuation = actuation.clone();
+    sol.options = *options;
+    let tangential = p.tangential_forces(x, &forces);
+    let (contacts, contact_force) = report(&p.active, &forces, &tangential, model, &cm, &sol);
+    let tip_reaction = p.tip.as_ref().map(|_| {
+        let f = res.fixed_rows::<3>(0) * fs;
+        let m = res.fixed_rows::<3>(3) * (fs * l);
+        [f.x, f.y, f.z, m.x, m.y, m.z]
+    });
+    // Stability: with a held tip, conjugate points and the free directions' stiffness; with
+    // a free tip, the tip criterion of `solve_statics` (contacts as dead loads).
+    let mut conjugate = None;
+    if let (Some(c), Some(tw)) = (p.tip, tip_twist) {
+        let (stable, margin, count) = held_stability(&mut sh, &x[..6], &c, &cols, &tw);
+        conjugate = count;
+        sol.stable = stable && sol.stats.converged;
+        let _ = sol.margin.set(margin);
+    } else if let Some(st) = free_stability.filter(|_| sol.stats.converged) {
+        let _ = sol.margin.set(st.margin);
+        sol.stable = st.stable;
+    } else if let Some(st) = coarse_mesh(options.integrator)
+        .filter(|_| sol.stats.converged)
+        .and_then(|mesh| stability_on(&sol, mesh))
+        .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
+    {
+        // Clear on the coarse mesh; the margin itself is computed on the mesh asked when
+        // read.
+        sol.stable = st.stable;
+    } else {
+        sol.stable = sol.stats.converged && sol.stability_margin() > -NEUTRAL_MARGIN;
+    }
+    if !sol.stats.converged && options.newton.throw {
+        return fail(
+            p,
+            &options.newton,
+            effort,
+            1.0,
+            "the residual at the solution is above the tolerance",
+        );
+    }
+    Ok(ContactSolution {
+        solution: sol,
+        tip_reaction,
+        contacts,
+        contact_force,
+        conjugate_points: conjugate,
+        compliance,
+    })
+}
