@@ -13,8 +13,10 @@ pub mod friction_linear;
 mod friction_march;
 mod guides;
 mod hyperelastic_local;
+mod options;
 pub mod sensitivity;
 pub(crate) mod shooting;
+mod solution;
 mod stability;
 pub mod statics;
 

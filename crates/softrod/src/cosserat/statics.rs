@@ -14,17 +14,15 @@
 //! chamber ends and point loads with fixed-step RK4 (the paper's method) or the adaptive
 //! Dormand–Prince 5(4) pair; rotation matrices are re-orthonormalised after every step.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
-use nalgebra::{Matrix3, Matrix6, Vector3};
+use nalgebra::{Matrix6, Vector3};
 
-use super::equations::{rot, v3, Equations, Evaluator, Workspace, FULL};
-use super::shooting::{Node, Shooting};
+use super::equations::{Equations, FULL};
+use super::shooting::Shooting;
 use super::stability::{tip_stability, Stability};
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
-use crate::integrate::AdaptiveOptions;
-use crate::math::so3::quaternion_xyzw;
 use crate::model::loads::{Frame, PointLoad};
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{
@@ -32,243 +30,13 @@ use crate::solve::{
     NewtonOptions, NewtonOutcome, NewtonSettings, Problem, SolverStats, Stopped,
 };
 
-/// Default number of RK4 steps over the whole rod (split among the intervals in proportion
-/// to their length, at least one each).
-pub const DEFAULT_RK4_STEPS: usize = 40;
-/// Largest accepted number of RK4 steps (the mesh is stored).
-pub const MAX_RK4_STEPS: usize = 10_000_000;
-/// Default tolerance on the scaled shooting residual (max norm).
-pub const DEFAULT_TOLERANCE: f64 = 1e-10;
-/// Default cap on Newton iterations per solve (per load step under continuation).
-pub const DEFAULT_MAX_ITERATIONS: usize = 30;
-/// Default cap on load steps under continuation.
-pub const DEFAULT_MAX_LOAD_STEPS: usize = 64;
-/// Most step halvings of the Newton line search.
-pub const MAX_LINE_SEARCH_HALVINGS: usize = 12;
-/// Largest predictor step (max norm of the scaled base wrench, about the bending in rad it
-/// predicts) taken directly when continuation is enabled; beyond it the load is stepped, so
-/// that the solution stays on the equilibrium branch connected to the unloaded rod.
-pub const DIRECT_STEP_LIMIT: f64 = 4.0;
-/// Largest change of the shape per continuation step: rotation in rad at any mesh node (and
-/// half of it, in units of the rod length, in position). Larger jumps may switch equilibrium
-/// branch, so the step is halved.
-pub const MAX_LOAD_STEP_TURN: f64 = 1.0;
-
-/// The ODE integrator used by the shooting method.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Integrator {
-    /// Classical RK4 with `steps` equal-length steps over `[0, L]` in total (each interval
-    /// between breaks gets `max(1, round(steps * length / L))`).
-    Rk4 {
-        /// Total number of steps (>= 1).
-        steps: usize,
-    },
-    /// Adaptive Dormand–Prince 5(4) with error control on `(p, R, N, M)`.
-    Adaptive(AdaptiveOptions),
-}
-
-impl Default for Integrator {
-    fn default() -> Self {
-        Integrator::Rk4 {
-            steps: DEFAULT_RK4_STEPS,
-        }
-    }
-}
-
-/// A starting point for the shooting unknowns, taken from a previous solution (the tensions
-/// of its displacement-controlled tendons go into [`Actuation::tension_guess`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WarmStart {
-    /// Total base wrench `[N(0); M(0)]` (N, N m; world frame) including the tendons' share.
-    pub base_wrench: [f64; 6],
-    /// The shooting Jacobian (scaled unknowns and residual) at that solution, if known: the
-    /// first Jacobian of the new solve.
-    pub jacobian: Option<Matrix6<f64>>,
-}
-
-impl WarmStart {
-    /// A warm start from a base wrench alone.
-    pub fn wrench(base_wrench: [f64; 6]) -> Self {
-        Self {
-            base_wrench,
-            jacobian: None,
-        }
-    }
-}
-
-/// Options of [`solve_statics`] (keyword arguments in Python).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolveOptions {
-    /// ODE integrator.
-    pub integrator: Integrator,
-    /// Nonlinear solve. The tolerance is on the scaled shooting residual; with the adaptive
-    /// integrator it is only resolved down to the integration error, `10 rtol (1 + |x|)`.
-    pub newton: NewtonOptions,
-    /// Initial guess of the base wrench; `None` starts from the unloaded rod.
-    pub warm_start: Option<WarmStart>,
-    /// When the equilibrium reached is unstable, search for a stable one (smaller load steps
-    /// from the unloaded rod, then along the unstable mode) and return it if found.
-    pub seek_stable: bool,
-}
-
-impl Default for SolveOptions {
-    fn default() -> Self {
-        Self {
-            integrator: Integrator::default(),
-            newton: NewtonOptions {
-                tolerance: DEFAULT_TOLERANCE,
-                max_iterations: DEFAULT_MAX_ITERATIONS,
-                continuation: true,
-                max_load_steps: DEFAULT_MAX_LOAD_STEPS,
-                throw: true,
-            },
-            warm_start: None,
-            seek_stable: true,
-        }
-    }
-}
-
-impl SolveOptions {
-    /// Checks the options.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] naming `integrator.steps`, `rtol`, `atol`, `max_steps`,
-    /// `tolerance`, `max_iterations`, `max_load_steps` or `warm_start.base_wrench[k]`.
-    pub fn validate(&self) -> Result<()> {
-        match self.integrator {
-            Integrator::Rk4 { steps } => {
-                if steps == 0 || steps > MAX_RK4_STEPS {
-                    return Err(Error::invalid(
-                        "integrator.steps",
-                        steps,
-                        format!("in [1, {MAX_RK4_STEPS}]"),
-                    ));
-                }
-            }
-            Integrator::Adaptive(a) => {
-                a.validated()?;
-            }
-        }
-        self.newton.validate()?;
-        if let Some(w) = &self.warm_start {
-            for (k, v) in w.base_wrench.iter().enumerate() {
-                if !v.is_finite() {
-                    return Err(Error::invalid(
-                        format!("warm_start.base_wrench[{k}]"),
-                        v,
-                        "finite",
-                    ));
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-/// A solved rod, sampled at the integration mesh, with the model, actuation and options it
-/// was solved with (so that [`crate::compliance::compliance`] and
-/// [`crate::compliance::tangent_compliance`] need nothing else).
-///
-/// Every array has one entry per sample. At an interval break (tendon termination, point
-/// load) the sample appears twice with the same `s`: the values just before and just after
-/// the jump. Vectors are `[x, y, z]`; rotations are body → world matrices; quaternions are
-/// scalar-last `[x, y, z, w]` with `w >= 0`.
-#[derive(Debug, Clone)]
-pub struct StaticsSolution {
-    /// Undeformed arc length (m).
-    pub s: Vec<f64>,
-    /// Backbone position (m, world), shape (N, 3).
-    pub position: Vec<[f64; 3]>,
-    /// Rotation body → world, row-major, shape (N, 3, 3).
-    pub rotation: Vec<[[f64; 3]; 3]>,
-    /// Orientation quaternion `[x, y, z, w]`, shape (N, 4).
-    pub quaternion: Vec<[f64; 4]>,
-    /// Rod's internal force `n` (N, world), excluding the tendons' tension.
-    pub n_world: Vec<[f64; 3]>,
-    /// Rod's internal moment `m` (N m, world).
-    pub m_world: Vec<[f64; 3]>,
-    /// Rod's internal force `n` in body components (N).
-    pub n_body: Vec<[f64; 3]>,
-    /// Rod's internal moment `m` in body components (N m).
-    pub m_body: Vec<[f64; 3]>,
-    /// Shear/stretch strain `v` (body, dimensionless; `(0, 0, 1)` undeformed).
-    pub v: Vec<[f64; 3]>,
-    /// Bending/twist strain `u` (body, 1/m per undeformed length).
-    pub u: Vec<[f64; 3]>,
-    /// Path length of each tendon from the base to its termination (m), `∫ |p_i'| ds`
-    /// (quadrature on the integration stages).
-    pub tendon_lengths: Vec<f64>,
-    /// Tension carried by each tendon (N): the input of a tension-controlled tendon, the
-    /// solved tension of a displacement-controlled one (0 when slack).
-    pub tendon_tensions: Vec<f64>,
-    /// Total base wrench (rod + tendons), for [`SolveOptions::warm_start`].
-    pub base_wrench: [f64; 6],
-    /// Solver statistics.
-    pub stats: SolverStats,
-    /// The model solved.
-    pub model: Arc<RobotModel>,
-    /// The actuation it was solved for.
-    pub actuation: Actuation,
-    /// The options it was solved with.
-    pub options: SolveOptions,
-    /// The (exact or updated) shooting Jacobian at the solution, in scaled unknowns.
-    pub jacobian: Option<Matrix6<f64>>,
-    /// The arc lengths the solution was asked at (m; empty: the integration mesh).
-    pub s_out: Vec<f64>,
-    /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
-    /// tension, dead loads) is positive definite (see [`StaticsSolution::stability_margin`]
-    /// and `docs/stability.md`). Always true without external loads; false for a result
-    /// that did not converge.
-    pub stable: bool,
-    /// The stability margin, once computed.
-    pub(crate) margin: OnceLock<f64>,
-}
-
-impl StaticsSolution {
-    /// Tip position (m, world).
-    pub fn tip_position(&self) -> [f64; 3] {
-        self.position.last().copied().unwrap_or([f64::NAN; 3])
-    }
-
-    /// Warm start for a nearby problem (base wrench and Jacobian).
-    pub fn warm_start(&self) -> WarmStart {
-        WarmStart {
-            base_wrench: self.base_wrench,
-            jacobian: self.jacobian,
-        }
-    }
-
-    /// Tension of every tendon (N), as [`StaticsSolution::tendon_tensions`].
-    pub fn tensions(&self) -> Vec<f64> {
-        self.tendon_tensions.clone()
-    }
-
-    /// Pressure of every chamber (Pa).
-    pub fn pressures(&self) -> Vec<f64> {
-        self.actuation.pressure_values(self.model.chambers().len())
-    }
-
-    /// The smallest eigenvalue of the symmetric part of the dimensionless tip tangent
-    /// stiffness `D K D / (E I(0) / L)`, `K` the inverse of the tip tangent compliance
-    /// (tendons at fixed tension, dead loads), `D = diag(L, L, L, 1, 1, 1)`: positive for a
-    /// stable equilibrium (see `docs/stability.md`). Computed during a loaded solve when its
-    /// sign is in doubt; for an unloaded one (always stable) and a loaded one certified
-    /// stable by the exact columns of a nearby Newton iterate, on first call, by one march
-    /// with the six base-wrench columns. NaN for a result that did not converge.
-    pub fn stability_margin(&self) -> f64 {
-        *self.margin.get_or_init(|| {
-            if !self.stats.converged {
-                return f64::NAN;
-            }
-            margin_of(self).unwrap_or(f64::NAN)
-        })
-    }
-}
-
-/// The stability margin of a solution, from one march with the base-wrench columns.
-fn margin_of(sol: &StaticsSolution) -> Option<f64> {
-    stability_on(sol, sol.options.integrator).map(|s| s.margin)
-}
+pub use super::options::{
+    Integrator, SolveOptions, WarmStart, DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_LOAD_STEPS,
+    DEFAULT_RK4_STEPS, DEFAULT_TOLERANCE, DIRECT_STEP_LIMIT, MAX_LINE_SEARCH_HALVINGS,
+    MAX_LOAD_STEP_TURN, MAX_RK4_STEPS,
+};
+pub use super::solution::StaticsSolution;
+pub(crate) use super::solution::{assemble, scaled_back};
 
 /// The stability of a solution from one march with the base-wrench columns by `integrator`
 /// (e.g. a coarser mesh than it was solved on).
@@ -808,7 +576,6 @@ fn check_inputs(
 }
 
 /// [`solve_statics_at`], the continuation refusing unstable states if `require_stable`.
-#[allow(clippy::too_many_lines)] // one sequential algorithm, documented above
 fn solve_with(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
@@ -844,28 +611,8 @@ fn solve_with(
     let opts = &options.newton;
     // Without external loads the equilibrium is unique (x = 0) and stable (docs/stability.md).
     let loaded = !model.loads().is_unloaded();
-    let mut reached = attempt(&mut p, options, &x0, loaded);
-    let stability = if reached.outcome.converged && loaded {
-        stable_outcome(&mut p, model, actuation, options, &mut reached)
-    } else {
-        None
-    };
-    let result = &mut reached.outcome;
-    // The recorded pass must be the one at the returned unknowns (and their load factor).
-    if !result.at_x {
-        let mut r = [0.0; 6];
-        if p.evaluate(&result.x, reached.load_factor, None, &mut r) != Evaluated::Failed {
-            result.residual = max_norm(&r);
-        } else {
-            result.residual = f64::INFINITY;
-        }
-        result.converged =
-            result.converged && result.residual <= p.tolerance(&result.x, opts.tolerance);
-    }
-    if result.converged {
-        // Material failures of rejected trial iterates are not the returned state's.
-        p.ws.material_error = None;
-    }
+    let (reached, stability) = settle(&mut p, model, actuation, options, &x0, loaded);
+    let result = &reached.outcome;
     let finite = p.nodes.iter().all(|n| n.y.iter().all(|v| v.is_finite()));
     let mut stats = SolverStats {
         iterations: reached.iterations,
@@ -892,24 +639,15 @@ fn solve_with(
     }
     sol.stats.function_evaluations = p.evaluations;
     if !stats.converged && opts.throw {
-        if let Some(e) = p.ws.material_error.take() {
-            return Err(e);
-        }
-        if matches!(reached.stopped, Some(Stopped::StartFailed)) {
-            if let Some(e) = super::collapse::compressed_to_zero(model, &tensions) {
-                return Err(e);
-            }
-        }
-        let mut what = failure(&reached, opts.max_load_steps);
-        if !finite || !strains_finite {
-            what.push_str(": non-finite values along the rod");
-        }
-        return Err(Error::NotConverged {
-            what,
-            iterations: stats.iterations,
-            residual: stats.residual,
-            load_factor: stats.load_factor,
-        });
+        let non_finite = !finite || !strains_finite;
+        return Err(not_converged(
+            &mut p,
+            &reached,
+            &stats,
+            &tensions,
+            opts.max_load_steps,
+            non_finite,
+        ));
     }
     sol.actuation = actuation.clone();
     sol.options = *options;
@@ -927,115 +665,70 @@ fn solve_with(
     Ok(sol)
 }
 
-/// The base wrench (N, N m) of scaled unknowns.
-pub(crate) fn scaled_back(model: &RobotModel, x: &[f64]) -> [f64; 6] {
-    let f = model.force_scale();
-    let fm = f * model.length();
-    [
-        x[0] * f,
-        x[1] * f,
-        x[2] * f,
-        x[3] * fm,
-        x[4] * fm,
-        x[5] * fm,
-    ]
-}
-
-fn arr(v: &Vector3<f64>) -> [f64; 3] {
-    [v.x, v.y, v.z]
-}
-
-fn rows(r: &Matrix3<f64>) -> [[f64; 3]; 3] {
-    [
-        [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
-        [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
-        [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
-    ]
-}
-
-/// Derived quantities at the recorded nodes of the last pass (which is at the solution).
-pub(crate) fn assemble(
+/// The loads reached from `x0` ([`attempt`]) and, when converged under loads, the stability
+/// of the equilibrium ([`stable_outcome`]); the last pass of `p` then at the returned
+/// unknowns, whose residual (and convergence) is re-checked there if it was not.
+fn settle(
     p: &mut Shooting<'_>,
-    shared: &Arc<RobotModel>,
-    base_wrench: [f64; 6],
-    stats: SolverStats,
-    s_out: &[f64],
-) -> StaticsSolution {
-    let n = p.nodes.len();
-    let model = p.eq.model;
-    let mut sol = StaticsSolution {
-        s: Vec::with_capacity(n),
-        position: Vec::with_capacity(n),
-        rotation: Vec::with_capacity(n),
-        quaternion: Vec::with_capacity(n),
-        n_world: Vec::with_capacity(n),
-        m_world: Vec::with_capacity(n),
-        n_body: Vec::with_capacity(n),
-        m_body: Vec::with_capacity(n),
-        v: Vec::with_capacity(n),
-        u: Vec::with_capacity(n),
-        tendon_lengths: if p.lengths.len() == p.eq.model.tendons().len() {
-            p.lengths.clone()
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+    x0: &[f64; 6],
+    loaded: bool,
+) -> (Reached, Option<Stability>) {
+    let mut reached = attempt(p, options, x0, loaded);
+    let stability = if reached.outcome.converged && loaded {
+        stable_outcome(p, model, actuation, options, &mut reached)
+    } else {
+        None
+    };
+    let result = &mut reached.outcome;
+    // The recorded pass must be the one at the returned unknowns (and their load factor).
+    if !result.at_x {
+        let mut r = [0.0; 6];
+        if p.evaluate(&result.x, reached.load_factor, None, &mut r) != Evaluated::Failed {
+            result.residual = max_norm(&r);
         } else {
-            vec![f64::NAN; p.eq.model.tendons().len()]
-        },
-        tendon_tensions: p.tensions.clone(),
-        base_wrench,
-        stats,
-        model: Arc::clone(shared),
-        actuation: Actuation::default(),
-        options: SolveOptions::default(),
-        jacobian: None,
-        s_out: Vec::new(),
-        stable: false,
-        margin: OnceLock::new(),
-    };
-    let mut ws = Workspace::new(model.tendons().len());
-    let mut ev = Evaluator {
-        eq: p.equations(),
-        ws: &mut ws,
-    };
-    // With `s_out`, only the nodes there (the last copy of a break).
-    let keep: Option<Vec<bool>> = (!s_out.is_empty()).then(|| {
-        let mut keep = vec![false; n];
-        for &s in s_out {
-            if let Some(j) = p.nodes.iter().rposition(|node| node.s == s) {
-                keep[j] = true;
-            }
+            result.residual = f64::INFINITY;
         }
-        keep
-    });
-    let mut current = usize::MAX;
-    let nodes: &[Node] = &p.nodes;
-    for (j, node) in nodes.iter().enumerate() {
-        if node.interval != current {
-            ev.set_interval(node.interval);
-            current = node.interval;
-        }
-        let y = &node.y;
-        let r = rot(y);
-        let nb_tot = r.tr_mul(&v3(y, 12));
-        let mb_tot = r.tr_mul(&v3(y, 15));
-        let props = model.rod().section_at(node.s);
-        let loc = ev.local(node.s, &props, &nb_tot, &mb_tot, false);
-        if keep.as_ref().is_some_and(|k| !k[j]) {
-            continue;
-        }
-        let nb = nb_tot - loc.tendon_force;
-        let mb = mb_tot - loc.tendon_moment;
-        sol.s.push(node.s);
-        sol.position.push(arr(&v3(y, 0)));
-        sol.rotation.push(rows(&r));
-        sol.quaternion.push(quaternion_xyzw(&r));
-        sol.n_world.push(arr(&(r * nb)));
-        sol.m_world.push(arr(&(r * mb)));
-        sol.n_body.push(arr(&nb));
-        sol.m_body.push(arr(&mb));
-        sol.v.push(arr(&loc.v));
-        sol.u.push(arr(&loc.u));
+        result.converged =
+            result.converged && result.residual <= p.tolerance(&result.x, options.newton.tolerance);
     }
-    if let Some(e) = ws.material_error.take() {
-        p.ws.material_error.get_or_insert(e);
+    if result.converged {
+        // Material failures of rejected trial iterates are not the returned state's.
+        p.ws.material_error = None;
     }
-    sol
+    (reached, stability)
+}
+
+/// The error of a solve that did not converge: a material failure of the state, a rod
+/// compressed to zero length by its tendons, else [`Error::NotConverged`] with the stage
+/// that failed ([`failure`], after at most `max_load_steps` load steps) and whether values
+/// along the rod are not finite.
+fn not_converged(
+    p: &mut Shooting<'_>,
+    reached: &Reached,
+    stats: &SolverStats,
+    tensions: &[f64],
+    max_load_steps: usize,
+    non_finite: bool,
+) -> Error {
+    if let Some(e) = p.ws.material_error.take() {
+        return e;
+    }
+    if matches!(reached.stopped, Some(Stopped::StartFailed)) {
+        if let Some(e) = super::collapse::compressed_to_zero(p.eq.model, tensions) {
+            return e;
+        }
+    }
+    let mut what = failure(reached, max_load_steps);
+    if non_finite {
+        what.push_str(": non-finite values along the rod");
+    }
+    Error::NotConverged {
+        what,
+        iterations: stats.iterations,
+        residual: stats.residual,
+        load_factor: stats.load_factor,
+    }
 }
