@@ -545,6 +545,7 @@ def _inverse_statics(
     atol: float | None = None,
     warm_state: _InverseWarmState | None = None,
     same_model: bool = False,
+    obstacles: Sequence[Any] | None = None,
 ) -> dict[str, Any]:
     """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
 
