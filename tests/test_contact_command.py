@@ -272,3 +272,28 @@ def test_a_path_with_obstacles_is_tracked_and_errors_are_named():
     with pytest.raises(softrod.TargetUnreachableError) as err:
         softrod.inverse_statics(robot, (0.3, 0.3, 0.0))
     assert err.value.distance > 0.05
+
+
+def test_pressure_columns_under_contact_match_central_differences():
+    """The pneumatic arm with its tip pressed on a plane: the chamber columns (per Pa)."""
+    arm = softrod.load_robot(softrod.examples.path("pneumatic_arm"))
+    plane = softrod.Plane((0.02, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    robot = softrod.Robot(arm.rod, chambers=arm.chambers, solver=arm.solver, obstacles=[plane])
+    p = np.array([c.pressure for c in arm.chambers]) + 2000.0
+    sol = robot.solve(None, p, tolerance=1e-14)
+    assert len(sol.contacts) == 1 and sol.contacts[0]["s"] == arm.rod.length
+    j = softrod.actuation_jacobian(sol)
+    h = 1.0
+    cols = []
+    for i in range(len(p)):
+        up, down = p.copy(), p.copy()
+        up[i] += h
+        down[i] -= h
+        sp = robot.solve(None, up, tolerance=1e-14)
+        sm = robot.solve(None, down, tolerance=1e-14)
+        dp = (sp.tip_position - sm.tip_position) / (2 * h)
+        dth = _rotation_difference(sp.tip_rotation, sm.tip_rotation) / (2 * h)
+        cols.append(np.concatenate([dp, dth]))
+    fd = np.array(cols).T
+    assert np.abs(j - fd).max() <= 1e-6 * np.abs(fd).max()
+    assert np.abs(j[0]).max() <= 1e-10 * np.abs(j).max()  # held along the plane's normal
