@@ -547,6 +547,7 @@ def _inverse_statics(
     atol: float | None = None,
     warm_state: _InverseWarmState | None = None,
     same_model: bool = False,
+    obstacles: Sequence[Any] | None = None,
 ) -> dict[str, Any]:
     """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
 
@@ -584,7 +585,13 @@ def actuation_jacobian(
     For a frictional equilibrium the derivative is one-sided: ``direction=1`` ("pull" or
     "load", default) for increasing inputs continued from the solution (``previous=solution``),
     ``-1`` ("release" or "unload") for decreasing ones, the column ``(f(a) - f(a - h e)) / h``; the
-    release column of a slack tendon is zero. Other solutions: both directions agree."""
+    release column of a slack tendon is zero. Other solutions: both directions agree.
+
+    For a solution with active contacts or a tip constraint, the active contacts and the held
+    tip directions are constraints (their reactions move with the actuation; the active set
+    held): frictionless contacts keep their gap, the held directions hold; derivative at the
+    node's undeformed arc length. A solution with a sticking or sliding contact raises
+    ParameterError naming ``solution``."""
 
 # ----------------------------------------------------------------------------- materials
 

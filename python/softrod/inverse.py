@@ -4,7 +4,11 @@ Objective (see ``docs/command.md``): among the actuations inside the bounds that
 target, the one of least weighted norm ``½ Σ w_i a_i²`` (default weights: 1/N² per tension and
 A²/N² per chamber pressure of area A: the norm of the actuator forces), so that antagonistic
 tendons do not pull against each other. Solved by sequential quadratic programming on the exact
-actuation Jacobian; external loads and gravity are those of the robot.
+actuation Jacobian; external loads and gravity are those of the robot. A robot with obstacles is
+solved with the contact solve as the forward model and the actuation Jacobian with the active
+contacts as constraints, so that a target may be reached with the arm resting on an obstacle
+(tip targets, frictionless obstacles). A tip constraint, tendon friction or guides, and friction
+at obstacles are refused (ParameterError naming ``robot``).
 """
 
 from __future__ import annotations
@@ -135,8 +139,38 @@ def _model_key(robot: Robot) -> tuple:
         *robot._tendons,
         robot._loads,
         *robot._chambers,
+        *robot._obstacles,
         tuple(sorted(robot.solver.items())),
     )
+
+
+def _refuse_unsupported(robot: Robot, obstacles_supported: bool = False) -> None:
+    """Raises ``ParameterError`` naming ``robot`` for what the inverse statics does not model
+    (rather than solving without it and reporting the forward solution with it)."""
+    why = None
+    if robot.tip_constraint is not None:
+        why = (
+            f"a tip constraint ({type(robot.tip_constraint).__name__}): the inverse statics "
+            "moves a free tip; solve the held robot with robot.solve"
+        )
+    elif any(t.friction > 0 or len(t.guides) > 0 for t in robot.tendons):
+        i = next(k for k, t in enumerate(robot.tendons) if t.friction > 0 or len(t.guides))
+        why = (
+            f"tendon friction or disk guides (tendons[{i}]): the inverse statics is "
+            "frictionless; give the tendons friction 0 and no guides"
+        )
+    elif robot.obstacles and not obstacles_supported:
+        why = "obstacles with a shape target (target_s): the contact inverse aims at the tip"
+    elif any(getattr(o, "friction", 0) for o in robot.obstacles):
+        i = next(k for k, o in enumerate(robot.obstacles) if getattr(o, "friction", 0))
+        why = (
+            f"an obstacle with friction (obstacles[{i}]): the inverse statics with obstacles "
+            "is frictionless; give the obstacles friction 0"
+        )
+    if why is not None:
+        err = _core.ParameterError(f"invalid parameter `robot` = {robot.name!r}: {why}")
+        err.parameter = "robot"
+        raise err
 
 
 def inverse_statics(
@@ -156,7 +190,9 @@ def inverse_statics(
     """The minimum-norm actuation that puts the tip of ``robot`` at ``target_position``.
 
     Args:
-        robot: The robot (:func:`softrod.load_robot` or built in code); its loads apply.
+        robot: The robot (:func:`softrod.load_robot` or built in code); its loads apply, and
+            its obstacles (frictionless; tip targets only): the forward model is then the
+            contact solve. A tip constraint, tendon friction or guides are refused.
         target_position: Tip position (m, world), shape (3,); with ``target_s``, a shape
             target: backbone points (m, world), shape (k, 3).
         target_rotation: Tip rotation (body -> world, 3x3), or None for a position target.
@@ -175,7 +211,9 @@ def inverse_statics(
         The actuation, its forward solution and the remaining errors.
 
     Raises:
-        ParameterError: A bad argument (named).
+        ParameterError: A bad argument (named); ``robot`` for what is not modelled (a tip
+            constraint, tendon friction or guides, friction at an obstacle, a shape target
+            with obstacles).
         TargetUnreachableError: The target is out of reach (``throw=True``).
         ConvergenceError: The iteration did not converge (``throw=True``).
     """
@@ -185,6 +223,7 @@ def inverse_statics(
         )
         err.parameter = "robot"
         raise err
+    _refuse_unsupported(robot, obstacles_supported=target_s is None)
     key = _model_key(robot)
     warm_start, extra = _warm_arguments(warm_start, key)
     if target_s is not None:
@@ -206,6 +245,7 @@ def inverse_statics(
         max_iterations=max_iterations,
         **{k: v for k, v in robot.solver.items() if k in ("integrator", "steps", "rtol", "atol")},
         **extra,
+        **({"obstacles": list(robot.obstacles)} if robot.obstacles else {}),
     )
     tensions, pressures = out["tensions"], out["pressures"]
     solution = _Deferred(

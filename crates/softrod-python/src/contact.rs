@@ -163,6 +163,12 @@ impl ContactData {
         }
     }
 
+    /// Whether the solution is held by active contacts or a tip constraint (whose
+    /// linearisations must hold them rather than take their forces as dead loads).
+    pub(crate) fn constrained(&self) -> bool {
+        !self.contacts.is_empty() || self.tip_reaction.is_some()
+    }
+
     /// The contacts as a list of dicts.
     pub(crate) fn contacts_py(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let out = pyo3::types::PyList::empty(py);

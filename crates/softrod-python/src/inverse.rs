@@ -180,7 +180,7 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
                     target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
                     throw=true, tolerance=None, max_iterations=None, integrator=None, steps=None,
-                    rtol=None, atol=None, warm_state=None, same_model=false))]
+                    rtol=None, atol=None, warm_state=None, same_model=false, obstacles=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _inverse_statics<'py>(
     py: Python<'py>,
@@ -204,7 +204,9 @@ pub(crate) fn _inverse_statics<'py>(
     #[pyo3(from_py_with = arg::atol)] atol: Option<f64>,
     warm_state: Option<Bound<'py, InverseWarmState>>,
     same_model: bool,
+    obstacles: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let obstacles = crate::contact::obstacles(py, obstacles.as_ref())?;
     let (target, o, warm) = target_and_options(
         &target_position,
         target_s.as_ref(),
@@ -234,6 +236,19 @@ pub(crate) fn _inverse_statics<'py>(
     let model = &problem.model;
     // The forward solution is made in Python (when it is asked for), not here.
     let inv = run(py, "inverse_statics", || {
+        if !obstacles.is_empty() {
+            // The forward model is the contact solve (the arm may rest on an obstacle).
+            if target.s.is_some() {
+                return Err(softrod::Error::invalid(
+                    "target_s",
+                    "given",
+                    "None with obstacles (the contact inverse aims at the tip)",
+                ));
+            }
+            let mut fwd = softrod::ContactForward::new(model, &solve, &obstacles)?;
+            return softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_ref())
+                .map_err(actuator_names);
+        }
         let mut fwd = softrod::CosseratForward::new(model, &solve, target.s.as_deref())
             .map_err(actuator_names)?;
         softrod::solve_inverse(&mut fwd, &target, &o, warm.as_ref()).map_err(actuator_names)

@@ -321,7 +321,9 @@ pub(crate) fn solve_statics<'py>(
 /// `direction` 1 (default, None: the same; "pull" or "load": increasing inputs, continued from the
 /// solution) or -1 ("release" or "unload": decreasing inputs, the column
 /// `(f(a) - f(a - h e)) / h`); for any other
-/// solution the two agree.
+/// solution the two agree. With active contacts or a tip constraint, the contacts and the
+/// held tip directions are constraints (`ContactCompliance::actuation_jacobian`; friction at
+/// a contact is refused naming `solution`).
 #[pyfunction]
 #[pyo3(signature = (solution, node=-1, direction=None))]
 pub(crate) fn actuation_jacobian<'py>(
@@ -348,9 +350,20 @@ pub(crate) fn actuation_jacobian<'py>(
                 &format!("a node index in [-{n}, {n})"),
             ));
         }
-        let j = run(py, "actuation_jacobian", || {
-            softrod::directional_actuation_jacobian(inner, Some(index as usize), direction)
-        })?;
+        let contact = &s.get().contact;
+        let j = if contact.constrained() {
+            // The active contacts and the held tip directions as constraints (their
+            // reactions move with the actuation).
+            run(py, "actuation_jacobian", || {
+                contact
+                    .compliance
+                    .actuation_jacobian(inner, Some(index as usize))
+            })?
+        } else {
+            run(py, "actuation_jacobian", || {
+                softrod::directional_actuation_jacobian(inner, Some(index as usize), direction)
+            })?
+        };
         return Ok(to_array(&j));
     }
     if let Ok(s) = solution.cast::<crate::pcc::PccSolution>() {

@@ -421,6 +421,14 @@ impl StaticsSolution {
                     .collect::<PyResult<Vec<_>>>()
             })
             .transpose()?;
+        if self.contact.constrained() {
+            return Err(param_err(
+                "solution",
+                "a solution with active contacts or a tip constraint",
+                "a solution without active contacts or tip constraint (its sensitivities \
+                 would hold the contact forces and the tip reaction as dead loads)",
+            ));
+        }
         let params = parameters
             .iter()
             .enumerate()

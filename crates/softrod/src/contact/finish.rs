@@ -12,7 +12,7 @@ use super::problem::{Active, Constrained, Pass, Site};
 use super::rows::Forces;
 use super::solve::coarse_mesh;
 use super::stability::{conjugate_points, free_stiffness};
-use super::{Contact, ContactCompliance, ContactSolution};
+use super::{Contact, ContactCompliance, ContactSolution, ContactState};
 use crate::cosserat::equations::{Equations, FULL, STATE};
 use crate::cosserat::shooting::Shooting;
 use crate::cosserat::statics::{assemble, scaled_back, stability_on, Integrator, SolveOptions};
@@ -59,33 +59,53 @@ impl Frozen {
         }
     }
 
+    /// The problem at full load with the active set of the solution.
+    fn problem(&self) -> Constrained<'_> {
+        Constrained {
+            model: &self.model,
+            shared: &self.model,
+            tensions: self.tensions.clone(),
+            pressures: self.pressures.clone(),
+            integrator: self.integrator,
+            tip: self.tip,
+            start: self.start,
+            obstacles: &self.obstacles,
+            active: self.active.clone(),
+            load: 1.0,
+            last: None,
+            reference: Vec::new(),
+            evaluations: 0,
+            coarse: None,
+            hint: None,
+            solved: None,
+            refine: true,
+            rough: false,
+            from: 1.0,
+            refused: None,
+        }
+    }
+
     /// The constrained tip compliance (see [`Constrained::compliance`]), computed once.
     pub(crate) fn compliance(&self) -> Option<Matrix6<f64>> {
-        *self.value.get_or_init(|| {
-            let mut p = Constrained {
-                model: &self.model,
-                shared: &self.model,
-                tensions: self.tensions.clone(),
-                pressures: self.pressures.clone(),
-                integrator: self.integrator,
-                tip: self.tip,
-                start: self.start,
-                obstacles: &self.obstacles,
-                active: self.active.clone(),
-                load: 1.0,
-                last: None,
-                reference: Vec::new(),
-                evaluations: 0,
-                coarse: None,
-                hint: None,
-                solved: None,
-                refine: true,
-                rough: false,
-                from: 1.0,
-                refused: None,
-            };
-            p.compliance(&self.x)
-        })
+        *self
+            .value
+            .get_or_init(|| self.problem().compliance(&self.x))
+    }
+
+    /// Whether an active contact has friction (sticking or sliding).
+    pub(crate) fn frictional(&self) -> bool {
+        self.active
+            .iter()
+            .any(|a| a.state != ContactState::Frictionless)
+    }
+
+    /// The constrained actuation Jacobian of node `node` and its position (see
+    /// [`Constrained::actuation_jacobian`]).
+    pub(crate) fn actuation_jacobian(
+        &self,
+        node: usize,
+    ) -> Option<(nalgebra::DMatrix<f64>, Vector3<f64>)> {
+        self.problem().actuation_jacobian(&self.x, node)
     }
 }
 

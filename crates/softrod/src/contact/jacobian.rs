@@ -11,8 +11,14 @@
 //! along each column are taken by central differences of those few evaluations (no march);
 //! the tip rows use the tip columns. One march replaces the `6 + 4 n_c` marches of forward
 //! differences.
+//!
+//! For the actuation Jacobian the same march carries one forced column per actuator (tension,
+//! then pressure, as in the contact-free sensitivities) and keeps the columns at one observed
+//! node: the rows' derivatives at fixed unknowns along those columns (the contact rows
+//! differenced with the actuator changed in the equations too, since their slope row
+//! evaluates the right-hand side) and the node's twist per unknown and per actuator.
 
-use nalgebra::Vector3;
+use nalgebra::{Vector3, Vector6};
 
 use super::problem::{equations, Active, Constrained, Pass, Site};
 use super::rows::AtContact;
@@ -153,34 +159,114 @@ fn scale(d: &[f64; STATE], l: f64, fs: f64) -> f64 {
     v
 }
 
+/// What the actuator columns of a march left (see [`Constrained::exact_actuated`]).
+pub(super) struct Actuated {
+    /// Per actuator (tensions, then pressures), the derivative of the residual rows at fixed
+    /// unknowns (per N, per Pa).
+    pub(super) rows: Vec<Vec<f64>>,
+    /// Per actuator, the twist `[δp; δθ]` (m, rad; world) of the observed node at fixed
+    /// unknowns.
+    pub(super) twist: Vec<Vector6<f64>>,
+    /// Per scaled unknown, the twist of the observed node.
+    pub(super) node: Vec<Vector6<f64>>,
+    /// Position of the observed node (m, world).
+    pub(super) position: Vector3<f64>,
+}
+
+/// The twist `[δp; δθ]` (m, rad; world) that march column `m` of `y` gives the state's
+/// pose (zero for none).
+fn twist_of(y: &[f64], m: Option<usize>) -> Vector6<f64> {
+    let Some(m) = m else {
+        return Vector6::zeros();
+    };
+    let b = STATE + COLUMN * m;
+    let (dp, w) = (v3(y, b), rotation_variation(&rot(y), &col_rot(y, b)));
+    Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
+}
+
+/// The march columns: the unknowns' `ncol`, then the actuators' (tensions, then pressures).
+struct MarchColumns<'a> {
+    ncol: usize,
+    actuators: &'a [Column],
+}
+
 impl Constrained<'_> {
     /// The residual rows at `x` and the exact Jacobian (column-major, `dim × dim`, into `j`)
     /// from one march; `None` if the march fails or the columns do not fit in one march (the
     /// caller then differences).
     pub(super) fn exact(&mut self, x: &[f64], mu: f64, j: &mut [f64]) -> Option<Vec<f64>> {
+        self.dispatch(x, mu, j, None).map(|(rows, _)| rows)
+    }
+
+    /// As [`Self::exact`], with the actuator columns and the columns at the node of index
+    /// `observe` (in the order of the march's nodes, those of a solution).
+    pub(super) fn exact_actuated(
+        &mut self,
+        x: &[f64],
+        j: &mut [f64],
+        observe: usize,
+    ) -> Option<(Vec<f64>, Actuated)> {
+        let (rows, act) = self.dispatch(x, 1.0, j, Some(observe))?;
+        Some((rows, act?))
+    }
+
+    /// [`Self::wide`] with the smallest march width that holds the columns.
+    fn dispatch(
+        &mut self,
+        x: &[f64],
+        mu: f64,
+        j: &mut [f64],
+        observe: Option<usize>,
+    ) -> Option<(Vec<f64>, Option<Actuated>)> {
         let interior = self.active.iter().filter(|a| a.site != Site::Tip).count();
-        match 6 + 4 * interior {
-            0..=6 => self.wide::<{ width(6) }>(x, mu, j),
-            7..=10 => self.wide::<{ width(10) }>(x, mu, j),
-            11..=14 => self.wide::<{ width(14) }>(x, mu, j),
-            15..=18 => self.wide::<{ width(18) }>(x, mu, j),
-            19..=26 => self.wide::<{ width(26) }>(x, mu, j),
+        let actuators = if observe.is_some() {
+            self.tensions.len() + self.pressures.len()
+        } else {
+            0
+        };
+        match 6 + 4 * interior + actuators {
+            0..=6 => self.wide::<{ width(6) }>(x, mu, j, observe),
+            7..=10 => self.wide::<{ width(10) }>(x, mu, j, observe),
+            11..=14 => self.wide::<{ width(14) }>(x, mu, j, observe),
+            15..=18 => self.wide::<{ width(18) }>(x, mu, j, observe),
+            19..=26 => self.wide::<{ width(26) }>(x, mu, j, observe),
+            27..=34 if observe.is_some() => self.wide::<{ width(34) }>(x, mu, j, observe),
             _ => None,
         }
     }
 
     /// [`Self::exact`] with the state and `(N - STATE) / COLUMN` columns in one march: the
-    /// march of the columns, the rows at its end, then the Jacobian column by column.
-    fn wide<const N: usize>(&mut self, x: &[f64], mu: f64, j: &mut [f64]) -> Option<Vec<f64>> {
+    /// march of the columns, the rows at its end, then the Jacobian column by column; with
+    /// an `observe`d node also the actuator columns ([`Self::actuated`]).
+    fn wide<const N: usize>(
+        &mut self,
+        x: &[f64],
+        mu: f64,
+        j: &mut [f64],
+        observe: Option<usize>,
+    ) -> Option<(Vec<f64>, Option<Actuated>)> {
         let model = self.contact_model(x)?;
         let n = self.dim();
         let offsets = self.offsets();
         let (mcol, mut sites, ncol) = self.march_columns_of(x);
+        let actuators: Vec<Column> = if observe.is_some() {
+            (0..self.tensions.len())
+                .map(Column::Tension)
+                .chain((0..self.pressures.len()).map(Column::Pressure))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let cols = MarchColumns {
+            ncol,
+            actuators: &actuators,
+        };
         let nt = model.tendons().len();
         let mut scratch = Workspace::new(nt);
-        let (y, nodes) = self.march_with_columns::<N>(&model, x, &mut sites, ncol, &mut scratch)?;
+        let (y, nodes, observed) =
+            self.march_with_columns::<N>(&model, x, &mut sites, &cols, observe, &mut scratch)?;
         let eq = equations(&model, &self.tensions, &self.pressures);
-        let (res, dres) = eq.residual(&y, ncol);
+        let (res, dres) = eq.residual(&y, ncol + actuators.len());
         let (p_tip, r_tip) = (v3(&y, 0), rot(&y));
         let mut rows = self.tip_rows(&res, &p_tip, &r_tip).to_vec();
         let tip = (head(&y), nodes.last()?.interval);
@@ -214,6 +300,10 @@ impl Constrained<'_> {
         for c in 0..n {
             twists.push(self.jacobian_column(&mut ev, &lin, c, j, &mut buf)?);
         }
+        let actuated = match &observed {
+            None => None,
+            Some(yo) => Some(self.actuated(&model, &lin, &cols, yo)?),
+        };
         self.last = Some(Pass {
             model: std::sync::Arc::clone(&model),
             nodes,
@@ -223,7 +313,116 @@ impl Constrained<'_> {
             jacobian: Some((j.to_vec(), twists)),
             marched: None,
         });
-        Some(rows)
+        Some((rows, actuated))
+    }
+
+    /// The actuator columns of the march `lin` (`cols.actuators`, after the unknowns'): per
+    /// actuator the derivative of the rows at fixed unknowns (the tip rows from its column,
+    /// the contact rows by central differences with the actuator changed in the equations
+    /// too) and the twist of the observed node (state and columns `yo`).
+    fn actuated(
+        &self,
+        model: &RobotModel,
+        lin: &Linear<'_>,
+        cols: &MarchColumns<'_>,
+        yo: &[f64],
+    ) -> Option<Actuated> {
+        let fs = self.model.force_scale();
+        let mut out = Actuated {
+            rows: Vec::with_capacity(cols.actuators.len()),
+            twist: Vec::with_capacity(cols.actuators.len()),
+            node: (0..lin.n).map(|c| twist_of(yo, lin.mcol[c])).collect(),
+            position: v3(yo, 0),
+        };
+        for (k, col) in cols.actuators.iter().enumerate() {
+            let m = cols.ncol + k;
+            let b = STATE + COLUMN * m;
+            let (dp, w) = (
+                v3(lin.y, b),
+                rotation_variation(&lin.r_tip, &col_rot(lin.y, b)),
+            );
+            let mut d = self.tip_rows_dot(&lin.dres[m], &dp, &w, &lin.r_tip).to_vec();
+            // The actuator's size: the force scale, or the pressure that makes it.
+            let unit = match *col {
+                Column::Pressure(q) => {
+                    let (start, _) = model.chamber_extents()[q];
+                    fs / model.chambers()[q].area_at(start)
+                }
+                _ => fs,
+            };
+            for held in lin.at {
+                self.actuated_contact_rows(model, lin, held, (*col, m, unit), &mut d)?;
+            }
+            if d.len() != lin.n || !d.iter().all(|v| v.is_finite()) {
+                return None;
+            }
+            out.rows.push(d);
+            out.twist.push(twist_of(yo, Some(m)));
+        }
+        Some(out)
+    }
+
+    /// Appends to `d` the derivatives of the rows of the contact `held` along the actuator
+    /// column `m` (the actuator `col` of size `unit`), by central differences of the rows
+    /// with the node states moved along the column and the actuator changed.
+    fn actuated_contact_rows(
+        &self,
+        model: &RobotModel,
+        lin: &Linear<'_>,
+        held: &RowsOf,
+        (col, m, unit): (Column, usize, f64),
+        d: &mut Vec<f64>,
+    ) -> Option<()> {
+        let (l, fs) = (self.model.length(), self.model.force_scale());
+        let ((yf, kf), (yl, kl)) = (held.first, held.last);
+        let (dyf, dyl) = match held.site {
+            None => {
+                let c = column_of(lin.y, Some(m));
+                (c, c)
+            }
+            Some(i) => (
+                column_of(&lin.sites[i].before.as_ref()?.0, Some(m)),
+                column_of(&lin.sites[i].after.as_ref()?.0, Some(m)),
+            ),
+        };
+        let h = ROW_STEP / scale(&dyf, l, fs).max(scale(&dyl, l, fs)).max(1.0 / unit);
+        let nt = model.tendons().len();
+        let side = |t: f64| -> Vec<f64> {
+            let (mut tp, mut pp) = (self.tensions.clone(), self.pressures.clone());
+            match col {
+                Column::Tension(i) => tp[i] += t,
+                Column::Pressure(q) => pp[q] += t,
+                _ => {}
+            }
+            let eq2 = equations(model, &tp, &pp);
+            let (mut w1, mut w2) = (Workspace::new(nt), Workspace::new(nt));
+            let mut ev2 = [
+                Evaluator {
+                    eq: eq2,
+                    ws: &mut w1,
+                },
+                Evaluator {
+                    eq: eq2,
+                    ws: &mut w2,
+                },
+            ];
+            let (mut yf2, mut yl2) = (yf, yl);
+            for i in 0..STATE {
+                yf2[i] += t * dyf[i];
+                yl2[i] += t * dyl[i];
+            }
+            let mut buf = Vec::with_capacity(4);
+            let here = AtContact {
+                s: held.s,
+                first: (&yf2, kf),
+                last: (&yl2, kl),
+            };
+            self.contact_rows(&mut ev2, &held.active, here, &held.f, lin.mu, &mut buf);
+            buf
+        };
+        let (plus, minus) = (side(h), side(-h));
+        d.extend(plus.iter().zip(&minus).map(|(p, q)| (p - q) / (2.0 * h)));
+        Some(())
     }
 
     /// The march column of every unknown at `x` (none for a tip contact's force: six for the
@@ -272,9 +471,10 @@ impl Constrained<'_> {
         model: &RobotModel,
         x: &[f64],
         sites: &mut [Site2],
-        ncol: usize,
+        cols: &MarchColumns<'_>,
+        observe: Option<usize>,
         scratch: &mut Workspace,
-    ) -> Option<([f64; N], Vec<Node>)> {
+    ) -> Option<([f64; N], Vec<Node>, Option<Vec<f64>>)> {
         let l = self.model.length();
         let fs = self.model.force_scale();
         let plan = match self.integrator {
@@ -290,9 +490,12 @@ impl Constrained<'_> {
         };
         let eq = equations(model, &self.tensions, &self.pressures);
         let mut ws = Workspace::new(model.tendons().len());
-        ws.set_columns(&vec![Column::Free; ncol], &[]);
+        let mut columns = vec![Column::Free; cols.ncol];
+        columns.extend_from_slice(cols.actuators);
+        ws.set_columns(&columns, &[]);
         let y0: [f64; N] = eq.initial(&x[..6]);
         let mut nodes = Vec::new();
+        let mut observed: Option<Vec<f64>> = None;
         let y = {
             let mut ev = Evaluator { eq, ws: &mut ws };
             let mut side = Evaluator { eq, ws: scratch };
@@ -308,6 +511,9 @@ impl Constrained<'_> {
                     for site in sites.iter_mut().filter(|c| c.s == s) {
                         site.record(&mut side, s, interval, y, (l, fs));
                     }
+                    if observe == Some(nodes.len()) {
+                        observed = Some(y.to_vec());
+                    }
                     nodes.push(Node {
                         s,
                         interval,
@@ -321,7 +527,10 @@ impl Constrained<'_> {
         if !y[..STATE].iter().all(|v| v.is_finite()) || sites.iter().any(|c| c.after.is_none()) {
             return None;
         }
-        Some((y, nodes))
+        if observe.is_some() && observed.is_none() {
+            return None;
+        }
+        Some((y, nodes, observed))
     }
 
     /// Appends to `rows` the rows of every active contact from its node states (the tip's

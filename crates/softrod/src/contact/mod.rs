@@ -11,9 +11,11 @@
 //! arc length, point, normal and force.
 
 mod active_set;
+mod actuation;
 mod constraint;
 mod finish;
 mod friction;
+mod inverse;
 mod jacobian;
 mod mesh;
 mod newton;
@@ -31,6 +33,7 @@ use nalgebra::Vector3;
 
 pub use active_set::MAX_ACTIVE_SET_ROUNDS;
 pub use constraint::TipConstraint;
+pub use inverse::{contact_inverse_statics, solve_contact_inverse, ContactForward};
 pub use obstacle::{Obstacle, TriangleMesh};
 pub use solve::solve_constrained;
 
@@ -130,6 +133,70 @@ impl ContactCompliance {
     /// singular there.
     pub fn get(&self) -> Option<nalgebra::Matrix6<f64>> {
         self.inner.as_ref().and_then(|f| f.compliance())
+    }
+
+    /// The actuation Jacobian of the contact equilibrium with the active contacts and the
+    /// tip constraint as constraints (frictionless and sliding contacts hold their gap,
+    /// sticking ones their point, the held tip directions hold; the active set and the
+    /// contact states fixed): `d[δp; δθ]/da` of node `node` of `solution` (m, rad; world; the
+    /// tip for `None`) per tendon tension (N), then chamber pressure (Pa), shape
+    /// (6, n_tendons + n_chambers). `solution` is the [`ContactSolution::solution`] this
+    /// linearisation belongs to. Exact: from the linearised constrained shooting problem (see
+    /// `contact/actuation.rs`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `node` off the mesh, or `solution` when it does not
+    /// belong to this linearisation or has a sticking or sliding contact (friction at
+    /// contacts: not modelled in this Jacobian); [`Error::NotConverged`] when the solve did not converge
+    /// or the constrained problem is singular there.
+    ///
+    /// [`Error::InvalidParameter`]: crate::Error::InvalidParameter
+    /// [`Error::NotConverged`]: crate::Error::NotConverged
+    pub fn actuation_jacobian(
+        &self,
+        solution: &StaticsSolution,
+        node: Option<usize>,
+    ) -> crate::Result<nalgebra::DMatrix<f64>> {
+        let n = solution.s.len();
+        let node = node.unwrap_or(n.saturating_sub(1));
+        if node >= n {
+            return Err(crate::Error::invalid("node", node, format!("< {n}")));
+        }
+        let Some(frozen) = &self.inner else {
+            return Err(crate::Error::not_converged(
+                "actuation Jacobian under contact: the contact solve did not converge",
+                0,
+                f64::INFINITY,
+            ));
+        };
+        if frozen.frictional() {
+            // The slip of a frictional contact is measured from its first touch on the
+            // proportional load path, which moves with the actuation: not the increment
+            // from this equilibrium that holding the contact state would give.
+            return Err(crate::Error::invalid(
+                "solution",
+                "a solution with a sticking or sliding contact",
+                "a solution whose active contacts are frictionless (the actuation Jacobian \
+                 with friction at contacts is not modelled)",
+            ));
+        }
+        let (j, at) = frozen.actuation_jacobian(node).ok_or_else(|| {
+            crate::Error::not_converged(
+                "actuation Jacobian under contact: the constrained problem is singular or \
+                 its march failed",
+                0,
+                f64::INFINITY,
+            )
+        })?;
+        let p = Vector3::from(solution.position[node]);
+        if (at - p).norm() > 1e-9 * (1.0 + solution.model.length()) {
+            return Err(crate::Error::invalid(
+                "solution",
+                "another solution",
+                "the solution of this contact linearisation",
+            ));
+        }
+        Ok(j)
     }
 
     pub(crate) fn of(frozen: Option<finish::Frozen>) -> Self {
