@@ -236,8 +236,7 @@ impl<'m> Fixed<'m> {
     /// Whether tendon `i` is there at `s` (m): before its termination, or at the tip if it
     /// ends there.
     fn present(&self, i: usize, s: f64) -> bool {
-        let (l, ends) = (self.l, self.ends);
-        s < ends[i] || (ends[i] == l && s == l)
+        present(self.ends, self.l, i, s)
     }
 
     /// The equations at the base tensions (no profile).
@@ -299,6 +298,12 @@ impl<'m> Fixed<'m> {
         let finite = v.iter().chain(u.iter()).all(|c| c.is_finite());
         finite.then(|| node_tangents(model, s, &r, &v, &u))
     }
+}
+
+/// Whether the tendon ending at `ends[i]` (m) is there at `s` (m) on a rod of length `l`
+/// (m): before its end, or at the tip if it ends there.
+fn present(ends: &[f64], l: f64, i: usize, s: f64) -> bool {
+    s < ends[i] || (ends[i] == l && s == l)
 }
 
 /// The error of a failed step of a cell: the workspace's material failure, else `what`
@@ -426,6 +431,7 @@ impl<'m, const N: usize> CellMarch<'m, N> {
         let (rates, guess): (&[Option<f64>], &mut [f64]) = (rates, guess);
         let (j, a, b, crosses) = (c.j, c.a, c.b, c.crosses);
         let (hint, prev, nt) = (fixed.hint, fixed.setup.prev, fixed.nt);
+        let (mus, ends, l): (&[f64], &[f64], f64) = (&fixed.mus, fixed.ends, fixed.l);
         for i in 0..nt {
             let theta = match hint.map(|h| (&h[j][i], &h[j + 1][i])) {
                 Some((Some(ta), Some(tb))) => {
@@ -444,8 +450,8 @@ impl<'m, const N: usize> CellMarch<'m, N> {
                 _ if crosses => 0.0,
                 _ => (extrapolated_rate(rates, nt, i) * (b - a)).max(0.0),
             };
-            guess[i] = if fixed.present(i, b) {
-                cell_rule(tau[j][i], fixed.mus[i] * theta, prev.map(|p| p[j + 1][i])).0
+            guess[i] = if present(ends, l, i, b) {
+                cell_rule(tau[j][i], mus[i] * theta, prev.map(|p| p[j + 1][i])).0
             } else {
                 0.0
             };
@@ -514,8 +520,9 @@ impl<'m, const N: usize> CellMarch<'m, N> {
             ..
         } = self;
         let (tau_j, guess): (&[f64], &[f64]) = (&tau[c.j], guess);
+        let (ends, l) = (fixed.ends, fixed.l);
         for i in 0..fixed.nt {
-            let distal = if fixed.present(i, c.b) {
+            let distal = if present(ends, l, i, c.b) {
                 guess[i]
             } else {
                 tau_j[i]
