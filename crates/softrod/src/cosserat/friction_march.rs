@@ -211,6 +211,7 @@ struct Fixed<'m> {
 }
 
 impl<'m> Fixed<'m> {
+    /// The fixed data of a march on `setup` (the other arguments those of [`march_cells`]).
     fn new(
         setup: &'m Setup<'m>,
         unloaded: bool,
