@@ -147,7 +147,6 @@ impl Setup<'_> {
 /// `cell_tolerance`: the change of a cell's distal tension, relative to the largest base
 /// tension, that ends its iteration ([`FrictionOptions::tolerance`] but for the early
 /// iterates of a loaded solve).
-#[allow(clippy::too_many_lines)] // one sequential march
 pub(super) fn march_cells<const N: usize>(
     setup: &Setup<'_>,
     x: &[f64; 6],
@@ -155,46 +154,130 @@ pub(super) fn march_cells<const N: usize>(
     hint: Option<&[Vec<Option<Vector3<f64>>>]>,
     cell_tolerance: f64,
 ) -> Result<Marched<N>> {
-    let Setup {
-        model,
-        options,
-        mesh,
-        base,
-        prev,
-        ..
-    } = *setup;
-    let nt = base.len();
-    let pressures = setup.pressures();
-    let (l, ends, breaks) = (model.length(), model.tendon_ends(), model.breaks());
-    let mus: Vec<f64> = model.tendons().iter().map(|t| t.friction()).collect();
-    let present = |i: usize, s: f64| s < ends[i] || (ends[i] == l && s == l);
-    let mut cell = TensionProfile::new(
-        (0..nt)
-            .map(|i| (mus[i] > 0.0).then(|| (vec![0.0, 0.0], vec![base[i]; 2])))
-            .collect(),
-    );
-    let scale = setup.scale();
-    let tol = cell_tolerance * scale;
-    let n = mesh.len();
-    let mut tau = vec![vec![0.0; nt]; n];
-    let mut slip = vec![vec![Slip::Absent; nt]; n];
-    let mut dirs: Vec<Vec<Option<Vector3<f64>>>> = Vec::with_capacity(n);
-    let mut nodes = Vec::with_capacity(n);
-    let mut ws = Workspace::new(nt);
-    let ncol = if N >= FULL { 6 } else { 0 };
-    ws.set_columns(&[], &[]);
-    ws.track_lengths = true;
-    let eq = Equations {
-        model,
-        tensions: base,
-        pressures: &pressures,
-        load_factor: 1.0,
-        profile: None,
-    };
-    // The strains at the node `s` of state `y` and the tendons' path tangents there. Without
-    // external loads the total wrench is zero all along, so the strains depend on `s` alone:
-    // after an RK4 step (`reuse`) they are those of its last stage, at the same `s`.
-    let at_node = |ev: &mut Evaluator<'_, '_>, s: f64, y: &[f64], reuse: bool| {
+    let fixed = Fixed::new(setup, unloaded, hint, cell_tolerance);
+    let mut march = CellMarch::<N>::start(fixed, x)?;
+    let (mesh, breaks) = (setup.mesh, setup.model.breaks());
+    for j in 0..mesh.len() - 1 {
+        let (b, interval) = (mesh[j + 1], march.interval);
+        march.cell(Cell {
+            j,
+            a: mesh[j],
+            b,
+            interval,
+            crosses: breaks[interval + 1] == b && interval + 2 < breaks.len(),
+        })?;
+    }
+    Ok(march.finish())
+}
+
+/// Per tendon, its unit path tangent (world) at a node, `None` where it is not there.
+type Tangents = Vec<Option<Vector3<f64>>>;
+
+/// Cell `j` of the friction mesh, `[a, b]`, the integration interval it starts in and
+/// whether `b` is a break into the next one.
+#[derive(Clone, Copy)]
+struct Cell {
+    j: usize,
+    a: f64,
+    b: f64,
+    interval: usize,
+    crosses: bool,
+}
+
+impl Cell {
+    /// The integration interval at the distal node `b`.
+    fn next_interval(self) -> usize {
+        self.interval + usize::from(self.crosses)
+    }
+}
+
+/// The fixed data of one frictional march: the setup, the number of tendons, the rod's
+/// length and the tendons' ends (m), the model's pressures and the tendons' friction
+/// coefficients, the hint of the first guesses, whether the strains at a
+/// node are those of the last RK4 stage (`reuse`), and the largest base tension `scale` (N)
+/// with the cell tolerance relative to it and in N (`tol`).
+struct Fixed<'m> {
+    setup: &'m Setup<'m>,
+    nt: usize,
+    l: f64,
+    ends: &'m [f64],
+    pressures: Vec<f64>,
+    mus: Vec<f64>,
+    hint: Option<&'m [Tangents]>,
+    reuse: bool,
+    cell_tolerance: f64,
+    scale: f64,
+    tol: f64,
+}
+
+impl<'m> Fixed<'m> {
+    /// The fixed data of a march on `setup` (the other arguments those of [`march_cells`]).
+    fn new(
+        setup: &'m Setup<'m>,
+        unloaded: bool,
+        hint: Option<&'m [Tangents]>,
+        cell_tolerance: f64,
+    ) -> Self {
+        let scale = setup.scale();
+        Fixed {
+            setup,
+            nt: setup.base.len(),
+            l: setup.model.length(),
+            ends: setup.model.tendon_ends(),
+            pressures: setup.pressures(),
+            mus: setup.model.tendons().iter().map(|t| t.friction()).collect(),
+            hint,
+            reuse: unloaded && matches!(setup.options.statics.integrator, Integrator::Rk4 { .. }),
+            cell_tolerance,
+            scale,
+            tol: cell_tolerance * scale,
+        }
+    }
+
+    /// Whether tendon `i` is there at `s` (m): before its termination, or at the tip if it
+    /// ends there.
+    fn present(&self, i: usize, s: f64) -> bool {
+        present(self.ends, self.l, i, s)
+    }
+
+    /// The equations at the base tensions (no profile).
+    fn eq(&self) -> Equations<'_> {
+        Equations {
+            model: self.setup.model,
+            tensions: self.setup.base,
+            pressures: &self.pressures,
+            load_factor: 1.0,
+            profile: None,
+        }
+    }
+
+    /// The evaluator of the equations on the tension profile `cell`.
+    fn evaluator<'e>(
+        &'e self,
+        cell: &'e TensionProfile,
+        ws: &'e mut Workspace,
+    ) -> Evaluator<'e, 'e> {
+        Evaluator {
+            eq: Equations {
+                profile: Some(cell),
+                ..self.eq()
+            },
+            ws,
+        }
+    }
+
+    /// The tendons' path tangents at the node `s` (m) of state `y` from the strains there,
+    /// `None` if they are not finite. Without external loads the total wrench is zero all
+    /// along, so the strains depend on `s` alone: after an RK4 step (`reuse`) they are those
+    /// of its last stage, at the same `s`.
+    fn tangents(
+        &self,
+        ev: &mut Evaluator<'_, '_>,
+        s: f64,
+        y: &[f64],
+        reuse: bool,
+    ) -> Option<Tangents> {
+        let model = self.setup.model;
         let r = rot(y);
         let (v, u) = match ev.ws.guess.filter(|_| reuse && !ev.ws.active.is_empty()) {
             Some(g) => (
@@ -215,62 +298,144 @@ pub(super) fn march_cells<const N: usize>(
         };
         let finite = v.iter().chain(u.iter()).all(|c| c.is_finite());
         finite.then(|| node_tangents(model, s, &r, &v, &u))
-    };
-    let reuse = unloaded && matches!(options.statics.integrator, Integrator::Rk4 { .. });
-    let failed = |ws: &mut Workspace, what: String, attempts: usize, residual: f64| {
-        ws.material_error.take().unwrap_or(Error::NotConverged {
-            what,
-            iterations: attempts,
-            residual,
-            load_factor: 1.0,
-        })
-    };
-    let mut y: [f64; N] = eq.initial(x);
-    for i in 0..nt {
-        if present(i, 0.0) {
-            tau[0][i] = base[i];
-            slip[0][i] = base_slip(base[i], prev.map(|p| p[0][i]));
+    }
+}
+
+/// Whether the tendon ending at `ends[i]` (m) is there at `s` (m) on a rod of length `l`
+/// (m): before its end, or at the tip if it ends there.
+fn present(ends: &[f64], l: f64, i: usize, s: f64) -> bool {
+    s < ends[i] || (ends[i] == l && s == l)
+}
+
+/// The error of a failed step of a cell: the workspace's material failure, else `what`
+/// not converged after `attempts` with `residual`.
+fn failed(ws: &mut Workspace, what: String, attempts: usize, residual: f64) -> Error {
+    ws.material_error.take().unwrap_or(Error::NotConverged {
+        what,
+        iterations: attempts,
+        residual,
+        load_factor: 1.0,
+    })
+}
+
+/// The state of one frictional march: the profile over the current cell, the workspace
+/// (with the tendon lengths so far) and its quadratures at the cell's proximal node
+/// (`saved`), the state and integration interval at the last accepted node, per node and
+/// tendon the tension, slip state, path tangent and path length, the recorded nodes, per
+/// cell and tendon the turning rate (see [`extrapolated_rate`]), the current cell's guess
+/// and rule of its distal tensions with the rule's slip states, and the cell steps so far
+/// with the largest accepted change of a cell (N).
+struct CellMarch<'m, const N: usize> {
+    fixed: Fixed<'m>,
+    cell: TensionProfile,
+    ws: Workspace,
+    saved: Vec<f64>,
+    y: [f64; N],
+    interval: usize,
+    tau: Vec<Vec<f64>>,
+    slip: Vec<Vec<Slip>>,
+    dirs: Vec<Tangents>,
+    path_length: Vec<Vec<f64>>,
+    nodes: Vec<Node>,
+    rates: Vec<Option<f64>>,
+    guess: Vec<f64>,
+    rule: Vec<f64>,
+    rule_slip: Vec<Slip>,
+    cell_steps: usize,
+    worst: f64,
+}
+
+impl<'m, const N: usize> CellMarch<'m, N> {
+    /// The march at the base from the scaled base wrench `x`: the base tensions and slip
+    /// states, the path tangents there and the base node.
+    fn start(fixed: Fixed<'m>, x: &[f64; 6]) -> Result<Self> {
+        let Setup { base, prev, .. } = *fixed.setup;
+        let (nt, n) = (base.len(), fixed.setup.mesh.len());
+        let cell = TensionProfile::new(
+            (0..nt)
+                .map(|i| (fixed.mus[i] > 0.0).then(|| (vec![0.0, 0.0], vec![base[i]; 2])))
+                .collect(),
+        );
+        let mut tau = vec![vec![0.0; nt]; n];
+        let mut slip = vec![vec![Slip::Absent; nt]; n];
+        let mut ws = Workspace::new(nt);
+        ws.set_columns(&[], &[]);
+        ws.track_lengths = true;
+        let y: [f64; N] = fixed.eq().initial(x);
+        for i in 0..nt {
+            if fixed.present(i, 0.0) {
+                tau[0][i] = base[i];
+                slip[0][i] = base_slip(base[i], prev.map(|p| p[0][i]));
+            }
         }
+        let mut dirs = Vec::with_capacity(n);
+        {
+            let mut ev = fixed.evaluator(&cell, &mut ws);
+            ev.set_interval(0);
+            let Some(d) = fixed.tangents(&mut ev, 0.0, &y, false) else {
+                return Err(failed(
+                    &mut ws,
+                    "friction: the constitutive solve failed at the base".into(),
+                    0,
+                    f64::INFINITY,
+                ));
+            };
+            dirs.push(d);
+        }
+        let mut nodes = Vec::with_capacity(n);
+        nodes.push(node(0.0, 0, &y));
+        Ok(CellMarch {
+            fixed,
+            cell,
+            ws,
+            saved: Vec::new(),
+            y,
+            interval: 0,
+            tau,
+            slip,
+            dirs,
+            path_length: vec![vec![0.0; nt]; n],
+            nodes,
+            rates: Vec::with_capacity(n * nt),
+            guess: vec![0.0; nt],
+            rule: vec![0.0; nt],
+            rule_slip: vec![Slip::Absent; nt],
+            cell_steps: 0,
+            worst: 0.0,
+        })
     }
-    let mut interval = 0;
-    {
-        let mut ev = Evaluator {
-            eq: Equations {
-                profile: Some(&cell),
-                ..eq
-            },
-            ws: &mut ws,
-        };
-        ev.set_interval(0);
-        let Some(d) = at_node(&mut ev, 0.0, &y, false) else {
-            return Err(failed(
-                &mut ws,
-                "friction: the constitutive solve failed at the base".into(),
-                0,
-                f64::INFINITY,
-            ));
-        };
-        dirs.push(d);
+
+    /// Marches over cell `c`: its first guess, the iteration to its rule, the repeat with
+    /// the columns, and the accepted distal node recorded.
+    fn cell(&mut self, c: Cell) -> Result<()> {
+        self.saved.clone_from(&self.ws.integral);
+        self.first_guess(c);
+        let (ys1, d1) = self.settle(c)?;
+        let y1 = self.repeat_with_columns(c, &ys1)?;
+        self.record(c, y1, d1);
+        Ok(())
     }
-    nodes.push(node(0.0, 0, &y));
-    let mut path_length = vec![vec![0.0; nt]; n];
-    let tiny = 10.0 * BREAK_OFFSET * l;
-    let mut rates: Vec<Option<f64>> = Vec::with_capacity(n * nt);
-    let (mut saved, mut guess, mut rule) = (Vec::new(), vec![0.0; nt], vec![0.0; nt]);
-    let mut rule_slip = vec![Slip::Absent; nt];
-    let mut last: Option<(Vec<f64>, Vec<f64>)>;
-    let mut attempts_total = 0;
-    let mut worst: f64 = 0.0;
-    for j in 0..n - 1 {
-        let (a, b) = (mesh[j], mesh[j + 1]);
-        let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
-        saved.clone_from(&ws.integral);
-        // First guess: the rule with the turning of the hint, or with the turning rate
-        // extrapolated from the last cells.
+
+    /// The first guess of the distal tensions of cell `c`: the rule with the turning of the
+    /// hint, corrected by the difference to the hint over the last cell; else with the
+    /// turning rate extrapolated from the last cells (none across a break).
+    fn first_guess(&mut self, c: Cell) {
+        let Self {
+            fixed,
+            tau,
+            dirs,
+            rates,
+            guess,
+            ..
+        } = self;
+        let (tau, dirs): (&[Vec<f64>], &[Tangents]) = (tau, dirs);
+        let (rates, guess): (&[Option<f64>], &mut [f64]) = (rates, guess);
+        let (j, a, b, crosses) = (c.j, c.a, c.b, c.crosses);
+        let (hint, prev, nt) = (fixed.hint, fixed.setup.prev, fixed.nt);
+        let (mus, ends, l): (&[f64], &[f64], f64) = (&fixed.mus, fixed.ends, fixed.l);
         for i in 0..nt {
             let theta = match hint.map(|h| (&h[j][i], &h[j + 1][i])) {
                 Some((Some(ta), Some(tb))) => {
-                    // Corrected by the difference to the hint over the last cell.
                     let shift = match (j.checked_sub(1), hint) {
                         (Some(k), Some(h)) if !crosses => match (&h[k][i], &dirs[k][i]) {
                             (Some(ha), Some(da)) => {
@@ -284,146 +449,220 @@ pub(super) fn march_cells<const N: usize>(
                     (angle(ta, tb) + shift).max(0.0)
                 }
                 _ if crosses => 0.0,
-                _ => (extrapolated_rate(&rates, nt, i) * (b - a)).max(0.0),
+                _ => (extrapolated_rate(rates, nt, i) * (b - a)).max(0.0),
             };
-            guess[i] = if present(i, b) {
+            guess[i] = if present(ends, l, i, b) {
                 cell_rule(tau[j][i], mus[i] * theta, prev.map(|p| p[j + 1][i])).0
             } else {
                 0.0
             };
         }
-        last = None;
+    }
+
+    /// Cell `c` repeated from its proximal node until the guess of its distal tensions and
+    /// the rule agree to the tolerance (each attempt from the next guess of
+    /// [`next_guess`]): the accepted distal state and path tangents, the rule's tensions and
+    /// slip states in `rule`, `rule_slip`.
+    fn settle(&mut self, c: Cell) -> Result<([f64; STATE], Tangents)> {
+        let mut last: Option<(Vec<f64>, Vec<f64>)> = None;
         let mut attempts = 0;
-        let ys = node(a, interval, &y).y;
-        let (ys1, k1, d1) = loop {
+        let ys = node(c.a, c.interval, &self.y).y;
+        loop {
             attempts += 1;
-            for i in 0..nt {
-                let distal = if present(i, b) { guess[i] } else { tau[j][i] };
-                cell.set_cell(i, [a, b], [tau[j][i], distal]);
-            }
-            let mut ev = Evaluator {
-                eq: Equations {
-                    profile: Some(&cell),
-                    ..eq
-                },
-                ws: &mut ws,
-            };
-            if ev.ws.interval != interval {
-                ev.set_interval(interval);
-            }
-            let y1 = match step_cell(&mut ev, &options.statics.integrator, [a, b], ys, crosses) {
-                Ok(y1) => y1,
-                Err(e) => return Err(ev.ws.material_error.take().unwrap_or(e)),
-            };
-            let k1 = interval + usize::from(crosses);
-            if crosses {
-                ev.set_interval(k1);
-            }
-            let Some(d1) = at_node(&mut ev, b, &y1, reuse && !crosses) else {
-                let what = format!("friction: the constitutive solve failed at s = {b} m");
-                return Err(failed(&mut ws, what, attempts, f64::INFINITY));
-            };
-            let mut change: f64 = 0.0;
-            for i in 0..nt {
-                (rule[i], rule_slip[i]) = match (&dirs[j][i], &d1[i]) {
-                    (Some(ta), Some(tb)) => {
-                        let mu_theta = if mus[i] > 0.0 {
-                            mus[i] * angle(ta, tb)
-                        } else {
-                            0.0
-                        };
-                        cell_rule(tau[j][i], mu_theta, prev.map(|p| p[j + 1][i]))
-                    }
-                    _ => (0.0, Slip::Absent),
-                };
-                change = change.max((rule[i] - guess[i]).abs());
-            }
+            let (y1, d1) = self.attempt(c, ys, attempts)?;
+            let change = self.apply_rule(c.j, &d1);
+            let fixed = &self.fixed;
             if !change.is_finite() {
                 let what = "friction: the tension profile became non-finite".to_string();
-                return Err(failed(&mut ws, what, attempts, change));
+                return Err(failed(&mut self.ws, what, attempts, change));
             }
-            if change <= tol {
-                worst = worst.max(change);
-                break (y1, k1, d1);
+            if change <= fixed.tol {
+                self.worst = self.worst.max(change);
+                self.cell_steps += attempts;
+                return Ok((y1, d1));
             }
             if attempts >= MAX_CELL_ATTEMPTS {
                 let what = format!(
-                    "friction: the tension at s = {b} m did not settle in {attempts} steps of \
+                    "friction: the tension at s = {} m did not settle in {attempts} steps of \
                      its cell (change {:e} > tolerance {:e} relative)",
-                    change / scale,
-                    cell_tolerance
+                    c.b,
+                    change / fixed.scale,
+                    fixed.cell_tolerance
                 );
-                return Err(failed(&mut ws, what, attempts, change / scale));
+                let residual = change / fixed.scale;
+                return Err(failed(&mut self.ws, what, attempts, residual));
             }
-            let before = guess.clone();
+            let before = self.guess.clone();
             next_guess(
-                &mut guess,
-                &rule,
+                &mut self.guess,
+                &self.rule,
                 last.as_ref().map(|(g, r)| (g.as_slice(), r.as_slice())),
             );
-            last = Some((before, rule.clone()));
-            ws.integral.clone_from(&saved);
+            last = Some((before, self.rule.clone()));
+            self.ws.integral.clone_from(&self.saved);
+        }
+    }
+
+    /// One attempt of cell `c` (the `attempts`-th): the profile over the cell from the
+    /// proximal tensions to the guessed distal ones, the state stepped over it from `ys`,
+    /// and the path tangents at its distal node.
+    fn attempt(
+        &mut self,
+        c: Cell,
+        ys: [f64; STATE],
+        attempts: usize,
+    ) -> Result<([f64; STATE], Tangents)> {
+        let Self {
+            fixed,
+            cell,
+            ws,
+            tau,
+            guess,
+            ..
+        } = self;
+        let (tau_j, guess): (&[f64], &[f64]) = (&tau[c.j], guess);
+        let (ends, l) = (fixed.ends, fixed.l);
+        for i in 0..fixed.nt {
+            let distal = if present(ends, l, i, c.b) {
+                guess[i]
+            } else {
+                tau_j[i]
+            };
+            cell.set_cell(i, [c.a, c.b], [tau_j[i], distal]);
+        }
+        let mut ev = fixed.evaluator(cell, ws);
+        if ev.ws.interval != c.interval {
+            ev.set_interval(c.interval);
+        }
+        let integrator = &fixed.setup.options.statics.integrator;
+        let y1 = match step_cell(&mut ev, integrator, [c.a, c.b], ys, c.crosses) {
+            Ok(y1) => y1,
+            Err(e) => return Err(ev.ws.material_error.take().unwrap_or(e)),
         };
-        attempts_total += attempts;
-        let y1: [f64; N] = if N > STATE {
-            // The accepted cell once more with the columns, from the same proximal state.
-            let kept = ws.integral.clone();
-            ws.integral.clone_from(&saved);
-            let mut ev = Evaluator {
-                eq: Equations {
-                    profile: Some(&cell),
-                    ..eq
-                },
-                ws: &mut ws,
+        if c.crosses {
+            ev.set_interval(c.next_interval());
+        }
+        let reuse = fixed.reuse && !c.crosses;
+        let Some(d1) = fixed.tangents(&mut ev, c.b, &y1, reuse) else {
+            let what = format!("friction: the constitutive solve failed at s = {} m", c.b);
+            return Err(failed(ws, what, attempts, f64::INFINITY));
+        };
+        Ok((y1, d1))
+    }
+
+    /// The capstan rule of cell `j` on the path tangents `d1` at its distal node: its
+    /// distal tensions and slip states in `rule`, `rule_slip`; returns their largest change
+    /// from the guess (N).
+    fn apply_rule(&mut self, j: usize, d1: &[Option<Vector3<f64>>]) -> f64 {
+        let Self {
+            fixed,
+            tau,
+            dirs,
+            guess,
+            rule,
+            rule_slip,
+            ..
+        } = self;
+        let (mus, prev): (&[f64], _) = (&fixed.mus, fixed.setup.prev);
+        let (tau_j, dirs_j, guess): (&[f64], &[_], &[f64]) = (&tau[j], &dirs[j], guess);
+        let (rule, rule_slip): (&mut [f64], &mut [Slip]) = (rule, rule_slip);
+        let mut change: f64 = 0.0;
+        for i in 0..fixed.nt {
+            (rule[i], rule_slip[i]) = match (&dirs_j[i], &d1[i]) {
+                (Some(ta), Some(tb)) => {
+                    let mu_theta = if mus[i] > 0.0 {
+                        mus[i] * angle(ta, tb)
+                    } else {
+                        0.0
+                    };
+                    cell_rule(tau_j[i], mu_theta, prev.map(|p| p[j + 1][i]))
+                }
+                _ => (0.0, Slip::Absent),
             };
-            with_columns(ev.ws, &[Column::Free; 6]);
-            ev.set_interval(interval);
-            let stepped = step_cell(&mut ev, &options.statics.integrator, [a, b], y, crosses);
-            with_columns(ev.ws, &[]);
-            ev.set_interval(k1);
-            let mut full = match stepped {
-                Ok(full) => full,
-                Err(e) => return Err(ev.ws.material_error.take().unwrap_or(e)),
-            };
-            // The state as the attempts found it (the columns' step repeats it to the
-            // local solve's tolerance).
-            full[..STATE].copy_from_slice(&ys1);
-            ws.integral = kept;
-            full
-        } else {
+            change = change.max((rule[i] - guess[i]).abs());
+        }
+        change
+    }
+
+    /// The accepted cell `c` once more with the base-wrench columns (`N > STATE`), from the
+    /// same proximal state and with the same profile, its state replaced by the attempts'
+    /// `ys1` (the columns' step repeats it to the local solve's tolerance); `ys1` alone
+    /// without columns.
+    fn repeat_with_columns(&mut self, c: Cell, ys1: &[f64; STATE]) -> Result<[f64; N]> {
+        if N <= STATE {
             let mut y1 = [0.0; N];
             y1.copy_from_slice(&ys1[..N]);
-            y1
+            return Ok(y1);
+        }
+        let Self {
+            fixed,
+            cell,
+            ws,
+            saved,
+            y,
+            ..
+        } = self;
+        let kept = ws.integral.clone();
+        ws.integral.clone_from(saved);
+        let mut ev = fixed.evaluator(cell, ws);
+        with_columns(ev.ws, &[Column::Free; 6]);
+        ev.set_interval(c.interval);
+        let integrator = &fixed.setup.options.statics.integrator;
+        let stepped = step_cell(&mut ev, integrator, [c.a, c.b], *y, c.crosses);
+        with_columns(ev.ws, &[]);
+        ev.set_interval(c.next_interval());
+        let mut full = match stepped {
+            Ok(full) => full,
+            Err(e) => return Err(ev.ws.material_error.take().unwrap_or(e)),
         };
-        rates.extend((0..nt).map(|i| match (&dirs[j][i], &d1[i]) {
-            (Some(ta), Some(tb)) if mus[i] > 0.0 && b - a > tiny && !crosses => {
-                Some(angle(ta, tb) / (b - a))
-            }
-            _ => None,
-        }));
-        tau[j + 1].copy_from_slice(&rule);
-        slip[j + 1].copy_from_slice(&rule_slip);
-        dirs.push(d1);
-        path_length[j + 1].copy_from_slice(&ws.integral[..nt]);
-        y = y1;
-        interval = k1;
-        nodes.push(node(b, interval, &y));
+        full[..STATE].copy_from_slice(ys1);
+        ws.integral = kept;
+        Ok(full)
     }
-    let (residual, columns) = eq.residual(&y, ncol);
-    Ok(Marched {
-        y,
-        residual,
-        columns,
-        tau,
-        slip,
-        dirs,
-        nodes,
-        path_length,
-        lengths: ws.integral[..nt].to_vec(),
-        cell_steps: attempts_total,
-        worst,
-        evaluations: ws.evaluations,
-    })
+
+    /// Records the accepted distal node of cell `c` (state `y1`, path tangents `d1`): the
+    /// cell's turning rates, the rule's tensions and slip states, the path lengths so far.
+    fn record(&mut self, c: Cell, y1: [f64; N], d1: Tangents) {
+        let (j, nt) = (c.j, self.fixed.nt);
+        let tiny = 10.0 * BREAK_OFFSET * self.fixed.l;
+        let (mus, dirs) = (&self.fixed.mus, &self.dirs);
+        self.rates
+            .extend((0..nt).map(|i| match (&dirs[j][i], &d1[i]) {
+                (Some(ta), Some(tb)) if mus[i] > 0.0 && c.b - c.a > tiny && !c.crosses => {
+                    Some(angle(ta, tb) / (c.b - c.a))
+                }
+                _ => None,
+            }));
+        self.tau[j + 1].copy_from_slice(&self.rule);
+        self.slip[j + 1].copy_from_slice(&self.rule_slip);
+        self.dirs.push(d1);
+        self.path_length[j + 1].copy_from_slice(&self.ws.integral[..nt]);
+        self.y = y1;
+        self.interval = c.next_interval();
+        self.nodes.push(node(c.b, self.interval, &self.y));
+    }
+
+    /// What the march gives: the tip residual (with its columns when `N == FULL`), the
+    /// profile along and the counts.
+    fn finish(self) -> Marched<N> {
+        let nt = self.fixed.nt;
+        let ncol = if N >= FULL { 6 } else { 0 };
+        let (residual, columns) = self.fixed.eq().residual(&self.y, ncol);
+        Marched {
+            y: self.y,
+            residual,
+            columns,
+            tau: self.tau,
+            slip: self.slip,
+            dirs: self.dirs,
+            nodes: self.nodes,
+            path_length: self.path_length,
+            lengths: self.ws.integral[..nt].to_vec(),
+            cell_steps: self.cell_steps,
+            worst: self.worst,
+            evaluations: self.ws.evaluations,
+        }
+    }
 }
 
 /// One step of the rod over the cell `[a, b]` from `y` (RK4: one step; adaptive: to its
