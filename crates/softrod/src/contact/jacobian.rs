@@ -184,6 +184,14 @@ fn twist_of(y: &[f64], m: Option<usize>) -> Vector6<f64> {
     Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
 }
 
+/// What a march with the columns leaves: the end state with its columns, the nodes, and the
+/// state with its columns at the observed node (if one is observed).
+struct ColumnMarch<const N: usize> {
+    y: [f64; N],
+    nodes: Vec<Node>,
+    observed: Option<Vec<f64>>,
+}
+
 /// The march columns: the unknowns' `ncol`, then the actuators' (tensions, then pressures).
 struct MarchColumns<'a> {
     ncol: usize,
@@ -263,7 +271,7 @@ impl Constrained<'_> {
         };
         let nt = model.tendons().len();
         let mut scratch = Workspace::new(nt);
-        let (y, nodes, observed) =
+        let ColumnMarch { y, nodes, observed } =
             self.march_with_columns::<N>(&model, x, &mut sites, &cols, observe, &mut scratch)?;
         let eq = equations(&model, &self.tensions, &self.pressures);
         let (res, dres) = eq.residual(&y, ncol + actuators.len());
@@ -341,7 +349,9 @@ impl Constrained<'_> {
                 v3(lin.y, b),
                 rotation_variation(&lin.r_tip, &col_rot(lin.y, b)),
             );
-            let mut d = self.tip_rows_dot(&lin.dres[m], &dp, &w, &lin.r_tip).to_vec();
+            let mut d = self
+                .tip_rows_dot(&lin.dres[m], &dp, &w, &lin.r_tip)
+                .to_vec();
             // The actuator's size: the force scale, or the pressure that makes it.
             let unit = match *col {
                 Column::Pressure(q) => {
@@ -462,10 +472,10 @@ impl Constrained<'_> {
         (mcol, sites, next)
     }
 
-    /// One march at `x` of the state with `ncol` columns on the contact model `model`, the
-    /// contacts inside the rod recorded and their columns seeded in `sites` (`scratch`
-    /// evaluates the sides of their jumps). Returns the end state and the nodes; `None` if
-    /// the march fails or does not reach every contact.
+    /// One march at `x` of the state with the columns `cols` on the contact model `model`,
+    /// the contacts inside the rod recorded and their columns seeded in `sites` (`scratch`
+    /// evaluates the sides of their jumps), the columns kept at node `observe`. `None` if
+    /// the march fails or does not reach every contact or the observed node.
     fn march_with_columns<const N: usize>(
         &mut self,
         model: &RobotModel,
@@ -474,7 +484,7 @@ impl Constrained<'_> {
         cols: &MarchColumns<'_>,
         observe: Option<usize>,
         scratch: &mut Workspace,
-    ) -> Option<([f64; N], Vec<Node>, Option<Vec<f64>>)> {
+    ) -> Option<ColumnMarch<N>> {
         let l = self.model.length();
         let fs = self.model.force_scale();
         let plan = match self.integrator {
@@ -530,7 +540,7 @@ impl Constrained<'_> {
         if observe.is_some() && observed.is_none() {
             return None;
         }
-        Some((y, nodes, observed))
+        Some(ColumnMarch { y, nodes, observed })
     }
 
     /// Appends to `rows` the rows of every active contact from its node states (the tip's
