@@ -64,9 +64,7 @@ def main() -> None:
         dt, s_contact = _time(lambda t=t: robot.solve(t))
         rows["forward_contact"].append(dt)
         rows["jacobian"].append(_time(lambda s=s_free: softrod.actuation_jacobian(s))[0])
-        rows["jacobian_contact"].append(
-            _time(lambda s=s_contact: softrod.actuation_jacobian(s))[0]
-        )
+        rows["jacobian_contact"].append(_time(lambda s=s_contact: softrod.actuation_jacobian(s))[0])
         dt, inv = _time(lambda p=target: softrod.inverse_statics(free, p, throw=False))
         rows["free_cold"].append(dt)
         misses["free_cold"] += not inv.converged

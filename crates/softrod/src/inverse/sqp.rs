@@ -8,7 +8,7 @@ use nalgebra::{DMatrix, DVector};
 use super::problem::{PoseError, Program};
 use super::steps::{
     bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change, probed_curvature,
-    scaled_jacobian_norm, solve_qp, trust_radius, QpStep,
+    scaled_jacobian_norm, solve_qp, trust_radius, ProbeSite, QpStep,
 };
 use super::{
     Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target, FIRST_RADIUS,
@@ -310,9 +310,13 @@ fn program_step<F: Forward + ?Sized>(
                 } else {
                     DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights))
                 };
-                let (h, used) = probed_curvature(
-                    forward, p, &it.a, &lin.e, &lin.jac, lambda, &free_w, &v, &base,
-                );
+                let at = ProbeSite {
+                    a: &it.a,
+                    e0: &lin.e,
+                    jac: &lin.jac,
+                    lambda,
+                };
+                let (h, used) = probed_curvature(forward, p, &at, &free_w, &v, &base);
                 it.probes += used;
                 if let Some(h) = h {
                     it.hess = h;

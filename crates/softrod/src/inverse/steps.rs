@@ -302,6 +302,16 @@ fn floored(m: &DMatrix<f64>, floor: f64) -> DMatrix<f64> {
     &e.eigenvectors * DMatrix::from_diagonal(&vals) * e.eigenvectors.transpose()
 }
 
+/// Where [`probed_curvature`] probes: the iterate `a` (scaled actuation), its pose error
+/// `e0`, the Jacobian `jac` of the poses and the multipliers `lambda` of the last QP.
+#[derive(Clone, Copy)]
+pub(super) struct ProbeSite<'a> {
+    pub(super) a: &'a [f64],
+    pub(super) e0: &'a DVector<f64>,
+    pub(super) jac: &'a DMatrix<f64>,
+    pub(super) lambda: &'a DVector<f64>,
+}
+
 /// The Hessian of the Lagrangian `½|a - c|²_W - λᵀ p(a)` on the span `S` of the range step
 /// `v` (its part `W`-orthogonal to the null space, dropped when negligible) and the null
 /// space `Z` of the free columns of `J`, from second differences of the poses alone
@@ -313,18 +323,15 @@ fn floored(m: &DMatrix<f64>, floor: f64) -> DMatrix<f64> {
 /// `Sᵀ P = I`, with `Zᵀ H Z` floored positive definite), or `W` corrected so if that is not
 /// positive definite; `None` without probes, more than [`MAX_PROBE_DIRECTIONS`] directions,
 /// a probe outside the bounds or failed. Also returns the probes used.
-#[allow(clippy::too_many_arguments)] // the iterate, its linearisation and the step
 pub(super) fn probed_curvature<F: Forward + ?Sized>(
     forward: &mut F,
     p: &Program<'_>,
-    a: &[f64],
-    e0: &DVector<f64>,
-    jac: &DMatrix<f64>,
-    lambda: &DVector<f64>,
+    at: &ProbeSite<'_>,
     free: &[bool],
     v: &[f64],
     base: &DMatrix<f64>,
 ) -> (Option<DMatrix<f64>>, usize) {
+    let ProbeSite { a, e0, jac, lambda } = *at;
     let n = a.len();
     let bounds = &p.bounds;
     let Some(z) = null_space(jac, &bounds.weights, free) else {
