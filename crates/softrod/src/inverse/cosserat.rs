@@ -339,12 +339,7 @@ impl Forward for CosseratForward {
     }
 
     fn chamber_areas(&self) -> Vec<f64> {
-        self.model
-            .chambers()
-            .iter()
-            .zip(self.model.chamber_extents())
-            .map(|(c, (start, _))| c.area_at(*start))
-            .collect()
+        self.model.chamber_start_areas()
     }
 
     fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation> {

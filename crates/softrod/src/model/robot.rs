@@ -226,6 +226,14 @@ impl RobotModel {
     pub fn chamber_extents(&self) -> &[(f64, f64)] {
         &self.chamber_extents
     }
+    /// Area of every chamber at its start (m²): the area that turns its pressure into a force.
+    pub fn chamber_start_areas(&self) -> Vec<f64> {
+        self.chambers
+            .iter()
+            .zip(&self.chamber_extents)
+            .map(|(c, (start, _))| c.area_at(*start))
+            .collect()
+    }
     /// Interval end points `0 = b_0 < b_1 < ... = L` (m): tendon terminations, chamber ends,
     /// point loads.
     pub fn breaks(&self) -> &[f64] {
