@@ -6,6 +6,8 @@ import statistics
 import time
 from collections.abc import Callable
 
+import numpy as np
+
 
 def median_time(fn: Callable[[], object], *, calls: int, repeats: int) -> float:
     """Median wall time of ``calls * repeats`` individually timed calls (s).
@@ -20,3 +22,22 @@ def median_time(fn: Callable[[], object], *, calls: int, repeats: int) -> float:
         fn()
         samples.append(time.perf_counter() - t0)
     return statistics.median(samples)
+
+
+def timed(fn: Callable[[], object]) -> tuple[float, object]:
+    """One call of ``fn``: its wall time (s) and its result."""
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def admissible_tensions(rng) -> np.ndarray:
+    """Random tensions (N) of the two-segment NiTi robot that pull two of the three tendons
+    of each segment (up to 3 N each): a target made from them is reachable without
+    co-contraction."""
+    t = np.zeros(6)
+    for seg in range(2):
+        o = rng.integers(3)
+        t[3 * seg + o] = rng.random() * 3.0
+        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
+    return t

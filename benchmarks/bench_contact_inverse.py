@@ -13,26 +13,11 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
+from _timing import admissible_tensions, timed
 
 import softrod
-
-
-def _admissible(rng):
-    t = np.zeros(6)
-    for seg in range(2):
-        o = rng.integers(3)
-        t[3 * seg + o] = rng.random() * 3.0
-        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
-    return t
-
-
-def _time(fn):
-    t0 = time.perf_counter()
-    out = fn()
-    return time.perf_counter() - t0, out
 
 
 def main() -> None:
@@ -51,7 +36,7 @@ def main() -> None:
     rng = np.random.default_rng(7)
     targets = []
     while len(targets) < args.targets:
-        sol = robot.solve(_admissible(rng))
+        sol = robot.solve(admissible_tensions(rng))
         if sol.contacts:
             targets.append((sol.tensions, sol.tip_position))
     keys = ("forward", "forward_contact", "jacobian", "jacobian_contact", "free_cold")
@@ -59,20 +44,20 @@ def main() -> None:
     rows: dict[str, list[float]] = {k: [] for k in keys}
     misses = {"free_cold": 0, "cold": 0, "warm": 0}
     for t, target in targets:
-        dt, s_free = _time(lambda t=t: free.solve(t))
+        dt, s_free = timed(lambda t=t: free.solve(t))
         rows["forward"].append(dt)
-        dt, s_contact = _time(lambda t=t: robot.solve(t))
+        dt, s_contact = timed(lambda t=t: robot.solve(t))
         rows["forward_contact"].append(dt)
-        rows["jacobian"].append(_time(lambda s=s_free: softrod.actuation_jacobian(s))[0])
-        rows["jacobian_contact"].append(_time(lambda s=s_contact: softrod.actuation_jacobian(s))[0])
-        dt, inv = _time(lambda p=target: softrod.inverse_statics(free, p, throw=False))
+        rows["jacobian"].append(timed(lambda s=s_free: softrod.actuation_jacobian(s))[0])
+        rows["jacobian_contact"].append(timed(lambda s=s_contact: softrod.actuation_jacobian(s))[0])
+        dt, inv = timed(lambda p=target: softrod.inverse_statics(free, p, throw=False))
         rows["free_cold"].append(dt)
         misses["free_cold"] += not inv.converged
-        dt, cold = _time(lambda p=target: softrod.inverse_statics(robot, p, throw=False))
+        dt, cold = timed(lambda p=target: softrod.inverse_statics(robot, p, throw=False))
         rows["cold"].append(dt)
         misses["cold"] += not cold.converged
         moved = target + np.array([0.0, 0.0, 1e-3])
-        dt, warm = _time(
+        dt, warm = timed(
             lambda m=moved, c=cold: softrod.inverse_statics(robot, m, warm_start=c, throw=False)
         )
         rows["warm"].append(dt)

@@ -15,28 +15,13 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
+from _timing import admissible_tensions, timed
 from scipy.optimize import least_squares
 
 import softrod
 from softrod import pcc
-
-
-def _admissible(rng):
-    t = np.zeros(6)
-    for seg in range(2):
-        o = rng.integers(3)
-        t[3 * seg + o] = rng.random() * 3.0
-        t[3 * seg + (o + 1) % 3] = rng.random() * 3.0
-    return t
-
-
-def _time(fn):
-    t0 = time.perf_counter()
-    out = fn()
-    return time.perf_counter() - t0, out
 
 
 def main() -> None:
@@ -45,7 +30,7 @@ def main() -> None:
     n = ap.parse_args().targets
     robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
     rng = np.random.default_rng(7)
-    targets = [robot.solve(_admissible(rng)).tip_position for _ in range(n)]
+    targets = [robot.solve(admissible_tensions(rng)).tip_position for _ in range(n)]
     keys = ("forward", "jacobian", "cold", "warm", "scipy", "path", "pcc_cold", "pcc_warm")
     rows: dict[str, list[float]] = {k: [] for k in keys}
     misses = {"cold": 0, "warm": 0, "scipy": 0, "path": 0, "pcc_cold": 0, "pcc_warm": 0}
@@ -57,14 +42,14 @@ def main() -> None:
     )
     sol = robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0])
     for _ in range(200):
-        rows["forward"].append(_time(lambda: robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0]))[0])
-        rows["jacobian"].append(_time(lambda: softrod.actuation_jacobian(sol))[0])
+        rows["forward"].append(timed(lambda: robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0]))[0])
+        rows["jacobian"].append(timed(lambda: softrod.actuation_jacobian(sol))[0])
     for target in targets:
-        dt, cold = _time(lambda t=target: softrod.inverse_statics(robot, t, throw=False))
+        dt, cold = timed(lambda t=target: softrod.inverse_statics(robot, t, throw=False))
         rows["cold"].append(dt)
         misses["cold"] += not cold.converged
         moved = target + np.array([1e-3, 0.0, 0.0])
-        dt, warm = _time(
+        dt, warm = timed(
             lambda m=moved, c=cold: softrod.inverse_statics(robot, m, warm_start=c, throw=False)
         )
         rows["warm"].append(dt)
@@ -73,7 +58,7 @@ def main() -> None:
         def residual(t, target=target):
             return robot.solve(t).tip_position - target
 
-        dt, ls = _time(
+        dt, ls = timed(
             lambda: least_squares(residual, np.full(6, 0.5), bounds=(0.0, np.inf), xtol=1e-15)
         )
         rows["scipy"].append(dt)
@@ -82,17 +67,17 @@ def main() -> None:
     th = np.linspace(0.0, 2.0 * np.pi, 41)
     circle = centre + 0.01 * np.stack([np.cos(th), np.sin(th), 0.0 * th], axis=1)
     for _ in range(3):
-        dt, path = _time(lambda: softrod.inverse_statics_path(robot, circle, throw=False))
+        dt, path = timed(lambda: softrod.inverse_statics_path(robot, circle, throw=False))
         rows["path"].append(dt / len(circle))
     misses["path"] = int(np.sum(~path.converged))
     prng = np.random.default_rng(8)
     for _ in range(n):
-        target = np.asarray(pcc.solve(probot, _admissible(prng)).tip_pose)[:3, 3]
-        dt, cold = _time(lambda t=target: pcc.inverse_statics(probot, t, throw=False))
+        target = np.asarray(pcc.solve(probot, admissible_tensions(prng)).tip_pose)[:3, 3]
+        dt, cold = timed(lambda t=target: pcc.inverse_statics(probot, t, throw=False))
         rows["pcc_cold"].append(dt)
         misses["pcc_cold"] += not cold.converged
         moved = target + np.array([1e-3, 0.0, 0.0])
-        dt, warm = _time(
+        dt, warm = timed(
             lambda m=moved, c=cold: pcc.inverse_statics(probot, m, warm_start=c, throw=False)
         )
         rows["pcc_warm"].append(dt)
