@@ -78,43 +78,36 @@ pub(super) fn exact_newton(
             refined += 1;
         }
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
-        if !(lu.factor(n, &j) && lu.solve_in_place(&mut dx)) {
-            if exact {
-                break;
-            }
-            // A singular update: the exact Jacobian here.
-            retries += 1;
-            if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
-                break;
-            }
-            exact = true;
-            norm = max_norm(&r);
-            continue;
-        }
-        let mut alpha = 1.0;
-        let mut accepted = false;
-        for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
-            for k in 0..n {
-                xt[k] = x[k] + alpha * dx[k];
-            }
-            if p.evaluate(&xt, 1.0, None, &mut rt) != Evaluated::Failed {
-                let trial = max_norm(&rt);
-                if trial <= (1.0 - 1e-4 * alpha) * norm {
-                    accepted = true;
+        let accepted = if lu.factor(n, &j) && lu.solve_in_place(&mut dx) {
+            let mut alpha = 1.0;
+            let mut accepted = None;
+            for _ in 0..=MAX_LINE_SEARCH_HALVINGS {
+                for k in 0..n {
+                    xt[k] = x[k] + alpha * dx[k];
+                }
+                if p.evaluate(&xt, 1.0, None, &mut rt) != Evaluated::Failed {
+                    let trial = max_norm(&rt);
+                    if trial <= (1.0 - 1e-4 * alpha) * norm {
+                        accepted = Some(alpha);
+                        break;
+                    }
+                }
+                if norm <= opts.tolerance || !exact {
+                    // Refining, or a Broyden step: a step that does not help is not halved.
                     break;
                 }
+                alpha *= 0.5;
             }
-            if norm <= opts.tolerance || !exact {
-                // Refining, or a Broyden step: a step that does not help is not halved.
-                break;
-            }
-            alpha *= 0.5;
-        }
-        if !accepted {
+            accepted
+        } else {
+            None
+        };
+        let Some(alpha) = accepted else {
             if exact {
                 break;
             }
-            // The exact Jacobian at the iterate, and its step.
+            // A singular update, or a step of it that does not help: the exact Jacobian at
+            // the iterate, and its step.
             retries += 1;
             if p.evaluate(&x, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
                 break;
@@ -122,7 +115,7 @@ pub(super) fn exact_newton(
             exact = true;
             norm = max_norm(&r);
             continue;
-        }
+        };
         effort.iterations += 1;
         steps += 1;
         let step: Vec<f64> = dx.iter().map(|v| alpha * v).collect();
