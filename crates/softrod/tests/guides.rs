@@ -252,6 +252,8 @@ fn dense_guides_approach_the_continuous_channel() {
             None,
         )
         .unwrap();
+        // The same tendons in channels: their stability is assessed.
+        assert!(cont.stability_assessed());
         let tc = Vector3::from(cont.tip_position());
         let mut errs = Vec::new();
         for per in [2, 4, 8] {
@@ -431,6 +433,8 @@ fn guided_niti_at_working_tensions() {
                     sol.iterations
                 );
                 assert!(force.amax() <= 1e-10 && moment.amax() <= 1e-10);
+                // Pulled through guides: the frozen-guide-force verdict is not the robot's.
+                assert!(!sol.stability_assessed());
                 if mu > 0.0 && k == levels.len() - 1 && how == "on the path" {
                     assert!(stuck > 0, "the partial unloading sticks at some guide");
                 }

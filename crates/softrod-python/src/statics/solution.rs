@@ -40,11 +40,9 @@ impl StaticsSolution {
     /// is not assessed (the rod is solved under the guide forces held in the guides' frames,
     /// which leaves out the chords' own stiffness; docs/friction.md).
     pub(crate) fn pulled_through_guides(&self) -> bool {
-        self.friction.as_ref().is_some_and(|f| {
-            f.guides
-                .iter()
-                .any(|row| row.first().is_some_and(|g| g.tension_in > 0.0))
-        })
+        self.friction
+            .as_ref()
+            .is_some_and(|f| !f.stability_assessed())
     }
 
     fn cached(

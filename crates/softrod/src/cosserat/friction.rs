@@ -164,6 +164,17 @@ impl FrictionalSolution {
     pub fn tip_position(&self) -> [f64; 3] {
         self.statics.tip_position()
     }
+
+    /// Whether the stability of this equilibrium is assessed: false while a tendon pulls
+    /// through disk guides, whose rod is solved under the guide forces held in the guides'
+    /// frames (`statics.stable` then judges that rod, not the guided robot: the chords' own
+    /// stiffness is left out; see `docs/friction.md`).
+    pub fn stability_assessed(&self) -> bool {
+        !self
+            .guides
+            .iter()
+            .any(|row| row.first().is_some_and(|g| g.tension_in > 0.0))
+    }
 }
 
 /// The nodes of the friction mesh of `model` (m): with RK4 the nodes of its steps, with the
