@@ -125,19 +125,6 @@ pub fn solve_inverse<F: Forward + ?Sized>(
             }
             it.snapped += usize::from(snap);
         }
-        if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
-            eprintln!(
-                "it {} ({} evaluations, {} probes): dist {:.3e} rot {:.3e} ls {least_squares} |step| {:.3e} radius {:.3e} a {:?}",
-                it.iterations,
-                it.evaluations,
-                it.probes,
-                lin.dist,
-                lin.rot,
-                p.scaled_norm(&step),
-                it.radius,
-                it.a
-            );
-        }
         // A small step that still moves an actuator onto its bound (or off it) is taken: the
         // minimum-norm actuation has it exactly there, not a round-off away.
         let same_bounds = free_set(y.as_slice(), &p.bounds) == free_set(&it.a, &p.bounds);
@@ -302,9 +289,6 @@ fn program_step<F: Forward + ?Sized>(
                 // The range step: that of the program with W (its part off the null space).
                 let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
                 let free_w = free_set(yw.as_slice(), &p.bounds);
-                if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
-                    eprintln!("probe: |v| {:.3e} |d| {:.3e}", p.scaled_norm(&v), d_norm);
-                }
                 let base = if it.curved_for.is_some() {
                     it.hess.clone()
                 } else {

@@ -212,9 +212,6 @@ pub(super) fn curvature<F: Forward + ?Sized>(
         return (None, 0);
     };
     let d = z.ncols();
-    if std::env::var("SOFTROD_DEBUG_INVERSE").is_ok() {
-        eprintln!("curvature: {d} null directions");
-    }
     let scale = 1.0
         + a.iter()
             .zip(&bounds.weights)
