@@ -76,6 +76,7 @@ mod problem;
 pub mod qp;
 mod sqp;
 mod steps;
+mod uniform;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
