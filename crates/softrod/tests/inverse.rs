@@ -456,7 +456,10 @@ fn the_closed_form_march_of_uniform_intervals_is_the_march() {
             let rot = Matrix3::from_fn(|i, j| r[i][j]);
             let dp = (ev.positions[0] - tip).norm();
             let dr = (ev.rotation - rot).amax();
-            assert!(dp <= 1e-14 && dr <= 1e-13, "{t:?}: tip {dp:e} m, rotation {dr:e}");
+            assert!(
+                dp <= 1e-14 && dr <= 1e-13,
+                "{t:?}: tip {dp:e} m, rotation {dr:e}"
+            );
             assert!((probe.positions[0] - ev.positions[0]).norm() <= 1e-15);
             let marched = actuation_jacobian(&sol, None).unwrap();
             let closed = &ev.jacobian.as_ref().unwrap()[0];
@@ -465,7 +468,10 @@ fn the_closed_form_march_of_uniform_intervals_is_the_march() {
                 let scale = m.amax();
                 let err = (closed.rows(rows, 3) - m).amax() / scale;
                 worst_j = worst_j.max(err);
-                assert!(err <= 1e-12, "{t:?}: rows {rows}.. differ by {err:e} relative");
+                assert!(
+                    err <= 1e-12,
+                    "{t:?}: rows {rows}.. differ by {err:e} relative"
+                );
             }
             worst_p = worst_p.max(dp);
         }

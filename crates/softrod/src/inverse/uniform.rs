@@ -127,17 +127,15 @@ fn interval(
         let tangent = ev.ws.tangent;
         let ends = model.tendon_ends();
         // The step's derivative along each unit strain (v, u), then per tension.
+        // (A stretch or shear strain moves q alone: δq = h S δv.)
         let basis: Vec<(Matrix3<f64>, Vector3<f64>)> = (0..6)
             .map(|j| {
-                let mut dv = Vector3::zeros();
-                let mut du = Vector3::zeros();
                 if j < 3 {
-                    dv[j] = 1.0;
-                } else {
-                    du[j - 3] = 1.0;
+                    return (Matrix3::zeros(), s.column(j) * h);
                 }
-                let (dp, ds) = step_derivatives(&xp, &hat(&(du * h)));
-                (projection_derivative(&p, &dp), (ds * v + s * dv) * h)
+                let du = Vector3::ith(j - 3, h);
+                let (dp, ds) = step_derivatives(&xp, &hat(&du));
+                (projection_derivative(&p, &dp), ds * v * h)
             })
             .collect();
         for (i, &end) in ends.iter().enumerate() {
@@ -195,14 +193,27 @@ pub(super) fn tip(
     let mut dr = vec![Matrix3::zeros(); ncol];
     for (k, &n) in plan.iter().enumerate() {
         let iv = interval(&mut ev, k, n, jacobian)?;
+        let (p0, r0) = (p, r);
+        // A tendon that does not pass the interval forces nothing there: its column moves with
+        // the rod as a rigid body (δR ← δR R₀ᵀ R, δp ← δp + δR R₀ᵀ (p - p₀)), applied at the end.
+        let forced: Vec<bool> = iv
+            .columns
+            .iter()
+            .map(|(dq, _)| *dq != Matrix3::zeros())
+            .collect();
         for _ in 0..iv.steps {
-            for c in 0..ncol {
+            for c in (0..ncol).filter(|&c| forced[c]) {
                 let (dq, dqp) = &iv.columns[c];
                 dp[c] += dr[c] * iv.q_pos + r * dqp;
                 dr[c] = dr[c] * iv.q_rot + r * dq;
             }
             p += r * iv.q_pos;
             r *= iv.q_rot;
+        }
+        let (rel, dp_rel) = (r0.tr_mul(&r), r0.tr_mul(&(p - p0)));
+        for c in (0..ncol).filter(|&c| !forced[c]) {
+            dp[c] += dr[c] * dp_rel;
+            dr[c] *= rel;
         }
     }
     if !(p.iter().chain(r.iter()).all(|x| x.is_finite())) {
