@@ -40,6 +40,21 @@ fn pcc_niti() -> PccRobot {
         .unwrap()
 }
 
+/// The ten 1 mm steps of the tracked path of `main` from `w`; the first tension at the end.
+fn track(
+    fwd: &mut CosseratForward,
+    tip: Vector3<f64>,
+    io: &InverseOptions,
+    w: &InverseWarmStart,
+) -> f64 {
+    let mut w = w.clone();
+    for k in 1..=10 {
+        let p = Target::tip(tip + Vector3::new(1e-3 * f64::from(k), 0.0, 0.0));
+        w = InverseWarmStart::from(&solve_inverse(fwd, &p, io, Some(&w)).unwrap());
+    }
+    w.actuation[0]
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let mode: usize = args.get(1).map_or(1, |a| a.parse().unwrap());
@@ -131,17 +146,7 @@ fn main() {
                     .actuation[0]
             }
             5 => fwd.probe(&t).unwrap().positions[0].x,
-            6 => {
-                // The ten 1 mm steps of the tracked path above.
-                let mut w = w.clone();
-                for k in 1..=10 {
-                    let p = Target::tip(tip + Vector3::new(1e-3 * f64::from(k), 0.0, 0.0));
-                    w = InverseWarmStart::from(
-                        &solve_inverse(&mut fwd, &p, &io, Some(&w)).unwrap(),
-                    );
-                }
-                w.actuation[0]
-            }
+            6 => track(&mut fwd, tip, &io, &w),
             _ => fwd.evaluate(&t, true).unwrap().positions[0].x,
         };
     }
