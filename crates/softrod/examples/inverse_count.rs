@@ -1,7 +1,8 @@
 //! Instruction-count harness (`valgrind --tool=callgrind`): N inverse statics of the
 //! two-segment NiTi tendon robot (default RK4 options), cold from zero tensions (mode 0), warm
 //! from the solution at a target 1 mm away (mode 1), or N forward evaluations with the
-//! actuation Jacobian (mode 2); the PCC inverse of the same robot (two arcs) cold (mode 3)
+//! actuation Jacobian (mode 2) or N probes (the tip pose alone, mode 5), or N times the ten 1 mm steps of a
+//! tracked path (mode 6); the PCC inverse of the same robot (two arcs) cold (mode 3)
 //! and warm, target moved 1 mm (mode 4). Prints the iterations and evaluations of each case
 //! on stderr.
 //!
@@ -37,6 +38,21 @@ fn pcc_niti() -> PccRobot {
         .unwrap()
         .with_segment_tendons(1, &tendons)
         .unwrap()
+}
+
+/// The ten 1 mm steps of the tracked path of `main` from `w`; the first tension at the end.
+fn track(
+    fwd: &mut CosseratForward,
+    tip: Vector3<f64>,
+    io: &InverseOptions,
+    w: &InverseWarmStart,
+) -> f64 {
+    let mut w = w.clone();
+    for k in 1..=10 {
+        let p = Target::tip(tip + Vector3::new(1e-3 * f64::from(k), 0.0, 0.0));
+        w = InverseWarmStart::from(&solve_inverse(fwd, &p, io, Some(&w)).unwrap());
+    }
+    w.actuation[0]
 }
 
 fn main() {
@@ -129,6 +145,8 @@ fn main() {
                     .unwrap()
                     .actuation[0]
             }
+            5 => fwd.probe(&t).unwrap().positions[0].x,
+            6 => track(&mut fwd, tip, &io, &w),
             _ => fwd.evaluate(&t, true).unwrap().positions[0].x,
         };
     }

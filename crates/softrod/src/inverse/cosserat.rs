@@ -7,7 +7,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
-use super::{InverseWarmStart, Target};
+use super::{uniform, InverseWarmStart, Target};
 use crate::cosserat::equations::{Column, Equations};
 use crate::cosserat::sensitivity::{
     actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
@@ -45,6 +45,9 @@ pub struct CosseratForward {
     /// The last march of an unloaded robot: its actuation, nodes, tendon path lengths and
     /// scaled tip residual (a statics solution is assembled from it without solving again).
     march: Option<March>,
+    /// Whether the tip pose and its Jacobian have the closed form of [`super::uniform`] (an
+    /// unloaded robot with uniform intervals, a tip target).
+    uniform: bool,
 }
 
 /// The state recorded along one march of an unloaded robot at the actuation `a`.
@@ -72,6 +75,7 @@ impl CosseratForward {
             last: None,
             solution: None,
             march: None,
+            uniform: false,
         };
         if let Some(s) = s {
             let l = model.length();
@@ -115,6 +119,9 @@ impl CosseratForward {
                 .collect::<Result<Vec<_>>>()?;
             me.nodes = Some(nodes);
         }
+        me.uniform = me.nodes.is_none()
+            && no_external_loads(&me.model)
+            && uniform::applies(&me.model, &me.options.integrator);
         Ok(me)
     }
 
@@ -194,6 +201,12 @@ impl CosseratForward {
         let (tensions, pressures) = (&a[..nt], &a[nt..]);
         let act = self.actuation(a);
         act.validate(nt, nc)?;
+        if self.uniform {
+            if let Some(ev) = uniform::tip(&self.model, &self.options.integrator, a, true) {
+                self.march = None;
+                return Ok(ev);
+            }
+        }
         let eq = Equations {
             model: &self.model,
             tensions,
@@ -269,6 +282,11 @@ impl CosseratForward {
         let (nt, nc) = self.dims();
         let act = self.actuation(a);
         act.validate(nt, nc)?;
+        if self.uniform {
+            if let Some(ev) = uniform::tip(&self.model, &self.options.integrator, a, false) {
+                return Ok(ev);
+            }
+        }
         let eq = Equations {
             model: &self.model,
             tensions: &a[..nt],

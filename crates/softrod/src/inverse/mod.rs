@@ -58,13 +58,15 @@
 //! within the tolerances and the step is below `optimality_tolerance` (relative): the KKT
 //! conditions of the program above hold. Every forward evaluation is one solve with its
 //! Jacobian (for a robot without external loads, one march of the state with one column per
-//! actuator).
+//! actuator; for such a robot with uniform intervals and a tip target, that march in closed
+//! form, `uniform.rs`: one rigid RK4 step per interval and its exact derivative).
 //!
 //! [`inverse_statics_path`] follows a sequence of targets, each warm-started from the last.
 //!
 //! The files: `problem.rs` (the checked program: bounds, weights, pose error rows), `sqp.rs`
 //! (the iteration), `steps.rs` (its steps: quadratic programs, Levenberg–Marquardt, curvature,
-//! trust radius), `cosserat.rs` (the Cosserat forward model), `pcc.rs` (the PCC forward model
+//! trust radius), `cosserat.rs` (the Cosserat forward model), `uniform.rs` (its closed-form
+//! march on uniform intervals), `pcc.rs` (the PCC forward model
 //! and its closed-form iteration), `qp.rs` (the small quadratic programs).
 //!
 //! [`Error::TargetUnreachable`]: crate::error::Error::TargetUnreachable
@@ -76,6 +78,7 @@ mod problem;
 pub mod qp;
 mod sqp;
 mod steps;
+mod uniform;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 

@@ -49,6 +49,19 @@ pub fn min_norm(
     bx: &Bounds,
     tol: f64,
 ) -> Option<(DVector<f64>, DVector<f64>)> {
+    min_norm_from(a, b, bx, tol, None)
+}
+
+/// [`min_norm`] with the dual iteration started from the multipliers `start` (one per row of
+/// `a`; e.g. those of the previous program of an SQP iteration, near the new ones), else from
+/// zero. The minimiser is the same (the dual is concave); only the iterations differ.
+pub fn min_norm_from(
+    a: &DMatrix<f64>,
+    b: &DVector<f64>,
+    bx: &Bounds,
+    tol: f64,
+    start: Option<&DVector<f64>>,
+) -> Option<(DVector<f64>, DVector<f64>)> {
     let (m, n) = a.shape();
     let inv_w: Vec<f64> = bx.weights.iter().map(|w| 1.0 / w).collect();
     let y_of = |lambda: &DVector<f64>| -> (DVector<f64>, Vec<bool>) {
@@ -70,7 +83,10 @@ pub fn min_norm(
         }
         f - lambda.dot(&(a * y - b))
     };
-    let mut lambda = DVector::zeros(m);
+    let mut lambda = match start {
+        Some(l) if l.len() == m && l.iter().all(|v| v.is_finite()) => l.clone(),
+        _ => DVector::zeros(m),
+    };
     let (mut y, mut free) = y_of(&lambda);
     let mut psi = dual(&lambda, &y);
     let scale = b.amax().max(1e-300);

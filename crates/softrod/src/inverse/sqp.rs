@@ -27,6 +27,9 @@ struct Iterate {
     hess: DMatrix<f64>,
     /// The free set `hess` was made for (`None`: `hess = W`).
     curved_for: Option<Vec<bool>>,
+    /// The multipliers of the last feasible minimum-norm program (the start of the next
+    /// one's dual iteration).
+    lambda: Option<DVector<f64>>,
     /// The penalty `ν` of the pose error in the merit function `½|a - c|²_W + ν |e|` near
     /// the target.
     nu: f64,
@@ -211,6 +214,7 @@ fn start<F: Forward + ?Sized>(
         ev,
         hess,
         curved_for,
+        lambda: None,
         nu: 0.0,
         last_step: 0.0,
         radius: f64::NAN,
@@ -264,11 +268,11 @@ fn program_step<F: Forward + ?Sized>(
     let n = p.n();
     let mut solved = solve_qp(
         p,
-        &lin.jac,
-        &lin.b,
+        (&lin.jac, &lin.b),
         &it.a,
         &it.hess,
         it.curved_for.is_some(),
+        it.lambda.as_ref(),
     );
     if !solved.least_squares && lin.merit <= p.near {
         let free = free_set(solved.y.as_slice(), &p.bounds);
@@ -305,7 +309,8 @@ fn program_step<F: Forward + ?Sized>(
                 if let Some(h) = h {
                     it.hess = h;
                     it.curved_for = Some(free_w);
-                    solved = solve_qp(p, &lin.jac, &lin.b, &it.a, &it.hess, true);
+                    let start = solved.lambda.clone();
+                    solved = solve_qp(p, (&lin.jac, &lin.b), &it.a, &it.hess, true, start.as_ref());
                     probed = true;
                 }
             }
@@ -317,13 +322,15 @@ fn program_step<F: Forward + ?Sized>(
                 if let Some(h) = h {
                     it.hess = h;
                     it.curved_for = Some(free);
-                    solved = solve_qp(p, &lin.jac, &lin.b, &it.a, &it.hess, true);
+                    let start = solved.lambda.clone();
+                    solved = solve_qp(p, (&lin.jac, &lin.b), &it.a, &it.hess, true, start.as_ref());
                 }
             }
         }
     }
     if let Some(l) = &solved.lambda {
         it.nu = 1.5 * l.norm();
+        it.lambda = Some(l.clone());
     }
     solved
 }

@@ -144,21 +144,23 @@ pub(super) struct QpStep {
 
 /// The program of one iteration at `a`: `min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ` (or `½ |y - c|²_W`
 /// when `H = W`, `curved == false`) s.t. `J y = b`, bounds; the bounded least squares if the
-/// target cannot be met (or for a shape target).
+/// target cannot be met (or for a shape target). The dual of the minimum-norm program starts
+/// from the multipliers `start` (the last program's) if given.
 pub(super) fn solve_qp(
     p: &Program<'_>,
-    jac: &DMatrix<f64>,
-    b: &DVector<f64>,
+    lin: (&DMatrix<f64>, &DVector<f64>),
     a: &[f64],
     hess: &DMatrix<f64>,
     curved: bool,
+    start: Option<&DVector<f64>>,
 ) -> QpStep {
+    let (jac, b) = lin;
     let n = a.len();
     let bounds = &p.bounds;
     let feasible = if p.shape {
         None
     } else {
-        qp::min_norm(jac, b, bounds, p.tol_qp)
+        qp::min_norm_from(jac, b, bounds, p.tol_qp, start)
     };
     match feasible {
         Some((y_w, l_w)) if curved => {
