@@ -417,10 +417,20 @@ pub fn inverse_statics(
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, StaticsSolution)> {
     let mut fwd = CosseratForward::new(model, solve, target.s.as_deref())?;
-    let out = solve_inverse(&mut fwd, target, options, warm)?;
+    let mut out = solve_inverse(&mut fwd, target, options, warm)?;
     let sol = match fwd.solution.take() {
         Some(s) if s.tensions() == out.tensions() && s.pressures() == out.pressures() => s,
         _ => fwd.solve(&out.actuation)?,
     };
+    if target.s.is_none() {
+        // The distance of the tip returned: the iteration's own evaluation may be the
+        // closed-form march (`uniform.rs`), equal to the returned solution's to round-off.
+        let tip = Vector3::from(sol.tip_position());
+        out.position_error = target
+            .points
+            .iter()
+            .map(|p| (tip - p).norm())
+            .fold(0.0, f64::max);
+    }
     Ok((out, sol))
 }
