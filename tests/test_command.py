@@ -327,8 +327,12 @@ def test_a_path_of_targets_is_tracked_with_arrays_out():
     for k in (0, 7, 24):
         tip = robot.solve(path.tensions[k]).tip_position
         assert np.linalg.norm(tip - targets[k]) <= 1e-9
+    # The error is the inverse's own evaluation of the tip (for this robot the RK4 march in
+    # closed form, which equals the march to round-off: 7e-16 m in crates/softrod/tests/inverse.rs,
+    # a few units in the last place of the 0.3 m tip), the solution is solved again in Python
+    # when read.
     np.testing.assert_allclose(
-        path.position_error, np.linalg.norm(path.tip_position - targets, axis=1), atol=1e-15
+        path.position_error, np.linalg.norm(path.tip_position - targets, axis=1), atol=2e-15
     )
     # Warm-started from the previous target: far fewer iterations than the first (cold) one.
     assert np.median(path.iterations[1:]) < path.iterations[0]
