@@ -112,9 +112,7 @@ pub fn solve_constrained(
         let mut start = *options;
         start.newton.tolerance = options.newton.tolerance.max(COARSE_TOLERANCE);
         let reached = reach(&mut p, &start, &mut effort);
-        if let Reach::Done(xc) = &reached {
-            at_coarse_solution(&mut p, xc);
-        }
+        at_coarse_solution(&mut p, &reached);
         (p.refine, p.rough) = (true, false);
         if let Reach::Done(xc) = reached {
             p.integrator = options.integrator;
@@ -179,11 +177,15 @@ fn refusal(p: &Constrained<'_>) -> Option<Error> {
     })
 }
 
-/// The exact Jacobian of the coarse mesh at its solution `xc` (one march with the columns),
+/// The exact Jacobian of the coarse mesh at its solution `xc` (if `reached`; one march with
+/// the columns),
 /// handed to Newton on the mesh asked in place of the updated one of the last coarse solve
 /// (taken where the iterate was still far), and with a free tip the stability of the coarse
 /// solution from it (see [`jacobian_stability`]).
-fn at_coarse_solution(p: &mut Constrained<'_>, xc: &[f64]) {
+fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
+    let Reach::Done(xc) = reached else {
+        return;
+    };
     let n = p.dim();
     let (mut j, mut r) = (vec![0.0; n * n], vec![0.0; n]);
     if p.evaluate(xc, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
