@@ -177,11 +177,10 @@ fn refusal(p: &Constrained<'_>) -> Option<Error> {
     })
 }
 
-/// The exact Jacobian of the coarse mesh at its solution `xc` (if `reached`; one march with
-/// the columns),
-/// handed to Newton on the mesh asked in place of the updated one of the last coarse solve
-/// (taken where the iterate was still far), and with a free tip the stability of the coarse
-/// solution from it (see [`jacobian_stability`]).
+/// The exact Jacobian of the coarse mesh at its solution, if `reached` (one march with the
+/// columns), handed to Newton on the mesh asked in place of the updated one of the last
+/// coarse solve (taken where the iterate was still far), and with a free tip the stability
+/// of the coarse solution from it (see [`jacobian_stability`]).
 fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
     let Reach::Done(xc) = reached else {
         return;
