@@ -82,6 +82,8 @@ impl Frozen {
             rough: false,
             from: 1.0,
             refused: None,
+            scratch: None,
+            coarse_stability: None,
         }
     }
 
@@ -262,7 +264,7 @@ fn held_stability(
 /// With a free tip, the stability of the contacts as dead loads from the exact Jacobian of
 /// the pass at `x` (its base-wrench block and tip columns, as the compliance left it), so
 /// that no march with the columns is needed again; `None` otherwise.
-fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) -> Option<Stability> {
+pub(super) fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) -> Option<Stability> {
     let (j, twists) = pass.jacobian.as_ref()?;
     if p.tip.is_some() || pass.key != p.key(x, 1.0) || twists.len() < 6 {
         return None;
@@ -274,6 +276,18 @@ fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) -> Option<Sta
     }
     let tw: [Vector6<f64>; 6] = std::array::from_fn(|k| twists[k]);
     tip_stability(&y, &tw, p.model.length())
+}
+
+/// The stability of the coarse mesh's solution ([`Constrained::coarse_stability`]) when it
+/// has the active set of `p` (the same contacts, sites and states).
+fn coarse_stability(p: &Constrained<'_>) -> Option<Stability> {
+    let (active, st) = p.coarse_stability.as_ref()?;
+    let same = active.len() == p.active.len()
+        && active
+            .iter()
+            .zip(&p.active)
+            .all(|(a, b)| (a.obstacle, a.site, a.state) == (b.obstacle, b.site, b.state));
+    same.then_some(*st)
 }
 
 /// The shooting residual at the solution `x` and, with a held tip, the base-wrench columns,
@@ -385,10 +399,9 @@ pub(super) fn finish(
     } else if let Some(st) = free_stability.filter(|_| sol.stats.converged) {
         let _ = sol.margin.set(st.margin);
         sol.stable = st.stable;
-    } else if let Some(st) = coarse_mesh(options.integrator)
-        .filter(|_| sol.stats.converged)
-        .and_then(|mesh| stability_on(&sol, mesh))
-        .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
+    } else if let Some(st) = coarse_stability(p)
+        .or_else(|| coarse_mesh(options.integrator).and_then(|mesh| stability_on(&sol, mesh)))
+        .filter(|st| sol.stats.converged && st.margin.abs() > COARSE_MARGIN_GAP)
     {
         // Clear on the coarse mesh; the margin itself is computed on the mesh asked when
         // read.

@@ -21,7 +21,7 @@
 use nalgebra::{Vector3, Vector6};
 
 use super::problem::{equations, Active, Constrained, Pass, Site};
-use super::rows::AtContact;
+use super::rows::{enter, AtContact};
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
 };
@@ -86,10 +86,10 @@ impl Site2 {
             return;
         };
         let post = head(y);
-        side.set_interval(k0);
+        enter(side, k0);
         let mut a = [0.0; STATE];
         side.rhs_into::<STATE>(s, &pre, &mut a);
-        side.set_interval(interval);
+        enter(side, interval);
         let mut b = [0.0; STATE];
         side.rhs_into::<STATE>(self.post_at, &post, &mut b);
         self.rate = [a, b];
@@ -270,23 +270,17 @@ impl Constrained<'_> {
             actuators: &actuators,
         };
         let nt = model.tendons().len();
-        let mut scratch = Workspace::new(nt);
+        let mut pair = self.scratch(nt);
+        let [scratch, other] = &mut *pair;
         let ColumnMarch { y, nodes, observed } =
-            self.march_with_columns::<N>(&model, x, &mut sites, &cols, observe, &mut scratch)?;
+            self.march_with_columns::<N>(&model, x, &mut sites, &cols, observe, scratch)?;
         let eq = equations(&model, &self.tensions, &self.pressures);
         let (res, dres) = eq.residual(&y, ncol + actuators.len());
         let (p_tip, r_tip) = (v3(&y, 0), rot(&y));
         let mut rows = self.tip_rows(&res, &p_tip, &r_tip).to_vec();
         let tip = (head(&y), nodes.last()?.interval);
         // The contact rows at the solution, and per contact the function of its node states.
-        let mut other = Workspace::new(nt);
-        let mut ev = [
-            Evaluator {
-                eq,
-                ws: &mut scratch,
-            },
-            Evaluator { eq, ws: &mut other },
-        ];
+        let mut ev = [Evaluator { eq, ws: scratch }, Evaluator { eq, ws: other }];
         let at = self.contact_rows_at(&mut ev, x, mu, tip, &sites, &mut rows)?;
         if rows.len() != n || !rows.iter().all(|v| v.is_finite()) {
             return None;
@@ -312,6 +306,7 @@ impl Constrained<'_> {
             None => None,
             Some(yo) => Some(self.actuated(&model, &lin, &cols, yo)?),
         };
+        self.scratch = Some(pair);
         self.last = Some(Pass {
             model: std::sync::Arc::clone(&model),
             nodes,

@@ -181,6 +181,12 @@ pub(crate) struct Constrained<'m> {
     pub(super) from: f64,
     /// The friction coefficient of an obstacle touched inside the rod, when refused.
     pub(super) refused: Option<f64>,
+    /// Scratch of the contact rows' evaluations, one per side of a contact, kept from march
+    /// to march as the warm start of their local solves (see [`super::rows::enter`]).
+    pub(super) scratch: Option<Box<[Workspace; 2]>>,
+    /// With a free tip, the stability (contacts as dead loads) of the coarse mesh's
+    /// solution, from its exact Jacobian there, and the active set it belongs to.
+    pub(super) coarse_stability: Option<(Vec<Active>, crate::cosserat::Stability)>,
 }
 
 impl<'m> Constrained<'m> {
@@ -264,10 +270,20 @@ impl<'m> Constrained<'m> {
         self.model.with_loads(loads).ok()
     }
 
+    /// The scratch of the contact rows ([`Self::scratch`], taken; new if none), for `nt`
+    /// tendons.
+    pub(super) fn scratch(&mut self, nt: usize) -> Box<[Workspace; 2]> {
+        self.scratch
+            .take()
+            .filter(|w| w[0].tendon_speed.len() == nt)
+            .unwrap_or_else(|| Box::new([Workspace::new(nt), Workspace::new(nt)]))
+    }
+
     /// One march at `x`; with `full`, the six base-wrench columns too. Returns the residual
     /// rows, and with `full` the exact Jacobian of the tip rows along the base wrench.
     pub(super) fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<Rows> {
         let model = self.contact_model(x)?;
+        let mut pair = self.scratch(model.tendons().len());
         let plan = match self.integrator {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
             Integrator::Adaptive(_) => Vec::new(),
@@ -295,16 +311,15 @@ impl<'m> Constrained<'m> {
             None
         };
         let l = self.model.length();
-        let nt = model.tendons().len();
-        let (mut before, mut after) = (Workspace::new(nt), Workspace::new(nt));
+        let [before, after] = &mut *pair;
         let mut ev = [
             Evaluator {
                 eq: sh.eq,
-                ws: &mut before,
+                ws: before,
             },
             Evaluator {
                 eq: sh.eq,
-                ws: &mut after,
+                ws: after,
             },
         ];
         for (a, o) in self.active.iter().zip(self.offsets()) {
@@ -323,6 +338,7 @@ impl<'m> Constrained<'m> {
             };
             self.contact_rows(&mut ev, a, at, &f, mu, &mut rows);
         }
+        self.scratch = Some(pair);
         if !rows.iter().all(|v| v.is_finite()) {
             return None;
         }
