@@ -7,17 +7,7 @@ mod common;
 use softrod::nalgebra::Vector3;
 use softrod::{solve_constrained, Loads, Obstacle, SolveOptions};
 
-/// A small deterministic generator (xorshift64*), so the sample is reproducible.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use common::Rng;
 
 /// Fraction of the tension vectors whose contact-free shape penetrates the sphere that the
 /// contact solve converges for, and how many penetrated.

@@ -221,3 +221,28 @@ pub fn rk4_options(steps: usize) -> SolveOptions {
         ..SolveOptions::default()
     }
 }
+
+/// A small deterministic generator (xorshift64*), so random samples are reproducible.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Tensions of the NiTi robot with each segment pulled by two of its three tendons (N,
+    /// each up to 3): admissible for a minimum-norm inverse (no antagonist pair).
+    pub fn admissible(&mut self) -> [f64; 6] {
+        let mut t = [0.0; 6];
+        for seg in 0..2 {
+            let o = ((self.uniform() * 3.0) as usize).min(2);
+            t[3 * seg + o] = 3.0 * self.uniform();
+            t[3 * seg + (o + 1) % 3] = 3.0 * self.uniform();
+        }
+        t
+    }
+}
