@@ -50,6 +50,8 @@ use crate::model::loads::{Frame, PointLoad};
 use crate::model::tendon::Tendon;
 use crate::model::{Actuation, RobotModel};
 
+mod jacobian;
+
 /// Depth of the Anderson acceleration of the guide points (deep: the rod's response to the
 /// lagged guide loads is not a contraction on a soft rod, and a deep history acts as a Krylov
 /// solve of the linearised fixed point).
@@ -243,6 +245,10 @@ pub enum GuideMethod {
     /// Newton on the guide forces only (with continuation in the tensions if a full step
     /// fails).
     Newton,
+    /// Newton on the guide forces only, its Jacobian by forward differences (one rod solve
+    /// per unknown) even where the exact one applies: the reference the exact Jacobian is
+    /// checked and timed against.
+    NewtonFiniteDifferences,
 }
 
 /// Rod solves the fixed point gets before Newton takes over ([`GuideMethod::Auto`]).
@@ -582,7 +588,8 @@ impl<'a> Guided<'a> {
         })
     }
 
-    /// The forward-difference Jacobian of the residual at `z` (evaluated in `cur`).
+    /// The Jacobian of the residual at `z` (evaluated in `cur`): exact from the linearised rod
+    /// ([`jacobian`]) where it applies, otherwise by forward differences.
     fn jacobian(
         &self,
         z: &[f64],
@@ -592,6 +599,11 @@ impl<'a> Guided<'a> {
         h: f64,
         c: &mut Counters,
     ) -> Result<DMatrix<f64>> {
+        if self.options.guide_method != GuideMethod::NewtonFiniteDifferences
+            && self.exact_jacobian_applies()
+        {
+            return self.exact_jacobian(cur, base, active, c);
+        }
         let n = z.len();
         let mut jac = DMatrix::zeros(n, n);
         let mut zk = z.to_vec();
@@ -827,7 +839,9 @@ pub(super) fn solve_guided(
         GuideMethod::FixedPoint => {
             problem.fixed_point(start, options.max_iterations, false, &mut c)
         }
-        GuideMethod::Newton => problem.newton_solve(&start, &mut c),
+        GuideMethod::Newton | GuideMethod::NewtonFiniteDifferences => {
+            problem.newton_solve(&start, &mut c)
+        }
         GuideMethod::Auto => {
             let budget = GUIDE_FIXED_POINT_BUDGET.min(options.max_iterations);
             match problem.fixed_point(start.clone(), budget, true, &mut c) {
