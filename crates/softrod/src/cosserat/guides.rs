@@ -44,6 +44,7 @@ use super::friction::{
     angle, base_slip, cell_rule, solve_frictional, Anderson, FrictionOptions, FrictionalSolution,
     Slip,
 };
+use crate::cosserat::statics::WarmStart;
 use crate::error::{Error, Result};
 use crate::model::actuation::TendonInput;
 use crate::model::loads::{Frame, PointLoad};
@@ -381,13 +382,13 @@ impl<'a> Guided<'a> {
         // The rod under frozen guide forces is not the guided robot: its stability (the
         // forces held in the guides' frames) is no reason to leave the branch.
         inner.statics.seek_stable = false;
-        inner.statics.warm_start = Some(warm.statics.warm_start());
         let prev = self.inner_prev.as_ref().map(|p| {
             let mut q = p.clone();
             q.statics.base_wrench = warm.statics.base_wrench;
             q.statics.jacobian = warm.statics.jacobian;
             q
         });
+        inner.statics.warm_start = Some(predicted_warm_start(m, warm));
         let sol = solve_frictional(m, &self.act, &inner, prev.as_ref())?;
         c.iterations += sol.iterations;
         c.cell_steps += sol.cell_steps;
@@ -808,6 +809,40 @@ impl<'a> Guided<'a> {
     }
 }
 
+/// The warm start of the rod solve of model `m` from the solution `warm` (of another model
+/// with the same rod): its base wrench changed by the balance, on `warm`'s shape, of the
+/// point loads of `m` less those of `warm`'s model (exact for a rigid rod; the guide forces
+/// of an evaluation change the base wrench by their whole sum, which the warm shape's base
+/// wrench alone leaves to the shooting Newton), and its Jacobian.
+fn predicted_warm_start(m: &RobotModel, warm: &FrictionalSolution) -> WarmStart {
+    let st = &warm.statics;
+    let p0 = Vector3::from(st.position[0]);
+    let wrench = |loads: &[PointLoad]| {
+        let (mut f, mut n) = (Vector3::zeros(), Vector3::zeros());
+        for pl in loads {
+            let j = node_at(&st.s, pl.s);
+            let (force, moment) = match pl.frame {
+                Frame::World => (pl.force, pl.moment),
+                Frame::Body => {
+                    let r = Matrix3::from_fn(|a, b| st.rotation[j][a][b]);
+                    (r * pl.force, r * pl.moment)
+                }
+            };
+            f += force;
+            n += (Vector3::from(st.position[j]) - p0).cross(&force) + moment;
+        }
+        (f, n)
+    };
+    let (f1, n1) = wrench(&m.loads().point_loads);
+    let (f0, n0) = wrench(&st.model.loads().point_loads);
+    let mut w = st.warm_start();
+    for k in 0..3 {
+        w.base_wrench[k] += f1[k] - f0[k];
+        w.base_wrench[3 + k] += n1[k] - n0[k];
+    }
+    w
+}
+
 /// Number of guide-force unknowns: 3 per anchor after the base hole of every active tendon.
 fn z_len(model: &RobotModel, guided: &[usize], active: &[bool]) -> usize {
     guided
@@ -840,6 +875,10 @@ pub(super) fn solve_guided(
             problem.fixed_point(start, options.max_iterations, false, &mut c)
         }
         GuideMethod::Newton | GuideMethod::NewtonFiniteDifferences => {
+            problem.newton_solve(&start, &mut c)
+        }
+        // With the exact Jacobian a Newton step costs about one rod solve: Newton directly.
+        GuideMethod::Auto if problem.exact_jacobian_applies() => {
             problem.newton_solve(&start, &mut c)
         }
         GuideMethod::Auto => {

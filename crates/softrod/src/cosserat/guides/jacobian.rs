@@ -44,9 +44,12 @@ const NCOL: usize = 12;
 /// State length of the transition march.
 const WIDTH: usize = STATE + COLUMN * NCOL;
 
-/// Relative step of the central differences of the capstan forces along a pose variation
-/// (of the largest change of a point over the rod's length, or of a frame, in rad).
-const POSE_STEP: f64 = 1e-6;
+/// Step of the central differences of the capstan forces in an anchor's twist: of its
+/// position over the rod's length, of its frame in rad. Small: at a guide of small wrap angle
+/// `θ` with friction the forces have a curvature of order `1/θ` (`θ` is not smooth at 0), and
+/// the truncation error falls with the square of the step (1.4e-6 relative at 1e-6 on the
+/// NiTi robot at 4 N, 1.4e-8 at 1e-7), while the rounding error stays below 1e-10.
+const POSE_STEP: f64 = 1e-7;
 
 /// The linearised rod at the anchors: per anchor arc length (increasing), the transition
 /// matrix after the anchor's jump, in the scaled coordinates `(δp/L, δθ, δN/f, δM/(f L))`,
@@ -221,36 +224,67 @@ impl Guided<'_> {
                 .all(|t| matches!(t, TendonInput::Tension(_)))
     }
 
-    /// The capstan forces `z'` (N, body; the active tendons' anchors after the base hole) of
-    /// the anchor poses `pose(k, g)` (position (m) and rotation of anchor `g` of active
-    /// guided tendon `k`) at base tensions `base`.
-    fn capstan_forces(
+    /// The capstan forces (N, body; its anchors after the base hole) of guided tendon `k`
+    /// (model tendon `i`) at the anchor poses `pose` (position (m) and rotation per anchor)
+    /// and base tension `base`.
+    fn tendon_forces(
         &self,
-        base: &[f64],
-        active: &[bool],
-        pose: &dyn Fn(usize, usize) -> (Vector3<f64>, Matrix3<f64>),
+        k: usize,
+        i: usize,
+        pose: &[(Vector3<f64>, Matrix3<f64>)],
+        base: f64,
     ) -> Vec<f64> {
         let model = self.model;
-        let mut z = Vec::new();
-        for (k, &i) in self.guided.iter().enumerate() {
-            if !active[k] {
-                continue;
-            }
-            let s = anchors(model, i);
-            let mut x = Vec::with_capacity(3 * s.len());
-            for (g, &sg) in s.iter().enumerate() {
-                let (p, r) = pose(k, g);
-                let props = model.rod().section_at(sg);
-                let (o, _) = model.tendons()[i].routing().offset(sg, &props);
-                x.extend_from_slice((p + r * Vector3::new(o[0], o[1], 0.0)).as_slice());
-            }
-            let st = states(model, i, &x, base[i], self.prev_states(k));
-            for (g, a) in st.iter().enumerate().skip(1) {
-                let (_, r) = pose(k, g);
-                z.extend_from_slice((r.transpose() * Vector3::from(a.force)).as_slice());
-            }
+        let s = anchors(model, i);
+        let mut x = Vec::with_capacity(3 * s.len());
+        for (&sg, (p, r)) in s.iter().zip(pose) {
+            let props = model.rod().section_at(sg);
+            let (o, _) = model.tendons()[i].routing().offset(sg, &props);
+            x.extend_from_slice((p + r * Vector3::new(o[0], o[1], 0.0)).as_slice());
+        }
+        let st = states(model, i, &x, base, self.prev_states(k));
+        let mut z = Vec::with_capacity(3 * (s.len() - 1));
+        for (a, (_, r)) in st.iter().zip(pose).skip(1) {
+            z.extend_from_slice((r.transpose() * Vector3::from(a.force)).as_slice());
         }
         z
+    }
+
+    /// The derivative (3 per anchor after the base hole, by 6 per anchor after it) of the
+    /// capstan forces of guided tendon `k` (model tendon `i`) with respect to the twists
+    /// `(δp, δθ)` (m, rad; world) of its anchors at the poses `pose`: central differences.
+    fn tendon_force_derivative(
+        &self,
+        k: usize,
+        i: usize,
+        pose: &[(Vector3<f64>, Matrix3<f64>)],
+        base: f64,
+    ) -> DMatrix<f64> {
+        let na = pose.len();
+        let l = self.model.length();
+        let mut d = DMatrix::zeros(3 * (na - 1), 6 * (na - 1));
+        let mut moved = pose.to_vec();
+        for g in 1..na {
+            for q in 0..6 {
+                let h = if q < 3 { POSE_STEP * l } else { POSE_STEP };
+                let mut at = |eps: f64| {
+                    let (p, r) = pose[g];
+                    moved[g] = if q < 3 {
+                        (p + Vector3::ith(q, eps), r)
+                    } else {
+                        (p, Rotation3::new(Vector3::ith(q - 3, eps)).matrix() * r)
+                    };
+                    let z = self.tendon_forces(k, i, &moved, base);
+                    moved[g] = pose[g];
+                    z
+                };
+                let (plus, minus) = (at(h), at(-h));
+                for r in 0..plus.len() {
+                    d[(r, 6 * (g - 1) + q)] = (plus[r] - minus[r]) / (2.0 * h);
+                }
+            }
+        }
+        d
     }
 
     /// The exact Jacobian of the residual `z' − z` at the evaluation `cur` (see the module
@@ -305,32 +339,30 @@ impl Guided<'_> {
                 )
             })
             .collect();
-        let l = model.length();
+        // Per active tendon, its capstan forces' derivative with respect to its anchors'
+        // twists, chained with the twists per unknown.
         let n = response.len();
         let mut jac = DMatrix::zeros(n, n);
-        for (u, d) in response.iter().enumerate() {
-            let size = d.iter().fold(0.0, |m: f64, v| {
-                m.max(v.fixed_rows::<3>(0).amax() / l)
-                    .max(v.fixed_rows::<3>(3).amax())
-            });
-            if size == 0.0 {
+        let mut row = 0;
+        for (k, &i) in self.guided.iter().enumerate() {
+            if !active[k] {
                 continue;
             }
-            let h = POSE_STEP / size;
-            let moved = |eps: f64| {
-                let pose = |k: usize, g: usize| {
-                    let a = index[k][g];
-                    let (p, r) = poses[a];
-                    let v = d[a];
-                    let turn = Rotation3::new(v.fixed_rows::<3>(3) * eps);
-                    (p + v.fixed_rows::<3>(0) * eps, turn.matrix() * r)
-                };
-                self.capstan_forces(base, active, &pose)
-            };
-            let (plus, minus) = (moved(h), moved(-h));
-            for r in 0..n {
-                jac[(r, u)] = (plus[r] - minus[r]) / (2.0 * h);
+            let pose: Vec<_> = index[k].iter().map(|&a| poses[a]).collect();
+            let d = self.tendon_force_derivative(k, i, &pose, base[i]);
+            let na = pose.len();
+            let mut twists = DMatrix::zeros(6 * (na - 1), n);
+            for (u, resp) in response.iter().enumerate() {
+                for g in 1..na {
+                    for q in 0..6 {
+                        twists[(6 * (g - 1) + q, u)] = resp[index[k][g]][q];
+                    }
+                }
             }
+            jac.rows_mut(row, d.nrows()).copy_from(&(d * twists));
+            row += 3 * (na - 1);
+        }
+        for u in 0..n {
             jac[(u, u)] -= 1.0;
         }
         Ok(jac)
@@ -371,10 +403,7 @@ mod tests {
 
     /// The exact Jacobian of the guide-force residual against central differences of the
     /// residual (two rod solves per unknown, step 1e-6 of the tension), at the first Newton
-    /// iterate (the capstan forces of the channel shape) from rest and on an unloading step
-    /// (guides sticking). On the unloading step some guides sit near their capstan bound (a
-    /// kink of the stick/slip rule): there the differences converge at first order in their
-    /// step (5e-6 at a step of 1e-5 of the tension, 4e-7 at 1e-6), elsewhere to 1e-9.
+    /// iterate from rest and at the solution of an unloading step (guides sticking).
     #[test]
     fn exact_jacobian_matches_central_differences() {
         let mut opts = FrictionOptions::default();
@@ -387,15 +416,27 @@ mod tests {
             let problem = Guided::new(&model, &a, &opts, previous.as_ref()).unwrap();
             assert!(problem.exact_jacobian_applies());
             let mut c = Counters::default();
-            let start = problem.start(&mut c).unwrap();
             let base = a.tension_values(6);
             let active = problem.active(&base, &base);
-            let x = points_on(&model, &problem.guided, &start);
-            let st = problem.states_at(&x, &base);
-            let z = problem.body_forces(&st, &start, &active);
-            let cur = problem
-                .evaluate(&z, &base, &active, &start, &mut c)
-                .unwrap();
+            // From rest: the first iterate, the capstan forces of the channel shape. On the
+            // unloading step its solution (the first iterate there, the previous shape, puts
+            // every sticking guide exactly at a bound of its capstan interval: a kink of the
+            // stick/slip rule, where the Jacobian is one-sided).
+            let (z, warm) = if previous.is_none() {
+                let start = problem.start(&mut c).unwrap();
+                let x = points_on(&model, &problem.guided, &start);
+                let st = problem.states_at(&x, &base);
+                (problem.body_forces(&st, &start, &active), start)
+            } else {
+                let sol = solve_frictional(&model, &a, &opts, previous.as_ref()).unwrap();
+                let st: Vec<_> = problem
+                    .guided
+                    .iter()
+                    .map(|&i| sol.guides[i].clone())
+                    .collect();
+                (problem.body_forces(&st, &sol, &active), sol)
+            };
+            let cur = problem.evaluate(&z, &base, &active, &warm, &mut c).unwrap();
             let exact = problem
                 .exact_jacobian(&cur, &base, &active, &mut c)
                 .unwrap();
