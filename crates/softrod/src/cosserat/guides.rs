@@ -23,16 +23,17 @@
 //! - Newton on the guide forces: the unknowns `z` are the body-frame forces at the anchors of
 //!   the pulled guided tendons, the map `z ↦ z'` solves the rod under `z` (follower point
 //!   loads at the guides' offsets) and reads the capstan forces `z'` of the points on the new
-//!   shape in its frames; `F(z) = z' − z = 0` is solved by Newton with a forward-difference
-//!   Jacobian (one warm rod solve per unknown, reused while steps contract the residual by
-//!   4), a backtracking line search, and, if the full step from the start fails,
+//!   shape in its frames; `F(z) = z' − z = 0` is solved by Newton with the exact Jacobian
+//!   of the linearised rod ([`jacobian`]; by forward differences, one warm rod solve per
+//!   unknown, where another tendon has channel friction or is displacement-controlled),
+//!   reused while steps contract the residual by 4, a backtracking line search, and, if the full step from the start fails,
 //!   continuation in the tensions from `previous` (or from zero). It ends at a residual of
 //!   [`GUIDE_FORCE_TOLERANCE`] times the largest tension. Unlike the points, the forces in
 //!   the guides' frames determine the rod solve alone, so `z ↦ z'` is a function and its
 //!   Jacobian exists.
 //!
-//! The default ([`GuideMethod::Auto`]) tries the fixed point for
-//! [`GUIDE_FIXED_POINT_BUDGET`] rod solves, then Newton. The reported tensions, chords and
+//! The default ([`GuideMethod::Auto`]) is Newton where the exact Jacobian applies; otherwise
+//! it tries the fixed point for [`GUIDE_FIXED_POINT_BUDGET`] rod solves, then Newton. The reported tensions, chords and
 //! wraps are those of the points on the returned shape, the guide forces those the returned
 //! rod was solved with, so the balance of rod + tendons holds to the residual.
 
@@ -235,9 +236,11 @@ fn split<'x>(model: &RobotModel, guided: &[usize], x: &'x [f64]) -> Vec<&'x [f64
 /// ([`FrictionOptions::guide_method`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum GuideMethod {
-    /// The fixed point on the guide points first (a few rod solves where the tendon load is
-    /// small against the rod's stiffness), Newton on the guide forces if it has not settled
-    /// in [`GUIDE_FIXED_POINT_BUDGET`] rod solves or diverges.
+    /// Newton on the guide forces where its exact Jacobian applies (the robot's other
+    /// tendons frictionless and tension-controlled); otherwise the fixed point on the guide
+    /// points first (a few rod solves where the tendon load is small against the rod's
+    /// stiffness), Newton if it has not settled in [`GUIDE_FIXED_POINT_BUDGET`] rod solves
+    /// or diverges.
     #[default]
     Auto,
     /// The fixed point on the guide points only (up to [`FrictionOptions::max_iterations`]

@@ -371,6 +371,7 @@ impl Guided<'_> {
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use std::sync::Arc;
 
     use super::super::{points_on, Counters, Guided};
