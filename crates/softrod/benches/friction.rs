@@ -1,6 +1,9 @@
 //! Tendon friction on the two-segment NiTi robot (tensions [4, 0, 0, 0, 2, 0] N, 50 RK4
 //! steps): the frictionless solve at the default nodes and at the friction mesh, and the
-//! frictional solve (μ = 0.1 and 0.2) from rest and as an unloading step, side by side.
+//! frictional solve (μ = 0.1 and 0.2) from rest and as an unloading step, side by side; and
+//! the tendons through 8 disks per segment (tensions `τ (1, 0, 0.3, 0, 0.5, 0.1)` N, from
+//! rest, default options) with the exact and the forward-difference Jacobian of the guide
+//! forces, beside the same tendons in continuous channels.
 //!
 //! Run: `cargo bench -p softrod --bench friction`.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -15,7 +18,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use softrod::nalgebra::Vector3;
 use softrod::{
     friction_mesh, solve_frictional, solve_statics, solve_statics_at, Actuation, FrictionOptions,
-    Integrator, Loads, RobotModel,
+    GuideMethod, Integrator, Loads, RobotModel,
 };
 
 fn niti(mu: f64) -> Arc<RobotModel> {
@@ -24,6 +27,47 @@ fn niti(mu: f64) -> Arc<RobotModel> {
 
 fn niti_with(mu: f64, loads: Loads) -> Arc<RobotModel> {
     robot::niti_model(loads, None, mu)
+}
+
+/// The NiTi robot with its tendons through 8 equally spaced disks per segment (coefficient
+/// `mu` at each).
+fn guided(mu: f64) -> Arc<RobotModel> {
+    let tendons = robot::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let end = if i < 3 { 0.2 } else { 0.4 };
+            let n = (8.0 * end / 0.2_f64).round() as usize;
+            let guides = (1..n).map(|g| end * g as f64 / n as f64).collect();
+            t.tendon.with_guides(guides, &[mu]).unwrap()
+        })
+        .collect();
+    RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap()
+}
+
+fn guides(c: &mut Criterion) {
+    let exact = FrictionOptions::default();
+    let fd = FrictionOptions {
+        guide_method: GuideMethod::NewtonFiniteDifferences,
+        ..Default::default()
+    };
+    let mut g = c.benchmark_group("guides_niti");
+    g.sample_size(10);
+    for (mu, tau) in [(0.0, 1.0), (0.2, 4.0)] {
+        let act = Actuation::tensions(&[tau, 0.0, 0.3 * tau, 0.0, 0.5 * tau, 0.1 * tau]);
+        let channel = niti(mu);
+        let disks = guided(mu);
+        g.bench_function(format!("mu_{mu}_tau_{tau}_channel"), |b| {
+            b.iter(|| solve_frictional(black_box(&channel), &act, &exact, None).unwrap())
+        });
+        g.bench_function(format!("mu_{mu}_tau_{tau}_guided_exact"), |b| {
+            b.iter(|| solve_frictional(black_box(&disks), &act, &exact, None).unwrap())
+        });
+        g.bench_function(format!("mu_{mu}_tau_{tau}_guided_fd"), |b| {
+            b.iter(|| solve_frictional(black_box(&disks), &act, &fd, None).unwrap())
+        });
+    }
+    g.finish();
 }
 
 fn friction(c: &mut Criterion) {
@@ -74,6 +118,6 @@ fn friction(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(2));
-    targets = friction
+    targets = friction, guides
 }
 criterion_main!(benches);

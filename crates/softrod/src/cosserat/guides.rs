@@ -23,16 +23,17 @@
 //! - Newton on the guide forces: the unknowns `z` are the body-frame forces at the anchors of
 //!   the pulled guided tendons, the map `z ↦ z'` solves the rod under `z` (follower point
 //!   loads at the guides' offsets) and reads the capstan forces `z'` of the points on the new
-//!   shape in its frames; `F(z) = z' − z = 0` is solved by Newton with a forward-difference
-//!   Jacobian (one warm rod solve per unknown, reused while steps contract the residual by
-//!   4), a backtracking line search, and, if the full step from the start fails,
+//!   shape in its frames; `F(z) = z' − z = 0` is solved by Newton with the exact Jacobian
+//!   of the linearised rod ([`jacobian`]; by forward differences, one warm rod solve per
+//!   unknown, where another tendon has channel friction or is displacement-controlled),
+//!   reused while steps contract the residual by 4, a backtracking line search, and, if the full step from the start fails,
 //!   continuation in the tensions from `previous` (or from zero). It ends at a residual of
 //!   [`GUIDE_FORCE_TOLERANCE`] times the largest tension. Unlike the points, the forces in
 //!   the guides' frames determine the rod solve alone, so `z ↦ z'` is a function and its
 //!   Jacobian exists.
 //!
-//! The default ([`GuideMethod::Auto`]) tries the fixed point for
-//! [`GUIDE_FIXED_POINT_BUDGET`] rod solves, then Newton. The reported tensions, chords and
+//! The default ([`GuideMethod::Auto`]) is Newton where the exact Jacobian applies; otherwise
+//! it tries the fixed point for [`GUIDE_FIXED_POINT_BUDGET`] rod solves, then Newton. The reported tensions, chords and
 //! wraps are those of the points on the returned shape, the guide forces those the returned
 //! rod was solved with, so the balance of rod + tendons holds to the residual.
 
@@ -44,11 +45,14 @@ use super::friction::{
     angle, base_slip, cell_rule, solve_frictional, Anderson, FrictionOptions, FrictionalSolution,
     Slip,
 };
+use crate::cosserat::statics::WarmStart;
 use crate::error::{Error, Result};
 use crate::model::actuation::TendonInput;
 use crate::model::loads::{Frame, PointLoad};
 use crate::model::tendon::Tendon;
 use crate::model::{Actuation, RobotModel};
+
+mod jacobian;
 
 /// Depth of the Anderson acceleration of the guide points (deep: the rod's response to the
 /// lagged guide loads is not a contraction on a soft rod, and a deep history acts as a Krylov
@@ -232,9 +236,11 @@ fn split<'x>(model: &RobotModel, guided: &[usize], x: &'x [f64]) -> Vec<&'x [f64
 /// ([`FrictionOptions::guide_method`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum GuideMethod {
-    /// The fixed point on the guide points first (a few rod solves where the tendon load is
-    /// small against the rod's stiffness), Newton on the guide forces if it has not settled
-    /// in [`GUIDE_FIXED_POINT_BUDGET`] rod solves or diverges.
+    /// Newton on the guide forces where its exact Jacobian applies (the robot's other
+    /// tendons frictionless and tension-controlled); otherwise the fixed point on the guide
+    /// points first (a few rod solves where the tendon load is small against the rod's
+    /// stiffness), Newton if it has not settled in [`GUIDE_FIXED_POINT_BUDGET`] rod solves
+    /// or diverges.
     #[default]
     Auto,
     /// The fixed point on the guide points only (up to [`FrictionOptions::max_iterations`]
@@ -243,6 +249,10 @@ pub enum GuideMethod {
     /// Newton on the guide forces only (with continuation in the tensions if a full step
     /// fails).
     Newton,
+    /// Newton on the guide forces only, its Jacobian by forward differences (one rod solve
+    /// per unknown) even where the exact one applies: the reference the exact Jacobian is
+    /// checked and timed against.
+    NewtonFiniteDifferences,
 }
 
 /// Rod solves the fixed point gets before Newton takes over ([`GuideMethod::Auto`]).
@@ -375,13 +385,13 @@ impl<'a> Guided<'a> {
         // The rod under frozen guide forces is not the guided robot: its stability (the
         // forces held in the guides' frames) is no reason to leave the branch.
         inner.statics.seek_stable = false;
-        inner.statics.warm_start = Some(warm.statics.warm_start());
         let prev = self.inner_prev.as_ref().map(|p| {
             let mut q = p.clone();
             q.statics.base_wrench = warm.statics.base_wrench;
             q.statics.jacobian = warm.statics.jacobian;
             q
         });
+        inner.statics.warm_start = Some(predicted_warm_start(m, warm));
         let sol = solve_frictional(m, &self.act, &inner, prev.as_ref())?;
         c.iterations += sol.iterations;
         c.cell_steps += sol.cell_steps;
@@ -582,7 +592,8 @@ impl<'a> Guided<'a> {
         })
     }
 
-    /// The forward-difference Jacobian of the residual at `z` (evaluated in `cur`).
+    /// The Jacobian of the residual at `z` (evaluated in `cur`): exact from the linearised rod
+    /// ([`jacobian`]) where it applies, otherwise by forward differences.
     fn jacobian(
         &self,
         z: &[f64],
@@ -592,6 +603,11 @@ impl<'a> Guided<'a> {
         h: f64,
         c: &mut Counters,
     ) -> Result<DMatrix<f64>> {
+        if self.options.guide_method != GuideMethod::NewtonFiniteDifferences
+            && self.exact_jacobian_applies()
+        {
+            return self.exact_jacobian(cur, base, active, c);
+        }
         let n = z.len();
         let mut jac = DMatrix::zeros(n, n);
         let mut zk = z.to_vec();
@@ -796,6 +812,40 @@ impl<'a> Guided<'a> {
     }
 }
 
+/// The warm start of the rod solve of model `m` from the solution `warm` (of another model
+/// with the same rod): its base wrench changed by the balance, on `warm`'s shape, of the
+/// point loads of `m` less those of `warm`'s model (exact for a rigid rod; the guide forces
+/// of an evaluation change the base wrench by their whole sum, which the warm shape's base
+/// wrench alone leaves to the shooting Newton), and its Jacobian.
+fn predicted_warm_start(m: &RobotModel, warm: &FrictionalSolution) -> WarmStart {
+    let st = &warm.statics;
+    let p0 = Vector3::from(st.position[0]);
+    let wrench = |loads: &[PointLoad]| {
+        let (mut f, mut n) = (Vector3::zeros(), Vector3::zeros());
+        for pl in loads {
+            let j = node_at(&st.s, pl.s);
+            let (force, moment) = match pl.frame {
+                Frame::World => (pl.force, pl.moment),
+                Frame::Body => {
+                    let r = Matrix3::from_fn(|a, b| st.rotation[j][a][b]);
+                    (r * pl.force, r * pl.moment)
+                }
+            };
+            f += force;
+            n += (Vector3::from(st.position[j]) - p0).cross(&force) + moment;
+        }
+        (f, n)
+    };
+    let (f1, n1) = wrench(&m.loads().point_loads);
+    let (f0, n0) = wrench(&st.model.loads().point_loads);
+    let mut w = st.warm_start();
+    for k in 0..3 {
+        w.base_wrench[k] += f1[k] - f0[k];
+        w.base_wrench[3 + k] += n1[k] - n0[k];
+    }
+    w
+}
+
 /// Number of guide-force unknowns: 3 per anchor after the base hole of every active tendon.
 fn z_len(model: &RobotModel, guided: &[usize], active: &[bool]) -> usize {
     guided
@@ -827,7 +877,13 @@ pub(super) fn solve_guided(
         GuideMethod::FixedPoint => {
             problem.fixed_point(start, options.max_iterations, false, &mut c)
         }
-        GuideMethod::Newton => problem.newton_solve(&start, &mut c),
+        GuideMethod::Newton | GuideMethod::NewtonFiniteDifferences => {
+            problem.newton_solve(&start, &mut c)
+        }
+        // With the exact Jacobian a Newton step costs about one rod solve: Newton directly.
+        GuideMethod::Auto if problem.exact_jacobian_applies() => {
+            problem.newton_solve(&start, &mut c)
+        }
         GuideMethod::Auto => {
             let budget = GUIDE_FIXED_POINT_BUDGET.min(options.max_iterations);
             match problem.fixed_point(start.clone(), budget, true, &mut c) {
