@@ -18,18 +18,10 @@ use std::sync::Arc;
 
 use softrod::{solve_frictional, Actuation, FrictionOptions, GuideMethod, Loads, RobotModel};
 
+/// The NiTi robot with its tendons through 8 equally spaced disks per segment (coefficient
+/// `mu` at each).
 fn guided(mu: f64) -> Arc<RobotModel> {
-    let tendons = robot::niti_tendons(&[0.0; 6])
-        .into_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let end = if i < 3 { 0.2 } else { 0.4 };
-            let n = (8.0 * end / 0.2_f64).round() as usize;
-            let guides = (1..n).map(|g| end * g as f64 / n as f64).collect();
-            t.tendon.with_guides(guides, &[mu]).unwrap()
-        })
-        .collect();
-    RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap()
+    robot::guided_niti(mu, 8)
 }
 
 fn main() {

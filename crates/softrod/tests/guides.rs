@@ -278,22 +278,6 @@ fn dense_guides_approach_the_continuous_channel() {
 #[path = "common/robot.rs"]
 mod robot;
 
-/// The two-segment NiTi robot with its tendons through `per_segment` equally spaced disks per
-/// 0.2 m (coefficient `mu` at each), as the Python tests build it.
-fn guided_niti(mu: f64, per_segment: usize) -> Arc<RobotModel> {
-    let tendons = robot::niti_tendons(&[0.0; 6])
-        .into_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let end = if i < 3 { 0.2 } else { 0.4 };
-            let n = (per_segment as f64 * end / 0.2).round() as usize;
-            let guides = (1..n).map(|g| end * g as f64 / n as f64).collect();
-            t.tendon.with_guides(guides, &[mu]).unwrap()
-        })
-        .collect();
-    RobotModel::new(robot::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap()
-}
-
 /// The capstan law at every interior guide of every guided tendon of `sol`, with the wrap
 /// angles from the guide points on the returned shape (position and rotation at the anchor's
 /// node and the tendon's offset), not the reported ones: sliding `Δ ln τ = ∓μθ`, sticking
@@ -374,7 +358,7 @@ fn newton_agrees_with_the_fixed_point_where_it_converges() {
         ),
         (
             "NiTi robot, 0.02 N",
-            guided_niti(0.3, 8),
+            robot::guided_niti(0.3, 8),
             Actuation::tensions(&[0.02, 0.0, 0.0, 0.0, 0.01, 0.0]),
             niti_opts,
         ),
@@ -415,7 +399,7 @@ fn guided_niti_at_working_tensions() {
         .map(|&tau| Actuation::tensions(&[tau, 0.0, 0.3 * tau, 0.0, 0.5 * tau, 0.1 * tau]))
         .collect();
     for mu in [0.0, 0.2] {
-        let model = guided_niti(mu, 8);
+        let model = robot::guided_niti(mu, 8);
         // Each level from rest, and the load/unload path (each step from the last).
         let path_sols = solve_path(&model, &path, &opts).unwrap();
         for (k, act) in path.iter().enumerate() {
@@ -524,7 +508,7 @@ fn dense_guides_approach_the_channel_at_a_working_tension() {
         let tc = Vector3::from(cont.tip_position());
         let mut errs = Vec::new();
         for per in [4, 8, 16] {
-            let sol = solve_frictional(&guided_niti(mu, per), &act, &opts, None).unwrap();
+            let sol = solve_frictional(&robot::guided_niti(mu, per), &act, &opts, None).unwrap();
             errs.push((Vector3::from(sol.tip_position()) - tc).norm());
         }
         let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
@@ -553,7 +537,7 @@ fn random_sweep(samples: usize) {
     let mut solves = 0;
     for k in 0..samples {
         let mu = 0.3 * uniform();
-        let model = guided_niti(mu, 8);
+        let model = robot::guided_niti(mu, 8);
         // From rest, then a step of the load path to other random tensions from there.
         let mut previous: Option<FrictionalSolution> = None;
         for step in 0..2 {

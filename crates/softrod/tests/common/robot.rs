@@ -222,6 +222,22 @@ pub fn rk4_options(steps: usize) -> SolveOptions {
     }
 }
 
+/// The two-segment NiTi robot with its tendons through `per_segment` equally spaced disks per
+/// 0.2 m (coefficient `mu` at each), as the Python tests build it.
+pub fn guided_niti(mu: f64, per_segment: usize) -> Arc<RobotModel> {
+    let tendons = niti_tendons(&[0.0; 6])
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let end = if i < 3 { 0.2 } else { 0.4 };
+            let n = (per_segment as f64 * end / 0.2).round() as usize;
+            let guides = (1..n).map(|g| end * g as f64 / n as f64).collect();
+            t.tendon.with_guides(guides, &[mu]).unwrap()
+        })
+        .collect();
+    RobotModel::new(niti_rod(), tendons, Vec::new(), Loads::default()).unwrap()
+}
+
 /// A small deterministic generator (xorshift64*), so random samples are reproducible.
 pub struct Rng(pub u64);
 
