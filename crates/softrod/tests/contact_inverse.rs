@@ -94,13 +94,14 @@ fn targets_pressed_on_a_sphere_are_reached_or_reported() {
 }
 
 /// The sample (run with `--ignored`): on the plane 359 of 359 touching samples are
-/// reached; pressed on a sphere, 66 of 95 and 209 of 256 (most misses stop where the
+/// reached; pressed on a sphere, 65 of 95 and 207 of 256 (most misses stop where the
 /// contact-free shape passes through the sphere's centre and the solve from a straight rod
 /// jumps to another side of the sphere, the others where the contact is released: see
 /// `examples/contact_inverse_misses.rs` and docs/command.md): below the 99 % asked.
 #[test]
 #[ignore = "1,000 random tension vectors; the spheres miss the 99 % asked (see docs/limitations.md)"]
 fn targets_on_obstacles_are_reached_for_1000_tension_vectors() {
+    let mut counts = Vec::new();
     for obstacle in [
         Obstacle::plane([0.05, 0.0, 0.0], [-1.0, 0.0, 0.0]).unwrap(),
         Obstacle::sphere([0.06, 0.0, 0.3], 0.04).unwrap(),
@@ -108,6 +109,10 @@ fn targets_on_obstacles_are_reached_for_1000_tension_vectors() {
     ] {
         let (touching, reached, misses) = round_trips(1000, 0x5eed, &obstacle);
         println!("{obstacle:?}: {reached} of {touching} reached; misses: {misses:#?}");
+        counts.push((reached, touching));
+    }
+    // Every obstacle measured before the verdict, so that one run reports all three counts.
+    for (reached, touching) in counts {
         assert!(
             reached as f64 >= 0.99 * touching as f64,
             "{reached} of {touching}"
