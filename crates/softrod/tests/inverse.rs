@@ -478,3 +478,35 @@ fn the_closed_form_march_of_uniform_intervals_is_the_march() {
     }
     println!("worst tip difference {worst_p:e} m, worst Jacobian difference {worst_j:e} relative");
 }
+
+/// The closed-form march with a tendon along the axis (offset 0): pulled alone on the straight
+/// rod it only shortens it (its column changes the step's translation, not its rotation),
+/// and its Jacobian column is still the marched one.
+#[test]
+fn the_closed_form_march_holds_a_tendon_along_the_axis() {
+    let o = SolveOptions::default();
+    let mut tendons: Vec<_> = common::niti_tendons(&[0.0; 6])
+        .into_iter()
+        .map(|t| t.tendon)
+        .collect();
+    tendons.push(common::tendon([0.0, 0.0], 0.0, None).unwrap().tendon);
+    let model = RobotModel::new(common::niti_rod(), tendons, Vec::new(), Loads::default()).unwrap();
+    let mut fwd = CosseratForward::new(&model, &o, None).unwrap();
+    for t in [
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 2.0],
+        [1.0, 0.0, 0.0, 0.0, 0.5, 0.0, 2.0],
+    ] {
+        let ev = fwd.evaluate(&t, true).unwrap();
+        let sol = solve_statics(&model, &Actuation::tensions(&t), &o).unwrap();
+        assert!((ev.positions[0] - Vector3::from(sol.tip_position())).norm() <= 1e-14);
+        let marched = actuation_jacobian(&sol, None).unwrap();
+        let closed = &ev.jacobian.as_ref().unwrap()[0];
+        let scale = marched.amax();
+        let err = (closed - &marched).amax() / scale;
+        assert!(err <= 1e-12, "{t:?}: Jacobians differ by {err:e} relative");
+        assert!(
+            marched[(2, 6)].abs() > 1e-9 * scale,
+            "the axial tendon shortens the rod"
+        );
+    }
+}

@@ -89,12 +89,14 @@ fn projection_derivative(a: &Matrix3<f64>, da: &Matrix3<f64>) -> Matrix3<f64> {
 }
 
 /// One interval of the closed-form march: the rigid step `(Q, q)`, its steps and, per
-/// column, the step's derivative `(δQ, δq)`.
+/// column, the step's derivative `(δQ, δq)` and whether the tendon passes the interval (a
+/// tendon that does not forces nothing there).
 struct Interval {
     q_rot: Matrix3<f64>,
     q_pos: Vector3<f64>,
     steps: usize,
     columns: Vec<(Matrix3<f64>, Vector3<f64>)>,
+    passes: Vec<bool>,
 }
 
 /// The interval `k` of the march of `model` at the tensions `a` (N) in `steps` RK4 steps,
@@ -123,6 +125,7 @@ fn interval(
     let q_rot = reorthonormalise(&p);
     let q_pos = s * v * h;
     let mut columns = Vec::new();
+    let mut passes = Vec::new();
     if jacobian {
         let tangent = ev.ws.tangent;
         let ends = model.tendon_ends();
@@ -139,6 +142,7 @@ fn interval(
             })
             .collect();
         for (i, &end) in ends.iter().enumerate() {
+            passes.push(end >= hi);
             if end < hi {
                 columns.push((Matrix3::zeros(), Vector3::zeros()));
                 continue;
@@ -159,6 +163,7 @@ fn interval(
         q_pos,
         steps,
         columns,
+        passes,
     })
 }
 
@@ -196,11 +201,7 @@ pub(super) fn tip(
         let (p0, r0) = (p, r);
         // A tendon that does not pass the interval forces nothing there: its column moves with
         // the rod as a rigid body (δR ← δR R₀ᵀ R, δp ← δp + δR R₀ᵀ (p - p₀)), applied at the end.
-        let forced: Vec<bool> = iv
-            .columns
-            .iter()
-            .map(|(dq, _)| *dq != Matrix3::zeros())
-            .collect();
+        let forced = &iv.passes;
         for _ in 0..iv.steps {
             for c in (0..ncol).filter(|&c| forced[c]) {
                 let (dq, dqp) = &iv.columns[c];
