@@ -21,7 +21,7 @@
 use nalgebra::{Vector3, Vector6};
 
 use super::problem::{equations, Active, Constrained, Pass, Site};
-use super::rows::{enter, AtContact};
+use super::rows::AtContact;
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
 };
@@ -86,10 +86,10 @@ impl Site2 {
             return;
         };
         let post = head(y);
-        enter(side, k0);
+        side.enter_interval(k0);
         let mut a = [0.0; STATE];
         side.rhs_into::<STATE>(s, &pre, &mut a);
-        enter(side, interval);
+        side.enter_interval(interval);
         let mut b = [0.0; STATE];
         side.rhs_into::<STATE>(self.post_at, &post, &mut b);
         self.rate = [a, b];

@@ -182,7 +182,7 @@ pub(crate) struct Constrained<'m> {
     /// The friction coefficient of an obstacle touched inside the rod, when refused.
     pub(super) refused: Option<f64>,
     /// Scratch of the contact rows' evaluations, one per side of a contact, kept from march
-    /// to march as the warm start of their local solves (see [`super::rows::enter`]).
+    /// to march as the warm start of their local solves (see [`Evaluator::enter_interval`](crate::cosserat::equations::Evaluator::enter_interval)).
     pub(super) scratch: Option<Box<[Workspace; 2]>>,
     /// With a free tip, the stability (contacts as dead loads) of the coarse mesh's
     /// solution, from its exact Jacobian there, and the active set it belongs to.

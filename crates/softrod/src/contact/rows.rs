@@ -27,56 +27,6 @@ pub(super) struct AtContact<'y> {
     pub(super) last: (&'y [f64; STATE], usize),
 }
 
-/// Puts `ev` on interval `k` of its model: as [`Evaluator::set_interval`], but keeping the
-/// warm start of the local solve (the last strains and the factorised local Jacobian) when
-/// the tendons and chambers acting there are those it already holds, so that the contact
-/// rows, evaluated at nearly the same states march after march, take a chord step or two
-/// instead of a local Newton solve from the straight-tendon guess.
-pub(super) fn enter(ev: &mut Evaluator<'_, '_>, k: usize) {
-    if ev.ws.guess.is_some() && same_actuators(ev, k) {
-        ev.ws.interval = k;
-    } else {
-        ev.set_interval(k);
-    }
-}
-
-/// Whether the tendons (tensioned and passive) and chambers that [`Evaluator::set_interval`]
-/// would select on interval `k` are those `ev` holds.
-fn same_actuators(ev: &Evaluator<'_, '_>, k: usize) -> bool {
-    let model = ev.eq.model;
-    let breaks = model.breaks();
-    if k + 1 >= breaks.len() {
-        return false;
-    }
-    let (a, b) = (breaks[k], breaks[k + 1]);
-    let (mut na, mut np) = (0, 0);
-    for (i, &end) in model.tendon_ends().iter().enumerate() {
-        if end < b {
-            continue;
-        }
-        let list = if ev.eq.tensions[i] != 0.0 {
-            na += 1;
-            ev.ws.active.get(na - 1)
-        } else {
-            np += 1;
-            ev.ws.passive.get(np - 1)
-        };
-        if list != Some(&i) {
-            return false;
-        }
-    }
-    let mut nc = 0;
-    for (i, &(start, end)) in model.chamber_extents().iter().enumerate() {
-        if start <= a && end >= b && ev.eq.pressures[i] != 0.0 {
-            nc += 1;
-            if ev.ws.chambers.get(nc - 1) != Some(&i) {
-                return false;
-            }
-        }
-    }
-    na == ev.ws.active.len() && np == ev.ws.passive.len() && nc == ev.ws.chambers.len()
-}
-
 impl Constrained<'_> {
     /// The target position and rotation of the tip at the current load factor.
     fn target(&self, c: &TipConstraint) -> (Vector3<f64>, Matrix3<f64>) {
@@ -207,7 +157,7 @@ impl Constrained<'_> {
             };
             let mut slope = 0.0;
             for (ev, (y, interval)) in ev.iter_mut().zip(sides) {
-                enter(ev, interval);
+                ev.enter_interval(interval);
                 let mut dy = [0.0; STATE];
                 ev.rhs_into::<STATE>(s, y, &mut dy);
                 slope += 0.5 * n.dot(&v3(&dy, 0));

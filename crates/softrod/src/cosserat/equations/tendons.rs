@@ -11,31 +11,75 @@ use crate::model::section::SectionProperties;
 impl Evaluator<'_, '_> {
     /// Selects the tendons and chambers active on interval `k`.
     pub fn set_interval(&mut self, k: usize) {
-        let model = self.eq.model;
-        let breaks = model.breaks();
+        let breaks = self.eq.model.breaks();
         let (a, b) = (breaks[k], breaks[k + 1]);
-        let ws = &mut *self.ws;
-        ws.interval = k;
-        ws.active.clear();
-        ws.passive.clear();
-        for (i, &end) in model.tendon_ends().iter().enumerate() {
-            ws.tendon_speed[i] = 0.0;
-            if end >= b {
-                if self.eq.tensions[i] != 0.0 {
-                    ws.active.push(i);
-                } else {
-                    ws.passive.push(i);
-                }
+        let nt = self.eq.model.tendons().len();
+        let nc = self.eq.model.chambers().len();
+        self.ws.interval = k;
+        self.ws.active.clear();
+        self.ws.passive.clear();
+        for i in 0..nt {
+            self.ws.tendon_speed[i] = 0.0;
+            match self.tendon_role(i, b) {
+                Some(true) => self.ws.active.push(i),
+                Some(false) => self.ws.passive.push(i),
+                None => {}
             }
         }
-        ws.guess = None;
-        ws.last_lu = None;
-        ws.chambers.clear();
-        for (i, &(start, end)) in model.chamber_extents().iter().enumerate() {
-            if start <= a && end >= b && self.eq.pressures[i] != 0.0 {
-                ws.chambers.push(i);
+        self.ws.guess = None;
+        self.ws.last_lu = None;
+        self.ws.chambers.clear();
+        for i in 0..nc {
+            if self.chamber_acts(i, a, b) {
+                self.ws.chambers.push(i);
             }
         }
+    }
+
+    /// [`Self::set_interval`], but keeping the warm start of the local solve (the last strains
+    /// and the factorised local Jacobian) when the tendons and chambers acting on interval `k`
+    /// are those already held: for evaluations at nearly the same states again and again (the
+    /// contact rows, march after march), a chord step or two instead of a local Newton solve
+    /// from the straight-tendon guess.
+    pub fn enter_interval(&mut self, k: usize) {
+        if self.ws.guess.is_some() && self.holds_actuators_of(k) {
+            self.ws.interval = k;
+        } else {
+            self.set_interval(k);
+        }
+    }
+
+    /// Whether tendon `i` acts on an interval ending at `b`: `Some(true)` pulled, `Some(false)`
+    /// passing tension-free (its path length tracked), `None` ended before.
+    #[inline]
+    fn tendon_role(&self, i: usize, b: f64) -> Option<bool> {
+        (self.eq.model.tendon_ends()[i] >= b).then(|| self.eq.tensions[i] != 0.0)
+    }
+
+    /// Whether chamber `i` is pressurised over all of the interval `[a, b]`.
+    #[inline]
+    fn chamber_acts(&self, i: usize, a: f64, b: f64) -> bool {
+        let (start, end) = self.eq.model.chamber_extents()[i];
+        start <= a && end >= b && self.eq.pressures[i] != 0.0
+    }
+
+    /// Whether the tendons and chambers [`Self::set_interval`] would select on interval `k`
+    /// are those the workspace holds.
+    fn holds_actuators_of(&self, k: usize) -> bool {
+        let breaks = self.eq.model.breaks();
+        if k + 1 >= breaks.len() {
+            return false;
+        }
+        let (a, b) = (breaks[k], breaks[k + 1]);
+        let nt = self.eq.model.tendons().len();
+        let nc = self.eq.model.chambers().len();
+        let ws = &*self.ws;
+        let active = (0..nt).filter(|&i| self.tendon_role(i, b) == Some(true));
+        let passive = (0..nt).filter(|&i| self.tendon_role(i, b) == Some(false));
+        let chambers = (0..nc).filter(|&i| self.chamber_acts(i, a, b));
+        active.eq(ws.active.iter().copied())
+            && passive.eq(ws.passive.iter().copied())
+            && chambers.eq(ws.chambers.iter().copied())
     }
 
     /// Body-frame wrench carried by the fluid of the active chambers at `s` (zero without).
