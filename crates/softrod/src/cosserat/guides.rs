@@ -115,13 +115,19 @@ fn points_on(model: &RobotModel, guided: &[usize], sol: &FrictionalSolution) -> 
 }
 
 /// The capstan rule through the anchors of tendon `i` with points `x` (3 per anchor), base
-/// tension `base` and the previous states `prev` of its anchors (`None`: from rest).
+/// tension `base` and the previous states `prev` of its anchors (`None`: from rest); with
+/// `branch` (a slip state per anchor) each interior guide keeps that branch of the rule
+/// instead of choosing it: sticking at its previous tension, sliding at the lower
+/// (loading) or upper (unloading) end of its capstan interval. The branch-fixed map is
+/// smooth in the points; the rule itself has a kink wherever the previous tension sits at a
+/// bound of the interval.
 fn states(
     model: &RobotModel,
     i: usize,
     x: &[f64],
     base: f64,
     prev: Option<&[GuideState]>,
+    branch: Option<&[Slip]>,
 ) -> Vec<GuideState> {
     let s = anchors(model, i);
     let na = s.len();
@@ -147,7 +153,12 @@ fn states(
         let (wrap, mu_g, out_tau, slip, force) = if g + 1 < na {
             let wrap = angle(&chord[g - 1], &chord[g]);
             let q = prev.map(|p| p[g].tension_out);
-            let (t, slip) = cell_rule(tau, mu[g - 1] * wrap, q);
+            let (t, slip) = match branch.map(|b| b[g]) {
+                Some(Slip::Stick) => (q.unwrap_or(0.0), Slip::Stick),
+                Some(Slip::Unloading) => (tau * (mu[g - 1] * wrap).exp(), Slip::Unloading),
+                Some(Slip::Loading) => (tau * (-mu[g - 1] * wrap).exp(), Slip::Loading),
+                _ => cell_rule(tau, mu[g - 1] * wrap, q),
+            };
             (wrap, mu[g - 1], t, slip, t * chord[g] - incoming)
         } else {
             (0.0, 0.0, 0.0, out[g - 1].slip, -incoming)
@@ -313,6 +324,10 @@ struct Guided<'a> {
     inner_prev: Option<FrictionalSolution>,
     previous: Option<&'a FrictionalSolution>,
     options: &'a FrictionOptions,
+    /// The slip state per anchor of every guided tendon held fixed in the capstan rule of
+    /// the evaluations (`None`: chosen by the rule; the branch-fixed residual is the oracle
+    /// of the exact Jacobian at a kink of the stick/slip rule).
+    frozen: Option<Vec<Vec<Slip>>>,
 }
 
 impl<'a> Guided<'a> {
@@ -353,6 +368,7 @@ impl<'a> Guided<'a> {
             inner_prev,
             previous,
             options,
+            frozen: None,
         })
     }
 
@@ -368,7 +384,8 @@ impl<'a> Guided<'a> {
             .enumerate()
             .map(|(k, xk)| {
                 let i = self.guided[k];
-                states(self.model, i, xk, base[i], self.prev_states(k))
+                let branch = self.frozen.as_ref().map(|f| f[k].as_slice());
+                states(self.model, i, xk, base[i], self.prev_states(k), branch)
             })
             .collect()
     }
@@ -951,4 +968,105 @@ fn finish(
     sol.cell_steps = cell_steps;
     sol.change = delta;
     sol
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use nalgebra::{Matrix3, Vector3};
+
+    use super::{states, GuideState};
+    use crate::cosserat::friction::Slip;
+    use crate::{LinearElastic, Loads, RobotModel, Rod, Section, Tendon};
+
+    /// One guide by hand: chords `c0 = e_z` into the guide, `c1 = (sin θ, 0, cos θ)` of
+    /// length `ℓ` out of it, base tension `τ0`, previous tension `q` at the guide. The force at
+    /// the guide is `F1 = τ1 c1 − τ0 c0`; moving the termination by `δ` turns `c1` by
+    /// `(I − c1 c1ᵀ) δ / ℓ`. Sticking (`τ1 = q`) its derivative is `q (I − c1 c1ᵀ) / ℓ`;
+    /// sliding toward the base (`τ1 = τ0 e^(−μθ)`) it adds `−μ τ1 c1 tᵀ / ℓ`, `t` the
+    /// direction of growing `θ`. With `q` inside the interval the rule's derivative is the
+    /// sticking one; with `q` at the lower bound (a kink) the one-sided derivatives are the
+    /// two branches, central differences of the rule average them (off by `μ q / (2ℓ)`), and
+    /// the sticking branch held fixed gives the sticking derivative.
+    #[test]
+    fn one_guide_derivative_by_hand_sticking_and_at_the_kink() {
+        let rod = Rod::new(
+            0.3,
+            Section::circular(1e-3).unwrap(),
+            LinearElastic::new(2e11, 0.3).unwrap(),
+        )
+        .unwrap();
+        let mu = 0.2;
+        let tendon = Tendon::constant([0.0, 0.0], None)
+            .unwrap()
+            .with_guides(vec![0.15], &[mu])
+            .unwrap();
+        let model = RobotModel::new(rod, vec![tendon], Vec::new(), Loads::default()).unwrap();
+        let (theta, ell, tau0): (f64, f64, f64) = (0.3, 0.15, 2.0);
+        let c1 = Vector3::new(theta.sin(), 0.0, theta.cos());
+        let t = Vector3::new(theta.cos(), 0.0, -theta.sin());
+        let x = |d: Vector3<f64>| {
+            let x2 = Vector3::new(0.0, 0.0, 0.15) + ell * c1 + d;
+            vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.15, x2.x, x2.y, x2.z]
+        };
+        let prev = |q: f64| {
+            let mut p = vec![
+                GuideState {
+                    s: 0.0,
+                    point: [0.0; 3],
+                    wrap: 0.0,
+                    friction: 0.0,
+                    tension_in: tau0,
+                    tension_out: tau0,
+                    slip: Slip::Loading,
+                    force: [0.0; 3],
+                };
+                3
+            ];
+            p[1].tension_out = q;
+            p[2].tension_out = 0.0;
+            p
+        };
+        let force = |d: Vector3<f64>, q: f64, branch: Option<&[Slip]>| {
+            let st = states(&model, 0, &x(d), tau0, Some(&prev(q)), branch);
+            Vector3::from(st[1].force)
+        };
+        let h = 1e-7;
+        let proj = Matrix3::identity() - c1 * c1.transpose();
+        // q strictly inside the interval: the sticking derivative, along every direction.
+        let q = tau0 * (-0.5 * mu * theta).exp();
+        let mut worst: f64 = 0.0;
+        for k in 0..3 {
+            let e = Vector3::ith(k, h);
+            let fd = (force(e, q, None) - force(-e, q, None)) / (2.0 * h);
+            let hand = q * proj.column(k) / ell;
+            worst = worst.max((fd - hand).amax() / q);
+        }
+        assert!(worst < 1e-8, "inside the interval: {worst:e}");
+        // q at the lower bound: one-sided along ±t, the held branch, the central average.
+        let q = tau0 * (-mu * theta).exp();
+        let f0 = force(Vector3::zeros(), q, None);
+        let stick = q * t / ell;
+        let slide = q * t / ell - mu * q * c1 / ell;
+        // Second-order one-sided differences (each side smooth).
+        let one_sided = |d: f64| {
+            (4.0 * force(d * t, q, None) - force(2.0 * d * t, q, None) - 3.0 * f0) / (2.0 * d)
+        };
+        let into_stick = one_sided(h);
+        let into_slide = one_sided(-h);
+        let held = [Slip::Loading, Slip::Stick, Slip::Loading];
+        let fixed = (force(h * t, q, Some(&held)) - force(-h * t, q, Some(&held))) / (2.0 * h);
+        let central = (force(h * t, q, None) - force(-h * t, q, None)) / (2.0 * h);
+        let e1 = (into_stick - stick).amax() / q;
+        let e2 = (into_slide - slide).amax() / q;
+        let e3 = (fixed - stick).amax() / q;
+        let e4 = (central - 0.5 * (stick + slide)).amax() / q;
+        eprintln!(
+            "one guide at the kink: one-sided into sticking {e1:e}, into sliding {e2:e}, \
+             sticking branch held {e3:e}, central = mean of the branches {e4:e} \
+             (the branches differ by {:e})",
+            (stick - slide).amax() / q
+        );
+        assert!(e1 < 1e-6 && e2 < 1e-6 && e3 < 1e-8 && e4 < 1e-6);
+    }
 }
