@@ -3,7 +3,9 @@
 //! `tau (1, 0, 0.3, 0, 0.5, 0.1)` N from rest, `n` solves of one case: `exact` (Newton on the
 //! guide forces with the exact Jacobian, the default), `fd` (the same Newton with the
 //! forward-difference Jacobian) or `channel` (the same tendons in continuous channels of
-//! coefficient `mu`). Prints the marches of one solve.
+//! coefficient `mu`). Prints the marches of one solve. Case `unload`: the default method's
+//! unloading step from `tau` to `0.9 tau` (from the solution at `tau`, guides sticking
+//! beyond the slip front), `n` times.
 //!
 //! Run: `valgrind --tool=callgrind target/release/examples/guides_workload exact 0.2 4 3`
 //! (after `cargo build --release -p softrod --example guides_workload`); the count of one
@@ -41,6 +43,19 @@ fn main() {
     };
     let act = Actuation::tensions(&[tau, 0.0, 0.3 * tau, 0.0, 0.5 * tau, 0.1 * tau]);
     let sol = solve_frictional(&model, &act, &opts, None).unwrap();
+    if case == "unload" {
+        let t = 0.9 * tau;
+        let down = Actuation::tensions(&[t, 0.0, 0.3 * t, 0.0, 0.5 * t, 0.1 * t]);
+        let back = solve_frictional(&model, &down, &opts, Some(&sol)).unwrap();
+        println!(
+            "unload, mu = {mu}, {tau} -> {t} N: {} marches",
+            back.iterations
+        );
+        for _ in 0..n {
+            black_box(solve_frictional(&model, &down, &opts, Some(&sol)).unwrap());
+        }
+        return;
+    }
     println!(
         "{case}, mu = {mu}, tau = {tau} N: {} marches",
         sol.iterations
