@@ -64,43 +64,61 @@ pub fn min_norm_from(
 ) -> Option<(DVector<f64>, DVector<f64>)> {
     let (m, n) = a.shape();
     let inv_w: Vec<f64> = bx.weights.iter().map(|w| 1.0 / w).collect();
-    let y_of = |lambda: &DVector<f64>| -> (DVector<f64>, Vec<bool>) {
-        let atl = a.tr_mul(lambda);
-        let mut y = DVector::zeros(n);
-        let mut free = vec![false; n];
+    // y(λ) and its free set, written into `y`, `free` (`atl` scratch: Aᵀλ).
+    let y_of = |lambda: &DVector<f64>,
+                atl: &mut DVector<f64>,
+                y: &mut DVector<f64>,
+                free: &mut Vec<bool>| {
+        a.tr_mul_to(lambda, atl);
+        free.clear();
         for i in 0..n {
             let v = bx.centre[i] + inv_w[i] * atl[i];
             y[i] = bx.clamp(i, v);
             // At a kink the generalised derivative is taken as free.
-            free[i] = v >= bx.lo[i] && v <= bx.hi[i];
+            free.push(v >= bx.lo[i] && v <= bx.hi[i]);
         }
-        (y, free)
     };
-    let dual = |lambda: &DVector<f64>, y: &DVector<f64>| -> f64 {
+    // The residual `b - A y` into `g`.
+    let residual = |y: &DVector<f64>, g: &mut DVector<f64>| {
+        a.mul_to(y, g);
+        g.neg_mut();
+        *g += b;
+    };
+    let dual = |lambda: &DVector<f64>, y: &DVector<f64>, g: &DVector<f64>| -> f64 {
         let mut f = 0.0;
         for i in 0..n {
             f += 0.5 * bx.weights[i] * (y[i] - bx.centre[i]).powi(2);
         }
-        f - lambda.dot(&(a * y - b))
+        f + lambda.dot(g)
     };
     let mut lambda = match start {
         Some(l) if l.len() == m && l.iter().all(|v| v.is_finite()) => l.clone(),
         _ => DVector::zeros(m),
     };
-    let (mut y, mut free) = y_of(&lambda);
-    let mut psi = dual(&lambda, &y);
+    let mut atl = DVector::zeros(n);
+    let (mut y, mut free) = (DVector::zeros(n), Vec::with_capacity(n));
+    let (mut yt, mut ft) = (DVector::zeros(n), Vec::with_capacity(n));
+    let (mut g, mut gt) = (DVector::zeros(m), DVector::zeros(m));
+    let mut trial = DVector::zeros(m);
+    let mut h = DMatrix::zeros(m, m);
+    y_of(&lambda, &mut atl, &mut y, &mut free);
+    residual(&y, &mut g);
+    let mut psi = dual(&lambda, &y, &g);
     let scale = b.amax().max(1e-300);
     for _ in 0..MAX_DUAL_ITERATIONS {
-        let g = b - a * &y;
         if g.amax() <= tol {
             return Some((y, lambda));
         }
         // Generalised Hessian A D W⁻¹ Aᵀ (regularised against a rank-deficient free set).
-        let mut h = DMatrix::zeros(m, m);
+        h.fill(0.0);
         for i in 0..n {
             if free[i] {
-                let col = a.column(i);
-                h += col * col.transpose() * inv_w[i];
+                for c in 0..m {
+                    let ac = a[(c, i)] * inv_w[i];
+                    for r in 0..m {
+                        h[(r, c)] += a[(r, i)] * ac;
+                    }
+                }
             }
         }
         let trace = h.trace();
@@ -119,23 +137,27 @@ pub fn min_norm_from(
         }
         let d = h.clone().cholesky()?.solve(&g);
         let slope = g.dot(&d);
+        let gmax = g.amax();
         let mut alpha = 1.0;
         let mut accepted = false;
         for _ in 0..60 {
-            let trial = &lambda + &d * alpha;
-            let (yt, ft) = y_of(&trial);
-            let pt = dual(&trial, &yt);
+            trial.copy_from(&lambda);
+            trial.axpy(alpha, &d, 1.0);
+            y_of(&trial, &mut atl, &mut yt, &mut ft);
+            residual(&yt, &mut gt);
+            let pt = dual(&trial, &yt, &gt);
             // On an unchanged free set the dual is a concave quadratic and the step a
             // (regularised) Newton step: a smaller residual is progress even where the dual's
             // value is lost in round-off (large multipliers of a nearly singular target).
-            let same_free = ft == free && (b - a * &yt).amax() < g.amax();
+            let same_free = ft == free && gt.amax() < gmax;
             if pt >= psi + 1e-4 * alpha * slope
                 || (pt - psi).abs() <= 1e-15 * psi.abs()
                 || same_free
             {
-                lambda = trial;
-                y = yt;
-                free = ft;
+                std::mem::swap(&mut lambda, &mut trial);
+                std::mem::swap(&mut y, &mut yt);
+                std::mem::swap(&mut free, &mut ft);
+                std::mem::swap(&mut g, &mut gt);
                 psi = pt;
                 accepted = true;
                 break;
@@ -146,7 +168,6 @@ pub fn min_norm_from(
             break;
         }
     }
-    let g = b - a * &y;
     (g.amax() <= tol).then_some((y, lambda))
 }
 
@@ -251,89 +272,177 @@ pub fn bounded_least_squares(
     bx: &Bounds,
     mu: f64,
 ) -> DVector<f64> {
-    let n = a.ncols();
-    let mut q = a.tr_mul(a);
-    let mut c = -a.tr_mul(b);
-    for i in 0..n {
-        q[(i, i)] += mu * bx.weights[i];
-        c[i] -= mu * bx.weights[i] * bx.centre[i];
+    NormalEquations::new(a, b).solve(bx, mu, &mut BlsWork::default())
+}
+
+/// The normal equations `AᵀA`, `-Aᵀb` of a bounded least squares, made once for several
+/// regularisations `μ` (the Levenberg–Marquardt search of `steps.rs`).
+pub(crate) struct NormalEquations {
+    ata: DMatrix<f64>,
+    atb: DVector<f64>,
+}
+
+/// The scratch of [`NormalEquations::solve`], reused across calls (no allocation once sized).
+#[derive(Default)]
+pub(crate) struct BlsWork {
+    q: Vec<f64>,
+    c: Vec<f64>,
+    target: Vec<f64>,
+    free: Vec<usize>,
+    fixed: Vec<Option<f64>>,
+    qf: Vec<f64>,
+    rhs: Vec<f64>,
+    grad: Vec<f64>,
+}
+
+impl NormalEquations {
+    /// The normal equations of `|A y - b|²`.
+    pub(crate) fn new(a: &DMatrix<f64>, b: &DVector<f64>) -> Self {
+        Self {
+            ata: a.tr_mul(a),
+            atb: -a.tr_mul(b),
+        }
     }
-    // Start from the centre, clamped; `fixed[i]` = Some(bound) holds y_i at a bound.
-    let mut y = DVector::from_fn(n, |i, _| bx.clamp(i, bx.centre[i]));
-    let mut fixed: Vec<Option<f64>> = (0..n)
-        .map(|i| (y[i] == bx.lo[i] || y[i] == bx.hi[i]).then_some(y[i]))
-        .collect();
-    for _ in 0..MAX_ACTIVE_SET_CHANGES * (n + 1) {
-        let free: Vec<usize> = (0..n).filter(|&i| fixed[i].is_none()).collect();
-        // The minimiser over the free variables with the others fixed.
-        let mut target = y.clone();
-        if !free.is_empty() {
-            let k = free.len();
-            let mut qf = DMatrix::zeros(k, k);
-            let mut rhs = DVector::zeros(k);
-            for (r, &i) in free.iter().enumerate() {
-                rhs[r] = -c[i];
-                for (s, &j) in free.iter().enumerate() {
-                    qf[(r, s)] = q[(i, j)];
+
+    /// The bounded least squares with the regularisation `μ` (as [`bounded_least_squares`]).
+    pub(crate) fn solve(&self, bx: &Bounds, mu: f64, ws: &mut BlsWork) -> DVector<f64> {
+        let n = self.ata.ncols();
+        ws.q.clear();
+        ws.q.extend_from_slice(self.ata.as_slice());
+        ws.c.clear();
+        ws.c.extend_from_slice(self.atb.as_slice());
+        // Column-major n × n: q[(i, j)] = q[i + n j].
+        let (q, c) = (&mut ws.q, &mut ws.c);
+        for i in 0..n {
+            q[i + n * i] += mu * bx.weights[i];
+            c[i] -= mu * bx.weights[i] * bx.centre[i];
+        }
+        // Start from the centre, clamped; `fixed[i]` = Some(bound) holds y_i at a bound.
+        let mut y = DVector::from_fn(n, |i, _| bx.clamp(i, bx.centre[i]));
+        ws.fixed.clear();
+        ws.fixed
+            .extend((0..n).map(|i| (y[i] == bx.lo[i] || y[i] == bx.hi[i]).then_some(y[i])));
+        for _ in 0..MAX_ACTIVE_SET_CHANGES * (n + 1) {
+            ws.free.clear();
+            ws.free.extend((0..n).filter(|&i| ws.fixed[i].is_none()));
+            let (free, fixed) = (&ws.free, &ws.fixed);
+            // The minimiser over the free variables with the others fixed.
+            ws.target.clear();
+            ws.target.extend_from_slice(y.as_slice());
+            if !free.is_empty() {
+                let k = free.len();
+                ws.qf.clear();
+                ws.qf.resize(k * k, 0.0);
+                ws.rhs.clear();
+                ws.rhs.resize(k, 0.0);
+                for (r, &i) in free.iter().enumerate() {
+                    ws.rhs[r] = -c[i];
+                    for (s, &j) in free.iter().enumerate() {
+                        ws.qf[r + k * s] = q[i + n * j];
+                    }
+                    for j in 0..n {
+                        if let Some(v) = fixed[j] {
+                            ws.rhs[r] -= q[i + n * j] * v;
+                        }
+                    }
                 }
-                for j in 0..n {
-                    if let Some(v) = fixed[j] {
-                        rhs[r] -= q[(i, j)] * v;
+                if !cholesky_solve(&mut ws.qf, k, &mut ws.rhs) {
+                    return y;
+                }
+                for (r, &i) in free.iter().enumerate() {
+                    ws.target[i] = ws.rhs[r];
+                }
+            }
+            let target = &ws.target;
+            // Step toward it until a bound is hit.
+            let mut t = 1.0;
+            let mut blocking = None;
+            for &i in free {
+                let d = target[i] - y[i];
+                if d < 0.0 && target[i] < bx.lo[i] {
+                    let ti = (bx.lo[i] - y[i]) / d;
+                    if ti < t {
+                        t = ti;
+                        blocking = Some((i, bx.lo[i]));
+                    }
+                } else if d > 0.0 && target[i] > bx.hi[i] {
+                    let ti = (bx.hi[i] - y[i]) / d;
+                    if ti < t {
+                        t = ti;
+                        blocking = Some((i, bx.hi[i]));
                     }
                 }
             }
-            let Some(ch) = qf.cholesky() else {
-                return y;
-            };
-            let sol = ch.solve(&rhs);
-            for (r, &i) in free.iter().enumerate() {
-                target[i] = sol[r];
+            for &i in free {
+                y[i] += t.max(0.0) * (target[i] - y[i]);
             }
-        }
-        // Step toward it until a bound is hit.
-        let mut t = 1.0;
-        let mut blocking = None;
-        for &i in &free {
-            let d = target[i] - y[i];
-            if d < 0.0 && target[i] < bx.lo[i] {
-                let ti = (bx.lo[i] - y[i]) / d;
-                if ti < t {
-                    t = ti;
-                    blocking = Some((i, bx.lo[i]));
-                }
-            } else if d > 0.0 && target[i] > bx.hi[i] {
-                let ti = (bx.hi[i] - y[i]) / d;
-                if ti < t {
-                    t = ti;
-                    blocking = Some((i, bx.hi[i]));
+            if let Some((i, v)) = blocking {
+                y[i] = v;
+                ws.fixed[i] = Some(v);
+                continue;
+            }
+            // Optimal on this face: release a fixed variable whose gradient points inward.
+            ws.grad.clear();
+            ws.grad
+                .extend((0..n).map(|i| (0..n).map(|j| q[i + n * j] * y[j]).sum::<f64>() + c[i]));
+            let grad = &ws.grad;
+            let gmax = grad.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let mut worst: Option<(usize, f64)> = None;
+            for i in 0..n {
+                if let Some(v) = ws.fixed[i] {
+                    let inward = if v == bx.lo[i] { -grad[i] } else { grad[i] };
+                    if inward > 1e-14 * (1.0 + gmax) && worst.is_none_or(|(_, w)| inward > w) {
+                        worst = Some((i, inward));
+                    }
                 }
             }
-        }
-        for &i in &free {
-            y[i] += t.max(0.0) * (target[i] - y[i]);
-        }
-        if let Some((i, v)) = blocking {
-            y[i] = v;
-            fixed[i] = Some(v);
-            continue;
-        }
-        // Optimal on this face: release a fixed variable whose gradient points inward.
-        let grad = &q * &y + &c;
-        let mut worst: Option<(usize, f64)> = None;
-        for i in 0..n {
-            if let Some(v) = fixed[i] {
-                let inward = if v == bx.lo[i] { -grad[i] } else { grad[i] };
-                if inward > 1e-14 * (1.0 + grad.amax()) && worst.is_none_or(|(_, w)| inward > w) {
-                    worst = Some((i, inward));
-                }
+            match worst {
+                Some((i, _)) => ws.fixed[i] = None,
+                None => return y,
             }
         }
-        match worst {
-            Some((i, _)) => fixed[i] = None,
-            None => return y,
+        y
+    }
+}
+
+/// Solves `M x = rhs` in place for the symmetric positive definite `M` (`k × k`, column-major
+/// in `m`, overwritten by its Cholesky factor); `false` if it is not positive definite.
+fn cholesky_solve(m: &mut [f64], k: usize, rhs: &mut [f64]) -> bool {
+    // Lower factor L (M = L Lᵀ) in the lower triangle, column by column.
+    for j in 0..k {
+        let mut d = m[j + k * j];
+        for p in 0..j {
+            d -= m[j + k * p] * m[j + k * p];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        let d = d.sqrt();
+        m[j + k * j] = d;
+        for i in j + 1..k {
+            let mut v = m[i + k * j];
+            for p in 0..j {
+                v -= m[i + k * p] * m[j + k * p];
+            }
+            m[i + k * j] = v / d;
         }
     }
-    y
+    // L z = rhs, then Lᵀ x = z.
+    for i in 0..k {
+        let mut v = rhs[i];
+        for p in 0..i {
+            v -= m[i + k * p] * rhs[p];
+        }
+        rhs[i] = v / m[i + k * i];
+    }
+    for i in (0..k).rev() {
+        let mut v = rhs[i];
+        for p in i + 1..k {
+            v -= m[p + k * i] * rhs[p];
+        }
+        rhs[i] = v / m[i + k * i];
+    }
+    true
 }
 
 #[cfg(test)]

@@ -102,8 +102,11 @@ pub(super) fn levenberg_marquardt_step(
     let mut mu = (sigma * e.norm() / radius).max(1e-6 * sigma * sigma);
     let mut best = vec![0.0; n];
     let mut fitted = false;
+    // The normal equations and the scratch are the same for every μ.
+    let normal = qp::NormalEquations::new(jac, &b);
+    let mut ws = qp::BlsWork::default();
     for _ in 0..60 {
-        let y = qp::bounded_least_squares(jac, &b, &local, mu);
+        let y = normal.solve(&local, mu, &mut ws);
         let d: Vec<f64> = (0..n).map(|i| y[i] - a[i]).collect();
         if norm(&d) <= radius * 1.000_001 {
             best = d;
