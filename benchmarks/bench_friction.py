@@ -116,13 +116,7 @@ def jacobians(timer, calls: int, repeats: int) -> None:
 def guided(mu: float, per_segment: int = 8) -> softrod.Robot:
     """The NiTi robot with its tendons through equally spaced disks (coefficient ``mu``)."""
     base = softrod.load_robot(softrod.examples.path("niti_two_segment"))
-    spec = base.spec.model_dump(mode="python", exclude_none=True)
-    for t in spec["tendons"]:
-        end = t.get("end", 0.4)
-        n = round(per_segment * end / 0.2)
-        t["guides"] = [end * g / n for g in range(1, n)]
-        t["guide_friction"] = mu
-    return softrod.Robot.from_dict(spec)
+    return base.with_disk_guides(0.2 / per_segment, friction=mu)
 
 
 def guides(timer, calls: int, repeats: int) -> None:

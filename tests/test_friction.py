@@ -82,13 +82,7 @@ def test_loaded_hysteresis_from_python():
 def guided_niti(mu: float, per_segment: int = 8) -> softrod.Robot:
     """The NiTi robot with its tendons through equally spaced disks (capstan `mu` at each)."""
     base = softrod.load_robot(softrod.examples.path("niti_two_segment"))
-    spec = base.spec.model_dump(mode="python", exclude_none=True)
-    for t in spec["tendons"]:
-        end = t.get("end", 0.4)
-        n = round(per_segment * end / 0.2)
-        t["guides"] = [end * g / n for g in range(1, n)]
-        t["guide_friction"] = mu
-    return softrod.Robot.from_dict(spec)
+    return base.with_disk_guides(0.2 / per_segment, friction=mu)
 
 
 def test_disk_guided_tendons_follow_the_capstan_law_per_guide():

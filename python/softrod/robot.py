@@ -13,6 +13,7 @@ back, and it pickles.
 
 from __future__ import annotations
 
+import math
 import os
 import pickle
 import re
@@ -428,6 +429,74 @@ class Robot:
     def with_pressures(self, pressures: Sequence[float] | np.ndarray) -> Robot:
         """The same robot with new chamber pressures (Pa, gauge), one per chamber."""
         return self._with_actuation("chambers", "pressure", self._pressurised(pressures))
+
+    def with_disk_guides(
+        self,
+        spacing: float,
+        *,
+        friction: float = 0.0,
+        tendons: Sequence[int] | None = None,
+    ) -> Robot:
+        """The same robot with its tendons run through spacer disks instead of channels.
+
+        Disks stand every ``spacing`` along the rod, at ``s = spacing, 2 spacing, ...``; each
+        chosen tendon passes through the disks strictly between the base and its end, in
+        straight chords between the base, the disks and its termination, with capstan
+        coefficient ``friction`` at each disk (``docs/friction.md``, "Disk-guided tendons").
+        Where ``spacing`` divides a tendon's span, its disks are at ``end * k / n`` exactly
+        (``n = end / spacing``).
+
+        Args:
+            spacing: Disk spacing (m), > 0 and below every chosen tendon's span.
+            friction: Capstan coefficient at each disk (>= 0).
+            tendons: Indices of the tendons to guide (default: all); each must be a
+                ``constant`` routing (a fixed offset from the backbone).
+
+        Returns:
+            The new robot (this one is unchanged), its description updated.
+
+        Raises:
+            ParameterError: Naming ``spacing``, ``friction`` or ``tendons`` (an index out of
+                range, a repeated index, or a routing other than ``constant``).
+        """
+        spacing = _args.number(spacing, "spacing", positive=True, unit="m")
+        friction = _args.number(friction, "friction")
+        if friction < 0:
+            raise _args.value_error("friction", friction, ">= 0")
+        n = len(self._tendons)
+        if tendons is None:
+            chosen = list(range(n))
+        else:
+            if isinstance(tendons, (str, bytes)) or not isinstance(tendons, Sequence):
+                raise _args.type_error("tendons", tendons, "a sequence of tendon indices")
+            chosen = [_args.count(i, f"tendons[{k}]", 0, n - 1) for k, i in enumerate(tendons)]
+            if len(set(chosen)) != len(chosen):
+                raise _args.value_error("tendons", list(tendons), "distinct tendon indices")
+        spec = self.spec
+        length = float(spec.rod.length)
+        values: dict[str, Any] = {}
+        for i in chosen:
+            table = spec.tendons[i]
+            if table.routing != "constant":
+                raise _args.value_error(
+                    f"tendons[{i}].routing",
+                    table.routing,
+                    "`constant` (disk guides hold a tendon at a fixed offset)",
+                )
+            end = length if table.end is None else float(table.end)
+            ratio = end / spacing
+            whole = round(ratio)
+            if whole >= 1 and abs(ratio - whole) <= 1e-9 * ratio:
+                guides = [end * k / whole for k in range(1, whole)]
+            else:
+                guides = [k * spacing for k in range(1, math.floor(ratio) + 1)]
+            if not guides:
+                raise _args.value_error(
+                    "spacing", spacing, f"< {end:g} m (the span of tendon {i}) for one disk"
+                )
+            values[f"tendons[{i}].guides"] = guides
+            values[f"tendons[{i}].guide_friction"] = friction
+        return self.with_parameters(values)
 
     # ------------------------------------------------------------------ design parameters
 
