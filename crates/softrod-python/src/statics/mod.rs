@@ -307,6 +307,7 @@ pub(crate) fn solve_statics<'py>(
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
         contact,
+        robot: problem.model.clone(),
     };
     report_unstable(py, sol, unstable)
 }

@@ -28,6 +28,9 @@ pub(crate) struct StaticsSolution {
     pub(super) call: Args,
     /// Contacts, contact forces and the tip reaction (with obstacles or a tip constraint).
     pub(super) contact: crate::contact::ContactData,
+    /// The robot as solved (with its guides: the rod of a disk-guided solution, `inner.model`,
+    /// carries the guide forces instead), the model of the displacements' zero.
+    pub(super) robot: Arc<softrod::RobotModel>,
 }
 
 fn rows3(py: Python<'_>, v: &[[f64; 3]]) -> Py<PyAny> {
@@ -300,7 +303,7 @@ impl StaticsSolution {
         let reference = match &inner.actuation.reference_lengths {
             Some(r) => r.clone(),
             None => run(py, "tendon_displacements", || {
-                softrod::reference_lengths(&inner.model, &inner.options)
+                softrod::reference_lengths(&self.robot, &inner.options)
             })?,
         };
         Ok(reference

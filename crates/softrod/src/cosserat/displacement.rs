@@ -42,9 +42,13 @@ pub const MAX_ACTIVE_SET_ROUNDS_PER_TENDON: usize = 3;
 
 /// Path length of every tendon at zero actuation (all tensions and pressures zero) under the
 /// model's external loads, with `options`' integrator (m): the zero of the displacements.
+/// A tendon routed through guides has the length of its polyline of chords through its
+/// anchors on the zero-actuation shape (what a guided solution reports as its
+/// `tendon_lengths`, [`super::solve_frictional`]).
 ///
 /// # Errors
-/// As [`super::statics::solve_statics`] for the zero-actuation solve.
+/// As [`super::statics::solve_statics`] for the zero-actuation solve (and
+/// [`super::solve_frictional`] for it with guided tendons).
 pub fn reference_lengths(model: &Arc<RobotModel>, options: &SolveOptions) -> Result<Vec<f64>> {
     let zero = Actuation::zero(model.tendons().len(), model.chambers().len());
     let opts = SolveOptions {
@@ -55,7 +59,23 @@ pub fn reference_lengths(model: &Arc<RobotModel>, options: &SolveOptions) -> Res
         },
         ..*options
     };
-    Ok(super::statics::solve_statics(model, &zero, &opts)?.tendon_lengths)
+    let mut lengths = super::statics::solve_statics(model, &zero, &opts)?.tendon_lengths;
+    let tendons = model.tendons();
+    if tendons.iter().any(crate::model::tendon::Tendon::is_guided) {
+        // The chords through the anchors on the same (zero-actuation) shape: no tendon
+        // pulls, so the guided solve is one rod solve.
+        let fo = super::friction::FrictionOptions {
+            statics: opts,
+            ..Default::default()
+        };
+        let chords = super::friction::solve_frictional(model, &zero, &fo, None)?;
+        for (i, t) in tendons.iter().enumerate() {
+            if t.is_guided() {
+                lengths[i] = chords.statics.tendon_lengths[i];
+            }
+        }
+    }
+    Ok(lengths)
 }
 
 /// One held tendon: its index, `ℓ_ref - δ` (m), compliance (m/N), slack scale (m).

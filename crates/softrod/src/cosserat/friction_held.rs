@@ -12,6 +12,11 @@
 //! go negative is released (slack, `τ = 0`), a slack one that comes out stretched is taken up.
 //! `ℓ_ref` is the path length at zero actuation ([`super::reference_lengths`]), unless the
 //! actuation gives it. With `μ = 0` this is the frictionless displacement solve.
+//!
+//! A tendon routed through guides (`cosserat::guides`) is held the same way: its path is the
+//! polyline of chords through its anchors, `ℓ_h` the polyline's length on the solved shape
+//! (the `tendon_lengths` of the guided solution), `ℓ_ref` that length at zero actuation, and
+//! `τ_h` the tension of its first chord; every evaluation is a guided solve.
 
 use std::sync::Arc;
 
@@ -28,23 +33,6 @@ pub const HELD_MAX_ITERATIONS: usize = 60;
 
 /// Tolerance on the length residual `g` of the held tendons, relative to the rod length.
 pub const HELD_TOLERANCE: f64 = 1e-13;
-
-/// A held tendon routed through guides is refused by name.
-fn check_guided(model: &RobotModel, actuation: &Actuation) -> Result<()> {
-    match actuation
-        .held()
-        .into_iter()
-        .find(|&i| model.tendons()[i].is_guided())
-    {
-        Some(i) => Err(Error::invalid(
-            format!("tendons[{i}]"),
-            "displacement-controlled and routed through guides",
-            "tension-controlled, or in a continuous channel (displacement control of a \
-             disk-guided tendon is not modelled)",
-        )),
-        None => Ok(()),
-    }
-}
 
 /// The first base tensions of the held tendons: the actuation's guess, the previous state's
 /// base tensions, or zero.
@@ -67,8 +55,7 @@ fn first_tensions(
 /// module documentation), from the state `previous` or from rest.
 ///
 /// # Errors
-/// What [`solve_frictional`] reports; [`Error::InvalidParameter`] naming `tendons[i]` for a
-/// held tendon routed through guides; [`Error::NotConverged`] if the base tensions do not
+/// What [`solve_frictional`] reports; [`Error::NotConverged`] if the base tensions do not
 /// settle in [`HELD_MAX_ITERATIONS`] iterations.
 pub(super) fn solve_held_frictional(
     model: &Arc<RobotModel>,
@@ -77,7 +64,6 @@ pub(super) fn solve_held_frictional(
     previous: Option<&FrictionalSolution>,
 ) -> Result<FrictionalSolution> {
     let nt = model.tendons().len();
-    check_guided(model, actuation)?;
     let reference = match &actuation.reference_lengths {
         Some(r) => r.clone(),
         None => super::reference_lengths(model, &options.statics)?,
@@ -119,6 +105,9 @@ pub(super) fn solve_held_frictional(
             .fold(0.0, f64::max);
         if worst <= tol {
             sol.iterations += iteration;
+            // The zero of the displacements goes with the solution (as in the frictionless
+            // displacement solve).
+            sol.statics.actuation.reference_lengths = Some(reference);
             return Ok(sol);
         }
         let j = match jac.take() {

@@ -560,9 +560,10 @@ fn check_inputs(
     }
     // A guided tendon loads the rod at its guides only (solve_frictional): its tension along
     // the continuous channel would be another robot's answer.
-    if let Some(i) =
-        (0..tensions.len()).find(|&i| model.tendons()[i].is_guided() && tensions[i] != 0.0)
-    {
+    if let Some(i) = (0..tensions.len()).find(|&i| {
+        model.tendons()[i].is_guided()
+            && (tensions[i] != 0.0 || actuation.tendons.get(i).is_some_and(|t| t.is_held()))
+    }) {
         return Err(Error::invalid(
             format!("tendons[{i}].guides"),
             format!("{} guides", model.tendons()[i].guides().len()),
