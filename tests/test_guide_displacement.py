@@ -18,12 +18,9 @@ def guided(mu: float, drop: int | None = None) -> softrod.Robot:
     """The NiTi robot with its tendons through 8 disks per segment (capstan `mu` at each),
     under a tip force; without tendon `drop` if given."""
     base = softrod.load_robot(softrod.examples.path("niti_two_segment"))
-    spec = base.spec.model_dump(mode="python", exclude_none=True)
-    for t in spec["tendons"]:
-        end = t.get("end", 0.4)
-        n = round(8 * end / 0.2)
-        t["guides"] = [end * g / n for g in range(1, n)]
-        t["guide_friction"] = mu
+    spec = base.with_disk_guides(0.025, friction=mu).spec.model_dump(
+        mode="python", exclude_none=True
+    )
     if drop is not None:
         del spec["tendons"][drop]
     spec["loads"] = {"tip_force": TIP_FORCE}
