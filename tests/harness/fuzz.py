@@ -851,6 +851,9 @@ def _define_targets() -> None:
     t("Robot.with_tensions")(
         lambda d: (_niti().with_tensions, dict(tensions=[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]))
     )
+    t("Robot.with_disk_guides")(
+        lambda d: (_niti().with_disk_guides, dict(spacing=0.02, friction=0.1, tendons=[0, 2]))
+    )
     t("Robot.with_pressures")(lambda d: (_chambered().with_pressures, dict(pressures=[3e3])))
     t("Robot.parameter")(lambda d: (_niti().parameter, dict(path="tendons[0].tension")))
     t("Robot.with_parameters")(
