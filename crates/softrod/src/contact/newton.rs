@@ -26,7 +26,7 @@ pub(super) fn correct(
 /// Residual below which [`exact_newton`] stops refining a converged iterate: a thousandth
 /// of the tolerance (three digits beyond it, enough for the global balance of the
 /// reactions), never below round-off.
-fn round_off(opts: &NewtonOptions) -> f64 {
+fn refinement_floor(opts: &NewtonOptions) -> f64 {
     (opts.tolerance * 1e-3).max(64.0 * f64::EPSILON)
 }
 
@@ -55,7 +55,7 @@ pub(super) fn exact_newton(
             return None;
         }
         let norm = max_norm(&r);
-        if norm <= round_off(opts) {
+        if norm <= refinement_floor(opts) {
             return Some((x, norm));
         }
     }
@@ -72,7 +72,7 @@ pub(super) fn exact_newton(
     let (mut steps, mut retries) = (0, 0);
     while steps < opts.max_iterations && retries <= opts.max_iterations {
         if norm <= opts.tolerance {
-            if norm <= round_off(opts) || refined >= 2 || !p.refine {
+            if norm <= refinement_floor(opts) || refined >= 2 || !p.refine {
                 p.solved = Some((p.active.clone(), j));
                 return Some((x, norm));
             }
