@@ -31,6 +31,19 @@ def timed(fn: Callable[[], object]) -> tuple[float, object]:
     return time.perf_counter() - t0, out
 
 
+def repeated(fn: Callable[[], object], repeats: int) -> tuple[float, object]:
+    """``repeats`` calls of ``fn``, each timed on its own: the median wall time (s) and the last
+    result. The same work each time, so the median is the cost of the call itself, not of the
+    caches and branch predictors another method of the same script left behind."""
+    samples = []
+    out = None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        samples.append(time.perf_counter() - t0)
+    return statistics.median(samples), out
+
+
 def admissible_tensions(rng) -> np.ndarray:
     """Random tensions (N) of the two-segment NiTi robot that pull two of the three tendons
     of each segment (up to 3 N each): a target made from them is reachable without

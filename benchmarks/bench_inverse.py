@@ -8,7 +8,11 @@ circle of radius 10 mm tracked with ``inverse_statics_path`` (time per target); 
 inverse (``softrod.pcc.inverse_statics``) of the same robot as two constant-curvature
 segments, cold and warm. Every method runs in this one process, side by side.
 
-    python benchmarks/bench_inverse.py [--targets N]
+Each call is repeated ``--repeats`` times on its target (the same work every time) and
+timed on its own; a target's time is the median of its repeats, and a row the median over
+targets.
+
+    python benchmarks/bench_inverse.py [--targets N] [--repeats R]
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ import argparse
 import statistics
 
 import numpy as np
-from _timing import admissible_tensions, timed
+from _timing import admissible_tensions, repeated, timed
 from scipy.optimize import least_squares
 
 import softrod
@@ -27,12 +31,15 @@ from softrod import pcc
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--targets", type=int, default=20)
-    n = ap.parse_args().targets
+    ap.add_argument("--repeats", type=int, default=5, help="timed calls per target")
+    args = ap.parse_args()
+    n, reps = args.targets, args.repeats
     robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
     rng = np.random.default_rng(7)
     targets = [robot.solve(admissible_tensions(rng)).tip_position for _ in range(n)]
     keys = ("forward", "jacobian", "cold", "warm", "scipy", "path", "pcc_cold", "pcc_warm")
     rows: dict[str, list[float]] = {k: [] for k in keys}
+    solves: list[int] = []  # forward solves per SciPy call (2-point Jacobian: 6 per Jacobian)
     misses = {"cold": 0, "warm": 0, "scipy": 0, "path": 0, "pcc_cold": 0, "pcc_warm": 0}
     angles = [np.pi / 2, -np.pi / 6, 7 * np.pi / 6]
     probot = (
@@ -45,12 +52,13 @@ def main() -> None:
         rows["forward"].append(timed(lambda: robot.solve([1.0, 0.5, 0.0, 0.0, 0.3, 0.0]))[0])
         rows["jacobian"].append(timed(lambda: softrod.actuation_jacobian(sol))[0])
     for target in targets:
-        dt, cold = timed(lambda t=target: softrod.inverse_statics(robot, t, throw=False))
+        dt, cold = repeated(lambda t=target: softrod.inverse_statics(robot, t, throw=False), reps)
         rows["cold"].append(dt)
         misses["cold"] += not cold.converged
         moved = target + np.array([1e-3, 0.0, 0.0])
-        dt, warm = timed(
-            lambda m=moved, c=cold: softrod.inverse_statics(robot, m, warm_start=c, throw=False)
+        dt, warm = repeated(
+            lambda m=moved, c=cold: softrod.inverse_statics(robot, m, warm_start=c, throw=False),
+            reps,
         )
         rows["warm"].append(dt)
         misses["warm"] += not warm.converged
@@ -58,10 +66,12 @@ def main() -> None:
         def residual(t, target=target):
             return robot.solve(t).tip_position - target
 
-        dt, ls = timed(
-            lambda: least_squares(residual, np.full(6, 0.5), bounds=(0.0, np.inf), xtol=1e-15)
+        dt, ls = repeated(
+            lambda: least_squares(residual, np.full(6, 0.5), bounds=(0.0, np.inf), xtol=1e-15),
+            reps,
         )
         rows["scipy"].append(dt)
+        solves.append(ls.nfev + ls.njev * 6)
         misses["scipy"] += not np.linalg.norm(ls.fun) <= 1e-9
     centre = robot.solve([2.0, 0.0, 0.0, 0.0, 2.0, 0.0]).tip_position - [0.0, 0.0, 0.005]
     th = np.linspace(0.0, 2.0 * np.pi, 41)
@@ -73,12 +83,13 @@ def main() -> None:
     prng = np.random.default_rng(8)
     for _ in range(n):
         target = np.asarray(pcc.solve(probot, admissible_tensions(prng)).tip_pose)[:3, 3]
-        dt, cold = timed(lambda t=target: pcc.inverse_statics(probot, t, throw=False))
+        dt, cold = repeated(lambda t=target: pcc.inverse_statics(probot, t, throw=False), reps)
         rows["pcc_cold"].append(dt)
         misses["pcc_cold"] += not cold.converged
         moved = target + np.array([1e-3, 0.0, 0.0])
-        dt, warm = timed(
-            lambda m=moved, c=cold: pcc.inverse_statics(probot, m, warm_start=c, throw=False)
+        dt, warm = repeated(
+            lambda m=moved, c=cold: pcc.inverse_statics(probot, m, warm_start=c, throw=False),
+            reps,
         )
         rows["pcc_warm"].append(dt)
         misses["pcc_warm"] += not warm.converged
@@ -100,6 +111,11 @@ def main() -> None:
         miss = f"{misses[k]}/{total}" if k in misses else ""
         print(f"{name:<44}{med[k]:>14.1f}{miss:>14}")
     print(f"scipy / cold: {med['scipy'] / med['cold']:.0f}x")
+    print(
+        f"scipy: {statistics.median(solves):.0f} forward solves per target (median); "
+        f"cold inverse = {med['cold'] / med['forward']:.1f} forward solves, "
+        f"warm = {med['warm'] / med['forward']:.1f}"
+    )
 
 
 if __name__ == "__main__":
