@@ -38,7 +38,13 @@ fn plane(mu: f64) -> Obstacle {
 }
 
 fn solve(force: Vector3<f64>, obstacle: &Obstacle) -> ContactSolution {
-    let model = RobotModel::rod_only(rod(RADIUS), Loads::tip_force(force)).unwrap();
+    solve_rod(RADIUS, force, obstacle)
+}
+
+/// The cantilever of radius `radius` (m) under the tip force `force` (N) against `obstacle`,
+/// RK4 on 100 steps; converged.
+fn solve_rod(radius: f64, force: Vector3<f64>, obstacle: &Obstacle) -> ContactSolution {
+    let model = RobotModel::rod_only(rod(radius), Loads::tip_force(force)).unwrap();
     let sol = solve_constrained(
         &model,
         &Actuation::default(),
@@ -51,12 +57,24 @@ fn solve(force: Vector3<f64>, obstacle: &Obstacle) -> ContactSolution {
     sol
 }
 
-/// No node penetrates by more than 1e-9 m, the force is inside the cone and split into its
-/// normal and tangential parts, and the base wrench equals the applied tip force and the
-/// contact forces (about the base) to 1e-10 of `scale`.
+/// [`assert_balanced_with`] for the cantilever of radius [`RADIUS`].
 fn assert_balanced(sol: &ContactSolution, obstacle: &Obstacle, force: Vector3<f64>, scale: f64) {
+    assert_balanced_with(sol, obstacle, RADIUS, force, scale);
+}
+
+/// No node of a rod of radius `radius` penetrates by more than 1e-9 m, the force is inside
+/// the cone (on it to 1e-10 when sliding) and split into its normal and tangential parts,
+/// and the base wrench equals the applied tip force and the contact forces (about the base)
+/// to 1e-10 of `scale`.
+fn assert_balanced_with(
+    sol: &ContactSolution,
+    obstacle: &Obstacle,
+    radius: f64,
+    force: Vector3<f64>,
+    scale: f64,
+) {
     for p in &sol.solution.position {
-        let g = obstacle.distance(&Vector3::from(*p)).0 - RADIUS;
+        let g = obstacle.distance(&Vector3::from(*p)).0 - radius;
         assert!(g >= -1e-9, "penetration {g:e} at {p:?}");
     }
     let mu = obstacle.friction();
@@ -65,12 +83,23 @@ fn assert_balanced(sol: &ContactSolution, obstacle: &Obstacle, force: Vector3<f6
         let t = Vector3::from(c.tangential_force);
         assert!(c.normal_force >= 0.0);
         assert!(t.dot(&n).abs() <= 1e-15 * scale, "tangential force along n");
+        // Inside the cone (on it to 1e-10 of μ f_n when sliding), beyond the round-off of
+        // splitting the force into its normal and tangential parts (1e-14 f_n, which a
+        // vanishing μ shows).
+        let split = 1e-14 * c.normal_force;
         assert!(
-            t.norm() <= mu * c.normal_force * (1.0 + 1e-9),
+            t.norm() <= mu * c.normal_force * (1.0 + 1e-9) + split,
             "outside the cone: |f_t| = {:e}, mu f_n = {:e}",
             t.norm(),
             mu * c.normal_force
         );
+        if c.state == ContactState::Slide {
+            let off = (t.norm() - mu * c.normal_force).abs();
+            assert!(
+                off <= 1e-10 * mu * c.normal_force + split,
+                "sliding off the cone by {off:e} N"
+            );
+        }
     }
     let tip = Vector3::from(sol.solution.tip_position());
     let (mut f, mut m) = (force, tip.cross(&force));
@@ -163,6 +192,115 @@ fn tip_friction_sticks_and_slides_as_the_cantilever_closed_form() {
     }
 }
 
+/// Radius (m) of the cantilever pressed onto the post: stout enough (R/L = 0.01) that the
+/// axial tension a sticking contact inside the rod picks up from the shortening of the bent
+/// rod stays far below the friction (see the test below).
+const POST_ROD: f64 = 1e-2;
+/// Surface gap (m) between that cantilever and the post.
+const POST_GAP: f64 = 1e-6 * L;
+/// Arc length (m) at which the post lies under the rod.
+const POST_AT: f64 = 0.6 * L;
+/// Radius (m) of the post.
+const POST_RADIUS: f64 = 0.05 * L;
+
+/// The post: a cylinder across the cantilever (axis along y, half-length 0.2 L) at
+/// `z = POST_AT`, its top at `x = -(POST_ROD + POST_GAP)` (so the outward normal under the
+/// rod is +x), with friction `mu`. Along y its surface is straight: a sideways displacement
+/// of the rod does not tilt the normal.
+fn post(mu: f64) -> Obstacle {
+    let x = -(POST_ROD + POST_GAP + POST_RADIUS);
+    Obstacle::cylinder([x, -0.2 * L, POST_AT], [x, 0.2 * L, POST_AT], POST_RADIUS)
+        .unwrap()
+        .with_friction(mu)
+        .unwrap()
+}
+
+/// Flexibilities (m/N) of the Timoshenko cantilever of radius [`POST_ROD`] (bending and
+/// Cowper's shear area, as the rod's section): `α` at `a` under a unit force at `a`, `β` at
+/// `a` under a unit force at `L` (and at `L` under one at `a`), `γ` at `L` under one at `L`.
+fn post_flexibilities() -> (f64, f64, f64) {
+    let k = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU);
+    let (ei, _, _, gas) = common::circular_constants(E, NU, POST_ROD, k);
+    let a = POST_AT;
+    (
+        a.powi(3) / (3.0 * ei) + a / gas,
+        a * a * (3.0 * L - a) / (6.0 * ei) + a / gas,
+        L.powi(3) / (3.0 * ei) + L / gas,
+    )
+}
+
+/// Coulomb friction inside the rod, against the propped cantilever under proportional
+/// loading: the cantilever over the post at `a` = 0.6 L (surface gap δ = 1e-6 L) under the
+/// tip force (-Fx, Fy, 0). With the flexibilities `α, β, γ` ([`post_flexibilities`]) the
+/// rod touches the post at the load fraction `λ0 = δ / (Fx β)`, where the rod at `a` is at
+/// `y = λ0 Fy β`; after it the post props the rod at `a`, and the load `(1 - λ0) F` is
+/// shared: the normal reaction is `R = (1 - λ0) Fx β / α`. Sticking, `y(a)` stays where it
+/// touched and the sideways reaction is `-(1 - λ0) Fy β / α`: the ratio of the two reactions
+/// is `|Fy| / Fx` at every load fraction after the touch, so the contact sticks iff
+/// `|Fy| <= μ Fx`. Sliding, the sideways reaction is `-sign(Fy) μ R` (the slip has the sign
+/// of Fy). The tip is at `x = -Fx γ + R β`, `y = Fy γ + R_y β`. Reactions and tip to 1e-4
+/// relative: the neglected effects are far below it (rotations ~1e-5 rad, so the
+/// geometric nonlinearity is ~1e-10 and the contact moves along the post by ~5e-7 m; the
+/// axial tension a sticking contact takes from the shortening of the bent rod, printed, is
+/// of order `E A δ² / a²`, about 1e-2 of the friction, and acts along the rod, not
+/// sideways).
+#[test]
+fn interior_friction_sticks_and_slides_as_the_propped_cantilever() {
+    let (alpha, beta, gamma) = post_flexibilities();
+    let fc = POST_GAP / beta;
+    let mu = 0.5;
+    let obstacle = post(mu);
+    for (ax, ay) in [
+        (2.0, 0.5),
+        (2.0, -0.9),
+        (3.0, 1.2),
+        (2.0, 2.0),
+        (2.0, -1.5),
+        (4.0, 3.0),
+    ] {
+        let (fx, fy) = (ax * fc, ay * fc);
+        let force = Vector3::new(-fx, fy, 0.0);
+        let sol = solve_rod(POST_ROD, force, &obstacle);
+        assert_balanced_with(&sol, &obstacle, POST_ROD, force, fx);
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        let k = sol.contacts[0];
+        assert!((k.s - POST_AT).abs() < 1e-4 * L, "contact at {}", k.s);
+        let lambda0 = fc / fx;
+        let normal = (1.0 - lambda0) * fx * beta / alpha;
+        let stick = fy.abs() <= mu * fx;
+        let ft = if stick {
+            -(1.0 - lambda0) * fy * beta / alpha
+        } else {
+            -fy.signum() * mu * normal
+        };
+        let (x, y) = (-fx * gamma + normal * beta, fy * gamma + ft * beta);
+        let tip = sol.solution.tip_position();
+        let err_n = (k.normal_force / normal - 1.0).abs();
+        let err_t = (k.tangential_force[1] / ft - 1.0).abs();
+        let (err_x, err_y) = ((tip[0] / x - 1.0).abs(), (tip[1] / y - 1.0).abs());
+        println!(
+            "Fx = {ax} F_c, Fy = {ay} F_c: {:?} at s = {:.9}; R = {:e} (err {err_n:.1e}), \
+             f_t = {:e} (err {err_t:.1e}), tip x err {err_x:.1e}, tip y err {err_y:.1e}; \
+             axial {:.1e} of mu R",
+            k.state,
+            k.s,
+            k.normal_force,
+            k.tangential_force[1],
+            k.tangential_force[2].abs() / (mu * normal)
+        );
+        let expected = if stick {
+            ContactState::Stick
+        } else {
+            ContactState::Slide
+        };
+        assert_eq!(k.state, expected, "Fx = {ax} F_c, Fy = {ay} F_c");
+        assert!(err_n < 1e-4, "normal reaction");
+        assert!(err_t < 1e-4, "sideways reaction");
+        assert!(err_x < 1e-4, "tip x");
+        assert!(err_y < 1e-4, "tip y");
+    }
+}
+
 /// μ = 0 and μ = 1e-12 reproduce the frictionless solve (tip position to 1e-12 m), and a
 /// frictionless obstacle reports frictionless contacts with no tangential force.
 #[test]
@@ -192,17 +330,105 @@ fn vanishing_friction_is_the_frictionless_solve() {
     }
 }
 
-/// A friction coefficient must be finite and >= 0; an obstacle with friction touched inside
-/// the rod is refused with an error naming `friction` (tip contacts only).
+/// Inside the rod too: μ = 0 is the frictionless solve exactly (the same shape and
+/// contact), and μ = 1e-12 reproduces its tip to 1e-12 m (the deflection is ~1e-5 m here).
 #[test]
-fn bad_friction_and_interior_friction_are_named_errors() {
+fn vanishing_friction_inside_the_rod_is_the_frictionless_solve() {
+    let (_, beta, _) = post_flexibilities();
+    let fc = POST_GAP / beta;
+    let x = -(POST_ROD + POST_GAP + POST_RADIUS);
+    let base =
+        Obstacle::cylinder([x, -0.2 * L, POST_AT], [x, 0.2 * L, POST_AT], POST_RADIUS).unwrap();
+    for (ax, ay) in [(2.0, 0.7), (3.0, -2.0)] {
+        let force = Vector3::new(-ax * fc, ay * fc, 0.0);
+        let free = solve_rod(POST_ROD, force, &base);
+        assert_eq!(free.contacts[0].state, ContactState::Frictionless);
+        assert_eq!(free.contacts[0].tangential_force, [0.0; 3]);
+        let same = solve_rod(POST_ROD, force, &post(0.0));
+        assert_eq!(same.contacts, free.contacts);
+        assert_eq!(same.solution.position, free.solution.position);
+        let sol = solve_rod(POST_ROD, force, &post(1e-12));
+        assert_balanced_with(&sol, &post(1e-12), POST_ROD, force, ax * fc);
+        let (a, b) = (sol.solution.tip_position(), free.solution.tip_position());
+        let d = (Vector3::from(a) - Vector3::from(b)).norm();
+        println!("Fx = {ax} F_c, Fy = {ay} F_c, mu = 1e-12: tip vs frictionless {d:e} m");
+        assert!(d <= 1e-12, "{d:e} m");
+        assert_eq!(sol.contacts[0].state, ContactState::Slide);
+    }
+}
+
+/// The two-segment NiTi robot pressing a sphere with friction (μ = 0.1, 1), solved from a
+/// straight rod: by its tendons (tensions [3, 0, 0, 0, 1, 0] N against the sphere of the
+/// contact benchmark: the actuation is then stepped with the loads so that the contact's
+/// first touch is on that path) and by a tip force on the unactuated robot. One contact
+/// inside the rod, sliding; converged, no penetration, forces inside the cone (on it when
+/// sliding), global balance with the friction forces to 1e-10.
+#[test]
+fn niti_robot_pressing_a_sphere_with_friction_converges_and_balances() {
+    let radius = 0.7e-3;
+    let cases: [([f64; 6], Vector3<f64>, [f64; 3], f64); 2] = [
+        (
+            [3.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            Vector3::zeros(),
+            [0.0, 0.07, 0.25],
+            0.06,
+        ),
+        (
+            [0.0; 6],
+            Vector3::new(-0.02, 0.005, 0.0),
+            [-0.0357, 0.0, 0.25],
+            0.03,
+        ),
+    ];
+    for (tensions, force, center, r) in cases {
+        for mu in [0.1, 1.0] {
+            let sphere = Obstacle::sphere(center, r)
+                .unwrap()
+                .with_friction(mu)
+                .unwrap();
+            let tendons = common::niti_tendons(&tensions);
+            let loads = Loads::tip_force(force);
+            let (model, act) = common::split(&common::niti_rod(), &tendons, &[], &loads).unwrap();
+            let sol = solve_constrained(
+                &model,
+                &act,
+                &softrod::SolveOptions::default(),
+                None,
+                std::slice::from_ref(&sphere),
+            )
+            .unwrap();
+            assert!(sol.solution.stats.converged);
+            assert!(!sol.contacts.is_empty());
+            for c in &sol.contacts {
+                println!(
+                    "tensions {tensions:?}, tip force {force:?}, mu = {mu}: {:?} at s = {:.4}, \
+                     f_n = {:.4e} N, |f_t| = {:.4e} N ({} iterations)",
+                    c.state,
+                    c.s,
+                    c.normal_force,
+                    Vector3::from(c.tangential_force).norm(),
+                    sol.solution.stats.iterations
+                );
+                assert!(c.s < 0.4, "a contact inside the rod");
+                assert_ne!(c.state, ContactState::Frictionless);
+            }
+            let scale = sol.contacts.iter().map(|c| c.normal_force).sum::<f64>() + force.norm();
+            assert_balanced_with(&sol, &sphere, radius, force, scale);
+        }
+    }
+}
+
+/// A friction coefficient must be finite and >= 0; a rod lying along a plane with friction
+/// (a contact interval) is refused with an error naming `friction` (point contacts only).
+#[test]
+fn bad_friction_and_friction_along_an_interval_are_named_errors() {
     let p = Obstacle::plane([0.0; 3], [1.0, 0.0, 0.0]).unwrap();
     for mu in [-0.1, f64::NAN, f64::INFINITY] {
         let e = p.clone().with_friction(mu).unwrap_err();
         assert!(matches!(e, Error::InvalidParameter { ref name, .. } if name == "friction"));
     }
     assert_eq!(p.with_friction(0.3).unwrap().friction(), 0.3);
-    // A uniform load on a floor at the gap δ touches it inside the rod.
+    // A uniform load on a floor at the gap δ lays the rod along it (an interval).
     let (ei, _) = constants();
     let q = 72.0 * ei * DELTA / (0.5 * L).powi(4);
     let loads = Loads {

@@ -94,7 +94,8 @@ fn parabola_minimum(g: &[GapSample]) -> f64 {
 }
 
 /// A plane touched twice (or an interval touched before its edge) becomes one interval from
-/// the first contact to the tip; `true` if a merge was made.
+/// the first contact to the tip; `true` if a merge was made, or refused: an interval on a
+/// plane with friction is not modelled (`p.refused` is then set).
 fn merge_plane(
     p: &mut Constrained<'_>,
     x: &mut Vec<f64>,
@@ -119,6 +120,11 @@ fn merge_plane(
         }
         if a >= l {
             continue;
+        }
+        let mu = p.obstacles[o].friction();
+        if mu > 0.0 {
+            p.refused = Some(mu);
+            return true;
         }
         for &i in on.iter().rev() {
             let size = p.active[i].size();
@@ -148,22 +154,37 @@ fn add_contacts(
         a.dg0 = 0.0;
         a.t0 = [0.0; 2];
     }
+    if added.iter().any(|&(o, ..)| p.obstacles[o].friction() > 0.0) {
+        if p.coarse.is_some() {
+            // A contact with friction first seen on the mesh asked after the coarse mesh (its
+            // penetration there below the coarse threshold) has no load path to be found
+            // on: the solve starts again on the mesh asked, from the unloaded rod.
+            return None;
+        }
+        let actuated = p.tensions.iter().chain(&p.pressures).any(|v| *v != 0.0);
+        if p.load <= p.from && p.path.is_none() && actuated && p.tip.is_none() && !p.pathless_ok {
+            // Made by the actuation (applied in full): its first touch is to be found with
+            // the actuation stepped.
+            p.pathless = true;
+            return None;
+        }
+    }
     // Where the new contacts with friction first touched, on the load path.
     let mut touched = Vec::with_capacity(added.len());
-    for &(o, site, _) in &added {
-        let rough = site == Site::Tip && p.obstacles[o].friction() > 0.0;
-        touched.push(if rough {
-            Some(first_touch(p, &x, o, opts, effort)?)
+    for &(o, site, s) in &added {
+        touched.push(if p.obstacles[o].friction() > 0.0 {
+            Some(first_touch(p, &x, o, (site, s), opts, effort)?)
         } else {
             None
         });
     }
     for ((o, site, s), touched) in added.into_iter().zip(touched) {
         let mut a = Active::frictionless(o, site);
-        if let Some((reference, touch, _)) = touched {
+        if let Some(t) = touched {
             a.state = ContactState::Stick;
-            a.reference = reference;
-            a.touch = touch;
+            a.reference = t.point;
+            a.arc = t.arc;
+            a.touch = t.load;
         }
         p.active.push(a);
         if site != Site::Tip {
@@ -187,7 +208,8 @@ fn add_contacts(
             a.dg0 = r[o + 1];
         }
         if a.state == ContactState::Stick {
-            a.t0 = [r[o + 1] * l, r[o + 2] * l];
+            let k = o + a.force_offset();
+            a.t0 = [r[k + 1] * l, r[k + 2] * l];
         }
     }
     let start = ContinuationSettings {
@@ -256,15 +278,12 @@ pub(super) fn active_set(
         if added.is_empty() {
             added = cell_candidates(p, &forces, penetration);
         }
-        if let Some(&(o, _, _)) = added
-            .iter()
-            .find(|(o, site, _)| *site != Site::Tip && p.obstacles[*o].friction() > 0.0)
-        {
-            // Friction inside the rod is not modelled: refused, not solved without it.
-            p.refused = Some(p.obstacles[o].friction());
-            return None;
-        }
         if merge_plane(p, &mut x, &forces, &added) {
+            if p.refused.is_some() {
+                // Friction along a contact interval is not modelled: refused, not solved
+                // without it.
+                return None;
+            }
             x = correct(p, &x, opts, effort)?;
             continue;
         }

@@ -82,6 +82,9 @@ impl Frozen {
             rough: false,
             from: 1.0,
             refused: None,
+            path: None,
+            pathless: false,
+            pathless_ok: false,
             scratch: None,
             coarse_stability: None,
         }

@@ -1,14 +1,31 @@
-//! Coulomb friction at tip contacts.
+//! Coulomb friction at point contacts, at the tip and inside the rod.
 //!
-//! A static problem needs a reference for the slip: here the contact point where the tip
-//! first touched the obstacle along the proportional load path of the solve (the load factor
-//! at which the gap of the solution without that contact vanishes, found by regula falsi
-//! between the last accepted load step and the current one). A sticking contact holds its
-//! contact point there: its rows are the gap and the two tangential displacements of the
-//! contact point from the reference (over `L`). A sliding contact keeps the gap row and
-//! puts its tangential force on the cone, opposite to the slip `u` (the tangential
-//! displacement from the reference): `f_t + μ f_n u / max(|u|, ε L) = 0`, two rows, with
-//! `ε` = [`SLIP_FLOOR`] so that the rows stay smooth where the slip starts from zero. The
+//! A static problem needs a reference for the slip: here where the contact first touched
+//! the obstacle along the proportional load path of the solve (the load factor at which the
+//! gap of the solution without that contact vanishes, found by regula falsi between the last
+//! accepted load step and the current one): the backbone point `p₀` of the contact there and
+//! its arc length `s₀`. Inside the rod the gap of the solution without the contact is read at
+//! a probe, a contact whose normal force is held at zero and whose arc length stays at the
+//! least gap, so that the touch is found on the same mesh and to the same round-off as the
+//! contact that follows it.
+//!
+//! The contact force acts on the backbone (a thin rod: the moment `R n × f_t` of a
+//! tangential force about the backbone is not applied), and the slip is the displacement
+//! work-conjugate to it: that of the backbone's material point at `s₀` along the obstacle's
+//! tangent plane, to first order in the distance the contact has moved along the rod,
+//! `u = P (p(s) + (s₀ - s) t(s) - p₀)`, with `s` the contact's arc length, `t` the rod's
+//! tangent (the body z axis) and `P` the projection onto the obstacle's tangent plane (at
+//! the tip `s = s₀ = L`). A rod turning about its backbone point at the contact moves the
+//! contact along the rod and the obstacle by the same length: no slip. (The surface fibre at
+//! the contact moves by `R` times the rotation of the section as the rod bends; counting it
+//! without the moment of the offset force would not be consistent, and against the axial
+//! stiffness `E A` it would ask for an axial friction force about `4 a / (3 R)` times the
+//! normal force at a contact `a` from the base of a bent rod.)
+//!
+//! A sticking contact holds `u` at zero: its rows are the gap and the two components of `u`
+//! (over `L`). A sliding contact keeps the gap row and puts its tangential force on the
+//! cone, opposite to the slip: `f_t + μ f_n u / max(|u|, ε L) = 0`, two rows, with `ε` =
+//! [`SLIP_FLOOR`] so that the rows stay smooth where the slip starts from zero. The
 //! active-set loop turns a sticking contact whose force leaves the cone into a sliding one,
 //! and a sliding contact whose slip has gone back below `ε L` (it would reverse) into a
 //! sticking one.
@@ -39,33 +56,40 @@ const TOUCH_TOLERANCE: f64 = 1e-10;
 const TOUCH_GAP: f64 = 1e-13;
 
 impl Constrained<'_> {
-    /// The contact point on the rod's surface (m, world) and the outward normal of the
-    /// obstacle of `a` for the tip state `y`, and the gap (m).
-    fn tip_point(&self, a: &Active, y: &[f64; STATE]) -> (Vector3<f64>, Vector3<f64>, f64) {
-        let l = self.model.length();
-        let p = v3(y, 0);
-        let (d, n) = self.obstacles[a.obstacle].distance(&p);
-        let radius = self.model.rod().section_at(l).radius;
-        (p - n * radius, n, d - radius)
+    /// The gap (m) between obstacle `o` and the rod's surface at arc length `s` (m) with the
+    /// rod's state `y` there.
+    fn gap_at(&self, o: usize, s: f64, y: &[f64; STATE]) -> f64 {
+        let radius = self.model.rod().section_at(s).radius;
+        self.obstacles[o].distance(&v3(y, 0)).0 - radius
     }
 
-    /// The two tangential rows of the tip contact `a` with friction at the tip state `y`,
-    /// scaled force `f`, homotopy parameter `relax` (see the module's documentation).
+    /// The slip `u` (m, world) of the contact `a` at arc length `s` (m) with the rod's state
+    /// `y` there (see the module's documentation), and the obstacle's outward normal.
+    fn slip(&self, a: &Active, s: f64, y: &[f64; STATE]) -> (Vector3<f64>, Vector3<f64>) {
+        let p = v3(y, 0);
+        let (_, n) = self.obstacles[a.obstacle].distance(&p);
+        let d = p + v3(y, 9) * (a.arc - s) - a.reference;
+        (d - n * d.dot(&n), n)
+    }
+
+    /// The two tangential rows of the contact `a` with friction at arc length `s` (m) with
+    /// the rod's state `y` there (before the jump of the force), scaled force `f`, homotopy
+    /// parameter `relax` (see the module's documentation).
     pub(super) fn friction_rows(
         &self,
         a: &Active,
+        s: f64,
         y: &[f64; STATE],
         f: &Vector3<f64>,
         relax: f64,
         rows: &mut Vec<f64>,
     ) {
         let l = self.model.length();
-        let (pc, n, _) = self.tip_point(a, y);
-        let d = pc - a.reference;
+        let (u, n) = self.slip(a, s, y);
         let (t1, t2) = obstacle_normal_basis(&n);
         if a.state == ContactState::Stick {
-            rows.push((d.dot(&t1) - (1.0 - relax) * a.t0[0]) / l);
-            rows.push((d.dot(&t2) - (1.0 - relax) * a.t0[1]) / l);
+            rows.push((u.dot(&t1) - (1.0 - relax) * a.t0[0]) / l);
+            rows.push((u.dot(&t2) - (1.0 - relax) * a.t0[1]) / l);
             return;
         }
         let mu = self.obstacles[a.obstacle].friction();
@@ -73,10 +97,7 @@ impl Constrained<'_> {
         let ft = f - n * normal;
         let r = match a.direction {
             Some(e) => ft + e * (mu * normal),
-            None => {
-                let u = d - n * d.dot(&n);
-                ft + u * (mu * normal / u.norm().max(SLIP_FLOOR * l))
-            }
+            None => ft + u * (mu * normal / u.norm().max(SLIP_FLOOR * l)),
         };
         rows.push(r.dot(&t1));
         rows.push(r.dot(&t2));
@@ -91,24 +112,40 @@ impl Constrained<'_> {
             .zip(self.offsets())
             .zip(forces)
             .map(|((a, o), force)| {
-                if a.state == ContactState::Frictionless || a.site != Site::Tip {
+                if a.state == ContactState::Frictionless {
                     return Vector3::zeros();
                 }
-                let f = Vector3::new(x[o], x[o + 1], x[o + 2]) * fs;
+                let k = o + a.force_offset();
+                let f = Vector3::new(x[k], x[k + 1], x[k + 2]) * fs;
                 let n = force.1;
                 f - n * f.dot(&n)
             })
             .collect()
     }
+
+    /// The arc length (m) of the active contact with unknowns from `o` at `x`.
+    pub(super) fn arc_of(&self, a: &Active, x: &[f64], o: usize) -> f64 {
+        match a.site {
+            Site::Tip => self.model.length(),
+            Site::Interior | Site::Interval => x[o] * self.model.length(),
+        }
+    }
+
+    /// The state of the rod at arc length `s` (m) in the last pass (its first node there,
+    /// before the jump of a force).
+    fn state_at(&self, s: f64) -> Option<[f64; STATE]> {
+        let pass = self.last.as_ref()?;
+        pass.nodes.iter().find(|n| n.s == s).map(|n| n.y)
+    }
 }
 
-/// The state a tip contact with friction turns to at the converged `x` (the last pass at
-/// it), if any: the first sticking contact whose tangential force is outside the cone
-/// slides (with the slip direction its force opposes, to start from: at the sticking
-/// solution the slip is zero), the first sliding contact whose slip is back below
-/// [`SLIP_FLOOR`] sticks. Not on a coarse mesh, whose Newton tolerance leaves the held
-/// displacements errors that the rod's axial stiffness turns into spurious forces: its
-/// contacts stick, and the mesh asked decides.
+/// The state a contact with friction turns to at the converged `x` (the last pass at it),
+/// if any: the first sticking contact whose tangential force is outside the cone slides
+/// (with the slip direction its force opposes, to start from: at the sticking solution the
+/// slip is zero), the first sliding contact whose slip is back below [`SLIP_FLOOR`] sticks.
+/// Not on a coarse mesh, whose Newton tolerance leaves the held displacements errors that
+/// the rod's axial stiffness turns into spurious forces: its contacts stick, and the mesh
+/// asked decides.
 pub(super) fn switch(
     p: &Constrained<'_>,
     x: &[f64],
@@ -117,15 +154,17 @@ pub(super) fn switch(
     if !p.refine {
         return None;
     }
-    let y = p.last.as_ref()?.nodes.last()?.y;
     let l = p.model.length();
     let fs = p.model.force_scale();
     for (i, (a, o)) in p.active.iter().zip(p.offsets()).enumerate() {
-        if a.site != Site::Tip || a.state == ContactState::Frictionless {
+        if a.state == ContactState::Frictionless {
             continue;
         }
-        let (pc, n, _) = p.tip_point(a, &y);
-        let f = Vector3::new(x[o], x[o + 1], x[o + 2]) * fs;
+        let s = p.arc_of(a, x, o);
+        let y = p.state_at(s)?;
+        let (u, n) = p.slip(a, s, &y);
+        let k = o + a.force_offset();
+        let f = Vector3::new(x[k], x[k + 1], x[k + 2]) * fs;
         let normal = f.dot(&n);
         let ft = f - n * normal;
         let tangential = ft.norm();
@@ -138,8 +177,6 @@ pub(super) fn switch(
                 }
             }
             _ => {
-                let d = pc - a.reference;
-                let u = d - n * d.dot(&n);
                 if u.norm() < SLIP_FLOOR * l {
                     return Some((i, ContactState::Stick, None));
                 }
@@ -149,50 +186,102 @@ pub(super) fn switch(
     None
 }
 
-/// The contact point (m, world) where the tip first touches obstacle `o` along the
-/// proportional load path: `x` is converged at the current load factor without that contact
-/// (and penetrates it); the gap of that solution is followed by regula falsi (Illinois) on
-/// the load factor between the last accepted load step and the current one. At the first
-/// load step (load factor 0, the actuated rod) or if the search fails, the contact point of
-/// `x` itself. The load factor is restored. Returns the point, the load factor of the touch
-/// and whether it was found by the search; `None` if `x` cannot be evaluated.
+/// Where a contact first touched its obstacle on the load path ([`first_touch`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Touch {
+    /// The backbone point of the contact (m, world).
+    pub(super) point: Vector3<f64>,
+    /// Its arc length (m).
+    pub(super) arc: f64,
+    /// The load factor of the touch.
+    pub(super) load: f64,
+    /// Whether the search found it (else it is the contact of the solution it started
+    /// from).
+    pub(super) found: bool,
+}
+
+/// Where a contact at `site` (inside the rod: near arc length `s`, m) first touches obstacle
+/// `o` along the proportional load path: `x` is converged at the current load factor without
+/// that contact (and penetrates it); the gap of that solution is followed by regula falsi
+/// (Illinois) on the load factor between the last accepted load step and the current one.
+/// Inside the rod the gap is read at a probe ([`Active::probe`]) held at the least gap. At
+/// the first load step (load factor 0, the actuated rod) or if the search fails, the
+/// contact point of `x` itself. The load factor and active set are restored. `None` if `x`
+/// cannot be evaluated (or, inside the rod, the probe not solved there).
 pub(super) fn first_touch(
     p: &mut Constrained<'_>,
     x: &[f64],
     o: usize,
+    (site, s): (Site, f64),
     opts: &NewtonOptions,
     effort: &mut Effort,
-) -> Option<(Vector3<f64>, f64, bool)> {
-    let probe = Active::frictionless(o, Site::Tip);
-    let at = |p: &Constrained<'_>| -> Option<(Vector3<f64>, f64)> {
-        let y = p.last.as_ref()?.nodes.last()?.y;
-        let (pc, _, gap) = p.tip_point(&probe, &y);
-        Some((pc, gap))
-    };
-    let mut r = vec![0.0; p.dim()];
-    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
-        return None;
-    }
-    let (here, g1) = at(p)?;
-    let target = p.load;
-    let from = p.from.min(target);
-    if target <= from || g1 >= 0.0 {
-        return Some((here, target, false));
-    }
+) -> Option<Touch> {
     let l = p.model.length();
-    let mut touch = here;
-    let mut found = (target, false);
+    let mut xs = x.to_vec();
     // The sticking rows hold the touch point along the rod too, where the rod is stiffest
     // (E A / L): the touch is solved to round-off, also on a coarse mesh.
     let refine = std::mem::replace(&mut p.refine, true);
     let mut strict = *opts;
     strict.tolerance = opts.tolerance.min(TOUCH_TOLERANCE);
-    let opts = &strict;
-    p.load = from;
-    if let Some(mut xs) = correct(p, x, opts, effort) {
-        if let Some((start, g0)) = at(p) {
-            touch = start;
-            found = (from, true);
+    let touched = if site == Site::Tip {
+        let mut r = vec![0.0; p.dim()];
+        (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed)
+            .then(|| search(p, xs, o, &strict, effort))
+            .flatten()
+    } else {
+        let mut probe = Active::frictionless(o, Site::Interior);
+        probe.probe = true;
+        p.active.push(probe);
+        xs.extend([s / l, 0.0, 0.0, 0.0]);
+        let touched =
+            correct(p, &xs, &strict, effort).and_then(|xs| search(p, xs, o, &strict, effort));
+        p.active.pop();
+        touched
+    };
+    p.refine = refine;
+    touched
+}
+
+/// The regula falsi of [`first_touch`] from `xs`, converged at the current load factor with
+/// the contact absent (at the tip) or as the last active contact, a probe (inside the rod).
+fn search(
+    p: &mut Constrained<'_>,
+    mut xs: Vec<f64>,
+    o: usize,
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Touch> {
+    let l = p.model.length();
+    let probe = p.active.last().is_some_and(|a| a.probe);
+    // The backbone point, arc length and gap of the contact in the last pass at `xs`.
+    let at = |p: &Constrained<'_>, xs: &[f64]| -> Option<(Vector3<f64>, f64, f64)> {
+        let s = if probe { xs[xs.len() - 4] * l } else { l };
+        let y = p.state_at(s)?;
+        Some((v3(&y, 0), s, p.gap_at(o, s, &y)))
+    };
+    let (here, s1, g1) = at(p, &xs)?;
+    let target = p.load;
+    let from = p.from.min(target);
+    let at_target = Touch {
+        point: here,
+        arc: s1,
+        load: target,
+        found: false,
+    };
+    if target <= from || g1 >= 0.0 {
+        return Some(at_target);
+    }
+    let mut touch = at_target;
+    p.set_load(from);
+    if let Some(start) = correct(p, &xs, opts, effort) {
+        xs = start;
+        if let Some((point, arc, g0)) = at(p, &xs) {
+            touch = Touch {
+                point,
+                arc,
+                load: from,
+                found: true,
+            };
             let (mut la, mut ga, mut lb, mut gb) = (from, g0, target, g1);
             let mut side = 0;
             for _ in 0..MAX_TOUCH_ITERATIONS {
@@ -200,17 +289,20 @@ pub(super) fn first_touch(
                     break;
                 }
                 let lambda = lb - gb * (lb - la) / (gb - ga);
-                p.load = lambda;
-                let Some(next) = correct(p, &xs, opts, effort) else {
-                    (touch, found) = (here, (target, false));
+                p.set_load(lambda);
+                let Some((next, (point, arc, g))) = correct(p, &xs, opts, effort)
+                    .and_then(|next| at(p, &next).map(|found| (next, found)))
+                else {
+                    touch = at_target;
                     break;
                 };
                 xs = next;
-                let Some((pc, g)) = at(p) else {
-                    (touch, found) = (here, (target, false));
-                    break;
+                touch = Touch {
+                    point,
+                    arc,
+                    load: lambda,
+                    found: true,
                 };
-                (touch, found) = (pc, (lambda, true));
                 if g.abs() <= TOUCH_GAP * l || g == ga || g == gb {
                     // Found, or the gap no longer moves (Newton within its tolerance).
                     break;
@@ -231,15 +323,14 @@ pub(super) fn first_touch(
             }
         }
     }
-    p.load = target;
-    p.refine = refine;
-    Some((touch, found.0, found.1))
+    p.set_load(target);
+    Some(touch)
 }
 
-/// The first-touch points of the tip contacts with friction found on another (coarser) mesh,
-/// found again on the mesh of `p` from the solution `x` there: the search of [`first_touch`]
-/// around the load factor of each touch, without that contact. A point not found again is
-/// kept. The active set, load factor and Jacobian hint of `p` are restored.
+/// The first touches of the contacts with friction found on another (coarser) mesh, found
+/// again on the mesh of `p` from the solution `x` there: the search of [`first_touch`] around
+/// the load factor (and arc length) of each touch, without that contact. A touch not found
+/// again is kept. The active set, load factor and Jacobian hint of `p` are restored.
 pub(super) fn retouch(
     p: &mut Constrained<'_>,
     x: &[f64],
@@ -250,25 +341,27 @@ pub(super) fn retouch(
     let (load, from) = (p.load, p.from);
     for i in 0..p.active.len() {
         let a = p.active[i];
-        if a.site != Site::Tip || a.state == ContactState::Frictionless {
+        if a.state == ContactState::Frictionless {
             continue;
         }
         let saved = p.active.clone();
         let o = p.offsets()[i];
         let mut xr = x.to_vec();
-        xr.drain(o..o + 3);
+        xr.drain(o..o + a.size());
         p.active.remove(i);
         let span = RETOUCH_SPAN * a.touch.max(RETOUCH_SPAN);
-        p.load = (a.touch + span).min(load);
+        p.set_load((a.touch + span).min(load));
         p.from = (a.touch - span).max(0.0);
         let again = correct(p, &xr, opts, effort)
-            .and_then(|xs| first_touch(p, &xs, a.obstacle, opts, effort));
+            .and_then(|xs| first_touch(p, &xs, a.obstacle, (a.site, a.arc), opts, effort));
         p.active = saved;
-        if let Some((point, lambda, true)) = again {
-            p.active[i].reference = point;
-            p.active[i].touch = lambda;
+        if let Some(t) = again.filter(|t| t.found) {
+            p.active[i].reference = t.point;
+            p.active[i].arc = t.arc;
+            p.active[i].touch = t.load;
         }
     }
-    (p.load, p.from) = (load, from);
+    p.set_load(load);
+    p.from = from;
     p.hint = hint;
 }

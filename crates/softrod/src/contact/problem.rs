@@ -36,9 +36,10 @@ pub(super) enum Site {
 }
 
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
-/// was added, relaxed to zero as the problem's parameter goes from 0 to 1); with friction (a
-/// tip contact), its state, the contact point where it first touched (m, world) and the
-/// homotopy targets of its sticking rows (its tangential displacements from there, m).
+/// was added, relaxed to zero as the problem's parameter goes from 0 to 1); with friction,
+/// its state, where it first touched (the contact point, m, world, and the arc length, m)
+/// and the homotopy targets of its sticking rows (its tangential displacements from there,
+/// m).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Active {
     pub(super) obstacle: usize,
@@ -47,10 +48,16 @@ pub(super) struct Active {
     pub(super) dg0: f64,
     pub(super) state: ContactState,
     pub(super) reference: Vector3<f64>,
+    /// Arc length (m) of the contact where it first touched (`L` at the tip).
+    pub(super) arc: f64,
     pub(super) touch: f64,
     pub(super) t0: [f64; 2],
     /// A slip direction (unit, world) held while a contact turns from sticking to sliding.
     pub(super) direction: Option<Vector3<f64>>,
+    /// A probe of the first-touch search inside the rod: its normal force is held at zero in
+    /// place of its gap, so that the rod is the one without it and the probe's arc length,
+    /// held at the least gap, gives where and how far the rod is from touching.
+    pub(super) probe: bool,
 }
 
 impl Active {
@@ -63,9 +70,11 @@ impl Active {
             dg0: 0.0,
             state: ContactState::Frictionless,
             reference: Vector3::zeros(),
+            arc: 0.0,
             touch: 0.0,
             t0: [0.0; 2],
             direction: None,
+            probe: false,
         }
     }
 }
@@ -76,6 +85,12 @@ impl Active {
             Site::Tip => 3,
             Site::Interior | Site::Interval => 4,
         }
+    }
+
+    /// Offset of the first force unknown among the contact's unknowns (after the arc length
+    /// inside the rod), and of its two tangential rows among its rows, less one.
+    pub(super) fn force_offset(&self) -> usize {
+        self.size() - 3
     }
 }
 
@@ -179,8 +194,18 @@ pub(crate) struct Constrained<'m> {
     pub(super) rough: bool,
     /// Load factor of the last accepted load step (where a first touch is searched from).
     pub(super) from: f64,
-    /// The friction coefficient of an obstacle touched inside the rod, when refused.
+    /// The friction coefficient of a plane with friction the rod lies along, when refused.
     pub(super) refused: Option<f64>,
+    /// With the actuation stepped with the loads: the full tensions (N) and pressures (Pa),
+    /// which the load factor then scales too ([`Self::set_load`]).
+    pub(super) path: Option<(Vec<f64>, Vec<f64>)>,
+    /// Whether a contact with friction was met where no load path leads to it (made by the
+    /// actuation, at load factor 0): its first touch is then searched with the actuation
+    /// stepped with the loads ([`ramp::stepped`](super::ramp::stepped)).
+    pub(super) pathless: bool,
+    /// Whether such a contact is taken as it is, its reference where the rod without it
+    /// touches it (when stepping the actuation failed, or with a held tip).
+    pub(super) pathless_ok: bool,
     /// Scratch of the contact rows' evaluations, one per side of a contact, kept from march
     /// to march as the warm start of their local solves (see [`Evaluator::enter_interval`](crate::cosserat::equations::Evaluator::enter_interval)).
     pub(super) scratch: Option<Box<[Workspace; 2]>>,
@@ -204,10 +229,25 @@ impl<'m> Constrained<'m> {
         o
     }
 
+    /// Sets the load factor (and, on the path of the actuation, the actuation with it).
+    pub(super) fn set_load(&mut self, lambda: f64) {
+        self.load = lambda;
+        if let Some((tensions, pressures)) = &self.path {
+            for (t, full) in self.tensions.iter_mut().zip(tensions) {
+                *t = lambda * full;
+            }
+            for (q, full) in self.pressures.iter_mut().zip(pressures) {
+                *q = lambda * full;
+            }
+        }
+    }
+
     /// The key of an evaluation at `x` and `mu` in the current state.
     pub(super) fn key(&self, x: &[f64], mu: f64) -> Key {
-        // (The load factor steps nothing on an unloaded rod with a free tip.)
-        let load = if self.tip.is_none() && self.model.loads().is_unloaded() {
+        // (The load factor steps nothing on an unloaded rod with a free tip, unless it steps
+        // the actuation.)
+        let load = if self.tip.is_none() && self.model.loads().is_unloaded() && self.path.is_none()
+        {
             1.0
         } else {
             self.load

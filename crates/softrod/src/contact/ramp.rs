@@ -192,7 +192,9 @@ pub(super) fn rest_shape(p: &mut Constrained<'_>, s: &[f64]) -> Option<Vec<Vecto
 
 /// The active-set solve with the actuation (`tensions`, `pressures`: the full ones) and the
 /// loads stepped together from zero, from the unactuated rod `rest` (at the samples `s`,
-/// radii `radius`), each step refused and halved if the rod crossed an obstacle on it.
+/// radii `radius`), each step refused and halved if the rod crossed an obstacle on it. The
+/// load factor scales the actuation too ([`Constrained::path`]), so that a contact with
+/// friction finds its first touch on this path.
 pub(super) fn stepped(
     p: &mut Constrained<'_>,
     (tensions, pressures): (&[f64], &[f64]),
@@ -204,18 +206,14 @@ pub(super) fn stepped(
     p.active.clear();
     p.hint = None;
     p.solved = None;
+    p.path = Some((tensions.to_vec(), pressures.to_vec()));
+    p.from = 0.0;
     let mut x = vec![0.0; 6];
     let mut previous = rest;
     let (mut lambda, mut step) = (0.0, MAX_STEP);
     while lambda < 1.0 {
         let next = (lambda + step).min(1.0);
-        for (t, full) in p.tensions.iter_mut().zip(tensions) {
-            *t = next * full;
-        }
-        for (q, full) in p.pressures.iter_mut().zip(pressures) {
-            *q = next * full;
-        }
-        p.load = next;
+        p.set_load(next);
         p.last = None;
         let saved = p.active.clone();
         let shape = active_set(p, &x, opts, effort).and_then(|xn| {
@@ -227,16 +225,19 @@ pub(super) fn stepped(
             Some((xn, shape)) => {
                 effort.load_steps += 1;
                 (x, previous, lambda) = (xn, shape, next);
+                p.from = lambda;
                 step = (2.0 * step).min(MAX_STEP);
             }
             None => {
                 p.active = saved;
                 step *= 0.5;
                 if step < MIN_LOAD_INCREMENT {
+                    p.path = None;
                     return None;
                 }
             }
         }
     }
+    p.path = None;
     Some(x)
 }

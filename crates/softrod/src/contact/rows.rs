@@ -145,7 +145,12 @@ impl Constrained<'_> {
         let props = self.model.rod().section_at(s);
         let (d, n) = ob.distance(&v3(first.0, 0));
         let g = d - props.radius;
-        rows.push((g - (1.0 - mu) * a.g0) / l);
+        if a.probe {
+            // The rod without the contact: its normal force held at zero.
+            rows.push(f.dot(&n));
+        } else {
+            rows.push((g - (1.0 - mu) * a.g0) / l);
+        }
         if a.site != Site::Tip {
             // A point contact sits at the kink of the gap (the shear jumps with the force):
             // the mean slope of its two sides vanishes; the segment of an interval lies flat
@@ -170,7 +175,7 @@ impl Constrained<'_> {
             rows.push(f.dot(&t1));
             rows.push(f.dot(&t2));
         } else {
-            self.friction_rows(a, first.0, f, mu, rows);
+            self.friction_rows(a, s, first.0, f, mu, rows);
         }
     }
 

@@ -31,7 +31,8 @@ const COARSE_TOLERANCE: f64 = 1e-5;
 
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
 /// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
-/// Coulomb friction at the tip: see [`Obstacle::with_friction`] and [`ContactState`]).
+/// Coulomb friction at point contacts: see [`Obstacle::with_friction`] and
+/// [`ContactState`]).
 ///
 /// The unknowns are the base wrench (as in [`solve_statics`]), the force of every active
 /// contact and, for a contact inside the rod, its arc length; the residual the tip
@@ -46,8 +47,8 @@ const COARSE_TOLERANCE: f64 = 1e-5;
 ///
 /// # Errors
 /// As [`solve_statics`] for the model, actuation and options; [`Error::InvalidParameter`]
-/// naming `friction` when an obstacle with friction is touched inside the rod (friction is
-/// modelled at tip contacts only); [`Error::NotConverged`] (with
+/// naming `friction` when the rod lies along a plane with friction (a contact interval:
+/// friction is modelled at point contacts only); [`Error::NotConverged`] (with
 /// the iterations, residual and load factor reached) when no equilibrium with a consistent
 /// active set is found and `options.newton.throw` is set.
 pub fn solve_constrained(
@@ -94,6 +95,9 @@ pub fn solve_constrained(
         rough: false,
         from: 0.0,
         refused: None,
+        path: None,
+        pathless: false,
+        pathless_ok: false,
         scratch: None,
         coarse_stability: None,
     };
@@ -131,16 +135,9 @@ pub fn solve_constrained(
         // Else the mesh asked from the start (its iterations and load steps are those
         // reported; the evaluations count both).
         effort = Effort::default();
-        p.integrator = options.integrator;
-        p.coarse = None;
-        p.active.clear();
-        p.last = None;
-        p.load = 0.0;
-        p.reference.clear();
-        p.hint = None;
-        p.solved = None;
+        restart(&mut p, options.integrator);
     }
-    let reached = reach(&mut p, options, &mut effort);
+    let reached = reach_asked(&mut p, options, &mut effort);
     if let Some(e) = refusal(&p) {
         return Err(e);
     }
@@ -149,6 +146,7 @@ pub fn solve_constrained(
             p.load = 1.0;
             finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort)
         }
+        Reach::Stepped(x) => finish(&mut p, model, actuation, options, &x, &effort, 1.0),
         Reach::Stopped { lambda, why, .. } if options.newton.throw => {
             fail(&p, &options.newton, &effort, lambda, why)
         }
@@ -165,14 +163,14 @@ pub fn solve_constrained(
     }
 }
 
-/// The error of an obstacle with friction touched inside the rod, if one was.
+/// The error of a plane with friction along which the rod lies, if one was met.
 fn refusal(p: &Constrained<'_>) -> Option<Error> {
     p.refused.map(|mu| {
         Error::invalid(
             "friction",
             mu,
-            "0 for an obstacle touched inside the rod (Coulomb friction is modelled at tip \
-             contacts only)",
+            "0 for a plane the rod lies along (a contact interval; Coulomb friction is \
+             modelled at point contacts only)",
         )
     })
 }
@@ -211,10 +209,58 @@ pub(super) fn coarse_mesh(integrator: Integrator) -> Option<Integrator> {
     }
 }
 
+/// The problem `p` back at the unloaded rod on the mesh `integrator`, with no contacts.
+fn restart(p: &mut Constrained<'_>, integrator: Integrator) {
+    p.integrator = integrator;
+    p.coarse = None;
+    (p.refine, p.rough) = (true, false);
+    p.active.clear();
+    p.last = None;
+    p.load = 0.0;
+    p.from = 0.0;
+    p.reference.clear();
+    p.hint = None;
+    p.solved = None;
+}
+
+/// [`reach`] on the mesh asked. If it meets a contact with friction made by the actuation
+/// ([`Constrained::pathless`]; or the coarse mesh met one), the solve with the actuation
+/// stepped with the loads from the unactuated rod ([`ramp::stepped`]), so that its first
+/// touch is on that path; failing that, [`reach`] again with that contact's reference where
+/// the actuated rod without it touches it.
+fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Effort) -> Reach {
+    if !p.pathless {
+        let reached = reach(p, options, effort);
+        if !p.pathless {
+            return reached;
+        }
+    }
+    p.pathless = false;
+    restart(p, options.integrator);
+    let (s, radius) = ramp::samples(p);
+    let full = (p.tensions.clone(), p.pressures.clone());
+    let stepped = ramp::rest_shape(p, &s).and_then(|rest| {
+        let (t, q) = (&full.0, &full.1);
+        ramp::stepped(p, (t, q), (&s, &radius, rest), &options.newton, effort)
+    });
+    (p.tensions, p.pressures) = full;
+    p.load = 1.0;
+    if let Some(x) = stepped {
+        return Reach::Stepped(x);
+    }
+    *effort = Effort::default();
+    restart(p, options.integrator);
+    p.pathless_ok = true;
+    reach(p, options, effort)
+}
+
 /// What [`reach`] reached.
 enum Reach {
     /// Converged at full load, the unknowns.
     Done(Vec<f64>),
+    /// Converged at full load with the actuation stepped with the loads (checked for
+    /// obstacles crossed on the way), the unknowns.
+    Stepped(Vec<f64>),
     /// Stopped at load factor `lambda` (the active set as left, the unknowns reached).
     Stopped {
         x: Vec<f64>,
