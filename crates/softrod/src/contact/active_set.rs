@@ -154,20 +154,14 @@ fn add_contacts(
         a.dg0 = 0.0;
         a.t0 = [0.0; 2];
     }
-    if added.iter().any(|&(o, ..)| p.obstacles[o].friction() > 0.0) {
-        if p.coarse.is_some() {
-            // A contact with friction first seen on the mesh asked after the coarse mesh (its
-            // penetration there below the coarse threshold) has no load path to be found
-            // on: the solve starts again on the mesh asked, from the unloaded rod.
-            return None;
-        }
-        let actuated = p.tensions.iter().chain(&p.pressures).any(|v| *v != 0.0);
-        if p.load <= p.from && p.path.is_none() && actuated && p.tip.is_none() && !p.pathless_ok {
-            // Made by the actuation (applied in full): its first touch is to be found with
-            // the actuation stepped.
-            p.pathless = true;
-            return None;
-        }
+    let rough = added.iter().any(|&(o, ..)| p.obstacles[o].friction() > 0.0);
+    let actuated = p.tensions.iter().chain(&p.pressures).any(|v| *v != 0.0);
+    let free = p.path.is_none() && p.tip.is_none() && !p.pathless_ok;
+    if rough && actuated && free && p.load <= p.from {
+        // Made by the actuation (applied in full): its first touch is to be found with the
+        // actuation stepped with the loads.
+        p.pathless = true;
+        return None;
     }
     // Where the new contacts with friction first touched, on the load path.
     let mut touched = Vec::with_capacity(added.len());
@@ -184,7 +178,6 @@ fn add_contacts(
             a.state = ContactState::Stick;
             a.reference = t.point;
             a.arc = t.arc;
-            a.touch = t.load;
         }
         p.active.push(a);
         if site != Site::Tip {

@@ -48,8 +48,6 @@ pub(super) const SLIP_FLOOR: f64 = 1e-9;
 const CONE_SLACK: f64 = 1e-9;
 /// Most regula falsi iterations of the first-touch search.
 const MAX_TOUCH_ITERATIONS: usize = 16;
-/// Half-width (relative) of the bracket of load factors about a first touch searched again.
-const RETOUCH_SPAN: f64 = 1e-2;
 /// Newton tolerance (at most) of the solves of the first-touch search.
 const TOUCH_TOLERANCE: f64 = 1e-10;
 /// Gap (relative to the rod length) at which the first-touch search stops.
@@ -143,17 +141,11 @@ impl Constrained<'_> {
 /// if any: the first sticking contact whose tangential force is outside the cone slides
 /// (with the slip direction its force opposes, to start from: at the sticking solution the
 /// slip is zero), the first sliding contact whose slip is back below [`SLIP_FLOOR`] sticks.
-/// Not on a coarse mesh, whose Newton tolerance leaves the held displacements errors that
-/// the rod's axial stiffness turns into spurious forces: its contacts stick, and the mesh
-/// asked decides.
 pub(super) fn switch(
     p: &Constrained<'_>,
     x: &[f64],
     opts: &NewtonOptions,
 ) -> Option<(usize, ContactState, Option<Vector3<f64>>)> {
-    if !p.refine {
-        return None;
-    }
     let l = p.model.length();
     let fs = p.model.force_scale();
     for (i, (a, o)) in p.active.iter().zip(p.offsets()).enumerate() {
@@ -193,11 +185,6 @@ pub(super) struct Touch {
     pub(super) point: Vector3<f64>,
     /// Its arc length (m).
     pub(super) arc: f64,
-    /// The load factor of the touch.
-    pub(super) load: f64,
-    /// Whether the search found it (else it is the contact of the solution it started
-    /// from).
-    pub(super) found: bool,
 }
 
 /// Where a contact at `site` (inside the rod: near arc length `s`, m) first touches obstacle
@@ -219,8 +206,7 @@ pub(super) fn first_touch(
     let l = p.model.length();
     let mut xs = x.to_vec();
     // The sticking rows hold the touch point along the rod too, where the rod is stiffest
-    // (E A / L): the touch is solved to round-off, also on a coarse mesh.
-    let refine = std::mem::replace(&mut p.refine, true);
+    // (E A / L): the touch is solved to round-off.
     let mut strict = *opts;
     strict.tolerance = opts.tolerance.min(TOUCH_TOLERANCE);
     let touched = if site == Site::Tip {
@@ -238,7 +224,6 @@ pub(super) fn first_touch(
         p.active.pop();
         touched
     };
-    p.refine = refine;
     touched
 }
 
@@ -265,8 +250,6 @@ fn search(
     let at_target = Touch {
         point: here,
         arc: s1,
-        load: target,
-        found: false,
     };
     if target <= from || g1 >= 0.0 {
         return Some(at_target);
@@ -276,12 +259,7 @@ fn search(
     if let Some(start) = correct(p, &xs, opts, effort) {
         xs = start;
         if let Some((point, arc, g0)) = at(p, &xs) {
-            touch = Touch {
-                point,
-                arc,
-                load: from,
-                found: true,
-            };
+            touch = Touch { point, arc };
             let (mut la, mut ga, mut lb, mut gb) = (from, g0, target, g1);
             let mut side = 0;
             for _ in 0..MAX_TOUCH_ITERATIONS {
@@ -297,12 +275,7 @@ fn search(
                     break;
                 };
                 xs = next;
-                touch = Touch {
-                    point,
-                    arc,
-                    load: lambda,
-                    found: true,
-                };
+                touch = Touch { point, arc };
                 if g.abs() <= TOUCH_GAP * l || g == ga || g == gb {
                     // Found, or the gap no longer moves (Newton within its tolerance).
                     break;
@@ -325,43 +298,4 @@ fn search(
     }
     p.set_load(target);
     Some(touch)
-}
-
-/// The first touches of the contacts with friction found on another (coarser) mesh, found
-/// again on the mesh of `p` from the solution `x` there: the search of [`first_touch`] around
-/// the load factor (and arc length) of each touch, without that contact. A touch not found
-/// again is kept. The active set, load factor and Jacobian hint of `p` are restored.
-pub(super) fn retouch(
-    p: &mut Constrained<'_>,
-    x: &[f64],
-    opts: &NewtonOptions,
-    effort: &mut Effort,
-) {
-    let hint = p.hint.take();
-    let (load, from) = (p.load, p.from);
-    for i in 0..p.active.len() {
-        let a = p.active[i];
-        if a.state == ContactState::Frictionless {
-            continue;
-        }
-        let saved = p.active.clone();
-        let o = p.offsets()[i];
-        let mut xr = x.to_vec();
-        xr.drain(o..o + a.size());
-        p.active.remove(i);
-        let span = RETOUCH_SPAN * a.touch.max(RETOUCH_SPAN);
-        p.set_load((a.touch + span).min(load));
-        p.from = (a.touch - span).max(0.0);
-        let again = correct(p, &xr, opts, effort)
-            .and_then(|xs| first_touch(p, &xs, a.obstacle, (a.site, a.arc), opts, effort));
-        p.active = saved;
-        if let Some(t) = again.filter(|t| t.found) {
-            p.active[i].reference = t.point;
-            p.active[i].arc = t.arc;
-            p.active[i].touch = t.load;
-        }
-    }
-    p.set_load(load);
-    p.from = from;
-    p.hint = hint;
 }

@@ -50,7 +50,6 @@ pub(super) struct Active {
     pub(super) reference: Vector3<f64>,
     /// Arc length (m) of the contact where it first touched (`L` at the tip).
     pub(super) arc: f64,
-    pub(super) touch: f64,
     pub(super) t0: [f64; 2],
     /// A slip direction (unit, world) held while a contact turns from sticking to sliding.
     pub(super) direction: Option<Vector3<f64>>,
@@ -71,7 +70,6 @@ impl Active {
             state: ContactState::Frictionless,
             reference: Vector3::zeros(),
             arc: 0.0,
-            touch: 0.0,
             t0: [0.0; 2],
             direction: None,
             probe: false,

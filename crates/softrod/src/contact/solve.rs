@@ -8,7 +8,6 @@ use nalgebra::{Matrix3, Vector3};
 use super::active_set::{active_set, step_loads};
 use super::constraint::TipConstraint;
 use super::finish::{fail, finish, jacobian_stability};
-use super::friction::retouch;
 use super::newton::Effort;
 use super::obstacle::Obstacle;
 use super::problem::Constrained;
@@ -104,11 +103,14 @@ pub fn solve_constrained(
     // The actuated rod without loads: the target of the tip at load factor 0.
     let mut effort = Effort::default();
     // (Not with a triangle mesh: the curvature of its distance jumps between faces and
-    // edges, and Newton from the coarse solution may settle on another face.)
-    let smooth = !obstacles
+    // edges, and Newton from the coarse solution may settle on another face. Nor with
+    // friction: the coarse tolerance leaves errors in the held displacements that the axial
+    // stiffness turns into spurious friction forces, so sticking and sliding cannot be told
+    // apart there, and a load path followed sticking throughout may end on another branch.)
+    let coarse_ok = !obstacles
         .iter()
-        .any(|o| matches!(o.shape(), Obstacle::Mesh(_)));
-    if let Some(coarse) = coarse_mesh(options.integrator).filter(|_| smooth) {
+        .any(|o| matches!(o.shape(), Obstacle::Mesh(_)) || o.friction() > 0.0);
+    if let Some(coarse) = coarse_mesh(options.integrator).filter(|_| coarse_ok) {
         // The contacts and the nonlinear iterations on the coarse mesh; then Newton on the
         // mesh asked from there, with the coarse Jacobian, and the active set checked there.
         p.integrator = coarse;
@@ -124,7 +126,6 @@ pub fn solve_constrained(
             p.last = None;
             p.load = 1.0;
             p.hint = p.solved.take();
-            retouch(&mut p, &xc, &options.newton, &mut effort);
             if let Some(x) = active_set(&mut p, &xc, &options.newton, &mut effort) {
                 return finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort);
             }
@@ -224,7 +225,7 @@ fn restart(p: &mut Constrained<'_>, integrator: Integrator) {
 }
 
 /// [`reach`] on the mesh asked. If it meets a contact with friction made by the actuation
-/// ([`Constrained::pathless`]; or the coarse mesh met one), the solve with the actuation
+/// ([`Constrained::pathless`]), the solve with the actuation
 /// stepped with the loads from the unactuated rod ([`ramp::stepped`]), so that its first
 /// touch is on that path; failing that, [`reach`] again with that contact's reference where
 /// the actuated rod without it touches it.
