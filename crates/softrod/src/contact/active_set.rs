@@ -140,7 +140,8 @@ fn merge_plane(
 }
 
 /// Adds the contacts `added` at zero force and relaxes their gaps from the values found to
-/// zero by continuation; the state at full contact targets.
+/// zero by continuation; the state at full contact targets. A contact with friction starts
+/// sticking where it first touched on the load path.
 fn add_contacts(
     p: &mut Constrained<'_>,
     mut x: Vec<f64>,
@@ -149,11 +150,6 @@ fn add_contacts(
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
     let l = p.model.length();
-    for a in &mut p.active {
-        a.g0 = 0.0;
-        a.dg0 = 0.0;
-        a.t0 = [0.0; 2];
-    }
     let rough = added.iter().any(|&(o, ..)| p.obstacles[o].friction() > 0.0);
     let actuated = p.tensions.iter().chain(&p.pressures).any(|v| *v != 0.0);
     let free = p.path.is_none() && p.tip.is_none() && !p.pathless_ok;
@@ -185,13 +181,30 @@ fn add_contacts(
         }
         x.extend([0.0; 3]);
     }
-    // Straight to the contact (one exact Newton solve), else by relaxing the gaps.
-    if let Some((xs, _)) = exact_newton(p, &x, opts, effort, false, true) {
+    reach_contacts(p, &x, opts, effort)
+}
+
+/// The state at full contact targets from `x`, where the newest contacts (at zero force)
+/// penetrate: one exact Newton solve with the predictor of new contacts, else their gaps
+/// relaxed from the values found to zero by continuation.
+fn reach_contacts(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
+    for a in &mut p.active {
+        a.g0 = 0.0;
+        a.dg0 = 0.0;
+        a.t0 = [0.0; 2];
+    }
+    if let Some((xs, _)) = exact_newton(p, x, opts, effort, false, true) {
         return Some(xs);
     }
     // The gap targets of the new contacts: their rows at zero force.
     let mut r = vec![0.0; p.dim()];
-    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
+    if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {
         return None;
     }
     let offsets = p.offsets();
@@ -206,7 +219,7 @@ fn add_contacts(
         }
     }
     let start = ContinuationSettings {
-        x0: &x,
+        x0: x,
         jacobian0: None,
         first_increment: 1.0,
         max_increment: 1.0,
