@@ -360,13 +360,15 @@ fn vanishing_friction_inside_the_rod_is_the_frictionless_solve() {
 /// The two-segment NiTi robot pressing a sphere with friction (μ = 0.1, 1), solved from a
 /// straight rod: by its tendons (tensions [3, 0, 0, 0, 1, 0] N against the sphere of the
 /// contact benchmark: the actuation is then stepped with the loads so that the contact's
-/// first touch is on that path) and by a tip force on the unactuated robot. One contact
-/// inside the rod, sliding; converged, no penetration, forces inside the cone (on it when
-/// sliding), global balance with the friction forces to 1e-10.
+/// first touch is on that path) and by tip forces on the unactuated robot, the larger of
+/// which bends it past the sphere (the frictionless rod slides around its +y side, pushed
+/// by the +y component of the force; with friction it must not end on the far side). One
+/// contact inside the rod, sliding; converged, no penetration, forces inside the cone (on
+/// it when sliding), global balance with the friction forces to 1e-10.
 #[test]
 fn niti_robot_pressing_a_sphere_with_friction_converges_and_balances() {
     let radius = 0.7e-3;
-    let cases: [([f64; 6], Vector3<f64>, [f64; 3], f64); 2] = [
+    let cases: [([f64; 6], Vector3<f64>, [f64; 3], f64); 3] = [
         (
             [3.0, 0.0, 0.0, 0.0, 1.0, 0.0],
             Vector3::zeros(),
@@ -376,6 +378,12 @@ fn niti_robot_pressing_a_sphere_with_friction_converges_and_balances() {
         (
             [0.0; 6],
             Vector3::new(-0.02, 0.005, 0.0),
+            [-0.0357, 0.0, 0.25],
+            0.03,
+        ),
+        (
+            [0.0; 6],
+            Vector3::new(-0.05, 0.02, 0.0),
             [-0.0357, 0.0, 0.25],
             0.03,
         ),
@@ -414,6 +422,10 @@ fn niti_robot_pressing_a_sphere_with_friction_converges_and_balances() {
             }
             let scale = sol.contacts.iter().map(|c| c.normal_force).sum::<f64>() + force.norm();
             assert_balanced_with(&sol, &sphere, radius, force, scale);
+            assert!(
+                sol.solution.tip_position()[1] * force.y >= 0.0,
+                "on the far side"
+            );
         }
     }
 }
