@@ -521,8 +521,10 @@ def solve_statics(
     max_load_steps 64, throw True, seek_stable True, on_unstable "warn". ``s_out`` (m) adds
     nodes at those arc lengths. ``displacements`` (m, one per tendon, None: tension control)
     holds tendons at a shortening of their path; ``tendon_stiffness`` (N/m) their stiffness.
-    ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``, ``Cylinder``) are touched by the
-    rod's surface without friction; ``tip_constraint`` (``softrod.Clamp(pose)``, ``Pin(point)``,
+    ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``, ``Cylinder``, ``Mesh``) are touched
+    by the rod's surface, with the Coulomb coefficient ``friction`` of each at point contacts
+    (at the tip or inside the rod; a plane with friction the rod lies along raises a
+    ``ValueError`` naming ``friction``); ``tip_constraint`` (``softrod.Clamp(pose)``, ``Pin(point)``,
     ``Slide(point, normal)``) holds the tip."""
 
 def _inverse_statics(

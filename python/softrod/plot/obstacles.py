@@ -76,7 +76,7 @@ def _check(obj, vectors: tuple[str, ...], radius: bool) -> None:
 class Plane:
     """A plane through ``point`` (m, world, shape (3,)) with unit ``normal`` (shape (3,));
     ``friction`` is the Coulomb coefficient of its surface (dimensionless, >= 0; friction
-    acts at tip contacts)."""
+    acts at point contacts, at the tip and inside the rod)."""
 
     point: tuple[float, float, float]
     normal: tuple[float, float, float]

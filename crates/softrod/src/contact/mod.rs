@@ -3,7 +3,7 @@
 //! [`solve_constrained`] solves the statics of a robot whose tip is held by a
 //! [`TipConstraint`] (clamped at a pose, pinned at a point, sliding on a plane, or any held
 //! directions of a frame) and whose surface touches rigid [`Obstacle`]s (planes, spheres,
-//! capsules, cylinders, triangle meshes), with Coulomb friction at tip contacts
+//! capsules, cylinders, triangle meshes), with Coulomb friction at point contacts
 //! ([`ContactState`]). The constraints are exact: the held tip directions
 //! and the contact gaps are residual rows of the shooting problem, their reactions unknowns,
 //! solved by the crate's Newton and continuation (see `docs/contact.md`). The solution

@@ -173,9 +173,9 @@ impl Obstacle {
     }
 
     /// The obstacle with Coulomb friction coefficient `mu` (dimensionless, finite, >= 0) at
-    /// its surface; `mu = 0` is the frictionless obstacle. Friction acts at contacts at the
-    /// tip (see [`super::ContactState`]); a frictional obstacle touched inside the rod is
-    /// refused by the solve.
+    /// its surface; `mu = 0` is the frictionless obstacle. Friction acts at point contacts, at
+    /// the tip and inside the rod (see [`super::ContactState`]); a plane with friction the rod
+    /// lies along (a contact interval) is refused by the solve.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `friction` if `mu` is negative or not finite.

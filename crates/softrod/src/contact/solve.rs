@@ -37,12 +37,14 @@ const COARSE_TOLERANCE: f64 = 1e-5;
 /// contact and, for a contact inside the rod, its arc length; the residual the tip
 /// conditions (the held directions' pose error, the free directions' wrench balance), and per
 /// contact its gap (zero), the slope of the gap along the rod (zero: the contact sits at the
-/// least gap), and the force's components along the obstacle's surface (zero: frictionless).
+/// least gap), and the force's components along the obstacle's surface (zero when
+/// frictionless; with friction the sticking or sliding rows of `contact/friction.rs`).
 /// The contacts are found by an active set: a contact is added at every local minimum of a
 /// gap below `-10 tolerance L` (reached by relaxing its gap from the penetration found) and
 /// released when its normal force is negative, until no force pulls and nothing penetrates.
 /// The external loads and the tip target (from the unloaded tip pose) are stepped by load
-/// continuation when the direct solve fails.
+/// continuation when the direct solve fails; with a free tip, a contact with friction made
+/// by the actuation has the actuation stepped with the loads.
 ///
 /// # Errors
 /// As [`solve_statics`] for the model, actuation and options; [`Error::InvalidParameter`]
