@@ -189,7 +189,47 @@ def test_bad_friction_is_a_named_value_error(make, bad):
     assert repr(bad) in str(err.value)
 
 
-def test_friction_in_robot_files_and_inside_the_rod():
+# The propped cantilever: a stout rod (R/L = 0.01) over a post (a cylinder across it, axis
+# along y) at a = 0.6 L, surface gap 1e-6 L, pressed by the tip force (-Fx, Fy, 0).
+R_POST, GAP, A, RC = 1e-2, 1e-6, 0.6, 0.05
+
+
+def _post(friction):
+    x = -(R_POST + GAP + RC)
+    return sr.Cylinder((x, -0.2, A), (x, 0.2, A), RC, friction=friction)
+
+
+@pytest.mark.parametrize(("fy", "state"), [(0.5, "stick"), (-1.5, "slide")])
+def test_interior_friction_is_the_propped_cantilever(fy, state):
+    # Timoshenko flexibilities (Cowper's shear area, as the rod's section): alpha at a under
+    # a unit force at a, beta at a under one at L (and at L under one at a), gamma at L.
+    ei = E * np.pi * R_POST**4 / 4
+    gas = 6 * (1 + NU) / (7 + 6 * NU) * E / (2 * (1 + NU)) * np.pi * R_POST**2
+    alpha = A**3 / (3 * ei) + A / gas
+    beta = A**2 * (3 * L - A) / (6 * ei) + A / gas
+    gamma = L**3 / (3 * ei) + L / gas
+    mu, closing = 0.5, GAP / beta
+    fx, fy = 2 * closing, fy * closing
+    rod = sr.Rod(L, sr.CircularSection(R_POST), sr.LinearElastic(E, NU))
+    loads = sr.Loads(tip_force=(-fx, fy, 0.0))
+    sol = sr.solve_statics(rod, loads=loads, obstacles=[_post(mu)], steps=100)
+    (c,) = sol.contacts
+    assert c["state"] == state
+    # Proportional loading: the rod touches the post at lambda0 = gap / (Fx beta); the post
+    # then props it at a, sticking (|Fy| <= mu Fx) where it touched, else sliding.
+    lambda0 = closing / fx
+    normal = (1 - lambda0) * fx * beta / alpha
+    ft = -(1 - lambda0) * fy * beta / alpha if state == "stick" else -np.sign(fy) * mu * normal
+    tip = (-fx * gamma + normal * beta, fy * gamma + ft * beta)
+    assert abs(c["s"] - A) < 1e-4
+    assert abs(c["normal_force"] / normal - 1) < 1e-4
+    assert abs(c["tangential_force"][1] / ft - 1) < 1e-4
+    np.testing.assert_allclose(sol.position[-1, :2], tip, rtol=1e-4)
+    total = np.asarray(c["normal"]) * c["normal_force"] + np.asarray(c["tangential_force"])
+    np.testing.assert_allclose(sol.contact_force.sum(axis=0), total, rtol=0, atol=1e-12 * fx)
+
+
+def test_friction_in_robot_files_and_along_an_interval():
     plane = sr.Plane((-(R + DELTA), 0.0, 0.0), (1.0, 0.0, 0.0), friction=0.4)
     robot = sr.Robot(_rod(), loads=sr.Loads(tip_force=(-2 * CLOSING, 0, 0)), obstacles=[plane])
     text = robot.to_toml()
@@ -209,8 +249,10 @@ def test_friction_in_robot_files_and_inside_the_rod():
     }
     with pytest.raises(ValueError, match="friction"):
         sr.Robot.from_dict(data)
-    # A frictional floor touched along the rod (a uniform load): refused, naming `friction`.
+    # A frictional floor the rod lies along (a uniform load: a contact interval): refused,
+    # naming `friction`.
     q = 72 * EI * DELTA / (0.5 * L) ** 4
     loads = sr.Loads(distributed_force=(-q, 0.0, 0.0))
-    with pytest.raises(ValueError, match="friction"):
+    with pytest.raises(ValueError, match="friction") as err:
         sr.solve_statics(_rod(), loads=loads, obstacles=[plane], steps=100)
+    assert err.value.parameter == "friction"

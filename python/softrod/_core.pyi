@@ -524,8 +524,8 @@ def solve_statics(
     ``obstacles`` (``softrod.Plane``, ``Sphere``, ``Capsule``, ``Cylinder``, ``Mesh``) are touched
     by the rod's surface, with the Coulomb coefficient ``friction`` of each at point contacts
     (at the tip or inside the rod; a plane with friction the rod lies along raises a
-    ``ValueError`` naming ``friction``); ``tip_constraint`` (``softrod.Clamp(pose)``, ``Pin(point)``,
-    ``Slide(point, normal)``) holds the tip."""
+    ``ValueError`` naming ``friction``); ``tip_constraint`` (``softrod.Clamp(pose)``,
+    ``Pin(point)``, ``Slide(point, normal)``) holds the tip."""
 
 def _inverse_statics(
     rod: Rod,
