@@ -368,7 +368,9 @@ fn vanishing_friction_inside_the_rod_is_the_frictionless_solve() {
 #[test]
 fn niti_robot_pressing_a_sphere_with_friction_converges_and_balances() {
     let radius = 0.7e-3;
-    let cases: [([f64; 6], Vector3<f64>, [f64; 3], f64); 3] = [
+    // (tensions (N), tip force (N), sphere centre (m), sphere radius (m))
+    type Case = ([f64; 6], Vector3<f64>, [f64; 3], f64);
+    let cases: [Case; 3] = [
         (
             [3.0, 0.0, 0.0, 0.0, 1.0, 0.0],
             Vector3::zeros(),

@@ -209,21 +209,18 @@ pub(super) fn first_touch(
     // (E A / L): the touch is solved to round-off.
     let mut strict = *opts;
     strict.tolerance = opts.tolerance.min(TOUCH_TOLERANCE);
-    let touched = if site == Site::Tip {
+    if site == Site::Tip {
         let mut r = vec![0.0; p.dim()];
-        (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed)
+        return (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed)
             .then(|| search(p, xs, o, &strict, effort))
-            .flatten()
-    } else {
-        let mut probe = Active::frictionless(o, Site::Interior);
-        probe.probe = true;
-        p.active.push(probe);
-        xs.extend([s / l, 0.0, 0.0, 0.0]);
-        let touched =
-            correct(p, &xs, &strict, effort).and_then(|xs| search(p, xs, o, &strict, effort));
-        p.active.pop();
-        touched
-    };
+            .flatten();
+    }
+    let mut probe = Active::frictionless(o, Site::Interior);
+    probe.probe = true;
+    p.active.push(probe);
+    xs.extend([s / l, 0.0, 0.0, 0.0]);
+    let touched = correct(p, &xs, &strict, effort).and_then(|xs| search(p, xs, o, &strict, effort));
+    p.active.pop();
     touched
 }
 
