@@ -153,7 +153,9 @@ pub(super) fn switch(
             continue;
         }
         let s = p.arc_of(a, x, o);
-        let y = p.state_at(s)?;
+        let Some(y) = p.state_at(s) else {
+            continue;
+        };
         let (u, n) = p.slip(a, s, &y);
         let k = o + a.force_offset();
         let f = Vector3::new(x[k], x[k + 1], x[k + 2]) * fs;
@@ -193,7 +195,7 @@ pub(super) struct Touch {
 /// (Illinois) on the load factor between the last accepted load step and the current one.
 /// Inside the rod the gap is read at a probe ([`Active::probe`]) held at the least gap. At
 /// the first load step (load factor 0, the actuated rod) or if the search fails, the
-/// contact point of `x` itself. The load factor and active set are restored. `None` if `x`
+/// contact of `x` itself. The load factor and active set are restored. `None` if `x`
 /// cannot be evaluated (or, inside the rod, the probe not solved there).
 pub(super) fn first_touch(
     p: &mut Constrained<'_>,
