@@ -109,6 +109,9 @@ pub(crate) struct Shooting<'a> {
     reference: Shape,
     /// Right-hand-side evaluations so far.
     pub evaluations: usize,
+    /// Subtracted from the tip rows of every residual: a coarse mesh's residual at a nearby
+    /// solution on a finer mesh (see `statics::coarse_first`), zero otherwise.
+    pub defect: [f64; 6],
 }
 
 impl<'a> Shooting<'a> {
@@ -130,6 +133,7 @@ impl<'a> Shooting<'a> {
             exact: None,
             reference: Vec::new(),
             evaluations: 0,
+            defect: [0.0; 6],
         }
     }
 
@@ -208,7 +212,10 @@ impl<'a> Shooting<'a> {
         let nt = self.eq.model.tendons().len();
         self.lengths.clear();
         self.lengths.extend_from_slice(&self.ws.integral[..nt]);
-        let (r, cols) = eq.residual(&y, columns.len());
+        let (mut r, cols) = eq.residual(&y, columns.len());
+        for k in 0..6 {
+            r[k] -= self.defect[k];
+        }
         self.columns = None;
         if N >= FULL {
             let mut j = [0.0; 36];
