@@ -149,8 +149,16 @@ impl<const N: usize> System<N> for Evaluator<'_, '_> {
 }
 
 impl<const N: usize> Piecewise<N> for Evaluator<'_, '_> {
+    /// Every march starts from the straight-tendon guess (interval 0: nothing of an earlier
+    /// march, which may have diverged, carries over); across an interior break the local
+    /// warm start of the interval before is kept if the same tendons and chambers act on
+    /// both sides (a point load's break, e.g. a contact's).
     fn enter_interval(&mut self, k: usize) {
-        self.set_interval(k);
+        if k > 0 && k == self.ws.interval + 1 {
+            Evaluator::enter_interval(self, k);
+        } else {
+            self.set_interval(k);
+        }
     }
     fn jump(&mut self, s: f64, y: &mut [f64; N]) {
         let ncol = self.ws.columns.len().min((N - STATE) / COLUMN);
