@@ -439,32 +439,44 @@ impl Constrained<'_> {
         for (k, m) in mcol.iter_mut().enumerate().take(6) {
             *m = Some(k);
         }
-        let mut sites: Vec<Site2> = Vec::new();
-        let mut next = 6;
-        for (a, &o) in self.active.iter().zip(&self.offsets()) {
-            if a.site == Site::Tip {
-                continue;
-            }
-            let s = x[o] * l;
+        // The contacts inside the rod (first unknown, arc length) in the order of the
+        // contacts; their march columns in the order of their arc lengths (those of a contact
+        // are zero before it, and the march integrates them from there: see
+        // [`Self::march_with_columns`]).
+        let interior: Vec<(usize, f64, Site)> = self
+            .active
+            .iter()
+            .zip(self.offsets())
+            .filter(|(a, _)| a.site != Site::Tip)
+            .map(|(a, o)| (o, x[o] * l, a.site))
+            .collect();
+        let mut order: Vec<usize> = (0..interior.len()).collect();
+        order.sort_by(|&a, &b| interior[a].1.total_cmp(&interior[b].1));
+        let mut rank = vec![0; interior.len()];
+        for (r, &i) in order.iter().enumerate() {
+            rank[i] = r;
+        }
+        let mut sites: Vec<Site2> = Vec::with_capacity(interior.len());
+        for (&(o, s, site), &r) in interior.iter().zip(&rank) {
+            let column = 6 + 4 * r;
             for q in 0..4 {
-                mcol[o + q] = Some(next + q);
+                mcol[o + q] = Some(column + q);
             }
-            let post_at = if a.site == Site::Interval {
+            let post_at = if site == Site::Interval {
                 f64::from_bits(s.to_bits() + 1)
             } else {
                 s
             };
             sites.push(Site2 {
                 s,
-                column: next,
+                column,
                 post_at,
                 before: None,
                 after: None,
                 rate: [[0.0; STATE]; 2],
             });
-            next += 4;
         }
-        (mcol, sites, next)
+        (mcol, sites, 6 + 4 * interior.len())
     }
 
     /// One march at `x` of the state with the columns `cols` on the contact model `model`,
@@ -495,7 +507,11 @@ impl Constrained<'_> {
         };
         let eq = equations(model, &self.tensions, &self.pressures);
         let mut ws = Workspace::new(model.tendons().len());
-        let mut columns = vec![Column::Free; cols.ncol];
+        // Without actuator columns (after the unknowns'), a contact's columns, zero before
+        // it, are integrated from its arc length on (they are in the order of the arc
+        // lengths): until then only the base wrench's six.
+        let from_sites = cols.actuators.is_empty();
+        let mut columns = vec![Column::Free; if from_sites { 6 } else { cols.ncol }];
         columns.extend_from_slice(cols.actuators);
         ws.set_columns(&columns, &[]);
         let y0: [f64; N] = eq.initial(&x[..6]);
@@ -512,9 +528,15 @@ impl Constrained<'_> {
                 &[],
                 y0,
                 scheme,
-                |_, s, interval, y: &mut [f64; N]| {
+                |ev, s, interval, y: &mut [f64; N]| {
                     for site in sites.iter_mut().filter(|c| c.s == s) {
                         site.record(&mut side, s, interval, y, (l, fs));
+                        if from_sites && site.after.is_some() {
+                            let seeded = site.column + 4;
+                            if ev.ws.columns.len() < seeded {
+                                ev.ws.columns.resize(seeded, Column::Free);
+                            }
+                        }
                     }
                     if observe == Some(nodes.len()) {
                         observed = Some(y.to_vec());

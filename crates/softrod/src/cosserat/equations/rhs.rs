@@ -4,7 +4,7 @@
 use nalgebra::{Vector3, Vector6};
 
 use super::{
-    col_rot, mul_hat, mul_hat2, project, put3, rot, v3, Column, Evaluator, Local, COLUMN, DM, DN,
+    col_rot, mul_hat, mul_hat2, project_columns, put3, rot, v3, Column, Evaluator, Local, COLUMN, DM, DN,
     DR, STATE,
 };
 use crate::integrate::march::Piecewise;
@@ -144,7 +144,8 @@ impl<const N: usize> System<N> for Evaluator<'_, '_> {
     }
     #[inline]
     fn project(&mut self, y: &mut [f64; N]) {
-        project(y);
+        // (The columns beyond the active ones have no right-hand side: held where they are.)
+        project_columns(y, self.ws.columns.len());
     }
 }
 
