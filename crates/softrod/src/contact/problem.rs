@@ -174,8 +174,10 @@ pub(crate) struct Constrained<'m> {
     /// Whether Newton continues past the tolerance toward round-off (not on the coarse
     /// mesh, whose solution is only a start).
     pub(super) refine: bool,
-    /// Whether the contact rows of a Jacobian are differenced one-sided (on the coarse
-    /// mesh, where the Jacobian only steers Newton) rather than centrally.
+    /// Whether the problem is on the coarse mesh, whose evaluations only steer Newton: the
+    /// contact rows of a Jacobian are then differenced one-sided rather than centrally, and
+    /// a march integrates the path lengths of the tensioned tendons only (no solution is
+    /// assembled from it).
     pub(super) rough: bool,
     /// Load factor of the last accepted load step (where a first touch is searched from).
     pub(super) from: f64,
@@ -290,6 +292,7 @@ impl<'m> Constrained<'m> {
         };
         let eq = equations(&model, &self.tensions, &self.pressures);
         let mut sh = Shooting::new(eq, self.integrator, plan);
+        sh.passive_lengths = !self.rough;
         let pass = if full {
             sh.pass::<FULL>(&x[..6], 1.0)
         } else {
@@ -349,7 +352,7 @@ impl<'m> Constrained<'m> {
             key: self.key(x, mu),
             rows: rows.clone(),
             jacobian: None,
-            marched: (!full).then(|| {
+            marched: (!full && !self.rough).then(|| {
                 (
                     self.integrator,
                     std::mem::take(&mut sh.lengths),
