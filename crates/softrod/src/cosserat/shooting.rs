@@ -116,7 +116,18 @@ pub(crate) struct Shooting<'a> {
 
 impl<'a> Shooting<'a> {
     pub fn new(eq: Equations<'a>, integrator: Integrator, plan: Vec<usize>) -> Self {
-        let ws = Workspace::new(eq.model.tendons().len());
+        Self::with_workspace(eq, integrator, plan, Workspace::new(eq.model.tendons().len()))
+    }
+
+    /// [`Self::new`] in the workspace `ws` of an earlier march of the same model's tendons
+    /// (every pass starts afresh in it: its quadratures reset, the local solve from the
+    /// straight-tendon guess).
+    pub fn with_workspace(
+        eq: Equations<'a>,
+        integrator: Integrator,
+        plan: Vec<usize>,
+        ws: Workspace,
+    ) -> Self {
         Self {
             eq,
             held: Vec::new(),
