@@ -345,7 +345,8 @@ impl<'m> Constrained<'m> {
             Integrator::Adaptive(_) => Vec::new(),
         };
         let eq = equations(&model, &self.tensions, &self.pressures);
-        let mut sh = Shooting::with_workspace(eq, self.integrator, plan, scratch.march_workspace(nt));
+        let mut sh =
+            Shooting::with_workspace(eq, self.integrator, plan, scratch.march_workspace(nt));
         sh.nodes = scratch.node_buffer();
         sh.passive_lengths = !self.rough;
         let pass = if full {

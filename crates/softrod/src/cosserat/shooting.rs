@@ -116,7 +116,12 @@ pub(crate) struct Shooting<'a> {
 
 impl<'a> Shooting<'a> {
     pub fn new(eq: Equations<'a>, integrator: Integrator, plan: Vec<usize>) -> Self {
-        Self::with_workspace(eq, integrator, plan, Workspace::new(eq.model.tendons().len()))
+        Self::with_workspace(
+            eq,
+            integrator,
+            plan,
+            Workspace::new(eq.model.tendons().len()),
+        )
     }
 
     /// [`Self::new`] in the workspace `ws` of an earlier march of the same model's tendons

@@ -4,8 +4,8 @@
 use nalgebra::{Vector3, Vector6};
 
 use super::{
-    col_rot, mul_hat, mul_hat2, project_columns, put3, rot, v3, Column, Evaluator, Local, COLUMN, DM, DN,
-    DR, STATE,
+    col_rot, mul_hat, mul_hat2, project_columns, put3, rot, v3, Column, Evaluator, Local, COLUMN,
+    DM, DN, DR, STATE,
 };
 use crate::integrate::march::Piecewise;
 use crate::integrate::System;
