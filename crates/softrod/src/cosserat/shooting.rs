@@ -103,6 +103,9 @@ pub(crate) struct Shooting<'a> {
     pub require_stable: bool,
     /// Tendon path lengths of the last pass (m).
     pub lengths: Vec<f64>,
+    /// Whether a pass integrates the path lengths of the tension-free tendons too (those of
+    /// the tensioned ones always are); when not, theirs in [`Self::lengths`] are zero.
+    pub passive_lengths: bool,
     /// The exact columns of the last pass with them, the certificate's evidence.
     exact: Option<ExactPass>,
     /// The shape of the committed state, the safeguard's reference.
@@ -116,7 +119,23 @@ pub(crate) struct Shooting<'a> {
 
 impl<'a> Shooting<'a> {
     pub fn new(eq: Equations<'a>, integrator: Integrator, plan: Vec<usize>) -> Self {
-        let ws = Workspace::new(eq.model.tendons().len());
+        Self::with_workspace(
+            eq,
+            integrator,
+            plan,
+            Workspace::new(eq.model.tendons().len()),
+        )
+    }
+
+    /// [`Self::new`] in the workspace `ws` of an earlier march of the same model's tendons
+    /// (every pass starts afresh in it: its quadratures reset, the local solve from the
+    /// straight-tendon guess).
+    pub fn with_workspace(
+        eq: Equations<'a>,
+        integrator: Integrator,
+        plan: Vec<usize>,
+        ws: Workspace,
+    ) -> Self {
         Self {
             eq,
             held: Vec::new(),
@@ -130,6 +149,7 @@ impl<'a> Shooting<'a> {
             columns: None,
             require_stable: false,
             lengths: Vec::new(),
+            passive_lengths: true,
             exact: None,
             reference: Vec::new(),
             evaluations: 0,
@@ -168,7 +188,7 @@ impl<'a> Shooting<'a> {
         self.ws.set_columns(columns, &[]);
         // The tendon lengths ride on the stages (the quadrature the displacement constraints
         // and their sensitivities use).
-        self.ws.track_lengths = true;
+        self.ws.track_lengths = self.passive_lengths;
         self.nodes.clear();
         let y0: [f64; N] = self.eq.initial(x);
         let scheme = Self::scheme(&self.integrator, &self.plan);
