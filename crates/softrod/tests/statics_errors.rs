@@ -239,10 +239,7 @@ fn bad_loads_and_options_are_named() {
     };
     assert_eq!(name_of(solve(&l, &o)), "max_iterations");
     let o = SolveOptions {
-        warm_start: Some(WarmStart {
-            base_wrench: [0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0],
-            jacobian: None,
-        }),
+        warm_start: Some(WarmStart::wrench([0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0])),
         ..d
     };
     assert_eq!(name_of(solve(&l, &o)), "warm_start.base_wrench[2]");

@@ -145,8 +145,11 @@ fn two_segment_robot_default_options_are_accurate() {
     assert!((k1 - 12f64.sqrt() * 0.01 / ei).abs() < 1e-9 * k1, "{k1}");
 }
 
+/// A warm start reaches the cold solution with less work. The work is counted in right-hand
+/// sides: a loaded solve iterates on a coarse mesh first (a fifth of the cost per iteration)
+/// and finishes on the mesh asked, so its iteration count mixes the two meshes.
 #[test]
-fn warm_start_reaches_the_cold_solution_in_fewer_iterations() {
+fn warm_start_reaches_the_cold_solution_with_fewer_evaluations() {
     let rod = common::niti_rod();
     let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
     let a = common::solve(
@@ -171,7 +174,6 @@ fn warm_start_reaches_the_cold_solution_in_fewer_iterations() {
         warm.stats.function_evaluations
     );
     assert!(dist(cold.tip_position(), warm.tip_position()) < 1e-12);
-    assert!(warm.stats.iterations < cold.stats.iterations);
     assert!(warm.stats.function_evaluations < cold.stats.function_evaluations);
 }
 

@@ -20,7 +20,7 @@
 
 use nalgebra::{Vector3, Vector6};
 
-use super::problem::{equations, Active, Constrained, Pass, Site};
+use super::problem::{equations, Active, Constrained, Pass, Scratch, Site};
 use super::rows::AtContact;
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, Workspace, COLUMN, DN, STATE,
@@ -270,17 +270,17 @@ impl Constrained<'_> {
             actuators: &actuators,
         };
         let nt = model.tendons().len();
-        let mut pair = self.scratch(nt);
-        let [scratch, other] = &mut *pair;
+        let mut scratch = self.scratch(nt);
         let ColumnMarch { y, nodes, observed } =
-            self.march_with_columns::<N>(&model, x, &mut sites, &cols, observe, scratch)?;
+            self.march_with_columns::<N>(&model, x, &mut sites, &cols, observe, &mut scratch)?;
         let eq = equations(&model, &self.tensions, &self.pressures);
         let (res, dres) = eq.residual(&y, ncol + actuators.len());
         let (p_tip, r_tip) = (v3(&y, 0), rot(&y));
         let mut rows = self.tip_rows(&res, &p_tip, &r_tip).to_vec();
         let tip = (head(&y), nodes.last()?.interval);
         // The contact rows at the solution, and per contact the function of its node states.
-        let mut ev = [Evaluator { eq, ws: scratch }, Evaluator { eq, ws: other }];
+        let [before, after] = &mut scratch.sides;
+        let mut ev = [Evaluator { eq, ws: before }, Evaluator { eq, ws: after }];
         let at = self.contact_rows_at(&mut ev, x, mu, tip, &sites, &mut rows)?;
         if rows.len() != n || !rows.iter().all(|v| v.is_finite()) {
             return None;
@@ -306,8 +306,7 @@ impl Constrained<'_> {
             None => None,
             Some(yo) => Some(self.actuated(&model, &lin, &cols, yo)?),
         };
-        self.scratch = Some(pair);
-        self.last = Some(Pass {
+        let replaced = self.last.replace(Pass {
             model: std::sync::Arc::clone(&model),
             nodes,
             residual: res,
@@ -316,6 +315,8 @@ impl Constrained<'_> {
             jacobian: Some((j.to_vec(), twists)),
             marched: None,
         });
+        scratch.keep_nodes(replaced);
+        self.scratch = Some(scratch);
         Some((rows, actuated))
     }
 
@@ -439,32 +440,44 @@ impl Constrained<'_> {
         for (k, m) in mcol.iter_mut().enumerate().take(6) {
             *m = Some(k);
         }
-        let mut sites: Vec<Site2> = Vec::new();
-        let mut next = 6;
-        for (a, &o) in self.active.iter().zip(&self.offsets()) {
-            if a.site == Site::Tip {
-                continue;
-            }
-            let s = x[o] * l;
+        // The contacts inside the rod (first unknown, arc length) in the order of the
+        // contacts; their march columns in the order of their arc lengths (those of a contact
+        // are zero before it, and the march integrates them from there: see
+        // [`Self::march_with_columns`]).
+        let interior: Vec<(usize, f64, Site)> = self
+            .active
+            .iter()
+            .zip(self.offsets())
+            .filter(|(a, _)| a.site != Site::Tip)
+            .map(|(a, o)| (o, x[o] * l, a.site))
+            .collect();
+        let mut order: Vec<usize> = (0..interior.len()).collect();
+        order.sort_by(|&a, &b| interior[a].1.total_cmp(&interior[b].1));
+        let mut rank = vec![0; interior.len()];
+        for (r, &i) in order.iter().enumerate() {
+            rank[i] = r;
+        }
+        let mut sites: Vec<Site2> = Vec::with_capacity(interior.len());
+        for (&(o, s, site), &r) in interior.iter().zip(&rank) {
+            let column = 6 + 4 * r;
             for q in 0..4 {
-                mcol[o + q] = Some(next + q);
+                mcol[o + q] = Some(column + q);
             }
-            let post_at = if a.site == Site::Interval {
+            let post_at = if site == Site::Interval {
                 f64::from_bits(s.to_bits() + 1)
             } else {
                 s
             };
             sites.push(Site2 {
                 s,
-                column: next,
+                column,
                 post_at,
                 before: None,
                 after: None,
                 rate: [[0.0; STATE]; 2],
             });
-            next += 4;
         }
-        (mcol, sites, next)
+        (mcol, sites, 6 + 4 * interior.len())
     }
 
     /// One march at `x` of the state with the columns `cols` on the contact model `model`,
@@ -478,7 +491,7 @@ impl Constrained<'_> {
         sites: &mut [Site2],
         cols: &MarchColumns<'_>,
         observe: Option<usize>,
-        scratch: &mut Workspace,
+        scratch: &mut Scratch,
     ) -> Option<ColumnMarch<N>> {
         let l = self.model.length();
         let fs = self.model.force_scale();
@@ -494,16 +507,24 @@ impl Constrained<'_> {
             },
         };
         let eq = equations(model, &self.tensions, &self.pressures);
-        let mut ws = Workspace::new(model.tendons().len());
-        let mut columns = vec![Column::Free; cols.ncol];
+        let mut ws = scratch.march_workspace(model.tendons().len());
+        ws.track_lengths = false;
+        // Without actuator columns (after the unknowns'), a contact's columns, zero before
+        // it, are integrated from its arc length on (they are in the order of the arc
+        // lengths): until then only the base wrench's six.
+        let from_sites = cols.actuators.is_empty();
+        let mut columns = vec![Column::Free; if from_sites { 6 } else { cols.ncol }];
         columns.extend_from_slice(cols.actuators);
         ws.set_columns(&columns, &[]);
         let y0: [f64; N] = eq.initial(&x[..6]);
-        let mut nodes = Vec::new();
+        let mut nodes = scratch.node_buffer();
         let mut observed: Option<Vec<f64>> = None;
         let y = {
             let mut ev = Evaluator { eq, ws: &mut ws };
-            let mut side = Evaluator { eq, ws: scratch };
+            let mut side = Evaluator {
+                eq,
+                ws: &mut scratch.sides[0],
+            };
             let nodes = &mut nodes;
             let sites = &mut *sites;
             march(
@@ -512,9 +533,15 @@ impl Constrained<'_> {
                 &[],
                 y0,
                 scheme,
-                |_, s, interval, y: &mut [f64; N]| {
+                |ev, s, interval, y: &mut [f64; N]| {
                     for site in sites.iter_mut().filter(|c| c.s == s) {
                         site.record(&mut side, s, interval, y, (l, fs));
+                        if from_sites && site.after.is_some() {
+                            let seeded = site.column + 4;
+                            if ev.ws.columns.len() < seeded {
+                                ev.ws.columns.resize(seeded, Column::Free);
+                            }
+                        }
                     }
                     if observe == Some(nodes.len()) {
                         observed = Some(y.to_vec());
@@ -526,9 +553,11 @@ impl Constrained<'_> {
                     });
                 },
             )
-            .ok()?
+            .ok()
         };
-        self.evaluations += ws.evaluations + scratch.evaluations;
+        self.evaluations += ws.evaluations + scratch.sides[0].evaluations;
+        scratch.keep(ws, None);
+        let y = y?;
         if !y[..STATE].iter().all(|v| v.is_finite()) || sites.iter().any(|c| c.after.is_none()) {
             return None;
         }

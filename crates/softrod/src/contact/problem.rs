@@ -159,6 +159,60 @@ pub(super) type Key = (Vec<f64>, f64, f64, Vec<Active>, Option<TipConstraint>);
 /// rows along the base wrench.
 type Rows = (Vec<f64>, Option<[[f64; 6]; 6]>);
 
+/// Scratch of the evaluations of a constrained problem, kept from march to march.
+pub(super) struct Scratch {
+    /// The contact rows' evaluations, one per side of a contact: the warm starts of their
+    /// local solves (see [`Evaluator::enter_interval`](crate::cosserat::equations::Evaluator::enter_interval)).
+    pub(super) sides: [Workspace; 2],
+    /// The workspace of a march (every march starts afresh in it; allocated once).
+    march: Option<Workspace>,
+    /// A node buffer (that of a pass no longer needed).
+    nodes: Vec<Node>,
+}
+
+impl Scratch {
+    fn new(nt: usize) -> Self {
+        Self {
+            sides: [Workspace::new(nt), Workspace::new(nt)],
+            march: None,
+            nodes: Vec::new(),
+        }
+    }
+
+    /// The march workspace for `nt` tendons (taken, new if none; give it back with
+    /// [`Self::keep`]), with no evaluations and no material failure recorded.
+    pub(super) fn march_workspace(&mut self, nt: usize) -> Workspace {
+        match self.march.take().filter(|w| w.tendon_speed.len() == nt) {
+            Some(mut ws) => {
+                ws.evaluations = 0;
+                ws.material_error = None;
+                ws
+            }
+            None => Workspace::new(nt),
+        }
+    }
+
+    /// The node buffer (taken, empty).
+    pub(super) fn node_buffer(&mut self) -> Vec<Node> {
+        let mut nodes = std::mem::take(&mut self.nodes);
+        nodes.clear();
+        nodes
+    }
+
+    /// Keeps the march workspace `ws` and the nodes of `pass` (replaced) for the next march.
+    pub(super) fn keep(&mut self, ws: Workspace, pass: Option<Pass>) {
+        self.march = Some(ws);
+        self.keep_nodes(pass);
+    }
+
+    /// Keeps the nodes of `pass` (replaced) for the next march.
+    pub(super) fn keep_nodes(&mut self, pass: Option<Pass>) {
+        if let Some(p) = pass {
+            self.nodes = p.nodes;
+        }
+    }
+}
+
 /// The constrained shooting problem at load factor `load`; the parameter of
 /// [`Problem::evaluate`] relaxes the gap targets of newly added contacts.
 pub(crate) struct Constrained<'m> {
@@ -187,8 +241,10 @@ pub(crate) struct Constrained<'m> {
     /// Whether Newton continues past the tolerance toward round-off (not on the coarse
     /// mesh, whose solution is only a start).
     pub(super) refine: bool,
-    /// Whether the contact rows of a Jacobian are differenced one-sided (on the coarse
-    /// mesh, where the Jacobian only steers Newton) rather than centrally.
+    /// Whether the problem is on the coarse mesh, whose evaluations only steer Newton: the
+    /// contact rows of a Jacobian are then differenced one-sided rather than centrally, and
+    /// a march integrates the path lengths of the tensioned tendons only (no solution is
+    /// assembled from it).
     pub(super) rough: bool,
     /// Load factor of the last accepted load step (where a first touch is searched from).
     pub(super) from: f64,
@@ -204,9 +260,8 @@ pub(crate) struct Constrained<'m> {
     /// Whether such a contact is taken as it is, its reference where the rod without it
     /// touches it (when stepping the actuation failed, or with a held tip).
     pub(super) pathless_ok: bool,
-    /// Scratch of the contact rows' evaluations, one per side of a contact, kept from march
-    /// to march as the warm start of their local solves (see [`Evaluator::enter_interval`](crate::cosserat::equations::Evaluator::enter_interval)).
-    pub(super) scratch: Option<Box<[Workspace; 2]>>,
+    /// Scratch of the evaluations, kept from march to march (see [`Scratch`]).
+    pub(super) scratch: Option<Box<Scratch>>,
     /// With a free tip, the stability (contacts as dead loads) of the coarse mesh's
     /// solution, from its exact Jacobian there, and the active set it belongs to.
     pub(super) coarse_stability: Option<(Vec<Active>, crate::cosserat::Stability)>,
@@ -308,26 +363,30 @@ impl<'m> Constrained<'m> {
         self.model.with_loads(loads).ok()
     }
 
-    /// The scratch of the contact rows ([`Self::scratch`], taken; new if none), for `nt`
+    /// The scratch of the evaluations ([`Self::scratch`], taken; new if none), for `nt`
     /// tendons.
-    pub(super) fn scratch(&mut self, nt: usize) -> Box<[Workspace; 2]> {
+    pub(super) fn scratch(&mut self, nt: usize) -> Box<Scratch> {
         self.scratch
             .take()
-            .filter(|w| w[0].tendon_speed.len() == nt)
-            .unwrap_or_else(|| Box::new([Workspace::new(nt), Workspace::new(nt)]))
+            .filter(|w| w.sides[0].tendon_speed.len() == nt)
+            .unwrap_or_else(|| Box::new(Scratch::new(nt)))
     }
 
     /// One march at `x`; with `full`, the six base-wrench columns too. Returns the residual
     /// rows, and with `full` the exact Jacobian of the tip rows along the base wrench.
     pub(super) fn run(&mut self, x: &[f64], mu: f64, full: bool) -> Option<Rows> {
         let model = self.contact_model(x)?;
-        let mut pair = self.scratch(model.tendons().len());
+        let nt = model.tendons().len();
+        let mut scratch = self.scratch(nt);
         let plan = match self.integrator {
             Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
             Integrator::Adaptive(_) => Vec::new(),
         };
         let eq = equations(&model, &self.tensions, &self.pressures);
-        let mut sh = Shooting::new(eq, self.integrator, plan);
+        let mut sh =
+            Shooting::with_workspace(eq, self.integrator, plan, scratch.march_workspace(nt));
+        sh.nodes = scratch.node_buffer();
+        sh.passive_lengths = !self.rough;
         let pass = if full {
             sh.pass::<FULL>(&x[..6], 1.0)
         } else {
@@ -349,7 +408,7 @@ impl<'m> Constrained<'m> {
             None
         };
         let l = self.model.length();
-        let [before, after] = &mut *pair;
+        let [before, after] = &mut scratch.sides;
         let mut ev = [
             Evaluator {
                 eq: sh.eq,
@@ -376,18 +435,15 @@ impl<'m> Constrained<'m> {
             };
             self.contact_rows(&mut ev, a, at, &f, mu, &mut rows);
         }
-        self.scratch = Some(pair);
-        if !rows.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        self.last = Some(Pass {
+        let finite = rows.iter().all(|v| v.is_finite());
+        let pass = finite.then(|| Pass {
             nodes: std::mem::take(&mut sh.nodes),
             residual: res,
             model: Arc::clone(&model),
             key: self.key(x, mu),
             rows: rows.clone(),
             jacobian: None,
-            marched: (!full).then(|| {
+            marched: (!full && !self.rough).then(|| {
                 (
                     self.integrator,
                     std::mem::take(&mut sh.lengths),
@@ -395,7 +451,10 @@ impl<'m> Constrained<'m> {
                 )
             }),
         });
-        Some((rows, jac))
+        let replaced = pass.and_then(|p| self.last.replace(p));
+        scratch.keep(sh.ws, replaced);
+        self.scratch = Some(scratch);
+        finite.then_some((rows, jac))
     }
 }
 

@@ -14,19 +14,10 @@ use super::problem::Constrained;
 use super::ramp;
 use super::{ContactCompliance, ContactSolution};
 use crate::cosserat::equations::{rot, v3};
-use crate::cosserat::statics::{scaled, solve_statics, Integrator, SolveOptions};
+use crate::cosserat::statics::{scaled, solve_statics, Integrator, SolveOptions, COARSE_TOLERANCE};
 use crate::error::{Error, Result};
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{Evaluated, Problem};
-
-/// Ratio of the RK4 steps of a contact solve to those of its coarse mesh.
-const COARSE_RATIO: usize = 5;
-/// Fewest RK4 steps of the coarse mesh of a contact solve.
-const MIN_COARSE_STEPS: usize = 8;
-/// Newton tolerance on the coarse mesh (at least the one asked): below the difference of the
-/// two meshes' residuals (2.6e-5 on the benchmark case), which Newton on the mesh asked
-/// removes; converging the coarse mesh further only adds coarse passes.
-const COARSE_TOLERANCE: f64 = 1e-5;
 
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
 /// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
@@ -199,17 +190,9 @@ fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
     p.solved = Some((p.active.clone(), j));
 }
 
-/// Steps of the coarse mesh of the contact solve with `integrator`: RK4 with a fifth of its
-/// steps (at least [`MIN_COARSE_STEPS`]); `None` (no coarse mesh) otherwise.
+/// The coarse mesh of the contact solve with `integrator` ([`Integrator::coarse`]).
 pub(super) fn coarse_mesh(integrator: Integrator) -> Option<Integrator> {
-    match integrator {
-        Integrator::Rk4 { steps } if steps >= COARSE_RATIO * MIN_COARSE_STEPS => {
-            Some(Integrator::Rk4 {
-                steps: steps / COARSE_RATIO,
-            })
-        }
-        _ => None,
-    }
+    integrator.coarse()
 }
 
 /// The problem `p` back at the unloaded rod on the mesh `integrator`, with no contacts.

@@ -78,19 +78,20 @@ pub(super) fn least_gap_in_cell(
     let bound = |t0: f64, g0: f64, t1: f64, g1: f64| 0.5 * (g0 + g1 - lipschitz * (t1 - t0));
     let mut best = if ga <= gb { (0.0, ga) } else { (1.0, gb) };
     // Intervals (t0, g0, t1, g1, bound): refined best first (least bound), until no interval
-    // may hold a gap below the best by more than a thousandth of the threshold.
+    // may hold a gap below the threshold (certified: nothing is below it), or the budget
+    // runs out. (Once a gap below the threshold is found, the intervals at it have bounds
+    // below it too: the search then spends its budget locating the least gap.)
     let first = bound(0.0, ga, 1.0, gb);
     if first >= threshold {
         return None;
     }
     let mut open = vec![(0.0, ga, 1.0, gb, first)];
-    let resolution = 1e-3 * threshold.abs();
     for _ in 0..MAX_EVALUATIONS {
         let Some(k) = (0..open.len()).min_by(|&i, &j| open[i].4.total_cmp(&open[j].4)) else {
             break;
         };
         let (t0, g0, t1, g1, lb) = open.swap_remove(k);
-        if lb >= threshold.max(best.1 - resolution) {
+        if lb >= threshold {
             break;
         }
         let tm = 0.5 * (t0 + t1);

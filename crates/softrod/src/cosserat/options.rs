@@ -29,6 +29,16 @@ pub const DIRECT_STEP_LIMIT: f64 = 4.0;
 /// branch, so the step is halved.
 pub const MAX_LOAD_STEP_TURN: f64 = 1.0;
 
+/// Ratio of the RK4 steps of a solve to those of its coarse mesh ([`Integrator::coarse`]).
+pub const COARSE_RATIO: usize = 5;
+/// Fewest RK4 steps of a coarse mesh.
+pub const MIN_COARSE_STEPS: usize = 8;
+/// Newton tolerance on the coarse mesh (at least the one asked): below the difference of the
+/// two meshes' residuals (2.6e-5 on the NiTi robot pressing a sphere, 3e-6 to 7e-5 under tip
+/// loads), which Newton on the mesh asked removes; converging the coarse mesh further only
+/// adds coarse passes.
+pub const COARSE_TOLERANCE: f64 = 1e-5;
+
 /// The ODE integrator used by the shooting method.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Integrator {
@@ -40,6 +50,23 @@ pub enum Integrator {
     },
     /// Adaptive Dormand–Prince 5(4) with error control on `(p, R, N, M)`.
     Adaptive(AdaptiveOptions),
+}
+
+impl Integrator {
+    /// The coarse mesh on which a loaded or contact solve runs its nonlinear iterations
+    /// before Newton on this one: RK4 with a fifth of the steps (at least
+    /// [`MIN_COARSE_STEPS`]); `None` (no coarse mesh) for fewer steps or the adaptive
+    /// integrator.
+    pub(crate) fn coarse(self) -> Option<Integrator> {
+        match self {
+            Integrator::Rk4 { steps } if steps >= COARSE_RATIO * MIN_COARSE_STEPS => {
+                Some(Integrator::Rk4 {
+                    steps: steps / COARSE_RATIO,
+                })
+            }
+            _ => None,
+        }
+    }
 }
 
 impl Default for Integrator {
@@ -59,6 +86,21 @@ pub struct WarmStart {
     /// The shooting Jacobian (scaled unknowns and residual) at that solution, if known: the
     /// first Jacobian of the new solve.
     pub jacobian: Option<Matrix6<f64>>,
+    /// The coarse mesh's residual at that solution, if it was solved from a coarse mesh: the
+    /// new solve's coarse iterations subtract it, so that they land near the solution on the
+    /// mesh asked rather than near the coarse one.
+    pub coarse_defect: Option<CoarseDefect>,
+}
+
+/// The scaled shooting residual of a coarse mesh ([`Integrator::coarse`]) at a solution on
+/// the mesh asked: the integration error that separates the two meshes' solutions, which
+/// changes little from one solve to a nearby one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoarseDefect {
+    /// RK4 steps of the coarse mesh.
+    pub steps: usize,
+    /// The coarse residual at the solution (dimensionless, as the shooting residual).
+    pub residual: [f64; 6],
 }
 
 impl WarmStart {
@@ -67,6 +109,7 @@ impl WarmStart {
         Self {
             base_wrench,
             jacobian: None,
+            coarse_defect: None,
         }
     }
 }

@@ -103,17 +103,39 @@ pub(crate) struct Shooting<'a> {
     pub require_stable: bool,
     /// Tendon path lengths of the last pass (m).
     pub lengths: Vec<f64>,
+    /// Whether a pass integrates the path lengths of the tension-free tendons too (those of
+    /// the tensioned ones always are); when not, theirs in [`Self::lengths`] are zero.
+    pub passive_lengths: bool,
     /// The exact columns of the last pass with them, the certificate's evidence.
     exact: Option<ExactPass>,
     /// The shape of the committed state, the safeguard's reference.
     reference: Shape,
     /// Right-hand-side evaluations so far.
     pub evaluations: usize,
+    /// Subtracted from the tip rows of every residual: a coarse mesh's residual at a nearby
+    /// solution on a finer mesh (see `statics::coarse_first`), zero otherwise.
+    pub defect: [f64; 6],
 }
 
 impl<'a> Shooting<'a> {
     pub fn new(eq: Equations<'a>, integrator: Integrator, plan: Vec<usize>) -> Self {
-        let ws = Workspace::new(eq.model.tendons().len());
+        Self::with_workspace(
+            eq,
+            integrator,
+            plan,
+            Workspace::new(eq.model.tendons().len()),
+        )
+    }
+
+    /// [`Self::new`] in the workspace `ws` of an earlier march of the same model's tendons
+    /// (every pass starts afresh in it: its quadratures reset, the local solve from the
+    /// straight-tendon guess).
+    pub fn with_workspace(
+        eq: Equations<'a>,
+        integrator: Integrator,
+        plan: Vec<usize>,
+        ws: Workspace,
+    ) -> Self {
         Self {
             eq,
             held: Vec::new(),
@@ -127,9 +149,11 @@ impl<'a> Shooting<'a> {
             columns: None,
             require_stable: false,
             lengths: Vec::new(),
+            passive_lengths: true,
             exact: None,
             reference: Vec::new(),
             evaluations: 0,
+            defect: [0.0; 6],
         }
     }
 
@@ -164,7 +188,7 @@ impl<'a> Shooting<'a> {
         self.ws.set_columns(columns, &[]);
         // The tendon lengths ride on the stages (the quadrature the displacement constraints
         // and their sensitivities use).
-        self.ws.track_lengths = true;
+        self.ws.track_lengths = self.passive_lengths;
         self.nodes.clear();
         let y0: [f64; N] = self.eq.initial(x);
         let scheme = Self::scheme(&self.integrator, &self.plan);
@@ -208,7 +232,10 @@ impl<'a> Shooting<'a> {
         let nt = self.eq.model.tendons().len();
         self.lengths.clear();
         self.lengths.extend_from_slice(&self.ws.integral[..nt]);
-        let (r, cols) = eq.residual(&y, columns.len());
+        let (mut r, cols) = eq.residual(&y, columns.len());
+        for k in 0..6 {
+            r[k] -= self.defect[k];
+        }
         self.columns = None;
         if N >= FULL {
             let mut j = [0.0; 36];

@@ -7,7 +7,7 @@ use std::sync::{Arc, OnceLock};
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
 use super::equations::{rot, v3, Evaluator, Workspace};
-use super::options::{SolveOptions, WarmStart};
+use super::options::{CoarseDefect, SolveOptions, WarmStart};
 use super::shooting::{Node, Shooting};
 use super::statics::stability_on;
 use crate::math::so3::quaternion_xyzw;
@@ -62,6 +62,9 @@ pub struct StaticsSolution {
     pub options: SolveOptions,
     /// The (exact or updated) shooting Jacobian at the solution, in scaled unknowns.
     pub jacobian: Option<Matrix6<f64>>,
+    /// The coarse mesh's residual at the solution, when it was solved from a coarse mesh
+    /// (carried by [`StaticsSolution::warm_start`]).
+    pub coarse_defect: Option<CoarseDefect>,
     /// The arc lengths the solution was asked at (m; empty: the integration mesh).
     pub s_out: Vec<f64>,
     /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
@@ -84,6 +87,7 @@ impl StaticsSolution {
         WarmStart {
             base_wrench: self.base_wrench,
             jacobian: self.jacobian,
+            coarse_defect: self.coarse_defect,
         }
     }
 
@@ -178,6 +182,7 @@ pub(crate) fn assemble(
         actuation: Actuation::default(),
         options: SolveOptions::default(),
         jacobian: None,
+        coarse_defect: None,
         s_out: Vec::new(),
         stable: false,
         margin: OnceLock::new(),

@@ -20,7 +20,7 @@ use nalgebra::{Matrix6, Vector3};
 
 use super::equations::{Equations, FULL};
 use super::shooting::Shooting;
-use super::stability::{tip_stability, Stability};
+use super::stability::{certifies, tip_stability, Stability};
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
 use crate::model::loads::{Frame, PointLoad};
@@ -31,9 +31,10 @@ use crate::solve::{
 };
 
 pub use super::options::{
-    Integrator, SolveOptions, WarmStart, DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_LOAD_STEPS,
-    DEFAULT_RK4_STEPS, DEFAULT_TOLERANCE, DIRECT_STEP_LIMIT, MAX_LINE_SEARCH_HALVINGS,
-    MAX_LOAD_STEP_TURN, MAX_RK4_STEPS,
+    CoarseDefect, Integrator, SolveOptions, WarmStart, COARSE_RATIO, COARSE_TOLERANCE,
+    DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_LOAD_STEPS, DEFAULT_RK4_STEPS, DEFAULT_TOLERANCE,
+    DIRECT_STEP_LIMIT, MAX_LINE_SEARCH_HALVINGS, MAX_LOAD_STEP_TURN, MAX_RK4_STEPS,
+    MIN_COARSE_STEPS,
 };
 pub use super::solution::StaticsSolution;
 pub(crate) use super::solution::{assemble, scaled_back};
@@ -98,6 +99,8 @@ struct Reached {
     iterations: usize,
     load_steps: usize,
     stopped: Option<Stopped>,
+    /// The coarse mesh's residual at the solution, when it was reached from a coarse mesh.
+    coarse_defect: Option<CoarseDefect>,
 }
 
 impl Reached {
@@ -107,6 +110,7 @@ impl Reached {
             iterations: outcome.iterations,
             load_steps: 0,
             stopped: None,
+            coarse_defect: None,
             outcome,
         }
     }
@@ -250,6 +254,7 @@ fn step_loads(
         iterations: c.iterations,
         load_steps: c.steps,
         stopped: Some(c.stopped),
+        coarse_defect: None,
     }
 }
 
@@ -263,6 +268,127 @@ fn attempt(p: &mut Shooting<'_>, options: &SolveOptions, x0: &[f64; 6], exact: b
     let mut c = step_loads(p, options, j0, first_step, 0.5, exact);
     c.iterations += iterations;
     c
+}
+
+/// Largest change of the scaled unknowns (max norm) that Newton on the mesh asked may make from
+/// the coarse solution of [`coarse_first`]: the two meshes' solutions differ by the
+/// integration error (about 1e-5 and below); a larger move is another equilibrium.
+const COARSE_TO_FINE_STEP: f64 = 1e-2;
+
+/// Newton tolerance on the coarse mesh when its residual is corrected by the defect of a warm
+/// start ([`CoarseDefect`]): the corrected coarse solution is then within the change of the
+/// defect (about 1e-7 for a 2 % change of the actuation) of the solution on the mesh asked,
+/// so the coarse iterations are worth converging further than [`COARSE_TOLERANCE`].
+const CORRECTED_COARSE_TOLERANCE: f64 = 1e-7;
+
+/// A cold loaded solve with its nonlinear iterations on the coarse mesh
+/// ([`Integrator::coarse`]): [`attempt`] there (the tangent predictor, Newton, load steps if
+/// needed) to [`COARSE_TOLERANCE`], one march with the columns at the coarse solution, then
+/// Newton on the mesh asked from the coarse solution with that Jacobian. A coarse march costs a
+/// fifth of one on the mesh asked and its Jacobian differs from that mesh's by the
+/// integration error, so Newton there contracts the residual by about 1e-5 a step. Returns
+/// `None` (the caller solves on the mesh asked from the start) where there is no coarse mesh,
+/// for a warm start, held tendons or a continuation that must refuse unstable states, and when
+/// either mesh fails or the mesh asked moves more than [`COARSE_TO_FINE_STEP`] from the coarse
+/// solution. With the reached state comes the stability when the coarse columns certify it
+/// ([`clearly_stable`]; its margin is then computed on the mesh asked when read).
+fn coarse_first(
+    p: &mut Shooting<'_>,
+    options: &SolveOptions,
+    x0: &[f64; 6],
+) -> Option<(Reached, Option<Stability>)> {
+    let coarse = options.integrator.coarse()?;
+    if !p.held.is_empty() || p.require_stable {
+        return None;
+    }
+    let Integrator::Rk4 { steps } = coarse else {
+        return None;
+    };
+    let mut c = Shooting::new(p.eq, coarse, rk4_plan(p.eq.model.breaks(), steps));
+    let defect = options
+        .warm_start
+        .and_then(|w| w.coarse_defect)
+        .filter(|d| d.steps == steps && d.residual.iter().all(|v| v.is_finite()));
+    let floor = match defect {
+        Some(d) => {
+            c.defect = d.residual;
+            CORRECTED_COARSE_TOLERANCE
+        }
+        None => COARSE_TOLERANCE,
+    };
+    let start = SolveOptions {
+        newton: NewtonOptions {
+            tolerance: options.newton.tolerance.max(floor),
+            throw: false,
+            ..options.newton
+        },
+        ..*options
+    };
+    let reached = attempt(&mut c, &start, x0, false);
+    let xc = reached.outcome.x.clone();
+    let (mut j, mut r) = (vec![0.0; 36], [0.0; 6]);
+    let jacobian = reached.outcome.converged
+        && c.evaluate(&xc, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian;
+    p.evaluations += c.evaluations;
+    if !jacobian {
+        return None;
+    }
+    let clear = clearly_stable(&c, &j, COARSE_TO_FINE_STEP);
+    let s = NewtonSettings {
+        residual_first: true,
+        ..settings(true, Some(&j), clear.is_none())
+    };
+    let out = newton(p, &xc, 1.0, &options.newton, &s);
+    let moved = (0..6).map(|k| (out.x[k] - xc[k]).abs()).fold(0.0, f64::max);
+    if !out.converged || moved > COARSE_TO_FINE_STEP {
+        return None;
+    }
+    // The coarse residual at the solution, to first order from the coarse solution: the
+    // defect a warm start from this solution corrects its coarse iterations by.
+    let residual = std::array::from_fn(|i| {
+        r[i] + c.defect[i]
+            + (0..6)
+                .map(|k| j[i + 6 * k] * (out.x[k] - xc[k]))
+                .sum::<f64>()
+    });
+    let fine = Reached {
+        iterations: reached.iterations + out.iterations,
+        load_steps: reached.load_steps,
+        coarse_defect: Some(CoarseDefect { steps, residual }),
+        ..Reached::direct(out)
+    };
+    Some((fine, clear))
+}
+
+/// Stable, as the columns of the last pass of `c` (on a coarse mesh; `j` its Jacobian) certify
+/// for a solution at most `distance` away on the mesh asked ([`certifies`]: the same floor
+/// and rate as the certificate of the predicted point, far above the coarse mesh's error in
+/// the margin); the margin itself is left to be computed on the mesh asked when read (NaN
+/// here).
+fn clearly_stable(c: &Shooting<'_>, j: &[f64], distance: f64) -> Option<Stability> {
+    c.tip_twist
+        .and_then(|tw| tip_stability(j, &tw, c.eq.model.length()))
+        .filter(|s| certifies(s, distance))
+        .map(|_| Stability {
+            stable: true,
+            margin: f64::NAN,
+            mode: None,
+        })
+}
+
+/// The stability of the converged unknowns `x` of `p` when one march with the columns on
+/// the coarse mesh certifies it ([`clearly_stable`]); `None` otherwise (and without a coarse
+/// mesh), when the columns are marched on the mesh asked.
+fn stable_on_coarse(p: &mut Shooting<'_>, x: &[f64]) -> Option<Stability> {
+    let coarse = p.integrator.coarse()?;
+    let Integrator::Rk4 { steps } = coarse else {
+        return None;
+    };
+    let mut c = Shooting::new(p.eq, coarse, rk4_plan(p.eq.model.breaks(), steps));
+    let (mut j, mut r) = ([0.0; 36], [0.0; 6]);
+    let marched = c.evaluate(x, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian;
+    p.evaluations += c.evaluations;
+    clearly_stable(&c, &j, 0.0).filter(|_| marched)
 }
 
 /// Scaled unknowns of a base wrench (N, N m).
@@ -654,6 +780,7 @@ fn solve_with(
     sol.options = *options;
     sol.s_out = s_out.to_vec();
     sol.jacobian = jacobian;
+    sol.coarse_defect = reached.coarse_defect;
     match stability {
         Some(s) => {
             sol.stable = s.stable;
@@ -677,9 +804,25 @@ fn settle(
     x0: &[f64; 6],
     loaded: bool,
 ) -> (Reached, Option<Stability>) {
-    let mut reached = attempt(p, options, x0, loaded);
-    let stability = if reached.outcome.converged && loaded {
-        stable_outcome(p, model, actuation, options, &mut reached)
+    let coarse = if loaded {
+        coarse_first(p, options, x0)
+    } else {
+        None
+    };
+    // With a coarse mesh, the stability is judged there first (a fifth of the columns' cost).
+    let judge_coarse = loaded && p.held.is_empty() && p.integrator.coarse().is_some();
+    let (mut reached, clear) = match coarse {
+        Some((reached, clear)) => (reached, clear),
+        None => (attempt(p, options, x0, loaded && !judge_coarse), None),
+    };
+    let converged = reached.outcome.converged;
+    let stability = if converged && loaded {
+        clear
+            .or_else(|| {
+                let x = reached.outcome.x.clone();
+                judge_coarse.then(|| stable_on_coarse(p, &x)).flatten()
+            })
+            .or_else(|| stable_outcome(p, model, actuation, options, &mut reached))
     } else {
         None
     };

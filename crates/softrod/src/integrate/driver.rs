@@ -32,14 +32,17 @@ impl<const N: usize, F: FnMut(f64, &[f64; N]) -> [f64; N]> System<N> for FnSyste
     }
 }
 
-/// Stage buffers of one integration (reused across steps).
-struct Stages<const N: usize, const S: usize> {
+/// Stage buffers of one integration (reused across steps, and by [`fixed_in`] across the
+/// integrations of a march).
+pub struct Stages<const N: usize, const S: usize> {
     k: [[f64; N]; S],
     tmp: [f64; N],
 }
 
 impl<const N: usize, const S: usize> Stages<N, S> {
-    fn new() -> Box<Self> {
+    /// Zeroed buffers, on the heap (`S + 1` states).
+    #[must_use]
+    pub fn new() -> Box<Self> {
         Box::new(Self {
             k: [[0.0; N]; S],
             tmp: [0.0; N],
@@ -158,9 +161,25 @@ pub fn fixed<const N: usize, const S: usize, Y: System<N>>(
     y0: [f64; N],
     t1: f64,
     steps: usize,
+    on_step: impl FnMut(&mut Y, f64, &mut [f64; N]),
+) -> Result<[f64; N]> {
+    fixed_in(tab, sys, &mut Stages::new(), (t0, y0), t1, steps, on_step)
+}
+
+/// [`fixed`] with the stage buffers `st` of the caller (a march of many intervals allocates
+/// them once), from `(t0, y0)`.
+///
+/// # Errors
+/// [`Error::NotConverged`] if a state becomes non-finite.
+pub fn fixed_in<const N: usize, const S: usize, Y: System<N>>(
+    tab: &Tableau<S>,
+    sys: &mut Y,
+    st: &mut Stages<N, S>,
+    (t0, y0): (f64, [f64; N]),
+    t1: f64,
+    steps: usize,
     mut on_step: impl FnMut(&mut Y, f64, &mut [f64; N]),
 ) -> Result<[f64; N]> {
-    let mut st = Stages::<N, S>::new();
     let h = (t1 - t0) / steps.max(1) as f64;
     let mut y = y0;
     for i in 0..steps {
@@ -168,11 +187,11 @@ pub fn fixed<const N: usize, const S: usize, Y: System<N>>(
         let t_end = if i + 1 == steps { t1 } else { t + h };
         sys.rhs(t, &y, &mut st.k[0]);
         sys.stage_evaluated(0);
-        stages(tab, sys, t, &y, h, t_end, &mut st);
+        stages(tab, sys, t, &y, h, t_end, st);
         if tab.fsal {
             y = st.tmp;
         } else {
-            advance(tab, &mut y, h, &st);
+            advance(tab, &mut y, h, st);
         }
         sys.step_accepted(&weights(tab, h), false);
         sys.project(&mut y);

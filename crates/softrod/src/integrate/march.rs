@@ -6,7 +6,7 @@
 //! compliance all march with this function; they differ only in their system (state and
 //! sensitivity columns) and their observer (recording nodes, seeding load columns).
 
-use super::driver::{adaptive, fixed, System};
+use super::driver::{adaptive, fixed_in, Stages, System};
 use super::tableau::{DP5, RK4};
 use super::AdaptiveOptions;
 use crate::error::Result;
@@ -61,6 +61,8 @@ pub fn march<const N: usize, Y: Piecewise<N>>(
     mut node: impl FnMut(&mut Y, f64, usize, &mut [f64; N]),
 ) -> Result<[f64; N]> {
     let mut y = y0;
+    // RK4's stage buffers, allocated once for every interval.
+    let mut rk4 = None;
     for k in 0..breaks.len() - 1 {
         let (a, b) = (breaks[k], breaks[k + 1]);
         sys.enter_interval(k);
@@ -75,7 +77,10 @@ pub fn march<const N: usize, Y: Piecewise<N>>(
                     } else {
                         ((plan[k] as f64 * (stop - start) / (b - a)).round() as usize).max(1)
                     };
-                    y = fixed(&RK4, sys, start, y, stop, n, |sys, s, y| node(sys, s, k, y))?;
+                    let st = rk4.get_or_insert_with(Stages::<N, 4>::new);
+                    y = fixed_in(&RK4, sys, st, (start, y), stop, n, |sys, s, y| {
+                        node(sys, s, k, y);
+                    })?;
                     start = stop;
                 }
             }

@@ -69,21 +69,22 @@ impl Evaluator<'_, '_> {
         let cd = Vector6::from_column_slice(&c);
         let xs = Vector6::new(vs.x, vs.y, vs.z, us.x, us.y, us.z);
         let wv = Vector6::from_column_slice(&wb);
-        let x = match self.ws.guess {
-            Some(g) => g,
-            None => {
-                // Straight tendons: t_i = e_z.
-                let mut tf = Vector3::zeros();
-                let mut tm = Vector3::zeros();
-                for (r, _, tau) in &self.ws.offsets {
-                    tf.z += tau;
-                    tm += r.cross(&Vector3::z()) * *tau;
+        let mut warm = self.ws.guess;
+        let x = loop {
+            let start = match warm {
+                Some(g) => g,
+                None => self.straight_guess(&xs, &cd, &wv),
+            };
+            match self.local_iteration(start, &xs, &cd, &wv, &c) {
+                Some(x) => break x,
+                // The warm start failed (a jump across a break, a far stage): from the
+                // straight-tendon guess with a fresh Newton iteration, as without one.
+                None if warm.is_some() => {
+                    warm = None;
+                    self.ws.last_lu = None;
                 }
-                xs + cd.component_mul(&(wv - Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)))
+                None => return Local::nan(),
             }
-        };
-        let Some(x) = self.local_iteration(x, &xs, &cd, &wv, &c) else {
-            return Local::nan();
         };
         let mut out = Local::strains(&x);
         if tangent {
@@ -107,6 +108,23 @@ impl Evaluator<'_, '_> {
         self.finish_tendons(s, props, &mut out, &fluid);
         self.ws.guess = Some(x);
         out
+    }
+
+    /// The strains with straight tendons (`t_i = e_z`): `x* + C (W - T_straight)`, the start
+    /// of the local iteration without a warm start.
+    fn straight_guess(
+        &self,
+        xs: &Vector6<f64>,
+        cd: &Vector6<f64>,
+        wv: &Vector6<f64>,
+    ) -> Vector6<f64> {
+        let mut tf = Vector3::zeros();
+        let mut tm = Vector3::zeros();
+        for (r, _, tau) in &self.ws.offsets {
+            tf.z += tau;
+            tm += r.cross(&Vector3::z()) * *tau;
+        }
+        xs + cd.component_mul(&(wv - Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)))
     }
 
     /// The local Newton (or chord) iteration on `G(x) = x - x* - C (W - T(x)) = 0` from `x`;

@@ -4,8 +4,8 @@
 use nalgebra::{Vector3, Vector6};
 
 use super::{
-    col_rot, mul_hat, mul_hat2, project, put3, rot, v3, Column, Evaluator, Local, COLUMN, DM, DN,
-    DR, STATE,
+    col_rot, mul_hat, mul_hat2, project_columns, put3, rot, v3, Column, Evaluator, Local, COLUMN,
+    DM, DN, DR, STATE,
 };
 use crate::integrate::march::Piecewise;
 use crate::integrate::System;
@@ -144,13 +144,22 @@ impl<const N: usize> System<N> for Evaluator<'_, '_> {
     }
     #[inline]
     fn project(&mut self, y: &mut [f64; N]) {
-        project(y);
+        // (The columns beyond the active ones have no right-hand side: held where they are.)
+        project_columns(y, self.ws.columns.len());
     }
 }
 
 impl<const N: usize> Piecewise<N> for Evaluator<'_, '_> {
+    /// Every march starts from the straight-tendon guess (interval 0: nothing of an earlier
+    /// march, which may have diverged, carries over); across an interior break the local
+    /// warm start of the interval before is kept if the same tendons and chambers act on
+    /// both sides (a point load's break, e.g. a contact's).
     fn enter_interval(&mut self, k: usize) {
-        self.set_interval(k);
+        if k > 0 && k == self.ws.interval + 1 {
+            Evaluator::enter_interval(self, k);
+        } else {
+            self.set_interval(k);
+        }
     }
     fn jump(&mut self, s: f64, y: &mut [f64; N]) {
         let ncol = self.ws.columns.len().min((N - STATE) / COLUMN);

@@ -78,12 +78,19 @@ pub(crate) fn mul_hat2(
 /// `R`).
 #[inline]
 pub(crate) fn project<const N: usize>(y: &mut [f64; N]) {
+    project_columns(y, (N - STATE) / COLUMN);
+}
+
+/// [`project`] with only the first `ncol` columns mapped (the others, held at zero, stay
+/// zero).
+#[inline]
+pub(crate) fn project_columns<const N: usize>(y: &mut [f64; N], ncol: usize) {
     let raw = rot(y);
     let r = reorthonormalise(&raw);
     y[3..12].copy_from_slice(r.as_slice());
     let rtr = raw.tr_mul(&raw);
     let half = Matrix3::identity() * 1.5 - rtr * 0.5;
-    for c in 0..(N - STATE) / COLUMN {
+    for c in 0..ncol.min((N - STATE) / COLUMN) {
         let b = STATE + COLUMN * c;
         let dr = col_rot(y, b);
         let sym = dr.tr_mul(&raw);

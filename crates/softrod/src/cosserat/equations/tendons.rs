@@ -39,8 +39,8 @@ impl Evaluator<'_, '_> {
     /// [`Self::set_interval`], but keeping the warm start of the local solve (the last strains
     /// and the factorised local Jacobian) when the tendons and chambers acting on interval `k`
     /// are those already held: for evaluations at nearly the same states again and again (the
-    /// contact rows, march after march), a chord step or two instead of a local Newton solve
-    /// from the straight-tendon guess.
+    /// contact rows, march after march) and for a march across a point load's break, a chord
+    /// step or two instead of a local Newton solve from the straight-tendon guess.
     pub fn enter_interval(&mut self, k: usize) {
         if self.ws.guess.is_some() && self.holds_actuators_of(k) {
             self.ws.interval = k;
