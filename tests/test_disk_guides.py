@@ -69,6 +69,8 @@ def test_dense_disks_with_friction_converge_to_the_channel_with_friction(niti):
         ({"spacing": 0.0}, "spacing"),
         ({"spacing": float("nan")}, "spacing"),
         ({"spacing": 0.5}, "spacing"),
+        ({"spacing": 1e-308}, "spacing"),
+        ({"spacing": 1e-4}, "spacing"),
         ({"spacing": 0.02, "friction": -0.1}, "friction"),
         ({"spacing": 0.02, "tendons": [6]}, "tendons[0]"),
         ({"spacing": 0.02, "tendons": [1, 1]}, "tendons"),

@@ -40,6 +40,10 @@ from .io.robot_file import FieldError, RobotFile
 
 __all__ = ["Robot", "load_robot", "solve_path"]
 
+# Most spacer disks ``Robot.with_disk_guides`` puts on one tendon (the guided solve is Newton
+# on three force unknowns per disk; real robots carry tens).
+MAX_DISKS = 1000
+
 _PATH_PART = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)\Z")
 
 
@@ -447,7 +451,8 @@ class Robot:
         (``n = end / spacing``).
 
         Args:
-            spacing: Disk spacing (m), > 0 and below every chosen tendon's span.
+            spacing: Disk spacing (m), > 0 and below every chosen tendon's span, with at most
+                1,000 disks on a span.
             friction: Capstan coefficient at each disk (>= 0).
             tendons: Indices of the tendons to guide (default: all); each must be a
                 ``constant`` routing (a fixed offset from the backbone).
@@ -485,6 +490,13 @@ class Robot:
                 )
             end = length if table.end is None else float(table.end)
             ratio = end / spacing
+            if ratio > MAX_DISKS + 1:
+                raise _args.value_error(
+                    "spacing",
+                    spacing,
+                    f">= {end / (MAX_DISKS + 1):g} m (at most {MAX_DISKS} disks on the "
+                    f"{end:g} m span of tendon {i})",
+                )
             whole = round(ratio)
             if whole >= 1 and abs(ratio - whole) <= 1e-9 * ratio:
                 guides = [end * k / whole for k in range(1, whole)]
