@@ -12,7 +12,7 @@ use numpy::ndarray::{Array2, ArrayD};
 use numpy::{PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::PyOverflowError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyBytes, PyDict, PyString};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use pyo3::{PyClass, PyTypeInfo};
 
 use softrod::nalgebra::Vector3;
@@ -190,6 +190,48 @@ pub(crate) fn float_array(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyR
         .map_err(|_| type_err(name, obj, what))?;
     let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
     Ok(r.as_array().to_owned())
+}
+
+/// Numbers of any shape flattened, as `numpy.asarray(obj, dtype=float).ravel()` gives them,
+/// without NumPy for the common cases (a float64 array, a list or tuple of numbers).
+pub(crate) fn raveled(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyResult<Vec<f64>> {
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        if let Ok(r) = a.try_readonly() {
+            return Ok(r.as_array().iter().copied().collect());
+        }
+    }
+    let listed = if let Ok(l) = obj.cast::<PyList>() {
+        numbers(l.iter())
+    } else if let Ok(t) = obj.cast::<PyTuple>() {
+        numbers(t.iter())
+    } else {
+        None
+    };
+    if let Some(v) = listed {
+        return Ok(v);
+    }
+    let np = obj.py().import("numpy")?;
+    let a = np
+        .getattr("asarray")?
+        .call1((obj, np.getattr("float64")?))
+        .and_then(|a| a.call_method0("ravel"))
+        .map_err(|_| type_err(name, obj, what))?;
+    let a = a
+        .cast_into::<PyArrayDyn<f64>>()
+        .map_err(|_| type_err(name, obj, what))?;
+    let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
+    Ok(r.as_array().iter().copied().collect())
+}
+
+/// The values of items that are all Python floats or ints (None if one is not, or does not
+/// convert).
+fn numbers<'py>(items: impl Iterator<Item = Bound<'py, PyAny>>) -> Option<Vec<f64>> {
+    items
+        .map(|x| {
+            let number = x.is_instance_of::<PyFloat>() || x.is_instance_of::<PyInt>();
+            number.then(|| x.extract::<f64>().ok()).flatten()
+        })
+        .collect()
 }
 
 /// Numbers of any shape, for element-wise functions: a number gives a 0-d array.
