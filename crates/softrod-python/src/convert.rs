@@ -132,15 +132,23 @@ impl<'a, 'py, T: PyClass + PyTypeInfo> Arg<'a, 'py> for Bound<'py, T> {
 
 impl<'a, 'py, T: PyClass + PyTypeInfo> Arg<'a, 'py> for Vec<Bound<'py, T>> {
     fn from_arg(obj: &'a Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
+        let item = |(i, item): (usize, Bound<'py, PyAny>)| {
+            item.cast::<T>()
+                .cloned()
+                .map_err(|_| type_err(&format!("{name}[{i}]"), &item, &format!("a {}", T::NAME)))
+        };
+        // A list or a tuple is read directly (no iterator, no intermediate vector).
+        if let Ok(l) = obj.cast_exact::<PyList>() {
+            return l.iter().enumerate().map(item).collect();
+        }
+        if let Ok(t) = obj.cast_exact::<PyTuple>() {
+            return t.iter().enumerate().map(item).collect();
+        }
         let what = format!("a sequence of {}", T::NAME);
         sequence(obj, name, &what)?
-            .iter()
+            .into_iter()
             .enumerate()
-            .map(|(i, item)| {
-                item.cast::<T>()
-                    .cloned()
-                    .map_err(|_| type_err(&format!("{name}[{i}]"), item, &format!("a {}", T::NAME)))
-            })
+            .map(item)
             .collect()
     }
 }
