@@ -1,12 +1,16 @@
-//! Binding of the Cosserat statics: `solve_statics` and its solution.
+//! Binding of the Cosserat statics: `solve_statics`, `Robot.solve` and their solution.
 //!
 //! The Python signature keeps the objects a user builds (a rod, tendons with their tensions,
 //! chambers with their pressures, loads); the binding splits them into the core's immutable
-//! `RobotModel` and its `Actuation`. Options start from the core's `SolveOptions::default()`:
-//! an option not given keeps the core's default (stated once, in the core).
+//! `RobotModel` and its `Actuation`. A `softrod.Robot` keeps its core model (validated once)
+//! and passes its tensions and pressures as the actuation. Options start from the core's
+//! `SolveOptions::default()`: an option not given keeps the core's default (stated once, in
+//! the core).
 //!
 //! The files: `options.rs` (the options, the core model and actuation of the user's objects,
-//! displacement control, actuator names in errors), `solution.rs` (the solution class).
+//! displacement control, actuator names in errors), `robot.rs` (the model of a robot and its
+//! solve), `call.rs` (the call a solution keeps for pickling), `solution.rs` (the solution
+//! class).
 
 mod call;
 mod options;

@@ -92,10 +92,14 @@ pub(crate) fn per_actuator(
     };
     let v = raveled(obj, name, "numbers")?;
     if v.len() != n {
+        let given = match v.len() {
+            1 => "1 value".to_string(),
+            k => format!("{k} values"),
+        };
         return Err(param_err(
             name,
-            format!("{} values", v.len()),
-            &format!("one per {what} ({n})"),
+            given,
+            &format!("one value per {what} ({n})"),
         ));
     }
     Ok(Some(v))
