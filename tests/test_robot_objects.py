@@ -79,6 +79,29 @@ def test_actuation_is_an_input(niti):
     assert info.value.parameter == "pressures"
 
 
+def test_solve_is_solve_statics_of_the_objects_at_that_actuation(niti):
+    t = [1.0, 0.5, 0.0, 0.0, 2.0, 0.0]
+    tendons = [x.with_tension(v) for x, v in zip(niti.tendons, t, strict=True)]
+    objects = softrod.solve_statics(niti.rod, tendons, niti.loads, **niti.solver)
+    for sol in (niti.solve(np.array(t)), niti.solve(t), niti.with_tensions(t).solve()):
+        np.testing.assert_array_equal(sol.position, objects.position)
+        np.testing.assert_array_equal(sol.force, objects.force)
+        again = pickle.loads(pickle.dumps(sol))  # solve_statics with the objects
+        np.testing.assert_array_equal(again.position, objects.position)
+        np.testing.assert_array_equal(again.tensions, t)
+    with pytest.raises(softrod.ParameterError) as info:
+        niti.solve([0.0, -1.0, 0.0, 0.0, 0.0, 0.0])
+    assert info.value.parameter == "tensions[1]"
+    with pytest.raises(TypeError) as info:
+        niti.solve("many")
+    assert info.value.parameter == "tensions"
+    bad = Robot(niti.rod, tendons=[softrod.Tendon((0.01, 0.0), 1.0, end=0.5)])
+    for _ in range(2):  # the model is checked when solving, every time until it is valid
+        with pytest.raises(softrod.ParameterError) as info:
+            bad.solve()
+        assert info.value.parameter == "tendons[0].end"
+
+
 def test_solver_overrides_still_work(niti):
     assert len(niti.solve(steps=10).s) < len(niti.solve().s)
 

@@ -527,6 +527,46 @@ def solve_statics(
     ``ValueError`` naming ``friction``); ``tip_constraint`` (``softrod.Clamp(pose)``,
     ``Pin(point)``, ``Slide(point, normal)``) holds the tip."""
 
+@final
+class _RobotModel:
+    """The validated core model of a robot's objects, built once by ``softrod.Robot`` and
+    shared by its solves; the objects' tensions and pressures are its default actuation."""
+
+    def __init__(
+        self,
+        rod: Rod,
+        tendons: Sequence[Tendon] = ...,
+        loads: Loads | None = None,
+        chambers: Sequence[Chamber] = ...,
+    ) -> None: ...
+
+def _solve_robot(
+    model: _RobotModel,
+    tensions: _Floats | None = None,
+    pressures: _Floats | None = None,
+    *,
+    integrator: Literal["rk4", "adaptive"] | None = None,
+    steps: int | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    continuation: bool | None = None,
+    max_load_steps: int | None = None,
+    warm_start: StaticsSolution | Sequence[float] | None = None,
+    throw: bool | None = None,
+    s_out: Sequence[float] | NDArray[np.float64] | None = None,
+    seek_stable: bool | None = None,
+    on_unstable: Literal["warn", "raise", "ignore"] | None = None,
+    previous: StaticsSolution | None = None,
+    displacements: Sequence[float | None] | NDArray[np.float64] | None = None,
+    tendon_stiffness: float | Sequence[float] | NDArray[np.float64] | None = None,
+    obstacles: Sequence[Any] | None = None,
+    tip_constraint: Any = None,
+) -> StaticsSolution:
+    """``solve_statics`` of a robot's model under tensions (N) and pressures (Pa), default
+    its objects' (``Robot.solve`` wraps it)."""
+
 def _inverse_statics(
     rod: Rod,
     tendons: Sequence[Tendon],

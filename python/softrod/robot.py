@@ -32,6 +32,8 @@ from ._core import (
     Rod,
     StaticsSolution,
     Tendon,
+    _RobotModel,
+    _solve_robot,
     solve_statics,
 )
 from .io import objects as _objects
@@ -134,6 +136,7 @@ class Robot:
         "_description",
         "_loads",
         "_loads_given",
+        "_model",
         "_name",
         "_obstacles",
         "_rod",
@@ -236,6 +239,7 @@ class Robot:
             ("_spec", spec),
             ("_obstacles", ()),
             ("_tip_constraint", None),
+            ("_model", None),
         ):
             object.__setattr__(self, key, value)
 
@@ -383,6 +387,36 @@ class Robot:
             ParameterError: Bad actuation (wrong count) or options.
             ConvergenceError: The solver did not converge (unless ``throw=False``).
         """
+        if options and not _MODEL_KEYS.isdisjoint(options):
+            return self._solve_objects(
+                tensions, pressures, displacements, tendon_stiffness, options
+            )
+        # The core model is validated once and shared; the actuation is an input of the core.
+        merged = {**self._solver, **options} if options else self._solver
+        if self._obstacles or self._tip_constraint is not None:
+            merged = dict(merged)
+            if self._obstacles:
+                merged.setdefault("obstacles", list(self._obstacles))
+            if self._tip_constraint is not None:
+                merged.setdefault("tip_constraint", self._tip_constraint)
+        return _solve_robot(
+            self._model or self._core_model(),
+            tensions,
+            pressures,
+            displacements=displacements,
+            tendon_stiffness=tendon_stiffness,
+            **merged,
+        )
+
+    def _core_model(self) -> _RobotModel:
+        """The validated core model of the rod, tendons, loads and chambers (built once)."""
+        model = _RobotModel(self._rod, self._tendons, self._loads, self._chambers)
+        object.__setattr__(self, "_model", model)
+        return model
+
+    def _solve_objects(self, tensions, pressures, displacements, tendon_stiffness, options):
+        """``solve`` with model objects among the options (``chambers=``): the objects at
+        this actuation, solved by :func:`softrod.solve_statics`."""
         tendons = self._tendons if tensions is None else self._tensioned(tensions)
         chambers = self._chambers if pressures is None else self._pressurised(pressures)
         merged = {**self._solver, **options}
@@ -410,6 +444,7 @@ class Robot:
         new = object.__new__(Robot)
         state = {k: getattr(self, k) for k in Robot.__slots__}
         state.update({f"_{k}": v for k, v in changes.items()})
+        state["_model"] = None  # built again from the new objects
         for k, v in state.items():
             object.__setattr__(new, k, v)
         return new
@@ -689,6 +724,9 @@ def _rebuild(parts: tuple, obstacles: tuple, tip_constraint: Any) -> Robot:
 def _from_pickled_spec(spec: RobotFile) -> Robot:
     return Robot.from_spec(spec)
 
+
+# Options that replace the robot's objects: solved by ``solve_statics`` with the objects.
+_MODEL_KEYS = frozenset(("rod", "tendons", "loads", "chambers"))
 
 _MINIMAL_ROD = {
     "length": 1.0,

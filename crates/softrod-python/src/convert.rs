@@ -12,7 +12,7 @@ use numpy::ndarray::{Array2, ArrayD};
 use numpy::{PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::PyOverflowError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyBytes, PyDict, PyString};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use pyo3::{PyClass, PyTypeInfo};
 
 use softrod::nalgebra::Vector3;
@@ -132,15 +132,23 @@ impl<'a, 'py, T: PyClass + PyTypeInfo> Arg<'a, 'py> for Bound<'py, T> {
 
 impl<'a, 'py, T: PyClass + PyTypeInfo> Arg<'a, 'py> for Vec<Bound<'py, T>> {
     fn from_arg(obj: &'a Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
+        let item = |(i, item): (usize, Bound<'py, PyAny>)| {
+            item.cast::<T>()
+                .cloned()
+                .map_err(|_| type_err(&format!("{name}[{i}]"), &item, &format!("a {}", T::NAME)))
+        };
+        // A list or a tuple is read directly (no iterator, no intermediate vector).
+        if let Ok(l) = obj.cast_exact::<PyList>() {
+            return l.iter().enumerate().map(item).collect();
+        }
+        if let Ok(t) = obj.cast_exact::<PyTuple>() {
+            return t.iter().enumerate().map(item).collect();
+        }
         let what = format!("a sequence of {}", T::NAME);
         sequence(obj, name, &what)?
-            .iter()
+            .into_iter()
             .enumerate()
-            .map(|(i, item)| {
-                item.cast::<T>()
-                    .cloned()
-                    .map_err(|_| type_err(&format!("{name}[{i}]"), item, &format!("a {}", T::NAME)))
-            })
+            .map(item)
             .collect()
     }
 }
@@ -190,6 +198,48 @@ pub(crate) fn float_array(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyR
         .map_err(|_| type_err(name, obj, what))?;
     let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
     Ok(r.as_array().to_owned())
+}
+
+/// Numbers of any shape flattened, as `numpy.asarray(obj, dtype=float).ravel()` gives them,
+/// without NumPy for the common cases (a float64 array, a list or tuple of numbers).
+pub(crate) fn raveled(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyResult<Vec<f64>> {
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        if let Ok(r) = a.try_readonly() {
+            return Ok(r.as_array().iter().copied().collect());
+        }
+    }
+    let listed = if let Ok(l) = obj.cast::<PyList>() {
+        numbers(l.iter())
+    } else if let Ok(t) = obj.cast::<PyTuple>() {
+        numbers(t.iter())
+    } else {
+        None
+    };
+    if let Some(v) = listed {
+        return Ok(v);
+    }
+    let np = obj.py().import("numpy")?;
+    let a = np
+        .getattr("asarray")?
+        .call1((obj, np.getattr("float64")?))
+        .and_then(|a| a.call_method0("ravel"))
+        .map_err(|_| type_err(name, obj, what))?;
+    let a = a
+        .cast_into::<PyArrayDyn<f64>>()
+        .map_err(|_| type_err(name, obj, what))?;
+    let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
+    Ok(r.as_array().iter().copied().collect())
+}
+
+/// The values of items that are all Python floats or ints (None if one is not, or does not
+/// convert).
+fn numbers<'py>(items: impl Iterator<Item = Bound<'py, PyAny>>) -> Option<Vec<f64>> {
+    items
+        .map(|x| {
+            let number = x.is_instance_of::<PyFloat>() || x.is_instance_of::<PyInt>();
+            number.then(|| x.extract::<f64>().ok()).flatten()
+        })
+        .collect()
 }
 
 /// Numbers of any shape, for element-wise functions: a number gives a 0-d array.

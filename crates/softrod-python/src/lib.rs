@@ -73,6 +73,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Loads>()?;
     m.add_class::<statics::StaticsSolution>()?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_class::<statics::robot::RobotModel>()?;
+    m.add_function(wrap_pyfunction!(statics::robot::_solve_robot, m)?)?;
     m.add_function(wrap_pyfunction!(statics::actuation_jacobian, m)?)?;
     m.add_class::<inverse::InverseWarmState>()?;
     m.add_function(wrap_pyfunction!(inverse::_inverse_statics, m)?)?;

@@ -486,15 +486,7 @@ impl Tendon {
         py: Python<'_>,
         #[pyo3(from_py_with = arg::tension)] tension: f64,
     ) -> PyResult<Self> {
-        let tension = check_tension(tension)?;
-        let args = Args(self.args.0.bind(py).copy()?.unbind());
-        args.0.bind(py).set_item("tension", tension)?;
-        Ok(Self {
-            inner: self.inner.clone(),
-            tension,
-            factory: self.factory,
-            args,
-        })
+        self.tensioned(py, tension)
     }
     /// Tension (N).
     #[getter]
@@ -636,15 +628,7 @@ impl Chamber {
         py: Python<'_>,
         #[pyo3(from_py_with = arg::pressure)] pressure: f64,
     ) -> PyResult<Self> {
-        let pressure =
-            softrod::model::chamber::check_pressure("pressure", pressure).map_err(to_py_err)?;
-        let args = Args(self.args.0.bind(py).copy()?.unbind());
-        args.0.bind(py).set_item("pressure", pressure)?;
-        Ok(Self {
-            inner: self.inner.clone(),
-            pressure,
-            args,
-        })
+        self.pressurised(py, pressure)
     }
     /// Gauge pressure (Pa).
     #[getter]
@@ -904,6 +888,19 @@ impl Rod {
 }
 
 impl Tendon {
+    /// The same tendon with another tension (N), checked (`tension`).
+    pub(crate) fn tensioned(&self, py: Python<'_>, tension: f64) -> PyResult<Self> {
+        let tension = check_tension(tension)?;
+        let args = Args(self.args.0.bind(py).copy()?.unbind());
+        args.0.bind(py).set_item("tension", tension)?;
+        Ok(Self {
+            inner: self.inner.clone(),
+            tension,
+            factory: self.factory,
+            args,
+        })
+    }
+
     /// Whether the routing is a Python callable.
     pub(crate) fn has_callables(&self) -> bool {
         matches!(self.inner.routing(), softrod::Routing::Function { .. })
@@ -911,6 +908,19 @@ impl Tendon {
 }
 
 impl Chamber {
+    /// The same chamber at another gauge pressure (Pa), checked (`pressure`).
+    pub(crate) fn pressurised(&self, py: Python<'_>, pressure: f64) -> PyResult<Self> {
+        let pressure =
+            softrod::model::chamber::check_pressure("pressure", pressure).map_err(to_py_err)?;
+        let args = Args(self.args.0.bind(py).copy()?.unbind());
+        args.0.bind(py).set_item("pressure", pressure)?;
+        Ok(Self {
+            inner: self.inner.clone(),
+            pressure,
+            args,
+        })
+    }
+
     /// Whether the area is a Python callable.
     pub(crate) fn has_callables(&self) -> bool {
         matches!(self.inner.area(), softrod::ChamberArea::Function(_))

@@ -183,6 +183,20 @@ fn bad_tendons_are_named() {
         &SolveOptions::default()
     ))
     .starts_with("tendons[0].offset"));
+    // A constant offset is checked once, at s = 0: too far from the backbone, or beyond the
+    // centre of a constant rest curvature (the tendon would run backwards).
+    let far = common::tendon([0.31, 0.0], 1.0, Some(0.2)).unwrap();
+    let solve = |r: &Rod, t| common::solve(r, &[t], &Loads::default(), &SolveOptions::default());
+    assert_eq!(name_of(solve(&rod(), far)), "tendons[0].offset(0)");
+    let curved = rod()
+        .with_rest_curvature(Profile::Constant(Vector3::new(0.0, 10.0, 0.0)))
+        .unwrap();
+    let inside = common::tendon([0.11, 0.0], 1.0, None).unwrap();
+    assert_eq!(name_of(solve(&curved, inside)), "tendons[0].offset(0)");
+    let outside = common::tendon([-0.11, 0.0], 1.0, None).unwrap();
+    assert!(
+        softrod::RobotModel::new(curved, vec![outside.tendon], vec![], Loads::default()).is_ok()
+    );
 }
 
 #[test]

@@ -1,14 +1,20 @@
-//! Binding of the Cosserat statics: `solve_statics` and its solution.
+//! Binding of the Cosserat statics: `solve_statics`, `Robot.solve` and their solution.
 //!
 //! The Python signature keeps the objects a user builds (a rod, tendons with their tensions,
 //! chambers with their pressures, loads); the binding splits them into the core's immutable
-//! `RobotModel` and its `Actuation`. Options start from the core's `SolveOptions::default()`:
-//! an option not given keeps the core's default (stated once, in the core).
+//! `RobotModel` and its `Actuation`. A `softrod.Robot` keeps its core model (validated once)
+//! and passes its tensions and pressures as the actuation. Options start from the core's
+//! `SolveOptions::default()`: an option not given keeps the core's default (stated once, in
+//! the core).
 //!
 //! The files: `options.rs` (the options, the core model and actuation of the user's objects,
-//! displacement control, actuator names in errors), `solution.rs` (the solution class).
+//! displacement control, actuator names in errors), `robot.rs` (the model of a robot and its
+//! solve), `call.rs` (the call a solution keeps for pickling), `solution.rs` (the solution
+//! class).
 
+mod call;
 mod options;
+pub(crate) mod robot;
 mod solution;
 
 use std::sync::Arc;
@@ -21,8 +27,10 @@ use pyo3::sync::PyOnceLock;
 use crate::callbacks::run;
 use crate::convert::{arg, count};
 use crate::errors::{param_err, type_err, StabilityError, StabilityWarning};
-use crate::model::{Args, Chamber, Loads, Rod, Tendon};
+use crate::model::{Chamber, Loads, Rod, Tendon};
 
+use call::{Call, Subject};
+use options::Names;
 pub(crate) use options::{actuator_names, apply_displacements, solve_options, OptionArgs, Problem};
 pub(crate) use solution::{stats_dict, StaticsSolution};
 
@@ -120,7 +128,124 @@ pub(crate) fn solve_statics<'py>(
     obstacles: Option<Bound<'py, PyAny>>,
     tip_constraint: Option<Bound<'py, PyAny>>,
 ) -> PyResult<StaticsSolution> {
-    let previous = previous.filter(|p| !p.is_none());
+    solve(
+        py,
+        Source::Objects {
+            rod,
+            tendons,
+            loads,
+            chambers,
+        },
+        Keywords {
+            integrator,
+            steps,
+            rtol,
+            atol,
+            tolerance,
+            max_iterations,
+            continuation,
+            max_load_steps,
+            warm_start,
+            throw,
+            s_out,
+            seek_stable,
+            on_unstable,
+            previous,
+            displacements,
+            tendon_stiffness,
+            obstacles,
+            tip_constraint,
+        },
+    )
+}
+
+/// The robot of a solve: the user's objects (a model built for this call), or a robot's
+/// model (built once) with the tensions and pressures given (`None`: its objects').
+pub(crate) enum Source<'py> {
+    Objects {
+        rod: Bound<'py, Rod>,
+        tendons: Vec<Bound<'py, Tendon>>,
+        loads: Option<Bound<'py, Loads>>,
+        chambers: Vec<Bound<'py, Chamber>>,
+    },
+    Robot {
+        model: Bound<'py, robot::RobotModel>,
+        tensions: Option<Vec<f64>>,
+        pressures: Option<Vec<f64>>,
+    },
+}
+
+impl Source<'_> {
+    /// The core model, the actuation, the names of the actuation in the core's errors and
+    /// the call's subject (kept for pickling).
+    fn resolve(self) -> PyResult<(Arc<softrod::RobotModel>, softrod::Actuation, Names, Subject)> {
+        match self {
+            Source::Objects {
+                rod,
+                tendons,
+                loads,
+                chambers,
+            } => {
+                let problem = Problem::new(
+                    rod.get(),
+                    &tendons,
+                    loads.as_ref().map(Bound::get),
+                    &chambers,
+                )?;
+                let subject = Subject::Objects {
+                    rod: rod.unbind(),
+                    tendons: tendons.into_iter().map(Bound::unbind).collect(),
+                    loads: loads.map(Bound::unbind),
+                    chambers: chambers.into_iter().map(Bound::unbind).collect(),
+                };
+                Ok((problem.model, problem.actuation, Names::OBJECTS, subject))
+            }
+            Source::Robot {
+                model,
+                tensions,
+                pressures,
+            } => {
+                let m = model.get();
+                let (actuation, names) = m.actuation(tensions.as_ref(), pressures.as_ref())?;
+                let core = Arc::clone(&m.problem.model);
+                let subject = Subject::Robot {
+                    model: model.unbind(),
+                    tensions,
+                    pressures,
+                };
+                Ok((core, actuation, names, subject))
+            }
+        }
+    }
+}
+
+/// The keyword arguments of a statics solve (`None`: not given).
+pub(crate) struct Keywords<'py> {
+    pub(crate) integrator: Option<&'py str>,
+    pub(crate) steps: Option<i64>,
+    pub(crate) rtol: Option<f64>,
+    pub(crate) atol: Option<f64>,
+    pub(crate) tolerance: Option<f64>,
+    pub(crate) max_iterations: Option<i64>,
+    pub(crate) continuation: Option<bool>,
+    pub(crate) max_load_steps: Option<i64>,
+    pub(crate) warm_start: Option<Bound<'py, PyAny>>,
+    pub(crate) throw: Option<bool>,
+    pub(crate) s_out: Option<Bound<'py, PyAny>>,
+    pub(crate) seek_stable: Option<bool>,
+    pub(crate) on_unstable: Option<&'py str>,
+    pub(crate) previous: Option<Bound<'py, PyAny>>,
+    pub(crate) displacements: Option<Bound<'py, PyAny>>,
+    pub(crate) tendon_stiffness: Option<Bound<'py, PyAny>>,
+    pub(crate) obstacles: Option<Bound<'py, PyAny>>,
+    pub(crate) tip_constraint: Option<Bound<'py, PyAny>>,
+}
+
+/// The one statics solve of the binding (`solve_statics`, `Robot.solve`): the options
+/// checked, the model and actuation of `source`, the solve with the GIL released, the
+/// solution.
+fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResult<StaticsSolution> {
+    let previous = k.previous.filter(|p| !p.is_none());
     let prev_state: Option<Arc<softrod::FrictionalSolution>> = match &previous {
         None => None,
         Some(p) => {
@@ -139,12 +264,12 @@ pub(crate) fn solve_statics<'py>(
             }
         }
     };
-    let obstacle_list = crate::contact::obstacles(py, obstacles.as_ref())?;
-    let tip = crate::contact::tip_constraint(tip_constraint.as_ref())?;
+    let obstacle_list = crate::contact::obstacles(py, k.obstacles.as_ref())?;
+    let tip = crate::contact::tip_constraint(k.tip_constraint.as_ref())?;
     let constrained = tip.is_some() || !obstacle_list.is_empty();
-    let warm_start = warm_start.filter(|w| !w.is_none());
-    let unstable = self::on_unstable(on_unstable)?;
-    let s_values = crate::convert::floats_opt(s_out.as_ref(), "s_out")?;
+    let warm_start = k.warm_start.filter(|w| !w.is_none());
+    let unstable = self::on_unstable(k.on_unstable)?;
+    let s_values = crate::convert::floats_opt(k.s_out.as_ref(), "s_out")?;
     if constrained && !s_values.is_empty() {
         return Err(crate::errors::param_err(
             "s_out",
@@ -153,31 +278,25 @@ pub(crate) fn solve_statics<'py>(
         ));
     }
     let args = OptionArgs {
-        integrator,
-        steps,
-        rtol,
-        atol,
-        tolerance,
-        max_iterations,
-        continuation,
-        max_load_steps,
+        integrator: k.integrator,
+        steps: k.steps,
+        rtol: k.rtol,
+        atol: k.atol,
+        tolerance: k.tolerance,
+        max_iterations: k.max_iterations,
+        continuation: k.continuation,
+        max_load_steps: k.max_load_steps,
         warm_start: warm_start.clone(),
-        throw,
-        seek_stable,
+        throw: k.throw,
+        seek_stable: k.seek_stable,
     };
     let options = solve_options(&args)?;
-    let problem = Problem::new(
-        rod.get(),
-        &tendons,
-        loads.as_ref().map(Bound::get),
-        &chambers,
-    )?;
-    let mut actuation = problem.actuation.clone();
+    let (model, mut actuation, names, subject) = source.resolve()?;
     apply_displacements(
         &mut actuation,
-        problem.model.tendons().len(),
-        displacements.as_ref(),
-        tendon_stiffness.as_ref(),
+        model.tendons().len(),
+        k.displacements.as_ref(),
+        k.tendon_stiffness.as_ref(),
     )?;
     if actuation.has_held() {
         if let Some(w) = warm_start
@@ -185,7 +304,7 @@ pub(crate) fn solve_statics<'py>(
             .and_then(|w| w.cast::<StaticsSolution>().ok())
         {
             let prev = &w.get().inner;
-            if prev.tendon_tensions.len() == problem.model.tendons().len()
+            if prev.tendon_tensions.len() == model.tendons().len()
                 && prev.tendon_tensions.iter().all(|t| t.is_finite())
             {
                 actuation.tension_guess = Some(prev.tendon_tensions.clone());
@@ -199,7 +318,7 @@ pub(crate) fn solve_statics<'py>(
             "None with obstacles or a tip constraint (tension control only)",
         ));
     }
-    let (model, act) = (&problem.model, &actuation);
+    let act = &actuation;
     let frictional = prev_state.is_some()
         || model
             .tendons()
@@ -219,14 +338,14 @@ pub(crate) fn solve_statics<'py>(
             "no obstacles and no tip constraint when a tendon has friction (not modelled together)",
         ));
     }
+    let rename = |e| names.rename(e);
     let (result, friction, contact) = if frictional {
         let fo = softrod::FrictionOptions {
             statics: options,
             ..Default::default()
         };
         let f = run(py, "solve_statics", || {
-            softrod::solve_frictional(model, act, &fo, prev_state.as_deref())
-                .map_err(actuator_names)
+            softrod::solve_frictional(&model, act, &fo, prev_state.as_deref()).map_err(rename)
         })?;
         (
             f.statics.clone(),
@@ -237,77 +356,45 @@ pub(crate) fn solve_statics<'py>(
         let (r, c) = run(py, "solve_statics", || {
             if constrained {
                 let c =
-                    softrod::solve_constrained(model, act, &options, tip.as_ref(), &obstacle_list)
-                        .map_err(actuator_names)?;
+                    softrod::solve_constrained(&model, act, &options, tip.as_ref(), &obstacle_list)
+                        .map_err(rename)?;
                 let data = crate::contact::ContactData::from_solution(&c);
                 Ok((c.solution, data))
             } else {
-                softrod::compliance::solve_at_output(model, act, &options, &s_values)
-                    .map_err(actuator_names)
+                softrod::compliance::solve_at_output(&model, act, &options, &s_values)
+                    .map_err(rename)
                     .map(|r| (r, crate::contact::ContactData::default()))
             }
         })?;
         (r, None, c)
     };
-    let o = |v: Option<Py<PyAny>>| v.unwrap_or_else(|| py.None());
-    let call = Args::new(
-        py,
-        &[
-            ("rod", rod.clone().into_any().unbind()),
-            ("tendons", tendons.into_pyobject(py)?.into_any().unbind()),
-            ("loads", o(loads.map(|l| l.clone().into_any().unbind()))),
-            (
-                "integrator",
-                integrator.into_pyobject(py)?.into_any().unbind(),
-            ),
-            ("steps", steps.into_pyobject(py)?.into_any().unbind()),
-            ("rtol", rtol.into_pyobject(py)?.into_any().unbind()),
-            ("atol", atol.into_pyobject(py)?.into_any().unbind()),
-            (
-                "tolerance",
-                tolerance.into_pyobject(py)?.into_any().unbind(),
-            ),
-            (
-                "max_iterations",
-                max_iterations.into_pyobject(py)?.into_any().unbind(),
-            ),
-            (
-                "continuation",
-                continuation.into_pyobject(py)?.into_any().unbind(),
-            ),
-            (
-                "max_load_steps",
-                max_load_steps.into_pyobject(py)?.into_any().unbind(),
-            ),
-            ("warm_start", o(warm_start.map(Bound::unbind))),
-            ("throw", throw.into_pyobject(py)?.into_any().unbind()),
-            ("chambers", chambers.into_pyobject(py)?.into_any().unbind()),
-            (
-                "s_out",
-                s_values.clone().into_pyobject(py)?.into_any().unbind(),
-            ),
-            (
-                "seek_stable",
-                seek_stable.into_pyobject(py)?.into_any().unbind(),
-            ),
-            (
-                "on_unstable",
-                "ignore".into_pyobject(py)?.into_any().unbind(),
-            ),
-            ("previous", o(previous.map(Bound::unbind))),
-            ("displacements", o(displacements.map(Bound::unbind))),
-            ("tendon_stiffness", o(tendon_stiffness.map(Bound::unbind))),
-            ("obstacles", o(obstacles.map(Bound::unbind))),
-            ("tip_constraint", o(tip_constraint.map(Bound::unbind))),
-        ],
-    )?;
+    let call = Call {
+        subject,
+        integrator: k.integrator.map(str::to_owned),
+        steps: k.steps,
+        rtol: k.rtol,
+        atol: k.atol,
+        tolerance: k.tolerance,
+        max_iterations: k.max_iterations,
+        continuation: k.continuation,
+        max_load_steps: k.max_load_steps,
+        warm_start: warm_start.map(Bound::unbind),
+        throw: k.throw,
+        s_out: s_values,
+        seek_stable: k.seek_stable,
+        previous: previous.map(Bound::unbind),
+        displacements: k.displacements.map(Bound::unbind),
+        tendon_stiffness: k.tendon_stiffness.map(Bound::unbind),
+        obstacles: k.obstacles.map(Bound::unbind),
+        tip_constraint: k.tip_constraint.map(Bound::unbind),
+    };
     let sol = StaticsSolution {
         inner: result,
         friction,
         cache: std::array::from_fn(|_| PyOnceLock::new()),
         call,
         contact,
-        robot: problem.model.clone(),
+        robot: model,
     };
     report_unstable(py, sol, unstable)
 }

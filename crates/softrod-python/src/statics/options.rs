@@ -221,28 +221,49 @@ pub(crate) fn apply_displacements(
 /// The core's `tensions[i]` / `pressures[i]` as the Python objects that carry them:
 /// `tendons[i].tension`, `chambers[i].pressure`.
 pub(crate) fn actuator_names(e: softrod::Error) -> softrod::Error {
-    match e {
-        softrod::Error::InvalidParameter {
-            name,
-            value,
-            expected,
-        } => {
-            let rename = |prefix: &str, object: &str, field: &str| -> Option<String> {
-                let index = name.strip_prefix(prefix)?.strip_suffix(']')?;
-                index
-                    .parse::<usize>()
-                    .ok()
-                    .map(|i| format!("{object}[{i}].{field}"))
-            };
-            let name = rename("tensions[", "tendons", "tension")
-                .or_else(|| rename("pressures[", "chambers", "pressure"))
-                .unwrap_or(name);
+    Names::OBJECTS.rename(e)
+}
+
+/// Which of the core's actuation names stand for the objects' own values in its errors.
+#[derive(Clone, Copy)]
+pub(crate) struct Names {
+    /// The tensions are the tendons' (`tensions[i]` is `tendons[i].tension`).
+    pub(crate) tendons: bool,
+    /// The pressures are the chambers' (`pressures[i]` is `chambers[i].pressure`).
+    pub(crate) chambers: bool,
+}
+
+impl Names {
+    /// Tensions and pressures both carried by the objects (`solve_statics`).
+    pub(crate) const OBJECTS: Self = Self {
+        tendons: true,
+        chambers: true,
+    };
+
+    /// The error with `tensions[i]` / `pressures[i]` renamed after the objects that carry
+    /// them; values given as `tensions` / `pressures` keep their names.
+    pub(crate) fn rename(self, e: softrod::Error) -> softrod::Error {
+        match e {
             softrod::Error::InvalidParameter {
                 name,
                 value,
                 expected,
+            } => {
+                let rename = |on: bool, prefix: &str, object: &str, field: &str| {
+                    let index = name.strip_prefix(prefix)?.strip_suffix(']')?;
+                    let i = index.parse::<usize>().ok().filter(|_| on)?;
+                    Some(format!("{object}[{i}].{field}"))
+                };
+                let name = rename(self.tendons, "tensions[", "tendons", "tension")
+                    .or_else(|| rename(self.chambers, "pressures[", "chambers", "pressure"))
+                    .unwrap_or(name);
+                softrod::Error::InvalidParameter {
+                    name,
+                    value,
+                    expected,
+                }
             }
+            other => other,
         }
-        other => other,
     }
 }

@@ -11,7 +11,6 @@ use pyo3::types::{PyDict, PyTuple};
 
 use crate::callbacks::run;
 use crate::errors::{param_err, to_py_err, type_err};
-use crate::model::Args;
 
 /// A solved rod, sampled at the integration mesh (SI units, world frame unless `_body`).
 ///
@@ -25,7 +24,7 @@ pub(crate) struct StaticsSolution {
     /// The arrays made so far (by getter).
     pub(super) cache: [PyOnceLock<Py<PyAny>>; 12],
     /// The call that produced it (for pickling: it is solved again, bit for bit).
-    pub(super) call: Args,
+    pub(super) call: super::call::Call,
     /// Contacts, contact forces and the tip reaction (with obstacles or a tip constraint).
     pub(super) contact: crate::contact::ContactData,
     /// The robot as solved (with its guides: the rod of a disk-guided solution, `inner.model`,
@@ -487,9 +486,7 @@ impl StaticsSolution {
         )
     }
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let py = slf.py();
-        let f = py.import("softrod._core")?.getattr("solve_statics")?;
-        slf.get().call.reduce(py, f)
+        slf.get().call.reduce(slf.py())
     }
 }
 

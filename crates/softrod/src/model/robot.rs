@@ -17,8 +17,8 @@ use crate::model::actuation::{Actuation, TendonInput};
 use crate::model::chamber::{self, Chamber};
 use crate::model::loads::{Frame, Loads};
 use crate::model::material::TangentCompliance;
-use crate::model::rod::{Rod, FUNCTION_CHECKS};
-use crate::model::tendon::Tendon;
+use crate::model::rod::{Profile, Rod, FUNCTION_CHECKS};
+use crate::model::tendon::{Routing, Tendon};
 
 /// A validated robot: rod, tendons (routing and termination), chambers (geometry) and external
 /// loads, with the precomputed data of the solvers.
@@ -329,11 +329,20 @@ fn force_free_of(loads: &Loads) -> bool {
 /// section, or through spacer disks outside it), and the tendon's path running forward in the
 /// rest shape (`v*_z + u*_x y - u*_y x > 0`: on a precurved rod, a tendon beyond the centre of
 /// the rest curvature would run backwards). Returns the largest distance (m).
+///
+/// A constant offset on a rod whose rest strains are constant has the same values at every
+/// check point: it is checked once, at `s = 0` (the first point, so the same error), unless
+/// the section is a user function (its calls at the check points are kept).
 fn check_routing(i: usize, tendon: &Tendon, rod: &Rod, end: f64) -> Result<f64> {
     let l = rod.length();
     let max_offset = MAX_OFFSET_RATIO * l;
     let mut reach: f64 = 0.0;
-    for k in 0..=FUNCTION_CHECKS {
+    let uniform = matches!(tendon.routing(), Routing::Constant(_))
+        && matches!(rod.rest_strain(), Profile::Constant(_))
+        && matches!(rod.rest_curvature(), Profile::Constant(_))
+        && !rod.section().is_function();
+    let checks = if uniform { 0 } else { FUNCTION_CHECKS };
+    for k in 0..=checks {
         let s = end * k as f64 / FUNCTION_CHECKS as f64;
         let (r, rp) = tendon.routing().offset(s, &rod.section_at(s));
         if !(r.iter().chain(rp.iter()).all(|v| v.is_finite())) {
