@@ -216,3 +216,10 @@ def test_a_robot_built_in_code_round_trips_through_toml_and_pickle():
     expected = robot.solve().position
     np.testing.assert_array_equal(again.solve().position, expected)
     np.testing.assert_array_equal(pickle.loads(pickle.dumps(robot)).solve().position, expected)
+
+
+def test_a_misspelt_option_names_the_method_called(niti):
+    with pytest.raises(TypeError) as info:
+        niti.solve(stepz=10)
+    assert "stepz" in str(info.value)
+    assert "_solve_robot" not in str(info.value)

@@ -399,14 +399,21 @@ class Robot:
                 merged.setdefault("obstacles", list(self._obstacles))
             if self._tip_constraint is not None:
                 merged.setdefault("tip_constraint", self._tip_constraint)
-        return _solve_robot(
-            self._model or self._core_model(),
-            tensions,
-            pressures,
-            displacements=displacements,
-            tendon_stiffness=tendon_stiffness,
-            **merged,
-        )
+        try:
+            return _solve_robot(
+                self._model or self._core_model(),
+                tensions,
+                pressures,
+                displacements=displacements,
+                tendon_stiffness=tendon_stiffness,
+                **merged,
+            )
+        except TypeError as err:
+            # A misspelt option: name the method the user called, not the core function.
+            text = str(err)
+            if type(err) is TypeError and text.startswith("_solve_robot()"):
+                raise TypeError("Robot.solve()" + text.removeprefix("_solve_robot()")) from None
+            raise
 
     def _core_model(self) -> _RobotModel:
         """The validated core model of the rod, tendons, loads and chambers (built once)."""
