@@ -74,6 +74,7 @@
 
 mod cosserat;
 pub mod pcc;
+mod pcc_closed;
 mod problem;
 pub mod qp;
 mod sqp;
