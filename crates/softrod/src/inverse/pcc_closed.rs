@@ -168,28 +168,27 @@ impl Chain {
         self.p.iter().all(|v| v.is_finite())
     }
 
-    /// `Mᵀ (Σ λ_k ∇²_θ p_k) M` (n × n, row-major) into `out`; `h` and `hm` are scratch.
-    fn curvature(
-        &self,
-        aff: &Affine,
-        lambda: &V3<f64>,
-        (h, hm): (&mut Vec<f64>, &mut Vec<f64>),
-        out: &mut Vec<f64>,
-    ) {
-        let (n, ns) = (aff.n, aff.rest.len());
+    /// `Σ λ_k ∇²_θ p_k` (q × q, row-major, `q = 3` per segment, symmetric) into `h`.
+    fn theta_hessian(&self, lambda: &V3<f64>, h: &mut Vec<f64>) {
+        let ns = self.kin.len();
         let q = 3 * ns;
         h.clear();
         h.resize(q * q, 0.0);
         for s in 0..ns {
             let (b, k) = (&self.base[s], &self.kin[s]);
             let dd = self.p - self.tip[s];
+            // λ·(B x) = (Bᵀλ)·x, λ·(a × (b × d)) = (λ × a)·(b × d), λ·((B x) × d) =
+            // (Bᵀ(d × λ))·x: the multipliers taken into each term once.
+            let (bl, bd) = (b.tr_mul(lambda), b.tr_mul(&dd.cross(lambda)));
+            let lo = self.oc[s].map(|o| lambda.cross(&o));
+            let od = self.oc[s].map(|o| o.cross(&dd));
             for c in 0..3 {
                 for m in 0..3 {
-                    let mut v = b * k.ddp[c][m] + self.oc[s][c].cross(&self.oc[s][m].cross(&dd));
+                    let mut v = bl.dot(&k.ddp[c][m]) + lo[c].dot(&od[m]);
                     if c < 2 && m < 2 {
-                        v += (b * k.dw[c][m]).cross(&dd);
+                        v += bd.dot(&k.dw[c][m]);
                     }
-                    h[(3 * s + c) * q + 3 * s + m] = lambda.dot(&v);
+                    h[(3 * s + c) * q + 3 * s + m] = v;
                 }
             }
             // Distal segments: λ·(Ω_sc × V_tm), symmetric.
@@ -212,36 +211,77 @@ impl Chain {
                 h[j * q + i] = v;
             }
         }
-        // Mᵀ (H M), H M first (q × n); row `3 s + c` of M is `cols[s n + k][c]`.
-        hm.clear();
-        hm.resize(q * n, 0.0);
-        for i in 0..q {
-            let row = &mut hm[i * n..(i + 1) * n];
-            for (t, cols) in aff.cols.chunks_exact(n).enumerate() {
-                for m in 0..3 {
-                    let hij = h[i * q + 3 * t + m];
-                    if hij != 0.0 {
-                        for (r, c) in row.iter_mut().zip(cols) {
-                            *r += hij * c[m];
-                        }
+    }
+}
+
+/// The Hessian of the Lagrangian `W - Mᵀ H_θ M` (n × n, row-major) into `out`, `H_θ` from
+/// [`Chain::theta_hessian`]; `hm` is scratch.
+fn lagrangian_hessian(aff: &Affine, h: &[f64], w: &[f64], hm: &mut Vec<f64>, out: &mut Vec<f64>) {
+    let n = aff.n;
+    let q = 3 * aff.rest.len();
+    // H M first (q × n); row `3 s + c` of M is `cols[s n + k][c]`.
+    hm.clear();
+    hm.resize(q * n, 0.0);
+    for i in 0..q {
+        let row = &mut hm[i * n..(i + 1) * n];
+        for (t, cols) in aff.cols.chunks_exact(n).enumerate() {
+            for m in 0..3 {
+                let hij = h[i * q + 3 * t + m];
+                if hij != 0.0 {
+                    for (r, c) in row.iter_mut().zip(cols) {
+                        *r += hij * c[m];
                     }
                 }
             }
         }
-        out.clear();
-        out.resize(n * n, 0.0);
-        for (s, cols) in aff.cols.chunks_exact(n).enumerate() {
-            for (k, c) in cols.iter().enumerate() {
-                let row = &mut out[k * n..(k + 1) * n];
-                for m in 0..3 {
-                    if c[m] != 0.0 {
-                        let hrow = &hm[(3 * s + m) * n..(3 * s + m + 1) * n];
-                        for (o, v) in row.iter_mut().zip(hrow) {
-                            *o += c[m] * v;
-                        }
+    }
+    out.clear();
+    out.resize(n * n, 0.0);
+    for (s, cols) in aff.cols.chunks_exact(n).enumerate() {
+        for (k, c) in cols.iter().enumerate() {
+            let row = &mut out[k * n..(k + 1) * n];
+            for m in 0..3 {
+                if c[m] != 0.0 {
+                    let hrow = &hm[(3 * s + m) * n..(3 * s + m + 1) * n];
+                    for (o, v) in row.iter_mut().zip(hrow) {
+                        *o -= c[m] * v;
                     }
                 }
             }
+        }
+    }
+    for k in 0..n {
+        out[k * n + k] += w[k];
+    }
+}
+
+/// `(W - Mᵀ H_θ M) v` into `out` (`u`, `hu`: scratch of length `q`).
+fn lagrangian_times(
+    aff: &Affine,
+    (h, w): (&[f64], &[f64]),
+    v: &[f64],
+    (u, hu): (&mut Vec<f64>, &mut Vec<f64>),
+    out: &mut [f64],
+) {
+    let n = aff.n;
+    let q = 3 * aff.rest.len();
+    u.clear();
+    u.resize(q, 0.0);
+    for (s, cols) in aff.cols.chunks_exact(n).enumerate() {
+        for (c, vk) in cols.iter().zip(v) {
+            for m in 0..3 {
+                u[3 * s + m] += c[m] * vk;
+            }
+        }
+    }
+    hu.clear();
+    hu.extend((0..q).map(|i| (0..q).map(|j| h[i * q + j] * u[j]).sum::<f64>()));
+    for k in 0..n {
+        out[k] = w[k] * v[k];
+    }
+    for (s, cols) in aff.cols.chunks_exact(n).enumerate() {
+        for (o, c) in out.iter_mut().zip(cols) {
+            *o -= c[0] * hu[3 * s] + c[1] * hu[3 * s + 1] + c[2] * hu[3 * s + 2];
         }
     }
 }
@@ -347,9 +387,13 @@ fn dual(
     // Whether the last step changed ψ by round-off alone (no rise, no fall of the gradient).
     let mut stalled = false;
     let mut last_g = f64::INFINITY;
+    // Whether the last step kept the free set (the dual a quadratic along it).
+    let mut kept = false;
     for _ in 0..100 {
         let gn = g.amax();
-        if gn <= tol {
+        // A step on an unchanged free set (the full one is exact for it) that leaves the
+        // gradient where it was: it is at round-off.
+        if gn <= tol || (kept && gn > 0.5 * last_g && gn <= 1e3 * tol) {
             return Some(lambda);
         }
         if stalled && gn > 0.5 * last_g {
@@ -380,6 +424,7 @@ fn dual(
             let falls = ws.trial_free == ws.free && gt.amax() < gn;
             if rises || falls || (pt - psi).abs() <= 1e-15 * psi.abs() {
                 stalled = !(rises || falls);
+                kept = ws.trial_free == ws.free;
                 (lambda, psi, g) = (lt, pt, gt);
                 y.copy_from_slice(&ws.trial);
                 ws.free.copy_from_slice(&ws.trial_free);
@@ -579,27 +624,12 @@ struct ConvexWork {
     chol: Vec<f64>,
 }
 
-/// The basis `Z` (into `ws.z`, `Zᵀ W Z = I`, zero on the fixed variables) of the null space
-/// of the columns `ws.idx` of `J` (scaled variables `W^{1/2} a`; the range is the span of the
-/// eigenvectors of `J_F W_F⁻¹ J_Fᵀ` above `1e-10` of the largest); returns its dimension.
-fn null_space(jac: &[V3<f64>], bx: &Box_, ws: &mut ConvexWork) -> usize {
-    let n = bx.w.len();
-    let k = ws.idx.len();
-    ws.cols.clear();
-    ws.cols
-        .extend(ws.idx.iter().map(|&i| jac[i] / bx.w[i].sqrt()));
-    let mut g = M3::zeros();
-    for v in &ws.cols {
-        g += v * v.transpose();
-    }
+/// `ws.proj -= Σ v vᵀ` over the orthonormal range vectors `v = A_Fᵀ u / √σ` of the
+/// eigenpairs `(σ, u)` of `G = A_F A_Fᵀ` above `1e-10` of the largest; returns their number.
+fn range_projector(g: &M3<f64>, ws: &mut ConvexWork) -> usize {
+    let k = ws.cols.len();
     let eig = g.symmetric_eigen();
     let top = eig.eigenvalues.iter().fold(0.0f64, |x, v| x.max(v.abs()));
-    // P = I - Σ v vᵀ over the orthonormal range vectors v = A_Fᵀ u / √σ.
-    ws.proj.clear();
-    ws.proj.resize(k * k, 0.0);
-    for i in 0..k {
-        ws.proj[i * k + i] = 1.0;
-    }
     let mut rank = 0;
     for (r, &s) in eig.eigenvalues.iter().enumerate() {
         if s.abs() <= 1e-10 * top {
@@ -615,6 +645,42 @@ fn null_space(jac: &[V3<f64>], bx: &Box_, ws: &mut ConvexWork) -> usize {
             }
         }
     }
+    rank
+}
+
+/// The basis `Z` (into `ws.z`, `Zᵀ W Z = I`, zero on the fixed variables) of the null space
+/// of the columns `ws.idx` of `J` (scaled variables `W^{1/2} a`; the range is the span of the
+/// eigenvectors of `J_F W_F⁻¹ J_Fᵀ` above `1e-10` of the largest); returns its dimension.
+fn null_space(jac: &[V3<f64>], bx: &Box_, ws: &mut ConvexWork) -> usize {
+    let n = bx.w.len();
+    let k = ws.idx.len();
+    ws.cols.clear();
+    ws.cols
+        .extend(ws.idx.iter().map(|&i| jac[i] / bx.w[i].sqrt()));
+    let mut g = M3::zeros();
+    for v in &ws.cols {
+        g += v * v.transpose();
+    }
+    ws.proj.clear();
+    ws.proj.resize(k * k, 0.0);
+    for i in 0..k {
+        ws.proj[i * k + i] = 1.0;
+    }
+    // Well conditioned (λ_min/λ_max >= det/tr³ > 1e-8, far from the rank test): P = I - Aᵀ G⁻¹ A
+    // without the eigenvectors.
+    let (det, tr) = (g.determinant(), g.trace());
+    let rank = match g.try_inverse() {
+        Some(inv) if det > 1e-8 * tr.powi(3) => {
+            for i in 0..k {
+                let gi = inv * ws.cols[i];
+                for j in 0..k {
+                    ws.proj[i * k + j] -= ws.cols[j].dot(&gi);
+                }
+            }
+            3
+        }
+        _ => range_projector(&g, ws),
+    };
     let d = k.saturating_sub(rank);
     ws.z.clear();
     ws.z.resize(n * d, 0.0);
@@ -649,13 +715,13 @@ fn null_space(jac: &[V3<f64>], bx: &Box_, ws: &mut ConvexWork) -> usize {
     d
 }
 
-/// Whether the symmetric `d × d` matrix `m - floor I` is positive definite (its Cholesky
-/// factorisation into `chol`).
-fn above_floor(m: &[f64], d: usize, floor: f64, chol: &mut Vec<f64>) -> bool {
+/// Whether the symmetric `d × d` matrix `m - shift I` is positive definite; its Cholesky
+/// factor (lower, row-major) into `chol`.
+fn cholesky(m: &[f64], d: usize, shift: f64, chol: &mut Vec<f64>) -> bool {
     chol.clear();
-    chol.extend_from_slice(m);
+    chol.extend_from_slice(&m[..d * d]);
     for i in 0..d {
-        chol[i * d + i] -= floor;
+        chol[i * d + i] -= shift;
     }
     for j in 0..d {
         let mut s = chol[j * d + j];
@@ -678,13 +744,26 @@ fn above_floor(m: &[f64], d: usize, floor: f64, chol: &mut Vec<f64>) -> bool {
     true
 }
 
+/// Solves `L Lᵀ x = b` in place with the factor of [`cholesky`]; `false` if not finite.
+fn cholesky_solve(l: &[f64], d: usize, b: &mut [f64]) -> bool {
+    for i in 0..d {
+        let s: f64 = (0..i).map(|k| l[i * d + k] * b[k]).sum();
+        b[i] = (b[i] - s) / l[i * d + i];
+    }
+    for i in (0..d).rev() {
+        let s: f64 = (i + 1..d).map(|k| l[k * d + i] * b[k]).sum();
+        b[i] = (b[i] - s) / l[i * d + i];
+    }
+    b[..d].iter().all(|v| v.is_finite())
+}
+
 /// The Hessian `h` (n × n, row-major) made positive definite on the null space `Z` of the
 /// free columns of `J` (those free in `y_w`, scaled variables `W^{1/2} a`): kept exact when
 /// `Zᵀ h Z` has its eigenvalues above [`CURVATURE_FLOOR`] (the cross terms `Zᵀ h Y` make the
 /// curved step Newton's), otherwise only `Zᵀ h Z` raised to that floor, so that the curved
 /// step is a descent step toward a minimum, never a saddle. Without a null space: `W` (the
-/// step is then the constraints' alone).
-fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_, ws: &mut ConvexWork) {
+/// step is then the constraints' alone, the minimum-norm step), and `false`.
+fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_, ws: &mut ConvexWork) -> bool {
     let n = y_w.len();
     ws.idx.clear();
     ws.idx.extend((0..n).filter(|&i| bx.inside(i, y_w[i])));
@@ -699,7 +778,7 @@ fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_, ws: &mut Co
                 h[r * n + c] = if r == c { bx.w[r] } else { 0.0 };
             }
         }
-        return;
+        return false;
     }
     for r in 0..n {
         for c in 0..r {
@@ -725,10 +804,10 @@ fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_, ws: &mut Co
             ws.zhz[j * d + i] = 0.5 * (u + v);
         }
     }
-    if above_floor(&ws.zhz, d, CURVATURE_FLOOR, &mut ws.chol) {
+    if cholesky(&ws.zhz, d, CURVATURE_FLOOR, &mut ws.chol) {
         // Positive definite on Z already: the exact Hessian, cross terms included (the step
         // is Newton's).
-        return;
+        return true;
     }
     // Only `Zᵀ H Z` raised (`Zᵀ W Z = I`): `h += W Z (floored - Zᵀ H Z) Zᵀ W`.
     let m = DMatrix::from_row_slice(d, d, &ws.zhz);
@@ -753,6 +832,197 @@ fn convexify(h: &mut [f64], jac: &[V3<f64>], y_w: &[f64], bx: &Box_, ws: &mut Co
             h[c * n + r] = v;
         }
     }
+    true
+}
+
+/// What [`reduced_step`] found.
+enum Reduced {
+    /// No null space of the free columns: the minimum-norm step is the curved one.
+    NoNullSpace,
+    /// The curved step, in [`ReducedWork::d`].
+    Step,
+    /// The step leaves the box, or a bound's multiplier has the wrong sign: the working set
+    /// changes.
+    Bounds,
+}
+
+/// The scratch of [`reduced_step`].
+#[derive(Default)]
+struct ReducedWork {
+    /// The step.
+    d: Vec<f64>,
+    /// `H' d_r`, then the gradient `H' d + W (a - c)`.
+    hd: Vec<f64>,
+    /// `H Z` (n × dim Z, column-major).
+    hz: Vec<f64>,
+    /// `Zᵀ H' Z`, its raise `Δ` and Cholesky factor (dim Z × dim Z).
+    m: Vec<f64>,
+    delta: Vec<f64>,
+    chol: Vec<f64>,
+    /// `t`, `Z t`, and the scratch of the raise.
+    t: Vec<f64>,
+    zt: Vec<f64>,
+    u: Vec<f64>,
+    prod: (Vec<f64>, Vec<f64>),
+}
+
+/// The curved step on the face of the minimum-norm point `y_w` by the null-space method:
+/// `d = d_r + Z t`, `d_r = y_w - a`, `t = -(Zᵀ H' Z)⁻¹ Zᵀ (H' d_r + W (a - c))`, `H'` the Hessian
+/// of the Lagrangian `W - Mᵀ H_θ M` (`H_θ` = `theta`) with `Zᵀ H Z` raised to
+/// [`CURVATURE_FLOOR`] as [`convexify`] raises it, applied to the `1 + dim Z` vectors it
+/// meets rather than formed. It is the first face of [`curved_step`]'s active set, and that
+/// step when it stays in the box and the multipliers of the bounds have their signs
+/// ([`Reduced::Step`]).
+fn reduced_step(
+    (aff, theta, jac): (&Affine, &[f64], &[V3<f64>]),
+    (a, y_w): (&[f64], &[f64]),
+    bx: &Box_,
+    cw: &mut ConvexWork,
+    ws: &mut ReducedWork,
+) -> Reduced {
+    let n = a.len();
+    cw.idx.clear();
+    cw.idx.extend((0..n).filter(|&i| bx.inside(i, y_w[i])));
+    let dz = null_space(jac, bx, cw);
+    if dz == 0 {
+        return Reduced::NoNullSpace;
+    }
+    let z = |j: usize| &cw.z[j * n..(j + 1) * n];
+    let hw = (theta, &bx.w[..]);
+    reduced_hessian(aff, hw, (&cw.z, dz), ws);
+    // `W Z Δ Zᵀ W v` added to `out` (the raise of `Zᵀ H Z`, `Zᵀ W Z = I`).
+    let raise = |v: &[f64], out: &mut [f64], u: &mut Vec<f64>, dl: &[f64]| {
+        u.clear();
+        u.extend((0..dz).map(|j| (0..n).map(|r| z(j)[r] * bx.w[r] * v[r]).sum::<f64>()));
+        for j in 0..dz {
+            let c: f64 = (0..dz).map(|k| dl[j * dz + k] * u[k]).sum();
+            for r in 0..n {
+                out[r] += bx.w[r] * z(j)[r] * c;
+            }
+        }
+    };
+    ws.d.clear();
+    ws.d.extend((0..n).map(|i| y_w[i] - a[i]));
+    ws.hd.resize(n, 0.0);
+    lagrangian_times(aff, hw, &ws.d, (&mut ws.prod.0, &mut ws.prod.1), &mut ws.hd);
+    raise(&ws.d, &mut ws.hd, &mut ws.u, &ws.delta);
+    // t = -M⁻¹ Zᵀ (H' d_r + g).
+    ws.t.clear();
+    ws.t.extend((0..dz).map(|j| {
+        -(0..n)
+            .map(|r| z(j)[r] * (ws.hd[r] + bx.w[r] * (a[r] - bx.c[r])))
+            .sum::<f64>()
+    }));
+    if !(cholesky(&ws.m, dz, 0.0, &mut ws.chol) && cholesky_solve(&ws.chol, dz, &mut ws.t)) {
+        return Reduced::Bounds;
+    }
+    for j in 0..dz {
+        for r in 0..n {
+            ws.d[r] += z(j)[r] * ws.t[j];
+        }
+    }
+    if cw
+        .idx
+        .iter()
+        .any(|&i| !(a[i] + ws.d[i] >= bx.lo[i] && a[i] + ws.d[i] <= bx.hi[i]))
+    {
+        return Reduced::Bounds;
+    }
+    // The gradient at the step, H' d + g = H' d_r + H' Z t + g, and the multipliers of the
+    // target from the free rows (`J_F λ = grad_F` at the face's minimum).
+    for j in 0..dz {
+        for r in 0..n {
+            ws.hd[r] += ws.hz[j * n + r] * ws.t[j];
+        }
+    }
+    ws.zt.clear();
+    ws.zt.resize(n, 0.0);
+    for j in 0..dz {
+        for r in 0..n {
+            ws.zt[r] += z(j)[r] * ws.t[j];
+        }
+    }
+    raise(&ws.zt, &mut ws.hd, &mut ws.u, &ws.delta);
+    for i in 0..n {
+        ws.hd[i] += bx.w[i] * (a[i] - bx.c[i]);
+    }
+    if bounds_hold(jac, bx, (&cw.idx, y_w), &ws.hd) {
+        Reduced::Step
+    } else {
+        Reduced::Bounds
+    }
+}
+
+/// `H Z` (into `ws.hz`) and `Zᵀ H Z` raised to [`CURVATURE_FLOOR`] (into `ws.m`, the raise
+/// into `ws.delta`) for the basis `z` (n × dz, column-major).
+fn reduced_hessian(
+    aff: &Affine,
+    hw: (&[f64], &[f64]),
+    (z, dz): (&[f64], usize),
+    ws: &mut ReducedWork,
+) {
+    let n = aff.n;
+    ws.hz.clear();
+    ws.hz.resize(n * dz, 0.0);
+    for j in 0..dz {
+        let prod = (&mut ws.prod.0, &mut ws.prod.1);
+        lagrangian_times(
+            aff,
+            hw,
+            &z[j * n..(j + 1) * n],
+            prod,
+            &mut ws.hz[j * n..(j + 1) * n],
+        );
+    }
+    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+    let col = |j: usize| j * n..(j + 1) * n;
+    ws.m.clear();
+    ws.m.resize(dz * dz, 0.0);
+    for i in 0..dz {
+        for j in 0..=i {
+            let zi_hzj = dot(&z[col(i)], &ws.hz[col(j)]);
+            let zj_hzi = dot(&z[col(j)], &ws.hz[col(i)]);
+            let v = 0.5 * (zi_hzj + zj_hzi);
+            ws.m[i * dz + j] = v;
+            ws.m[j * dz + i] = v;
+        }
+    }
+    ws.delta.clear();
+    ws.delta.resize(dz * dz, 0.0);
+    if !cholesky(&ws.m, dz, CURVATURE_FLOOR, &mut ws.chol) {
+        let m = DMatrix::from_row_slice(dz, dz, &ws.m);
+        let e = m.clone().symmetric_eigen();
+        let vals = e.eigenvalues.map(|v| v.max(CURVATURE_FLOOR));
+        let f = &e.eigenvectors * DMatrix::from_diagonal(&vals) * e.eigenvectors.transpose();
+        for i in 0..dz {
+            for j in 0..dz {
+                let fij = 0.5 * (f[(i, j)] + f[(j, i)]);
+                ws.delta[i * dz + j] = fij - ws.m[i * dz + j];
+                ws.m[i * dz + j] = fij;
+            }
+        }
+    }
+}
+
+/// Whether the multipliers of the bounds at the fixed variables of `y_w` (those not in
+/// `free`) have their signs for the gradient `grad` of the face's minimum: `μ = grad - Jᵀ λ`,
+/// `J_F λ = grad_F`, `>= 0` at a lower bound and `<= 0` at an upper.
+fn bounds_hold(jac: &[V3<f64>], bx: &Box_, (free, y_w): (&[usize], &[f64]), grad: &[f64]) -> bool {
+    let (mut g, mut r) = (M3::zeros(), V3::zeros());
+    for &i in free {
+        g += jac[i] * jac[i].transpose();
+        r += jac[i] * grad[i];
+    }
+    let Some(lambda) = g.try_inverse().map(|gi| gi * r) else {
+        return false;
+    };
+    let gmax = grad.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let gscale = 1e-12 * (1.0 + gmax);
+    (0..y_w.len()).filter(|&i| !bx.inside(i, y_w[i])).all(|i| {
+        let mu = grad[i] - jac[i].dot(&lambda);
+        let wrong = if y_w[i] <= bx.lo[i] { -mu } else { mu };
+        wrong <= gscale
+    })
 }
 
 /// The scratch of [`curved_step`].
@@ -895,7 +1165,11 @@ fn curved_step(
 struct Work {
     dual: DualWork,
     lm: LmWork,
-    curvature: (Vec<f64>, Vec<f64>),
+    /// `Σ λ_k ∇²_θ p_k` of the last curved step (q × q).
+    theta: Vec<f64>,
+    /// Scratch of the products with the Hessian (q, q, and n × q).
+    hm: Vec<f64>,
+    reduced: ReducedWork,
     convex: ConvexWork,
     curved: CurvedWork,
     /// The curved step.
@@ -928,8 +1202,10 @@ struct ClosedForm {
     lambda: V3<f64>,
     /// The Hessian of the Lagrangian of the last curved step (n × n, row-major).
     hess: Vec<f64>,
-    /// Whether the last step was curved (`hess` is its Hessian).
+    /// Whether the last step was curved, and whether `hess` was formed for it (the reduced
+    /// step applies it without forming it).
     curved: bool,
+    hess_formed: bool,
     /// The trial actuation, and the second-order corrected one.
     trial: Vec<f64>,
     corrected: Vec<f64>,
@@ -1077,25 +1353,37 @@ impl ClosedForm {
         if merit > CURVED_FROM * self.length || (far && !fits) {
             return Some(lambda);
         }
-        let hess = &mut self.hess;
-        if (0..n).filter(|&i| bx.inside(i, self.y[i])).count() > 3 {
-            let scratch = (&mut ws.curvature.0, &mut ws.curvature.1);
-            self.cur.curvature(&self.aff, &l, scratch, hess);
-            for r in 0..n {
-                for c in 0..n {
-                    let v = &mut hess[r * n + c];
-                    *v = if r == c { bx.w[r] - *v } else { -*v };
+        if (0..n).filter(|&i| bx.inside(i, self.y[i])).count() <= 3 {
+            // No null space of the free columns: the curved step is the minimum-norm one.
+            return Some(lambda);
+        }
+        self.cur.theta_hessian(&l, &mut ws.theta);
+        let cols = (&self.aff, &ws.theta[..], &jac[..]);
+        match reduced_step(
+            cols,
+            (&self.a, &self.y),
+            bx,
+            &mut ws.convex,
+            &mut ws.reduced,
+        ) {
+            Reduced::NoNullSpace => {}
+            Reduced::Step => {
+                self.step.copy_from_slice(&ws.reduced.d);
+                self.curved = true;
+                self.hess_formed = false;
+            }
+            Reduced::Bounds => {
+                // The bounds change on the face: the primal active set on the whole Hessian.
+                let hess = &mut self.hess;
+                lagrangian_hessian(&self.aff, &ws.theta, &bx.w, &mut ws.hm, hess);
+                convexify(hess, jac, &self.y, bx, &mut ws.convex);
+                let h = (&hess[..], &jac[..]);
+                if curved_step(h, &self.a, &self.y, bx, &mut ws.d, &mut ws.curved) {
+                    self.step.copy_from_slice(&ws.d);
+                    self.curved = true;
+                    self.hess_formed = true;
                 }
             }
-        } else {
-            hess.clear();
-            hess.resize(n * n, 0.0);
-        }
-        // Without a null space of the free columns (three or fewer free): `W`.
-        convexify(hess, jac, &self.y, bx, &mut ws.convex);
-        if curved_step((hess, jac), &self.a, &self.y, bx, &mut ws.d, &mut ws.curved) {
-            self.step.copy_from_slice(&ws.d);
-            self.curved = true;
         }
         Some(lambda)
     }
@@ -1209,7 +1497,19 @@ impl ClosedForm {
     /// The result at the iterate (reached): its pose, the pose Jacobian in the actuation
     /// (position rows, then rotation rows `Ω M`) and the Hessian (`W` unless the last step
     /// was curved).
-    fn solution(&self, nt: usize) -> InverseSolution {
+    fn solution(&mut self, nt: usize) -> InverseSolution {
+        if self.curved && !self.hess_formed {
+            // The reduced step formed no Hessian: the whole one at the last program.
+            let ws = &mut self.work;
+            lagrangian_hessian(&self.aff, &ws.theta, &self.bx.w, &mut ws.hm, &mut self.hess);
+            convexify(
+                &mut self.hess,
+                &self.cur.jac,
+                &self.y,
+                &self.bx,
+                &mut ws.convex,
+            );
+        }
         let (aff, cur, n) = (&self.aff, &self.cur, self.aff.n);
         let dist = (self.target - cur.p).norm();
         let ns = aff.rest.len();
