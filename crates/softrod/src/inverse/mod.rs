@@ -292,6 +292,16 @@ impl InverseWarmStart {
     }
 }
 
+impl From<InverseSolution> for InverseWarmStart {
+    fn from(s: InverseSolution) -> Self {
+        Self {
+            actuation: s.actuation,
+            evaluation: Some(s.evaluation),
+            hessian: Some(s.hessian),
+        }
+    }
+}
+
 impl From<&InverseSolution> for InverseWarmStart {
     fn from(s: &InverseSolution) -> Self {
         Self {
