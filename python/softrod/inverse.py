@@ -97,22 +97,28 @@ InverseSolution.solution = property(  # type: ignore[assignment]
 )
 
 
-def _warm_arguments(warm_start: Any, key: tuple) -> tuple[Any, dict[str, Any]]:
-    """The actuation of a warm start and, for a previous :class:`InverseSolution`, its state
-    (its evaluation reused only on the same model: ``key``'s objects are the same)."""
+def _warm_arguments(warm_start: Any, key: Any) -> tuple[Any, Any, bool]:
+    """The actuation of a warm start, and for a previous :class:`InverseSolution` its state and
+    whether it was made on the same model (``key``: the same object, or a tuple of the same
+    objects, tuples among them equal)."""
     if not isinstance(warm_start, InverseSolution):
-        return warm_start, {}
-    old = warm_start._model_key
-    same = (
-        old is not None
-        and len(old) == len(key)
-        and all(a is b or (isinstance(a, tuple) and a == b) for a, b in zip(old, key, strict=True))
-    )
+        return warm_start, None, False
     state = warm_start._warm_state
     if state is None:
-        return warm_start.actuation, {}
+        return warm_start.actuation, None, False
     # The state carries the actuation: the extension takes it from there.
-    return None, {"warm_state": state, "same_model": same}
+    return None, state, _same_key(warm_start._model_key, key)
+
+
+def _same_key(old: Any, key: Any) -> bool:
+    if old is key:
+        return True
+    if not (isinstance(old, tuple) and isinstance(key, tuple) and len(old) == len(key)):
+        return False
+    for a, b in zip(old, key):
+        if not (a is b or (isinstance(a, tuple) and a == b)):
+            return False
+    return True
 
 
 def _from_core(out: dict, solution: Any, warm_state: Any, key: Any) -> InverseSolution:
@@ -225,9 +231,8 @@ def inverse_statics(
         raise err
     _refuse_unsupported(robot, obstacles_supported=target_s is None)
     key = _model_key(robot)
-    warm_start, extra = _warm_arguments(warm_start, key)
-    if target_s is not None:
-        extra = {}
+    warm_start, state, same = _warm_arguments(warm_start, key)
+    extra = {} if target_s is not None else {"warm_state": state, "same_model": same}
     out = _core._inverse_statics(
         robot._rod,
         list(robot._tendons),

@@ -94,8 +94,11 @@ def inverse_statics(
         TargetUnreachableError: The target is out of reach (``throw=True``).
         ConvergenceError: The iteration did not converge (``throw=True``).
     """
-    key = (robot, (_loads_key(tip_force), _loads_key(tip_moment)))
-    warm_start, extra = _warm_arguments(warm_start, key)
+    if tip_force is None and tip_moment is None:
+        key = robot
+    else:
+        key = (robot, (_loads_key(tip_force), _loads_key(tip_moment)))
+    warm_start, state, same = _warm_arguments(warm_start, key)
     out = _core._pcc_inverse_statics(
         robot,
         target_position,
@@ -109,7 +112,8 @@ def inverse_statics(
         throw=throw,
         tolerance=tolerance,
         max_iterations=max_iterations,
-        **extra,
+        warm_state=state,
+        same_model=same,
     )
     tensions, pressures = out["tensions"], out["pressures"]
     # The PCC solution at the actuation found is solved when it is first read.

@@ -9,7 +9,7 @@
 //! Values that convert but are out of range are the core's to reject (`ParameterError`).
 
 use numpy::ndarray::{Array2, ArrayD};
-use numpy::{PyArrayDyn, PyArrayMethods};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyOverflowError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
@@ -320,6 +320,15 @@ pub(crate) fn floats_n(
     n: usize,
     what: &str,
 ) -> PyResult<Vec<f64>> {
+    // A one-dimensional float64 array (of any strides) is read in place.
+    if let Ok(a) = obj.cast::<PyArray1<f64>>() {
+        if a.len() != n {
+            return Err(type_err(name, obj, what));
+        }
+        return (0..n)
+            .map(|i| a.get_owned([i]).ok_or_else(|| type_err(name, obj, what)))
+            .collect();
+    }
     let a = float_array(obj, name, what)?;
     if a.ndim() != 1 || a.len() != n {
         return Err(type_err(name, obj, what));

@@ -1,9 +1,12 @@
 //! Binding of the inverse statics: the actuation reaching a target, as a dict the Python
 //! wrapper (`softrod.inverse_statics`) turns into an `InverseSolution`.
 
+use std::borrow::Cow;
+
 use numpy::IntoPyArray;
+use pyo3::intern;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 
 use softrod::nalgebra::{Matrix3, Vector3};
 use softrod::pcc::statics::{PccLoads, PccSolveOptions};
@@ -25,27 +28,26 @@ pub(crate) struct InverseWarmState {
 /// The warm start of a call: `warm_state` (if its actuation is that of `warm_start`, or
 /// `warm_start` is not given; with its evaluation only when `same_model`), else the actuation
 /// of `warm_start` alone.
-fn merge_warm(
+fn merge_warm<'a>(
     warm: Option<InverseWarmStart>,
-    state: Option<&Bound<'_, InverseWarmState>>,
+    state: Option<&'a Bound<'_, InverseWarmState>>,
     same_model: bool,
-) -> Option<InverseWarmStart> {
-    let Some(w) = warm else {
-        let mut inner = state?.get().inner.clone();
-        if !same_model {
-            inner.evaluation = None;
+) -> Option<Cow<'a, InverseWarmStart>> {
+    let from_state = |st: &'a Bound<'_, InverseWarmState>| {
+        let inner = &st.get().inner;
+        if same_model {
+            Cow::Borrowed(inner)
+        } else {
+            Cow::Owned(InverseWarmStart {
+                evaluation: None,
+                ..inner.clone()
+            })
         }
-        return Some(inner);
     };
-    match state {
-        Some(st) if st.get().inner.actuation == w.actuation => {
-            let mut inner = st.get().inner.clone();
-            if !same_model {
-                inner.evaluation = None;
-            }
-            Some(inner)
-        }
-        _ => Some(w),
+    match (warm, state) {
+        (None, st) => st.map(from_state),
+        (Some(w), Some(st)) if st.get().inner.actuation == w.actuation => Some(from_state(st)),
+        (Some(w), _) => Some(Cow::Owned(w)),
     }
 }
 
@@ -121,31 +123,26 @@ fn target_and_options(
     Ok((target, o, warm))
 }
 
-/// The result of an inverse call as the dict the Python wrappers read.
-fn result_dict<'py>(
-    py: Python<'py>,
-    inv: &softrod::InverseSolution,
-) -> PyResult<Bound<'py, PyDict>> {
+/// The result of an inverse call as the dict the Python wrappers read (the warm state takes
+/// the result's evaluation and Hessian).
+fn result_dict(py: Python<'_>, inv: softrod::InverseSolution) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("actuation", inv.actuation.clone().into_pyarray(py))?;
-    d.set_item("tensions", inv.tensions().to_vec().into_pyarray(py))?;
-    d.set_item("pressures", inv.pressures().to_vec().into_pyarray(py))?;
-    d.set_item("n_tendons", inv.n_tendons)?;
-    d.set_item("position_error", inv.position_error)?;
-    d.set_item("rotation_error", inv.rotation_error)?;
-    d.set_item("iterations", inv.iterations)?;
-    d.set_item("evaluations", inv.evaluations)?;
-    d.set_item("converged", inv.converged)?;
-    d.set_item("reached", inv.reached)?;
     d.set_item(
-        "warm_state",
-        Bound::new(
-            py,
-            InverseWarmState {
-                inner: InverseWarmStart::from(inv),
-            },
-        )?,
+        intern!(py, "tensions"),
+        inv.tensions().to_vec().into_pyarray(py),
     )?;
+    d.set_item(
+        intern!(py, "pressures"),
+        inv.pressures().to_vec().into_pyarray(py),
+    )?;
+    d.set_item(intern!(py, "position_error"), inv.position_error)?;
+    d.set_item(intern!(py, "rotation_error"), inv.rotation_error)?;
+    d.set_item(intern!(py, "iterations"), inv.iterations)?;
+    d.set_item(intern!(py, "converged"), inv.converged)?;
+    let state = InverseWarmState {
+        inner: InverseWarmStart::from(inv),
+    };
+    d.set_item(intern!(py, "warm_state"), Bound::new(py, state)?)?;
     Ok(d)
 }
 
@@ -155,7 +152,10 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
         return Ok(default);
     };
     let what = "a pair (lo, hi) of numbers (hi may be None: unbounded)";
-    let items = crate::convert::sequence(b, name, what)?;
+    let items = match b.cast::<PyTuple>() {
+        Ok(t) if t.len() == 2 => vec![t.get_item(0)?, t.get_item(1)?],
+        _ => crate::convert::sequence(b, name, what)?,
+    };
     if items.len() != 2 {
         return Err(param_err(
             &format!("{name}.len()"),
@@ -173,9 +173,9 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 }
 
 /// Inverse statics of the robot `(rod, tendons, loads, chambers)` for a tip target (see
-/// `softrod.inverse_statics`). Returns a dict: `actuation` (tensions then pressures),
-/// `tensions`, `pressures`, `n_tendons`, `position_error` (m), `rotation_error` (rad),
-/// `iterations`, `evaluations`, `converged`, `reached`.
+/// `softrod.inverse_statics`). Returns a dict: `tensions`, `pressures`, `position_error` (m),
+/// `rotation_error` (rad), `iterations`, `converged` and `warm_state` (what a call
+/// warm-started from this one reuses).
 #[pyfunction]
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
                     target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
@@ -246,14 +246,14 @@ pub(crate) fn _inverse_statics<'py>(
                 ));
             }
             let mut fwd = softrod::ContactForward::new(model, &solve, &obstacles)?;
-            return softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_ref())
+            return softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_deref())
                 .map_err(actuator_names);
         }
         let mut fwd = softrod::CosseratForward::new(model, &solve, target.s.as_deref())
             .map_err(actuator_names)?;
-        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_ref()).map_err(actuator_names)
+        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_deref()).map_err(actuator_names)
     })?;
-    result_dict(py, &inv)
+    result_dict(py, inv)
 }
 
 /// Inverse statics of the PCC robot `robot` under a tip wrench (`tip_force` N, `tip_moment`
@@ -314,8 +314,8 @@ pub(crate) fn _pcc_inverse_statics<'py>(
             &target,
             &o,
             &PccSolveOptions::default(),
-            warm.as_ref(),
+            warm.as_deref(),
         )
     })?;
-    result_dict(py, &inv)
+    result_dict(py, inv)
 }

@@ -242,7 +242,6 @@ fn a_rotation_target_is_reached() {
 }
 
 #[test]
-#[ignore = "warm-started tracking takes 4.5 evaluations with the Jacobian and 0.6 probes per 1 mm step (0.52 M instructions with the closed-form march), more than the bound of 4 evaluations; probing the curvature at every step meets it (3.6 evaluations and 6 probes) but costs more instructions (0.60 M)"]
 fn warm_started_tracking_takes_few_iterations() {
     let model = niti(Loads::default(), None);
     let o = SolveOptions::default();

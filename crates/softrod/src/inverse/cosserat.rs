@@ -8,7 +8,7 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
 use super::{uniform, InverseWarmStart, Target};
-use crate::cosserat::equations::{Column, Equations};
+use crate::cosserat::equations::{Column, Equations, Workspace};
 use crate::cosserat::sensitivity::{
     actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
 };
@@ -48,6 +48,8 @@ pub struct CosseratForward {
     /// Whether the tip pose and its Jacobian have the closed form of [`super::uniform`] (an
     /// unloaded robot with uniform intervals, a tip target).
     uniform: bool,
+    /// The workspace of those closed-form marches, renewed by each.
+    uniform_ws: Workspace,
 }
 
 /// The state recorded along one march of an unloaded robot at the actuation `a`.
@@ -76,6 +78,7 @@ impl CosseratForward {
             solution: None,
             march: None,
             uniform: false,
+            uniform_ws: Workspace::new(model.tendons().len()),
         };
         if let Some(s) = s {
             let l = model.length();
@@ -202,7 +205,13 @@ impl CosseratForward {
         let act = self.actuation(a);
         act.validate(nt, nc)?;
         if self.uniform {
-            if let Some(ev) = uniform::tip(&self.model, &self.options.integrator, a, true) {
+            if let Some(ev) = uniform::tip(
+                &self.model,
+                &self.options.integrator,
+                a,
+                true,
+                &mut self.uniform_ws,
+            ) {
                 self.march = None;
                 return Ok(ev);
             }
@@ -278,12 +287,18 @@ impl CosseratForward {
 impl CosseratForward {
     /// The observed poses of an unloaded robot at `a` from one march of the state alone (no
     /// columns); the march recorded for [`CosseratForward::solve`] is kept.
-    fn unloaded_poses(&self, a: &[f64]) -> Result<Evaluation> {
+    fn unloaded_poses(&mut self, a: &[f64]) -> Result<Evaluation> {
         let (nt, nc) = self.dims();
         let act = self.actuation(a);
         act.validate(nt, nc)?;
         if self.uniform {
-            if let Some(ev) = uniform::tip(&self.model, &self.options.integrator, a, false) {
+            if let Some(ev) = uniform::tip(
+                &self.model,
+                &self.options.integrator,
+                a,
+                false,
+                &mut self.uniform_ws,
+            ) {
                 return Ok(ev);
             }
         }

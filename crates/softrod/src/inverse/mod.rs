@@ -44,13 +44,15 @@
 //!   makes that curvature from second differences of the poses instead ([`PROBE_STEP`]), on
 //!   the span of the range step `v` (the minimum-norm step off the null space) and `Z`:
 //!   `Zᵀ H Z` and the cross term `Zᵀ H v`, which is all the SQP step uses of `H`, so the
-//!   next step is Newton's on the KKT conditions (three probes for one null direction, not
-//!   within [`PROBE_FROM`] of the stopping test). Without the cross term (the directional
-//!   differences above, or a secant) the steps contract only linearly, by about ten per
-//!   step: a position error along the stiff axis of the rod asks for large range steps,
-//!   and their coupling into the null space is first order. Probing at every near step
-//!   converges quadratically (three evaluations and six probes for a warm 1 mm move) but
-//!   costs more instructions along a tracked path than probing where the curvature is stale.
+//!   next step is Newton's on the KKT conditions (three probes for one null direction). It
+//!   probes at every near step whose minimum-norm step is not within [`PROBE_FROM`] of the
+//!   stopping test, and solves the step's program once, with the probed curvature (the
+//!   program with the last curvature is solved only where no probe is made). Without the
+//!   cross term (the directional differences above, or a secant) the steps contract only
+//!   linearly, by about ten per step: a position error along the stiff axis of the rod asks
+//!   for large range steps, and their coupling into the null space is first order; probing
+//!   every near step converges quadratically (a warm-started 1 mm move in three or four
+//!   evaluations and six probes).
 //!
 //! When the linearised target cannot be met inside the bounds, the bounded least squares
 //! `min |J_k (a - a_k) - e_k|²` ([`qp::bounded_least_squares`], with the same norm as a
@@ -74,6 +76,7 @@
 
 mod cosserat;
 pub mod pcc;
+mod pcc_closed;
 mod problem;
 pub mod qp;
 mod sqp;
@@ -117,7 +120,7 @@ pub const PROBE_STEP: f64 = 1e-4;
 /// Most directions (range step and null directions) of the curvature made from probes: `k`
 /// directions take `k (k + 1) / 2` probes.
 pub const MAX_PROBE_DIRECTIONS: usize = 3;
-/// Steps (relative to the stopping test's) above which the curvature is probed again.
+/// Minimum-norm steps (relative to the stopping test's) above which the curvature is probed.
 pub const PROBE_FROM: f64 = 100.0;
 
 /// What the inverse statics aims at.
@@ -287,6 +290,16 @@ impl InverseWarmStart {
             actuation,
             evaluation: None,
             hessian: None,
+        }
+    }
+}
+
+impl From<InverseSolution> for InverseWarmStart {
+    fn from(s: InverseSolution) -> Self {
+        Self {
+            actuation: s.actuation,
+            evaluation: Some(s.evaluation),
+            hessian: Some(s.hessian),
         }
     }
 }

@@ -128,6 +128,17 @@ impl<'a> Program<'a> {
     pub fn error(&self, ev: &Evaluation) -> PoseError {
         error_rows(self.target, ev, self.rotation_weight)
     }
+
+    /// `|e|` of [`Program::error`] alone (the merit of a trial).
+    pub fn error_norm(&self, ev: &Evaluation) -> f64 {
+        let mut sq: f64 = (self.target.points.iter().zip(&ev.positions))
+            .map(|(p, q)| (p - q).norm_squared())
+            .sum();
+        if let Some(rt) = &self.target.rotation {
+            sq += (log_so3(&(rt * ev.rotation.transpose())) * self.rotation_weight).norm_squared();
+        }
+        sq.sqrt()
+    }
 }
 
 pub(crate) fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f64) -> Result<()> {

@@ -16,6 +16,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::math::linalg::DenseLu;
+
 /// Most Newton iterations of the dual (each changes the free set or ends).
 const MAX_DUAL_ITERATIONS: usize = 100;
 /// Most active-set changes of the bounded least squares (per variable).
@@ -188,31 +190,53 @@ pub fn active_set_qp(
     let mut fixed: Vec<bool> = (0..n)
         .map(|i| y[i] <= bx.lo[i] || y[i] >= bx.hi[i])
         .collect();
+    // The vectors of every working set, allocated once.
+    let mut free: Vec<usize> = Vec::with_capacity(n);
+    let (mut grad, mut p) = (vec![0.0; n], vec![0.0; n]);
+    let (mut kkt, mut rhs) = (
+        Vec::with_capacity((n + m) * (n + m)),
+        Vec::with_capacity(n + m),
+    );
+    let mut lu = DenseLu::default();
+    let mut lambda = DVector::zeros(m);
+    let gradient = |y: &DVector<f64>, grad: &mut [f64]| {
+        for (i, g) in grad.iter_mut().enumerate() {
+            *g = q[i] + (0..n).map(|j| h[(i, j)] * y[j]).sum::<f64>();
+        }
+    };
     for _ in 0..MAX_ACTIVE_SET_CHANGES * (n + 1) {
-        let free: Vec<usize> = (0..n).filter(|&i| !fixed[i]).collect();
+        free.clear();
+        free.extend((0..n).filter(|&i| !fixed[i]));
         let k = free.len();
-        // KKT: [H_FF  A_Fᵀ; A_F 0] [p_F; -λ] = [-(H y + q)_F; 0].
-        let grad = h * &y + q;
-        let mut kkt = DMatrix::zeros(k + m, k + m);
-        let mut rhs = DVector::zeros(k + m);
+        let size = k + m;
+        // KKT: [H_FF  A_Fᵀ; A_F 0] [p_F; -λ] = [-(H y + q)_F; 0], column-major.
+        gradient(&y, &mut grad);
+        kkt.clear();
+        kkt.resize(size * size, 0.0);
+        rhs.clear();
+        rhs.resize(size, 0.0);
         for (r, &i) in free.iter().enumerate() {
             rhs[r] = -grad[i];
             for (c, &j) in free.iter().enumerate() {
-                kkt[(r, c)] = h[(i, j)];
+                kkt[r + c * size] = h[(i, j)];
             }
             for e in 0..m {
-                kkt[(r, k + e)] = a[(e, i)];
-                kkt[(k + e, r)] = a[(e, i)];
+                kkt[r + (k + e) * size] = a[(e, i)];
+                kkt[k + e + r * size] = a[(e, i)];
             }
         }
-        let sol = kkt.lu().solve(&rhs)?;
-        let lambda = DVector::from_fn(m, |e, _| -sol[k + e]);
-        let mut p = DVector::zeros(n);
+        if !lu.factor(size, &kkt) || !lu.solve_in_place(&mut rhs) {
+            return None;
+        }
+        for e in 0..m {
+            lambda[e] = -rhs[k + e];
+        }
+        p.iter_mut().for_each(|v| *v = 0.0);
         for (r, &i) in free.iter().enumerate() {
-            p[i] = sol[r];
+            p[i] = rhs[r];
         }
         let scale = 1.0 + y.amax();
-        let mut at_minimum = p.amax() <= 1e-14 * scale;
+        let mut at_minimum = p.iter().all(|v| v.abs() <= 1e-14 * scale);
         if !at_minimum {
             let mut t = 1.0;
             let mut blocking = None;
@@ -231,7 +255,10 @@ pub fn active_set_qp(
                     }
                 }
             }
-            y += &p * t.max(0.0);
+            let t = t.max(0.0);
+            for i in 0..n {
+                y[i] += p[i] * t;
+            }
             match blocking {
                 Some((i, v)) => {
                     y[i] = v;
@@ -242,17 +269,15 @@ pub fn active_set_qp(
             }
         }
         if at_minimum {
-            let grad = h * &y + q;
+            gradient(&y, &mut grad);
             // Bound multipliers μ = H y + q - Aᵀ λ: >= 0 at a lower bound, <= 0 at an upper.
-            let mu = &grad - a.tr_mul(&lambda);
-            let gscale = 1e-12 * (1.0 + grad.amax());
+            let gscale = 1e-12 * (1.0 + grad.iter().fold(0.0f64, |g, v| g.max(v.abs())));
             let mut worst: Option<(usize, f64)> = None;
-            for i in 0..n {
-                if fixed[i] {
-                    let wrong = if y[i] <= bx.lo[i] { -mu[i] } else { mu[i] };
-                    if wrong > gscale && worst.is_none_or(|(_, w)| wrong > w) {
-                        worst = Some((i, wrong));
-                    }
+            for i in (0..n).filter(|&i| fixed[i]) {
+                let mu = grad[i] - (0..m).map(|e| a[(e, i)] * lambda[e]).sum::<f64>();
+                let wrong = if y[i] <= bx.lo[i] { -mu } else { mu };
+                if wrong > gscale && worst.is_none_or(|(_, w)| wrong > w) {
+                    worst = Some((i, wrong));
                 }
             }
             match worst {

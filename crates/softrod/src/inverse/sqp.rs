@@ -7,8 +7,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::problem::{PoseError, Program};
 use super::steps::{
-    bfgs_update, curvature, free_set, levenberg_marquardt_step, objective_change, probed_curvature,
-    scaled_jacobian_norm, solve_qp, trust_radius, ProbeSite, QpStep,
+    bfgs_update, curvature, curved_qp, free_set, levenberg_marquardt_step, objective_change,
+    probed_curvature, scaled_jacobian_norm, solve_qp, trust_radius, ProbeSite, QpStep,
 };
 use super::{
     Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target, FIRST_RADIUS,
@@ -47,6 +47,8 @@ struct Iterate {
     probes_available: bool,
     /// How many times actuators were put on their bounds at the end.
     snapped: usize,
+    /// The pose error of `ev`, if made already (the evaluation accepted last).
+    err: Option<PoseError>,
 }
 
 impl Iterate {
@@ -102,7 +104,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
     let n = p.n();
     let mut it = start(forward, &p, warm)?;
     loop {
-        let lin = linearise(&p, &it)?;
+        let lin = linearise(&p, &mut it)?;
         let solved = program_step(forward, &p, &mut it, &lin);
         let least_squares = solved.least_squares;
         let lambda_k = solved.lambda;
@@ -130,7 +132,9 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         }
         // A small step that still moves an actuator onto its bound (or off it) is taken: the
         // minimum-norm actuation has it exactly there, not a round-off away.
-        let same_bounds = free_set(y.as_slice(), &p.bounds) == free_set(&it.a, &p.bounds);
+        let bx = &p.bounds;
+        let inside = |v: f64, i: usize| v > bx.lo[i] && v < bx.hi[i];
+        let same_bounds = (0..n).all(|i| inside(y[i], i) == inside(it.a[i], i));
         let stationary = small && (lin.reached || least_squares) && same_bounds;
         if stationary || it.iterations >= options.max_iterations {
             return stopped(&p, it, &lin, stationary, least_squares);
@@ -153,14 +157,16 @@ pub fn solve_inverse<F: Forward + ?Sized>(
         };
         // The curvature met along the step refines the Hessian (far from the target too: a
         // warm start's first step is the longest secant it gets).
+        let err = p.error(&t);
         if it.curved_for.is_some() {
-            if let (Some(lambda), Some(jn)) = (&lambda_k, p.error(&t).jac) {
+            if let (Some(lambda), Some(jn)) = (&lambda_k, &err.jac) {
                 let w = &p.bounds.weights;
-                bfgs_update(&mut it.hess, w, &it.a, &trial, &lin.jac, &jn, lambda);
+                bfgs_update(&mut it.hess, w, &it.a, &trial, &lin.jac, jn, lambda);
             }
         }
         it.a = trial;
         it.ev = t;
+        it.err = Some(err);
     }
 }
 
@@ -223,6 +229,7 @@ fn start<F: Forward + ?Sized>(
         probes: 0,
         probes_available,
         snapped: 0,
+        err: None,
     })
 }
 
@@ -230,8 +237,8 @@ fn start<F: Forward + ?Sized>(
 ///
 /// # Errors
 /// [`Error::NotConverged`] if the evaluation has no Jacobian.
-fn linearise(p: &Program<'_>, it: &Iterate) -> Result<Linear> {
-    let PoseError { e, jac, dist, rot } = p.error(&it.ev);
+fn linearise(p: &Program<'_>, it: &mut Iterate) -> Result<Linear> {
+    let PoseError { e, jac, dist, rot } = it.err.take().unwrap_or_else(|| p.error(&it.ev));
     let reached = dist <= p.options.tolerance && rot <= p.options.rotation_tolerance;
     let Some(jac) = jac else {
         return Err(Error::NotConverged {
@@ -256,8 +263,9 @@ fn linearise(p: &Program<'_>, it: &Iterate) -> Result<Linear> {
 }
 
 /// The quadratic program of one iteration in `y = a + Δ` (`min ½ |y - c|²_W`, `J y = b`,
-/// bounds); near the target with the curvature, made again where it is stale (a warm
-/// start's, or another point's: the free set changed or the steps stopped contracting).
+/// bounds); near the target with the curvature, probed at every near step (a model with
+/// probes) or made again where it is stale (a warm start's, or another point's: the free set
+/// changed or the steps stopped contracting).
 /// Sets the merit penalty from the multipliers.
 fn program_step<F: Forward + ?Sized>(
     forward: &mut F,
@@ -266,55 +274,29 @@ fn program_step<F: Forward + ?Sized>(
     lin: &Linear,
 ) -> QpStep {
     let n = p.n();
-    let mut solved = solve_qp(
-        p,
-        (&lin.jac, &lin.b),
-        &it.a,
-        &it.hess,
-        it.curved_for.is_some(),
-        it.lambda.as_ref(),
-    );
+    let jb = (&lin.jac, &lin.b);
+    // A model with cheap probes has its curvature probed at every near step (below): the
+    // program with the last curvature is solved only where it is not.
+    let probing = it.probes_available && p.target.rotation.is_none() && !p.shape;
+    let probe_here = probing && lin.merit <= p.near;
+    let curved = it.curved_for.is_some() && !probe_here;
+    let mut solved = solve_qp(p, jb, &it.a, &it.hess, curved, it.lambda.as_ref());
     if !solved.least_squares && lin.merit <= p.near {
-        let free = free_set(solved.y.as_slice(), &p.bounds);
-        let d: Vec<f64> = (0..n).map(|i| solved.y[i] - it.a[i]).collect();
-        let d_norm = p.scaled_norm(&d);
-        let stalled = it.last_step > 0.0 && d_norm > STALLED * it.last_step;
-        // Where the curvature is stale (the free set changed, the steps stopped contracting)
-        // and the model has cheap probes, it is made from them (range step and null space:
-        // the next step is Newton's); otherwise from directional differences of the Jacobian.
         let tol_step = p.options.optimality_tolerance * (1.0 + p.scaled_norm(&it.a));
-        let probing = it.probes_available && p.target.rotation.is_none() && !p.shape;
         let mut probed = false;
-        if probing
-            && d_norm > PROBE_FROM * tol_step
-            && (stalled || it.curved_for.as_ref() != Some(&free))
-        {
-            if let (Some(lambda), Some(yw)) = (&solved.lambda, &solved.y_min_norm) {
-                // The range step: that of the program with W (its part off the null space).
-                let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
-                let free_w = free_set(yw.as_slice(), &p.bounds);
-                let base = if it.curved_for.is_some() {
-                    it.hess.clone()
-                } else {
-                    DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights))
-                };
-                let at = ProbeSite {
-                    a: &it.a,
-                    e0: &lin.e,
-                    jac: &lin.jac,
-                    lambda,
-                };
-                let (h, used) = probed_curvature(forward, p, &at, &free_w, &v, &base);
-                it.probes += used;
-                if let Some(h) = h {
-                    it.hess = h;
-                    it.curved_for = Some(free_w);
-                    let start = solved.lambda.clone();
-                    solved = solve_qp(p, (&lin.jac, &lin.b), &it.a, &it.hess, true, start.as_ref());
-                    probed = true;
+        if probe_here {
+            probed = probe(forward, p, it, lin, &mut solved, tol_step);
+            if !probed && it.curved_for.is_some() {
+                if let (Some(yw), Some(l)) = (solved.y_min_norm.take(), solved.lambda.take()) {
+                    solved = curved_qp(p, &lin.jac, &it.a, &it.hess, (yw, l));
                 }
             }
         }
+        let free = free_set(solved.y.as_slice(), &p.bounds);
+        let d: Vec<f64> = (0..n).map(|i| solved.y[i] - it.a[i]).collect();
+        let stalled = it.last_step > 0.0 && p.scaled_norm(&d) > STALLED * it.last_step;
+        // Where the curvature is stale (the free set changed, the steps stopped contracting)
+        // and it was not probed, it is made from directional differences of the Jacobian.
         if !probed && (stalled || it.curved_for.as_ref() != Some(&free)) {
             if let Some(lambda) = &solved.lambda {
                 let (h, used) = curvature(forward, p, &it.a, &lin.jac, lambda, &free);
@@ -323,7 +305,7 @@ fn program_step<F: Forward + ?Sized>(
                     it.hess = h;
                     it.curved_for = Some(free);
                     let start = solved.lambda.clone();
-                    solved = solve_qp(p, (&lin.jac, &lin.b), &it.a, &it.hess, true, start.as_ref());
+                    solved = solve_qp(p, jb, &it.a, &it.hess, true, start.as_ref());
                 }
             }
         }
@@ -333,6 +315,55 @@ fn program_step<F: Forward + ?Sized>(
         it.lambda = Some(l.clone());
     }
     solved
+}
+
+/// The curvature probed at the iterate (range step and null space: the next step is
+/// Newton's on the KKT conditions) unless the minimum-norm step is within [`PROBE_FROM`] of the
+/// stopping test, and the program solved with it into `solved`; whether it was.
+fn probe<F: Forward + ?Sized>(
+    forward: &mut F,
+    p: &Program<'_>,
+    it: &mut Iterate,
+    lin: &Linear,
+    solved: &mut QpStep,
+    tol_step: f64,
+) -> bool {
+    let n = p.n();
+    let (Some(lambda), Some(yw)) = (&solved.lambda, &solved.y_min_norm) else {
+        return false;
+    };
+    // The range step: that of the program with W (its part off the null space).
+    let v: Vec<f64> = (0..n).map(|i| yw[i] - it.a[i]).collect();
+    if p.scaled_norm(&v) <= PROBE_FROM * tol_step {
+        return false;
+    }
+    let free_w = free_set(yw.as_slice(), &p.bounds);
+    let w_diag;
+    let base = if it.curved_for.is_some() {
+        &it.hess
+    } else {
+        w_diag = DMatrix::from_diagonal(&DVector::from_column_slice(&p.bounds.weights));
+        &w_diag
+    };
+    let at = ProbeSite {
+        a: &it.a,
+        e0: &lin.e,
+        jac: &lin.jac,
+        lambda,
+    };
+    let (h, used) = probed_curvature(forward, p, &at, &free_w, &v, base);
+    it.probes += used;
+    let Some(h) = h else {
+        return false;
+    };
+    it.hess = h;
+    it.curved_for = Some(free_w);
+    // The minimum-norm program is the one solved already.
+    let (Some(yw), Some(l)) = (solved.y_min_norm.take(), solved.lambda.take()) else {
+        return false;
+    };
+    *solved = curved_qp(p, &lin.jac, &it.a, &it.hess, (yw, l));
+    true
 }
 
 /// The result of an iteration stopped at a stationary point or at the iteration cap.
@@ -425,7 +456,7 @@ fn search<F: Forward + ?Sized>(
             merit - (e - jac * d).norm()
         };
         if let Ok(t) = forward.evaluate(&trial, true) {
-            let mt = p.error(&t).e.norm();
+            let mt = p.error_norm(&t);
             let ok = if near_phase {
                 // The change of the merit, summed without cancellation.
                 let df = objective_change(&bounds.weights, &bounds.centre, &it.a[..n], &trial[..n]);

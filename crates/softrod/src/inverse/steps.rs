@@ -44,10 +44,14 @@ pub(super) fn bfgs_update(
     if sr.is_nan() || sr <= 0.0 {
         return false;
     }
-    *h += &r * r.transpose() / sr - &hs * hs.transpose() / shs;
-    // Keep it symmetric to round-off.
-    let sym = (&*h + h.transpose()) * 0.5;
-    h.copy_from(&sym);
+    // h += r rᵀ / sr - hs hsᵀ / shs, symmetric to round-off.
+    for c in 0..n {
+        for k in 0..=c {
+            let v = 0.5 * (h[(k, c)] + h[(c, k)]) + r[k] * r[c] / sr - hs[k] * hs[c] / shs;
+            h[(k, c)] = v;
+            h[(c, k)] = v;
+        }
+    }
     true
 }
 
@@ -64,6 +68,19 @@ fn ls_regularisation(jac: &DMatrix<f64>, bounds: &Bounds) -> f64 {
 
 /// The spectral norm of `J W^{-1/2}` (the pose change per unit scaled actuation).
 pub(super) fn scaled_jacobian_norm(jac: &DMatrix<f64>, weights: &[f64]) -> f64 {
+    if jac.nrows() == 3 {
+        // A tip position: the 3 × 3 Gram matrix on the stack.
+        let mut g = nalgebra::Matrix3::zeros();
+        for (c, w) in weights.iter().enumerate() {
+            let col = jac.fixed_view::<3, 1>(0, c) / w.sqrt();
+            g += col * col.transpose();
+        }
+        return g
+            .symmetric_eigenvalues()
+            .iter()
+            .fold(0.0f64, |m, v| m.max(*v))
+            .sqrt();
+    }
     let js = DMatrix::from_fn(jac.nrows(), jac.ncols(), |r, c| {
         jac[(r, c)] / weights[c].sqrt()
     });
@@ -158,7 +175,6 @@ pub(super) fn solve_qp(
     start: Option<&DVector<f64>>,
 ) -> QpStep {
     let (jac, b) = lin;
-    let n = a.len();
     let bounds = &p.bounds;
     let feasible = if p.shape {
         None
@@ -166,20 +182,7 @@ pub(super) fn solve_qp(
         qp::min_norm_from(jac, b, bounds, p.tol_qp, start)
     };
     match feasible {
-        Some((y_w, l_w)) if curved => {
-            let av = DVector::from_column_slice(a);
-            let wd = DVector::from_fn(n, |i, _| bounds.weights[i] * (a[i] - bounds.centre[i]));
-            let q = wd - hess * &av;
-            // The multipliers of the program with W (those of the target at a solution).
-            let r = qp::active_set_qp(hess, &q, jac, bounds, &y_w);
-            let y = r.map_or_else(|| y_w.clone(), |(y, _)| y);
-            QpStep {
-                y,
-                lambda: Some(l_w),
-                least_squares: false,
-                y_min_norm: Some(y_w),
-            }
-        }
+        Some((y_w, l_w)) if curved => curved_qp(p, jac, a, hess, (y_w, l_w)),
         Some((y, l)) => QpStep {
             y_min_norm: Some(y.clone()),
             y,
@@ -192,6 +195,31 @@ pub(super) fn solve_qp(
             least_squares: true,
             y_min_norm: None,
         },
+    }
+}
+
+/// The curved program of one iteration at `a` (`min ½ Δᵀ H Δ + (W (a - c))ᵀ Δ` s.t. the
+/// linearised target, bounds) from its minimum-norm point `y_w` and multipliers `l_w` (those
+/// of the program with `W`, kept: the target's at a solution).
+pub(super) fn curved_qp(
+    p: &Program<'_>,
+    jac: &DMatrix<f64>,
+    a: &[f64],
+    hess: &DMatrix<f64>,
+    (y_w, l_w): (DVector<f64>, DVector<f64>),
+) -> QpStep {
+    let n = a.len();
+    let bounds = &p.bounds;
+    let av = DVector::from_column_slice(a);
+    let wd = DVector::from_fn(n, |i, _| bounds.weights[i] * (a[i] - bounds.centre[i]));
+    let q = wd - hess * &av;
+    let r = qp::active_set_qp(hess, &q, jac, bounds, &y_w);
+    let y = r.map_or_else(|| y_w.clone(), |(y, _)| y);
+    QpStep {
+        y,
+        lambda: Some(l_w),
+        least_squares: false,
+        y_min_norm: Some(y_w),
     }
 }
 
@@ -340,11 +368,11 @@ pub(super) fn probed_curvature<F: Forward + ?Sized>(
         return (None, 0);
     };
     let d = z.ncols();
-    let w = DMatrix::from_diagonal(&DVector::from_column_slice(&bounds.weights));
+    let wt = &bounds.weights;
     let scale = 1.0 + p.scaled_norm(a);
     // The range part of v, W-orthogonal to Z, in unit W-norm (if not negligible).
     let mut vr = DVector::from_column_slice(v);
-    let zw = z.tr_mul(&(&w * &vr));
+    let zw = z.tr_mul(&DVector::from_fn(n, |i, _| wt[i] * vr[i]));
     vr -= &z * zw;
     let vn = p.scaled_norm(vr.as_slice());
     let with_v = vn > 1e-12 * scale;
@@ -361,6 +389,8 @@ pub(super) fn probed_curvature<F: Forward + ?Sized>(
     }
     let h = PROBE_STEP * scale;
     let mut used = 0;
+    // The probe's actuation.
+    let mut trial = vec![0.0; n];
     // λᵀ p''[u, u] along the direction u (scaled length 1 or √2), ±h inside the bounds.
     let mut second = |u: &DVector<f64>, used: &mut usize| -> Option<f64> {
         let inside = |t: f64| {
@@ -370,16 +400,25 @@ pub(super) fn probed_curvature<F: Forward + ?Sized>(
             })
         };
         let t = [h, -h].into_iter().find(|&t| inside(t))?;
-        let trial: Vec<f64> = (0..n).map(|i| a[i] + t * u[i]).collect();
+        for i in 0..n {
+            trial[i] = a[i] + t * u[i];
+        }
         *used += 1;
         let ev = forward.probe(&trial).ok()?;
-        let e1 = p.error(&ev).e;
-        if e1.len() != e0.len() {
+        if ev.positions.len() != p.target.points.len() || e0.len() != 3 * ev.positions.len() {
             return None;
         }
-        // e = target - p: p(a + t u) - p(a) - t J u = -(e1 - e0) - t J u.
-        let dp = -(e1 - e0) - jac * u * t;
-        let q = 2.0 * lambda.dot(&dp) / (t * t);
+        // e = target - p: p(a + t u) - p(a) - t J u = -(e1 - e0) - t J u, dotted with λ.
+        let mut ldp = 0.0;
+        for (k, (target, pos)) in p.target.points.iter().zip(&ev.positions).enumerate() {
+            for c in 0..3 {
+                let r = 3 * k + c;
+                let ju: f64 = (0..n).map(|i| jac[(r, i)] * u[i]).sum();
+                let e1 = target[c] - pos[c];
+                ldp += lambda[r] * (-(e1 - e0[r]) - ju * t);
+            }
+        }
+        let q = 2.0 * ldp / (t * t);
         q.is_finite().then_some(q)
     };
     let mut lpp = DMatrix::zeros(k, k);
@@ -400,7 +439,7 @@ pub(super) fn probed_curvature<F: Forward + ?Sized>(
             lpp[(j, i)] = c;
         }
     }
-    let mut hs = s.tr_mul(&(&w * &s)) - lpp;
+    let mut hs = s.tr_mul(&DMatrix::from_fn(n, k, |i, j| wt[i] * s[(i, j)])) - lpp;
     // Positive definite on Z (a strict local minimum has it; clamp otherwise).
     let zz = hs.view((k - d, k - d), (d, d)).into_owned();
     hs.view_mut((k - d, k - d), (d, d))
@@ -413,11 +452,13 @@ pub(super) fn probed_curvature<F: Forward + ?Sized>(
         let h = b + &pm * (&hs - s.tr_mul(&(b * &s))) * pm.transpose();
         (&h + h.transpose()) * 0.5
     };
-    for b in [base, &w] {
-        let h = corrected(b);
-        if h.clone().cholesky().is_some() {
-            return (Some(h), used);
-        }
+    let h = corrected(base);
+    if h.clone().cholesky().is_some() {
+        return (Some(h), used);
+    }
+    let h = corrected(&DMatrix::from_diagonal(&DVector::from_column_slice(wt)));
+    if h.clone().cholesky().is_some() {
+        return (Some(h), used);
     }
     (None, used)
 }

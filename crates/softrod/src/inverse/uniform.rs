@@ -175,6 +175,7 @@ pub(super) fn tip(
     integrator: &Integrator,
     a: &[f64],
     jacobian: bool,
+    ws: &mut Workspace,
 ) -> Option<Evaluation> {
     let Integrator::Rk4 { steps } = *integrator else {
         return None;
@@ -188,8 +189,8 @@ pub(super) fn tip(
         load_factor: 1.0,
         profile: None,
     };
-    let mut ws = Workspace::new(nt);
-    let mut ev = Evaluator { eq, ws: &mut ws };
+    ws.renew(nt);
+    let mut ev = Evaluator { eq, ws };
     let base = model.rod().base_pose();
     let mut p = base.position();
     let mut r = base.rotation();

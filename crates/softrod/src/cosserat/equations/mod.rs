@@ -277,6 +277,36 @@ impl Workspace {
         }
     }
 
+    /// Resets to the state [`Workspace::new`] makes for `n_tendons`, keeping the storage of its
+    /// vectors (a sequence of solves with one workspace allocates once).
+    pub fn renew(&mut self, n_tendons: usize) {
+        self.active.clear();
+        self.passive.clear();
+        self.offsets.clear();
+        self.guess = None;
+        self.last_lu = None;
+        self.tendon_speed.clear();
+        self.tendon_speed.resize(n_tendons, 0.0);
+        self.evaluations = 0;
+        self.chambers.clear();
+        self.interval = 0;
+        self.columns.clear();
+        self.length_tendons.clear();
+        self.integrand.clear();
+        self.integrand.resize(n_tendons, 0.0);
+        self.stages.clear();
+        self.integral.clear();
+        self.integral.resize(n_tendons, 0.0);
+        self.track_lengths = false;
+        self.tangent = Tangent {
+            diag: [f64::NAN; 6],
+            lu: None,
+        };
+        self.dirs.clear();
+        self.dirs.resize(n_tendons, None);
+        self.material_error = None;
+    }
+
     /// Sets the columns and the tendons whose length sensitivities are integrated, and resets
     /// the quadratures.
     pub fn set_columns(&mut self, columns: &[Column], length_tendons: &[usize]) {
