@@ -16,7 +16,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::math::linalg::DenseLu;
+use crate::math::linalg::{cholesky_factor, cholesky_solve, DenseLu};
 
 /// Most Newton iterations of the dual (each changes the free set or ends).
 const MAX_DUAL_ITERATIONS: usize = 100;
@@ -316,6 +316,7 @@ pub(crate) struct BlsWork {
     free: Vec<usize>,
     fixed: Vec<Option<f64>>,
     qf: Vec<f64>,
+    chol: Vec<f64>,
     rhs: Vec<f64>,
     grad: Vec<f64>,
 }
@@ -371,7 +372,9 @@ impl NormalEquations {
                         }
                     }
                 }
-                if !cholesky_solve(&mut ws.qf, k, &mut ws.rhs) {
+                if !(cholesky_factor(&ws.qf, k, 0.0, &mut ws.chol)
+                    && cholesky_solve(&ws.chol, k, &mut ws.rhs))
+                {
                     return y;
                 }
                 for (r, &i) in free.iter().enumerate() {
@@ -428,46 +431,6 @@ impl NormalEquations {
         }
         y
     }
-}
-
-/// Solves `M x = rhs` in place for the symmetric positive definite `M` (`k × k`, column-major
-/// in `m`, overwritten by its Cholesky factor); `false` if it is not positive definite.
-fn cholesky_solve(m: &mut [f64], k: usize, rhs: &mut [f64]) -> bool {
-    // Lower factor L (M = L Lᵀ) in the lower triangle, column by column.
-    for j in 0..k {
-        let mut d = m[j + k * j];
-        for p in 0..j {
-            d -= m[j + k * p] * m[j + k * p];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
-        }
-        let d = d.sqrt();
-        m[j + k * j] = d;
-        for i in j + 1..k {
-            let mut v = m[i + k * j];
-            for p in 0..j {
-                v -= m[i + k * p] * m[j + k * p];
-            }
-            m[i + k * j] = v / d;
-        }
-    }
-    // L z = rhs, then Lᵀ x = z.
-    for i in 0..k {
-        let mut v = rhs[i];
-        for p in 0..i {
-            v -= m[i + k * p] * rhs[p];
-        }
-        rhs[i] = v / m[i + k * i];
-    }
-    for i in (0..k).rev() {
-        let mut v = rhs[i];
-        for p in i + 1..k {
-            v -= m[p + k * i] * rhs[p];
-        }
-        rhs[i] = v / m[i + k * i];
-    }
-    true
 }
 
 #[cfg(test)]

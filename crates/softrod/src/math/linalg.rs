@@ -317,6 +317,51 @@ impl DenseLu {
     }
 }
 
+/// Cholesky factor of `A − shift·I` for the symmetric `n × n` matrix `a` (either storage
+/// order: only the triangle below the diagonal of its row-major reading is used): the lower
+/// factor `L` (row-major, `L Lᵀ = A − shift·I`) into `l`, whose storage is reused; `false` if
+/// `A − shift·I` is not positive definite (a pivot not positive or not finite).
+pub fn cholesky_factor(a: &[f64], n: usize, shift: f64, l: &mut Vec<f64>) -> bool {
+    l.clear();
+    l.extend_from_slice(&a[..n * n]);
+    for i in 0..n {
+        l[i * n + i] -= shift;
+    }
+    for j in 0..n {
+        let mut d = l[j * n + j];
+        for k in 0..j {
+            d -= l[j * n + k] * l[j * n + k];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        let d = d.sqrt();
+        l[j * n + j] = d;
+        for i in j + 1..n {
+            let mut v = l[i * n + j];
+            for k in 0..j {
+                v -= l[i * n + k] * l[j * n + k];
+            }
+            l[i * n + j] = v / d;
+        }
+    }
+    true
+}
+
+/// Solves `L Lᵀ x = b` in place (`b` of length `n`) with the factor of [`cholesky_factor`];
+/// `false` if the result is not finite.
+pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) -> bool {
+    for i in 0..n {
+        let s: f64 = (0..i).map(|k| l[i * n + k] * b[k]).sum();
+        b[i] = (b[i] - s) / l[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let s: f64 = (i + 1..n).map(|k| l[k * n + i] * b[k]).sum();
+        b[i] = (b[i] - s) / l[i * n + i];
+    }
+    b[..n].iter().all(|v| v.is_finite())
+}
+
 /// Inverse of the symmetric positive definite sub-matrix of `c` on the indices `free` (the
 /// other rows and columns of the result are zero), by Cholesky `C = L Lᵀ`, `C⁻¹ = L⁻ᵀ L⁻¹`;
 /// `None` if a pivot is not positive.
