@@ -364,7 +364,7 @@ impl NormalEquations {
                 for (r, &i) in free.iter().enumerate() {
                     ws.rhs[r] = -c[i];
                     for (s, &j) in free.iter().enumerate() {
-                        ws.qf[r + k * s] = q[i + n * j];
+                        ws.qf[r * k + s] = q[i + n * j];
                     }
                     for j in 0..n {
                         if let Some(v) = fixed[j] {

@@ -352,12 +352,18 @@ pub fn cholesky_factor(a: &[f64], n: usize, shift: f64, l: &mut Vec<f64>) -> boo
 /// `false` if the result is not finite.
 pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) -> bool {
     for i in 0..n {
-        let s: f64 = (0..i).map(|k| l[i * n + k] * b[k]).sum();
-        b[i] = (b[i] - s) / l[i * n + i];
+        let mut v = b[i];
+        for k in 0..i {
+            v -= l[i * n + k] * b[k];
+        }
+        b[i] = v / l[i * n + i];
     }
     for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| l[k * n + i] * b[k]).sum();
-        b[i] = (b[i] - s) / l[i * n + i];
+        let mut v = b[i];
+        for k in i + 1..n {
+            v -= l[k * n + i] * b[k];
+        }
+        b[i] = v / l[i * n + i];
     }
     b[..n].iter().all(|v| v.is_finite())
 }
