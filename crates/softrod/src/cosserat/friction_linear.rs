@@ -116,7 +116,7 @@ impl<'a> Frozen<'a> {
             base: solution.tendon_tensions.clone(),
             pressures: solution.pressures(),
             mus: mus.to_vec(),
-            x: super::sensitivity::scaled_base_wrench(model, &solution.base_wrench),
+            x: super::statics::scaled(model, &solution.base_wrench),
             integrator: solution.options.integrator,
             nb: 6,
         })
