@@ -108,12 +108,7 @@ fn convert(job: &Bound<'_, PyDict>, k: usize) -> PyResult<Converted> {
     } else {
         Some(loads.cast::<Loads>()?.clone())
     };
-    let problem = Problem::new(
-        rod.get(),
-        &tendons,
-        loads.as_ref().map(Bound::get),
-        &chambers,
-    )?;
+    let problem = Problem::new(rod, &tendons, loads.as_ref(), &chambers)?;
     let opts = item(job, k, "options")?;
     let opts = opts.cast::<PyDict>()?;
     let integrator: Option<String> = option(opts, k, "integrator")?;

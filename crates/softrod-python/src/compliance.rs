@@ -610,12 +610,7 @@ pub(crate) fn _workspace_map<'py>(
         tolerance,
         ..Default::default()
     })?;
-    let problem = Problem::new(
-        rod.get(),
-        &tendons,
-        loads.as_ref().map(Bound::get),
-        &chambers,
-    )?;
+    let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;
     let nt = problem.model.tendons().len();
     let chunk = count("chunk", chunk, 1, usize::MAX >> 1)?;
     let a = tensions.0.view();

@@ -226,12 +226,7 @@ pub(crate) fn _inverse_statics<'py>(
         atol,
         ..OptionArgs::default()
     })?;
-    let problem = Problem::new(
-        rod.get(),
-        &tendons,
-        loads.as_ref().map(Bound::get),
-        &chambers,
-    )?;
+    let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;
     let warm = merge_warm(warm, warm_state.as_ref(), same_model);
     let model = &problem.model;
     // The forward solution is made in Python (when it is asked for), not here.

@@ -186,12 +186,7 @@ impl Source<'_> {
                 loads,
                 chambers,
             } => {
-                let problem = Problem::new(
-                    rod.get(),
-                    &tendons,
-                    loads.as_ref().map(Bound::get),
-                    &chambers,
-                )?;
+                let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;
                 let subject = Subject::Objects {
                     rod: rod.unbind(),
                     tendons: tendons.into_iter().map(Bound::unbind).collect(),
@@ -532,7 +527,7 @@ pub(crate) fn _time_solve_statics<'py>(
         warm_start: warm_start.filter(|w| !w.is_none()),
         ..Default::default()
     })?;
-    let problem = Problem::new(rod.get(), &tendons, loads.as_ref().map(Bound::get), &[])?;
+    let problem = Problem::new(&rod, &tendons, loads.as_ref(), &[])?;
     let (model, act) = (&problem.model, &problem.actuation);
     run(py, "_time_solve_statics", || {
         let mut times = Vec::with_capacity(repeats);

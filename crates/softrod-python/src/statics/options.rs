@@ -103,12 +103,15 @@ pub(crate) struct Problem {
 }
 
 impl Problem {
+    /// The model of the user's `rod`, `tendons`, `loads` (none: unloaded) and `chambers`, with
+    /// the actuation of the tendons' tensions (N) and the chambers' pressures (Pa).
     pub(crate) fn new(
-        rod: &Rod,
+        rod: &Bound<'_, Rod>,
         tendons: &[Bound<'_, Tendon>],
-        loads: Option<&Loads>,
+        loads: Option<&Bound<'_, Loads>>,
         chambers: &[Bound<'_, Chamber>],
     ) -> PyResult<Self> {
+        let (rod, loads) = (rod.get(), loads.map(Bound::get));
         let (r, l) = (rod.inner.clone(), loads.map(|l| l.inner.clone()));
         let ts: Vec<softrod::Tendon> = tendons.iter().map(|t| t.get().inner.clone()).collect();
         let cs: Vec<softrod::Chamber> = chambers.iter().map(|c| c.get().inner.clone()).collect();

@@ -32,12 +32,7 @@ impl RobotModel {
         #[pyo3(from_py_with = arg::loads)] loads: Option<Bound<'_, Loads>>,
         #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'_, Chamber>>,
     ) -> PyResult<Self> {
-        let problem = Problem::new(
-            rod.get(),
-            &tendons,
-            loads.as_ref().map(Bound::get),
-            &chambers,
-        )?;
+        let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;
         Ok(Self {
             problem,
             rod: rod.unbind(),

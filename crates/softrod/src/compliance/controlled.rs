@@ -15,8 +15,8 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
-use crate::cosserat::equations::{project, rot, v3, Equations, Evaluator, Local, Workspace, STATE};
-use crate::cosserat::statics::{Integrator, StaticsSolution};
+use crate::cosserat::equations::{project, rot, v3, Evaluator, Local, Workspace, STATE};
+use crate::cosserat::statics::{interior, scaled, Integrator, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Piecewise, Scheme};
 use crate::integrate::{AdaptiveOptions, System};
@@ -174,27 +174,11 @@ pub(crate) fn march_compliance(
             ));
         }
     }
-    let tensions = solution.tensions();
     let pressures = solution.pressures();
-    let eq = Equations {
-        model,
-        tensions: &tensions,
-        pressures: &pressures,
-        load_factor: solution.stats.load_factor,
-        profile: solution.actuation.profile.as_deref(),
-    };
-    let f = model.force_scale();
-    let fm = f * length;
-    let b = &solution.base_wrench;
-    let x = [
-        b[0] / f,
-        b[1] / f,
-        b[2] / f,
-        b[3] / fm,
-        b[4] / fm,
-        b[5] / fm,
-    ];
-    let head: [f64; STATE] = eq.initial(&x);
+    let eq = solution.equations(&pressures, solution.stats.load_factor);
+    // The moment scale `F L` of the scaled unknowns.
+    let fm = model.force_scale() * length;
+    let head: [f64; STATE] = eq.initial(&scaled(model, &solution.base_wrench));
     let mut y0 = [0.0; WIDTH];
     y0[..STATE].copy_from_slice(&head);
     let mut ws = Workspace::new(model.tendons().len());
@@ -202,14 +186,10 @@ pub(crate) fn march_compliance(
         ev: Evaluator { eq, ws: &mut ws },
         p0: model.rod().base_pose().position(),
         inv_length: 1.0 / length,
-        scale: f * length,
+        scale: fm,
         index: triangle(),
     };
-    let mut stops: Vec<f64> = s_out
-        .iter()
-        .copied()
-        .filter(|&s| s > 0.0 && s < length)
-        .collect();
+    let mut stops = interior(s_out, length);
     stops.sort_by(f64::total_cmp);
     stops.dedup();
     let scheme = Scheme::Adaptive {
@@ -248,7 +228,7 @@ pub(crate) fn march_compliance(
         let (s, y, element) = &recorded[k];
         let mut q = Matrix6::zeros();
         for (m, &(i, j)) in index.iter().enumerate() {
-            let v = y[STATE + m] * unscale(i) * unscale(j) / (f * length);
+            let v = y[STATE + m] * unscale(i) * unscale(j) / fm;
             q[(i, j)] = v;
             q[(j, i)] = v;
         }

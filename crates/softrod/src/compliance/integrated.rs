@@ -58,6 +58,30 @@ pub struct Compliance {
 }
 
 impl Compliance {
+    /// The compliance at the nodes `s` (m) with their element compliances `element` and
+    /// world and body blocks (as the fields), [`Self::gamma_c`] from the body blocks scaled
+    /// by `rod` (one scale for all nodes, see [`gamma_c`]).
+    fn of_rod(
+        rod: &Rod,
+        s: Vec<f64>,
+        element: Vec<[f64; 6]>,
+        world: Vec<Matrix6<f64>>,
+        body: Vec<Matrix6<f64>>,
+    ) -> Self {
+        let gk = gamma_c(rod, &Matrix6::identity())[0];
+        let gamma_c = body
+            .iter()
+            .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
+            .collect();
+        Self {
+            s,
+            element,
+            world,
+            body,
+            gamma_c,
+        }
+    }
+
     /// Compliance at the tip, world frame.
     pub fn tip_world(&self) -> Matrix6<f64> {
         self.world
@@ -435,18 +459,13 @@ fn transport(
 /// differ in length.
 pub fn configuration_compliance(rod: &Rod, config: Configuration) -> Result<Compliance> {
     let (world, body) = compliance_matrices(&config, false)?;
-    let gk = gamma_c(rod, &Matrix6::identity())[0];
-    let gamma = body
-        .iter()
-        .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
-        .collect();
-    Ok(Compliance {
-        s: config.s,
-        element: config.element,
+    Ok(Compliance::of_rod(
+        rod,
+        config.s,
+        config.element,
         world,
         body,
-        gamma_c: gamma,
-    })
+    ))
 }
 
 /// The paper's integrated compliance (eqs. 6-7) at every node of `solution`. For an adaptive
@@ -510,18 +529,13 @@ pub fn compliance_at(solution: &StaticsSolution, s_out: &[f64]) -> Result<Compli
         (n.position, rotation, n.q)
     };
     let (world, body) = transport(&p0, nodes.iter().map(frame));
-    let gk = gamma_c(rod, &Matrix6::identity())[0];
-    let gamma = body
-        .iter()
-        .map(|b| [b[(0, 0)] * gk, b[(1, 1)] * gk, b[(2, 2)] * gk])
-        .collect();
-    Ok(Compliance {
-        s: nodes.iter().map(|n| n.s).collect(),
-        element: nodes.iter().map(|n| n.element).collect(),
+    Ok(Compliance::of_rod(
+        rod,
+        nodes.iter().map(|n| n.s).collect(),
+        nodes.iter().map(|n| n.element).collect(),
         world,
         body,
-        gamma_c: gamma,
-    })
+    ))
 }
 
 /// The paper's integrated compliance along the arcs of a PCC solution (same computation as

@@ -17,6 +17,7 @@
 use nalgebra::{Matrix3, Matrix6};
 
 use crate::cosserat::friction_linear::{frictional_tip_compliance, Direction};
+use crate::cosserat::sensitivity::node_or_tip;
 pub use crate::cosserat::sensitivity::COLUMNS_PER_PASS;
 use crate::cosserat::sensitivity::{held_rows, linearise, HeldRow, Seed};
 use crate::cosserat::statics::StaticsSolution;
@@ -113,13 +114,8 @@ pub fn tangent_compliance_held(
     held: &[usize],
     node: Option<usize>,
 ) -> Result<TangentCompliance> {
-    let model = &*solution.model;
-    let nt = model.tendons().len();
-    let n = solution.s.len();
-    let node = node.unwrap_or(n.saturating_sub(1));
-    if node >= n {
-        return Err(Error::invalid("node", node, format!("in [0, {n})")));
-    }
+    let nt = solution.model.tendons().len();
+    let node = node_or_tip(solution, node)?;
     for (k, &i) in held.iter().enumerate() {
         if i >= nt || held[..k].contains(&i) {
             return Err(Error::invalid(
@@ -140,15 +136,12 @@ fn tangent_with_rows(
     rows: &[HeldRow],
     node: Option<usize>,
 ) -> Result<TangentCompliance> {
-    let n = solution.s.len();
-    let node = node.unwrap_or(n.saturating_sub(1));
-    if node < n {
-        // A strongly curved RK4 solution: the derivative of a finer march (super::refine).
-        if let Some((fine, map)) = super::refine::refined(solution) {
-            let mut out = tangent_on_mesh(&fine, rows, Some(map[node]))?;
-            out.node = node;
-            return Ok(out);
-        }
+    let node = node_or_tip(solution, node)?;
+    // A strongly curved RK4 solution: the derivative of a finer march (super::refine).
+    if let Some((fine, map)) = super::refine::refined(solution) {
+        let mut out = tangent_on_mesh(&fine, rows, Some(map[node]))?;
+        out.node = node;
+        return Ok(out);
     }
     tangent_on_mesh(solution, rows, Some(node))
 }
@@ -159,13 +152,8 @@ fn tangent_on_mesh(
     rows: &[HeldRow],
     node: Option<usize>,
 ) -> Result<TangentCompliance> {
-    let model = &*solution.model;
-    let nt = model.tendons().len();
-    let n = solution.s.len();
-    let node = node.unwrap_or(n.saturating_sub(1));
-    if node >= n {
-        return Err(Error::invalid("node", node, format!("in [0, {n})")));
-    }
+    let nt = solution.model.tendons().len();
+    let node = node_or_tip(solution, node)?;
     let target = solution.s[node];
     let mut tension_rate = vec![[0.0; 6]; nt];
     if target <= 0.0 {

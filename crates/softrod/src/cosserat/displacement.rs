@@ -27,14 +27,13 @@ use super::sensitivity::slack_scale;
 use super::shooting::{Held, Shooting};
 use super::statics::{
     assemble, Integrator, SolveOptions, StaticsSolution, WarmStart, DIRECT_STEP_LIMIT,
-    MAX_LINE_SEARCH_HALVINGS,
 };
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
 use crate::model::{Actuation, RobotModel, TendonInput};
 use crate::solve::{
-    continuation, max_norm, newton, Armijo, ContinuationSettings, Evaluated, LineSearch,
-    NewtonOutcome, NewtonSettings, Problem, SolverStats,
+    continuation, max_norm, newton, ContinuationSettings, Evaluated, NewtonOutcome, NewtonSettings,
+    Problem, SolverStats,
 };
 
 /// Most rounds of the active set (changes of the taut set) per held tendon, plus a few.
@@ -102,19 +101,10 @@ pub(super) fn held_of(model: &RobotModel, actuation: &Actuation, reference: &[f6
         .collect()
 }
 
+/// The shooting's Newton settings ([`super::statics::settings`]) without a given Jacobian or
+/// an exact one at the solution.
 fn settings(broyden: bool) -> NewtonSettings<'static> {
-    NewtonSettings {
-        line_search: LineSearch {
-            factor: 0.5,
-            max_halvings: MAX_LINE_SEARCH_HALVINGS,
-        },
-        condition: Armijo::default(),
-        first_step_limit: None,
-        residual_first: false,
-        broyden,
-        jacobian: None,
-        exact_at_solution: false,
-    }
+    super::statics::settings(broyden, None, false)
 }
 
 /// Solves the smooth problem of the current taut set from `z0`: directly at full load when

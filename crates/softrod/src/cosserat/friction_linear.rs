@@ -45,6 +45,7 @@ use super::equations::{
 };
 use super::friction::angle;
 use super::friction_cell::{angle_variation, Bounds, Branch, CellRule, CellSystem, NodeLin};
+use super::friction_march::Cell;
 use super::statics::{Integrator, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::integrate::{adaptive, fixed, DP5, RK4};
@@ -116,7 +117,7 @@ impl<'a> Frozen<'a> {
             base: solution.tendon_tensions.clone(),
             pressures: solution.pressures(),
             mus: mus.to_vec(),
-            x: super::sensitivity::scaled_base_wrench(model, &solution.base_wrench),
+            x: super::statics::scaled(model, &solution.base_wrench),
             integrator: solution.options.integrator,
             nb: 6,
         })
@@ -176,21 +177,10 @@ fn march<const N: usize>(
     let mut poses = Vec::with_capacity(n);
     poses.push((0..ctx.nm).map(|c| pose_of(&at.y, c)).collect::<Vec<_>>());
     let mut branches = Vec::new();
-    let mut interval = 0;
-    for j in 0..n - 1 {
-        let (a, b) = (fr.mesh[j], fr.mesh[j + 1]);
-        let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
-        let c = Cell {
-            j,
-            a,
-            b,
-            interval,
-            crosses,
-        };
+    for c in Cell::along(fr.mesh, breaks) {
         let first = ctx.cell(&mut cell, &mut ws, &mut at, c)?;
         branches.extend_from_slice(&first);
         poses.push((0..ctx.nm).map(|c| pose_of(&at.y, c)).collect());
-        interval += usize::from(crosses);
     }
     let (_, residual) = ctx.eq().residual(&at.y, ctx.nm);
     Ok(Pass {
@@ -198,17 +188,6 @@ fn march<const N: usize>(
         residual,
         branches,
     })
-}
-
-/// Cell `j` of the mesh, `[a, b]`, the integration interval it lies in and whether `b` is a
-/// break into the next one.
-#[derive(Clone, Copy)]
-struct Cell {
-    j: usize,
-    a: f64,
-    b: f64,
-    interval: usize,
-    crosses: bool,
 }
 
 /// What the variational march carries from node to node: the state with its main columns,

@@ -156,16 +156,8 @@ pub(super) fn march_cells<const N: usize>(
 ) -> Result<Marched<N>> {
     let fixed = Fixed::new(setup, unloaded, hint, cell_tolerance);
     let mut march = CellMarch::<N>::start(fixed, x)?;
-    let (mesh, breaks) = (setup.mesh, setup.model.breaks());
-    for j in 0..mesh.len() - 1 {
-        let (b, interval) = (mesh[j + 1], march.interval);
-        march.cell(Cell {
-            j,
-            a: mesh[j],
-            b,
-            interval,
-            crosses: breaks[interval + 1] == b && interval + 2 < breaks.len(),
-        })?;
+    for c in Cell::along(setup.mesh, setup.model.breaks()) {
+        march.cell(c)?;
     }
     Ok(march.finish())
 }
@@ -173,18 +165,38 @@ pub(super) fn march_cells<const N: usize>(
 /// Per tendon, its unit path tangent (world) at a node, `None` where it is not there.
 type Tangents = Vec<Option<Vector3<f64>>>;
 
-/// Cell `j` of the friction mesh, `[a, b]`, the integration interval it starts in and
-/// whether `b` is a break into the next one.
+/// Cell `j` of the friction mesh, `[a, b]` (m), the integration interval it starts in and
+/// whether `b` is a break into the next one (the cells of this march and of the variational
+/// march of `friction_linear`).
 #[derive(Clone, Copy)]
-struct Cell {
-    j: usize,
-    a: f64,
-    b: f64,
-    interval: usize,
-    crosses: bool,
+pub(super) struct Cell {
+    pub(super) j: usize,
+    pub(super) a: f64,
+    pub(super) b: f64,
+    pub(super) interval: usize,
+    pub(super) crosses: bool,
 }
 
 impl Cell {
+    /// The cells of `mesh` (m, increasing, every break of the model a node of it), base to
+    /// tip, with the intervals of the model's `breaks` (m) they start in.
+    pub(super) fn along<'a>(mesh: &'a [f64], breaks: &'a [f64]) -> impl Iterator<Item = Cell> + 'a {
+        let mut interval = 0;
+        mesh.windows(2).enumerate().map(move |(j, ab)| {
+            let (a, b) = (ab[0], ab[1]);
+            let crosses = breaks[interval + 1] == b && interval + 2 < breaks.len();
+            let c = Cell {
+                j,
+                a,
+                b,
+                interval,
+                crosses,
+            };
+            interval = c.next_interval();
+            c
+        })
+    }
+
     /// The integration interval at the distal node `b`.
     fn next_interval(self) -> usize {
         self.interval + usize::from(self.crosses)

@@ -45,10 +45,10 @@ use super::friction::{
     angle, base_slip, cell_rule, solve_frictional, Anderson, FrictionOptions, FrictionalSolution,
     Slip,
 };
-use crate::cosserat::statics::WarmStart;
+use crate::cosserat::statics::{StaticsSolution, WarmStart};
 use crate::error::{Error, Result};
 use crate::model::actuation::TendonInput;
-use crate::model::loads::{Frame, PointLoad};
+use crate::model::loads::{Frame, Loads, PointLoad};
 use crate::model::tendon::Tendon;
 use crate::model::{Actuation, RobotModel};
 
@@ -97,6 +97,16 @@ fn node_at(mesh: &[f64], s: f64) -> usize {
     j.min(mesh.len() - 1)
 }
 
+/// The rotation (body to world) of the solution `st` at its node `j`.
+fn node_rotation(st: &StaticsSolution, j: usize) -> Matrix3<f64> {
+    Matrix3::from_fn(|a, b| st.rotation[j][a][b])
+}
+
+/// The rotation (body to world) of `st` at its node at `s` (m, see [`node_at`]).
+fn rotation_at(st: &StaticsSolution, s: f64) -> Matrix3<f64> {
+    node_rotation(st, node_at(&st.s, s))
+}
+
 /// The world points of the anchors of every guided tendon on the shape `sol`, flattened.
 fn points_on(model: &RobotModel, guided: &[usize], sol: &FrictionalSolution) -> Vec<f64> {
     let st = &sol.statics;
@@ -104,7 +114,7 @@ fn points_on(model: &RobotModel, guided: &[usize], sol: &FrictionalSolution) -> 
     for &i in guided {
         for s in anchors(model, i) {
             let j = node_at(&st.s, s);
-            let r = Matrix3::from_fn(|a, b| st.rotation[j][a][b]);
+            let r = node_rotation(st, j);
             let props = model.rod().section_at(s);
             let (o, _) = model.tendons()[i].routing().offset(s, &props);
             let x = Vector3::from(st.position[j]) + r * Vector3::new(o[0], o[1], 0.0);
@@ -202,6 +212,16 @@ fn channel_model(model: &RobotModel, guided: &[usize]) -> Result<Arc<RobotModel>
             }
         })
         .collect::<Result<Vec<_>>>()?;
+    with_tendons_and_loads(model, tendons, loads)
+}
+
+/// The model with the rod and chambers of `model` and the given `tendons` and `loads` (the
+/// stand-ins of a guided robot).
+fn with_tendons_and_loads(
+    model: &RobotModel,
+    tendons: Vec<Tendon>,
+    loads: Loads,
+) -> Result<Arc<RobotModel>> {
     RobotModel::new(
         model.rod().clone(),
         tendons,
@@ -534,12 +554,7 @@ impl<'a> Guided<'a> {
             }
         }
         let tendons = model.tendons().iter().map(Tendon::without_guides).collect();
-        RobotModel::new(
-            model.rod().clone(),
-            tendons,
-            model.chambers().to_vec(),
-            loads,
-        )
+        with_tendons_and_loads(model, tendons, loads)
     }
 
     /// The forces of `states` at the anchors of the active tendons in the frames of `sol`
@@ -556,8 +571,7 @@ impl<'a> Guided<'a> {
                 continue;
             }
             for g in st.iter().skip(1) {
-                let j = node_at(&sol.statics.s, g.s);
-                let r = Matrix3::from_fn(|a, b| sol.statics.rotation[j][a][b]);
+                let r = rotation_at(&sol.statics, g.s);
                 z.extend_from_slice((r.transpose() * Vector3::from(g.force)).as_slice());
             }
         }
@@ -595,8 +609,7 @@ impl<'a> Guided<'a> {
                 continue;
             }
             for g in st.iter_mut().skip(1) {
-                let j = node_at(&sol.statics.s, g.s);
-                let r = Matrix3::from_fn(|a, b| sol.statics.rotation[j][a][b]);
+                let r = rotation_at(&sol.statics, g.s);
                 g.force = (r * Vector3::new(z[q], z[q + 1], z[q + 2])).into();
                 q += 3;
             }
@@ -844,7 +857,7 @@ fn predicted_warm_start(m: &RobotModel, warm: &FrictionalSolution) -> WarmStart 
             let (force, moment) = match pl.frame {
                 Frame::World => (pl.force, pl.moment),
                 Frame::Body => {
-                    let r = Matrix3::from_fn(|a, b| st.rotation[j][a][b]);
+                    let r = node_rotation(st, j);
                     (r * pl.force, r * pl.moment)
                 }
             };
@@ -948,7 +961,7 @@ fn finish(
             let g = (a.partition_point(|x| x.s <= s) - 1).min(a.len() - 2);
             let (_, c) = chord(g);
             let before: f64 = (0..g).map(|h| chord(h).0).sum();
-            let r = Matrix3::from_fn(|p, q| sol.statics.rotation[j][p][q]);
+            let r = node_rotation(&sol.statics, j);
             let (o, _) = model.tendons()[i].routing().offset(s, &props(s));
             let y = Vector3::from(sol.statics.position[j]) + r * Vector3::new(o[0], o[1], 0.0);
             sol.tension[j][i] = a[g].tension_out;

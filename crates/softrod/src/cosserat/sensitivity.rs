@@ -138,20 +138,6 @@ pub(crate) struct HeldRow {
     pub compliance: f64,
 }
 
-/// The scaled base wrench of a solution.
-pub(crate) fn scaled_base_wrench(model: &RobotModel, bw: &[f64; 6]) -> [f64; 6] {
-    let f_ref = model.force_scale();
-    let fm = f_ref * model.length();
-    [
-        bw[0] / f_ref,
-        bw[1] / f_ref,
-        bw[2] / f_ref,
-        bw[3] / fm,
-        bw[4] / fm,
-        bw[5] / fm,
-    ]
-}
-
 /// The taut displacement-controlled tendons of a solution.
 pub(crate) fn held_rows(solution: &StaticsSolution) -> Vec<HeldRow> {
     solution
@@ -206,17 +192,10 @@ pub(crate) fn linearise(
     load_node: Option<usize>,
 ) -> Result<Linear> {
     let model = &*solution.model;
-    let x = scaled_base_wrench(model, &solution.base_wrench);
+    let x = super::statics::scaled(model, &solution.base_wrench);
     let lambda = solution.stats.load_factor;
-    let tensions = &solution.tendon_tensions;
     let pressures = solution.pressures();
-    let eq = Equations {
-        model,
-        tensions,
-        pressures: &pressures,
-        load_factor: lambda,
-        profile: solution.actuation.profile.as_deref(),
-    };
+    let eq = solution.equations(&pressures, lambda);
     let loads_seeded = seeds.iter().any(|s| matches!(s, Seed::Load(_)));
     let free = !loads_seeded && force_free_at(model, &x, lambda);
     let nb = if free { 0 } else { 6 };

@@ -6,7 +6,7 @@ use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
-use super::equations::{rot, v3, Evaluator, Workspace};
+use super::equations::{rot, v3, Equations, Evaluator, Workspace};
 use super::options::{CoarseDefect, SolveOptions, WarmStart};
 use super::shooting::{Node, Shooting};
 use super::statics::stability_on;
@@ -99,6 +99,19 @@ impl StaticsSolution {
     /// Pressure of every chamber (Pa).
     pub fn pressures(&self) -> Vec<f64> {
         self.actuation.pressure_values(self.model.chambers().len())
+    }
+
+    /// The equations of this solution's model under its actuation: its tendon tensions (N),
+    /// the chamber `pressures` (Pa, those of [`Self::pressures`]) and its tension profile, at
+    /// the load factor `load_factor`.
+    pub(crate) fn equations<'a>(&'a self, pressures: &'a [f64], load_factor: f64) -> Equations<'a> {
+        Equations {
+            model: &self.model,
+            tensions: &self.tendon_tensions,
+            pressures,
+            load_factor,
+            profile: self.actuation.profile.as_deref(),
+        }
     }
 
     /// The smallest eigenvalue of the symmetric part of the dimensionless tip tangent

@@ -43,15 +43,8 @@ pub(crate) use super::solution::{assemble, scaled_back};
 /// (e.g. a coarser mesh than it was solved on).
 pub(crate) fn stability_on(sol: &StaticsSolution, integrator: Integrator) -> Option<Stability> {
     let model = &*sol.model;
-    let tensions = sol.tensions();
     let pressures = sol.pressures();
-    let eq = Equations {
-        model,
-        tensions: &tensions,
-        pressures: &pressures,
-        load_factor: 1.0,
-        profile: sol.actuation.profile.as_deref(),
-    };
+    let eq = sol.equations(&pressures, 1.0);
     let plan = match integrator {
         Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
         Integrator::Adaptive(_) => Vec::new(),
@@ -391,7 +384,8 @@ fn stable_on_coarse(p: &mut Shooting<'_>, x: &[f64]) -> Option<Stability> {
     clearly_stable(&c, &j, 0.0).filter(|_| marched)
 }
 
-/// Scaled unknowns of a base wrench (N, N m).
+/// The dimensionless unknowns of a base wrench `[f; m]` (N, N m): the force over the model's
+/// force scale `F`, the moment over `F L`.
 pub(crate) fn scaled(model: &RobotModel, b: &[f64; 6]) -> [f64; 6] {
     let f = model.force_scale();
     let fm = f * model.length();

@@ -187,17 +187,13 @@ pub fn fixed_in<const N: usize, const S: usize, Y: System<N>>(
         let t_end = if i + 1 == steps { t1 } else { t + h };
         sys.rhs(t, &y, &mut st.k[0]);
         sys.stage_evaluated(0);
-        stages(tab, sys, t, &y, h, t_end, st);
-        if tab.fsal {
-            y = st.tmp;
-        } else {
-            advance(tab, &mut y, h, st);
-        }
+        y = step(tab, sys, t, &y, h, t_end, st);
         sys.step_accepted(&weights(tab, h), false);
         sys.project(&mut y);
         if !y.iter().all(|v| v.is_finite()) {
-            return Err(Error::not_converged(
-                format!("{} integration: non-finite state", tab.name),
+            return Err(not_converged(
+                tab.name,
+                ": non-finite state",
                 i + 1,
                 f64::INFINITY,
             ));

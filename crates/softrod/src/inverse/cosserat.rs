@@ -197,11 +197,14 @@ impl CosseratForward {
 }
 
 impl CosseratForward {
-    /// The evaluation of an unloaded robot with its Jacobian: the base wrench is zero and does
-    /// not move with the actuation, so one march of the state with one column per actuator.
-    fn unloaded(&mut self, a: &[f64]) -> Result<Evaluation> {
+    /// One march of an unloaded robot at the actuation `a` (tensions in N, then pressures in
+    /// Pa): the base wrench is zero and does not move with the actuation. With `jacobian`, one
+    /// column per actuator rides on the march (per observed pose a `6 × (nt + nc)` matrix of
+    /// world-frame position and rotation rates per unit actuation) and the march is recorded
+    /// for [`CosseratForward::solve`]; without, the state alone is marched and the recorded
+    /// march is kept.
+    fn unloaded(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation> {
         let (nt, nc) = self.dims();
-        let (tensions, pressures) = (&a[..nt], &a[nt..]);
         let act = self.actuation(a);
         act.validate(nt, nc)?;
         if self.uniform {
@@ -209,28 +212,33 @@ impl CosseratForward {
                 &self.model,
                 &self.options.integrator,
                 a,
-                true,
+                jacobian,
                 &mut self.uniform_ws,
             ) {
-                self.march = None;
+                if jacobian {
+                    self.march = None;
+                }
                 return Ok(ev);
             }
         }
         let eq = Equations {
             model: &self.model,
-            tensions,
-            pressures,
+            tensions: &a[..nt],
+            pressures: &a[nt..],
             load_factor: 1.0,
             profile: None,
         };
-        let seeds: Vec<Seed> = (0..nt)
-            .map(|i| Seed::Forced(Column::Tension(i)))
-            .chain((0..nc).map(|j| Seed::Forced(Column::Pressure(j))))
-            .collect();
+        let seeds: Vec<Seed> = if jacobian {
+            (0..nt)
+                .map(|i| Seed::Forced(Column::Tension(i)))
+                .chain((0..nc).map(|j| Seed::Forced(Column::Pressure(j))))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let mut plan = Vec::new();
         let scheme = scheme_of(&self.options.integrator, &self.model, &mut plan);
-        let observe = self.nodes.clone().unwrap_or_default();
-        let mut sorted = observe.clone();
+        let mut sorted = self.nodes.clone().unwrap_or_default();
         sorted.sort_unstable();
         sorted.dedup();
         let mut cols = integrate(
@@ -242,7 +250,7 @@ impl CosseratForward {
                 lengths: &[],
                 observe: &sorted,
                 load_node: None,
-                record_nodes: true,
+                record_nodes: jacobian || self.nodes.is_some(),
                 stops: &[],
             },
         )?;
@@ -251,88 +259,7 @@ impl CosseratForward {
             None => Evaluation {
                 positions: vec![cols.tip_pose.0],
                 rotation: cols.tip_pose.1,
-                jacobian: Some(vec![to_matrix(&cols.tip)]),
-            },
-            Some(nodes) => {
-                let at = |i: usize| sorted.iter().position(|&x| x == i).unwrap_or(0);
-                let positions = nodes
-                    .iter()
-                    .map(|&i| crate::cosserat::equations::v3(&cols.nodes[i].y, 0))
-                    .collect();
-                let last = *nodes.last().unwrap_or(&0);
-                Evaluation {
-                    positions,
-                    rotation: cols.rotations[at(last)],
-                    jacobian: Some(
-                        nodes
-                            .iter()
-                            .map(|&i| to_matrix(&cols.poses[at(i)]))
-                            .collect(),
-                    ),
-                }
-            }
-        };
-        // The nodes move into the record of the march (after the positions are read).
-        self.march = Some(March {
-            a: a.to_vec(),
-            nodes: std::mem::take(&mut cols.nodes),
-            lengths: std::mem::take(&mut cols.lengths),
-            residual: crate::solve::max_norm(cols.residual.as_slice()),
-            evaluations: cols.evaluations,
-        });
-        Ok(out)
-    }
-}
-
-impl CosseratForward {
-    /// The observed poses of an unloaded robot at `a` from one march of the state alone (no
-    /// columns); the march recorded for [`CosseratForward::solve`] is kept.
-    fn unloaded_poses(&mut self, a: &[f64]) -> Result<Evaluation> {
-        let (nt, nc) = self.dims();
-        let act = self.actuation(a);
-        act.validate(nt, nc)?;
-        if self.uniform {
-            if let Some(ev) = uniform::tip(
-                &self.model,
-                &self.options.integrator,
-                a,
-                false,
-                &mut self.uniform_ws,
-            ) {
-                return Ok(ev);
-            }
-        }
-        let eq = Equations {
-            model: &self.model,
-            tensions: &a[..nt],
-            pressures: &a[nt..],
-            load_factor: 1.0,
-            profile: None,
-        };
-        let mut plan = Vec::new();
-        let scheme = scheme_of(&self.options.integrator, &self.model, &mut plan);
-        let observe = self.nodes.clone().unwrap_or_default();
-        let mut sorted = observe.clone();
-        sorted.sort_unstable();
-        sorted.dedup();
-        let cols = integrate(
-            eq,
-            scheme,
-            &[0.0; 6],
-            &Request {
-                seeds: &[],
-                lengths: &[],
-                observe: &sorted,
-                load_node: None,
-                record_nodes: self.nodes.is_some(),
-                stops: &[],
-            },
-        )?;
-        Ok(match &self.nodes {
-            None => Evaluation {
-                positions: vec![cols.tip_pose.0],
-                rotation: cols.tip_pose.1,
-                jacobian: None,
+                jacobian: jacobian.then(|| vec![to_matrix(&cols.tip)]),
             },
             Some(nodes) => {
                 let at = |i: usize| sorted.iter().position(|&x| x == i).unwrap_or(0);
@@ -343,10 +270,26 @@ impl CosseratForward {
                         .map(|&i| crate::cosserat::equations::v3(&cols.nodes[i].y, 0))
                         .collect(),
                     rotation: cols.rotations[at(last)],
-                    jacobian: None,
+                    jacobian: jacobian.then(|| {
+                        nodes
+                            .iter()
+                            .map(|&i| to_matrix(&cols.poses[at(i)]))
+                            .collect()
+                    }),
                 }
             }
-        })
+        };
+        if jacobian {
+            // The nodes move into the record of the march (after the positions are read).
+            self.march = Some(March {
+                a: a.to_vec(),
+                nodes: std::mem::take(&mut cols.nodes),
+                lengths: std::mem::take(&mut cols.lengths),
+                residual: crate::solve::max_norm(cols.residual.as_slice()),
+                evaluations: cols.evaluations,
+            });
+        }
+        Ok(out)
     }
 }
 
@@ -358,7 +301,7 @@ impl Forward for CosseratForward {
 
     fn probe(&mut self, a: &[f64]) -> Result<Evaluation> {
         if no_external_loads(&self.model) {
-            return self.unloaded_poses(a);
+            return self.unloaded(a, false);
         }
         self.evaluate(a, false)
     }
@@ -377,7 +320,7 @@ impl Forward for CosseratForward {
 
     fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation> {
         if no_external_loads(&self.model) && jacobian {
-            return self.unloaded(a);
+            return self.unloaded(a, true);
         }
         let sol = self.solve(a)?;
         self.last = Some(sol.warm_start());

@@ -450,18 +450,26 @@ mod tests {
         }
     }
 
-    /// Brute force: every subset of bounds fixed at lower/upper/free, solving the KKT system of
-    /// each and keeping the best feasible point.
-    fn brute_min_norm(a: &DMatrix<f64>, b: &DVector<f64>, bx: &Bounds) -> Option<DVector<f64>> {
-        let (m, n) = a.shape();
-        let mut best: Option<(f64, DVector<f64>)> = None;
-        for code in 0..3usize.pow(n as u32) {
+    /// Every face of an `n`-dimensional box, as per variable `0` (free), `1` (at its lower
+    /// bound) or `2` (at its upper bound): the `3ⁿ` cases of the brute-force references.
+    fn faces(n: usize) -> impl Iterator<Item = Vec<u8>> {
+        (0..3usize.pow(n as u32)).map(move |code| {
             let mut state = vec![0u8; n];
             let mut c = code;
             for s in state.iter_mut() {
                 *s = (c % 3) as u8;
                 c /= 3;
             }
+            state
+        })
+    }
+
+    /// Brute force: every subset of bounds fixed at lower/upper/free, solving the KKT system of
+    /// each and keeping the best feasible point.
+    fn brute_min_norm(a: &DMatrix<f64>, b: &DVector<f64>, bx: &Bounds) -> Option<DVector<f64>> {
+        let (m, n) = a.shape();
+        let mut best: Option<(f64, DVector<f64>)> = None;
+        for state in faces(n) {
             let free: Vec<usize> = (0..n).filter(|&i| state[i] == 0).collect();
             let mut y = DVector::zeros(n);
             let mut ok = true;
@@ -616,13 +624,7 @@ mod tests {
                         .sum::<f64>()
         };
         let mut best: Option<(f64, DVector<f64>)> = None;
-        for code in 0..3usize.pow(n as u32) {
-            let mut state = vec![0u8; n];
-            let mut c = code;
-            for s in state.iter_mut() {
-                *s = (c % 3) as u8;
-                c /= 3;
-            }
+        for state in faces(n) {
             let mut y = DVector::zeros(n);
             if (0..n).any(|i| state[i] == 2 && !bx.hi[i].is_finite()) {
                 continue;

@@ -4,6 +4,22 @@
 
 use nalgebra::{Matrix3, Matrix6};
 
+/// Partial pivoting on column `k` of the row-major 6×6 `a`: the row `p >= k` of the largest
+/// `|a[p][k]|` (the first on ties), `None` if that pivot is zero or not finite (singular to
+/// working precision). Shared by [`Lu6::new`] and [`Inverse6::new`].
+#[inline(always)]
+fn pivot_row(a: &[[f64; 6]; 6], k: usize) -> Option<usize> {
+    let mut p = k;
+    let mut best = a[k][k].abs();
+    for i in k + 1..6 {
+        if a[i][k].abs() > best {
+            best = a[i][k].abs();
+            p = i;
+        }
+    }
+    (best > 0.0 && best.is_finite()).then_some(p)
+}
+
 /// LU factorisation with partial pivoting of a 6×6 matrix (no allocation).
 #[derive(Debug, Clone, Copy)]
 pub struct Lu6 {
@@ -25,17 +41,7 @@ impl Lu6 {
         let mut perm = [0, 1, 2, 3, 4, 5];
         let mut inv_diag = [0.0; 6];
         for k in 0..6 {
-            let mut p = k;
-            let mut best = a[k][k].abs();
-            for i in k + 1..6 {
-                if a[i][k].abs() > best {
-                    best = a[i][k].abs();
-                    p = i;
-                }
-            }
-            if !(best > 0.0 && best.is_finite()) {
-                return None;
-            }
+            let p = pivot_row(&a, k)?;
             if p != k {
                 a.swap(p, k);
                 perm.swap(p, k);
@@ -113,17 +119,7 @@ impl Inverse6 {
             b[i][i] = 1.0;
         }
         for k in 0..6 {
-            let mut p = k;
-            let mut best = a[k][k].abs();
-            for i in k + 1..6 {
-                if a[i][k].abs() > best {
-                    best = a[i][k].abs();
-                    p = i;
-                }
-            }
-            if !(best > 0.0 && best.is_finite()) {
-                return None;
-            }
+            let p = pivot_row(&a, k)?;
             if p != k {
                 a.swap(p, k);
                 b.swap(p, k);

@@ -573,43 +573,78 @@ fn elastic_jacobian<F: Fn(usize) -> Loading>(
     })
 }
 
-/// Tendon `i` at unit tension: axial force `-1` (compression) and tip moment
-/// `r_i × (-z) = d_i (-sin β_i, cos β_i)`.
-fn tendon_loading(tendons: &PccTendons) -> impl Fn(usize) -> Loading + '_ {
-    move |i| {
-        let d = tendons.distances[i];
-        (-1.0, -d * tendons.sin[i], d * tendons.cos[i])
+/// A layout of actuators of one segment whose unit actuation loads it (tendons, chambers).
+trait Actuators {
+    /// Name of the actuation values in errors.
+    const VALUES: &'static str;
+    /// Whether the values must be `>= 0` (tensions) or only finite (pressures).
+    const NON_NEGATIVE: bool;
+    /// Number of actuators.
+    fn count(&self) -> usize;
+    /// [`Loading`] of actuator `i` at unit actuation.
+    fn loading(&self, i: usize) -> Loading;
+}
+
+impl Actuators for PccTendons {
+    const VALUES: &'static str = "tensions";
+    const NON_NEGATIVE: bool = true;
+    fn count(&self) -> usize {
+        self.len()
+    }
+    /// Tendon `i` at unit tension: axial force `-1` (compression) and tip moment
+    /// `r_i × (-z) = d_i (-sin β_i, cos β_i)`.
+    fn loading(&self, i: usize) -> Loading {
+        let d = self.distances[i];
+        (-1.0, -d * self.sin[i], d * self.cos[i])
     }
 }
 
-/// Chamber `i` at unit pressure: axial force `A_i` and moment `r_i × (A_i z)`.
-fn chamber_loading(chambers: &PccChambers) -> impl Fn(usize) -> Loading + '_ {
-    move |i| {
-        let (a, r) = (chambers.areas[i], chambers.distances[i]);
-        (a, a * r * chambers.sin[i], -a * r * chambers.cos[i])
+impl Actuators for PccChambers {
+    const VALUES: &'static str = "pressures";
+    const NON_NEGATIVE: bool = false;
+    fn count(&self) -> usize {
+        self.len()
+    }
+    /// Chamber `i` at unit pressure: axial force `A_i` and moment `r_i × (A_i z)`.
+    fn loading(&self, i: usize) -> Loading {
+        let (a, r) = (self.areas[i], self.distances[i]);
+        (a, a * r * self.sin[i], -a * r * self.cos[i])
     }
 }
 
-/// `(u_x, u_y, ℓ)` of the checked `tensions` (N).
-fn tension_arc(
-    tensions: &[f64],
-    tendons: &PccTendons,
+/// `(u_x, u_y, ℓ)` (1/m, 1/m, m) of the checked actuation `values` (tensions in N, pressures
+/// in Pa), one per actuator.
+fn actuated_arc<A: Actuators>(
+    values: &[f64],
+    actuators: &A,
     body: &ElasticSegment,
 ) -> Result<(f64, f64, f64)> {
-    check_count("tensions", tensions.len(), tendons.len())?;
-    check_values("tensions", tensions, true)?;
-    elastic_arc("tensions", tensions, tendon_loading(tendons), body)
+    check_count(A::VALUES, values.len(), actuators.count())?;
+    check_values(A::VALUES, values, A::NON_NEGATIVE)?;
+    elastic_arc(A::VALUES, values, |i| actuators.loading(i), body)
 }
 
-/// `(u_x, u_y, ℓ)` of the checked `pressures` (Pa).
-fn pressure_arc(
-    pressures: &[f64],
-    chambers: &PccChambers,
+/// The segment of [`actuated_arc`] (`κ >= 0`).
+fn actuated_segment<A: Actuators>(
+    values: &[f64],
+    actuators: &A,
     body: &ElasticSegment,
-) -> Result<(f64, f64, f64)> {
-    check_count("pressures", pressures.len(), chambers.len())?;
-    check_values("pressures", pressures, false)?;
-    elastic_arc("pressures", pressures, chamber_loading(chambers), body)
+) -> Result<PccSegment> {
+    let (ux, uy, l) = actuated_arc(values, actuators, body)?;
+    PccSegment::from_curvature_vector(ux, uy, l)
+}
+
+/// The 3×n Jacobian of the arc of [`actuated_arc`] with respect to the `n` actuation values,
+/// in `coordinates`.
+fn actuated_jacobian<A: Actuators>(
+    values: &[f64],
+    actuators: &A,
+    body: &ElasticSegment,
+    coordinates: ArcCoordinates,
+) -> Result<Matrix3xX<f64>> {
+    let (ux, uy, _) = actuated_arc(values, actuators, body)?;
+    let j = elastic_jacobian(actuators.count(), |i| actuators.loading(i), body);
+    to_coordinates(j, ux, uy, coordinates)
 }
 
 /// The arc of a linear elastic uniform segment `body` pulled by `tensions` (N, >= 0) in
@@ -626,8 +661,7 @@ pub fn arc_from_tendon_tensions(
     tendons: &PccTendons,
     body: &ElasticSegment,
 ) -> Result<PccSegment> {
-    let (ux, uy, l) = tension_arc(tensions, tendons, body)?;
-    PccSegment::from_curvature_vector(ux, uy, l)
+    actuated_segment(tensions, tendons, body)
 }
 
 /// The 3×n Jacobian of [`arc_from_tendon_tensions`] with respect to the tensions (constant in
@@ -641,9 +675,7 @@ pub fn arc_from_tendon_tensions_jacobian(
     body: &ElasticSegment,
     coordinates: ArcCoordinates,
 ) -> Result<Matrix3xX<f64>> {
-    let (ux, uy, _) = tension_arc(tensions, tendons, body)?;
-    let j = elastic_jacobian(tendons.len(), tendon_loading(tendons), body);
-    to_coordinates(j, ux, uy, coordinates)
+    actuated_jacobian(tensions, tendons, body, coordinates)
 }
 
 /// The arc of a linear elastic uniform segment `body` with chamber `pressures` (Pa, gauge;
@@ -659,8 +691,7 @@ pub fn arc_from_pressures(
     chambers: &PccChambers,
     body: &ElasticSegment,
 ) -> Result<PccSegment> {
-    let (ux, uy, l) = pressure_arc(pressures, chambers, body)?;
-    PccSegment::from_curvature_vector(ux, uy, l)
+    actuated_segment(pressures, chambers, body)
 }
 
 /// The 3×n Jacobian of [`arc_from_pressures`] with respect to the pressures (constant in
@@ -674,7 +705,5 @@ pub fn arc_from_pressures_jacobian(
     body: &ElasticSegment,
     coordinates: ArcCoordinates,
 ) -> Result<Matrix3xX<f64>> {
-    let (ux, uy, _) = pressure_arc(pressures, chambers, body)?;
-    let j = elastic_jacobian(chambers.len(), chamber_loading(chambers), body);
-    to_coordinates(j, ux, uy, coordinates)
+    actuated_jacobian(pressures, chambers, body, coordinates)
 }

@@ -243,6 +243,20 @@ impl PlanarCableArm {
         Ok(self.radius(in_range(name, s, self.length)?))
     }
 
+    /// Smallest section radius over the loaded part `[0, anchor]` (m): the taper is linear,
+    /// so the smaller of `R(0)` and `R(anchor)`.
+    #[inline]
+    fn min_loaded_radius(&self) -> f64 {
+        self.radius(0.0).min(self.radius(self.anchor))
+    }
+
+    /// Relative taper rate `|R'| / R_min` over the loaded part (1/m), the bound on how fast the
+    /// profile varies with the section that the panel counts of both marches use.
+    #[inline]
+    fn relative_taper(&self) -> f64 {
+        self.taper.abs() / self.min_loaded_radius()
+    }
+
     /// Taper rate `dR/ds` (dimensionless).
     #[inline]
     pub fn radius_rate(&self) -> f64 {
@@ -313,7 +327,7 @@ impl PlanarCableArm {
     /// Supremum of the tension for which `1 + q > 0` along the loaded part (N);
     /// infinite when `a >= 1/2`.
     pub fn max_tension(&self) -> f64 {
-        let r_min = self.radius(0.0).min(self.radius(self.anchor));
+        let r_min = self.min_loaded_radius();
         let a2 = self.offset_ratio * self.offset_ratio;
         let c = 1.0 - 4.0 * a2;
         if c <= 0.0 {
@@ -424,7 +438,7 @@ const LOBATTO3: Rule<3> = Rule {
     max_taper: 0.006,
 };
 
-/// Lobatto IIIA, 4 stages, order 6.
+/// Lobatto IIIA, 4 stages, order 6 (also the rule of the sensitivity march).
 const LOBATTO4: Rule<4> = Rule {
     c: [0.0, (5.0 - SQ5) / 10.0, (5.0 + SQ5) / 10.0, 1.0],
     a: [
@@ -651,7 +665,7 @@ fn solve_into(
 ) -> Result<((f64, f64, f64), Option<IntegrationStats>)> {
     arm.check_tension(tension)?;
     let (l, anchor) = (arm.length, arm.anchor);
-    let taper = arm.taper.abs() / arm.radius(0.0).min(arm.radius(anchor));
+    let taper = arm.relative_taper();
     match method {
         PlanarMethod::ClosedForm => {
             let turn = |(k, q): (f64, f64)| ((1.0 + q) * k).abs();

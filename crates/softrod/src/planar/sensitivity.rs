@@ -151,24 +151,9 @@ struct State {
     d_l: [f64; NP],
 }
 
-const SQ5: f64 = 2.236_067_977_499_79;
-const C: [f64; 4] = [0.0, (5.0 - SQ5) / 10.0, (5.0 + SQ5) / 10.0, 1.0];
-const A: [[f64; 4]; 4] = [
-    [0.0, 0.0, 0.0, 0.0],
-    [
-        (11.0 + SQ5) / 120.0,
-        (25.0 - SQ5) / 120.0,
-        (25.0 - 13.0 * SQ5) / 120.0,
-        (-1.0 + SQ5) / 120.0,
-    ],
-    [
-        (11.0 - SQ5) / 120.0,
-        (25.0 + 13.0 * SQ5) / 120.0,
-        (25.0 + SQ5) / 120.0,
-        (-1.0 - SQ5) / 120.0,
-    ],
-    [1.0 / 12.0, 5.0 / 12.0, 5.0 / 12.0, 1.0 / 12.0],
-];
+/// The 4-stage Lobatto IIIA rule of the backbone march (nodes, stage matrix).
+const C: [f64; 4] = super::LOBATTO4.c;
+const A: [[f64; 4]; 4] = super::LOBATTO4.a;
 
 impl State {
     /// One Lobatto IIIA panel over `[self.s, b]`, loaded.
@@ -297,7 +282,7 @@ pub fn planar_sensitivities(
         let (k, q, _, _) = profile(arm, s, tension);
         ((1.0 + q) * k).abs()
     };
-    let taper = arm.taper.abs() / arm.radius(0.0).min(arm.radius(anchor));
+    let taper = arm.relative_taper();
     let rates = (turn(0.0).max(turn(anchor)), taper);
     let mut st = State {
         q: profile(arm, 0.0, tension).1,

@@ -182,13 +182,8 @@ fn start<P: Problem + ?Sized>(
     it.xt.resize(n, 0.0);
     it.rt.resize(n, 0.0);
     it.jt.resize(n * n, 0.0);
-    if !have_j {
-        if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) != Evaluated::Jacobian {
-            out.at_x = false;
-            return None;
-        }
-        it.rn = problem.norm(&it.r);
-        it.exact = true;
+    if !have_j && !exact_jacobian(problem, &mut it, lambda, out) {
+        return None;
     }
     Some(it)
 }
@@ -336,7 +331,9 @@ fn full_step<P: Problem + ?Sized>(
     true
 }
 
-/// The exact Jacobian at the current iterate; false if the evaluation fails.
+/// The exact Jacobian (column-major `n × n`) and residual at the current iterate `it.x`, into
+/// `it.jac`, `it.r`, `it.rn`, marking it exact and `out.at_x`; `false` (and `out.at_x`
+/// cleared) if the evaluation fails.
 fn exact_jacobian<P: Problem + ?Sized>(
     problem: &mut P,
     it: &mut Iterate,
@@ -359,11 +356,7 @@ fn jacobian_at_solution<P: Problem + ?Sized>(
     options: &NewtonOptions,
     out: &mut NewtonOutcome,
 ) {
-    out.at_x = false;
-    if problem.evaluate(&it.x, lambda, Some(&mut it.jac), &mut it.r) == Evaluated::Jacobian {
-        it.rn = problem.norm(&it.r);
-        it.exact = true;
-        out.at_x = true;
+    if exact_jacobian(problem, it, lambda, out) {
         out.converged = it.rn <= problem.tolerance(&it.x, options.tolerance);
     }
 }

@@ -26,11 +26,9 @@ use nalgebra::{DMatrix, Matrix3, Rotation3, SMatrix, Vector3, Vector6};
 use super::{anchors, node_at, states, Counters, Evaluation, Guided};
 use crate::cosserat::columns::scheme_of;
 use crate::cosserat::equations::{
-    col_rot, rot, rotation_variation, Column, Equations, Evaluator, Workspace, COLUMN, DM, DN, DR,
-    STATE,
+    col_rot, rot, rotation_variation, Column, Evaluator, Workspace, COLUMN, DM, DN, DR, STATE,
 };
 use crate::cosserat::friction::Slip;
-use crate::cosserat::sensitivity::scaled_base_wrench;
 use crate::cosserat::statics::interior;
 use crate::cosserat::StaticsSolution;
 use crate::error::{Error, Result};
@@ -83,15 +81,9 @@ fn scaled_column(y: &[f64], c: usize, l: f64, fs: f64) -> [f64; NCOL] {
 fn transition(sol: &StaticsSolution, at: &[f64]) -> Result<Transition> {
     let model = &*sol.model;
     let (l, fs) = (model.length(), model.force_scale());
-    let x = scaled_base_wrench(model, &sol.base_wrench);
+    let x = crate::cosserat::statics::scaled(model, &sol.base_wrench);
     let pressures = sol.pressures();
-    let eq = Equations {
-        model,
-        tensions: &sol.tendon_tensions,
-        pressures: &pressures,
-        load_factor: sol.stats.load_factor,
-        profile: sol.actuation.profile.as_deref(),
-    };
+    let eq = sol.equations(&pressures, sol.stats.load_factor);
     let mut plan = Vec::new();
     let stops = interior(&sol.s_out, l);
     let scheme = scheme_of(&sol.options.integrator, model, &mut plan);

@@ -38,6 +38,30 @@ pub(super) struct DualProgram<'c> {
     pub(super) tol: f64,
 }
 
+impl<'c> DualProgram<'c> {
+    /// The minimum-norm program (`μ = 1`, `ρ = 0`) centred on `centre`, to `tol` (m).
+    pub(super) fn min_norm(centre: &'c [f64], tol: f64) -> Self {
+        Self {
+            centre,
+            mu: 1.0,
+            rho: 0.0,
+            tol,
+        }
+    }
+}
+
+/// The right-hand side `b = e + J a` (m) of the linearised target `J y = b` of the programs,
+/// for the pose error `e` (m) at the actuation `a`: `jac` the position Jacobian columns (m
+/// per unit actuation), the first `a.len()` of them used.
+#[inline]
+pub(super) fn linearised_target(jac: &[V3<f64>], e: &V3<f64>, a: &[f64]) -> V3<f64> {
+    let mut b = *e;
+    for i in 0..a.len() {
+        b += jac[i] * a[i];
+    }
+    b
+}
+
 /// The scratch of [`dual`].
 #[derive(Default)]
 pub(super) struct DualWork {
@@ -251,10 +275,7 @@ pub(super) fn lm_step(
     ws: &mut LmWork,
 ) {
     let n = a.len();
-    let mut b = *e;
-    for i in 0..n {
-        b += jac[i] * a[i];
-    }
+    let b = linearised_target(jac, e, a);
     let sigma = scaled_norm_of(jac, &bx.w).max(1e-300);
     let mu0 = (sigma * e.norm() / radius).max(1e-6 * sigma * sigma);
     let grid = |k: i32| mu0 * 4f64.powi(k);

@@ -43,7 +43,7 @@ use super::{
 use crate::pcc::statics::PccRobot;
 use chain::{lagrangian_hessian, Affine, Chain};
 use curved::{convexify, curved_step, reduced_step, ConvexWork, CurvedWork, Reduced, ReducedWork};
-use dual::{dual, lm_step, scaled_norm_of, Box_, DualProgram, DualWork, LmWork};
+use dual::{dual, linearised_target, lm_step, scaled_norm_of, Box_, DualProgram, DualWork, LmWork};
 
 /// Most changes of the working set per variable in [`curved_step`].
 pub(super) const CURVED_ACTIVE_SET_CHANGES: usize = 10;
@@ -191,16 +191,8 @@ impl ClosedForm {
     fn program_step(&mut self, e: &V3<f64>, merit: f64) -> Option<Option<V3<f64>>> {
         let n = self.aff.n;
         let (jac, bx) = (&self.cur.jac, &self.bx);
-        let mut b = *e;
-        for i in 0..n {
-            b += jac[i] * self.a[i];
-        }
-        let min_norm = DualProgram {
-            centre: &bx.c,
-            mu: 1.0,
-            rho: 0.0,
-            tol: self.tol_qp,
-        };
+        let b = linearised_target(jac, e, &self.a[..n]);
+        let min_norm = DualProgram::min_norm(&bx.c, self.tol_qp);
         let ws = &mut self.work;
         let lambda = dual(
             jac,
@@ -351,16 +343,8 @@ impl ClosedForm {
     fn correct(&mut self, merit: f64, slope: f64) -> bool {
         let n = self.aff.n;
         let jac = &self.cur.jac;
-        let mut b = self.target - self.next.p;
-        for i in 0..n {
-            b += jac[i] * self.trial[i];
-        }
-        let program = DualProgram {
-            centre: &self.trial,
-            mu: 1.0,
-            rho: 0.0,
-            tol: self.tol_qp,
-        };
+        let b = linearised_target(jac, &(self.target - self.next.p), &self.trial[..n]);
+        let program = DualProgram::min_norm(&self.trial, self.tol_qp);
         let ws = &mut self.work.dual;
         if dual(
             jac,

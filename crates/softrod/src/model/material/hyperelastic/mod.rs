@@ -57,15 +57,7 @@ pub const INVERSE_STRETCH_MAX: f64 = 1e6;
 /// # Errors
 /// [`Error::InvalidParameter`] naming `name` otherwise.
 pub fn check_stretch(name: &str, stretch: f64) -> Result<f64> {
-    if stretch.is_finite() && stretch > 0.0 {
-        Ok(stretch)
-    } else {
-        Err(Error::invalid(
-            name,
-            stretch,
-            "finite and > 0 (stretch = current length / rest length)",
-        ))
-    }
+    check_positive(name, stretch, "(stretch = current length / rest length)")
 }
 
 /// Checks an engineering strain `ε = λ − 1`: finite and `> −1`; returns the stretch `1 + ε`.
