@@ -115,7 +115,7 @@ def _same_key(old: Any, key: Any) -> bool:
         return True
     if not (isinstance(old, tuple) and isinstance(key, tuple) and len(old) == len(key)):
         return False
-    for a, b in zip(old, key):
+    for a, b in zip(old, key, strict=True):
         if not (a is b or (isinstance(a, tuple) and a == b)):
             return False
     return True
