@@ -10,7 +10,7 @@ use softrod::{ActuationTable, SampleStatus, SweepJob, SweepRequest, SweepSample}
 
 use crate::errors::param_err;
 use crate::model::{Chamber, Loads, Rod, Tendon};
-use crate::statics::{solve_options, OptionArgs, Problem};
+use crate::statics::{solve_options, Given, OptionArgs, Problem};
 
 /// The output names of a sweep, in the order of the docs.
 const OUTPUTS: &str = "\"tip_pose\", \"tendon_lengths\", \"backbone\", \"compliance\", \
@@ -114,13 +114,16 @@ fn convert(job: &Bound<'_, PyDict>, k: usize) -> PyResult<Converted> {
     let integrator: Option<String> = option(opts, k, "integrator")?;
     let options = solve_options(&OptionArgs {
         integrator: integrator.as_deref(),
-        steps: option(opts, k, "steps")?,
-        rtol: option(opts, k, "rtol")?,
-        atol: option(opts, k, "atol")?,
-        tolerance: option(opts, k, "tolerance")?,
-        max_iterations: option(opts, k, "max_iterations")?,
-        continuation: option(opts, k, "continuation")?,
-        max_load_steps: option(opts, k, "max_load_steps")?,
+        given: Given {
+            steps: option(opts, k, "steps")?,
+            rtol: option(opts, k, "rtol")?,
+            atol: option(opts, k, "atol")?,
+            tolerance: option(opts, k, "tolerance")?,
+            max_iterations: option(opts, k, "max_iterations")?,
+            continuation: option(opts, k, "continuation")?,
+            max_load_steps: option(opts, k, "max_load_steps")?,
+            ..Given::default()
+        },
         ..Default::default()
     })?;
     let samples: usize = item(job, k, "samples")?.extract()?;

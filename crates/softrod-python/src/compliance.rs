@@ -15,7 +15,7 @@ use crate::convert::{arg, count, Matrix};
 use crate::errors::{param_err, to_py_err, type_err};
 use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 use crate::pcc::PccSolution;
-use crate::statics::{solve_options, OptionArgs, Problem, StaticsSolution};
+use crate::statics::{solve_options, Given, OptionArgs, Problem, StaticsSolution};
 
 fn mat6<'py>(py: Python<'py>, m: &Matrix6<f64>) -> Bound<'py, PyArray2<f64>> {
     Array::from_shape_fn((6, 6), |(i, j)| m[(i, j)]).into_pyarray(py)
@@ -604,10 +604,13 @@ pub(crate) fn _workspace_map<'py>(
     };
     let options = solve_options(&OptionArgs {
         integrator,
-        steps,
-        rtol,
-        atol,
-        tolerance,
+        given: Given {
+            steps,
+            rtol,
+            atol,
+            tolerance,
+            ..Given::default()
+        },
         ..Default::default()
     })?;
     let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;

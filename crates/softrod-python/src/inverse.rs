@@ -16,7 +16,7 @@ use crate::callbacks::run;
 use crate::convert::{arg, floats_opt, vec3, Matrix};
 use crate::errors::param_err;
 use crate::model::{Chamber, Loads, Rod, Tendon};
-use crate::statics::{actuator_names, solve_options, OptionArgs, Problem};
+use crate::statics::{actuator_names, solve_options, Given, OptionArgs, Problem};
 
 /// The state an inverse result hands to the next call (its actuation, last evaluation with
 /// the Jacobian, and Lagrangian Hessian): opaque to Python, passed back as `warm_state`.
@@ -221,9 +221,12 @@ pub(crate) fn _inverse_statics<'py>(
     )?;
     let solve = solve_options(&OptionArgs {
         integrator,
-        steps,
-        rtol,
-        atol,
+        given: Given {
+            steps,
+            rtol,
+            atol,
+            ..Given::default()
+        },
         ..OptionArgs::default()
     })?;
     let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;

@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use pyo3::IntoPyObjectExt;
 
+use super::options::Given;
 use super::robot::RobotModel;
 use crate::model::{Args, Chamber, Loads, Rod, Tendon};
 
@@ -31,17 +32,9 @@ pub(crate) enum Subject {
 pub(crate) struct Call {
     pub(crate) subject: Subject,
     pub(crate) integrator: Option<String>,
-    pub(crate) steps: Option<i64>,
-    pub(crate) rtol: Option<f64>,
-    pub(crate) atol: Option<f64>,
-    pub(crate) tolerance: Option<f64>,
-    pub(crate) max_iterations: Option<i64>,
-    pub(crate) continuation: Option<bool>,
-    pub(crate) max_load_steps: Option<i64>,
+    pub(crate) given: Given,
     pub(crate) warm_start: Option<Py<PyAny>>,
-    pub(crate) throw: Option<bool>,
     pub(crate) s_out: Vec<f64>,
-    pub(crate) seek_stable: Option<bool>,
     pub(crate) previous: Option<Py<PyAny>>,
     pub(crate) displacements: Option<Py<PyAny>>,
     pub(crate) tendon_stiffness: Option<Py<PyAny>>,
@@ -64,18 +57,18 @@ impl Call {
                 ("tendons", tendons),
                 ("loads", loads),
                 ("integrator", self.integrator.clone().into_py_any(py)?),
-                ("steps", self.steps.into_py_any(py)?),
-                ("rtol", self.rtol.into_py_any(py)?),
-                ("atol", self.atol.into_py_any(py)?),
-                ("tolerance", self.tolerance.into_py_any(py)?),
-                ("max_iterations", self.max_iterations.into_py_any(py)?),
-                ("continuation", self.continuation.into_py_any(py)?),
-                ("max_load_steps", self.max_load_steps.into_py_any(py)?),
+                ("steps", self.given.steps.into_py_any(py)?),
+                ("rtol", self.given.rtol.into_py_any(py)?),
+                ("atol", self.given.atol.into_py_any(py)?),
+                ("tolerance", self.given.tolerance.into_py_any(py)?),
+                ("max_iterations", self.given.max_iterations.into_py_any(py)?),
+                ("continuation", self.given.continuation.into_py_any(py)?),
+                ("max_load_steps", self.given.max_load_steps.into_py_any(py)?),
                 ("warm_start", o(&self.warm_start)),
-                ("throw", self.throw.into_py_any(py)?),
+                ("throw", self.given.throw.into_py_any(py)?),
                 ("chambers", chambers),
                 ("s_out", self.s_out.clone().into_py_any(py)?),
-                ("seek_stable", self.seek_stable.into_py_any(py)?),
+                ("seek_stable", self.given.seek_stable.into_py_any(py)?),
                 ("on_unstable", "ignore".into_py_any(py)?),
                 ("previous", o(&self.previous)),
                 ("displacements", o(&self.displacements)),

@@ -31,7 +31,9 @@ use crate::model::{Chamber, Loads, Rod, Tendon};
 
 use call::{Call, Subject};
 use options::Names;
-pub(crate) use options::{actuator_names, apply_displacements, solve_options, OptionArgs, Problem};
+pub(crate) use options::{
+    actuator_names, apply_displacements, solve_options, Given, OptionArgs, Problem,
+};
 pub(crate) use solution::{stats_dict, StaticsSolution};
 
 /// What to do when the equilibrium returned is unstable.
@@ -138,17 +140,19 @@ pub(crate) fn solve_statics<'py>(
         },
         Keywords {
             integrator,
-            steps,
-            rtol,
-            atol,
-            tolerance,
-            max_iterations,
-            continuation,
-            max_load_steps,
+            given: Given {
+                steps,
+                rtol,
+                atol,
+                tolerance,
+                max_iterations,
+                continuation,
+                max_load_steps,
+                throw,
+                seek_stable,
+            },
             warm_start,
-            throw,
             s_out,
-            seek_stable,
             on_unstable,
             previous,
             displacements,
@@ -217,17 +221,9 @@ impl Source<'_> {
 /// The keyword arguments of a statics solve (`None`: not given).
 pub(crate) struct Keywords<'py> {
     pub(crate) integrator: Option<&'py str>,
-    pub(crate) steps: Option<i64>,
-    pub(crate) rtol: Option<f64>,
-    pub(crate) atol: Option<f64>,
-    pub(crate) tolerance: Option<f64>,
-    pub(crate) max_iterations: Option<i64>,
-    pub(crate) continuation: Option<bool>,
-    pub(crate) max_load_steps: Option<i64>,
+    pub(crate) given: Given,
     pub(crate) warm_start: Option<Bound<'py, PyAny>>,
-    pub(crate) throw: Option<bool>,
     pub(crate) s_out: Option<Bound<'py, PyAny>>,
-    pub(crate) seek_stable: Option<bool>,
     pub(crate) on_unstable: Option<&'py str>,
     pub(crate) previous: Option<Bound<'py, PyAny>>,
     pub(crate) displacements: Option<Bound<'py, PyAny>>,
@@ -274,16 +270,8 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
     }
     let args = OptionArgs {
         integrator: k.integrator,
-        steps: k.steps,
-        rtol: k.rtol,
-        atol: k.atol,
-        tolerance: k.tolerance,
-        max_iterations: k.max_iterations,
-        continuation: k.continuation,
-        max_load_steps: k.max_load_steps,
         warm_start: warm_start.clone(),
-        throw: k.throw,
-        seek_stable: k.seek_stable,
+        given: k.given,
     };
     let options = solve_options(&args)?;
     let (model, mut actuation, names, subject) = source.resolve()?;
@@ -366,17 +354,9 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
     let call = Call {
         subject,
         integrator: k.integrator.map(str::to_owned),
-        steps: k.steps,
-        rtol: k.rtol,
-        atol: k.atol,
-        tolerance: k.tolerance,
-        max_iterations: k.max_iterations,
-        continuation: k.continuation,
-        max_load_steps: k.max_load_steps,
+        given: k.given,
         warm_start: warm_start.map(Bound::unbind),
-        throw: k.throw,
         s_out: s_values,
-        seek_stable: k.seek_stable,
         previous: previous.map(Bound::unbind),
         displacements: k.displacements.map(Bound::unbind),
         tendon_stiffness: k.tendon_stiffness.map(Bound::unbind),
@@ -520,12 +500,14 @@ pub(crate) fn _time_solve_statics<'py>(
     let repeats = count("repeats", repeats, 1, softrod::limits::MAX_SAMPLES)?;
     let options = solve_options(&OptionArgs {
         integrator,
-        steps,
-        rtol,
-        atol,
-        tolerance,
         warm_start: warm_start.filter(|w| !w.is_none()),
-        ..Default::default()
+        given: Given {
+            steps,
+            rtol,
+            atol,
+            tolerance,
+            ..Given::default()
+        },
     })?;
     let problem = Problem::new(&rod, &tendons, loads.as_ref(), &[])?;
     let (model, act) = (&problem.model, &problem.actuation);

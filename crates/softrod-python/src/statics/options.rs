@@ -13,10 +13,10 @@ use crate::convert::{count, floats_n};
 use crate::errors::{param_err, to_py_err};
 use crate::model::{Chamber, Loads, Rod, Tendon};
 
-/// The user's options, each `None` when not given.
-#[derive(Default)]
-pub(crate) struct OptionArgs<'py> {
-    pub integrator: Option<&'py str>,
+/// The numerical solve options as the user gave them, each `None` when not given (what a
+/// solution keeps to pickle its call).
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Given {
     pub steps: Option<i64>,
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
@@ -24,9 +24,16 @@ pub(crate) struct OptionArgs<'py> {
     pub max_iterations: Option<i64>,
     pub continuation: Option<bool>,
     pub max_load_steps: Option<i64>,
-    pub warm_start: Option<Bound<'py, PyAny>>,
     pub throw: Option<bool>,
     pub seek_stable: Option<bool>,
+}
+
+/// The user's options, each `None` when not given.
+#[derive(Default)]
+pub(crate) struct OptionArgs<'py> {
+    pub integrator: Option<&'py str>,
+    pub warm_start: Option<Bound<'py, PyAny>>,
+    pub given: Given,
 }
 
 /// The one keyword parser of the solve options: from the core's defaults, each given option
@@ -37,14 +44,14 @@ pub(crate) fn solve_options(a: &OptionArgs<'_>) -> PyResult<SolveOptions> {
     let defaults = AdaptiveOptions::default();
     // Tolerances are checked when given, whichever integrator uses them.
     let adaptive = AdaptiveOptions {
-        rtol: a.rtol.unwrap_or(defaults.rtol),
-        atol: a.atol.unwrap_or(defaults.atol),
+        rtol: a.given.rtol.unwrap_or(defaults.rtol),
+        atol: a.given.atol.unwrap_or(defaults.atol),
         ..defaults
     }
     .validated()
     .map_err(to_py_err)?;
     o.integrator = match a.integrator.unwrap_or("rk4") {
-        "rk4" => match (a.steps, o.integrator) {
+        "rk4" => match (a.given.steps, o.integrator) {
             (Some(s), _) => Integrator::Rk4 {
                 steps: count("steps", s, 1, softrod::cosserat::statics::MAX_RK4_STEPS)?,
             },
@@ -59,22 +66,22 @@ pub(crate) fn solve_options(a: &OptionArgs<'_>) -> PyResult<SolveOptions> {
             ))
         }
     };
-    if let Some(t) = a.tolerance {
+    if let Some(t) = a.given.tolerance {
         o.newton.tolerance = t;
     }
-    if let Some(m) = a.max_iterations {
+    if let Some(m) = a.given.max_iterations {
         o.newton.max_iterations = count("max_iterations", m, 1, MAX_ITERATIONS)?;
     }
-    if let Some(c) = a.continuation {
+    if let Some(c) = a.given.continuation {
         o.newton.continuation = c;
     }
-    if let Some(m) = a.max_load_steps {
+    if let Some(m) = a.given.max_load_steps {
         o.newton.max_load_steps = count("max_load_steps", m, 1, MAX_ITERATIONS)?;
     }
-    if let Some(t) = a.throw {
+    if let Some(t) = a.given.throw {
         o.newton.throw = t;
     }
-    if let Some(t) = a.seek_stable {
+    if let Some(t) = a.given.seek_stable {
         o.seek_stable = t;
     }
     if let Some(w) = &a.warm_start {

@@ -4,7 +4,7 @@
 
 use pyo3::prelude::*;
 
-use super::options::{Names, Problem};
+use super::options::{Given, Names, Problem};
 use super::{solve, Keywords, Source, StaticsSolution};
 use crate::convert::{arg, raveled};
 use crate::errors::{param_err, to_py_err};
@@ -148,17 +148,19 @@ pub(crate) fn _solve_robot<'py>(
         },
         Keywords {
             integrator,
-            steps,
-            rtol,
-            atol,
-            tolerance,
-            max_iterations,
-            continuation,
-            max_load_steps,
+            given: Given {
+                steps,
+                rtol,
+                atol,
+                tolerance,
+                max_iterations,
+                continuation,
+                max_load_steps,
+                throw,
+                seek_stable,
+            },
             warm_start,
-            throw,
             s_out,
-            seek_stable,
             on_unstable,
             previous,
             displacements,
