@@ -1,0 +1,107 @@
+//! A contact is reached from the obstacle's near side: a soft rod bent by a tendon against a
+//! cylinder whose contact-free shape passes through the cylinder close to its axis.
+//!
+//! Oracle (geometry, independent of the solver): the unactuated rod is straight along `z`, so
+//! the material point of a contact at arc length `s` started at `(0, 0, s)`. A rod that reaches
+//! the cylinder without crossing it touches it where that starting point lies on the outer side
+//! of the tangent plane of the cylinder grown by the rod's radius: `(P_rest − p)·n > 0`, with
+//! `p` the backbone point at the contact and `n` the outward normal. Before the check of
+//! touched obstacles, 0.5–0.8 N returned the rod on the far side (normal ≈ (0.63, 0, −0.78),
+//! tip at x ≈ 214 mm), converged and stable: the contact-free actuated rod runs past the
+//! cylinder's axis and relaxing the contact's gap pushes it out through the far side. The
+//! load path (the tension stepped by 1 % from zero) stays on the near side. Cold solves and
+//! a sweep warm-started from the previous tension are checked.
+//!
+//! Both tests are ignored: the defect is known and not fixed (docs/contact.md, "An arm bent
+//! onto a cylinder"); run them with `--ignored`.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use std::sync::Arc;
+
+use softrod::nalgebra::Vector3;
+use softrod::{
+    solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, Obstacle,
+    RobotModel, Rod, Routing, Section, SolveOptions, Tendon,
+};
+
+const L: f64 = 0.3;
+const R: f64 = 0.005;
+const RC: f64 = 0.03;
+
+fn setup() -> (Arc<RobotModel>, [Obstacle; 1], SolveOptions) {
+    let rod = Rod::new(
+        L,
+        Section::circular(R).unwrap(),
+        LinearElastic::new(1e6, 0.45).unwrap(),
+    )
+    .unwrap();
+    let tendon = Tendon::new(Routing::Constant([0.004, 0.0]), None).unwrap();
+    let model = RobotModel::new(rod, vec![tendon], vec![], Loads::default()).unwrap();
+    let xc = RC + R + 0.002;
+    let cylinder = Obstacle::cylinder([xc, -0.05, 0.14], [xc, 0.05, 0.14], RC).unwrap();
+    let options = SolveOptions {
+        integrator: Integrator::Rk4 { steps: 80 },
+        ..SolveOptions::default()
+    };
+    (model, [cylinder], options)
+}
+
+/// The solution at tension `t` (N), from a straight guess or warm-started.
+fn solve(t: f64, warm: Option<&ContactSolution>) -> ContactSolution {
+    let (model, obstacles, mut options) = setup();
+    options.warm_start = warm.map(|w| w.solution.warm_start());
+    solve_constrained(
+        &model,
+        &Actuation::tensions(&[t]),
+        &options,
+        None,
+        &obstacles,
+    )
+    .unwrap()
+}
+
+#[test]
+#[ignore = "known defect: the rod is returned on the cylinder's far side at 0.5-0.8 N (docs/contact.md)"]
+fn a_rod_bent_against_a_cylinder_touches_it_from_its_own_side() {
+    for t in [0.3, 0.5, 0.6, 0.7, 0.8, 1.0, 2.0] {
+        near_side(t, &solve(t, None));
+    }
+}
+
+#[test]
+#[ignore = "known defect: the rod is returned on the cylinder's far side at 0.5-0.8 N (docs/contact.md)"]
+fn a_warm_started_sweep_stays_on_the_near_side() {
+    let mut last = solve(0.1, None);
+    for k in 2..=12 {
+        let t = 0.1 * f64::from(k);
+        let sol = solve(t, Some(&last));
+        near_side(t, &sol);
+        last = sol;
+    }
+}
+
+/// Checks the solution at tension `t` (N): converged, touching, every contact reached from
+/// the near side, nothing penetrating.
+fn near_side(t: f64, sol: &ContactSolution) {
+    let (_, obstacles, _) = setup();
+    assert!(sol.solution.stats.converged, "T = {t} N");
+    assert!(!sol.contacts.is_empty(), "T = {t} N: no contact");
+    for c in &sol.contacts {
+        let n = Vector3::from(c.normal);
+        // The backbone point at the contact: the surface point moved out by the radius.
+        let p = Vector3::from(c.point) + R * n;
+        let rest = Vector3::new(0.0, 0.0, c.s);
+        let side = (rest - p).dot(&n);
+        assert!(
+            side > 0.0,
+            "T = {t} N: contact at s = {} reached from behind the cylinder \
+             (normal {n:?}, (P_rest - p).n = {side:e} m)",
+            c.s
+        );
+    }
+    // No penetration anywhere (nodes).
+    for q in &sol.solution.position {
+        let gap = obstacles[0].distance(&Vector3::from(*q)).0 - R;
+        assert!(gap >= -1e-9, "T = {t} N: penetration {gap:e} m");
+    }
+}
