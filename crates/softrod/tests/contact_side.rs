@@ -61,7 +61,7 @@ fn solve(t: f64, warm: Option<&ContactSolution>) -> ContactSolution {
 }
 
 #[test]
-#[ignore = "known defect: the rod is returned on the cylinder's far side at 0.5-0.8 N (docs/contact.md)"]
+
 fn a_rod_bent_against_a_cylinder_touches_it_from_its_own_side() {
     for t in [0.3, 0.5, 0.6, 0.7, 0.8, 1.0, 2.0] {
         near_side(t, &solve(t, None));
@@ -69,7 +69,7 @@ fn a_rod_bent_against_a_cylinder_touches_it_from_its_own_side() {
 }
 
 #[test]
-#[ignore = "known defect: the rod is returned on the cylinder's far side at 0.5-0.8 N (docs/contact.md)"]
+
 fn a_warm_started_sweep_stays_on_the_near_side() {
     let mut last = solve(0.1, None);
     for k in 2..=12 {

@@ -6,6 +6,7 @@ use super::friction::{first_touch, switch};
 use super::newton::{correct, exact_newton, Effort};
 use super::obstacle::Obstacle;
 use super::problem::{Active, Constrained, Site};
+use super::ramp;
 use super::rows::{Forces, GapSample};
 use super::ContactState;
 use crate::cosserat::statics::settings;
@@ -139,6 +140,27 @@ fn merge_plane(
     false
 }
 
+/// Whether one of the contacts `added` lies in its obstacle past its middle
+/// ([`ramp::past_middle`]) seen from the unactuated rod or from the last accepted step.
+fn far_side(p: &mut Constrained<'_>, added: &[(usize, Site, f64)]) -> bool {
+    if !added.iter().any(|&(o, ..)| ramp::thick(&p.obstacles[o])) {
+        return false;
+    }
+    let from = match p.approach.take() {
+        Some(nodes) => Some(nodes),
+        None if p.path.is_none() => ramp::rest_nodes(p),
+        None => None,
+    };
+    let Some(from) = from else {
+        return false;
+    };
+    let far = ramp::past_middle(p, added, &from);
+    if p.path.is_some() {
+        p.approach = Some(from);
+    }
+    far
+}
+
 /// Adds the contacts `added` at zero force and relaxes their gaps from the values found to
 /// zero by continuation; the state at full contact targets. A contact with friction starts
 /// sticking where it first touched on the load path.
@@ -157,6 +179,12 @@ fn add_contacts(
         // Made by the actuation (applied in full): its first touch is to be found with the
         // actuation stepped with the loads.
         p.pathless = true;
+        return None;
+    }
+    if actuated && p.tip.is_none() && !p.pathless_ok && far_side(p, &added) {
+        if p.path.is_none() {
+            (p.pathless, p.crossing) = (true, true);
+        }
         return None;
     }
     // Where the new contacts with friction first touched, on the load path.

@@ -85,6 +85,9 @@ impl Frozen {
             path: None,
             pathless: false,
             pathless_ok: false,
+            rest: None,
+            approach: None,
+            crossing: false,
             scratch: None,
             coarse_stability: None,
         }

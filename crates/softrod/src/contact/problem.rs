@@ -260,6 +260,12 @@ pub(crate) struct Constrained<'m> {
     /// Whether such a contact is taken as it is, its reference where the rod without it
     /// touches it (when stepping the actuation failed, or with a held tip).
     pub(super) pathless_ok: bool,
+    /// The unactuated, unloaded rod's nodes and the mesh they were marched on, once asked.
+    pub(super) rest: Option<(Integrator, Vec<Node>)>,
+    /// With the actuation stepped with the loads, the nodes of the last accepted step.
+    pub(super) approach: Option<Vec<Node>>,
+    /// Whether the actuated rod was found past the middle of an obstacle of finite thickness.
+    pub(super) crossing: bool,
     /// Scratch of the evaluations, kept from march to march (see [`Scratch`]).
     pub(super) scratch: Option<Box<Scratch>>,
     /// With a free tip, the stability (contacts as dead loads) of the coarse mesh's

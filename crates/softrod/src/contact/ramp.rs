@@ -16,15 +16,20 @@ use nalgebra::Vector3;
 use super::active_set::active_set;
 use super::newton::Effort;
 use super::obstacle::Obstacle;
+use super::problem::Site;
 use super::problem::{Constrained, Pass};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
 use crate::cosserat::equations::v3;
+use crate::cosserat::shooting::Node;
 use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};
 
 /// Most sample points along the rod for the crossing check.
 const MAX_SAMPLES: usize = 4000;
 /// Largest step of the load factor when stepping.
 const MAX_STEP: f64 = 0.25;
+/// The cosine below which a new contact's outward normal, against the normal where its
+/// material point entered the obstacle, sends the rod out forward through the obstacle.
+const FORWARD_EXIT: f64 = 0.0;
 
 /// The thickness (m) an obstacle offers to a rod crossing it: `None` for a plane (a rod
 /// beyond it penetrates it).
@@ -73,7 +78,11 @@ pub(super) fn samples(p: &Constrained<'_>) -> (Vec<f64>, Vec<f64>) {
 /// The backbone of `pass` at the arc lengths `s` (sorted): the cubic Hermite arc through the
 /// two nodes around each (tangents `Δs R e₃`).
 pub(super) fn positions_at(pass: &Pass, s: &[f64]) -> Vec<Vector3<f64>> {
-    let nodes = &pass.nodes;
+    positions_on(&pass.nodes, s)
+}
+
+/// The backbone through `nodes` at the arc lengths `s` (sorted), as [`positions_at`].
+pub(super) fn positions_on(nodes: &[Node], s: &[f64]) -> Vec<Vector3<f64>> {
     let mut j = 0;
     s.iter()
         .map(|&t| {
@@ -93,6 +102,11 @@ pub(super) fn positions_at(pass: &Pass, s: &[f64]) -> Vec<Vector3<f64>> {
             )
         })
         .collect()
+}
+
+/// Whether `o` has a finite thickness (a rod can pass it or through it).
+pub(super) fn thick(o: &Obstacle) -> bool {
+    thickness(o).is_some()
 }
 
 /// Whether obstacle `i` is checked for crossing: of finite thickness and not touched in
@@ -165,29 +179,72 @@ fn too_far(
     })
 }
 
-/// The rod's unactuated, unloaded backbone at the samples `s` (one march at zero unknowns),
-/// leaving `p` as it was but for its last pass.
-pub(super) fn rest_shape(p: &mut Constrained<'_>, s: &[f64]) -> Option<Vec<Vector3<f64>>> {
+/// The rod's unactuated, unloaded nodes on `p`'s mesh (one march at zero unknowns, kept in
+/// `p.rest` for that mesh), leaving `p` as it was.
+pub(super) fn rest_nodes(p: &mut Constrained<'_>) -> Option<Vec<Node>> {
+    if let Some((mesh, nodes)) = &p.rest {
+        if *mesh == p.integrator {
+            return Some(nodes.clone());
+        }
+    }
     let saved = (
         std::mem::take(&mut p.active),
         p.tensions.clone(),
         p.pressures.clone(),
         p.load,
         p.tip.take(),
+        p.last.take(),
     );
     p.tensions.iter_mut().for_each(|t| *t = 0.0);
     p.pressures.iter_mut().for_each(|t| *t = 0.0);
     p.load = 0.0;
-    p.last = None;
     let ok = p.run(&[0.0; 6], 1.0, false).is_some();
-    let shape = p.last.as_ref().map(|pass| positions_at(pass, s));
-    (p.active, p.tensions, p.pressures, p.load, p.tip) = saved;
-    p.last = None;
-    if ok {
-        shape
-    } else {
-        None
-    }
+    let nodes = p.last.take().filter(|_| ok).map(|pass| pass.nodes);
+    (p.active, p.tensions, p.pressures, p.load, p.tip, p.last) = saved;
+    p.rest = nodes.clone().map(|n| (p.integrator, n));
+    nodes
+}
+
+/// Whether one of the contacts `added` (obstacle, site, arc length) to `p`'s last pass lies
+/// in an obstacle of finite thickness past its middle, seen from where its material point
+/// came from (in the rod through the nodes `from`, clear of the obstacle): the straight
+/// segment from there enters the obstacle where its outward normal opposes the normal at the
+/// contact's place (cosine below [`FORWARD_EXIT`]).
+pub(super) fn past_middle(
+    p: &Constrained<'_>,
+    added: &[(usize, Site, f64)],
+    from: &[Node],
+) -> bool {
+    let Some(pass) = p.last.as_ref() else {
+        return false;
+    };
+    let rod = p.model.rod();
+    added.iter().any(|&(o, _, s)| {
+        let obstacle = &p.obstacles[o];
+        if thickness(obstacle).is_none() {
+            return false;
+        }
+        let r = rod.section_at(s).radius;
+        let (a, b) = (
+            positions_on(from, &[s])[0],
+            positions_on(&pass.nodes, &[s])[0],
+        );
+        let gap = |t: f64| obstacle.distance(&(a + (b - a) * t)).0 - r;
+        if !(gap(0.0) > 0.0 && gap(1.0) < 0.0) {
+            return false;
+        }
+        let (mut clear, mut inside) = (0.0, 1.0);
+        for _ in 0..60 {
+            let t = 0.5 * (clear + inside);
+            if gap(t) > 0.0 {
+                clear = t;
+            } else {
+                inside = t;
+            }
+        }
+        let entry = obstacle.distance(&(a + (b - a) * clear)).1;
+        entry.dot(&obstacle.distance(&b).1) < FORWARD_EXIT
+    })
 }
 
 /// The active-set solve with the actuation (`tensions`, `pressures`: the full ones) and the
@@ -198,18 +255,19 @@ pub(super) fn rest_shape(p: &mut Constrained<'_>, s: &[f64]) -> Option<Vec<Vecto
 pub(super) fn stepped(
     p: &mut Constrained<'_>,
     (tensions, pressures): (&[f64], &[f64]),
-    (s, radius, rest): (&[f64], &[f64], Vec<Vector3<f64>>),
+    (s, radius, rest): (&[f64], &[f64], Vec<Node>),
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
     let depth = 10.0 * opts.tolerance * p.model.length();
+    let mut previous = positions_on(&rest, s);
+    p.approach = Some(rest);
     p.active.clear();
     p.hint = None;
     p.solved = None;
     p.path = Some((tensions.to_vec(), pressures.to_vec()));
     p.from = 0.0;
     let mut x = vec![0.0; 6];
-    let mut previous = rest;
     let (mut lambda, mut step) = (0.0, MAX_STEP);
     while lambda < 1.0 {
         let next = (lambda + step).min(1.0);
@@ -224,6 +282,7 @@ pub(super) fn stepped(
         match shape {
             Some((xn, shape)) => {
                 effort.load_steps += 1;
+                p.approach = p.last.as_ref().map(|pass| pass.nodes.clone());
                 (x, previous, lambda) = (xn, shape, next);
                 p.from = lambda;
                 step = (2.0 * step).min(MAX_STEP);
@@ -232,12 +291,12 @@ pub(super) fn stepped(
                 p.active = saved;
                 step *= 0.5;
                 if step < MIN_LOAD_INCREMENT {
-                    p.path = None;
+                    (p.path, p.approach) = (None, None);
                     return None;
                 }
             }
         }
     }
-    p.path = None;
+    (p.path, p.approach) = (None, None);
     Some(x)
 }

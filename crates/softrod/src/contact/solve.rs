@@ -90,6 +90,9 @@ pub fn solve_constrained(
         path: None,
         pathless: false,
         pathless_ok: false,
+        rest: None,
+        approach: None,
+        crossing: false,
         scratch: None,
         coarse_stability: None,
     };
@@ -225,7 +228,7 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
     restart(p, options.integrator);
     let (s, radius) = ramp::samples(p);
     let full = (p.tensions.clone(), p.pressures.clone());
-    let stepped = ramp::rest_shape(p, &s).and_then(|rest| {
+    let stepped = ramp::rest_nodes(p).and_then(|rest| {
         let (t, q) = (&full.0, &full.1);
         ramp::stepped(p, (t, q), (&s, &radius, rest), &options.newton, effort)
     });
@@ -233,6 +236,14 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
     p.load = 1.0;
     if let Some(x) = stepped {
         return Reach::Stepped(x);
+    }
+    if p.crossing {
+        return Reach::Stopped {
+            x: vec![0.0; 6],
+            lambda: 0.0,
+            why: "the actuated rod runs past the middle of an obstacle, and stepping the \
+                  actuation with the loads up to it failed",
+        };
     }
     *effort = Effort::default();
     restart(p, options.integrator);
@@ -346,14 +357,11 @@ fn not_crossed(
     let Some(shape) = p.last.as_ref().map(|pass| ramp::positions_at(pass, &s)) else {
         return Ok(x);
     };
-    let last = p.last.take();
-    let Some(rest) = ramp::rest_shape(p, &s) else {
-        p.last = last;
+    let Some(rest) = ramp::rest_nodes(p) else {
         return Ok(x);
     };
     let depth = 10.0 * options.newton.tolerance * p.model.length();
-    if !ramp::crossed(p, (&rest, &shape), &radius, depth) {
-        p.last = last;
+    if !ramp::crossed(p, (&ramp::positions_on(&rest, &s), &shape), &radius, depth) {
         return Ok(x);
     }
     // Stepped on the mesh asked.
