@@ -49,16 +49,7 @@ impl TipConstraint {
     /// # Errors
     /// [`Error::InvalidParameter`] naming `point` or `normal` (not finite, zero).
     pub fn slide(point: [f64; 3], normal: [f64; 3]) -> Result<Self> {
-        let n = Vector3::from(normal);
-        let l = n.norm();
-        if !(l.is_finite() && l > 0.0) {
-            return Err(Error::invalid(
-                "normal",
-                format!("{normal:?}"),
-                "a non-zero vector",
-            ));
-        }
-        let z = n / l;
+        let z = super::obstacle::unit_normal(normal)?;
         let x = crate::contact::obstacle_normal_basis(&z).0;
         let y = z.cross(&x);
         let r = Matrix3::from_columns(&[x, y, z]);

@@ -61,36 +61,18 @@ impl Frozen {
 
     /// The problem at full load with the active set of the solution.
     fn problem(&self) -> Constrained<'_> {
-        Constrained {
-            model: &self.model,
-            shared: &self.model,
-            tensions: self.tensions.clone(),
-            pressures: self.pressures.clone(),
-            integrator: self.integrator,
-            tip: self.tip,
-            start: self.start,
-            obstacles: &self.obstacles,
-            active: self.active.clone(),
-            load: 1.0,
-            last: None,
-            reference: Vec::new(),
-            evaluations: 0,
-            coarse: None,
-            hint: None,
-            solved: None,
-            refine: true,
-            rough: false,
-            from: 1.0,
-            refused: None,
-            path: None,
-            pathless: false,
-            pathless_ok: false,
-            rest: None,
-            approach: None,
-            crossing: false,
-            scratch: None,
-            coarse_stability: None,
-        }
+        let mut p = Constrained::new(
+            &self.model,
+            (self.tensions.clone(), self.pressures.clone()),
+            self.integrator,
+            self.tip,
+            &self.obstacles,
+        );
+        p.start = self.start;
+        p.active = self.active.clone();
+        p.load = 1.0;
+        p.from = 1.0;
+        p
     }
 
     /// The constrained tip compliance (see [`Constrained::compliance`]), computed once.

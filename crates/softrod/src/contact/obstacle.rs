@@ -72,6 +72,23 @@ fn finite3(name: &str, v: [f64; 3]) -> Result<Vector3<f64>> {
     Ok(Vector3::from(v))
 }
 
+/// The vector `normal` made unit.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `normal` if it is zero or its length not finite.
+pub(super) fn unit_normal(normal: [f64; 3]) -> Result<Vector3<f64>> {
+    let n = Vector3::from(normal);
+    let l = n.norm();
+    if !(l.is_finite() && l > 0.0) {
+        return Err(Error::invalid(
+            "normal",
+            format!("{normal:?}"),
+            "a non-zero vector",
+        ));
+    }
+    Ok(n / l)
+}
+
 fn positive(name: &str, r: f64) -> Result<f64> {
     if r.is_finite() && r > 0.0 {
         Ok(r)
@@ -111,18 +128,10 @@ impl Obstacle {
     /// [`Error::InvalidParameter`] naming `point[k]` or `normal` (not finite or zero).
     pub fn plane(point: [f64; 3], normal: [f64; 3]) -> Result<Self> {
         let point = finite3("point", point)?;
-        let n = finite3("normal", normal)?;
-        let l = n.norm();
-        if !(l.is_finite() && l > 0.0) {
-            return Err(Error::invalid(
-                "normal",
-                format!("{normal:?}"),
-                "a non-zero vector",
-            ));
-        }
+        finite3("normal", normal)?;
         Ok(Self::Plane {
             point,
-            normal: n / l,
+            normal: unit_normal(normal)?,
         })
     }
 

@@ -274,6 +274,48 @@ pub(crate) struct Constrained<'m> {
 }
 
 impl<'m> Constrained<'m> {
+    /// The problem of `model` under the actuation `(tensions, pressures)` (N, Pa) with the
+    /// tip held by `tip` (if any) among `obstacles`, on the mesh `integrator`: at load factor
+    /// 0, no contact, nothing evaluated.
+    pub(super) fn new(
+        model: &'m Arc<RobotModel>,
+        (tensions, pressures): (Vec<f64>, Vec<f64>),
+        integrator: Integrator,
+        tip: Option<TipConstraint>,
+        obstacles: &'m [Obstacle],
+    ) -> Self {
+        Self {
+            model,
+            shared: model,
+            tensions,
+            pressures,
+            integrator,
+            tip,
+            start: (Vector3::zeros(), Matrix3::identity()),
+            obstacles,
+            active: Vec::new(),
+            load: 0.0,
+            last: None,
+            reference: Vec::new(),
+            evaluations: 0,
+            coarse: None,
+            hint: None,
+            solved: None,
+            refine: true,
+            rough: false,
+            from: 0.0,
+            refused: None,
+            path: None,
+            pathless: false,
+            pathless_ok: false,
+            rest: None,
+            approach: None,
+            crossing: false,
+            scratch: None,
+            coarse_stability: None,
+        }
+    }
+
     pub(super) fn dim_of(active: &[Active]) -> usize {
         6 + active.iter().map(Active::size).sum::<usize>()
     }

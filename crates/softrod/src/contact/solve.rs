@@ -3,8 +3,6 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
-
 use super::active_set::{active_set, step_loads};
 use super::constraint::TipConstraint;
 use super::finish::{fail, finish, jacobian_stability};
@@ -66,36 +64,13 @@ pub fn solve_constrained(
     }
     let tensions = actuation.tension_values(model.tendons().len());
     let pressures = actuation.pressure_values(model.chambers().len());
-    let mut p = Constrained {
+    let mut p = Constrained::new(
         model,
-        shared: model,
-        tensions,
-        pressures,
-        integrator: options.integrator,
-        tip: tip.copied(),
-        start: (Vector3::zeros(), Matrix3::identity()),
+        (tensions, pressures),
+        options.integrator,
+        tip.copied(),
         obstacles,
-        active: Vec::new(),
-        load: 0.0,
-        last: None,
-        reference: Vec::new(),
-        evaluations: 0,
-        coarse: None,
-        hint: None,
-        solved: None,
-        refine: true,
-        rough: false,
-        from: 0.0,
-        refused: None,
-        path: None,
-        pathless: false,
-        pathless_ok: false,
-        rest: None,
-        approach: None,
-        crossing: false,
-        scratch: None,
-        coarse_stability: None,
-    };
+    );
     // The actuated rod without loads: the target of the tip at load factor 0.
     let mut effort = Effort::default();
     // (Not with a triangle mesh: the curvature of its distance jumps between faces and
