@@ -29,7 +29,13 @@ const MAX_SAMPLES: usize = 4000;
 const MAX_STEP: f64 = 0.25;
 /// The cosine below which a new contact's outward normal, against the normal where its
 /// material point entered the obstacle, sends the rod out forward through the obstacle.
-const FORWARD_EXIT: f64 = 0.0;
+const FORWARD_EXIT: f64 = -0.1;
+/// Below this step of the load factor, a stepped solve that follows the path through
+/// bifurcations accepts a corrector off the path's secant (the rod snaps).
+const SNAP_STEP: f64 = 1.0 / 256.0;
+/// What a corrector may lie off the path's secant besides half the predicted motion, as a
+/// fraction of the rod's length.
+const BRANCH_TOLERANCE: f64 = 1e-4;
 
 /// The thickness (m) an obstacle offers to a rod crossing it: `None` for a plane (a rod
 /// beyond it penetrates it).
@@ -102,6 +108,31 @@ pub(super) fn positions_on(nodes: &[Node], s: &[f64]) -> Vec<Vector3<f64>> {
             )
         })
         .collect()
+}
+
+/// The obstacles and sites of `p`'s active contacts.
+fn signature(p: &Constrained<'_>) -> Vec<(usize, Site)> {
+    p.active.iter().map(|a| (a.obstacle, a.site)).collect()
+}
+
+/// Whether the shape `now` (at the samples) lies on the secant of the path through the
+/// shapes `before` and `at` of the last two steps, extended by `r` times the last step: no
+/// sample off the prediction by more than half the predicted motion plus [`BRANCH_TOLERANCE`]
+/// times the rod's length `l` (m). A corrector that lands farther has left the branch (at a
+/// bifurcation) or the path turns faster than the step can follow (near a fold).
+fn on_secant(
+    now: &[Vector3<f64>],
+    (before, at): (&[Vector3<f64>], &[Vector3<f64>]),
+    r: f64,
+    l: f64,
+) -> bool {
+    let (mut off, mut motion) = (0.0f64, 0.0f64);
+    for ((n, b), a) in now.iter().zip(before).zip(at) {
+        let predicted = a + (a - b) * r;
+        off = off.max((n - predicted).norm());
+        motion = motion.max((predicted - a).norm());
+    }
+    off <= 0.5 * motion + BRANCH_TOLERANCE * l
 }
 
 /// Whether `o` has a finite thickness (a rod can pass it or through it).
@@ -268,21 +299,66 @@ pub(super) fn stepped(
     p.path = Some((tensions.to_vec(), pressures.to_vec()));
     p.from = 0.0;
     let mut x = vec![0.0; 6];
+    let faithful = p.crossing;
+    let l = p.model.length();
+    // The secant of the path: the step (of the load factor) to the current state, and the
+    // state before it (unknowns, shape), both with the active set `signature`.
+    let mut secant: Option<(f64, Vec<f64>, Vec<Vector3<f64>>)> = None;
     let (mut lambda, mut step) = (0.0, MAX_STEP);
     while lambda < 1.0 {
         let next = (lambda + step).min(1.0);
+        let sig = signature(p);
+        let along = secant
+            .as_ref()
+            .filter(|(_, xb, _)| faithful && xb.len() == x.len());
+        let start: Vec<f64> = match along {
+            Some((h, xb, _)) => {
+                let r = (next - lambda) / h;
+                x.iter().zip(xb).map(|(a, b)| a + (a - b) * r).collect()
+            }
+            None => x.clone(),
+        };
         p.set_load(next);
         p.last = None;
         let saved = p.active.clone();
-        let shape = active_set(p, &x, opts, effort).and_then(|xn| {
+        let shape = active_set(p, &start, opts, effort).and_then(|xn| {
             let shape = positions_at(p.last.as_ref()?, s);
             let moved = (&previous[..], &shape[..]);
-            (!too_far(p, moved, radius) && !crossed(p, moved, radius, depth)).then_some((xn, shape))
+            let on_branch = match along {
+                Some((h, _, before)) if next - lambda > SNAP_STEP && signature(p) == sig => {
+                    on_secant(&shape, (before, &previous), (next - lambda) / h, l)
+                }
+                _ => true,
+            };
+            (on_branch && !too_far(p, moved, radius) && !crossed(p, moved, radius, depth))
+                .then_some((xn, shape))
+        });
+        let shape = shape.or_else(|| {
+            if !(faithful && next - lambda <= SNAP_STEP) {
+                return None;
+            }
+            // The branch ends (a fold): the rod snaps. It lands where the solve at this load
+            // factor from the contact-free shape puts it, unless it crossed an obstacle on
+            // the way there (a new contact past the middle of its obstacle, seen from the
+            // last step, is refused by the active set).
+            p.active.clear();
+            p.last = None;
+            let xn = active_set(p, &[0.0; 6], opts, effort)?;
+            let shape = positions_at(p.last.as_ref()?, s);
+            let landed = !crossed(p, (&previous[..], &shape[..]), radius, depth);
+            landed.then_some((xn, shape))
         });
         match shape {
             Some((xn, shape)) => {
                 effort.load_steps += 1;
                 p.approach = p.last.as_ref().map(|pass| pass.nodes.clone());
+                secant = (signature(p) == sig).then(|| {
+                    (
+                        next - lambda,
+                        std::mem::take(&mut x),
+                        std::mem::take(&mut previous),
+                    )
+                });
                 (x, previous, lambda) = (xn, shape, next);
                 p.from = lambda;
                 step = (2.0 * step).min(MAX_STEP);
