@@ -1,4 +1,4 @@
-//! Thin obstacles crossed on the way: the actuation stepped with the loads.
+//! Obstacles crossed on the way: the actuation stepped with the loads.
 //!
 //! The contact solve applies the actuation in full (the actuated rod without loads is one
 //! march) and adds contacts where that shape penetrates. An obstacle the rod would meet on
@@ -10,6 +10,12 @@
 //! crossed it, and the problem is solved again with the actuation and the loads stepped
 //! together from zero, each step checked the same way against the previous one (and halved
 //! if it crossed), so that the rod meets the obstacle on its side.
+//!
+//! The same stepped solve is taken from the start when a contact about to be added lies past
+//! the middle of its obstacle seen from the unactuated rod ([`past_middle`]): relaxing its gap
+//! would push the rod out through the obstacle. It then follows the load path ([`on_secant`]):
+//! secant predictors, steps refused where the corrector leaves the secant (a fold or a
+//! bifurcation), snaps below [`SNAP_STEP`].
 
 use nalgebra::Vector3;
 
@@ -279,10 +285,15 @@ pub(super) fn past_middle(
 }
 
 /// The active-set solve with the actuation (`tensions`, `pressures`: the full ones) and the
-/// loads stepped together from zero, from the unactuated rod `rest` (at the samples `s`,
-/// radii `radius`), each step refused and halved if the rod crossed an obstacle on it. The
+/// loads stepped together from zero, from the unactuated rod `rest` (its nodes; the samples
+/// `s`, radii `radius`), each step refused and halved if the rod crossed an obstacle on it. The
 /// load factor scales the actuation too ([`Constrained::path`]), so that a contact with
-/// friction finds its first touch on this path.
+/// friction finds its first touch on this path. When the solve was sent here by a contact
+/// past the middle of its obstacle (`p.crossing`), the path is followed: each step starts
+/// from the secant of the last two (with an unchanged active set), is refused if its shape
+/// leaves that secant ([`on_secant`]) or adds a contact past the middle of its obstacle seen
+/// from the previous step, and below [`SNAP_STEP`] the rod snaps to the solve from the
+/// contact-free shape at that load factor unless it crossed an obstacle.
 pub(super) fn stepped(
     p: &mut Constrained<'_>,
     (tensions, pressures): (&[f64], &[f64]),
