@@ -20,7 +20,7 @@ use crate::solve::{Evaluated, Problem};
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
 /// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
 /// Coulomb friction at point contacts: see [`Obstacle::with_friction`] and
-/// [`ContactState`]).
+/// [`ContactState`](super::ContactState)).
 ///
 /// The unknowns are the base wrench (as in [`solve_statics`]), the force of every active
 /// contact and, for a contact inside the rod, its arc length; the residual the tip

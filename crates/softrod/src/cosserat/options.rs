@@ -29,7 +29,7 @@ pub const DIRECT_STEP_LIMIT: f64 = 4.0;
 /// branch, so the step is halved.
 pub const MAX_LOAD_STEP_TURN: f64 = 1.0;
 
-/// Ratio of the RK4 steps of a solve to those of its coarse mesh ([`Integrator::coarse`]).
+/// Ratio of the RK4 steps of a solve to those of its coarse mesh (RK4 of at least 40 steps).
 pub const COARSE_RATIO: usize = 5;
 /// Fewest RK4 steps of a coarse mesh.
 pub const MIN_COARSE_STEPS: usize = 8;
@@ -78,7 +78,7 @@ impl Default for Integrator {
 }
 
 /// A starting point for the shooting unknowns, taken from a previous solution (the tensions
-/// of its displacement-controlled tendons go into [`Actuation::tension_guess`]).
+/// of its displacement-controlled tendons go into [`Actuation::tension_guess`](crate::Actuation::tension_guess)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WarmStart {
     /// Total base wrench `[N(0); M(0)]` (N, N m; world frame) including the tendons' share.
@@ -92,7 +92,7 @@ pub struct WarmStart {
     pub coarse_defect: Option<CoarseDefect>,
 }
 
-/// The scaled shooting residual of a coarse mesh ([`Integrator::coarse`]) at a solution on
+/// The scaled shooting residual of a coarse mesh (RK4 with [`COARSE_RATIO`] times fewer steps) at a solution on
 /// the mesh asked: the integration error that separates the two meshes' solutions, which
 /// changes little from one solve to a nearby one.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,7 +114,7 @@ impl WarmStart {
     }
 }
 
-/// Options of [`solve_statics`] (keyword arguments in Python).
+/// Options of [`solve_statics`](crate::solve_statics) (keyword arguments in Python).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveOptions {
     /// ODE integrator.

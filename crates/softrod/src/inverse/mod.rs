@@ -168,8 +168,8 @@ pub struct InverseOptions {
     pub rotation_weight: Option<f64>,
     /// Cap on the iterations.
     pub max_iterations: usize,
-    /// `true`: a target out of reach is [`Error::TargetUnreachable`]; non-convergence is
-    /// [`Error::NotConverged`]. `false`: returned with `converged == false`.
+    /// `true`: a target out of reach is [`Error::TargetUnreachable`](crate::Error::TargetUnreachable); non-convergence is
+    /// [`Error::NotConverged`](crate::Error::NotConverged). `false`: returned with `converged == false`.
     pub throw: bool,
 }
 
