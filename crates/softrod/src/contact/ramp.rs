@@ -311,7 +311,8 @@ pub(super) fn stepped(
     let mut x = vec![0.0; 6];
     let l = p.model.length();
     // The secant of the path: the step (of the load factor) to the current state, and the
-    // state before it (unknowns, shape), both with the active set `signature`.
+    // state before it (unknowns, shape); kept only when that step left the active set as it
+    // was.
     let mut secant: Option<(f64, Vec<f64>, Vec<Vector3<f64>>)> = None;
     let (mut lambda, mut step) = (0.0, MAX_STEP);
     while lambda < 1.0 {
