@@ -13,9 +13,9 @@
 //!
 //! The same stepped solve is taken from the start when a contact about to be added lies past
 //! the middle of its obstacle seen from the unactuated rod ([`past_middle`]): relaxing its gap
-//! would push the rod out through the obstacle. The stepped solve follows the load path
-//! ([`on_secant`]): secant predictors, steps refused where the corrector leaves the secant (a
-//! fold or a bifurcation), snaps below [`SNAP_STEP`].
+//! would push the rod out through the obstacle. It then follows the load path ([`on_secant`]):
+//! secant predictors, steps refused where the corrector leaves the secant (a fold or a
+//! bifurcation), snaps below [`SNAP_STEP`].
 
 use nalgebra::Vector3;
 
@@ -36,8 +36,8 @@ const MAX_STEP: f64 = 0.25;
 /// The cosine below which a new contact's outward normal, against the normal where its
 /// material point entered the obstacle, sends the rod out forward through the obstacle.
 const FORWARD_EXIT: f64 = -0.1;
-/// Below this step of the load factor, the stepped solve accepts a corrector off the path's
-/// secant, or lands the rod from the contact-free shape (the rod snaps).
+/// Below this step of the load factor, a stepped solve that follows the path through
+/// bifurcations accepts a corrector off the path's secant (the rod snaps).
 const SNAP_STEP: f64 = 1.0 / 256.0;
 /// What a corrector may lie off the path's secant besides half the predicted motion, as a
 /// fraction of the rod's length.
@@ -288,11 +288,12 @@ pub(super) fn past_middle(
 /// loads stepped together from zero, from the unactuated rod `rest` (its nodes; the samples
 /// `s`, radii `radius`), each step refused and halved if the rod crossed an obstacle on it. The
 /// load factor scales the actuation too ([`Constrained::path`]), so that a contact with
-/// friction finds its first touch on this path. The path is followed: each step starts from
-/// the secant of the last two (with an unchanged active set), is refused if its shape leaves
-/// that secant ([`on_secant`]) or adds a contact past the middle of its obstacle seen from the
-/// previous step, and below [`SNAP_STEP`] the rod snaps to the solve from the contact-free
-/// shape at that load factor unless it crossed an obstacle.
+/// friction finds its first touch on this path. When the solve was sent here by a contact
+/// past the middle of its obstacle (`p.crossing`), the path is followed: each step starts
+/// from the secant of the last two (with an unchanged active set), is refused if its shape
+/// leaves that secant ([`on_secant`]) or adds a contact past the middle of its obstacle seen
+/// from the previous step, and below [`SNAP_STEP`] the rod snaps to the solve from the
+/// contact-free shape at that load factor unless it crossed an obstacle.
 pub(super) fn stepped(
     p: &mut Constrained<'_>,
     (tensions, pressures): (&[f64], &[f64]),
@@ -309,6 +310,7 @@ pub(super) fn stepped(
     p.path = Some((tensions.to_vec(), pressures.to_vec()));
     p.from = 0.0;
     let mut x = vec![0.0; 6];
+    let faithful = p.crossing;
     let l = p.model.length();
     // The secant of the path: the step (of the load factor) to the current state, and the
     // state before it (unknowns, shape); kept only when that step left the active set as it
@@ -318,7 +320,9 @@ pub(super) fn stepped(
     while lambda < 1.0 {
         let next = (lambda + step).min(1.0);
         let sig = signature(p);
-        let along = secant.as_ref().filter(|(_, xb, _)| xb.len() == x.len());
+        let along = secant
+            .as_ref()
+            .filter(|(_, xb, _)| faithful && xb.len() == x.len());
         let start: Vec<f64> = match along {
             Some((h, xb, _)) => {
                 let r = (next - lambda) / h;
@@ -342,7 +346,7 @@ pub(super) fn stepped(
                 .then_some((xn, shape))
         });
         let shape = shape.or_else(|| {
-            if next - lambda > SNAP_STEP {
+            if !(faithful && next - lambda <= SNAP_STEP) {
                 return None;
             }
             // The branch ends (a fold): the rod snaps. It lands where the solve at this load
