@@ -146,19 +146,14 @@ fn far_side(p: &mut Constrained<'_>, added: &[(usize, Site, f64)]) -> bool {
     if !added.iter().any(|&(o, ..)| ramp::thick(&p.obstacles[o])) {
         return false;
     }
-    let from = match p.approach.take() {
-        Some(nodes) => Some(nodes),
-        None if p.path.is_none() => ramp::rest_nodes(p),
-        None => None,
-    };
-    let Some(from) = from else {
+    if p.path.is_none() && ramp::rest_nodes(p).is_none() {
         return false;
-    };
-    let far = ramp::past_middle(p, added, &from);
-    if p.path.is_some() {
-        p.approach = Some(from);
     }
-    far
+    let from = match p.path {
+        Some(_) => p.approach.as_deref(),
+        None => p.rest.as_ref().map(|(_, nodes)| nodes.as_slice()),
+    };
+    from.is_some_and(|from| ramp::past_middle(p, added, from))
 }
 
 /// Adds the contacts `added` at zero force and relaxes their gaps from the values found to

@@ -253,9 +253,11 @@ pub(crate) struct Constrained<'m> {
     /// With the actuation stepped with the loads: the full tensions (N) and pressures (Pa),
     /// which the load factor then scales too ([`Self::set_load`]).
     pub(super) path: Option<(Vec<f64>, Vec<f64>)>,
-    /// Whether a contact with friction was met where no load path leads to it (made by the
-    /// actuation, at load factor 0): its first touch is then searched with the actuation
-    /// stepped with the loads ([`ramp::stepped`](super::ramp::stepped)).
+    /// Whether the actuation applied in full cannot be trusted to reach the contacts: a
+    /// contact with friction was met where no load path leads to it (made by the actuation,
+    /// at load factor 0: its first touch is to be found), or a contact past the middle of its
+    /// obstacle (`crossing`). The solve is then made with the actuation stepped with the
+    /// loads ([`ramp::stepped`](super::ramp::stepped)).
     pub(super) pathless: bool,
     /// Whether such a contact is taken as it is, its reference where the rod without it
     /// touches it (when stepping the actuation failed, or with a held tip).

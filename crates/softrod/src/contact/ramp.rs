@@ -218,11 +218,12 @@ fn too_far(
 
 /// The rod's unactuated, unloaded nodes on `p`'s mesh (one march at zero unknowns, kept in
 /// `p.rest` for that mesh), leaving `p` as it was.
-pub(super) fn rest_nodes(p: &mut Constrained<'_>) -> Option<Vec<Node>> {
-    if let Some((mesh, nodes)) = &p.rest {
-        if *mesh == p.integrator {
-            return Some(nodes.clone());
-        }
+pub(super) fn rest_nodes<'a>(p: &'a mut Constrained<'_>) -> Option<&'a [Node]> {
+    if p.rest
+        .as_ref()
+        .is_some_and(|(mesh, _)| *mesh == p.integrator)
+    {
+        return p.rest.as_ref().map(|(_, nodes)| nodes.as_slice());
     }
     let saved = (
         std::mem::take(&mut p.active),
@@ -238,8 +239,8 @@ pub(super) fn rest_nodes(p: &mut Constrained<'_>) -> Option<Vec<Node>> {
     let ok = p.run(&[0.0; 6], 1.0, false).is_some();
     let nodes = p.last.take().filter(|_| ok).map(|pass| pass.nodes);
     (p.active, p.tensions, p.pressures, p.load, p.tip, p.last) = saved;
-    p.rest = nodes.clone().map(|n| (p.integrator, n));
-    nodes
+    p.rest = nodes.map(|n| (p.integrator, n));
+    p.rest.as_ref().map(|(_, nodes)| nodes.as_slice())
 }
 
 /// Whether one of the contacts `added` (obstacle, site, arc length) to `p`'s last pass lies

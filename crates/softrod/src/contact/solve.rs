@@ -203,7 +203,7 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
     restart(p, options.integrator);
     let (s, radius) = ramp::samples(p);
     let full = (p.tensions.clone(), p.pressures.clone());
-    let stepped = ramp::rest_nodes(p).and_then(|rest| {
+    let stepped = ramp::rest_nodes(p).map(<[_]>::to_vec).and_then(|rest| {
         let (t, q) = (&full.0, &full.1);
         ramp::stepped(p, (t, q), (&s, &radius, rest), &options.newton, effort)
     });
@@ -332,7 +332,7 @@ fn not_crossed(
     let Some(shape) = p.last.as_ref().map(|pass| ramp::positions_at(pass, &s)) else {
         return Ok(x);
     };
-    let Some(rest) = ramp::rest_nodes(p) else {
+    let Some(rest) = ramp::rest_nodes(p).map(<[_]>::to_vec) else {
         return Ok(x);
     };
     let depth = 10.0 * options.newton.tolerance * p.model.length();
