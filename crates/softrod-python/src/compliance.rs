@@ -604,13 +604,7 @@ pub(crate) fn _workspace_map<'py>(
     };
     let options = solve_options(&OptionArgs {
         integrator,
-        given: Given {
-            steps,
-            rtol,
-            atol,
-            tolerance,
-            ..Given::default()
-        },
+        given: Given::mesh(steps, rtol, atol, tolerance),
         ..Default::default()
     })?;
     let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;

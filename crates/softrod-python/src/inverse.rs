@@ -221,12 +221,7 @@ pub(crate) fn _inverse_statics<'py>(
     )?;
     let solve = solve_options(&OptionArgs {
         integrator,
-        given: Given {
-            steps,
-            rtol,
-            atol,
-            ..Given::default()
-        },
+        given: Given::mesh(steps, rtol, atol, None),
         ..OptionArgs::default()
     })?;
     let problem = Problem::new(&rod, &tendons, loads.as_ref(), &chambers)?;

@@ -501,13 +501,7 @@ pub(crate) fn _time_solve_statics<'py>(
     let options = solve_options(&OptionArgs {
         integrator,
         warm_start: warm_start.filter(|w| !w.is_none()),
-        given: Given {
-            steps,
-            rtol,
-            atol,
-            tolerance,
-            ..Given::default()
-        },
+        given: Given::mesh(steps, rtol, atol, tolerance),
     })?;
     let problem = Problem::new(&rod, &tendons, loads.as_ref(), &[])?;
     let (model, act) = (&problem.model, &problem.actuation);

@@ -28,6 +28,25 @@ pub(crate) struct Given {
     pub seek_stable: Option<bool>,
 }
 
+impl Given {
+    /// Only the mesh and tolerance options given (`steps`, `rtol`, `atol`, `tolerance`): those
+    /// of the entry points that take no load-step or stability options.
+    pub(crate) fn mesh(
+        steps: Option<i64>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        tolerance: Option<f64>,
+    ) -> Self {
+        Self {
+            steps,
+            rtol,
+            atol,
+            tolerance,
+            ..Self::default()
+        }
+    }
+}
+
 /// The user's options, each `None` when not given.
 #[derive(Default)]
 pub(crate) struct OptionArgs<'py> {
