@@ -14,9 +14,10 @@
 use nalgebra::Vector3;
 
 use super::active_set::active_set;
+use super::belt;
 use super::newton::Effort;
 use super::obstacle::Obstacle;
-use super::problem::{Constrained, Pass};
+use super::problem::{Active, Constrained, Pass, Site};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
 use crate::cosserat::equations::v3;
 use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};
@@ -190,6 +191,31 @@ pub(super) fn rest_shape(p: &mut Constrained<'_>, s: &[f64]) -> Option<Vec<Vecto
     }
 }
 
+/// The tip contacts whose gap (at the tip, on an obstacle free of friction and not touched
+/// at the tip), extrapolated linearly from its value at the step accepted before (in `gaps`,
+/// replaced by those of the last pass), closes within the next step of the same length.
+fn closing_tips(p: &Constrained<'_>, gaps: &mut Vec<f64>) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let now: Vec<f64> = (0..p.obstacles.len())
+        .map(|o| p.gaps(o).last().map_or(f64::INFINITY, |g| g.2))
+        .collect();
+    let out = (0..p.obstacles.len())
+        .filter(|&o| {
+            p.obstacles[o].friction() == 0.0
+                && !p
+                    .active
+                    .iter()
+                    .any(|a| a.obstacle == o && a.site == Site::Tip)
+                && gaps
+                    .get(o)
+                    .is_some_and(|&g0| now[o] < g0 && 2.0 * now[o] - g0 <= 0.0)
+        })
+        .map(|o| (o, Site::Tip, l))
+        .collect();
+    *gaps = now;
+    out
+}
+
 /// The active-set solve with the actuation (`tensions`, `pressures`: the full ones) and the
 /// loads stepped together from zero, from the unactuated rod `rest` (at the samples `s`,
 /// radii `radius`), each step refused and halved if the rod crossed an obstacle on it.
@@ -207,6 +233,12 @@ pub(super) fn stepped(
     let mut x = vec![0.0; 6];
     let mut previous = rest;
     let (mut lambda, mut step) = (0.0, MAX_STEP);
+    // The accepted step before the last (load factor, unknowns, active set): the secant
+    // predictor of the next step when the active set is the same.
+    let mut before: Option<(f64, Vec<f64>, Vec<Active>)> = None;
+    // Tip contacts about to close on the next step, from the tip's gaps at the last two.
+    let mut near: Vec<(usize, Site, f64)> = Vec::new();
+    let mut tip_gaps: Vec<f64> = Vec::new();
     while lambda < 1.0 {
         let next = (lambda + step).min(1.0);
         for (t, full) in p.tensions.iter_mut().zip(tensions) {
@@ -218,7 +250,34 @@ pub(super) fn stepped(
         p.load = next;
         p.last = None;
         let saved = p.active.clone();
-        let shape = active_set(p, &x, opts, effort).and_then(|xn| {
+        let predicted = before
+            .as_ref()
+            .filter(|(l0, x0, a0)| *a0 == saved && x0.len() == x.len() && lambda > *l0)
+            .map(|(l0, x0, _)| {
+                let t = (next - lambda) / (lambda - l0);
+                x.iter()
+                    .zip(x0)
+                    .map(|(a, b)| a + (a - b) * t)
+                    .collect::<Vec<f64>>()
+            });
+        let mut solved = predicted.and_then(|xp| active_set(p, &xp, opts, effort));
+        if solved.is_none() {
+            p.active.clone_from(&saved);
+            p.last = None;
+            solved = active_set(p, &x, opts, effort);
+        }
+        if solved.is_none() && !near.is_empty() {
+            // The tip about to touch (a belt reaching it, an arm closing on an obstacle):
+            // held from the start of the step.
+            p.active.clone_from(&saved);
+            p.last = None;
+            let mut xt = x.clone();
+            for &(o, _, _) in &near {
+                xt = belt::anticipate_tip(p, xt, o);
+            }
+            solved = active_set(p, &xt, opts, effort);
+        }
+        let shape = solved.and_then(|xn| {
             let shape = positions_at(p.last.as_ref()?, s);
             let moved = (&previous[..], &shape[..]);
             (!too_far(p, moved, radius) && !crossed(p, moved, radius, depth)).then_some((xn, shape))
@@ -226,7 +285,9 @@ pub(super) fn stepped(
         match shape {
             Some((xn, shape)) => {
                 effort.load_steps += 1;
-                (x, previous, lambda) = (xn, shape, next);
+                near = closing_tips(p, &mut tip_gaps);
+                before = Some((lambda, std::mem::replace(&mut x, xn), saved));
+                (previous, lambda) = (shape, next);
                 step = (2.0 * step).min(MAX_STEP);
             }
             None => {
