@@ -278,8 +278,15 @@ pub(super) fn active_set(
                 // (Its boundary layers need the mesh asked.)
                 return None;
             }
-            x = belt::form(p, x, &plan, opts, effort)?;
-            continue;
+            let saved = p.active.clone();
+            if let Some(xf) = belt::form(p, x.clone(), &plan, opts, effort) {
+                x = xf;
+                continue;
+            }
+            // No belt found there: the new contacts are added as points (the last pass
+            // restored at `x` first).
+            p.active = saved;
+            x = correct(p, &x, opts, effort)?;
         }
         if merge_plane(p, &mut x, &forces, &added) {
             x = correct(p, &x, opts, effort)?;
