@@ -178,3 +178,78 @@ fn the_tip_with_a_belt_converges_with_the_mesh() {
     assert!(d[0] < 1e-6, "{d:?}");
     assert!(orders.iter().all(|&o| o > 3.5), "{d:?}: orders {orders:?}");
 }
+
+/// A clamped rod pulled sideways by a tip force onto a cylinder across it (the rod 0.5 mm
+/// clear of it, its axis at z = 0.1 m): at 1 N the rod lies on the cylinder over about
+/// 17 mm. Its tip is the one the solve found with point contacts only (the version before
+/// belts: eight point contacts from s = 0.1158 to 0.1316 m, tip (0.0916459, 0, 0.1399805)
+/// m, 15 s) to 1e-5 m, and the belt passes the checks above (the base wrench now balancing
+/// the tip force as well).
+#[test]
+fn a_rod_pulled_onto_a_cylinder_lies_on_it_where_point_contacts_did() {
+    let p = 1.0;
+    let rod = Rod::new(
+        L,
+        Section::circular(R).unwrap(),
+        LinearElastic::new(1e6, 0.45).unwrap(),
+    )
+    .unwrap();
+    let model = RobotModel::new(
+        rod,
+        vec![],
+        vec![],
+        Loads::tip_force(Vector3::new(p, 0.0, 0.0)),
+    )
+    .unwrap();
+    let xc = RC + R + 0.0005;
+    let ob = Obstacle::cylinder([xc, -0.1, 0.1], [xc, 0.1, 0.1], RC).unwrap();
+    let opts = SolveOptions {
+        integrator: Integrator::Rk4 { steps: 160 },
+        ..SolveOptions::default()
+    };
+    let sol = solve_constrained(
+        &model,
+        &Actuation::tensions(&[]),
+        &opts,
+        None,
+        std::slice::from_ref(&ob),
+    )
+    .unwrap();
+    let (a, b) = belt(&sol).unwrap();
+    assert!(b - a > 0.01, "[{a}, {b}]");
+    let tip = Vector3::from(*sol.solution.position.last().unwrap());
+    let points = Vector3::new(0.09164591775935328, 0.0, 0.13998047659557092);
+    assert!((tip - points).norm() <= 1e-5, "{tip:?}");
+    let (mut f, mut m) = (
+        Vector3::new(p, 0.0, 0.0),
+        tip.cross(&Vector3::new(p, 0.0, 0.0)),
+    );
+    for (j, cf) in sol.contact_force.iter().enumerate() {
+        let cf = Vector3::from(*cf);
+        let x = Vector3::from(sol.solution.position[j]);
+        f += cf;
+        m += x.cross(&cf);
+        assert!(ob.distance(&x).0 - R >= -1e-9);
+        let s = sol.solution.s[j];
+        if s >= a && s <= b {
+            let (d, normal) = ob.distance(&x);
+            assert!((d - R).abs() <= 1e-9, "gap {:e} at s = {s}", d - R);
+            assert!(normal.dot(&cf) >= -1e-9 * p, "pulling at s = {s}");
+        }
+    }
+    let w = sol.solution.base_wrench;
+    for k in 0..3 {
+        assert!(
+            (w[k] - f[k]).abs() <= 1e-10 * p,
+            "force {k}: {} vs {}",
+            w[k],
+            f[k]
+        );
+        assert!(
+            (w[3 + k] - m[k]).abs() <= 1e-10 * p * L,
+            "moment {k}: {} vs {}",
+            w[3 + k],
+            m[k]
+        );
+    }
+}
