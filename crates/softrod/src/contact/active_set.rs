@@ -2,6 +2,7 @@
 //! of the gaps (or inside a cell, for thin obstacles), merged into intervals on a plane, and
 //! the load steps of the external loads and the tip target.
 
+use super::belt;
 use super::friction::{first_touch, switch};
 use super::newton::{correct, exact_newton, Effort};
 use super::obstacle::Obstacle;
@@ -36,7 +37,8 @@ fn candidates(p: &Constrained<'_>, forces: &Forces, penetration: f64) -> Vec<(us
                 .active
                 .iter()
                 .zip(forces)
-                .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2);
+                .any(|(a, f)| a.obstacle == o && a.site == Site::Interval && s >= f.2)
+                || belt::covers(p, o, (s, s));
             if minimum && !taken && !inside {
                 if at_tip {
                     added.push((o, Site::Tip, s));
@@ -67,6 +69,7 @@ fn cell_candidates(
             let covered = forces.iter().zip(&p.active).any(|(f, a)| {
                 a.obstacle == o && (near(f.2) || (a.site == Site::Interval && s1 >= f.2))
             });
+            let covered = covered || belt::covers(p, o, (s0, s1));
             if covered || g[i - 1].2 < -penetration || g[i].2 < -penetration {
                 continue;
             }
@@ -280,7 +283,7 @@ pub(super) fn active_set(
         let worst = forces
             .iter()
             .enumerate()
-            .filter(|(_, f)| f.0 < -opts.tolerance * fs)
+            .filter(|(i, f)| !p.active[*i].site.held() && f.0 < -opts.tolerance * fs)
             .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
             .map(|(i, _)| i);
         if let Some(i) = worst {
@@ -289,6 +292,11 @@ pub(super) fn active_set(
             p.active.remove(i);
             x.drain(o..o + size);
             x = correct(p, &x, opts, effort)?;
+            continue;
+        }
+        // A belt whose forces pull (see `belt::change`).
+        if let Some(change) = belt::change(p, &x, opts.tolerance * fs, opts.tolerance * fs / l) {
+            x = belt::apply(p, x, change, opts, effort)?;
             continue;
         }
         // Sticking outside the cone, or sliding back to where it touched.
@@ -306,6 +314,22 @@ pub(super) fn active_set(
         let mut added = candidates(p, &forces, penetration);
         if added.is_empty() {
             added = cell_candidates(p, &forces, penetration);
+        }
+        // Next to a contact on a curved obstacle, with the rod on it in between: a belt.
+        if let Some(plan) = belt::plan(p, &forces, &added, belt::clearance(p)) {
+            if p.rough {
+                // (Its boundary layers need the mesh asked.)
+                return None;
+            }
+            let saved = p.active.clone();
+            if let Some(xf) = belt::form(p, x.clone(), &plan, opts, effort) {
+                x = xf;
+                continue;
+            }
+            // No belt found there: the new contacts are added as points (the last pass
+            // restored at `x` first).
+            p.active = saved;
+            x = correct(p, &x, opts, effort)?;
         }
         if merge_plane(p, &mut x, &forces, &added) {
             if p.refused.is_some() {

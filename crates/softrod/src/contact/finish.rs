@@ -5,10 +5,11 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
+use super::belt::{lumps, Held};
 use super::constraint::TipConstraint;
 use super::newton::{exact_newton, Effort};
 use super::obstacle::Obstacle;
-use super::problem::{Active, Constrained, Pass, Site};
+use super::problem::{mesh_of, Active, Constrained, Pass, Site};
 use super::rows::Forces;
 use super::solve::coarse_mesh;
 use super::stability::{conjugate_points, free_stiffness};
@@ -18,7 +19,6 @@ use crate::cosserat::shooting::Shooting;
 use crate::cosserat::statics::{assemble, scaled_back, stability_on, Integrator, SolveOptions};
 use crate::cosserat::{tip_stability, Stability, NEUTRAL_MARGIN};
 use crate::error::{Error, Result};
-use crate::integrate::march::rk4_plan;
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{max_norm, Evaluated, NewtonOptions, Problem, SolverStats};
 
@@ -139,6 +139,7 @@ fn report(
     active: &[Active],
     forces: &Forces,
     tangential: &[Vector3<f64>],
+    held: &[Option<Held>],
     model: &RobotModel,
     cm: &RobotModel,
     sol: &crate::cosserat::StaticsSolution,
@@ -146,7 +147,11 @@ fn report(
     let l = model.length();
     let mut contact_force = vec![[0.0; 3]; sol.s.len()];
     let mut contacts = Vec::with_capacity(forces.len());
-    for (((fnorm, n, s, pc), a), ft) in forces.iter().zip(active).zip(tangential) {
+    for (i, (((fnorm, n, s, pc), a), ft)) in forces.iter().zip(active).zip(tangential).enumerate() {
+        if let Some(h) = held.get(i).and_then(Option::as_ref) {
+            contacts.push(report_belt(a, h, model, cm, sol, &mut contact_force));
+            continue;
+        }
         let radius = model.rod().section_at(*s).radius;
         let point = pc - n * radius;
         contacts.push(Contact {
@@ -216,6 +221,62 @@ fn report(
         }
     }
     (contacts, contact_force)
+}
+
+/// The contact of the belt `a` that carries `held` on the solution `sol` (of the contact
+/// model `cm`), its pressure lumped into `contact_force` (see [`lumps`]): at its start `s`,
+/// of `length` `b - a`, its point where the pressure is largest, its normal force the
+/// magnitude of the resultant of the lumps and its normal the resultant's direction (so that
+/// `normal_force * normal` is the belt's share of `contact_force`, as for the other
+/// contacts).
+fn report_belt(
+    a: &Active,
+    held: &Held,
+    model: &RobotModel,
+    cm: &RobotModel,
+    sol: &crate::cosserat::StaticsSolution,
+    contact_force: &mut [[f64; 3]],
+) -> Contact {
+    let applied = |t: f64| {
+        let mut f = cm
+            .loads()
+            .distributed_force
+            .as_ref()
+            .map_or(Vector3::zeros(), |p| p.at(t));
+        if let Some(g) = cm.rho_g() {
+            f += g * cm.rod().section_at(t).area;
+        }
+        f
+    };
+    let mut resultant = Vector3::zeros();
+    for (j, c) in lumps(held, &sol.s, &sol.position, &applied) {
+        resultant += c;
+        for k in 0..3 {
+            contact_force[j][k] += c[k];
+        }
+    }
+    let (sa, sb) = held.range();
+    let peak = held.peak().copied();
+    let (point, peak_normal) = peak.map_or((Vector3::zeros(), Vector3::z()), |h| {
+        let radius = model.rod().section_at(h.s).radius;
+        (h.point - h.normal * radius, h.normal)
+    });
+    let force = resultant.norm();
+    let normal = if force > 0.0 {
+        resultant / force
+    } else {
+        peak_normal
+    };
+    Contact {
+        obstacle: a.obstacle,
+        s: sa,
+        length: sb - sa,
+        point: [point.x, point.y, point.z],
+        normal: [normal.x, normal.y, normal.z],
+        normal_force: force,
+        tangential_force: [0.0; 3],
+        state: ContactState::Frictionless,
+    }
 }
 
 /// The stability of a rod with a held tip (see [`super::stability`]): whether stable, the
@@ -341,11 +402,10 @@ pub(super) fn finish(
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
     let free_stability = jacobian_stability(p, &pass, x);
+    let held = pass.held.clone();
+    let belts = held.iter().any(Option::is_some);
     let cm = Arc::clone(&pass.model);
-    let plan = match options.integrator {
-        Integrator::Rk4 { steps } => rk4_plan(cm.breaks(), steps),
-        Integrator::Adaptive(_) => Vec::new(),
-    };
+    let (plan, stops) = mesh_of(&cm, options.integrator);
     let eq = Equations {
         model: &cm,
         tensions: &p.tensions,
@@ -354,6 +414,7 @@ pub(super) fn finish(
         profile: None,
     };
     let mut sh = Shooting::new(eq, options.integrator, plan);
+    sh.stops = stops;
     let (res, cols) = final_march(p, &mut sh, pass, x)?;
     let tip_twist = sh.tip_twist;
     let stats = SolverStats {
@@ -370,7 +431,8 @@ pub(super) fn finish(
     sol.actuation = actuation.clone();
     sol.options = *options;
     let tangential = p.tangential_forces(x, &forces);
-    let (contacts, contact_force) = report(&p.active, &forces, &tangential, model, &cm, &sol);
+    let (contacts, contact_force) =
+        report(&p.active, &forces, &tangential, &held, model, &cm, &sol);
     let tip_reaction = p.tip.as_ref().map(|_| {
         let f = res.fixed_rows::<3>(0) * fs;
         let m = res.fixed_rows::<3>(3) * (fs * l);
@@ -389,7 +451,7 @@ pub(super) fn finish(
         sol.stable = st.stable;
     } else if let Some(st) = coarse_stability(p)
         .or_else(|| coarse_mesh(options.integrator).and_then(|mesh| stability_on(&sol, mesh)))
-        .filter(|st| sol.stats.converged && st.margin.abs() > COARSE_MARGIN_GAP)
+        .filter(|st| sol.stats.converged && st.margin.abs() > COARSE_MARGIN_GAP && !belts)
     {
         // Clear on the coarse mesh; the margin itself is computed on the mesh asked when
         // read.

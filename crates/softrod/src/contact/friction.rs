@@ -125,7 +125,9 @@ impl Constrained<'_> {
     pub(super) fn arc_of(&self, a: &Active, x: &[f64], o: usize) -> f64 {
         match a.site {
             Site::Tip => self.model.length(),
-            Site::Interior | Site::Interval => x[o] * self.model.length(),
+            Site::Interior | Site::Interval | Site::Belt | Site::BeltTip => {
+                x[o] * self.model.length()
+            }
         }
     }
 

@@ -226,6 +226,10 @@ impl Constrained<'_> {
         j: &mut [f64],
         observe: Option<usize>,
     ) -> Option<(Vec<f64>, Option<Actuated>)> {
+        if self.active.iter().any(|a| a.site.held()) {
+            // (A belt's pressure depends on the state: its Jacobian is differenced.)
+            return None;
+        }
         let interior = self.active.iter().filter(|a| a.site != Site::Tip).count();
         let actuators = if observe.is_some() {
             self.tensions.len() + self.pressures.len()
@@ -313,6 +317,7 @@ impl Constrained<'_> {
             key: self.key(x, mu),
             rows: rows.clone(),
             jacobian: Some((j.to_vec(), twists)),
+            held: vec![None; self.active.len()],
             marched: None,
         });
         scratch.keep_nodes(replaced);

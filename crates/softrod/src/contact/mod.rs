@@ -12,6 +12,7 @@
 
 mod active_set;
 mod actuation;
+mod belt;
 mod constraint;
 mod finish;
 mod friction;

@@ -225,6 +225,9 @@ fn broyden(j: &mut [f64], dx: &[f64], r: &[f64], rt: &[f64]) {
 /// normal force per contact (the contact-free compliance along the normal gives the force
 /// that closes the gap). `None` if that system is singular.
 fn normal_step(p: &Constrained<'_>, x: &[f64], j: &[f64], r: &[f64]) -> Option<Vec<f64>> {
+    if p.active.iter().any(|a| a.site.held()) {
+        return None;
+    }
     let n = p.dim();
     let forces = p.normal_forces(x);
     let offsets = p.offsets();

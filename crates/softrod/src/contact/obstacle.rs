@@ -12,6 +12,8 @@ use nalgebra::Vector3;
 
 pub use super::mesh::TriangleMesh;
 
+use crate::model::hold::Surface;
+
 use crate::error::{Error, Result};
 
 /// A rigid obstacle (world frame, m).
@@ -264,6 +266,68 @@ impl Obstacle {
                     (dr, e)
                 } else {
                     (dz, axial)
+                }
+            }
+        }
+    }
+}
+
+impl Surface for Obstacle {
+    fn distance(&self, x: &Vector3<f64>) -> (f64, Vector3<f64>) {
+        Obstacle::distance(self, x)
+    }
+
+    fn curvature(&self, x: &Vector3<f64>, t: &Vector3<f64>) -> Option<f64> {
+        self.distance_curvature(x, t)
+    }
+}
+
+impl Obstacle {
+    /// `tᵀ H t` with `H` the Hessian of the signed distance at `x` (m, world; `t` any
+    /// vector): `(|t|² - (n·t)²)/ρ` about a sphere's centre or a capsule's end (`ρ` the
+    /// distance to it), `(|t|² - (n·t)² - (e·t)²)/ρ` about the axis of a capsule or of a
+    /// cylinder's side (`e` the axis, `ρ` the distance to it), zero for a plane or a
+    /// cylinder's flat cap; `None` for a triangle mesh, on a cylinder's rim and on an axis
+    /// or centre.
+    pub(crate) fn distance_curvature(&self, x: &Vector3<f64>, t: &Vector3<f64>) -> Option<f64> {
+        let about = |d: Vector3<f64>, axis: Option<Vector3<f64>>| {
+            let rho = d.norm();
+            if rho <= 0.0 {
+                return None;
+            }
+            let n = d / rho;
+            let along = axis.map_or(0.0, |e| e.dot(t).powi(2));
+            Some((t.norm_squared() - n.dot(t).powi(2) - along) / rho)
+        };
+        match *self {
+            Self::Frictional { ref shape, .. } => shape.distance_curvature(x, t),
+            Self::Mesh(_) => None,
+            Self::Plane { .. } => Some(0.0),
+            Self::Sphere { center, .. } => about(x - center, None),
+            Self::Capsule { a, b, .. } => {
+                let u = b - a;
+                let s = (x - a).dot(&u) / u.norm_squared();
+                if s <= 0.0 {
+                    about(x - a, None)
+                } else if s >= 1.0 {
+                    about(x - b, None)
+                } else {
+                    about(x - (a + u * s), Some(u.normalize()))
+                }
+            }
+            Self::Cylinder { a, b, radius } => {
+                let h = (b - a).norm();
+                let u = (b - a) / h;
+                let s = (x - a).dot(&u);
+                let rho = x - a - u * s;
+                let dr = rho.norm() - radius;
+                let dz = if s < 0.5 * h { -s } else { s - h };
+                if dr > 0.0 && dz > 0.0 {
+                    None
+                } else if dr > dz {
+                    about(rho, Some(u))
+                } else {
+                    Some(0.0)
                 }
             }
         }

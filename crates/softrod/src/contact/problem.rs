@@ -6,8 +6,10 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
+use super::belt::Held;
 use super::constraint::TipConstraint;
 use super::obstacle::Obstacle;
+use super::obstacle_normal_basis;
 use super::rows::AtContact;
 use super::ContactState;
 use crate::cosserat::equations::{rot, v3, Equations, Evaluator, Workspace, FULL, STATE};
@@ -33,6 +35,20 @@ pub(super) enum Site {
     /// (unknowns: `a`, force) and, on `(a, L]`, the distributed reaction that cancels the
     /// normal component of the distributed loads (the segment lies flat on the plane).
     Interval,
+    /// Lying on a curved obstacle from an unknown arc length `a` to an unknown `b`
+    /// (unknowns: `a`, `b`): on `[a, b]` the normal pressure that keeps the gap zero (a
+    /// held interval of the model, see `contact/belt.rs`).
+    Belt,
+    /// Lying on a curved obstacle from an unknown arc length `a` to the tip, with a force at
+    /// the tip (unknowns: `a`, the tip force).
+    BeltTip,
+}
+
+impl Site {
+    /// Whether the contact holds an interval of the rod on the obstacle (a belt).
+    pub(super) fn held(self) -> bool {
+        matches!(self, Site::Belt | Site::BeltTip)
+    }
 }
 
 /// An active contact and the homotopy targets of its gap rows (its gap and gap slope when it
@@ -80,8 +96,9 @@ impl Active {
 impl Active {
     pub(super) fn size(&self) -> usize {
         match self.site {
+            Site::Belt => 2,
             Site::Tip => 3,
-            Site::Interior | Site::Interval => 4,
+            Site::Interior | Site::Interval | Site::BeltTip => 4,
         }
     }
 
@@ -104,6 +121,35 @@ pub(super) fn equations<'a>(
         pressures,
         load_factor: 1.0,
         profile: None,
+    }
+}
+
+/// The RK4 steps per step of the uniform mesh on a belt (see [`mesh_of`]).
+const BELT_SUBSTEPS: usize = 4;
+
+/// The RK4 plan and the stops of a march of the contact model `model` with `integrator`:
+/// [`rk4_plan`] over its breaks, or with a belt (a held interval, whose ends move with the
+/// unknowns) one step between the nodes of the uniform mesh and the breaks (an empty plan
+/// with the uniform nodes as stops), so that the march changes continuously with the ends;
+/// on a belt the uniform mesh is refined [`BELT_SUBSTEPS`] times (the gap is held there by
+/// integrating `g'' = 0`, whose drift falls as the fourth power of the step).
+pub(super) fn mesh_of(model: &RobotModel, integrator: Integrator) -> (Vec<usize>, Vec<f64>) {
+    match integrator {
+        Integrator::Rk4 { steps } if !model.holds().is_empty() => {
+            let l = model.length();
+            let fine = steps * BELT_SUBSTEPS;
+            let stops = (1..fine)
+                .map(|k| l * k as f64 / fine as f64)
+                .enumerate()
+                .filter(|&(k, s)| {
+                    (k + 1) % BELT_SUBSTEPS == 0 || model.holds().iter().any(|h| s > h.a && s < h.b)
+                })
+                .map(|(_, s)| s)
+                .collect();
+            (Vec::new(), stops)
+        }
+        Integrator::Rk4 { steps } => (rk4_plan(model.breaks(), steps), Vec::new()),
+        Integrator::Adaptive(_) => (Vec::new(), Vec::new()),
     }
 }
 
@@ -146,6 +192,8 @@ pub(super) struct Pass {
     /// With an exact Jacobian: it (column-major) and the tip twist `[δp; δθ]` (m, rad;
     /// world) per scaled unknown.
     pub(super) jacobian: Option<(Vec<f64>, Vec<Vector6<f64>>)>,
+    /// Per active contact, what its belt carries (`None` for the other sites).
+    pub(super) held: Vec<Option<Held>>,
     /// Of a march of the state alone by `integrator`: the tendon path lengths (m) and
     /// tensions (N) it left (what a solution is assembled from, with the nodes).
     pub(super) marched: Option<(Integrator, Vec<f64>, Vec<f64>)>,
@@ -367,10 +415,30 @@ impl<'m> Constrained<'m> {
         let l = self.model.length();
         let f = self.model.force_scale();
         let mut loads = scaled_loads(self.model.loads(), self.load);
+        let mut holds = Vec::new();
         for (a, o) in self.active.iter().zip(self.offsets()) {
             let (s, k) = match a.site {
                 Site::Tip => (l, o),
                 Site::Interior | Site::Interval => (x[o] * l, o + 1),
+                Site::Belt => {
+                    holds.push(self.hold_of(a, x[o] * l, x[o + 1] * l)?);
+                    let h = holds.last()?;
+                    loads
+                        .point_loads
+                        .push(PointLoad::force(h.a, Vector3::zeros()));
+                    loads
+                        .point_loads
+                        .push(PointLoad::force(h.b, Vector3::zeros()));
+                    continue;
+                }
+                Site::BeltTip => {
+                    holds.push(self.hold_of(a, x[o] * l, l)?);
+                    let h = holds.last()?;
+                    loads
+                        .point_loads
+                        .push(PointLoad::force(h.a, Vector3::zeros()));
+                    (l, o + 1)
+                }
             };
             if !(s > 0.0 && s <= l) {
                 return None;
@@ -410,7 +478,11 @@ impl<'m> Constrained<'m> {
                 })));
             }
         }
-        self.model.with_loads(loads).ok()
+        if holds.is_empty() {
+            self.model.with_loads(loads).ok()
+        } else {
+            self.model.with_loads_and_holds(loads, holds).ok()
+        }
     }
 
     /// The scratch of the evaluations ([`Self::scratch`], taken; new if none), for `nt`
@@ -428,13 +500,11 @@ impl<'m> Constrained<'m> {
         let model = self.contact_model(x)?;
         let nt = model.tendons().len();
         let mut scratch = self.scratch(nt);
-        let plan = match self.integrator {
-            Integrator::Rk4 { steps } => rk4_plan(model.breaks(), steps),
-            Integrator::Adaptive(_) => Vec::new(),
-        };
+        let (plan, stops) = mesh_of(&model, self.integrator);
         let eq = equations(&model, &self.tensions, &self.pressures);
         let mut sh =
             Shooting::with_workspace(eq, self.integrator, plan, scratch.march_workspace(nt));
+        sh.stops = stops;
         sh.nodes = scratch.node_buffer();
         sh.passive_lengths = !self.rough;
         let pass = if full {
@@ -457,7 +527,6 @@ impl<'m> Constrained<'m> {
         } else {
             None
         };
-        let l = self.model.length();
         let [before, after] = &mut scratch.sides;
         let mut ev = [
             Evaluator {
@@ -469,22 +538,7 @@ impl<'m> Constrained<'m> {
                 ws: after,
             },
         ];
-        for (a, o) in self.active.iter().zip(self.offsets()) {
-            let (s, k) = match a.site {
-                Site::Tip => (l, o),
-                Site::Interior | Site::Interval => (x[o] * l, o + 1),
-            };
-            let first = sh.nodes.iter().position(|n| n.s == s)?;
-            let last = sh.nodes.iter().rposition(|n| n.s == s)?;
-            let (nf, nl) = (&sh.nodes[first], &sh.nodes[last]);
-            let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
-            let at = AtContact {
-                s,
-                first: (&nf.y, nf.interval),
-                last: (&nl.y, nl.interval),
-            };
-            self.contact_rows(&mut ev, a, at, &f, mu, &mut rows);
-        }
+        let held = self.rows_of_contacts(&mut ev, &sh.nodes, x, mu, &mut rows)?;
         let finite = rows.iter().all(|v| v.is_finite());
         let pass = finite.then(|| Pass {
             nodes: std::mem::take(&mut sh.nodes),
@@ -493,6 +547,7 @@ impl<'m> Constrained<'m> {
             key: self.key(x, mu),
             rows: rows.clone(),
             jacobian: None,
+            held,
             marched: (!full && !self.rough).then(|| {
                 (
                     self.integrator,
@@ -505,6 +560,61 @@ impl<'m> Constrained<'m> {
         scratch.keep(sh.ws, replaced);
         self.scratch = Some(scratch);
         finite.then_some((rows, jac))
+    }
+}
+
+impl Constrained<'_> {
+    /// Appends the rows of every active contact at `x` (homotopy `mu`) from the `nodes` of a
+    /// march (see [`Self::contact_rows`], [`Self::belt_rows`]); returns what each belt
+    /// carries, `None` if a contact's arc length is not a node.
+    fn rows_of_contacts(
+        &self,
+        ev: &mut [Evaluator<'_, '_>; 2],
+        nodes: &[Node],
+        x: &[f64],
+        mu: f64,
+        rows: &mut Vec<f64>,
+    ) -> Option<Vec<Option<Held>>> {
+        let l = self.model.length();
+        let mut held = Vec::with_capacity(self.active.len());
+        for (a, o) in self.active.iter().zip(self.offsets()) {
+            let (s, k) = match a.site {
+                Site::Tip => (l, o),
+                Site::Interior | Site::Interval => (x[o] * l, o + 1),
+                Site::Belt | Site::BeltTip => (x[o] * l, o + 1),
+            };
+            let first = nodes.iter().position(|n| n.s == s)?;
+            let last = nodes.iter().rposition(|n| n.s == s)?;
+            let (nf, nl) = (&nodes[first], &nodes[last]);
+            let at = AtContact {
+                s,
+                first: (&nf.y, nf.interval),
+                last: (&nl.y, nl.interval),
+            };
+            if a.site.held() {
+                self.belt_rows(&mut ev[1], a, at, mu, rows);
+                let b = if a.site == Site::Belt {
+                    x[o + 1] * l
+                } else {
+                    l
+                };
+                held.push(Some(self.held(&mut ev[1], nodes, (s, b))?));
+                if a.site == Site::BeltTip {
+                    // The tip force along the obstacle's normal at the tip.
+                    let tip = v3(&nodes.last()?.y, 0);
+                    let (_, n) = self.obstacles[a.obstacle].distance(&tip);
+                    let (t1, t2) = obstacle_normal_basis(&n);
+                    let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
+                    rows.push(f.dot(&t1));
+                    rows.push(f.dot(&t2));
+                }
+                continue;
+            }
+            let f = Vector3::new(x[k], x[k + 1], x[k + 2]);
+            self.contact_rows(ev, a, at, &f, mu, rows);
+            held.push(None);
+        }
+        Some(held)
     }
 }
 

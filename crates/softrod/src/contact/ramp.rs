@@ -20,10 +20,10 @@
 use nalgebra::Vector3;
 
 use super::active_set::active_set;
+use super::belt;
 use super::newton::Effort;
 use super::obstacle::Obstacle;
-use super::problem::Site;
-use super::problem::{Constrained, Pass};
+use super::problem::{Constrained, Pass, Site};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
 use crate::cosserat::equations::v3;
 use crate::cosserat::shooting::Node;
@@ -285,6 +285,31 @@ pub(super) fn past_middle(
     })
 }
 
+/// The tip contacts whose gap (at the tip, on an obstacle free of friction and not touched
+/// at the tip), extrapolated linearly from its value at the step accepted before (in `gaps`,
+/// replaced by those of the last pass), closes within the next step of the same length.
+fn closing_tips(p: &Constrained<'_>, gaps: &mut Vec<f64>) -> Vec<(usize, Site, f64)> {
+    let l = p.model.length();
+    let now: Vec<f64> = (0..p.obstacles.len())
+        .map(|o| p.gaps(o).last().map_or(f64::INFINITY, |g| g.2))
+        .collect();
+    let out = (0..p.obstacles.len())
+        .filter(|&o| {
+            p.obstacles[o].friction() == 0.0
+                && !p
+                    .active
+                    .iter()
+                    .any(|a| a.obstacle == o && a.site == Site::Tip)
+                && gaps
+                    .get(o)
+                    .is_some_and(|&g0| now[o] < g0 && 2.0 * now[o] - g0 <= 0.0)
+        })
+        .map(|o| (o, Site::Tip, l))
+        .collect();
+    *gaps = now;
+    out
+}
+
 /// The active-set solve with the actuation (`tensions`, `pressures`: the full ones) and the
 /// loads stepped together from zero, from the unactuated rod `rest` (its nodes; the samples
 /// `s`, radii `radius`), each step refused and halved if the rod crossed an obstacle on it. The
@@ -318,12 +343,13 @@ pub(super) fn stepped(
     // was.
     let mut secant: Option<(f64, Vec<f64>, Vec<Vector3<f64>>)> = None;
     let (mut lambda, mut step) = (0.0, MAX_STEP);
+    // Tip contacts about to close on the next step, from the tip's gaps at the last two.
+    let mut near: Vec<(usize, Site, f64)> = Vec::new();
+    let mut tip_gaps: Vec<f64> = Vec::new();
     while lambda < 1.0 {
         let next = (lambda + step).min(1.0);
         let sig = signature(p);
-        let along = secant
-            .as_ref()
-            .filter(|(_, xb, _)| faithful && xb.len() == x.len());
+        let along = secant.as_ref().filter(|(_, xb, _)| xb.len() == x.len());
         let start: Vec<f64> = match along {
             Some((h, xb, _)) => {
                 let r = (next - lambda) / h;
@@ -334,11 +360,31 @@ pub(super) fn stepped(
         p.set_load(next);
         p.last = None;
         let saved = p.active.clone();
-        let shape = active_set(p, &start, opts, effort).and_then(|xn| {
+        let mut solved = active_set(p, &start, opts, effort);
+        if solved.is_none() && !faithful && along.is_some() {
+            // Off the secant's prediction: from the last step's state.
+            p.active.clone_from(&saved);
+            p.last = None;
+            solved = active_set(p, &x, opts, effort);
+        }
+        if solved.is_none() && !near.is_empty() {
+            // The tip about to touch (a belt reaching it, an arm closing on an obstacle):
+            // held from the start of the step.
+            p.active.clone_from(&saved);
+            p.last = None;
+            let mut xt = x.clone();
+            for &(o, _, _) in &near {
+                xt = belt::anticipate_tip(p, xt, o);
+            }
+            solved = active_set(p, &xt, opts, effort);
+        }
+        let shape = solved.and_then(|xn| {
             let shape = positions_at(p.last.as_ref()?, s);
             let moved = (&previous[..], &shape[..]);
             let on_branch = match along {
-                Some((h, _, before)) if next - lambda > SNAP_STEP && signature(p) == sig => {
+                Some((h, _, before))
+                    if faithful && next - lambda > SNAP_STEP && signature(p) == sig =>
+                {
                     on_secant(&shape, (before, &previous), (next - lambda) / h, l)
                 }
                 _ => true,
@@ -364,6 +410,7 @@ pub(super) fn stepped(
         match shape {
             Some((xn, shape)) => {
                 effort.load_steps += 1;
+                near = closing_tips(p, &mut tip_gaps);
                 p.approach = p.last.as_ref().map(|pass| pass.nodes.clone());
                 secant = (signature(p) == sig).then(|| {
                     (

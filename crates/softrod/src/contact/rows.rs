@@ -228,10 +228,23 @@ impl Constrained<'_> {
         self.active
             .iter()
             .zip(self.offsets())
-            .map(|(a, o)| {
+            .enumerate()
+            .map(|(i, (a, o))| {
                 let (s, k) = match a.site {
                     Site::Tip => (l, o),
                     Site::Interior | Site::Interval => (x[o] * l, o + 1),
+                    Site::Belt | Site::BeltTip => {
+                        // The total of its pressure, along the normal where it is largest.
+                        let held = pass.held.get(i).and_then(Option::as_ref);
+                        let total = held.map_or(0.0, |h| h.total());
+                        let n = held
+                            .and_then(|h| h.peak())
+                            .map_or(Vector3::z(), |h| h.normal);
+                        let p = held
+                            .and_then(|h| h.samples.first())
+                            .map_or(Vector3::zeros(), |h| h.point);
+                        return (total, n, x[o] * l, p);
+                    }
                 };
                 let node = pass
                     .nodes

@@ -47,7 +47,9 @@ pub fn rk4_plan(breaks: &[f64], steps: usize) -> Vec<usize> {
 /// of every interval and after every step (`y` may be modified there, e.g. to seed a column).
 /// Every point of `stops` (sorted) inside an interval ends a step there: an adaptive step is
 /// cut short; with RK4 the interval is split there and its steps shared among the parts in
-/// proportion to their lengths (at least one each), so a stop is a node of the mesh.
+/// proportion to their lengths (at least one each), so a stop is a node of the mesh. With
+/// an empty RK4 plan every part takes one step: a mesh anchored at the stops, which a
+/// moving break changes continuously (no step count jumps).
 /// Returns the state at the last break.
 ///
 /// # Errors
@@ -72,10 +74,13 @@ pub fn march<const N: usize, Y: Piecewise<N>>(
                 // Stops split the interval; its steps are shared in proportion to length.
                 let mut start = a;
                 for &stop in stops.iter().filter(|&&s| s > a && s < b).chain([&b]) {
-                    let n = if stop == b && start == a {
-                        plan[k]
-                    } else {
-                        ((plan[k] as f64 * (stop - start) / (b - a)).round() as usize).max(1)
+                    let n = match plan.get(k) {
+                        // (An empty plan: one step from stop to stop.)
+                        None => 1,
+                        Some(&steps) if stop == b && start == a => steps,
+                        Some(&steps) => {
+                            ((steps as f64 * (stop - start) / (b - a)).round() as usize).max(1)
+                        }
                     };
                     let st = rk4.get_or_insert_with(Stages::<N, 4>::new);
                     y = fixed_in(&RK4, sys, st, (start, y), stop, n, |sys, s, y| {

@@ -2,6 +2,7 @@
 
 pub mod actuation;
 pub mod chamber;
+pub(crate) mod hold;
 pub mod loads;
 pub mod material;
 pub mod robot;

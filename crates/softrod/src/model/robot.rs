@@ -15,6 +15,7 @@ use crate::error::{Error, Result};
 use crate::limits::{check_load, MAX_OFFSET_RATIO};
 use crate::model::actuation::{Actuation, TendonInput};
 use crate::model::chamber::{self, Chamber};
+use crate::model::hold::Hold;
 use crate::model::loads::{Frame, Loads};
 use crate::model::material::TangentCompliance;
 use crate::model::rod::{Profile, Rod, FUNCTION_CHECKS};
@@ -47,6 +48,13 @@ pub struct RobotModel {
     /// The section compliance when it does not depend on `s` (linear material, uniform
     /// section).
     uniform_compliance: Option<TangentCompliance>,
+    /// Whether the constitutive law at a given body wrench is the same at every `s` (uniform
+    /// linear section, constant rest strains and tendon offsets, no chambers).
+    uniform_along: bool,
+    /// Intervals of the backbone held on a surface (a contact solve's intervals on curved
+    /// obstacles; none for a user's model), and per integration interval the one it lies in.
+    holds: Vec<Hold>,
+    hold_of: Vec<Option<usize>>,
 }
 
 impl RobotModel {
@@ -80,6 +88,47 @@ impl RobotModel {
     /// The rod, tendons and chambers were validated with this model: only the loads are
     /// checked, and what depends on them (breaks, `rho g`, force-free) is recomputed.
     pub fn with_loads(&self, loads: Loads) -> Result<Arc<Self>> {
+        self.loaded(loads).map(Arc::new)
+    }
+
+    /// The same robot under `loads` with the backbone held on the surfaces of `holds` (their
+    /// ends are breaks of the integration intervals: `loads` has a point load at each).
+    ///
+    /// # Errors
+    /// As [`Self::with_loads`]; [`Error::InvalidParameter`] naming `holds` if an interval is
+    /// not inside `(0, L]` or its ends are not breaks.
+    pub(crate) fn with_loads_and_holds(&self, loads: Loads, holds: Vec<Hold>) -> Result<Arc<Self>> {
+        let mut model = self.loaded(loads)?;
+        let l = self.length();
+        let mut hold_of = vec![None; model.breaks.len() - 1];
+        for (i, h) in holds.iter().enumerate() {
+            let ka = model.breaks.iter().position(|&b| b == h.a);
+            let kb = model.breaks.iter().position(|&b| b == h.b);
+            let (Some(ka), Some(kb)) = (ka, kb) else {
+                return Err(Error::invalid(
+                    "holds",
+                    format!("[{}, {}]", h.a, h.b),
+                    "breaks",
+                ));
+            };
+            if !(h.a > 0.0 && h.a < h.b && h.b <= l) {
+                return Err(Error::invalid(
+                    "holds",
+                    format!("[{}, {}]", h.a, h.b),
+                    "in (0, L]",
+                ));
+            }
+            for k in &mut hold_of[ka..kb] {
+                *k = Some(i);
+            }
+        }
+        model.holds = holds;
+        model.hold_of = hold_of;
+        Ok(Arc::new(model))
+    }
+
+    /// [`Self::with_loads`], not shared.
+    fn loaded(&self, loads: Loads) -> Result<Self> {
         let l = self.length();
         loads.validate(l, self.rod.density())?;
         check_load_limits(&loads, &self.rod, self.force_scale)?;
@@ -105,10 +154,13 @@ impl RobotModel {
             rho_g: None,
             force_free: false,
             uniform_compliance: self.uniform_compliance,
+            uniform_along: self.uniform_along,
+            holds: Vec::new(),
+            hold_of: Vec::new(),
         };
         model.rho_g = rho_g_of(&model.rod, &model.loads);
         model.force_free = force_free_of(&model.loads);
-        Ok(Arc::new(model))
+        Ok(model)
     }
 
     fn build(rod: Rod, tendons: Vec<Tendon>, chambers: Vec<Chamber>, loads: Loads) -> Result<Self> {
@@ -181,6 +233,17 @@ impl RobotModel {
                 rod.material()
                     .compliance(&props0, rod.shear_coefficient(), rod.inextensible())
             });
+        let uniform_along = uniform_compliance.is_some()
+            && chambers.is_empty()
+            && matches!(rod.rest_strain(), Profile::Constant(_))
+            && matches!(rod.rest_curvature(), Profile::Constant(_))
+            && tendons.iter().all(|t| {
+                t.guides().is_empty()
+                    && matches!(
+                        t.routing(),
+                        Routing::Constant(_) | Routing::RadiusProportional { .. }
+                    )
+            });
         Ok(Self {
             rod,
             tendons,
@@ -195,6 +258,9 @@ impl RobotModel {
             rho_g,
             force_free,
             uniform_compliance,
+            uniform_along,
+            holds: Vec::new(),
+            hold_of: Vec::new(),
         })
     }
 
@@ -302,6 +368,27 @@ impl RobotModel {
     /// The section compliance if it is the same at every `s`.
     pub fn uniform_compliance(&self) -> Option<&TangentCompliance> {
         self.uniform_compliance.as_ref()
+    }
+
+    /// Whether the strains at a given body wrench are the same at every `s` (uniform linear
+    /// section, constant rest strains and tendon offsets, no chambers).
+    pub(crate) fn uniform_along(&self) -> bool {
+        self.uniform_along
+    }
+
+    /// The held interval (see [`Hold`]) that integration interval `k` lies in, if any.
+    #[inline]
+    pub(crate) fn hold_on(&self, k: usize) -> Option<&Hold> {
+        self.hold_of
+            .get(k)
+            .copied()
+            .flatten()
+            .map(|i| &self.holds[i])
+    }
+
+    /// The held intervals.
+    pub(crate) fn holds(&self) -> &[Hold] {
+        &self.holds
     }
 }
 

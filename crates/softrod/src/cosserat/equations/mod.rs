@@ -69,6 +69,7 @@
 //! right-hand side of the state and its columns, the integrator's interface).
 
 mod boundary;
+mod hold;
 mod local;
 mod rhs;
 mod state;
@@ -248,6 +249,9 @@ pub(crate) struct Workspace {
     pub dirs: Vec<Option<Vector6<f64>>>,
     /// First material failure met by a local solve, reported if the solve fails.
     pub material_error: Option<Error>,
+    /// The normal pressure (N/m) of a held interval at the last evaluation on one (see
+    /// `hold.rs`), and its outward normal.
+    pub hold_pressure: (f64, Vector3<f64>),
 }
 
 impl Workspace {
@@ -274,6 +278,7 @@ impl Workspace {
             },
             dirs: vec![None; n_tendons],
             material_error: None,
+            hold_pressure: (0.0, Vector3::zeros()),
         }
     }
 

@@ -3,6 +3,7 @@
 
 use nalgebra::{Vector3, Vector6};
 
+use super::hold::HeldState;
 use super::{
     col_rot, mul_hat, mul_hat2, project_columns, put3, rot, v3, Column, Evaluator, Local, COLUMN,
     DM, DN, DR, STATE,
@@ -25,11 +26,20 @@ impl Evaluator<'_, '_> {
         let nb = r.tr_mul(&nw);
         let mb = r.tr_mul(&mw);
         let ncol = self.ws.columns.len().min((N - STATE) / COLUMN);
-        let loc = self.local(s, &props, &nb, &mb, ncol > 0);
+        // A held interval (a contact interval on a curved obstacle): its normal pressure.
+        let hold = eq.model.hold_on(self.ws.interval);
+        let rate = hold.map(|_| self.strain_rate(s, &nb, &mb));
+        let loc = self.local(s, &props, &nb, &mb, ncol > 0 || hold.is_some());
         let (v, u) = (loc.v, loc.u);
         let pd = r * v;
-        let nd = -eq.distributed_force(s, &props);
+        let mut nd = -eq.distributed_force(s, &props);
         let md = -pd.cross(&nw) - eq.distributed_moment(s);
+        if let (Some(h), Some(rate)) = (hold, rate) {
+            let st = HeldState { nb, mb, nd, md };
+            let (q, n) = self.hold_pressure(h, y, &loc, &st, rate);
+            self.ws.hold_pressure = (q, n);
+            nd -= n * q;
+        }
         put3(out, 0, &pd);
         mul_hat(&r, &u, &mut out[3..12]);
         put3(out, 12, &nd);
