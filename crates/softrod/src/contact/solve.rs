@@ -312,7 +312,11 @@ fn finish_unless_crossed(
 ) -> Result<ContactSolution> {
     match not_crossed(p, x, options, effort) {
         Ok(x) => finish(p, model, actuation, options, &x, effort, 1.0),
-        Err(why) => fail(p, &options.newton, effort, 0.0, why),
+        Err(why) => {
+            // (The load factor the stepped actuation reached.)
+            let lambda = p.from;
+            fail(p, &options.newton, effort, lambda, why)
+        }
     }
 }
 
