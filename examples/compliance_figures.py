@@ -1,9 +1,10 @@
 """Figures of docs/compliance.md: ellipsoids along the arm, gamma_c(s), a workspace map.
 
-Run from the repository root: ``python examples/compliance_figures.py``.
+``python examples/compliance_figures.py`` (from any directory; the figures go to docs/figures).
 """
 
 import time
+from pathlib import Path
 
 import matplotlib
 
@@ -13,13 +14,16 @@ import numpy as np
 import softrod
 from softrod.plot import plot_compliance_ellipsoids, plot_gamma_c, plot_workspace_map
 
+# The repository's figures, wherever the script is run from.
+FIGURES = Path(__file__).resolve().parents[1] / "docs" / "figures"
+
 robot = softrod.examples.load("niti_two_segment")
 sol = robot.solve()
 comp = softrod.compliance(sol)
 fig = plot_compliance_ellipsoids(
     sol, comp, nodes=7, title="NiTi robot, tensions [4, 0, 0, 0, 2, 0] N"
 )
-fig.savefig("docs/figures/compliance_ellipsoids.png", dpi=110)
+fig.savefig(FIGURES / "compliance_ellipsoids.png", dpi=110)
 
 scales = [0.0, 0.5, 1.0, 1.5]
 comps = [
@@ -31,7 +35,7 @@ fig = plot_gamma_c(
     labels=[f"tensions x {k}" for k in scales],
     title="NiTi robot: dimensionless flexural compliance along the arm",
 )
-fig.savefig("docs/figures/compliance_gamma_c.png", dpi=110)
+fig.savefig(FIGURES / "compliance_gamma_c.png", dpi=110)
 for k, c in zip(scales, comps, strict=True):
     print(f"tensions x {k}: gamma_c at the tip = {np.round(c.gamma_c[-1], 4)}")
 
@@ -46,7 +50,7 @@ r = np.linalg.norm(wmap.tip_position[:, :2], axis=1)
 centre, edge = c[np.argmin(r)], c[np.argmax(r)]
 print(f"largest translational compliance: centre {centre:.4f} m/N, periphery {edge:.4f} m/N")
 fig = plot_workspace_map(wmap, title="NiTi robot: segment-1 tendons 0 and 1 swept over 0-4 N")
-fig.savefig("docs/figures/compliance_workspace.png", dpi=110)
+fig.savefig(FIGURES / "compliance_workspace.png", dpi=110)
 ct = wmap.tangent_max_translational_compliance
 centre, edge = ct[np.argmin(r)], ct[np.argmax(r)]
 print(f"tangent, all tendons at fixed length: centre {centre:.4f} m/N, periphery {edge:.4f} m/N")
@@ -55,7 +59,7 @@ fig = plot_workspace_map(
     measure="tangent_max_translational_compliance",
     title="NiTi robot: exact tangent compliance, all six tendons held at fixed length",
 )
-fig.savefig("docs/figures/compliance_workspace_tangent.png", dpi=110)
+fig.savefig(FIGURES / "compliance_workspace_tangent.png", dpi=110)
 
 # The compliance-methodology paper's Fig. 1e in kind: the pneumatic arm with pairs 1 and 2
 # pressurised together.
@@ -73,4 +77,4 @@ fig = plot_gamma_c(
     labels=[f"P1 = P2 = {p} kPa" for p in pressures],
     title="compliance-methodology pneumatic arm: dimensionless flexural compliance along the arm",
 )
-fig.savefig("docs/figures/compliance_gamma_c_pneumatic.png", dpi=110)
+fig.savefig(FIGURES / "compliance_gamma_c_pneumatic.png", dpi=110)

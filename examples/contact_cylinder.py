@@ -6,12 +6,13 @@ along y at x = 37 mm, z = 0.14 m: 2 mm of surface gap to the straight rod). Prin
 the contacts, the tip, the stability verdict and the median wall time of three solves, and
 writes ``docs/figures/contact_cylinder.png``.
 
-Run from the repository root: ``python examples/contact_cylinder.py``.
+``python examples/contact_cylinder.py`` (from any directory; the figure goes to docs/figures).
 """
 
 import statistics
 import time
 import warnings
+from pathlib import Path
 
 import matplotlib
 
@@ -20,6 +21,9 @@ import numpy as np
 
 import softrod
 from softrod.plot import plot_rod
+
+# The repository's figures, wherever the script is run from.
+FIGURES = Path(__file__).resolve().parents[1] / "docs" / "figures"
 
 L, R, E = 0.3, 0.005, 1e6
 RC = 0.03
@@ -80,5 +84,5 @@ ax = fig.axes[0]
 ax.set_yticks([])  # seen along the cylinder's axis (y)
 ax.set_ylabel("")
 ax.set_title("Tendon-bent rod against a cylinder (side view, along its axis)")
-fig.savefig("docs/figures/contact_cylinder.png", dpi=100)
-print("wrote docs/figures/contact_cylinder.png")
+fig.savefig(FIGURES / "contact_cylinder.png", dpi=100)
+print(f"wrote {FIGURES / 'contact_cylinder.png'}")
