@@ -212,14 +212,13 @@ fn add_contacts(
 
 /// The state at full contact targets from `x`, where the newest contacts (at zero force)
 /// penetrate: one exact Newton solve with the predictor of new contacts, else their gaps
-/// relaxed from the values found to zero by continuation.
+/// relaxed from the values found to zero by continuation ([`relax`]).
 fn reach_contacts(
     p: &mut Constrained<'_>,
     x: &[f64],
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    let l = p.model.length();
     for a in &mut p.active {
         a.g0 = 0.0;
         a.dg0 = 0.0;
@@ -228,6 +227,19 @@ fn reach_contacts(
     if let Some((xs, _)) = exact_newton(p, x, opts, effort, false, true) {
         return Some(xs);
     }
+    relax(p, x, opts, effort)
+}
+
+/// The state at full contact targets from `x`: the rows of every active contact (gap, its
+/// slope, a sticking contact's tangential displacement) relaxed from their values at `x` to
+/// zero by continuation, then Newton.
+pub(super) fn relax(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let l = p.model.length();
     // The gap targets of the new contacts: their rows at zero force.
     let mut r = vec![0.0; p.dim()];
     if p.evaluate(x, 1.0, None, &mut r) == Evaluated::Failed {

@@ -28,14 +28,15 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-use super::newton::{correct, exact_newton, Effort};
+use super::active_set;
+use super::newton::{exact_newton, Effort};
 use super::obstacle::Obstacle;
 use super::problem::{Active, Constrained, Site};
 use super::rows::{AtContact, Forces};
 use crate::cosserat::equations::{v3, Evaluator, STATE};
 use crate::cosserat::shooting::Node;
 use crate::model::hold::Hold;
-use crate::solve::{continuation, ContinuationSettings, Evaluated, NewtonOptions, Problem};
+use crate::solve::NewtonOptions;
 
 /// The pressure of a belt at one node: arc length (m), pressure (N/m), outward normal,
 /// backbone point (m, world).
@@ -418,8 +419,8 @@ pub(super) fn anticipate_tip(p: &mut Constrained<'_>, mut x: Vec<f64>, o: usize)
     x
 }
 
-/// Newton on the current active set from `x`; else the gap rows of every contact relaxed
-/// from their values at `x` to zero by continuation.
+/// Newton on the current active set from `x`; else the rows of every contact relaxed from
+/// their values at `x` to zero by continuation ([`active_set::relax`]).
 fn relax(
     p: &mut Constrained<'_>,
     x: Vec<f64>,
@@ -429,39 +430,7 @@ fn relax(
     if let Some((xs, _)) = exact_newton(p, &x, opts, effort, true, false) {
         return Some(xs);
     }
-    let l = p.model.length();
-    let mut r = vec![0.0; p.dim()];
-    if p.evaluate(&x, 1.0, None, &mut r) == Evaluated::Failed {
-        return None;
-    }
-    let offsets = p.offsets();
-    for (a, o) in p.active.iter_mut().zip(offsets) {
-        a.g0 = r[o] * l;
-        if a.site != Site::Tip {
-            a.dg0 = r[o + 1];
-        }
-    }
-    let start = ContinuationSettings {
-        x0: &x,
-        jacobian0: None,
-        first_increment: 1.0,
-        max_increment: 1.0,
-    };
-    let c = continuation(
-        p,
-        &start,
-        opts,
-        &crate::cosserat::statics::settings(true, None, false),
-    );
-    effort.iterations += c.iterations;
-    for a in &mut p.active {
-        a.g0 = 0.0;
-        a.dg0 = 0.0;
-    }
-    if !(c.outcome.converged && c.load_factor >= 1.0) {
-        return None;
-    }
-    correct(p, &c.outcome.x, opts, effort)
+    active_set::relax(p, &x, opts, effort)
 }
 
 /// The contact force of a belt at the samples `s` (m) with backbone `position` (m, world) of

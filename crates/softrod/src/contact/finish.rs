@@ -172,18 +172,8 @@ fn report(
         if a.site == Site::Interval {
             // The distributed reaction on (a, L], lumped at the samples by the trapezoid rule.
             let after = f64::from_bits(s.to_bits() + 1);
-            let density = |t: f64| {
-                let mut f = cm
-                    .loads()
-                    .distributed_force
-                    .as_ref()
-                    .map_or(Vector3::zeros(), |p| p.at(t));
-                // The model's distributed force already carries the reaction: take it alone.
-                if let Some(g) = cm.rho_g() {
-                    f += g * cm.rod().section_at(t).area;
-                }
-                f
-            };
+            // The contact model's distributed force already carries the reaction.
+            let density = |t: f64| distributed(cm, t);
             let base = model.loads().distributed_force.as_ref();
             let mut total = 0.0;
             let idx: Vec<usize> = (0..sol.s.len()).filter(|j| sol.s[*j] >= after).collect();
@@ -223,6 +213,20 @@ fn report(
     (contacts, contact_force)
 }
 
+/// The distributed force per length (N/m, world) on the rod of `model` at arc length `t`
+/// (m): its distributed load and its weight.
+fn distributed(model: &RobotModel, t: f64) -> Vector3<f64> {
+    let mut f = model
+        .loads()
+        .distributed_force
+        .as_ref()
+        .map_or(Vector3::zeros(), |p| p.at(t));
+    if let Some(g) = model.rho_g() {
+        f += g * model.rod().section_at(t).area;
+    }
+    f
+}
+
 /// The contact of the belt `a` that carries `held` on the solution `sol` (of the contact
 /// model `cm`), its pressure lumped into `contact_force` (see [`lumps`]): at its start `s`,
 /// of `length` `b - a`, its point where the pressure is largest, its normal force the
@@ -237,17 +241,7 @@ fn report_belt(
     sol: &crate::cosserat::StaticsSolution,
     contact_force: &mut [[f64; 3]],
 ) -> Contact {
-    let applied = |t: f64| {
-        let mut f = cm
-            .loads()
-            .distributed_force
-            .as_ref()
-            .map_or(Vector3::zeros(), |p| p.at(t));
-        if let Some(g) = cm.rho_g() {
-            f += g * cm.rod().section_at(t).area;
-        }
-        f
-    };
+    let applied = |t: f64| distributed(cm, t);
     let mut resultant = Vector3::zeros();
     for (j, c) in lumps(held, &sol.s, &sol.position, &applied) {
         resultant += c;
