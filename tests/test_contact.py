@@ -256,3 +256,28 @@ def test_friction_in_robot_files_and_along_an_interval():
     with pytest.raises(ValueError, match="friction") as err:
         sr.solve_statics(_rod(), loads=loads, obstacles=[plane], steps=100)
     assert err.value.parameter == "friction"
+
+
+def test_a_belt_is_reported_and_its_linearisations_refused_by_name():
+    """A tendon-bent soft rod lying on a cylinder (3.3 N: a belt of about 8 mm): the contact
+    has a length, its lumped pressure balances the base wrench (the tendon's loads are
+    internal), and the tangent compliance and the actuation Jacobian, which are not
+    linearised about a belt, raise a ParameterError naming ``solution``."""
+    length, radius = 0.3, 0.005
+    rod = sr.Rod(length, sr.CircularSection(radius), sr.LinearElastic(1e6, 0.45))
+    xc = 0.03 + radius + 0.002
+    cylinder = sr.Cylinder((xc, -0.1, 0.14), (xc, 0.1, 0.14), 0.03)
+    with pytest.warns(sr.StabilityWarning):
+        sol = sr.solve_statics(rod, [sr.Tendon((0.004, 0.0), 3.3)], obstacles=[cylinder], steps=80)
+    (belt,) = sol.contacts
+    assert 0.005 < belt["length"] < 0.012
+    # The base wrench is the contact forces' resultant and moment about the origin (to
+    # 1e-10 of the tension, and of the tension times the length).
+    force = sol.contact_force.sum(axis=0)
+    moment = np.cross(sol.position, sol.contact_force).sum(axis=0)
+    assert np.abs(sol.base_wrench[:3] - force).max() <= 1e-10 * 3.3
+    assert np.abs(sol.base_wrench[3:] - moment).max() <= 1e-10 * 3.3 * length
+    assert sol.contact_compliance is None
+    for call in (lambda: sr.tangent_compliance(sol), lambda: sr.actuation_jacobian(sol)):
+        with pytest.raises(sr.ParameterError, match="solution"):
+            call()

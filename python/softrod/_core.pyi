@@ -456,7 +456,8 @@ class StaticsSolution:
     @property
     def contact_compliance(self) -> NDArray[np.float64] | None:
         """Tip compliance with the active contacts and the tip constraint as constraints,
-        [dp; dtheta] per [dF; dM] (world), shape (6, 6)."""
+        [dp; dtheta] per [dF; dM] (world), shape (6, 6); None without obstacles and tip
+        constraint, when not converged, or with a belt (not linearised)."""
     @property
     def tendon_tensions(self) -> NDArray[np.float64]: ...
     @property

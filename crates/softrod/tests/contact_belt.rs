@@ -253,3 +253,32 @@ fn a_rod_pulled_onto_a_cylinder_lies_on_it_where_point_contacts_did() {
         );
     }
 }
+
+/// What is not linearised about a belt is refused by name, not answered from a mismatched
+/// mesh: the tangent compliance and the actuation Jacobians (with and without the contact
+/// held) raise an invalid parameter naming `solution`; the compliance under contact is
+/// absent.
+#[test]
+fn linearisations_of_a_belt_are_refused_by_name() {
+    let sol = solve(3.3, 80);
+    assert!(belt(&sol).is_some(), "3.3 N lies on the cylinder");
+    let named = |r: softrod::Error| match r {
+        softrod::Error::InvalidParameter { name, .. } => assert_eq!(name, "solution"),
+        other => panic!("expected a refusal naming `solution`, got {other}"),
+    };
+    named(
+        softrod::compliance::tangent_compliance(
+            &sol.solution,
+            softrod::compliance::TendonControl::Tension,
+            None,
+        )
+        .unwrap_err(),
+    );
+    named(softrod::actuation_jacobian(&sol.solution, None).unwrap_err());
+    named(
+        sol.compliance
+            .actuation_jacobian(&sol.solution, None)
+            .unwrap_err(),
+    );
+    assert!(sol.compliance.get().is_none());
+}

@@ -277,7 +277,8 @@ impl StaticsSolution {
     /// constraints (frictionless contacts hold the normal only), `[dp; dtheta]` of the tip
     /// (m, rad; world) per `[dF; dM]` of a dead tip load (N, N m; world), shape (6, 6); None
     /// without obstacles and tip constraint (then `tangent_compliance`, which treats contact
-    /// forces as dead loads, is the same) or when not converged. Computed on first read.
+    /// forces as dead loads, is the same), when not converged, or with a belt (a contact
+    /// interval on a curved obstacle: not linearised). Computed on first read.
     #[getter]
     fn contact_compliance<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
         self.contact

@@ -130,8 +130,8 @@ pub struct ContactCompliance {
 
 impl ContactCompliance {
     /// `[δp; δθ]` of the tip (m, rad; world) per `[δF; δM]` of a dead tip load (N, N m;
-    /// world), 6×6; `None` when the solve did not converge or the constrained problem is
-    /// singular there.
+    /// world), 6×6; `None` when the solve did not converge, the constrained problem is
+    /// singular there or a contact is a belt (its Jacobian is differenced: no tip columns).
     pub fn get(&self) -> Option<nalgebra::Matrix6<f64>> {
         self.inner.as_ref().and_then(|f| f.compliance())
     }
@@ -147,8 +147,9 @@ impl ContactCompliance {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `node` off the mesh, or `solution` when it does not
-    /// belong to this linearisation or has a sticking or sliding contact (friction at
-    /// contacts: not modelled in this Jacobian); [`Error::NotConverged`] when the solve did not converge
+    /// belong to this linearisation, has a sticking or sliding contact (friction at
+    /// contacts: not modelled in this Jacobian) or a belt (see [`belt_refused`]);
+    /// [`Error::NotConverged`] when the solve did not converge
     /// or the constrained problem is singular there.
     ///
     /// [`Error::InvalidParameter`]: crate::Error::InvalidParameter
@@ -181,6 +182,9 @@ impl ContactCompliance {
                  with friction at contacts is not modelled)",
             ));
         }
+        if !solution.model.holds().is_empty() {
+            return Err(belt_refused("the actuation Jacobian"));
+        }
         let (j, at) = frozen.actuation_jacobian(node).ok_or_else(|| {
             crate::Error::not_converged(
                 "actuation Jacobian under contact: the constrained problem is singular or \
@@ -205,4 +209,19 @@ impl ContactCompliance {
             inner: frozen.map(Arc::new),
         }
     }
+}
+
+/// The error of a linearisation asked of a solution with a belt (a contact interval on a
+/// curved obstacle): its march takes the belt's own mesh and holds the pressure that keeps
+/// the gap zero, and neither is linearised; [`crate::Error::InvalidParameter`] naming
+/// `solution`.
+pub(crate) fn belt_refused(what: &str) -> crate::Error {
+    crate::Error::invalid(
+        "solution",
+        "a contact solution with a belt (a contact interval on a curved obstacle)",
+        format!(
+            "one without a belt: {what} of a rod lying along a sphere, capsule or cylinder is \
+             not available"
+        ),
+    )
 }

@@ -192,6 +192,9 @@ pub(crate) fn linearise(
     load_node: Option<usize>,
 ) -> Result<Linear> {
     let model = &*solution.model;
+    if !model.holds().is_empty() {
+        return Err(crate::contact::belt_refused("the linearisation"));
+    }
     let x = super::statics::scaled(model, &solution.base_wrench);
     let lambda = solution.stats.load_factor;
     let pressures = solution.pressures();
