@@ -117,6 +117,15 @@ impl Forward for ContactForward {
         let r = s.rotation[n - 1];
         let rotation = Matrix3::from_fn(|i, j| r[i][j]);
         let jac = if jacobian {
+            if !s.model.holds().is_empty() {
+                // (Not a parameter of the inverse: this forward solution's step is refused.)
+                return Err(crate::Error::not_converged(
+                    "contact inverse statics: the forward solution lies along a curved \
+                     obstacle (a belt), whose actuation Jacobian is not available",
+                    0,
+                    f64::INFINITY,
+                ));
+            }
             let j = if sol.contacts.is_empty() {
                 crate::cosserat::sensitivity::actuation_jacobian(s, None)?
             } else {
