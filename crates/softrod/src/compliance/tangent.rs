@@ -74,8 +74,9 @@ pub struct TangentCompliance {
 /// integrated with the solution's integrator and mesh.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for a node out of range; [`Error::NotConverged`] if the
-/// integration fails or the linear system is singular.
+/// [`Error::InvalidParameter`] for a node out of range, or naming `solution` for a contact
+/// solution with a belt (a contact interval on a curved obstacle: not linearised);
+/// [`Error::NotConverged`] if the integration fails or the linear system is singular.
 pub fn tangent_compliance(
     solution: &StaticsSolution,
     control: TendonControl,

@@ -148,7 +148,8 @@ impl ContactCompliance {
     /// # Errors
     /// [`Error::InvalidParameter`] naming `node` off the mesh, or `solution` when it does not
     /// belong to this linearisation, has a sticking or sliding contact (friction at
-    /// contacts: not modelled in this Jacobian) or a belt (see [`belt_refused`]);
+    /// contacts: not modelled in this Jacobian) or a belt (a contact interval on a curved
+    /// obstacle: not linearised);
     /// [`Error::NotConverged`] when the solve did not converge
     /// or the constrained problem is singular there.
     ///

@@ -663,7 +663,9 @@ pub fn sensitivities(
 /// [`Direction::Pull`]).
 ///
 /// # Errors
-/// As [`sensitivities`] (`node` out of range).
+/// As [`sensitivities`] (`node` out of range); [`Error::InvalidParameter`] naming `solution`
+/// for a contact solution with a belt (a contact interval on a curved obstacle: not
+/// linearised).
 pub fn actuation_jacobian(solution: &StaticsSolution, node: Option<usize>) -> Result<DMatrix<f64>> {
     let node = node_or_tip(solution, node)?;
     let mut jac = actuation_jacobians(solution, &[node], Linearisation::Tension)?;
