@@ -5,36 +5,26 @@
 //! as the mesh is refined.
 #![allow(clippy::unwrap_used, missing_docs)]
 
+mod common;
+
 use softrod::nalgebra::Vector3;
 use softrod::{
     solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, Obstacle,
-    RobotModel, Rod, Routing, Section, SolveOptions, Tendon,
+    RobotModel, Rod, Section, SolveOptions,
 };
 
-const L: f64 = 0.3;
-const R: f64 = 0.005;
-const RC: f64 = 0.03;
-
-fn cylinder() -> Obstacle {
-    let xc = RC + R + 0.002;
-    Obstacle::cylinder([xc, -0.1, 0.14], [xc, 0.1, 0.14], RC).unwrap()
-}
+use common::SOFT_ARM_RADIUS as R;
+use common::{
+    soft_arm, soft_arm_cylinder as cylinder, CYLINDER_RADIUS as RC, SOFT_ARM_LENGTH as L,
+};
 
 fn solve(t: f64, steps: usize) -> ContactSolution {
-    let rod = Rod::new(
-        L,
-        Section::circular(R).unwrap(),
-        LinearElastic::new(1e6, 0.45).unwrap(),
-    )
-    .unwrap();
-    let tendon = Tendon::new(Routing::Constant([0.004, 0.0]), None).unwrap();
-    let model = RobotModel::new(rod, vec![tendon], vec![], Loads::default()).unwrap();
     let opts = SolveOptions {
         integrator: Integrator::Rk4 { steps },
         ..SolveOptions::default()
     };
     solve_constrained(
-        &model,
+        &soft_arm(),
         &Actuation::tensions(&[t]),
         &opts,
         None,

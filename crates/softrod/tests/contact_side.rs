@@ -26,30 +26,19 @@ use std::sync::Arc;
 
 use softrod::nalgebra::Vector3;
 use softrod::{
-    solve_constrained, Actuation, ContactSolution, Integrator, LinearElastic, Loads, Obstacle,
-    RobotModel, Rod, Routing, Section, SolveOptions, Tendon,
+    solve_constrained, Actuation, ContactSolution, Integrator, Loads, Obstacle, RobotModel,
+    SolveOptions,
 };
 
-const L: f64 = 0.3;
-const R: f64 = 0.005;
-const RC: f64 = 0.03;
+use common::SOFT_ARM_RADIUS as R;
+use common::{soft_arm, soft_arm_cylinder};
 
 fn setup() -> (Arc<RobotModel>, [Obstacle; 1], SolveOptions) {
-    let rod = Rod::new(
-        L,
-        Section::circular(R).unwrap(),
-        LinearElastic::new(1e6, 0.45).unwrap(),
-    )
-    .unwrap();
-    let tendon = Tendon::new(Routing::Constant([0.004, 0.0]), None).unwrap();
-    let model = RobotModel::new(rod, vec![tendon], vec![], Loads::default()).unwrap();
-    let xc = RC + R + 0.002;
-    let cylinder = Obstacle::cylinder([xc, -0.05, 0.14], [xc, 0.05, 0.14], RC).unwrap();
     let options = SolveOptions {
         integrator: Integrator::Rk4 { steps: 80 },
         ..SolveOptions::default()
     };
-    (model, [cylinder], options)
+    (soft_arm(), [soft_arm_cylinder()], options)
 }
 
 /// The solution at tension `t` (N), from a straight guess or warm-started.

@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use softrod::{
-    solve_statics, Actuation, Chamber, ChamberArea, Integrator, LinearElastic, Loads, Result,
-    RobotModel, Rod, Routing, Section, SolveOptions, StaticsSolution, Tendon,
+    solve_statics, Actuation, Chamber, ChamberArea, Integrator, LinearElastic, Loads, Obstacle,
+    Result, RobotModel, Rod, Routing, Section, SolveOptions, StaticsSolution, Tendon,
 };
 
 /// A tendon and the tension it is pulled with (N).
@@ -261,4 +261,32 @@ impl Rng {
         }
         t
     }
+}
+
+/// Length (m) of the soft arm of [`soft_arm`].
+pub const SOFT_ARM_LENGTH: f64 = 0.3;
+/// Radius (m) of the soft arm of [`soft_arm`].
+pub const SOFT_ARM_RADIUS: f64 = 0.005;
+/// Radius (m) of the cylinder of [`soft_arm_cylinder`].
+pub const CYLINDER_RADIUS: f64 = 0.03;
+
+/// The soft arm of docs/contact.md ("An arm bent onto a cylinder"): a rod of 0.3 m, circular
+/// radius 5 mm, E = 1 MPa, ν = 0.45, one tendon at the constant offset (4 mm, 0) bending it
+/// toward +x.
+pub fn soft_arm() -> Arc<RobotModel> {
+    let rod = Rod::new(
+        SOFT_ARM_LENGTH,
+        Section::circular(SOFT_ARM_RADIUS).unwrap(),
+        LinearElastic::new(1e6, 0.45).unwrap(),
+    )
+    .unwrap();
+    let tendon = Tendon::new(Routing::Constant([0.004, 0.0]), None).unwrap();
+    RobotModel::new(rod, vec![tendon], vec![], Loads::default()).unwrap()
+}
+
+/// The cylinder across the soft arm's bending plane: radius 30 mm, axis along `y` (from
+/// y = -0.1 to 0.1 m) through x = 37 mm, z = 0.14 m (2 mm clear of the straight rod).
+pub fn soft_arm_cylinder() -> Obstacle {
+    let xc = CYLINDER_RADIUS + SOFT_ARM_RADIUS + 0.002;
+    Obstacle::cylinder([xc, -0.1, 0.14], [xc, 0.1, 0.14], CYLINDER_RADIUS).unwrap()
 }
