@@ -42,10 +42,14 @@ class TargetUnreachableError(ConvergenceError):
     rotation: float
 
 class StabilityWarning(UserWarning):
-    """The equilibrium returned is unstable and no stable one was found."""
+    """The equilibrium returned is unstable (its tip tangent stiffness, in N/m and N m/rad,
+    is not positive definite) and no stable one was found; see
+    ``StaticsSolution.stability_margin`` and docs/stability.md."""
 
 class StabilityError(RuntimeError):
-    """The equilibrium reached is unstable (``on_unstable="raise"``)."""
+    """The equilibrium reached is unstable (``on_unstable="raise"``); carries
+    ``stability_margin`` (dimensionless: the tip tangent stiffness per EI(0)/L, EI in N m^2,
+    L in m) and the unstable ``solution``."""
 
     stability_margin: float
     solution: StaticsSolution

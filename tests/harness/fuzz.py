@@ -1746,6 +1746,8 @@ NOT_CONSTRUCTED = {
     "PlanarSolution",
     "Section",
     "Silicone",
+    "StabilityError",
+    "StabilityWarning",
     "StaticsSolution",
     "TangentCompliance",
     "TargetUnreachableError",

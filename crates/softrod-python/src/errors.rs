@@ -46,15 +46,19 @@ create_exception!(
     _core,
     StabilityWarning,
     PyUserWarning,
-    "The equilibrium returned is unstable (its tip tangent stiffness is not positive \
-     definite) and no stable one was found; see `StaticsSolution.stability_margin`."
+    "The equilibrium returned is unstable (its tip tangent stiffness, in N/m and N m/rad, \
+     is not positive definite) and no stable one was found.\n\nIssued by the solves \
+     (`on_unstable=\"warn\"`, the default); its measure is \
+     `StaticsSolution.stability_margin` (dimensionless: stiffness per EI(0)/L, EI in N m^2, \
+     L in m); docs/stability.md."
 );
 create_exception!(
     _core,
     StabilityError,
     PyRuntimeError,
     "The equilibrium reached is unstable and no stable one was found \
-     (`on_unstable=\"raise\"`); carries `stability_margin` and the unstable `solution`."
+     (`on_unstable=\"raise\"`).\n\nCarries `stability_margin` (dimensionless: the tip \
+     tangent stiffness per EI(0)/L, EI in N m^2, L in m) and the unstable `solution`."
 );
 create_exception!(
     _core,
