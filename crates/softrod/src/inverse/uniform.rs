@@ -36,7 +36,6 @@ use crate::cosserat::equations::{rotation_variation, Equations, Evaluator, Works
 use crate::cosserat::statics::Integrator;
 use crate::integrate::march::rk4_plan;
 use crate::math::so3::{hat, reorthonormalise};
-use crate::model::rod::Profile;
 use crate::model::tendon::Routing;
 use crate::model::RobotModel;
 
@@ -44,15 +43,12 @@ use crate::model::RobotModel;
 /// closed form of this module: RK4, a uniform linear-elastic rod with constant rest strains,
 /// no chambers, tendons at constant offsets without friction or guides.
 pub(super) fn applies(model: &RobotModel, integrator: &Integrator) -> bool {
-    let rod = model.rod();
     matches!(integrator, Integrator::Rk4 { .. })
-        && model.chambers().is_empty()
-        && model.uniform_compliance().is_some()
-        && matches!(rod.rest_strain(), Profile::Constant(_))
-        && matches!(rod.rest_curvature(), Profile::Constant(_))
-        && model.tendons().iter().all(|t| {
-            matches!(t.routing(), Routing::Constant(_)) && t.friction() == 0.0 && !t.is_guided()
-        })
+        && model.uniform_along()
+        && model
+            .tendons()
+            .iter()
+            .all(|t| matches!(t.routing(), Routing::Constant(_)) && t.friction() == 0.0)
 }
 
 /// `X^k` for `k = 1..4` of `X = h û`.
