@@ -172,9 +172,13 @@ fn report(
         if a.site == Site::Interval {
             // The distributed reaction on (a, L], lumped at the samples by the trapezoid rule.
             let after = f64::from_bits(s.to_bits() + 1);
-            // The contact model's distributed force already carries the reaction.
-            let density = |t: f64| distributed(cm, t);
-            let base = model.loads().distributed_force.as_ref();
+            // The contact model's distributed force carries the reaction on top of the loads'.
+            let force = |m: &RobotModel, t: f64| {
+                m.loads()
+                    .distributed_force
+                    .as_ref()
+                    .map_or(Vector3::zeros(), |p| p.at(t))
+            };
             let mut total = 0.0;
             let idx: Vec<usize> = (0..sol.s.len()).filter(|j| sol.s[*j] >= after).collect();
             for w in idx.windows(2) {
@@ -185,11 +189,7 @@ fn report(
                 }
                 for j in [j0, j1] {
                     let t = sol.s[j];
-                    let applied = base.map_or(Vector3::zeros(), |p| p.at(t));
-                    let reaction = density(t)
-                        - applied
-                        - cm.rho_g()
-                            .map_or(Vector3::zeros(), |g| g * cm.rod().section_at(t).area);
+                    let reaction = force(cm, t) - force(model, t);
                     let lump = reaction * (0.5 * h);
                     total += lump.dot(n);
                     for k in 0..3 {
