@@ -367,11 +367,13 @@ fn compliance_under_an_interior_contact_is_the_constrained_derivative() {
     }
 }
 
-/// The stability of a contact solution with a free tip comes from the exact Jacobian at the
-/// solution; it equals the margin of the same rod with the contact forces as dead loads
-/// solved again without obstacles (one march with the base-wrench columns).
+/// The stability of a contact solution with a free tip holds its frictionless contacts: its
+/// margin is the tip criterion of the compliance under contact, here (a rod pressed on a
+/// small sphere by a tip force) set by the torsion, as that of the same rod with the contact
+/// force as a dead load solved again without obstacles (to the sphere's small effect on the
+/// twist, 1e-4; see `contact_stability.rs` for the closed forms).
 #[test]
-fn contact_stability_is_that_of_the_contacts_as_dead_loads() {
+fn contact_stability_holds_the_contact() {
     let radius = 1e-3;
     let delta = 1e-3 * L;
     let (ei, _, _, _) = common::circular_constants(E, NU, radius, 1.0);
@@ -389,5 +391,5 @@ fn contact_stability_is_that_of_the_contacts_as_dead_loads() {
     let err = (margin / reference - 1.0).abs();
     println!("contact stability margin {margin:e}, dead-load re-solve {reference:e}, rel. {err:e}");
     assert!(sol.solution.stable && again.stable);
-    assert!(err < 1e-6, "{margin:e} vs {reference:e}");
+    assert!(err < 1e-4, "{margin:e} vs {reference:e}");
 }

@@ -12,7 +12,7 @@ use super::obstacle::Obstacle;
 use super::problem::{mesh_of, Active, Constrained, Pass, Site};
 use super::rows::Forces;
 use super::solve::coarse_mesh;
-use super::stability::{conjugate_points, free_stiffness};
+use super::stability::{conjugate_points, constrained_stability, free_stiffness, held_contacts};
 use super::{Contact, ContactCompliance, ContactSolution, ContactState};
 use crate::cosserat::equations::{Equations, FULL, STATE};
 use crate::cosserat::shooting::Shooting;
@@ -392,10 +392,24 @@ pub(super) fn finish(
     // The compliance under the constraints, on first read.
     let compliance =
         ContactCompliance::of((residual <= options.newton.tolerance).then(|| Frozen::at(p, x)));
+    // With a free tip: the frictionless point contacts held (from the coarse mesh when its
+    // sign is clear there), else the contacts as dead loads.
+    let held = held_contacts(p);
+    let held_verdict = if held {
+        coarse_stability(p)
+            .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
+            .or_else(|| constrained_stability(p, x))
+    } else {
+        None
+    };
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
-    let free_stability = jacobian_stability(p, &pass, x);
+    let free_stability = if held {
+        held_verdict
+    } else {
+        jacobian_stability(p, &pass, x)
+    };
     let held = pass.held.clone();
     let belts = held.iter().any(Option::is_some);
     let cm = Arc::clone(&pass.model);

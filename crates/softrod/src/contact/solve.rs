@@ -6,6 +6,7 @@ use std::sync::Arc;
 use super::active_set::{active_set, step_loads};
 use super::constraint::TipConstraint;
 use super::finish::{fail, finish, jacobian_stability};
+use super::stability::constrained_stability;
 use super::newton::Effort;
 use super::obstacle::Obstacle;
 use super::problem::Constrained;
@@ -160,10 +161,14 @@ fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
     if p.evaluate(xc, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
         return;
     }
-    p.coarse_stability = p
-        .last
-        .as_ref()
-        .and_then(|pass| jacobian_stability(p, pass, xc))
+    // (The contacts held where they can be, from this pass: no march.)
+    let held = constrained_stability(p, xc);
+    p.coarse_stability = held
+        .or_else(|| {
+            p.last
+                .as_ref()
+                .and_then(|pass| jacobian_stability(p, pass, xc))
+        })
         .map(|st| (p.active.clone(), st));
     p.solved = Some((p.active.clone(), j));
 }

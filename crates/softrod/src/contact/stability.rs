@@ -14,12 +14,16 @@
 
 use nalgebra::{Complex, Matrix3, Matrix6, SymmetricEigen};
 
+use super::obstacle::Obstacle;
+use super::problem::{Constrained, Site};
+use super::ContactState;
+
 use crate::cosserat::equations::{
     col_rot, rot, rotation_variation, v3, Column, Evaluator, COLUMN, DM, DN, FULL, STATE,
 };
 use crate::cosserat::shooting::Shooting;
 use crate::cosserat::statics::Integrator;
-use crate::cosserat::NEUTRAL_MARGIN;
+use crate::cosserat::{compliance_stability, Stability, NEUTRAL_MARGIN};
 use crate::integrate::march::{march, Scheme};
 
 /// The scaled pose and wrench blocks of the six base-wrench columns of a state, in
@@ -165,4 +169,48 @@ pub(crate) fn free_stiffness(
         .filter(|v| **v < -NEUTRAL_MARGIN)
         .count();
     margin.is_finite().then_some((margin, negative))
+}
+
+/// Whether the stability of `p`'s equilibria holds its contacts ([`constrained_stability`]):
+/// a free tip and frictionless point contacts (at the tip or inside the rod) on obstacles
+/// other than triangle meshes.
+pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
+    p.tip.is_none()
+        && !p.active.is_empty()
+        && p.active.iter().all(|a| {
+            let o = &p.obstacles[a.obstacle];
+            matches!(a.site, Site::Tip | Site::Interior)
+                && a.state == ContactState::Frictionless
+                && o.friction() == 0.0
+                && !matches!(o.shape(), Obstacle::Mesh(_))
+        })
+}
+
+/// The stability of a free-tip equilibrium with its frictionless point contacts held as
+/// constraints (see `docs/stability.md`, "Under contact"): the tip criterion of
+/// `solve_statics` on the tip compliance with the active contacts as constraints (each
+/// contact keeps its gap, slides along the rod to its least gap and turns its force with the
+/// obstacle's normal), which is exact when the rod with its tip clamped too and the contacts
+/// held has no conjugate point. `None` where it does not apply (a held tip, friction, a
+/// contact interval or belt, a triangle mesh, or a singular constrained problem): the
+/// contacts are then read as dead loads. The last pass of `p` is kept.
+pub(super) fn constrained_stability(p: &mut Constrained<'_>, x: &[f64]) -> Option<Stability> {
+    if !held_contacts(p) {
+        return None;
+    }
+    let key = p.key(x, 1.0);
+    let exact = p
+        .last
+        .as_ref()
+        .is_some_and(|pass| pass.key == key && pass.jacobian.is_some());
+    let c = if exact {
+        p.compliance(x)
+    } else {
+        // (One march with the columns at `x`; the last pass kept for the solution.)
+        let kept = p.last.take();
+        let c = p.compliance(x);
+        p.last = kept;
+        c
+    };
+    compliance_stability(&c?, p.model.length(), p.model.force_scale())
 }

@@ -81,6 +81,46 @@ pub struct Stability {
     pub(crate) mode: Option<[f64; 6]>,
 }
 
+/// The eigen-decomposition of the symmetric part of a dimensionless tip compliance `c`, its
+/// smallest stiffness `1/μ` over the eigenvalues `μ` (directions of zero compliance, below
+/// [`CONSTRAINT_COMPLIANCE`] of the largest, left out) and the index of that eigenvalue;
+/// `None` if no direction is left.
+fn softest(c: &Matrix6<f64>) -> Option<(SymmetricEigen<f64, nalgebra::U6>, f64, Option<usize>)> {
+    let eig = SymmetricEigen::new((c + c.transpose()) * 0.5);
+    let big = eig.eigenvalues.amax();
+    let mut margin = f64::INFINITY;
+    let mut softest = None;
+    for (k, &mu) in eig.eigenvalues.iter().enumerate() {
+        if mu.abs() <= CONSTRAINT_COMPLIANCE * big {
+            continue;
+        }
+        let stiffness = 1.0 / mu;
+        if stiffness < margin {
+            margin = stiffness;
+            softest = Some(k);
+        }
+    }
+    margin.is_finite().then_some((eig, margin, softest))
+}
+
+/// The stability read from a tip compliance `c` (m, rad per N, N m; world) of a rod of length
+/// `length` and force scale `force` (`E I(0) / L²`, N): the tip criterion on its
+/// dimensionless form `(E I(0) / L) D⁻¹ c D⁻¹` (see the module documentation), without a
+/// mode; `None` if it is not finite or has no direction of nonzero compliance.
+pub(crate) fn compliance_stability(c: &Matrix6<f64>, length: f64, force: f64) -> Option<Stability> {
+    if !c.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let d = |i: usize| if i < 3 { length } else { 1.0 };
+    let hat = Matrix6::from_fn(|i, k| c[(i, k)] * force * length / (d(i) * d(k)));
+    let (_, margin, _) = softest(&hat)?;
+    Some(Stability {
+        stable: margin > -NEUTRAL_MARGIN,
+        margin,
+        mode: None,
+    })
+}
+
 /// The stability from the scaled shooting Jacobian `y` (column-major 6×6) and the tip twist
 /// of each base-wrench column `x` (m, rad per scaled unit), for a rod of length `length`.
 /// `None` if the Jacobian is not finite.
@@ -107,24 +147,7 @@ pub(crate) fn tip_stability(y: &[f64], x: &[Vector6<f64>; 6], length: f64) -> Op
             c[(i, k)] = sol[k];
         }
     }
-    let sym = (c + c.transpose()) * 0.5;
-    let eig = SymmetricEigen::new(sym);
-    let big = eig.eigenvalues.amax();
-    let mut margin = f64::INFINITY;
-    let mut softest = None;
-    for (k, &mu) in eig.eigenvalues.iter().enumerate() {
-        if mu.abs() <= CONSTRAINT_COMPLIANCE * big {
-            continue;
-        }
-        let stiffness = 1.0 / mu;
-        if stiffness < margin {
-            margin = stiffness;
-            softest = Some(k);
-        }
-    }
-    if !margin.is_finite() {
-        return None;
-    }
+    let (eig, margin, softest) = softest(&c)?;
     let stable = margin > -NEUTRAL_MARGIN;
     let mode = match softest {
         Some(k) if !stable => {

@@ -1,0 +1,163 @@
+//! Stability of contact equilibria with the active contacts as constraints: a straight rod
+//! pressing its tip on top of a sphere slides off once the push exceeds the tip's lateral
+//! stiffness times the distance to the sphere's centre, `P > k ρ` (closed form), and a
+//! tendon-bent rod resting on a cylinder is held by it, with the margin computed
+//! independently from the dead-load rod's tangent compliance at the contact (a dead-load
+//! reading of the contact force calls both the wrong way).
+#![allow(clippy::unwrap_used, missing_docs)]
+
+mod common;
+
+use std::sync::Arc;
+
+use softrod::nalgebra::{Matrix6, SymmetricEigen, Vector3};
+use softrod::{
+    solve_constrained, Actuation, ContactSolution, LinearElastic, Loads, Obstacle, RobotModel, Rod,
+    Routing, Section, Tendon,
+};
+
+use common::{beam as rod, rk4_options as options, BEAM_E as E, BEAM_LENGTH as L, BEAM_NU as NU};
+
+/// Radius (m) of the slender rod: `L / r = 500`, so that shear and axial strain move the
+/// critical loads by about 1e-5.
+const R: f64 = 2e-3;
+
+fn ei() -> f64 {
+    E * std::f64::consts::PI * R.powi(4) / 4.0
+}
+
+fn solve(loads: Loads, obstacles: &[Obstacle]) -> ContactSolution {
+    let model = Arc::new(RobotModel::rod_only(rod(R), loads).unwrap());
+    solve_constrained(&model, &Actuation::default(), &options(80), None, obstacles).unwrap()
+}
+
+/// The tip criterion on a tip compliance `c` (SI, world) of a rod of length `l` and force
+/// scale `fs` (`E I(0) / L²`): the smallest `1/μ` over the eigenvalues `μ` of the symmetric
+/// part of `(E I(0) / L) D⁻¹ c D⁻¹`, directions of zero compliance (below 1e-9 of the
+/// largest: the held normals) left out.
+fn tip_criterion(c: &Matrix6<f64>, l: f64, fs: f64) -> f64 {
+    let d = |i: usize| if i < 3 { l } else { 1.0 };
+    let hat = Matrix6::from_fn(|i, k| c[(i, k)] * fs * l / (d(i) * d(k)));
+    let eig = SymmetricEigen::new((hat + hat.transpose()) * 0.5).eigenvalues;
+    let big = eig.amax();
+    eig.iter()
+        .filter(|mu| mu.abs() > 1e-9 * big)
+        .map(|mu| 1.0 / mu)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The tendon-bent soft rod of `examples/contact_cylinder.py` resting on a cylinder at one
+/// point: with the contact force read as a dead load it was reported unstable from 2.5 N (the
+/// force is what bends the lower rod back), with the contact held it is stable; the margin is
+/// the tip criterion
+/// of the compliance under contact (itself checked against central differences of the
+/// constrained solve in `contact.rs`).
+#[test]
+fn a_rod_resting_on_a_cylinder_is_held_by_it() {
+    let (l, r, e) = (0.3, 0.005, 1e6);
+    let rc = 0.03;
+    let xc = rc + r + 0.002;
+    let rod = Rod::new(
+        l,
+        Section::circular(r).unwrap(),
+        LinearElastic::new(e, 0.45).unwrap(),
+    );
+    let tendon = Tendon::new(Routing::Constant([0.004, 0.0]), None).unwrap();
+    let model = RobotModel::new(rod.unwrap(), vec![tendon], vec![], Loads::default()).unwrap();
+    let cylinder = [Obstacle::cylinder([xc, -0.1, 0.14], [xc, 0.1, 0.14], rc).unwrap()];
+    for tension in [2.0, 3.0] {
+        let expect_stable = tension < 2.5;
+        let sol = solve_constrained(
+            &model,
+            &Actuation::tensions(&[tension]),
+            &options(80),
+            None,
+            &cylinder,
+        )
+        .unwrap();
+        assert_eq!(sol.contacts.len(), 1);
+        assert_eq!(sol.contacts[0].length, 0.0);
+        let m = &sol.solution.model;
+        let expected = tip_criterion(&sol.compliance.get().unwrap(), l, m.force_scale());
+        let margin = sol.solution.stability_margin();
+        println!("{tension} N: margin {margin:e}, tip criterion of the compliance {expected:e}");
+        assert_eq!(sol.solution.stable, margin > 0.0);
+        if expect_stable {
+            assert!(sol.solution.stable, "{tension} N");
+        }
+        assert!(
+            (margin - expected).abs() < 1e-6 * expected.abs(),
+            "{margin:e} vs {expected:e}"
+        );
+    }
+}
+
+/// The straight rod pressing its tip on top of a sphere of radius `RS` (centre on the axis)
+/// with a push of `ratio` times `k ρ`: `k` the tip's lateral stiffness (bending and shear,
+/// Timoshenko), `ρ = RS + R` the distance of the centreline's tip from the centre.
+const RS: f64 = 0.05;
+
+fn lateral_stiffness() -> f64 {
+    let g = E / (2.0 * (1.0 + NU));
+    let area = std::f64::consts::PI * R * R;
+    let shear = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU) * g * area;
+    1.0 / (L.powi(3) / (3.0 * ei()) + L / shear)
+}
+
+fn on_sphere(ratio: f64) -> ContactSolution {
+    let p = ratio * lateral_stiffness() * (RS + R);
+    let sphere = [Obstacle::sphere([0.0, 0.0, L + R + RS], RS).unwrap()];
+    let sol = solve(Loads::tip_force(Vector3::new(0.0, 0.0, p)), &sphere);
+    assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+    assert!((sol.contacts[0].normal_force - p).abs() < 1e-6 * p);
+    sol
+}
+
+#[test]
+fn a_rod_pushing_on_top_of_a_sphere_slides_off_past_its_lateral_stiffness() {
+    for ratio in [0.5, 0.99] {
+        let sol = on_sphere(ratio);
+        assert!(
+            sol.solution.stable,
+            "{ratio}: {}",
+            sol.solution.stability_margin()
+        );
+    }
+    for ratio in [1.01, 2.0] {
+        let sol = on_sphere(ratio);
+        assert!(
+            !sol.solution.stable,
+            "{ratio}: {}",
+            sol.solution.stability_margin()
+        );
+    }
+    // The margin in closed form: the tip's bending stiffness (Timoshenko) with `P / ρ` taken
+    // off its lateral term, in units of `E I / L` (`D = diag(L, 1)`), or the torsion's
+    // `G J / E I = 1 / (1 + ν)` if softer.
+    for ratio in [0.9, 1.1] {
+        let margin = on_sphere(ratio).solution.stability_margin();
+        let g = E / (2.0 * (1.0 + NU));
+        let shear = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU) * g * std::f64::consts::PI * R * R;
+        let c = softrod::nalgebra::Matrix2::new(
+            L.powi(3) / (3.0 * ei()) + L / shear,
+            L * L / (2.0 * ei()),
+            L * L / (2.0 * ei()),
+            L / ei(),
+        );
+        let mut k = c.try_inverse().unwrap();
+        k[(0, 0)] -= ratio * lateral_stiffness();
+        let hat = softrod::nalgebra::Matrix2::new(
+            k[(0, 0)] * L.powi(3) / ei(),
+            k[(0, 1)] * L * L / ei(),
+            k[(1, 0)] * L * L / ei(),
+            k[(1, 1)] * L / ei(),
+        );
+        let bending = SymmetricEigen::new(hat).eigenvalues.min();
+        let expected = bending.min(1.0 / (1.0 + NU));
+        println!("{ratio}: margin {margin:e}, closed form {expected:e}");
+        assert!(
+            (margin - expected).abs() < 1e-6 * expected.abs(),
+            "{margin:e} vs {expected:e}"
+        );
+    }
+}
