@@ -64,7 +64,8 @@ def _check(sol, gap, tension, length):
 
 def _solve(rod, tendon, obstacle):
     with warnings.catch_warnings():
-        # (A rod pressed on a convex obstacle may be judged unstable: contacts as dead loads.)
+        # (Stability is not what these tests check: a rod pressed on a convex obstacle may be
+        # unstable with the contact held.)
         warnings.simplefilter("ignore", sr.StabilityWarning)
         return sr.solve_statics(rod, [tendon], obstacles=[obstacle], steps=60)
 

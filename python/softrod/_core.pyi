@@ -470,8 +470,9 @@ class StaticsSolution:
     def base_wrench(self) -> NDArray[np.float64]: ...
     @property
     def stable(self) -> bool | None:
-        """Whether the equilibrium is stable (tip tangent stiffness positive definite); None:
-        not assessed (a tendon pulling through disk guides)."""
+        """Whether the equilibrium is stable (tip tangent stiffness positive definite; with
+        obstacles and a free tip, frictionless point contacts held); None: not assessed (a
+        tendon pulling through disk guides)."""
     @property
     def stability_margin(self) -> float:
         """Smallest eigenvalue of the scaled tip tangent stiffness (> 0: stable; NaN: not

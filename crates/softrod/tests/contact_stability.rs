@@ -161,3 +161,35 @@ fn a_rod_pushing_on_top_of_a_sphere_slides_off_past_its_lateral_stiffness() {
         );
     }
 }
+
+/// The NiTi robot driven into a sphere by the tensions of the contact benchmark and some
+/// others: the margin reported (from the coarse mesh when its sign is clear there) against
+/// the tip criterion of the compliance under contact on the mesh asked; the same sign, and
+/// the coarse mesh's value within 1e-3 of it (the difference of the meshes).
+#[test]
+fn the_niti_robot_against_a_sphere_reads_its_margin_on_the_coarse_mesh() {
+    let model = common::niti_model(Loads::default(), None, 0.0);
+    let sphere = [Obstacle::sphere([0.0, 0.07, 0.25], 0.06).unwrap()];
+    let opts = softrod::SolveOptions::default();
+    let mut worst: f64 = 0.0;
+    for t in [
+        [3.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        [4.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0, 2.0, 0.0, 0.0],
+        [5.0, 0.0, 1.0, 1.0, 0.0, 0.0],
+    ] {
+        let sol =
+            solve_constrained(&model, &Actuation::tensions(&t), &opts, None, &sphere).unwrap();
+        if sol.contacts.is_empty() {
+            continue;
+        }
+        let l = model.length();
+        let expected = tip_criterion(&sol.compliance.get().unwrap(), l, model.force_scale());
+        let margin = sol.solution.stability_margin();
+        let rel = (margin - expected).abs() / expected.abs();
+        println!("{t:?}: margin {margin:e}, mesh asked {expected:e}, rel. {rel:e}");
+        assert_eq!(sol.solution.stable, expected > 0.0);
+        worst = worst.max(rel);
+    }
+    assert!(worst < 1e-3, "{worst:e}");
+}

@@ -357,9 +357,10 @@ impl StaticsSolution {
         self.inner.stats.converged
     }
     /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
-    /// tension, dead loads) is positive definite; always True without external loads,
-    /// False for a result that did not converge; None (not assessed) when a tendon pulls
-    /// through disk guides (docs/stability.md).
+    /// tension, dead loads; with obstacles and a free tip, frictionless point contacts held)
+    /// is positive definite; always True without external loads or contacts, False for a
+    /// result that did not converge; None (not assessed) when a tendon pulls through disk
+    /// guides (docs/stability.md).
     #[getter]
     fn stable(&self) -> Option<bool> {
         (!self.pulled_through_guides()).then_some(self.inner.stable)

@@ -68,9 +68,10 @@ pub struct StaticsSolution {
     /// The arc lengths the solution was asked at (m; empty: the integration mesh).
     pub s_out: Vec<f64>,
     /// Whether the equilibrium is stable: its tip tangent stiffness (tendons at fixed
-    /// tension, dead loads) is positive definite (see [`StaticsSolution::stability_margin`]
-    /// and `docs/stability.md`). Always true without external loads; false for a result
-    /// that did not converge.
+    /// tension, dead loads; for a contact solution with a free tip, its frictionless point
+    /// contacts held) is positive definite (see [`StaticsSolution::stability_margin`] and
+    /// `docs/stability.md`). Always true without external loads; false for a result that did
+    /// not converge.
     pub stable: bool,
     /// The stability margin, once computed.
     pub(crate) margin: OnceLock<f64>,
