@@ -2,6 +2,7 @@
 obstacles in a Robot and in robot files, pickling."""
 
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -281,3 +282,22 @@ def test_a_belt_is_reported_and_its_linearisations_refused_by_name():
     for call in (lambda: sr.tangent_compliance(sol), lambda: sr.actuation_jacobian(sol)):
         with pytest.raises(sr.ParameterError, match="solution"):
             call()
+
+
+@pytest.mark.parametrize("ratio, stable", [(0.95, True), (1.05, False)])
+def test_a_push_on_top_of_a_sphere_slides_off_past_the_tip_stiffness(ratio, stable):
+    """Stability holds the contact: a straight rod pushing its tip on top of a sphere is stable
+    while the push P is below k rho (k its lateral tip stiffness, rho the distance of the
+    centreline's tip from the centre); past it the tip slides off (a warning says so)."""
+    radius = 0.05
+    k = 3 * EI / L**3  # (shear adds 9e-6 relative at L/r = 1000)
+    push = ratio * k * (radius + R)
+    sphere = sr.Sphere((0.0, 0.0, L + R + radius), radius)
+    loads = sr.Loads(tip_force=(0, 0, push))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = sr.solve_statics(_rod(), loads=loads, obstacles=[sphere], steps=40)
+    assert len(sol.contacts) == 1 and sol.contacts[0]["s"] == L
+    assert sol.stable is stable and (sol.stability_margin > 0) is stable
+    warned = any(issubclass(w.category, sr.StabilityWarning) for w in caught)
+    assert warned is not stable
