@@ -73,10 +73,15 @@ fn report_unstable(
         return Ok(sol);
     }
     let margin = inner.stability_margin();
+    // (A solve with contacts or a held tip does not look for a stable equilibrium.)
+    let after = if sol.contact.contact_force.is_some() {
+        "with its contacts held; a solve with obstacles or a tip constraint reports it as found"
+    } else {
+        "and no stable equilibrium was found from it"
+    };
     let msg = format!(
         "the equilibrium returned is unstable (stability margin {margin:.4e}: the tip \
-         tangent stiffness is not positive definite) and no stable equilibrium was found \
-         from it; see docs/stability.md"
+         tangent stiffness is not positive definite) {after}; see docs/stability.md"
     );
     if mode == OnUnstable::Warn {
         let category = py.get_type::<StabilityWarning>();

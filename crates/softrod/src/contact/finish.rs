@@ -321,6 +321,15 @@ pub(super) fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) ->
     tip_stability(&y, &tw, p.model.length())
 }
 
+/// With a free tip and frictionless point contacts ([`held_contacts`]), the stability with
+/// the contacts held at the solution `x`: from the coarse mesh when its sign is clear there,
+/// else on the mesh asked ([`constrained_stability`]).
+fn held_contacts_stability(p: &mut Constrained<'_>, x: &[f64]) -> Option<Stability> {
+    coarse_stability(p)
+        .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
+        .or_else(|| constrained_stability(p, x))
+}
+
 /// The stability of the coarse mesh's solution ([`Constrained::coarse_stability`]) when it
 /// has the active set of `p` (the same contacts, sites and states).
 fn coarse_stability(p: &Constrained<'_>) -> Option<Stability> {
@@ -392,24 +401,11 @@ pub(super) fn finish(
     // The compliance under the constraints, on first read.
     let compliance =
         ContactCompliance::of((residual <= options.newton.tolerance).then(|| Frozen::at(p, x)));
-    // With a free tip: the frictionless point contacts held (from the coarse mesh when its
-    // sign is clear there), else the contacts as dead loads.
-    let held = held_contacts(p);
-    let held_verdict = if held {
-        coarse_stability(p)
-            .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
-            .or_else(|| constrained_stability(p, x))
-    } else {
-        None
-    };
+    let held_verdict = held_contacts(p).then(|| held_contacts_stability(p, x));
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };
-    let free_stability = if held {
-        held_verdict
-    } else {
-        jacobian_stability(p, &pass, x)
-    };
+    let free_stability = held_verdict.unwrap_or_else(|| jacobian_stability(p, &pass, x));
     let held = pass.held.clone();
     let belts = held.iter().any(Option::is_some);
     let cm = Arc::clone(&pass.model);
