@@ -443,7 +443,8 @@ pub(super) fn finish(
         [f.x, f.y, f.z, m.x, m.y, m.z]
     });
     // Stability: with a held tip, conjugate points and the free directions' stiffness; with
-    // a free tip, the tip criterion of `solve_statics` (contacts as dead loads).
+    // a free tip, the tip criterion of `solve_statics` (frictionless point contacts held,
+    // other contacts as dead loads).
     let mut conjugate = None;
     if let (Some(c), Some(tw)) = (p.tip, tip_twist) {
         let (stable, margin, count) = held_stability(&mut sh, &x[..6], &c, &cols, &tw);
