@@ -10,7 +10,7 @@ mod common;
 
 use std::sync::Arc;
 
-use softrod::nalgebra::{Matrix6, SymmetricEigen, Vector3};
+use softrod::nalgebra::{SymmetricEigen, Vector3};
 use softrod::{
     solve_constrained, Actuation, ContactSolution, LinearElastic, Loads, Obstacle, RobotModel, Rod,
     Routing, Section, Tendon,
@@ -29,21 +29,6 @@ fn ei() -> f64 {
 fn solve(loads: Loads, obstacles: &[Obstacle]) -> ContactSolution {
     let model = Arc::new(RobotModel::rod_only(rod(R), loads).unwrap());
     solve_constrained(&model, &Actuation::default(), &options(80), None, obstacles).unwrap()
-}
-
-/// The tip criterion on a tip compliance `c` (SI, world) of a rod of length `l` and force
-/// scale `fs` (`E I(0) / L²`): the smallest `1/μ` over the eigenvalues `μ` of the symmetric
-/// part of `(E I(0) / L) D⁻¹ c D⁻¹`, directions of zero compliance (below 1e-9 of the
-/// largest: the held normals) left out.
-fn tip_criterion(c: &Matrix6<f64>, l: f64, fs: f64) -> f64 {
-    let d = |i: usize| if i < 3 { l } else { 1.0 };
-    let hat = Matrix6::from_fn(|i, k| c[(i, k)] * fs * l / (d(i) * d(k)));
-    let eig = SymmetricEigen::new((hat + hat.transpose()) * 0.5).eigenvalues;
-    let big = eig.amax();
-    eig.iter()
-        .filter(|mu| mu.abs() > 1e-9 * big)
-        .map(|mu| 1.0 / mu)
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The tendon-bent soft rod of `examples/contact_cylinder.py` resting on a cylinder at one
@@ -78,7 +63,7 @@ fn a_rod_resting_on_a_cylinder_is_held_by_it() {
         assert_eq!(sol.contacts.len(), 1);
         assert_eq!(sol.contacts[0].length, 0.0);
         let m = &sol.solution.model;
-        let expected = tip_criterion(&sol.compliance.get().unwrap(), l, m.force_scale());
+        let expected = common::tip_criterion(&sol.compliance.get().unwrap(), l, m.force_scale());
         let margin = sol.solution.stability_margin();
         println!("{tension} N: margin {margin:e}, tip criterion of the compliance {expected:e}");
         assert_eq!(sol.solution.stable, margin > 0.0);
@@ -184,7 +169,8 @@ fn the_niti_robot_against_a_sphere_reads_its_margin_on_the_coarse_mesh() {
             continue;
         }
         let l = model.length();
-        let expected = tip_criterion(&sol.compliance.get().unwrap(), l, model.force_scale());
+        let expected =
+            common::tip_criterion(&sol.compliance.get().unwrap(), l, model.force_scale());
         let margin = sol.solution.stability_margin();
         let rel = (margin - expected).abs() / expected.abs();
         println!("{t:?}: margin {margin:e}, mesh asked {expected:e}, rel. {rel:e}");

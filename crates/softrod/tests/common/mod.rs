@@ -131,3 +131,18 @@ pub fn circular_constants(e: f64, nu: f64, radius: f64, k: f64) -> (f64, f64, f6
     let i = PI * radius.powi(4) / 4.0;
     (e * i, g * 2.0 * i, e * a, k * g * a)
 }
+
+/// The tip criterion on a tip compliance `c` (SI, world) of a rod of length `l` and force
+/// scale `fs` (`E I(0) / L²`): the smallest `1/μ` over the eigenvalues `μ` of the symmetric
+/// part of `(E I(0) / L) D⁻¹ c D⁻¹`, directions of zero compliance (below 1e-9 of the
+/// largest: the held normals) left out.
+pub fn tip_criterion(c: &Matrix6<f64>, l: f64, fs: f64) -> f64 {
+    let d = |i: usize| if i < 3 { l } else { 1.0 };
+    let hat = Matrix6::from_fn(|i, k| c[(i, k)] * fs * l / (d(i) * d(k)));
+    let eig = softrod::nalgebra::SymmetricEigen::new((hat + hat.transpose()) * 0.5).eigenvalues;
+    let big = eig.amax();
+    eig.iter()
+        .filter(|mu| mu.abs() > 1e-9 * big)
+        .map(|mu| 1.0 / mu)
+        .fold(f64::INFINITY, f64::min)
+}
