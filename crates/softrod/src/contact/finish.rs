@@ -323,11 +323,21 @@ pub(super) fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) ->
 
 /// With a free tip and frictionless point contacts ([`held_contacts`]), the stability with
 /// the contacts held at the solution `x`: from the coarse mesh when its sign is clear there,
-/// else on the mesh asked ([`constrained_stability`]).
-fn held_contacts_stability(p: &mut Constrained<'_>, x: &[f64]) -> Option<Stability> {
-    coarse_stability(p)
-        .filter(|st| st.margin.abs() > COARSE_MARGIN_GAP)
-        .or_else(|| constrained_stability(p, x))
+/// else on the mesh asked ([`constrained_stability`]), whose compliance under contact is
+/// then kept in `frozen` (the solution's, read later without another march).
+fn held_contacts_stability(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+    frozen: Option<&Frozen>,
+) -> Option<Stability> {
+    if let Some(st) = coarse_stability(p).filter(|st| st.margin.abs() > COARSE_MARGIN_GAP) {
+        return Some(st);
+    }
+    let (st, c) = constrained_stability(p, x)?;
+    if let Some(f) = frozen {
+        let _ = f.value.set(Some(c));
+    }
+    Some(st)
 }
 
 /// The stability of the coarse mesh's solution ([`Constrained::coarse_stability`]) when it
@@ -399,9 +409,9 @@ pub(super) fn finish(
     let x: &[f64] = &polished;
     let forces = p.normal_forces(x);
     // The compliance under the constraints, on first read.
-    let compliance =
-        ContactCompliance::of((residual <= options.newton.tolerance).then(|| Frozen::at(p, x)));
-    let held_verdict = held_contacts(p).then(|| held_contacts_stability(p, x));
+    let frozen = (residual <= options.newton.tolerance).then(|| Frozen::at(p, x));
+    let held_verdict = held_contacts(p).then(|| held_contacts_stability(p, x, frozen.as_ref()));
+    let compliance = ContactCompliance::of(frozen);
     let Some(pass) = p.last.take() else {
         return fail(p, &options.newton, effort, 1.0, "no pass");
     };

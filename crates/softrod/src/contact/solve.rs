@@ -162,7 +162,7 @@ fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
         return;
     }
     // (The contacts held where they can be, from this pass: no march.)
-    let held = constrained_stability(p, xc);
+    let held = constrained_stability(p, xc).map(|(st, _)| st);
     p.coarse_stability = held
         .or_else(|| {
             p.last

@@ -193,8 +193,12 @@ pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
 /// obstacle's normal), which is exact when the rod with its tip clamped too and the contacts
 /// held has no conjugate point. `None` where it does not apply (a held tip, friction, a
 /// contact interval or belt, a triangle mesh, or a singular constrained problem): the
-/// contacts are then read as dead loads. The last pass of `p` is kept.
-pub(super) fn constrained_stability(p: &mut Constrained<'_>, x: &[f64]) -> Option<Stability> {
+/// contacts are then read as dead loads. Returns it with the compliance under contact (m,
+/// rad per N, N m; world) it was read from. The last pass of `p` is kept.
+pub(super) fn constrained_stability(
+    p: &mut Constrained<'_>,
+    x: &[f64],
+) -> Option<(Stability, Matrix6<f64>)> {
     if !held_contacts(p) {
         return None;
     }
@@ -212,5 +216,6 @@ pub(super) fn constrained_stability(p: &mut Constrained<'_>, x: &[f64]) -> Optio
         p.last = kept;
         c
     };
-    compliance_stability(&c?, p.model.length(), p.model.force_scale())
+    let c = c?;
+    compliance_stability(&c, p.model.length(), p.model.force_scale()).map(|st| (st, c))
 }
