@@ -10,6 +10,8 @@ contact solves; the KKT conditions of the minimum-norm program checked with an i
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -297,3 +299,42 @@ def test_pressure_columns_under_contact_match_central_differences():
     fd = np.array(cols).T
     assert np.abs(j - fd).max() <= 1e-6 * np.abs(fd).max()
     assert np.abs(j[0]).max() <= 1e-10 * np.abs(j).max()  # held along the plane's normal
+
+
+def test_a_target_past_the_fold_of_its_branch_is_reached_but_not_certified():
+    """A target whose least-norm actuations run into the fold where the rod would slide off
+    the sphere: no minimum of the norm can be certified there. The answer is the target reached
+    by the least change of the closest actuation (``reached``, not ``converged``), checked by a
+    fresh forward solve at the tensions returned; with ``throw`` a ConvergenceError, not
+    "unreachable"."""
+    robot = _niti(obstacles=[SPHERE])
+    t = [0.11561677469544662, 0.0, 1.0458587917754096, 0.7420743560444638, 1.8988485339962127, 0.0]
+    target = robot.solve(t).tip_position
+    inv = softrod.inverse_statics(robot, target, throw=False)
+    assert inv.reached and not inv.converged
+    assert np.all(inv.tensions >= 0.0)
+    fresh = robot.solve(inv.tensions)
+    assert np.linalg.norm(fresh.tip_position - target) <= 1e-9
+    _check_contact_solution(fresh, [SPHERE])
+    with pytest.raises(softrod.ConvergenceError) as err:
+        softrod.inverse_statics(robot, target)
+    assert not isinstance(err.value, softrod.TargetUnreachableError)
+
+
+def test_an_unstable_contact_answer_of_the_inverse_warns():
+    """A target made by an unstable forward contact equilibrium is reached on an unstable one:
+    the answer's own stability (its forward solve with the contacts held) decides the
+    warning; a stable answer to a target on the same sphere does not warn."""
+    robot = _niti(obstacles=[SPHERE])
+    target = robot.solve([1.333, 2.866, 0.0, 1.411, 2.745, 0.0], on_unstable="ignore").tip_position
+    with pytest.warns(softrod.StabilityWarning, match="unstable contact equilibrium"):
+        inv = softrod.inverse_statics(robot, target)
+    assert inv.converged
+    fresh = robot.solve(inv.tensions, on_unstable="ignore")
+    assert not fresh.stable and fresh.stability_margin < 0.0
+    assert np.linalg.norm(fresh.tip_position - target) <= 1e-9
+    target = robot.solve(TENSIONS).tip_position
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", softrod.StabilityWarning)
+        inv = softrod.inverse_statics(robot, target)
+    assert inv.converged and inv.solution.stable

@@ -13,6 +13,7 @@ at obstacles are refused (ParameterError naming ``robot``).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -36,6 +37,8 @@ class InverseSolution:
         rotation_error: Angle from the tip rotation to the target's (rad; 0 without one).
         iterations: Iterations of the SQP.
         converged: Whether the target was reached and the actuation is the minimum-norm one.
+        reached: Whether the target was reached within the tolerance (with obstacles it may be
+            reached without the minimum norm being certified: ``converged`` is then False).
     """
 
     tensions: np.ndarray
@@ -45,6 +48,7 @@ class InverseSolution:
     rotation_error: float
     iterations: int
     converged: bool
+    reached: bool = False
     # What the next call warm-started from this one reuses (the last evaluation, with its
     # Jacobian, and the Lagrangian Hessian), and the model it belongs to.
     _warm_state: Any = field(default=None, repr=False, compare=False)
@@ -133,6 +137,7 @@ def _from_core(out: dict, solution: Any, warm_state: Any, key: Any) -> InverseSo
         rotation_error=out["rotation_error"],
         iterations=out["iterations"],
         converged=out["converged"],
+        reached=out["reached"],
         _warm_state=warm_state,
         _model_key=key,
     )
@@ -216,6 +221,10 @@ def inverse_statics(
     Returns:
         The actuation, its forward solution and the remaining errors.
 
+    Warns:
+        StabilityWarning: With obstacles, the target is reached on an unstable equilibrium
+            (the contacts held; ``solution.stability_margin`` < 0).
+
     Raises:
         ParameterError: A bad argument (named); ``robot`` for what is not modelled (a tip
             constraint, tendon friction or guides, friction at an obstacle, a shape target
@@ -252,6 +261,15 @@ def inverse_statics(
         **extra,
         **({"obstacles": list(robot.obstacles)} if robot.obstacles else {}),
     )
+    if out.get("stable") is False and out["reached"]:
+        warnings.warn(
+            _core.StabilityWarning(
+                "the actuation found reaches the target on an unstable contact equilibrium "
+                f"(stability margin {out['stability_margin']:.4e} with the contacts held: the "
+                "tip tangent stiffness is not positive definite); see docs/stability.md"
+            ),
+            stacklevel=2,
+        )
     tensions, pressures = out["tensions"], out["pressures"]
     solution = _Deferred(
         lambda: robot.solve(
@@ -274,8 +292,10 @@ class InversePath:
         position_error: Distance from each tip to its target (m), shape (n_targets,).
         rotation_error: Angle to each target rotation (rad; 0 without one), shape (n_targets,).
         iterations: SQP iterations per target, shape (n_targets,).
-        converged: Whether each target was reached, shape (n_targets,).
+        converged: Whether each target was reached with the minimum-norm actuation, shape
+            (n_targets,).
         solutions: The forward statics solution of each target (a list of n_targets).
+        reached: Whether each target was reached within the tolerance, shape (n_targets,).
     """
 
     tensions: np.ndarray
@@ -286,6 +306,7 @@ class InversePath:
     iterations: np.ndarray
     converged: np.ndarray
     solutions: list
+    reached: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
     def __len__(self) -> int:
         return len(self.position_error)
@@ -389,4 +410,5 @@ def inverse_statics_path(
         iterations=np.array([r.iterations for r in rows], dtype=int),
         converged=np.array([r.converged for r in rows], dtype=bool),
         solutions=[r.solution for r in rows],
+        reached=np.array([r.reached for r in rows], dtype=bool),
     )

@@ -139,6 +139,7 @@ fn result_dict(py: Python<'_>, inv: softrod::InverseSolution) -> PyResult<Bound<
     d.set_item(intern!(py, "rotation_error"), inv.rotation_error)?;
     d.set_item(intern!(py, "iterations"), inv.iterations)?;
     d.set_item(intern!(py, "converged"), inv.converged)?;
+    d.set_item(intern!(py, "reached"), inv.reached)?;
     let state = InverseWarmState {
         inner: InverseWarmStart::from(inv),
     };
@@ -174,8 +175,9 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 
 /// Inverse statics of the robot `(rod, tendons, loads, chambers)` for a tip target (see
 /// `softrod.inverse_statics`). Returns a dict: `tensions`, `pressures`, `position_error` (m),
-/// `rotation_error` (rad), `iterations`, `converged` and `warm_state` (what a call
-/// warm-started from this one reuses).
+/// `rotation_error` (rad), `iterations`, `converged`, `reached`, `warm_state` (what a call
+/// warm-started from this one reuses) and, with obstacles, `stable` and `stability_margin` of
+/// the contact solution at the answer (when it is the last one solved).
 #[pyfunction]
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
                     target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
@@ -239,14 +241,32 @@ pub(crate) fn _inverse_statics<'py>(
                 ));
             }
             let mut fwd = softrod::ContactForward::new(model, &solve, &obstacles)?;
-            return softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_deref())
-                .map_err(actuator_names);
+            let inv = softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_deref())
+                .map_err(actuator_names)?;
+            // The stability of the contact solution at the answer, if it was the last solved.
+            let stability = fwd
+                .solution
+                .as_ref()
+                .filter(|s| {
+                    s.solution.tensions() == inv.tensions()
+                        && s.solution.pressures() == inv.pressures()
+                })
+                .map(|s| (s.solution.stable, s.solution.stability_margin()));
+            return Ok((inv, stability));
         }
         let mut fwd = softrod::CosseratForward::new(model, &solve, target.s.as_deref())
             .map_err(actuator_names)?;
-        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_deref()).map_err(actuator_names)
+        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_deref())
+            .map(|inv| (inv, None))
+            .map_err(actuator_names)
     })?;
-    result_dict(py, inv)
+    let (inv, stability) = inv;
+    let d = result_dict(py, inv)?;
+    if let Some((stable, margin)) = stability {
+        d.set_item(intern!(py, "stable"), stable)?;
+        d.set_item(intern!(py, "stability_margin"), margin)?;
+    }
+    Ok(d)
 }
 
 /// Inverse statics of the PCC robot `robot` under a tip wrench (`tip_force` N, `tip_moment`

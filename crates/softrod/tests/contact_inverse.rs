@@ -160,3 +160,55 @@ fn a_shape_target_and_a_rough_obstacle_are_refused_by_name() {
     .unwrap_err();
     assert!(err.to_string().contains("obstacles[0].friction"), "{err}");
 }
+
+/// A target whose least-norm actuations run into the fold of its contact branch (the rod
+/// about to slide off the sphere; past it the forward solve puts the rod on another side):
+/// no minimum of the norm is certified there, and the answer is the target reached by the
+/// least change of the closest actuation: `reached`, not `converged`. Checked by a fresh
+/// forward solve at the answer.
+#[test]
+fn a_target_past_the_fold_of_its_branch_is_reached_but_not_certified() {
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[0.0; 6]);
+    let (model, _) = common::split(&rod, &tendons, &[], &Loads::default()).unwrap();
+    let options = common::rk4_options(50);
+    let sphere = Obstacle::sphere([0.06, 0.0, 0.3], 0.04).unwrap();
+    let obstacles = [sphere.clone()];
+    // (Sample 76 of the 1,000 round trips on this sphere.)
+    let t = [
+        0.115_616_774_695_446_62,
+        0.0,
+        1.045_858_791_775_409_6,
+        0.742_074_356_044_463_8,
+        1.898_848_533_996_212_7,
+        0.0,
+    ];
+    let fwd =
+        solve_constrained(&model, &Actuation::tensions(&t), &options, None, &obstacles).unwrap();
+    assert_eq!(fwd.contacts.len(), 1);
+    let target = Target::tip(Vector3::from(fwd.solution.tip_position()));
+    let quiet = InverseOptions {
+        throw: false,
+        ..InverseOptions::default()
+    };
+    let (out, _) =
+        contact_inverse_statics(&model, &obstacles, &target, &quiet, &options, None).unwrap();
+    assert!(out.reached && !out.converged, "{out:?}");
+    assert!(out.actuation.iter().all(|&a| a >= 0.0));
+    let again = solve_constrained(
+        &model,
+        &Actuation::tensions(&out.actuation),
+        &options,
+        None,
+        &obstacles,
+    )
+    .unwrap();
+    let err = (Vector3::from(again.solution.tip_position()) - target.points[0]).norm();
+    assert!(err <= 1e-9, "{err:e}");
+    assert!(again
+        .solution
+        .position
+        .iter()
+        .all(|p| sphere.distance(&Vector3::from(*p)).0 - RADIUS >= -1e-9));
+    assert!(again.contacts.iter().all(|c| c.normal_force > 0.0));
+}

@@ -149,7 +149,9 @@ impl Forward for ContactForward {
 /// where the first iteration does not converge: from the contact-free inverse to the same
 /// target (the arm's shape without the obstacles, a start on the other side of a fold of the
 /// contact map), then from the last actuation with a fresh trust region and curvature. The
-/// first converged answer is returned, else the closest; the iterations are the total.
+/// first converged answer is returned; else, if the target is reached from the closest
+/// answer by the least change of its actuation, that (`reached`, not `converged`), else the
+/// closest; the iterations are the total.
 ///
 /// # Errors
 /// As [`solve_inverse`] (with `options.throw`: [`Error::TargetUnreachable`] with the
@@ -190,6 +192,14 @@ pub fn solve_contact_inverse(
             best = next;
         }
     }
+    if !best.converged && !best.reached {
+        if let Some(r) = restore(fwd, target, &quiet, &best.actuation) {
+            iterations += r.iterations;
+            if r.position_error < best.position_error {
+                best = r;
+            }
+        }
+    }
     best.iterations = iterations;
     if options.throw && !best.converged {
         if best.reached {
@@ -207,6 +217,29 @@ pub fn solve_contact_inverse(
         });
     }
     Ok(best)
+}
+
+/// The target reached from `a` by the least weighted change of the actuation (the program of
+/// `options` with `a` as its reference), when the minimum-norm iterations stop short of it:
+/// typically where the least-norm actuations run into a fold of the contact branch (the rod
+/// about to slide off a sphere), past which the forward solve lands on another side of the
+/// obstacle and no minimum of the norm can be certified. `None` unless the target is
+/// reached; the answer is then `reached` but not `converged` (its actuation is not the
+/// minimum-norm one).
+fn restore(
+    fwd: &mut ContactForward,
+    target: &Target,
+    options: &InverseOptions,
+    a: &[f64],
+) -> Option<InverseSolution> {
+    let nearest = InverseOptions {
+        reference: Some(a.to_vec()),
+        ..options.clone()
+    };
+    let from = InverseWarmStart::actuation(a.to_vec());
+    let mut out = solve_inverse(fwd, target, &nearest, Some(&from)).ok()?;
+    out.converged = false;
+    out.reached.then_some(out)
 }
 
 /// The inverse statics of `model` among the frictionless `obstacles` for a tip `target` (the
