@@ -266,9 +266,10 @@ def add_actuation(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_data_outputs(parser: argparse.ArgumentParser, what: str) -> None:
-    """``--csv FILE`` and ``--json FILE``."""
-    parser.add_argument("--csv", metavar="FILE", help=f"write {what} to CSV")
+def add_data_outputs(parser: argparse.ArgumentParser, what: str, rows: str | None = None) -> None:
+    """``--csv FILE`` and ``--json FILE``; ``rows`` says what a CSV row is."""
+    csv = f"write {what} to CSV" + (f" ({rows})" if rows else "")
+    parser.add_argument("--csv", metavar="FILE", help=csv)
     parser.add_argument("--json", metavar="FILE", help=f"write {what} to JSON")
 
 

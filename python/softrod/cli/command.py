@@ -180,7 +180,7 @@ def register(sub) -> None:
     inv.add_argument(
         "--tolerance", type=finite_float, help="tolerance on the distance to the target (m)"
     )
-    add_data_outputs(inv, "the actuation per target (CSV: one row per target)")
+    add_data_outputs(inv, "the actuation per target", "one row per target")
     files(inv, inputs=("robot",), outputs=("csv", "json"))
 
     def run(args: argparse.Namespace) -> int:

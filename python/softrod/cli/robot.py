@@ -324,7 +324,7 @@ def register(sub) -> None:
     so.add_argument(
         "--projections", action="store_true", help="add the top, front and side projections"
     )
-    add_data_outputs(so, "the solution (CSV: one row per mesh node)")
+    add_data_outputs(so, "the solution", "one row per mesh node")
     files(so, inputs=("robot",), outputs=("csv", "json", "plot"), figures=("plot",))
     so.set_defaults(func=_cmd_solve)
     add_figure_options(so, "plot")
@@ -343,7 +343,7 @@ def register(sub) -> None:
         help="arc lengths (m) of the ellipsoids (default: six nodes along the arm)",
     )
     co.add_argument("--gamma-plot", metavar="FILE", help="figure of gamma_c(s) per body axis")
-    add_data_outputs(co, "the compliance along the arm (CSV: one row per node, C in world)")
+    add_data_outputs(co, "the compliance along the arm", "one row per node, C in world")
     files(
         co,
         inputs=("robot",),
