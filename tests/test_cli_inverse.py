@@ -1,6 +1,7 @@
 """``softrod inverse``: the actuation printed and written reaches the target (checked by an
 independent forward solve at the tensions read back from the CSV); bad input is one line with
-exit status 2, a target out of reach exit status 3; inputs are never overwritten."""
+exit status 2, a target out of reach exit status 3 after every target was reported; inputs are
+never overwritten."""
 
 import csv
 import json
@@ -65,6 +66,25 @@ def test_bounds_are_honoured(capsys, tmp_path):
 def test_a_target_out_of_reach_exits_3_with_the_distance(capsys):
     status, _, err = _run(["inverse", "niti_two_segment", "--target", 0.3, 0.3, 0.0], capsys)
     assert status == 3 and "out of reach" in _one_error_line(err)
+
+
+def test_a_path_with_a_target_out_of_reach_reports_every_target(tmp_path, capsys):
+    """The target out of reach does not hide the others: both are printed and written (the
+    reachable one checked by an independent forward solve), then exit status 3 naming it."""
+    robot, a, _ = _targets()
+    out_csv = tmp_path / "inv.csv"
+    argv = ["inverse", NITI, "--target", 0.3, 0.3, 0.0, "--target", *a, "--csv", out_csv]
+    status, out, err = _run(argv, capsys)
+    line = _one_error_line(err)
+    assert status == 3 and "target 1 is not reached" in line and "1 of 2 targets" in line
+    assert "(target not reached)" in out and "converged True" in out
+    with open(out_csv, encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["converged"] for r in rows] == ["False", "True"]
+    assert [r["reached"] for r in rows] == ["False", "True"]
+    assert float(rows[0]["position_error"]) > 0.05  # (0.3, 0.3, 0) m: far outside the workspace
+    tensions = [float(rows[1][f"tension_{i}"]) for i in range(6)]
+    assert np.linalg.norm(robot.solve(tensions).tip_position - a) <= 1e-9
 
 
 @pytest.mark.parametrize(

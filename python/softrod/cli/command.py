@@ -2,7 +2,8 @@
 
 ``ROBOT`` is a robot file or the name of a shipped example. ``--target`` may be repeated: the
 targets are then a path, each warm-started from the last one reached
-(:func:`softrod.inverse_statics_path`).
+(:func:`softrod.inverse_statics_path`). Every target is solved, printed and written; a target
+that did not converge makes the exit status 3 after that.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import math
 
 import numpy as np
 
+from .._core import ConvergenceError
 from ._common import add_data_outputs, bad, files, finite_float, write_csv, write_json
 
 _ROBOT_HELP = "robot description file (TOML), or the name of a shipped example"
@@ -59,6 +61,7 @@ def _cmd_inverse(args) -> int:
         target_rotations=rotations,
         weights=args.weights,
         tolerance=args.tolerance,
+        throw=False,
         **kwargs,
     )
     print(f"robot: {robot.name} ({args.robot})")
@@ -75,13 +78,14 @@ def _cmd_inverse(args) -> int:
         print(
             f"  position error {path.position_error[k]:.2e} m{rot}, "
             f"iterations {path.iterations[k]}, converged {bool(path.converged[k])}"
+            + _status(path, k)
         )
     nt, nc = path.tensions.shape[1], path.pressures.shape[1]
     if args.csv:
         header = ["target_x", "target_y", "target_z"]
         header += [f"tension_{i}" for i in range(nt)] + [f"pressure_{i}" for i in range(nc)]
         header += ["tip_x", "tip_y", "tip_z", "position_error", "rotation_error"]
-        header += ["iterations", "converged"]
+        header += ["iterations", "converged", "reached"]
         rows = [
             [
                 *map(float, targets[k]),
@@ -92,6 +96,7 @@ def _cmd_inverse(args) -> int:
                 float(path.rotation_error[k]),
                 int(path.iterations[k]),
                 bool(path.converged[k]),
+                bool(path.reached[k]),
             ]
             for k in range(len(targets))
         ]
@@ -110,9 +115,36 @@ def _cmd_inverse(args) -> int:
                 "rotation_error": path.rotation_error,
                 "iterations": path.iterations,
                 "converged": path.converged,
+                "reached": path.reached,
             },
         )
-    return 0
+    return _verdict(path)
+
+
+def _status(path, k: int) -> str:
+    """What a target that did not converge got: reached without the least norm, or not."""
+    if path.converged[k]:
+        return ""
+    if path.reached[k]:
+        return " (target reached; the least norm is not certified)"
+    return " (target not reached)"
+
+
+def _verdict(path) -> int:
+    """0 when every target converged; else (after the results were printed and written) a
+    ConvergenceError naming the first target that did not (exit status 3)."""
+    missed = np.flatnonzero(~path.converged)
+    if not len(missed):
+        return 0
+    k = int(missed[0])
+    what = (
+        "was reached but the least-norm actuation is not certified"
+        if path.reached[k]
+        else "is not reached (out of reach, or the iterations stopped): remaining distance "
+        f"{path.position_error[k]:.3e} m"
+    )
+    more = f" ({len(missed)} of {len(path)} targets did not converge)" if len(path) > 1 else ""
+    raise ConvergenceError(f"target {k + 1} {what}{more}")
 
 
 def _check_rotation(values: list[float]) -> None:
@@ -135,8 +167,9 @@ def register(sub) -> None:
             "The minimum-norm actuation (least norm of the actuator forces, inside the bounds) "
             "that puts the tip of ROBOT at the target; the robot file's loads and gravity apply, "
             "its tensions and pressures are replaced. A repeated --target is a path, each target "
-            "warm-started from the last. A target out of reach exits with status 3 and the "
-            "remaining distance."
+            "warm-started from the last. Every target's result is printed and written; if one "
+            "did not converge (out of reach, or reached without the least norm certified) the "
+            "exit status is 3, with the first such target and its remaining distance."
         ),
     )
     inv.add_argument("robot", metavar="ROBOT", help=_ROBOT_HELP)
