@@ -16,7 +16,7 @@ use crate::cosserat::equations::{rot, v3};
 use crate::cosserat::statics::{scaled, solve_statics, Integrator, SolveOptions, COARSE_TOLERANCE};
 use crate::error::{Error, Result};
 use crate::model::{Actuation, RobotModel};
-use crate::solve::{Evaluated, Problem};
+use crate::solve::{Evaluated, NewtonOptions, Problem};
 
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
 /// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
@@ -89,21 +89,25 @@ pub fn solve_constrained(
         (p.refine, p.rough) = (false, true);
         let mut start = *options;
         start.newton.tolerance = options.newton.tolerance.max(COARSE_TOLERANCE);
-        let reached = reach(&mut p, &start, &mut effort);
-        at_coarse_solution(&mut p, &reached);
-        (p.refine, p.rough) = (true, false);
-        if let Reach::Done(xc) = reached {
-            p.integrator = options.integrator;
-            p.coarse = Some(coarse);
-            p.last = None;
-            p.load = 1.0;
-            p.hint = p.solved.take();
-            if let Some(x) = active_set(&mut p, &xc, &options.newton, &mut effort) {
+        if let Reach::Done(xc) = reach(&mut p, &start, &mut effort) {
+            at_coarse_solution(&mut p, &xc);
+            if let Some(x) = refined(&mut p, options, coarse, &xc, &mut effort) {
                 return finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort);
             }
         }
         if let Some(e) = refusal(&p) {
             return Err(e);
+        }
+        if p.pathless && p.crossing {
+            // Past the middle of an obstacle: the load path followed on the coarse mesh
+            // (each step there costs a fifth), then Newton on the mesh asked from its end.
+            p.pathless = false;
+            if let Some(xc) = step_actuation(&mut p, (coarse, true), &start.newton, &mut effort) {
+                at_coarse_solution(&mut p, &xc);
+                if let Some(x) = refined(&mut p, options, coarse, &xc, &mut effort) {
+                    return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
+                }
+            }
         }
         // Else the mesh asked from the start (its iterations and load steps are those
         // reported; the evaluations count both).
@@ -148,14 +152,11 @@ fn refusal(p: &Constrained<'_>) -> Option<Error> {
     })
 }
 
-/// The exact Jacobian of the coarse mesh at its solution, if `reached` (one march with the
-/// columns), handed to Newton on the mesh asked in place of the updated one of the last
-/// coarse solve (taken where the iterate was still far), and with a free tip the stability
-/// of the coarse solution from it (see [`jacobian_stability`]).
-fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
-    let Reach::Done(xc) = reached else {
-        return;
-    };
+/// The exact Jacobian of the coarse mesh at its solution `xc` (one march with the columns),
+/// handed to Newton on the mesh asked in place of the updated one of the last coarse solve
+/// (taken where the iterate was still far), and with a free tip the stability of the coarse
+/// solution from it (see [`jacobian_stability`]).
+fn at_coarse_solution(p: &mut Constrained<'_>, xc: &[f64]) {
     let n = p.dim();
     let (mut j, mut r) = (vec![0.0; n * n], vec![0.0; n]);
     if p.evaluate(xc, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
@@ -176,6 +177,24 @@ fn at_coarse_solution(p: &mut Constrained<'_>, reached: &Reach) {
 /// The coarse mesh of the contact solve with `integrator` ([`Integrator::coarse`]).
 pub(super) fn coarse_mesh(integrator: Integrator) -> Option<Integrator> {
     integrator.coarse()
+}
+
+/// Newton on the mesh asked (`options`) from the coarse solution `xc`, with the coarse
+/// Jacobian there (see [`at_coarse_solution`]) and the active set checked on the mesh asked.
+fn refined(
+    p: &mut Constrained<'_>,
+    options: &SolveOptions,
+    coarse: Integrator,
+    xc: &[f64],
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    (p.refine, p.rough) = (true, false);
+    p.integrator = options.integrator;
+    p.coarse = Some(coarse);
+    p.last = None;
+    p.load = 1.0;
+    p.hint = p.solved.take();
+    active_set(p, xc, &options.newton, effort)
 }
 
 /// The problem `p` back at the unloaded rod on the mesh `integrator`, with no contacts.
@@ -205,16 +224,7 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
         }
     }
     p.pathless = false;
-    restart(p, options.integrator);
-    let (s, radius) = ramp::samples(p);
-    let full = (p.tensions.clone(), p.pressures.clone());
-    let stepped = ramp::rest_nodes(p).map(<[_]>::to_vec).and_then(|rest| {
-        let (t, q) = (&full.0, &full.1);
-        ramp::stepped(p, (t, q), (&s, &radius, rest), &options.newton, effort)
-    });
-    (p.tensions, p.pressures) = full;
-    p.load = 1.0;
-    if let Some(x) = stepped {
+    if let Some(x) = step_actuation(p, (options.integrator, false), &options.newton, effort) {
         return Reach::Stepped(x);
     }
     if p.crossing {
@@ -229,6 +239,29 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
     restart(p, options.integrator);
     p.pathless_ok = true;
     reach(p, options, effort)
+}
+
+/// The solve with the actuation stepped with the loads from the unactuated rod on the mesh
+/// `integrator` ([`ramp::stepped`]; `rough`: that mesh is the coarse one, whose solution
+/// only starts Newton on the mesh asked): the unknowns at full load, with the full actuation
+/// restored in `p` either way.
+fn step_actuation(
+    p: &mut Constrained<'_>,
+    (integrator, rough): (Integrator, bool),
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    restart(p, integrator);
+    (p.refine, p.rough) = (!rough, rough);
+    let (s, radius) = ramp::samples(p);
+    let full = (p.tensions.clone(), p.pressures.clone());
+    let stepped = ramp::rest_nodes(p).map(<[_]>::to_vec).and_then(|rest| {
+        let (t, q) = (&full.0, &full.1);
+        ramp::stepped(p, (t, q), (&s, &radius, rest), opts, effort)
+    });
+    (p.tensions, p.pressures) = full;
+    p.load = 1.0;
+    stepped
 }
 
 /// What [`reach`] reached.
