@@ -381,15 +381,17 @@ fn not_crossed(
     if !ramp::crossed(p, (&ramp::positions_on(&rest, &s), &shape), &radius, depth) {
         return Ok(x);
     }
-    // Stepped on the mesh asked.
-    (p.integrator, p.coarse, p.refine, p.rough) = (options.integrator, None, true, false);
-    let full = (p.tensions.clone(), p.pressures.clone());
-    let stepped = ramp::stepped(
-        p,
-        (&full.0, &full.1),
-        (&s, &radius, rest),
-        &options.newton,
-        effort,
-    );
-    stepped.ok_or("the rod crossed a thin obstacle on its way from the unactuated rod, and stepping the actuation with the loads past it failed")
+    // Stepped on the coarse mesh if the solve has one (then Newton on the mesh asked from its
+    // end), else, or if that fails, on the mesh asked.
+    if let Some(coarse) = p.coarse {
+        let mut start = options.newton;
+        start.tolerance = start.tolerance.max(COARSE_TOLERANCE);
+        if let Some(xc) = step_actuation(p, (coarse, true), &start, effort) {
+            at_coarse_solution(p, &xc);
+            if let Some(x) = refined(p, options, coarse, &xc, effort) {
+                return Ok(x);
+            }
+        }
+    }
+    step_actuation(p, (options.integrator, false), &options.newton, effort).ok_or("the rod crossed a thin obstacle on its way from the unactuated rod, and stepping the actuation with the loads past it failed")
 }
