@@ -243,15 +243,17 @@ pub(crate) fn _inverse_statics<'py>(
             let mut fwd = softrod::ContactForward::new(model, &solve, &obstacles)?;
             let inv = softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_deref())
                 .map_err(actuator_names)?;
-            // The stability of the contact solution at the answer, if it was the last solved.
-            let stability = fwd
-                .solution
-                .as_ref()
-                .filter(|s| {
-                    s.solution.tensions() == inv.tensions()
-                        && s.solution.pressures() == inv.pressures()
-                })
-                .map(|s| (s.solution.stable, s.solution.stability_margin()));
+            // The stability of the contact solution at the answer (the last one solved, or
+            // solved again) when the target was reached.
+            let last = fwd.solution.take().filter(|s| {
+                s.solution.tensions() == inv.tensions() && s.solution.pressures() == inv.pressures()
+            });
+            let at_answer = match last {
+                Some(s) => Some(s),
+                None if inv.reached => fwd.solve(&inv.actuation).ok(),
+                None => None,
+            };
+            let stability = at_answer.map(|s| (s.solution.stable, s.solution.stability_margin()));
             return Ok((inv, stability));
         }
         let mut fwd = softrod::CosseratForward::new(model, &solve, target.s.as_deref())

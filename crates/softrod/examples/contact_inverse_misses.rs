@@ -21,8 +21,8 @@ use softrod::{
 /// gradient of the distance projected on the bounds, the forward solve along the
 /// Gauss–Newton step against its linearisation, cold and warm-started solves at tiny
 /// fractions of that step, and the distance along the segment to the generating tensions
-/// (not for a target reached without the least norm certified, nor with `ANALYSE=0`); then
-/// the count. docs/command.md "With obstacles" quotes its output.
+/// (not for a target reached without the least norm certified, nor with `ANALYSE=0`); per
+/// converged answer on an unstable equilibrium its margin; then the counts. docs/command.md "With obstacles" quotes its output.
 fn main() {
     let which: usize = std::env::var("SPHERE")
         .ok()
@@ -43,7 +43,7 @@ fn main() {
     let options = common::rk4_options(50);
     let obstacles = [sphere.clone()];
     let mut rng = Rng(0x5eed);
-    let (mut touching, mut missed, mut reached) = (0, 0, 0);
+    let (mut touching, mut missed, mut reached, mut unstable) = (0, 0, 0, 0);
     let analyse = std::env::var("ANALYSE").map_or(true, |v| v != "0");
     for k in 0..samples {
         let t = rng.admissible();
@@ -63,6 +63,14 @@ fn main() {
         let (out, sol) =
             contact_inverse_statics(&model, &obstacles, &target, &inv, &options, None).unwrap();
         if out.converged {
+            if !sol.solution.stable {
+                unstable += 1;
+                println!(
+                    "#{k} converged on an unstable equilibrium: margin {:.3e} (target's {:.3e})",
+                    sol.solution.stability_margin(),
+                    f.solution.stability_margin()
+                );
+            }
             continue;
         }
         missed += 1;
@@ -98,7 +106,10 @@ fn main() {
             analyse_miss(&model, &options, &obstacles, &target, &t, &out);
         }
     }
-    println!("missed {missed} of {touching} ({reached} of them reached, not certified)");
+    println!(
+        "missed {missed} of {touching} ({reached} of them reached, not certified); \
+         {unstable} converged on an unstable equilibrium"
+    );
 }
 
 /// The measurements of one miss of `main` (printed): the contact-free
