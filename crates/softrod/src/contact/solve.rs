@@ -90,8 +90,7 @@ pub fn solve_constrained(
         let mut start = *options;
         start.newton.tolerance = options.newton.tolerance.max(COARSE_TOLERANCE);
         if let Reach::Done(xc) = reach(&mut p, &start, &mut effort) {
-            at_coarse_solution(&mut p, &xc);
-            if let Some(x) = refined(&mut p, options, coarse, &xc, &mut effort) {
+            if let Some(x) = refined(&mut p, options, (coarse, Verdict::Coarse), &xc, &mut effort) {
                 return finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort);
             }
         }
@@ -103,7 +102,8 @@ pub fn solve_constrained(
             // (each step there costs a fifth), then Newton on the mesh asked from its end.
             p.pathless = false;
             if let Some(xc) = step_actuation(&mut p, (coarse, true), &start.newton, &mut effort) {
-                if let Some(x) = refined_from_path(&mut p, options, coarse, &xc, &mut effort) {
+                let path = (coarse, Verdict::Asked);
+                if let Some(x) = refined(&mut p, options, path, &xc, &mut effort) {
                     return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
                 }
             }
@@ -178,15 +178,31 @@ pub(super) fn coarse_mesh(integrator: Integrator) -> Option<Integrator> {
     integrator.coarse()
 }
 
-/// Newton on the mesh asked (`options`) from the coarse solution `xc`, with the coarse
-/// Jacobian there (see [`at_coarse_solution`]) and the active set checked on the mesh asked.
+/// Where the stability verdict of a solution refined from the coarse mesh is taken.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Verdict {
+    /// On the coarse mesh when its margin is clear (see [`at_coarse_solution`]).
+    Coarse,
+    /// On the mesh asked: after a load path stepped on the coarse mesh, whose margin at the
+    /// path's end can be further off (3e-4 relative on the rod resting on the cylinder of
+    /// `tests/contact_stability.rs`), as when the path was stepped on the mesh asked.
+    Asked,
+}
+
+/// Newton on the mesh asked (`options`) from the coarse solution `xc`, with the exact coarse
+/// Jacobian there (see [`at_coarse_solution`]) and the active set checked on the mesh asked;
+/// the stability verdict taken where `verdict` says.
 fn refined(
     p: &mut Constrained<'_>,
     options: &SolveOptions,
-    coarse: Integrator,
+    (coarse, verdict): (Integrator, Verdict),
     xc: &[f64],
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
+    at_coarse_solution(p, xc);
+    if verdict == Verdict::Asked {
+        p.coarse_stability = None;
+    }
     (p.refine, p.rough) = (true, false);
     p.integrator = options.integrator;
     p.coarse = Some(coarse);
@@ -194,22 +210,6 @@ fn refined(
     p.load = 1.0;
     p.hint = p.solved.take();
     active_set(p, xc, &options.newton, effort)
-}
-
-/// [`refined`] from the end `xc` of a load path stepped on the coarse mesh, with its exact
-/// Jacobian there; the stability verdict is left to the mesh asked, as when the path was
-/// stepped there (the coarse margin at a path's end can be further off: 3e-4 relative on the
-/// rod resting on the cylinder of `tests/contact_stability.rs`).
-fn refined_from_path(
-    p: &mut Constrained<'_>,
-    options: &SolveOptions,
-    coarse: Integrator,
-    xc: &[f64],
-    effort: &mut Effort,
-) -> Option<Vec<f64>> {
-    at_coarse_solution(p, xc);
-    p.coarse_stability = None;
-    refined(p, options, coarse, xc, effort)
 }
 
 /// The problem `p` back at the unloaded rod on the mesh `integrator`, with no contacts.
@@ -402,7 +402,7 @@ fn not_crossed(
         let mut start = options.newton;
         start.tolerance = start.tolerance.max(COARSE_TOLERANCE);
         if let Some(xc) = step_actuation(p, (coarse, true), &start, effort) {
-            if let Some(x) = refined_from_path(p, options, coarse, &xc, effort) {
+            if let Some(x) = refined(p, options, (coarse, Verdict::Asked), &xc, effort) {
                 return Ok(x);
             }
         }
