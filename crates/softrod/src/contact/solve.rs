@@ -153,23 +153,26 @@ fn refusal(p: &Constrained<'_>) -> Option<Error> {
 
 /// The exact Jacobian of the coarse mesh at its solution `xc` (one march with the columns),
 /// handed to Newton on the mesh asked in place of the updated one of the last coarse solve
-/// (taken where the iterate was still far), and with a free tip the stability of the coarse
-/// solution from it (see [`jacobian_stability`]).
-fn at_coarse_solution(p: &mut Constrained<'_>, xc: &[f64]) {
+/// (taken where the iterate was still far), and with a free tip and `verdict` on the coarse
+/// mesh the stability of the coarse solution from it (see [`jacobian_stability`]).
+fn at_coarse_solution(p: &mut Constrained<'_>, xc: &[f64], verdict: Verdict) {
+    p.coarse_stability = None;
     let n = p.dim();
     let (mut j, mut r) = (vec![0.0; n * n], vec![0.0; n]);
     if p.evaluate(xc, 1.0, Some(&mut j), &mut r) != Evaluated::Jacobian {
         return;
     }
-    // (The contacts held where they can be, from this pass: no march.)
-    let held = constrained_stability(p, xc).map(|(st, _)| st);
-    p.coarse_stability = held
-        .or_else(|| {
-            p.last
-                .as_ref()
-                .and_then(|pass| jacobian_stability(p, pass, xc))
-        })
-        .map(|st| (p.active.clone(), st));
+    if verdict == Verdict::Coarse {
+        // (The contacts held where they can be, from this pass: no march.)
+        let held = constrained_stability(p, xc).map(|(st, _)| st);
+        p.coarse_stability = held
+            .or_else(|| {
+                p.last
+                    .as_ref()
+                    .and_then(|pass| jacobian_stability(p, pass, xc))
+            })
+            .map(|st| (p.active.clone(), st));
+    }
     p.solved = Some((p.active.clone(), j));
 }
 
@@ -199,10 +202,7 @@ fn refined(
     xc: &[f64],
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    at_coarse_solution(p, xc);
-    if verdict == Verdict::Asked {
-        p.coarse_stability = None;
-    }
+    at_coarse_solution(p, xc, verdict);
     (p.refine, p.rough) = (true, false);
     p.integrator = options.integrator;
     p.coarse = Some(coarse);
