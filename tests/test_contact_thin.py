@@ -75,3 +75,28 @@ def test_a_wire_crossed_on_the_way_from_the_straight_rod_is_met(free, k, frac, w
     radius = robot.rod.section.radius
     assert _least_gap_on_chords(p, capsule, radius) > 0.0
     _assert_rests_on_the_straight_side(robot, capsule, mid)
+
+
+def test_a_rod_that_cannot_pass_a_thin_obstacle_stops_with_the_load_factor_reached(free):
+    """The NiTi robot pressed across a capsule whose contact slides off its end at 80.5 % of
+    the tensions, where the contact-free shape passes through the capsule: where the rod
+    lands after that snap is not determined, and the solve says so. With ``throw=False`` it
+    returns the last load step's state (not converged, its load factor, the residual of the
+    balance at the full tensions); with ``throw`` a ``ConvergenceError`` carries the same."""
+    robot, _ = free
+    capsule = sr.Capsule((0.04, -0.05, 0.25), (0.04, 0.05, 0.25), 0.008)
+    arm = sr.Robot(robot.rod, tendons=robot.tendons, obstacles=[capsule])
+    tensions = [1.5882, 1.6902, 0.0319, 1.4133, 0.3265, 0.0811]
+    # The load path: pressed on the capsule's near side, the contact near its end (y = 50 mm).
+    near = arm.solve(0.8 * np.asarray(tensions))
+    assert near.converged and len(near.contacts) == 1
+    c = near.contacts[0]
+    assert c["normal"][0] < -0.9 and 0.045 < c["point"][1] < 0.05
+    sol = arm.solve(tensions, throw=False)
+    assert not sol.converged
+    assert 0.8 < sol.stats["load_factor"] < 0.81
+    assert sol.stats["residual"] > 1e-3
+    with pytest.raises(sr.ConvergenceError, match="crossed a thin obstacle") as info:
+        arm.solve(tensions)
+    assert info.value.load_factor == pytest.approx(sol.stats["load_factor"])
+    assert info.value.residual == pytest.approx(sol.stats["residual"])

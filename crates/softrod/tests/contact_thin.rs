@@ -3,12 +3,19 @@
 //! node comes near the wire, so a check of the nodes alone lets the rod pass through it; the
 //! gap is also checked along the arc between the nodes, and the wire props the cantilever
 //! with the closed-form reaction `R = (F c² (3L - c) / (6 E I) - δ) 3 E I / c³`.
+//!
+//! A rod that slides off the end of a thin obstacle it was pressed on: the two-segment NiTi
+//! robot bent across a capsule (radius 8 mm, axis along `y` from -50 to 50 mm). Along the
+//! load path (checked at 60 % and 62 % of the tensions) the rod presses on the capsule's near
+//! side and its contact slides along the axis toward the end; past the end (62.7 %) there
+//! is no equilibrium on that side and the rod snaps free. Oracle: the contact-free solve (no
+//! obstacle) at the full tensions, whose shape is clear of the capsule on its far side.
 #![allow(clippy::unwrap_used, missing_docs)]
 
 mod common;
 
 use softrod::nalgebra::Vector3;
-use softrod::{solve_constrained, Actuation, Loads, Obstacle, RobotModel};
+use softrod::{solve_constrained, Actuation, Loads, Obstacle, RobotModel, SolveOptions};
 
 use common::{beam as rod, rk4_options as options, BEAM_E as E, BEAM_LENGTH as L, BEAM_NU as NU};
 
@@ -93,4 +100,57 @@ fn a_wire_between_two_nodes_props_the_cantilever() {
             );
         }
     }
+}
+
+#[test]
+fn the_niti_robot_slides_off_the_end_of_a_capsule_and_snaps_free() {
+    let t = [
+        0.264_747_984_257_505_2,
+        2.180_351_781_701_029,
+        0.504_262_202_902_081_9,
+        0.353_654_675_678_841_46,
+        2.609_703_895_885_274_5,
+        0.959_686_396_973_821,
+    ];
+    let (a, b) = ([0.04, -0.05, 0.25], [0.04, 0.05, 0.25]);
+    let capsule = Obstacle::capsule(a, b, 0.008).unwrap();
+    let rod = common::niti_rod();
+    let radius = 0.7e-3;
+    let solve = |scale: f64, obstacles: &[Obstacle]| {
+        let (model, act) = common::split(
+            &rod,
+            &common::niti_tendons(&t.map(|v| scale * v)),
+            &[],
+            &Loads::default(),
+        )
+        .unwrap();
+        solve_constrained(&model, &act, &SolveOptions::default(), None, obstacles).unwrap()
+    };
+    // The load path: pressed on the near side (normal along -x), sliding toward y = -50 mm.
+    let mut y = 0.0;
+    for scale in [0.60, 0.62] {
+        let sol = solve(scale, std::slice::from_ref(&capsule));
+        assert_eq!(sol.contacts.len(), 1, "{scale}: {:?}", sol.contacts);
+        let k = sol.contacts[0];
+        println!("{scale} T: contact at {:?}, normal {:?}", k.point, k.normal);
+        assert!(k.normal[0] < -0.9 && k.normal_force > 0.0);
+        assert!(k.point[1] < y && k.point[1] > -0.05);
+        y = k.point[1];
+    }
+    let sol = solve(1.0, std::slice::from_ref(&capsule));
+    let free = solve(1.0, &[]);
+    assert!(sol.solution.stats.converged && sol.solution.stable);
+    assert!(sol.contacts.is_empty(), "{:?}", sol.contacts);
+    let (tip, want) = (
+        Vector3::from(sol.solution.tip_position()),
+        Vector3::from(free.solution.tip_position()),
+    );
+    println!("tip {tip:?}, contact-free {want:?}");
+    assert!((tip - want).norm() < 1e-12);
+    let least = least_gap_on_chords(&free.solution.position, &capsule, radius);
+    println!("least gap of the contact-free shape {least:e} m");
+    assert!(least > 1e-3);
+    // Beyond the capsule: the backbone where it touched (s = 0.26 m) has passed its axis.
+    let node = free.solution.s.iter().position(|&s| s >= 0.26).unwrap();
+    assert!(free.solution.position[node][0] > a[0] + 0.008);
 }

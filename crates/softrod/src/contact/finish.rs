@@ -20,7 +20,7 @@ use crate::cosserat::statics::{assemble, scaled_back, stability_on, Integrator, 
 use crate::cosserat::{tip_stability, Stability, NEUTRAL_MARGIN};
 use crate::error::{Error, Result};
 use crate::model::{Actuation, RobotModel};
-use crate::solve::{max_norm, Evaluated, NewtonOptions, Problem, SolverStats};
+use crate::solve::{max_norm, Evaluated, Problem, SolverStats};
 
 /// Stability margin on the coarse mesh beyond which its sign decides whether a contact
 /// solution is stable (closer to zero, the margin is computed on the mesh asked).
@@ -102,19 +102,19 @@ impl Frozen {
 /// The error (or, without `throw`, nothing better to return) of a failed solve.
 pub(super) fn fail(
     p: &Constrained<'_>,
-    opts: &NewtonOptions,
     effort: &Effort,
     lambda: f64,
     why: &str,
 ) -> Result<ContactSolution> {
-    let _ = opts;
+    let held = if p.tip.is_some() { "held tip" } else { "free tip" };
+    let kind = if p.obstacles.is_empty() { "" } else { " and contact" };
     Err(Error::NotConverged {
-        what: format!("constrained shooting (tip constraint, contact): {why}"),
+        what: format!("constrained shooting ({held}{kind}; {why})"),
         iterations: effort.iterations,
         residual: p
             .last
             .as_ref()
-            .map_or(f64::INFINITY, |l| max_norm(l.residual.as_slice())),
+            .map_or(f64::INFINITY, |l| max_norm(&l.rows)),
         load_factor: lambda,
     })
 }
@@ -400,7 +400,6 @@ pub(super) fn finish(
     let Some((polished, residual)) = reached else {
         return fail(
             p,
-            &options.newton,
             effort,
             1.0,
             "the solution could not be integrated",
@@ -413,7 +412,7 @@ pub(super) fn finish(
     let held_verdict = held_contacts(p).then(|| held_contacts_stability(p, x, frozen.as_ref()));
     let compliance = ContactCompliance::of(frozen);
     let Some(pass) = p.last.take() else {
-        return fail(p, &options.newton, effort, 1.0, "no pass");
+        return fail(p, effort, 1.0, "no pass");
     };
     let free_stability = held_verdict.unwrap_or_else(|| jacobian_stability(p, &pass, x));
     let held = pass.held.clone();
@@ -477,7 +476,6 @@ pub(super) fn finish(
     if !sol.stats.converged && options.newton.throw {
         return fail(
             p,
-            &options.newton,
             effort,
             1.0,
             "the residual at the solution is above the tolerance",

@@ -23,7 +23,7 @@ use super::active_set::active_set;
 use super::belt;
 use super::newton::Effort;
 use super::obstacle::Obstacle;
-use super::problem::{Constrained, Pass, Site};
+use super::problem::{Active, Constrained, Pass, Site};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
 use crate::cosserat::equations::v3;
 use crate::cosserat::shooting::Node;
@@ -285,6 +285,37 @@ pub(super) fn past_middle(
     })
 }
 
+/// The shape `at` (at the samples, radii `radius`) slid off the obstacles of finite thickness
+/// it touches in `touched`: every sample moved by one vector that sums, for each such
+/// obstacle, its thickness plus the rod's diameter along the way the sample nearest to it
+/// moved on the last step (from `before`), less its part along the obstacle's normal. A rod
+/// that snaps when its contact slides off an obstacle's end (the edge of a cylinder, the cap
+/// of a capsule) passes there on its way to where it lands. `None` if nothing slid.
+fn slid_off(
+    p: &Constrained<'_>,
+    touched: &[Active],
+    (before, at): (&[Vector3<f64>], &[Vector3<f64>]),
+    radius: &[f64],
+) -> Option<Vec<Vector3<f64>>> {
+    let mut shift = Vector3::zeros();
+    for a in touched {
+        let o = &p.obstacles[a.obstacle];
+        let Some(t) = thickness(o) else {
+            continue;
+        };
+        let gap = |k: usize| o.distance(&at[k]).0 - radius[k];
+        let k = (0..at.len()).min_by(|&i, &j| gap(i).total_cmp(&gap(j)))?;
+        let n = o.distance(&at[k]).1;
+        let moved = at[k] - before.get(k)?;
+        let slide = moved - n * n.dot(&moved);
+        if slide.norm() <= f64::EPSILON * p.model.length() {
+            continue;
+        }
+        shift += slide.normalize() * (t + 2.0 * radius[k]);
+    }
+    (shift != Vector3::zeros()).then(|| at.iter().map(|x| x + shift).collect())
+}
+
 /// The tip contacts whose gap (at the tip, on an obstacle free of friction and not touched
 /// at the tip), extrapolated linearly from its value at the step accepted before (in `gaps`,
 /// replaced by those of the last pass), closes within the next step of the same length.
@@ -320,13 +351,16 @@ fn closing_tips(p: &Constrained<'_>, gaps: &mut Vec<f64>) -> Vec<(usize, Site, f
 /// leaves that secant ([`on_secant`]) or adds a contact past the middle of its obstacle seen
 /// from the previous step, and below [`SNAP_STEP`] the rod snaps to the solve from the
 /// contact-free shape at that load factor unless it crossed an obstacle.
+///
+/// Failing, the unknowns of the last step accepted (at load factor `p.from`, the active set
+/// left as it was there).
 pub(super) fn stepped(
     p: &mut Constrained<'_>,
     (tensions, pressures): (&[f64], &[f64]),
     (s, radius, rest): (&[f64], &[f64], Vec<Node>),
     opts: &NewtonOptions,
     effort: &mut Effort,
-) -> Option<Vec<f64>> {
+) -> Result<Vec<f64>, Vec<f64>> {
     let depth = 10.0 * opts.tolerance * p.model.length();
     let mut previous = positions_on(&rest, s);
     p.approach = Some(rest);
@@ -393,18 +427,29 @@ pub(super) fn stepped(
                 .then_some((xn, shape))
         });
         let shape = shape.or_else(|| {
-            if !(faithful && next - lambda <= SNAP_STEP) {
+            // The last step before the stepping stops, and the only one where stepping for
+            // obstacles crossed on the way snaps.
+            let last = 0.5 * step < MIN_LOAD_INCREMENT;
+            if !(last || faithful && next - lambda <= SNAP_STEP) {
                 return None;
             }
             // The branch ends (a fold): the rod snaps. It lands where the solve at this load
             // factor from the contact-free shape puts it, unless it crossed an obstacle on
-            // the way there (a new contact past the middle of its obstacle, seen from the
-            // last step, is refused by the active set).
-            p.active.clear();
+            // the way there: straight, or (at the last step) after sliding off the obstacles
+            // it touched. A new contact past the middle of its obstacle, seen from the last
+            // step, is refused by the active set.
+            let touched = std::mem::take(&mut p.active);
+            let off = along.filter(|_| last).and_then(|(_, _, before)| {
+                slid_off(p, &touched, (before, &previous), radius)
+            });
             p.last = None;
             let xn = active_set(p, &[0.0; 6], opts, effort)?;
             let shape = positions_at(p.last.as_ref()?, s);
-            let landed = !crossed(p, (&previous[..], &shape[..]), radius, depth);
+            let landed = !crossed(p, (&previous[..], &shape[..]), radius, depth)
+                || off.is_some_and(|off| {
+                    !crossed(p, (&previous[..], &off[..]), radius, depth)
+                        && !crossed(p, (&off[..], &shape[..]), radius, depth)
+                });
             landed.then_some((xn, shape))
         });
         match shape {
@@ -428,11 +473,11 @@ pub(super) fn stepped(
                 step *= 0.5;
                 if step < MIN_LOAD_INCREMENT {
                     (p.path, p.approach) = (None, None);
-                    return None;
+                    return Err(x);
                 }
             }
         }
     }
     (p.path, p.approach) = (None, None);
-    Some(x)
+    Ok(x)
 }

@@ -101,7 +101,7 @@ pub fn solve_constrained(
             // Past the middle of an obstacle: the load path followed on the coarse mesh
             // (each step there costs a fifth), then Newton on the mesh asked from its end.
             p.pathless = false;
-            if let Some(xc) = step_actuation(&mut p, (coarse, true), &start.newton, &mut effort) {
+            if let Ok(xc) = step_actuation(&mut p, (coarse, true), &start.newton, &mut effort) {
                 let path = (coarse, Verdict::Asked);
                 if let Some(x) = refined(&mut p, options, path, &xc, &mut effort) {
                     return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
@@ -124,7 +124,7 @@ pub fn solve_constrained(
         }
         Reach::Stepped(x) => finish(&mut p, model, actuation, options, &x, &effort, 1.0),
         Reach::Stopped { lambda, why, .. } if options.newton.throw => {
-            fail(&p, &options.newton, &effort, lambda, why)
+            fail(&p, &effort, lambda, why)
         }
         Reach::Stopped { x, lambda, .. } => {
             p.load = 1.0;
@@ -239,15 +239,16 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
         }
     }
     p.pathless = false;
-    if let Some(x) = step_actuation(p, (options.integrator, false), &options.newton, effort) {
-        return Reach::Stepped(x);
-    }
+    let x = match step_actuation(p, (options.integrator, false), &options.newton, effort) {
+        Ok(x) => return Reach::Stepped(x),
+        Err(x) => x,
+    };
     if p.crossing {
         return Reach::Stopped {
-            x: vec![0.0; 6],
-            lambda: 0.0,
-            why: "the actuated rod runs past the middle of an obstacle, and stepping the \
-                  actuation with the loads up to it failed",
+            x,
+            lambda: p.from,
+            why: "the actuated rod runs past the middle of an obstacle, and the load path \
+                  stepped toward it stops",
         };
     }
     *effort = Effort::default();
@@ -258,22 +259,25 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
 
 /// The solve with the actuation stepped with the loads from the unactuated rod on the mesh
 /// `integrator` ([`ramp::stepped`]; `rough`: that mesh is the coarse one, whose solution
-/// only starts Newton on the mesh asked): the unknowns at full load, with the full actuation
-/// restored in `p` either way.
+/// only starts Newton on the mesh asked): the unknowns at full load, or those of the last
+/// step accepted (at load factor `p.from`), with the full actuation restored in `p` either way.
 fn step_actuation(
     p: &mut Constrained<'_>,
     (integrator, rough): (Integrator, bool),
     opts: &NewtonOptions,
     effort: &mut Effort,
-) -> Option<Vec<f64>> {
+) -> std::result::Result<Vec<f64>, Vec<f64>> {
     restart(p, integrator);
     (p.refine, p.rough) = (!rough, rough);
     let (s, radius) = ramp::samples(p);
     let full = (p.tensions.clone(), p.pressures.clone());
-    let stepped = ramp::rest_nodes(p).map(<[_]>::to_vec).and_then(|rest| {
-        let (t, q) = (&full.0, &full.1);
-        ramp::stepped(p, (t, q), (&s, &radius, rest), opts, effort)
-    });
+    let stepped = match ramp::rest_nodes(p).map(<[_]>::to_vec) {
+        Some(rest) => {
+            let (t, q) = (&full.0, &full.1);
+            ramp::stepped(p, (t, q), (&s, &radius, rest), opts, effort)
+        }
+        None => Err(vec![0.0; 6]),
+    };
     (p.tensions, p.pressures) = full;
     p.load = 1.0;
     stepped
@@ -365,23 +369,33 @@ fn finish_unless_crossed(
 ) -> Result<ContactSolution> {
     match not_crossed(p, x, options, effort) {
         Ok(x) => finish(p, model, actuation, options, &x, effort, 1.0),
-        Err(why) => {
-            // (The load factor the stepped actuation reached.)
+        Err(x) => {
+            // The state of the last load step taken, under the full actuation and loads.
             let lambda = p.from;
-            fail(p, &options.newton, effort, lambda, why)
+            p.load = 1.0;
+            if !options.newton.throw {
+                return finish(p, model, actuation, options, &x, effort, lambda);
+            }
+            if p.evaluate(&x, 1.0, None, &mut vec![0.0; p.dim()]) == Evaluated::Failed {
+                p.last = None;
+            }
+            let why = "the rod crossed a thin obstacle on its way from the unactuated rod, and \
+                       the load path stepped past it stops";
+            fail(p, effort, lambda, why)
         }
     }
 }
 
 /// The solution `x` (its pass the last of `p`) if no point of the rod crossed an obstacle on
 /// its way from the unactuated rod, else the solve again with the actuation and the loads
-/// stepped together ([`ramp`](super::ramp); free tip only).
+/// stepped together ([`ramp`](super::ramp); free tip only), failing with the unknowns of its
+/// last step accepted (at load factor `p.from`).
 fn not_crossed(
     p: &mut Constrained<'_>,
     x: Vec<f64>,
     options: &SolveOptions,
     effort: &mut Effort,
-) -> std::result::Result<Vec<f64>, &'static str> {
+) -> std::result::Result<Vec<f64>, Vec<f64>> {
     if p.tip.is_some() || !ramp::any_checked(p) {
         return Ok(x);
     }
@@ -401,11 +415,11 @@ fn not_crossed(
     if let Some(coarse) = p.coarse {
         let mut start = options.newton;
         start.tolerance = start.tolerance.max(COARSE_TOLERANCE);
-        if let Some(xc) = step_actuation(p, (coarse, true), &start, effort) {
+        if let Ok(xc) = step_actuation(p, (coarse, true), &start, effort) {
             if let Some(x) = refined(p, options, (coarse, Verdict::Asked), &xc, effort) {
                 return Ok(x);
             }
         }
     }
-    step_actuation(p, (options.integrator, false), &options.newton, effort).ok_or("the rod crossed a thin obstacle on its way from the unactuated rod, and stepping the actuation with the loads past it failed")
+    step_actuation(p, (options.integrator, false), &options.newton, effort)
 }
