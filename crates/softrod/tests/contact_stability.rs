@@ -116,35 +116,40 @@ fn a_rod_pushing_on_top_of_a_sphere_slides_off_past_its_lateral_stiffness() {
             sol.solution.stability_margin()
         );
     }
-    // The margin in closed form: the tip's bending stiffness (Timoshenko) with `P / ρ` taken
-    // off its lateral term, in units of `E I / L` (`D = diag(L, 1)`), or the torsion's
-    // `G J / E I = 1 / (1 + ν)` if softer.
     for ratio in [0.9, 1.1] {
         let margin = on_sphere(ratio).solution.stability_margin();
-        let g = E / (2.0 * (1.0 + NU));
-        let shear = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU) * g * std::f64::consts::PI * R * R;
-        let c = softrod::nalgebra::Matrix2::new(
-            L.powi(3) / (3.0 * ei()) + L / shear,
-            L * L / (2.0 * ei()),
-            L * L / (2.0 * ei()),
-            L / ei(),
-        );
-        let mut k = c.try_inverse().unwrap();
-        k[(0, 0)] -= ratio * lateral_stiffness();
-        let hat = softrod::nalgebra::Matrix2::new(
-            k[(0, 0)] * L.powi(3) / ei(),
-            k[(0, 1)] * L * L / ei(),
-            k[(1, 0)] * L * L / ei(),
-            k[(1, 1)] * L / ei(),
-        );
-        let bending = SymmetricEigen::new(hat).eigenvalues.min();
-        let expected = bending.min(1.0 / (1.0 + NU));
+        let expected = pushed_tip_margin(ratio);
         println!("{ratio}: margin {margin:e}, closed form {expected:e}");
         assert!(
             (margin - expected).abs() < 1e-6 * expected.abs(),
             "{margin:e} vs {expected:e}"
         );
     }
+}
+
+/// The margin in closed form of the straight rod pushing its tip on a convex point with
+/// `P / ρ = ratio k`: the tip's bending stiffness (Timoshenko) with `ratio k` taken off its
+/// lateral term, in units of `E I / L` (`D = diag(L, 1)`), or the torsion's
+/// `G J / E I = 1 / (1 + ν)` if softer.
+fn pushed_tip_margin(ratio: f64) -> f64 {
+    let g = E / (2.0 * (1.0 + NU));
+    let shear = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU) * g * std::f64::consts::PI * R * R;
+    let c = softrod::nalgebra::Matrix2::new(
+        L.powi(3) / (3.0 * ei()) + L / shear,
+        L * L / (2.0 * ei()),
+        L * L / (2.0 * ei()),
+        L / ei(),
+    );
+    let mut k = c.try_inverse().unwrap();
+    k[(0, 0)] -= ratio * lateral_stiffness();
+    let hat = softrod::nalgebra::Matrix2::new(
+        k[(0, 0)] * L.powi(3) / ei(),
+        k[(0, 1)] * L * L / ei(),
+        k[(1, 0)] * L * L / ei(),
+        k[(1, 1)] * L / ei(),
+    );
+    let bending = SymmetricEigen::new(hat).eigenvalues.min();
+    bending.min(1.0 / (1.0 + NU))
 }
 
 /// The NiTi robot driven into a sphere by the tensions of the contact benchmark and some
@@ -178,4 +183,98 @@ fn the_niti_robot_against_a_sphere_reads_its_margin_on_the_coarse_mesh() {
         worst = worst.max(rel);
     }
     assert!(worst < 1e-3, "{worst:e}");
+}
+
+/// A triangle mesh is held like the other obstacles: a square pyramid of half-width `W` and
+/// height `W`, apex down at `(0, 0, L + R)` on the straight rod's axis, and a box whose
+/// bottom face lies at the same height. The tip pushing on the apex touches a vertex, where
+/// the distance is that to a point: it slides off once `P > k ρ` with `ρ = R` (the sphere's
+/// closed form with the sphere's radius zero, margin included); pushing on the box's bottom
+/// face with nine tenths of the rod's Euler load it is held as on a plane, with the margin of
+/// a `Plane` obstacle (an independent formulation), where the same push on the vertex slides
+/// off.
+const W: f64 = 0.05;
+
+fn pyramid() -> Obstacle {
+    let z = L + R;
+    let vertices = vec![
+        [0.0, 0.0, z],
+        [-W, -W, z + W],
+        [W, -W, z + W],
+        [W, W, z + W],
+        [-W, W, z + W],
+    ];
+    // Counter-clockwise seen from outside.
+    let faces = vec![
+        [0, 2, 1],
+        [0, 3, 2],
+        [0, 4, 3],
+        [0, 1, 4],
+        [1, 2, 3],
+        [1, 3, 4],
+    ];
+    Obstacle::mesh(vertices, faces).unwrap()
+}
+
+fn box_above() -> Obstacle {
+    let z = L + R;
+    let vertices: Vec<[f64; 3]> = (0..8)
+        .map(|i| {
+            [
+                if i & 1 == 0 { -W } else { W },
+                if i & 2 == 0 { -W } else { W },
+                if i & 4 == 0 { z } else { z + W },
+            ]
+        })
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let faces = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    Obstacle::mesh(vertices, faces).unwrap()
+}
+
+#[test]
+fn a_rod_pushing_on_a_mesh_vertex_slides_off_and_on_a_mesh_face_is_held() {
+    let k = lateral_stiffness();
+    for (ratio, stable) in [(0.5, true), (0.99, true), (1.01, false), (2.0, false)] {
+        let p = ratio * k * R;
+        let sol = solve(Loads::tip_force(Vector3::new(0.0, 0.0, p)), &[pyramid()]);
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        assert!((sol.contacts[0].normal_force - p).abs() < 1e-6 * p);
+        let margin = sol.solution.stability_margin();
+        let expected = pushed_tip_margin(ratio);
+        println!("vertex, {ratio} k R: margin {margin:e}, closed form {expected:e}");
+        assert_eq!(sol.solution.stable, stable, "{ratio}: {margin:e}");
+        // (Near the flip the margin's relative error grows as the margin goes to zero.)
+        if (ratio - 1.0f64).abs() > 0.1 {
+            assert!(
+                (margin - expected).abs() < 1e-6 * expected.abs(),
+                "{margin:e} vs {expected:e}"
+            );
+        }
+    }
+    // Far past the vertex's k R: on the face as on the plane.
+    let p = 0.9 * std::f64::consts::PI.powi(2) * ei() / (4.0 * L * L);
+    let loads = || Loads::tip_force(Vector3::new(0.0, 0.0, p));
+    let on_mesh = solve(loads(), &[box_above()]);
+    let plane = Obstacle::plane([0.0, 0.0, L + R], [0.0, 0.0, -1.0]).unwrap();
+    let on_plane = solve(loads(), &[plane]);
+    let (a, b) = (
+        on_mesh.solution.stability_margin(),
+        on_plane.solution.stability_margin(),
+    );
+    println!("face: margin {a:e}, plane {b:e}");
+    assert!(on_mesh.solution.stable && on_plane.solution.stable);
+    assert!((a - b).abs() < 1e-9 * b.abs(), "{a:e} vs {b:e}");
+    // (The same push on the vertex, P / (k R) about 370, slides off.)
+    assert!(!solve(loads(), &[pyramid()]).solution.stable);
 }

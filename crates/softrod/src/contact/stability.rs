@@ -14,7 +14,6 @@
 
 use nalgebra::{Complex, Matrix3, Matrix6, SymmetricEigen};
 
-use super::obstacle::Obstacle;
 use super::problem::{Constrained, Site};
 use super::ContactState;
 
@@ -172,8 +171,7 @@ pub(crate) fn free_stiffness(
 }
 
 /// Whether the stability of `p`'s equilibria holds its contacts ([`constrained_stability`]):
-/// a free tip and frictionless point contacts (at the tip or inside the rod) on obstacles
-/// other than triangle meshes.
+/// a free tip and frictionless point contacts (at the tip or inside the rod).
 pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
     p.tip.is_none()
         && !p.active.is_empty()
@@ -182,7 +180,6 @@ pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
             matches!(a.site, Site::Tip | Site::Interior)
                 && a.state == ContactState::Frictionless
                 && o.friction() == 0.0
-                && !matches!(o.shape(), Obstacle::Mesh(_))
         })
 }
 
@@ -192,7 +189,7 @@ pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
 /// contact keeps its gap, slides along the rod to its least gap and turns its force with the
 /// obstacle's normal), which is exact when the rod with its tip clamped too and the contacts
 /// held has no conjugate point. `None` where it does not apply (a held tip, friction, a
-/// contact interval or belt, a triangle mesh, or a singular constrained problem): the
+/// contact interval or belt, or a singular constrained problem): the
 /// contacts are then read as dead loads. Returns it with the compliance under contact (m,
 /// rad per N, N m; world) it was read from. The last pass of `p` is kept.
 pub(super) fn constrained_stability(
