@@ -106,15 +106,20 @@ pub(super) fn fail(
     lambda: f64,
     why: &str,
 ) -> Result<ContactSolution> {
-    let held = if p.tip.is_some() { "held tip" } else { "free tip" };
-    let kind = if p.obstacles.is_empty() { "" } else { " and contact" };
+    let held = if p.tip.is_some() {
+        "held tip"
+    } else {
+        "free tip"
+    };
+    let kind = if p.obstacles.is_empty() {
+        ""
+    } else {
+        " and contact"
+    };
     Err(Error::NotConverged {
         what: format!("constrained shooting ({held}{kind}; {why})"),
         iterations: effort.iterations,
-        residual: p
-            .last
-            .as_ref()
-            .map_or(f64::INFINITY, |l| max_norm(&l.rows)),
+        residual: p.last.as_ref().map_or(f64::INFINITY, |l| max_norm(&l.rows)),
         load_factor: lambda,
     })
 }
@@ -398,12 +403,7 @@ pub(super) fn finish(
         (p.evaluate(x, 1.0, None, &mut r) != Evaluated::Failed).then(|| (x.to_vec(), max_norm(&r)))
     };
     let Some((polished, residual)) = reached else {
-        return fail(
-            p,
-            effort,
-            1.0,
-            "the solution could not be integrated",
-        );
+        return fail(p, effort, 1.0, "the solution could not be integrated");
     };
     let x: &[f64] = &polished;
     let forces = p.normal_forces(x);

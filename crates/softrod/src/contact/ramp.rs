@@ -319,6 +319,30 @@ fn slid_off(
     (shift != Vector3::zeros()).then(|| at.iter().map(|x| x + shift).collect())
 }
 
+/// The branch ends (a fold): the rod snaps from the shape `from` (at the samples `s`, radii
+/// `radius`). It lands where the solve at the current load factor from the contact-free
+/// shape puts it, unless it crossed an obstacle deeper than `depth` (m) on the way there:
+/// straight, or, given the shape `before` a step earlier, after sliding off the obstacles it
+/// touched ([`slid_off`]). A new contact past the middle of its obstacle, seen from the last
+/// step, is refused by the active set. The unknowns and the shape where it lands.
+fn snap(
+    p: &mut Constrained<'_>,
+    (s, radius, depth): (&[f64], &[f64], f64),
+    (before, from): (Option<&[Vector3<f64>]>, &[Vector3<f64>]),
+    opts: &NewtonOptions,
+    effort: &mut Effort,
+) -> Option<(Vec<f64>, Vec<Vector3<f64>>)> {
+    let touched = std::mem::take(&mut p.active);
+    let off = before.and_then(|b| slid_off(p, &touched, (b, from), radius));
+    p.last = None;
+    let xn = active_set(p, &[0.0; 6], opts, effort)?;
+    let shape = positions_at(p.last.as_ref()?, s);
+    let clear = |a: &[Vector3<f64>], b: &[Vector3<f64>]| !crossed(p, (a, b), radius, depth);
+    let landed =
+        clear(from, &shape) || off.is_some_and(|off| clear(from, &off) && clear(&off, &shape));
+    landed.then_some((xn, shape))
+}
+
 /// The tip contacts whose gap (at the tip, on an obstacle free of friction and not touched
 /// at the tip), extrapolated linearly from its value at the step accepted before (in `gaps`,
 /// replaced by those of the last pass), closes within the next step of the same length.
@@ -437,24 +461,9 @@ pub(super) fn stepped(
             if !(last || faithful && next - lambda <= SNAP_STEP) {
                 return None;
             }
-            // The branch ends (a fold): the rod snaps. It lands where the solve at this load
-            // factor from the contact-free shape puts it, unless it crossed an obstacle on
-            // the way there: straight, or (at the last step) after sliding off the obstacles
-            // it touched. A new contact past the middle of its obstacle, seen from the last
-            // step, is refused by the active set.
-            let touched = std::mem::take(&mut p.active);
-            let off = along.filter(|_| last).and_then(|(_, _, before)| {
-                slid_off(p, &touched, (before, &previous), radius)
-            });
-            p.last = None;
-            let xn = active_set(p, &[0.0; 6], opts, effort)?;
-            let shape = positions_at(p.last.as_ref()?, s);
-            let landed = !crossed(p, (&previous[..], &shape[..]), radius, depth)
-                || off.is_some_and(|off| {
-                    !crossed(p, (&previous[..], &off[..]), radius, depth)
-                        && !crossed(p, (&off[..], &shape[..]), radius, depth)
-                });
-            landed.then_some((xn, shape))
+            // (At the last step, also after sliding off the obstacles it touched.)
+            let before = along.filter(|_| last).map(|(_, _, b)| &b[..]);
+            snap(p, (s, radius, depth), (before, &previous), opts, effort)
         });
         effort.budget = None;
         match shape {
