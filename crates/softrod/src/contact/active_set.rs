@@ -239,9 +239,6 @@ pub(super) fn relax(
     opts: &NewtonOptions,
     effort: &mut Effort,
 ) -> Option<Vec<f64>> {
-    if effort.exhausted() {
-        return None;
-    }
     let l = p.model.length();
     // The gap targets of the new contacts: their rows at zero force.
     let mut r = vec![0.0; p.dim()];

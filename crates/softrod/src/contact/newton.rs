@@ -12,16 +12,6 @@ use crate::solve::{max_norm, Evaluated, NewtonOptions, Problem};
 pub(super) struct Effort {
     pub(super) iterations: usize,
     pub(super) load_steps: usize,
-    /// The iterations after which a load step being tried gives up (see
-    /// [`ramp::stepped`](super::ramp::stepped)).
-    pub(super) budget: Option<usize>,
-}
-
-impl Effort {
-    /// Whether the iterations of the load step being tried ran past its budget.
-    pub(super) fn exhausted(&self) -> bool {
-        self.budget.is_some_and(|b| self.iterations > b)
-    }
 }
 
 /// Newton at the full contact targets from `x`; the last pass left at the result.
@@ -63,9 +53,6 @@ pub(super) fn exact_newton(
     residual_first: bool,
     normal_first: bool,
 ) -> Option<(Vec<f64>, f64)> {
-    if effort.exhausted() {
-        return None;
-    }
     let n = p.dim();
     let mut x = x.to_vec();
     let mut r = vec![0.0; n];

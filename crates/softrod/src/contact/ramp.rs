@@ -39,9 +39,6 @@ const FORWARD_EXIT: f64 = -0.1;
 /// Below this step of the load factor, a stepped solve that follows the path through
 /// bifurcations accepts a corrector off the path's secant (the rod snaps).
 const SNAP_STEP: f64 = 1.0 / 256.0;
-/// Newton iterations a load step may take (its active set, relaxations and snap included)
-/// before it is given up and halved.
-const STEP_BUDGET: usize = 400;
 /// What a corrector may lie off the path's secant besides half the predicted motion, as a
 /// fraction of the rod's length.
 const BRANCH_TOLERANCE: f64 = 1e-4;
@@ -421,7 +418,6 @@ pub(super) fn stepped(
         p.set_load(next);
         p.last = None;
         let saved = p.active.clone();
-        effort.budget = Some(effort.iterations + STEP_BUDGET);
         let mut solved = active_set(p, &start, opts, effort);
         if solved.is_none() && !faithful && along.is_some() {
             // Off the secant's prediction: from the last step's state.
@@ -465,7 +461,6 @@ pub(super) fn stepped(
             let before = along.filter(|_| last).map(|(_, _, b)| &b[..]);
             snap(p, (s, radius, depth), (before, &previous), opts, effort)
         });
-        effort.budget = None;
         match shape {
             Some((xn, shape)) => {
                 effort.load_steps += 1;
