@@ -123,13 +123,13 @@ pub fn solve_constrained(
             finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort)
         }
         Reach::Stepped(x) => finish(&mut p, model, actuation, options, &x, &effort, 1.0),
-        Reach::Stopped { lambda, why, .. } if options.newton.throw => {
-            fail(&p, &effort, lambda, why)
-        }
-        Reach::Stopped { x, lambda, .. } => {
-            p.load = 1.0;
-            finish(&mut p, model, actuation, options, &x, &effort, lambda)
-        }
+        Reach::Stopped { x, lambda, why } => stopped(
+            &mut p,
+            (model, actuation),
+            options,
+            (&x, lambda, why),
+            &effort,
+        ),
         Reach::Unintegrable => Err(Error::not_converged(
             "constrained shooting: the actuated rod without external loads could not be \
              integrated",
@@ -370,20 +370,33 @@ fn finish_unless_crossed(
     match not_crossed(p, x, options, effort) {
         Ok(x) => finish(p, model, actuation, options, &x, effort, 1.0),
         Err(x) => {
-            // The state of the last load step taken, under the full actuation and loads.
-            let lambda = p.from;
-            p.load = 1.0;
-            if !options.newton.throw {
-                return finish(p, model, actuation, options, &x, effort, lambda);
-            }
-            if p.evaluate(&x, 1.0, None, &mut vec![0.0; p.dim()]) == Evaluated::Failed {
-                p.last = None;
-            }
             let why = "the rod crossed a thin obstacle on its way from the unactuated rod, and \
                        the load path stepped past it stops";
-            fail(p, effort, lambda, why)
+            let lambda = p.from;
+            stopped(p, (model, actuation), options, (&x, lambda, why), effort)
         }
     }
+}
+
+/// A solve stopped at load factor `lambda` with the unknowns `x` reached there, for the
+/// reason `why`: the state `x` under the full actuation and loads, not converged (its
+/// residual and `lambda` in the statistics), or with `throw` the error carrying them.
+fn stopped(
+    p: &mut Constrained<'_>,
+    (model, actuation): (&Arc<RobotModel>, &Actuation),
+    options: &SolveOptions,
+    (x, lambda, why): (&[f64], f64, &str),
+    effort: &Effort,
+) -> Result<ContactSolution> {
+    p.load = 1.0;
+    if !options.newton.throw {
+        return finish(p, model, actuation, options, x, effort, lambda);
+    }
+    if p.dim() != x.len() || p.evaluate(x, 1.0, None, &mut vec![0.0; x.len()]) == Evaluated::Failed
+    {
+        p.last = None;
+    }
+    fail(p, effort, lambda, why)
 }
 
 /// The solution `x` (its pass the last of `p`) if no point of the rod crossed an obstacle on
