@@ -186,13 +186,13 @@ fn the_niti_robot_against_a_sphere_reads_its_margin_on_the_coarse_mesh() {
 }
 
 /// A triangle mesh is held like the other obstacles: a square pyramid of half-width `W` and
-/// height `W`, apex down at `(0, 0, L + R)` on the straight rod's axis, and a box whose
-/// bottom face lies at the same height. The tip pushing on the apex touches a vertex, where
-/// the distance is that to a point: it slides off once `P > k ρ` with `ρ = R` (the sphere's
-/// closed form with the sphere's radius zero, margin included); pushing on the box's bottom
-/// face with nine tenths of the rod's Euler load it is held as on a plane, with the margin of
-/// a `Plane` obstacle (an independent formulation), where the same push on the vertex slides
-/// off.
+/// height `W`, apex down at `(0, 0, L + R)` on the straight rod's axis, and a tetrahedron
+/// whose bottom face lies at the same height. The tip pushing on the apex touches a vertex,
+/// where the distance is that to a point: it slides off once `P > k ρ` with `ρ = R` (the
+/// sphere's closed form with the sphere's radius zero, margin included); pushing on the
+/// tetrahedron's bottom face with nine tenths of the rod's Euler load it is held as on a
+/// plane, with the margin of a `Plane` obstacle (an independent formulation), where the same
+/// push on the vertex slides off.
 const W: f64 = 0.05;
 
 fn pyramid() -> Obstacle {
@@ -216,29 +216,13 @@ fn pyramid() -> Obstacle {
     Obstacle::mesh(vertices, faces).unwrap()
 }
 
-fn box_above() -> Obstacle {
+/// A tetrahedron whose bottom face (horizontal, at `z = L + R`) lies over the rod's tip, its
+/// edges at least `W / 2` from the axis.
+fn face_above() -> Obstacle {
     let z = L + R;
-    let vertices: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            [
-                if i & 1 == 0 { -W } else { W },
-                if i & 2 == 0 { -W } else { W },
-                if i & 4 == 0 { z } else { z + W },
-            ]
-        })
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let faces = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
+    let vertices = vec![[-W, -W, z], [W, -W, z], [0.0, W, z], [0.0, 0.0, z + W]];
+    // Counter-clockwise seen from outside (the bottom face seen from below).
+    let faces = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
     Obstacle::mesh(vertices, faces).unwrap()
 }
 
@@ -265,7 +249,7 @@ fn a_rod_pushing_on_a_mesh_vertex_slides_off_and_on_a_mesh_face_is_held() {
     // Far past the vertex's k R: on the face as on the plane.
     let p = 0.9 * std::f64::consts::PI.powi(2) * ei() / (4.0 * L * L);
     let loads = || Loads::tip_force(Vector3::new(0.0, 0.0, p));
-    let on_mesh = solve(loads(), &[box_above()]);
+    let on_mesh = solve(loads(), &[face_above()]);
     let plane = Obstacle::plane([0.0, 0.0, L + R], [0.0, 0.0, -1.0]).unwrap();
     let on_plane = solve(loads(), &[plane]);
     let (a, b) = (
