@@ -330,13 +330,14 @@ fn snap(
     effort: &mut Effort,
 ) -> Option<(Vec<f64>, Vec<Vector3<f64>>)> {
     let touched = std::mem::take(&mut p.active);
-    let off = before.and_then(|b| slid_off(p, &touched, (b, from), radius));
     p.last = None;
     let xn = active_set(p, &[0.0; 6], opts, effort)?;
     let shape = positions_at(p.last.as_ref()?, s);
     let clear = |a: &[Vector3<f64>], b: &[Vector3<f64>]| !crossed(p, (a, b), radius, depth);
-    let landed =
-        clear(from, &shape) || off.is_some_and(|off| clear(from, &off) && clear(&off, &shape));
+    let landed = clear(from, &shape)
+        || before
+            .and_then(|b| slid_off(p, &touched, (b, from), radius))
+            .is_some_and(|off| clear(from, &off) && clear(&off, &shape));
     landed.then_some((xn, shape))
 }
 

@@ -87,8 +87,10 @@ pub fn solve_constrained(
         // mesh asked from there, with the coarse Jacobian, and the active set checked there.
         p.integrator = coarse;
         (p.refine, p.rough) = (false, true);
-        let mut start = *options;
-        start.newton.tolerance = options.newton.tolerance.max(COARSE_TOLERANCE);
+        let start = SolveOptions {
+            newton: coarse_newton(&options.newton),
+            ..*options
+        };
         if let Reach::Done(xc) = reach(&mut p, &start, &mut effort) {
             if let Some(x) = refined(&mut p, options, (coarse, Verdict::Coarse), &xc, &mut effort) {
                 return finish_unless_crossed(&mut p, (model, actuation), options, x, &mut effort);
@@ -101,11 +103,8 @@ pub fn solve_constrained(
             // Past the middle of an obstacle: the load path followed on the coarse mesh
             // (each step there costs a fifth), then Newton on the mesh asked from its end.
             p.pathless = false;
-            if let Ok(xc) = step_actuation(&mut p, (coarse, true), &start.newton, &mut effort) {
-                let path = (coarse, Verdict::Asked);
-                if let Some(x) = refined(&mut p, options, path, &xc, &mut effort) {
-                    return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
-                }
+            if let Some(x) = stepped_on_coarse(&mut p, options, coarse, &mut effort) {
+                return finish(&mut p, model, actuation, options, &x, &effort, 1.0);
             }
         }
         // Else the mesh asked from the start (its iterations and load steps are those
@@ -425,14 +424,32 @@ fn not_crossed(
     }
     // Stepped on the coarse mesh if the solve has one (then Newton on the mesh asked from its
     // end), else, or if that fails, on the mesh asked.
-    if let Some(coarse) = p.coarse {
-        let mut start = options.newton;
-        start.tolerance = start.tolerance.max(COARSE_TOLERANCE);
-        if let Ok(xc) = step_actuation(p, (coarse, true), &start, effort) {
-            if let Some(x) = refined(p, options, (coarse, Verdict::Asked), &xc, effort) {
-                return Ok(x);
-            }
-        }
+    if let Some(x) = p
+        .coarse
+        .and_then(|coarse| stepped_on_coarse(p, options, coarse, effort))
+    {
+        return Ok(x);
     }
     step_actuation(p, (options.integrator, false), &options.newton, effort)
+}
+
+/// The Newton options of the coarse mesh: those asked with the tolerance no tighter than
+/// [`COARSE_TOLERANCE`] (its solution only starts Newton on the mesh asked).
+fn coarse_newton(asked: &NewtonOptions) -> NewtonOptions {
+    NewtonOptions {
+        tolerance: asked.tolerance.max(COARSE_TOLERANCE),
+        ..*asked
+    }
+}
+
+/// The actuation stepped with the loads on the mesh `coarse` ([`step_actuation`]), then
+/// Newton on the mesh asked from its end ([`refined`], the stability verdict taken there).
+fn stepped_on_coarse(
+    p: &mut Constrained<'_>,
+    options: &SolveOptions,
+    coarse: Integrator,
+    effort: &mut Effort,
+) -> Option<Vec<f64>> {
+    let xc = step_actuation(p, (coarse, true), &coarse_newton(&options.newton), effort).ok()?;
+    refined(p, options, (coarse, Verdict::Asked), &xc, effort)
 }
