@@ -44,10 +44,10 @@ def solve(tension: float):
 
 shown = []
 print(
-    f"{'T (N)':>6} {'contact s (m)':>14} {'force (N)':>10} {'normal (x, z)':>16} "
+    f"{'T (N)':>6} {'contact s (m)':>16} {'force (N)':>10} {'normal (x, z)':>16} "
     f"{'tip x, z (mm)':>16} {'stable':>7} {'time (ms)':>10}"
 )
-for tension in (0.3, 0.6, 1.0, 2.0, 3.0, 3.5):
+for tension in (0.3, 0.6, 1.0, 2.0, 3.0, 3.3, 3.5):
     times = []
     try:
         with warnings.catch_warnings():
@@ -64,13 +64,17 @@ for tension in (0.3, 0.6, 1.0, 2.0, 3.0, 3.5):
         n = np.asarray(c["normal"])
         normal = f"({n[0]:.2f}, {n[2]:.2f})"
         tip = f"{1e3 * sol.tip_position[0]:.1f}, {1e3 * sol.tip_position[2]:.1f}"
+        # A point contact at s, or a belt [s, s + length] with its resultant force.
+        where = f"{c['s']:.4f}"
+        if c["length"] > 0:
+            where = f"[{c['s']:.4f}, {c['s'] + c['length']:.4f}]"
         print(
-            f"{tension:>6.1f} {c['s']:>14.4f} {c['normal_force']:>10.4f} "
+            f"{tension:>6.1f} {where:>16} {c['normal_force']:>10.4f} "
             f"{normal:>16} "
             f"{tip:>16} "
             f"{sol.stable!s:>7} {1e3 * statistics.median(times):>10.1f}"
         )
-    if tension in (0.3, 1.0, 2.0, 3.0):
+    if tension in (0.3, 1.0, 2.0, 3.3):
         shown.append((tension, sol))
 
 fig = plot_rod(
