@@ -484,3 +484,72 @@ fn a_sticking_tip_contact_holds_the_tip_in_the_compliance() {
     );
     assert!((slide[(1, 1)] / free - 1.0).abs() < 1e-3);
 }
+
+/// Compliance under a contact inside the rod, against the propped cantilever of
+/// [`interior_friction_sticks_and_slides_as_the_propped_cantilever`] (flexibilities `α, β, γ`,
+/// axial `E A`; the same post, μ = 0.5, Fx = 2 F_c). Sticking holds the rod's point at `a` in
+/// all three directions: the tip's translation per tip force is `γ - β²/α` across the rod and
+/// `(L - a)/(E A)` along it. Sliding (|Fy| > μ Fx) holds the normal only: across the rod along
+/// the normal `γ - β²/α`, sideways `γ`; the friction force `-μ R ŝ` follows the normal
+/// reaction, `dR/df_x = -β/α`, so a tip force along the normal moves the tip sideways by
+/// `sign(Fy) μ β²/α` (the compliance is not symmetric); and `ŝ`, the slip direction of the
+/// point at `a` (slip `s` from its first touch), turns with an axial slip, a spring
+/// `k = μ R / |s|` along the rod at `a`: `(L - a)/(E A) + 1/(E A / a + k)`. Frictionless:
+/// `γ - β²/α`, `γ`, `L/(E A)`. Each entry of the translational block to 1e-5 of its closed
+/// form, the others below 1e-5 γ (the same neglected effects as the reactions, ~1e-5
+/// rotations).
+#[test]
+fn compliance_under_interior_friction_is_the_propped_cantilever() {
+    let (alpha, beta, gamma) = post_flexibilities();
+    let fc = POST_GAP / beta;
+    let (_, _, ea, _) = common::circular_constants(E, NU, POST_ROD, 1.0);
+    let propped = gamma - beta * beta / alpha;
+    let mu = 0.5;
+    for (friction, fy) in [(mu, 0.5), (mu, 2.0), (mu, -2.0), (0.0, 0.5)] {
+        let (fx, fy) = (2.0 * fc, fy * fc);
+        let sol = solve_rod(POST_ROD, Vector3::new(-fx, fy, 0.0), &post(friction));
+        let state = sol.contacts[0].state;
+        let c = sol.compliance.get().unwrap();
+        let mut expected = [[0.0; 3]; 3];
+        expected[0][0] = propped;
+        match state {
+            ContactState::Stick => {
+                expected[1][1] = propped;
+                expected[2][2] = (L - POST_AT) / ea;
+            }
+            ContactState::Slide => {
+                let lambda0 = fc / fx;
+                let r = (1.0 - lambda0) * fx * beta / alpha;
+                let ft = -fy.signum() * mu * r;
+                let slip = fy * beta + ft * alpha - lambda0 * fy * beta;
+                let k = mu * r / slip.abs();
+                expected[1][1] = gamma;
+                expected[1][0] = fy.signum() * mu * beta * beta / alpha;
+                expected[2][2] = (L - POST_AT) / ea + 1.0 / (ea / POST_AT + k);
+            }
+            ContactState::Frictionless => {
+                expected[1][1] = gamma;
+                expected[2][2] = L / ea;
+            }
+        }
+        for (i, row) in expected.iter().enumerate() {
+            for (k, &e) in row.iter().enumerate() {
+                let err = if e == 0.0 {
+                    c[(i, k)].abs() / gamma
+                } else {
+                    (c[(i, k)] / e - 1.0).abs()
+                };
+                println!(
+                    "mu = {friction}, Fy = {fy:e}: {state:?}, C[{i}][{k}] = {:e} vs {e:e} \
+                     (err {err:.1e})",
+                    c[(i, k)]
+                );
+                assert!(
+                    err < 1e-5,
+                    "{state:?}: C[{i}][{k}] = {:e} vs {e:e}",
+                    c[(i, k)]
+                );
+            }
+        }
+    }
+}
