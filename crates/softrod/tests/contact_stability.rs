@@ -262,3 +262,62 @@ fn a_rod_pushing_on_a_mesh_vertex_slides_off_and_on_a_mesh_face_is_held() {
     // (The same push on the vertex, P / (k R) about 370, slides off.)
     assert!(!solve(loads(), &[pyramid()]).solution.stable);
 }
+
+/// The rod pressed end-on against a wall (a plane across its axis at the tip): a rest
+/// stretch `1 + ε` the wall does not let it take compresses it by `P = E A ε`. On a
+/// frictionless wall the tip slides sideways under the wall's fixed-direction force: the
+/// clamped-free column, unstable past `π² E I / (4 L²)`. On a rough wall (μ = 0.5) the contact
+/// sticks (no sideways force) and holds the tip's point: the clamped-pinned column, stable up
+/// to `λ² E I / L²` with `tan λ = λ` (20.1907; read as a dead load the contact gave the
+/// clamped-free verdict). Shear and axial strain move these loads by about 1e-4 (`L/r` =
+/// 500): the verdicts at 0.999 and 1.001 of them, and the margin near the clamped-pinned
+/// load against the closed-form rotational stiffness of the pinned end,
+/// `λ (sin λ - λ cos λ) / (2 - 2 cos λ - λ sin λ)` (E I / L), to 1e-3 (the shift of the load
+/// times the slope, -0.32 per unit of `P L² / E I`).
+#[test]
+fn a_column_against_a_rough_wall_is_pinned_and_against_a_smooth_one_slides() {
+    let ea = E * std::f64::consts::PI * R * R;
+    let column = |mu: f64, ratio: f64| {
+        let p = ratio * ei() / (L * L);
+        let stretched = Vector3::new(0.0, 0.0, 1.0 + p / ea);
+        let rod = rod(R)
+            .with_rest_strain(softrod::Profile::Constant(stretched))
+            .unwrap();
+        let wall = Obstacle::plane([0.0, 0.0, L + R], [0.0, 0.0, -1.0])
+            .unwrap()
+            .with_friction(mu)
+            .unwrap();
+        let model = Arc::new(RobotModel::rod_only(rod, Loads::default()).unwrap());
+        let sol =
+            solve_constrained(&model, &Actuation::default(), &options(80), None, &[wall]).unwrap();
+        assert_eq!(sol.contacts.len(), 1, "{:?}", sol.contacts);
+        assert!((sol.contacts[0].normal_force / p - 1.0).abs() < 1e-6);
+        sol
+    };
+    let free = std::f64::consts::PI.powi(2) / 4.0;
+    let lambda = 4.493_409_457_909_064_f64;
+    let pinned = lambda * lambda;
+    for (mu, critical) in [(0.0, free), (0.5, pinned)] {
+        for (ratio, stable) in [(0.999, true), (1.001, false)] {
+            let sol = column(mu, ratio * critical);
+            let state = sol.contacts[0].state;
+            println!(
+                "mu = {mu}, P = {ratio} x {critical:.4} E I / L^2: {state:?}, stable {}, \
+                 margin {:e}",
+                sol.solution.stable,
+                sol.solution.stability_margin()
+            );
+            assert_eq!(sol.solution.stable, stable, "mu = {mu}, {ratio}");
+        }
+    }
+    // The sticking contact's margin: the pinned end's rotational stiffness.
+    for ratio in [19.9, 20.5] {
+        let sol = column(0.5, ratio);
+        assert_eq!(sol.contacts[0].state, softrod::ContactState::Stick);
+        let l: f64 = ratio.sqrt();
+        let closed = l * (l.sin() - l * l.cos()) / (2.0 - 2.0 * l.cos() - l * l.sin());
+        let margin = sol.solution.stability_margin();
+        println!("P = {ratio} E I / L^2: margin {margin:e}, closed form {closed:e}");
+        assert!((margin - closed).abs() < 1e-3, "{margin:e} vs {closed:e}");
+    }
+}

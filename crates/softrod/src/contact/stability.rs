@@ -171,25 +171,32 @@ pub(crate) fn free_stiffness(
 }
 
 /// Whether the stability of `p`'s equilibria holds its contacts ([`constrained_stability`]):
-/// a free tip and frictionless point contacts (at the tip or inside the rod).
+/// a free tip and frictionless or sticking point contacts (at the tip or inside the rod).
+/// A sticking contact stays sticking under a small enough disturbance (its force is inside
+/// the cone), so it holds its point as a bilateral constraint; a sliding one does not (its
+/// friction force is not conservative).
 pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
     p.tip.is_none()
         && !p.active.is_empty()
         && p.active.iter().all(|a| {
             let o = &p.obstacles[a.obstacle];
             matches!(a.site, Site::Tip | Site::Interior)
-                && a.state == ContactState::Frictionless
-                && o.friction() == 0.0
+                && match a.state {
+                    ContactState::Frictionless => o.friction() == 0.0,
+                    ContactState::Stick => true,
+                    ContactState::Slide => false,
+                }
         })
 }
 
-/// The stability of a free-tip equilibrium with its frictionless point contacts held as
-/// constraints (see `docs/stability.md`, "Under contact"): the tip criterion of
+/// The stability of a free-tip equilibrium with its frictionless or sticking point contacts
+/// held as constraints (see `docs/stability.md`, "Under contact"): the tip criterion of
 /// `solve_statics` on the tip compliance with the active contacts as constraints (each
 /// contact keeps its gap, slides along the rod to its least gap and turns its force with the
-/// obstacle's normal), which is exact when the rod with its tip clamped too and the contacts
-/// held has no conjugate point. `None` where it does not apply (a held tip, friction, a
-/// contact interval or belt, or a singular constrained problem): the
+/// obstacle's normal; a sticking one holds its point), which is exact when the rod with its
+/// tip clamped too and the contacts held has no conjugate point. `None` where it does not
+/// apply (a held tip, a sliding contact, a contact interval or belt, or a singular
+/// constrained problem): the
 /// contacts are then read as dead loads. Returns it with the compliance under contact (m,
 /// rad per N, N m; world) it was read from. The last pass of `p` is kept.
 pub(super) fn constrained_stability(
