@@ -154,3 +154,63 @@ fn the_niti_robot_slides_off_the_end_of_a_capsule_and_snaps_free() {
     let node = free.solution.s.iter().position(|&s| s >= 0.26).unwrap();
     assert!(free.solution.position[node][0] > a[0] + 0.008);
 }
+
+/// A long stepped solve counts each right-hand-side evaluation once. The NiTi robot at the
+/// tensions of its robot file, [4, 0, 0, 0, 2, 0] N, with a sphere (radius 30 mm, friction
+/// 0.3) between its straight and bent shapes: the actuation is stepped (about 1,600 Newton iterations), the
+/// rod presses on the sphere on the way and slides off it, and lands on its contact-free
+/// shape (oracle: the solve without the obstacle, tip to 1e-12 m, 12 mm clear of the sphere).
+/// A Newton iteration marches at most `MAX_LINE_SEARCH_HALVINGS + 1` trial points and once
+/// with the columns: so at most 16 marches of `4 × steps` evaluations per iteration (4.3
+/// measured). The count grew with the square of the solve's length before (the contact rows'
+/// evaluations, kept from march to march, were added again at every march with the
+/// columns: 1.07e9 here).
+#[test]
+fn a_long_stepped_solve_counts_each_evaluation_once() {
+    let steps = 100;
+    let model = common::niti_model(Loads::default(), None, 0.0);
+    let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let sphere = Obstacle::sphere([0.1, 0.1, 0.34], 0.03)
+        .unwrap()
+        .with_friction(0.3)
+        .unwrap();
+    let sol = solve_constrained(
+        &model,
+        &act,
+        &options(steps),
+        None,
+        std::slice::from_ref(&sphere),
+    )
+    .unwrap();
+    let stats = sol.solution.stats;
+    println!(
+        "iterations {}, load steps {}, evaluations {} ({:.1} marches per iteration)",
+        stats.iterations,
+        stats.load_steps,
+        stats.function_evaluations,
+        stats.function_evaluations as f64 / (4 * steps * stats.iterations.max(1)) as f64
+    );
+    assert!(stats.converged && stats.load_steps > 0 && stats.iterations > 100);
+    let free = softrod::solve_statics(&model, &act, &options(steps)).unwrap();
+    let (a, b) = (sol.solution.tip_position(), free.tip_position());
+    let apart = (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max);
+    assert!(
+        sol.contacts.is_empty() && apart < 1e-12,
+        "{:?}, {apart:e}",
+        sol.contacts
+    );
+    let clear = sol
+        .solution
+        .position
+        .iter()
+        .map(|p| sphere.distance(&Vector3::from(*p)).0 - 0.0007)
+        .fold(f64::INFINITY, f64::min);
+    assert!(clear > 0.01, "{clear:e}");
+    let bound = 16 * 4 * steps * (stats.iterations + stats.load_steps + 1);
+    assert!(
+        stats.function_evaluations <= bound,
+        "{} evaluations for {} iterations",
+        stats.function_evaluations,
+        stats.iterations
+    );
+}

@@ -306,6 +306,7 @@ impl Constrained<'_> {
         for c in 0..n {
             twists.push(self.jacobian_column(&mut ev, &lin, c, j, &mut buf)?);
         }
+        self.evaluations += scratch.side_evaluations();
         let actuated = match &observed {
             None => None,
             Some(yo) => Some(self.actuated(&model, &lin, &cols, yo)?),
@@ -560,7 +561,7 @@ impl Constrained<'_> {
             )
             .ok()
         };
-        self.evaluations += ws.evaluations + scratch.sides[0].evaluations;
+        self.evaluations += ws.evaluations + scratch.side_evaluations();
         scratch.keep(ws, None);
         let y = y?;
         if !y[..STATE].iter().all(|v| v.is_finite()) || sites.iter().any(|c| c.after.is_none()) {

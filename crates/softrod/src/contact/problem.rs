@@ -227,6 +227,15 @@ impl Scratch {
         }
     }
 
+    /// The right-hand-side evaluations of the contact rows since the last call (each counted
+    /// once: the side workspaces live from march to march).
+    pub(super) fn side_evaluations(&mut self) -> usize {
+        self.sides
+            .iter_mut()
+            .map(|w| std::mem::take(&mut w.evaluations))
+            .sum()
+    }
+
     /// The march workspace for `nt` tendons (taken, new if none; give it back with
     /// [`Self::keep`]), with no evaluations and no material failure recorded.
     pub(super) fn march_workspace(&mut self, nt: usize) -> Workspace {
@@ -538,7 +547,9 @@ impl<'m> Constrained<'m> {
                 ws: after,
             },
         ];
-        let held = self.rows_of_contacts(&mut ev, &sh.nodes, x, mu, &mut rows)?;
+        let held = self.rows_of_contacts(&mut ev, &sh.nodes, x, mu, &mut rows);
+        self.evaluations += scratch.side_evaluations();
+        let held = held?;
         let finite = rows.iter().all(|v| v.is_finite());
         let pass = finite.then(|| Pass {
             nodes: std::mem::take(&mut sh.nodes),
