@@ -553,3 +553,75 @@ fn compliance_under_interior_friction_is_the_propped_cantilever() {
         }
     }
 }
+
+/// The NiTi robot bending its tip onto a wall with friction (μ = 0.1, 0.3, 1): the contact is
+/// made by the actuation, so its slip is measured from where the tip first touches the wall
+/// with the tensions applied proportionally. Oracle: that touch found independently, by
+/// bisection of the load factor on contact-free solves until the tip's surface reaches the
+/// wall (1e-12 of the load factor); the tip slides (the tendons keep dragging it), its
+/// tangential force on the cone and opposite to its slip from that point (to 1e-6). Before,
+/// the sticking tip pulled on the wall one load step past the touch and was released and
+/// added again until the stepping gave up (7,240 Newton iterations, 1.1 s), and the answer came
+/// from a fallback that measured the slip from the contact-free tip's foot on the wall
+/// (tangential force 86–87° off the slip from the touch).
+#[test]
+fn a_tip_dragged_along_a_wall_slides_from_its_first_touch() {
+    let model = common::niti_model(Loads::default(), None, 0.0);
+    let full = [4.0, 0.0, 0.0, 0.0, 2.0, 0.0];
+    let scaled = |lambda: f64| Actuation::tensions(&full.map(|t| t * lambda));
+    let (wall_x, radius) = (0.1, 0.0007);
+    let tip_x = |lambda: f64| {
+        softrod::solve_statics(&model, &scaled(lambda), &options(100))
+            .unwrap()
+            .tip_position()[0]
+            + radius
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    while hi - lo > 1e-12 {
+        let mid = 0.5 * (lo + hi);
+        if tip_x(mid) < wall_x {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let touch = Vector3::from(
+        softrod::solve_statics(&model, &scaled(lo), &options(100))
+            .unwrap()
+            .tip_position(),
+    );
+    for mu in [0.1, 0.3, 1.0] {
+        let wall = Obstacle::plane([wall_x, 0.0, 0.0], [-1.0, 0.0, 0.0])
+            .unwrap()
+            .with_friction(mu)
+            .unwrap();
+        let sol = solve_constrained(
+            &model,
+            &scaled(1.0),
+            &options(100),
+            None,
+            std::slice::from_ref(&wall),
+        )
+        .unwrap();
+        assert_eq!(sol.contacts.len(), 1);
+        let c = sol.contacts[0];
+        assert_eq!(c.state, ContactState::Slide);
+        let tip = Vector3::from(sol.solution.tip_position());
+        let mut slip = tip - touch;
+        slip.x = 0.0;
+        let ft = Vector3::from(c.tangential_force);
+        let off = (ft / ft.norm() + slip / slip.norm()).norm();
+        println!(
+            "mu = {mu}: touch at load factor {lo:.9}, slip {:.2} mm, friction {:e} N \
+             (mu f_n {:e}), direction off by {off:e}; {} iterations, {} evaluations",
+            1e3 * slip.norm(),
+            ft.norm(),
+            mu * c.normal_force,
+            sol.solution.stats.iterations,
+            sol.solution.stats.function_evaluations
+        );
+        assert!(off < 1e-6, "friction not opposite to the slip: {off:e}");
+        assert!((ft.norm() / (mu * c.normal_force) - 1.0).abs() < 1e-9);
+        assert_balanced_with(&sol, &wall, radius, Vector3::zeros(), c.normal_force);
+    }
+}

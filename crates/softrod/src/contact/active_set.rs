@@ -305,7 +305,10 @@ pub(super) fn active_set(
         let worst = forces
             .iter()
             .enumerate()
-            .filter(|(i, f)| !p.active[*i].site.held() && f.0 < -opts.tolerance * fs)
+            .filter(|(i, f)| {
+                let a = &p.active[*i];
+                !a.site.held() && a.state != ContactState::Stick && f.0 < -opts.tolerance * fs
+            })
             .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
             .map(|(i, _)| i);
         if let Some(i) = worst {
