@@ -50,6 +50,10 @@ def _cmd_solve(args) -> int:
     if len(robot.tendons):
         lengths = ", ".join(f"{x:.9f}" for x in sol.tendon_lengths)
         print(f"tendon path lengths (m): [{lengths}]")
+    # Obstacles or a tip constraint: the contacts and reactions too (also in the files).
+    touching = bool(robot.obstacles) or robot.tip_constraint is not None
+    if touching:
+        _print_contacts(robot, sol)
     print(
         f"solver: converged={st['converged']}, iterations={st['iterations']}, "
         f"residual={st['residual']:.2e}, evaluations={st['function_evaluations']}, "
@@ -58,12 +62,13 @@ def _cmd_solve(args) -> int:
     if args.csv:
         from ..io import write_statics_csv
 
-        write_statics_csv(args.csv, sol)
+        write_statics_csv(args.csv, sol, contacts=touching)
         print(f"wrote {args.csv}", file=sys.stderr)
     if args.json:
         from ..io import statics_to_dict
 
-        write_json(args.json, {"robot": robot.name, "solution": statics_to_dict(sol)})
+        solution = statics_to_dict(sol, contacts=touching)
+        write_json(args.json, {"robot": robot.name, "solution": solution})
     if args.plot:
         use_agg()
         from ..plot import plot_robot
@@ -71,6 +76,36 @@ def _cmd_solve(args) -> int:
         fig = plot_robot(robot, sol, projections=args.projections, **figure_options(args))
         save_figure(fig, args.plot, args=args)
     return 0
+
+
+def _print_contacts(robot, sol) -> None:
+    """The active contacts of ``sol`` (a point ``s`` or a belt ``[a, b]``, the obstacle, the
+    state, the forces and the touching point), the tip reaction and the stability verdict."""
+    contacts = sol.contacts
+    if not contacts:
+        print("contacts: none")
+    else:
+        print(f"contacts ({len(contacts)}):")
+    for c in contacts:
+        obstacle = robot.obstacles[c["obstacle"]]
+        kind = obstacle.get("type") if isinstance(obstacle, dict) else type(obstacle).__name__
+        kind = str(kind).lower()
+        where = f"s = {c['s']:.6f} m"
+        if c["length"] > 0:
+            where = f"s = [{c['s']:.6f}, {c['s'] + c['length']:.6f}] m"
+        tangential = fmt_vector(c["tangential_force"], digits=4, unit="N")
+        point = fmt_vector(c["point"], scale=1e3, unit="mm", digits=4)
+        print(
+            f"  obstacle {c['obstacle']} ({kind}): {where}, {c['state']}, "
+            f"normal force {c['normal_force']:.6g} N, tangential {tangential}, at {point}"
+        )
+    if sol.tip_reaction is not None:
+        r = sol.tip_reaction
+        print(
+            f"tip reaction: force {fmt_vector(r[:3], digits=6, unit='N')}, "
+            f"moment {fmt_vector(r[3:], digits=6, unit='N m')}"
+        )
+    print(f"stable: {sol.stable} (margin {sol.stability_margin:.4g})")
 
 
 def _cmd_compliance(args) -> int:

@@ -10,6 +10,7 @@ from .robot_file import (
     validate_robot_dict,
 )
 from .tables import (
+    contacts_to_list,
     read_backbone_csv,
     solution_to_dict,
     statics_to_dict,
@@ -20,6 +21,7 @@ from .tables import (
 __all__ = [
     "FieldError",
     "RobotFile",
+    "contacts_to_list",
     "dump_robot_toml",
     "read_backbone_csv",
     "read_robot_toml",

@@ -143,23 +143,68 @@ STATICS_COLUMNS = (
 )
 
 
-def write_statics_csv(path: str | os.PathLike[str], sol: StaticsSolution) -> None:
+def write_statics_csv(
+    path: str | os.PathLike[str], sol: StaticsSolution, contacts: bool | None = None
+) -> None:
     """Writes a statics solution's samples to CSV, one row per sample (SI units).
 
     Columns: ``s``; position ``x, y, z`` (world); quaternion ``qx, qy, qz, qw``; internal force
-    ``nx, ny, nz`` and moment ``mx, my, mz`` (world); strains ``vx..vz``, ``ux..uz`` (body).
+    ``nx, ny, nz`` and moment ``mx, my, mz`` (world); strains ``vx..vz``, ``ux..uz`` (body);
+    with ``contacts`` the contact force on the rod at the sample, ``cfx, cfy, cfz`` (N, world;
+    by default when the solution has a contact).
     """
     blocks = [
         np.asarray(getattr(sol, name), dtype=float).reshape(len(sol), -1)
         for name, _ in STATICS_COLUMNS
     ]
+    names = [c for _, cols in STATICS_COLUMNS for c in cols]
+    if _with_contacts(sol, contacts):
+        blocks.append(np.asarray(sol.contact_force, dtype=float).reshape(len(sol), 3))
+        names += ["cfx", "cfy", "cfz"]
     table = np.hstack(blocks)
-    header = ",".join(c for _, cols in STATICS_COLUMNS for c in cols)
-    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.17g")
+    np.savetxt(path, table, delimiter=",", header=",".join(names), comments="", fmt="%.17g")
 
 
-def statics_to_dict(sol: StaticsSolution) -> dict[str, Any]:
-    """A JSON-ready dict of a statics solution (lists of floats, SI units, world frame)."""
+def _with_contacts(sol: StaticsSolution, contacts: bool | None) -> bool:
+    """Whether the contacts of ``sol`` are written: ``contacts`` if given, else whether it
+    has a contact or a tip reaction."""
+    if contacts is not None:
+        return bool(contacts)
+    return bool(sol.contacts) or sol.tip_reaction is not None
+
+
+def contacts_to_list(sol: StaticsSolution) -> list[dict[str, Any]]:
+    """The active contacts of ``sol`` as JSON-ready dicts: ``obstacle`` (index), ``s`` and
+    ``length`` (m; a belt or interval from ``s`` to ``s + length``), ``point``, ``normal``,
+    ``normal_force`` (N), ``tangential_force`` (N), their sum ``force`` (N, world) and ``state``.
+    """
+    out = []
+    for c in sol.contacts:
+        normal = np.asarray(c["normal"], dtype=float)
+        tangential = np.asarray(c["tangential_force"], dtype=float)
+        out.append(
+            {
+                "obstacle": int(c["obstacle"]),
+                "s": float(c["s"]),
+                "length": float(c["length"]),
+                "point": np.asarray(c["point"], dtype=float).tolist(),
+                "normal": normal.tolist(),
+                "normal_force": float(c["normal_force"]),
+                "tangential_force": tangential.tolist(),
+                "force": (normal * float(c["normal_force"]) + tangential).tolist(),
+                "state": str(c["state"]),
+            }
+        )
+    return out
+
+
+def statics_to_dict(sol: StaticsSolution, contacts: bool | None = None) -> dict[str, Any]:
+    """A JSON-ready dict of a statics solution (lists of floats, SI units, world frame).
+
+    With ``contacts`` (by default when the solution has a contact or a tip reaction) also
+    ``contacts`` (:func:`contacts_to_list`), ``contact_force`` per
+    sample (N, world, shape (N, 3)) and, with a tip constraint, ``tip_reaction`` (N, N m).
+    """
     out: dict[str, Any] = {
         name: np.asarray(getattr(sol, name)).tolist()
         for name in (
@@ -177,5 +222,11 @@ def statics_to_dict(sol: StaticsSolution) -> dict[str, Any]:
             "tip_rotation",
         )
     }
+    out["stable"] = sol.stable
     out["stats"] = dict(sol.stats)
+    if _with_contacts(sol, contacts):
+        out["contacts"] = contacts_to_list(sol)
+        out["contact_force"] = np.asarray(sol.contact_force, dtype=float).tolist()
+        if sol.tip_reaction is not None:
+            out["tip_reaction"] = np.asarray(sol.tip_reaction, dtype=float).tolist()
     return out
