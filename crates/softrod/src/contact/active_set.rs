@@ -300,7 +300,7 @@ pub(super) fn active_set(
     let penetration = 10.0 * opts.tolerance * l;
     let mut x = correct(p, x, opts, effort)?;
     for _ in 0..MAX_ACTIVE_SET_ROUNDS {
-        // Release the most negative contact force.
+        // Release the most negative contact force (a sticking one slides first, below).
         let forces = p.normal_forces(&x);
         let worst = forces
             .iter()
