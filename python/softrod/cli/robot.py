@@ -82,10 +82,10 @@ def _print_contacts(robot, sol) -> None:
     """The active contacts of ``sol`` (a point ``s`` or a belt ``[a, b]``, the obstacle, the
     state, the forces and the touching point), the tip reaction and the stability verdict."""
     contacts = sol.contacts
-    if not contacts:
-        print("contacts: none")
-    else:
+    if contacts:
         print(f"contacts ({len(contacts)}):")
+    elif robot.obstacles:
+        print("contacts: none")
     for c in contacts:
         obstacle = robot.obstacles[c["obstacle"]]
         kind = obstacle.get("type") if isinstance(obstacle, dict) else type(obstacle).__name__
