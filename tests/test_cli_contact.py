@@ -74,3 +74,16 @@ def test_solve_with_an_obstacle_out_of_reach_says_no_contact(tmp_path, capsys):
     assert "contacts: none" in capsys.readouterr().out
     data = json.loads(out_json.read_text())["solution"]
     assert data["contacts"] == [] and np.abs(np.asarray(data["contact_force"])).max() == 0.0
+
+
+def test_the_figure_draws_the_robots_obstacles(tmp_path):
+    from softrod.plot import plot_robot
+
+    robot = softrod.load_robot(_robot_with_wall(tmp_path))
+    fig = plot_robot(robot)
+    assert len(fig.axes[0].softrod_obstacles) == 1
+    # Asked for none, none is drawn.
+    assert not getattr(plot_robot(robot, obstacles=[]).axes[0], "softrod_obstacles", [])
+    png = tmp_path / "wall.png"
+    assert main(["solve", str(_robot_with_wall(tmp_path)), "--plot", str(png)]) == 0
+    assert png.stat().st_size > 0

@@ -568,13 +568,14 @@ def plot_robot(robot, solution=None, **options):
     """Figure of a :class:`softrod.Robot` solved as it is (or of a given solution of it).
 
     Args:
-        robot: The robot (its tendons, chambers and section are drawn).
+        robot: The robot (its tendons, chambers, section and obstacles are drawn).
         solution: A :class:`softrod.StaticsSolution` of it (default: ``robot.solve()``).
         **options: Keyword arguments of :func:`plot_rod` (``view``, ``projections``,
-            ``disks``, ``obstacles``, ``size``, ``dpi``, ``style``, ...).
+            ``disks``, ``obstacles`` (default the robot's), ``size``, ``dpi``, ``style``, ...).
 
     Returns:
         The matplotlib figure (millimetres, world frame).
     """
     sol = robot.solve() if solution is None else solution
+    options.setdefault("obstacles", tuple(getattr(robot, "obstacles", ())) or None)
     return plot_rod(sol, robot=robot, **options)
