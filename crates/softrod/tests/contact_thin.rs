@@ -199,12 +199,7 @@ fn a_long_stepped_solve_counts_each_evaluation_once() {
         "{:?}, {apart:e}",
         sol.contacts
     );
-    let clear = sol
-        .solution
-        .position
-        .iter()
-        .map(|p| sphere.distance(&Vector3::from(*p)).0 - 0.0007)
-        .fold(f64::INFINITY, f64::min);
+    let clear = least_gap_on_chords(&sol.solution.position, &sphere, 0.0007);
     assert!(clear > 0.01, "{clear:e}");
     let bound = 16 * 4 * steps * (stats.iterations + stats.load_steps + 1);
     assert!(

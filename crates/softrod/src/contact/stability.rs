@@ -196,9 +196,9 @@ pub(super) fn held_contacts(p: &Constrained<'_>) -> bool {
 /// obstacle's normal; a sticking one holds its point), which is exact when the rod with its
 /// tip clamped too and the contacts held has no conjugate point. `None` where it does not
 /// apply (a held tip, a sliding contact, a contact interval or belt, or a singular
-/// constrained problem): the
-/// contacts are then read as dead loads. Returns it with the compliance under contact (m,
-/// rad per N, N m; world) it was read from. The last pass of `p` is kept.
+/// constrained problem): the contacts are then read as dead loads. Returns it with the
+/// compliance under contact (m, rad per N, N m; world) it was read from. The last pass of
+/// `p` is kept.
 pub(super) fn constrained_stability(
     p: &mut Constrained<'_>,
     x: &[f64],
