@@ -149,3 +149,53 @@ fn the_niti_robot_snaps_around_a_sphere_as_on_its_load_path() {
         );
     }
 }
+
+/// A straight rod pulled along its axis by a tip force toward a sphere 1 mm ahead of its tip
+/// (rod radius 1 mm, so a gap of 1 mm at rest): the tip must stop on the near side with the
+/// closed-form reaction `R = F - E A δ / L` (axial stretch `1 + n/(E A)` of the linear law).
+/// From 94 N the contact-free tip lands past the sphere's centre (15.9 mm at 100 N, centre 12
+/// mm ahead), where the nearest surface is the far one; before loads alone (no actuation)
+/// were checked for that, 100 N returned the rod through the sphere with a contact on its far
+/// side (tip 23 mm ahead, base force 144.5 N), converged. 150 N lands beyond the sphere.
+#[test]
+fn a_rod_pulled_into_a_sphere_stops_on_its_near_side() {
+    let (l, radius, e) = (1.0, 1e-3, 2e9);
+    let rod = softrod::Rod::new(
+        l,
+        softrod::Section::circular(radius).unwrap(),
+        softrod::LinearElastic::new(e, 0.3).unwrap(),
+    )
+    .unwrap();
+    let ea = e * std::f64::consts::PI * radius * radius;
+    let delta = 1e-3;
+    let sphere = Obstacle::sphere([0.0, 0.0, l + 2.0 * radius + 0.01], 0.01).unwrap();
+    for f in [30.0, 60.0, 94.0, 100.0, 120.0, 150.0] {
+        let model = Arc::new(
+            RobotModel::rod_only(rod.clone(), Loads::tip_force(Vector3::new(0.0, 0.0, f)))
+                .unwrap(),
+        );
+        let sol = solve_constrained(
+            &model,
+            &Actuation::default(),
+            &SolveOptions::default(),
+            None,
+            std::slice::from_ref(&sphere),
+        )
+        .unwrap();
+        let tip = sol.solution.tip_position();
+        assert!(
+            (tip[2] - (l + delta)).abs() < 1e-9 && tip[0].abs() < 1e-9 && tip[1].abs() < 1e-9,
+            "F = {f} N: tip {tip:?}, expected on the near side at z = {}",
+            l + delta
+        );
+        assert_eq!(sol.contacts.len(), 1, "F = {f} N");
+        let r = f - ea * delta / l;
+        let c = &sol.contacts[0];
+        assert!(
+            (c.normal_force - r).abs() < 1e-8 * f,
+            "F = {f} N: reaction {} against {r}",
+            c.normal_force
+        );
+        assert!(c.normal[2] < -0.999_999, "F = {f} N: normal {:?}", c.normal);
+    }
+}

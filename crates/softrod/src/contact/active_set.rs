@@ -185,7 +185,7 @@ fn add_contacts(
         p.pathless = true;
         return None;
     }
-    if actuated && p.tip.is_none() && !p.pathless_ok && far_side(p, &added) {
+    if p.tip.is_none() && !p.pathless_ok && far_side(p, &added) {
         if p.path.is_none() {
             (p.pathless, p.crossing) = (true, true);
         }
