@@ -27,6 +27,7 @@ use super::problem::{Active, Constrained, Pass, Site};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
 use crate::cosserat::equations::v3;
 use crate::cosserat::shooting::Node;
+use crate::error::Error;
 use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};
 
 /// Most sample points along the rod for the crossing check.
@@ -241,6 +242,55 @@ pub(super) fn rest_nodes<'a>(p: &'a mut Constrained<'_>) -> Option<&'a [Node]> {
     (p.active, p.tensions, p.pressures, p.load, p.tip, p.last) = saved;
     p.rest = nodes.map(|n| (p.integrator, n));
     p.rest.as_ref().map(|(_, nodes)| nodes.as_slice())
+}
+
+/// The rod must start clear of every obstacle: an obstacle its unactuated, unloaded backbone
+/// lies in (the base in a plane's solid side, a sphere around the rod) leaves no load path
+/// out of it, and no contact set at load factor 0. Checked at the nodes of `p`'s mesh and at
+/// the crossing check's samples (between the nodes, for obstacles thinner than a cell); the
+/// backbone may lie on a surface (a rod mounted on a plane through its base).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `obstacles[i]`, with the depth and where.
+pub(super) fn check_rest_clear(p: &mut Constrained<'_>) -> crate::error::Result<()> {
+    if p.obstacles.is_empty() {
+        return Ok(());
+    }
+    let (s, _) = samples(p);
+    let depth = 1e-9 * p.model.length();
+    let obstacles = p.obstacles;
+    let Some(nodes) = rest_nodes(p) else {
+        // Not integrable: the solve reports that.
+        return Ok(());
+    };
+    let points = nodes
+        .iter()
+        .map(|n| (n.s, v3(&n.y, 0)))
+        .chain(s.iter().copied().zip(positions_on(nodes, &s)));
+    for (sk, x) in points {
+        for (i, o) in obstacles.iter().enumerate() {
+            let d = o.distance(&x).0;
+            if d < -depth {
+                let kind = match o.shape() {
+                    Obstacle::Plane { .. } => "a plane",
+                    Obstacle::Sphere { .. } => "a sphere",
+                    Obstacle::Capsule { .. } => "a capsule",
+                    Obstacle::Cylinder { .. } => "a cylinder",
+                    _ => "a mesh",
+                };
+                return Err(Error::invalid(
+                    format!("obstacles[{i}]"),
+                    kind,
+                    format!(
+                        "clear of the rod at rest (its unactuated, unloaded backbone lies \
+                         {:.3e} m inside it at s = {sk:.4} m, ({:.4}, {:.4}, {:.4}) m)",
+                        -d, x.x, x.y, x.z
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Whether one of the contacts `added` (obstacle, site, arc length) to `p`'s last pass lies

@@ -82,7 +82,12 @@ pub fn solve_constrained(
     let coarse_ok = !obstacles
         .iter()
         .any(|o| matches!(o.shape(), Obstacle::Mesh(_)) || o.friction() > 0.0);
-    if let Some(coarse) = coarse_mesh(options.integrator).filter(|_| coarse_ok) {
+    let coarse = coarse_mesh(options.integrator).filter(|_| coarse_ok);
+    // (On the mesh the solve starts on: the march of the rod at rest is kept for the check of
+    // contacts past the middle of their obstacle.)
+    p.integrator = coarse.unwrap_or(options.integrator);
+    ramp::check_rest_clear(&mut p)?;
+    if let Some(coarse) = coarse {
         // The contacts and the nonlinear iterations on the coarse mesh; then Newton on the
         // mesh asked from there, with the coarse Jacobian, and the active set checked there.
         p.integrator = coarse;
