@@ -327,3 +327,34 @@ fn extreme_inputs_never_panic() {
         }
     }
 }
+
+/// A rod compressed to or through zero length is refused by name, not returned converged: an
+/// axial tip force of 1.5 `E A` gives a linear law the stretch `v₃ = 1 - F/(E A) = -0.5` (the
+/// rod inverted through its base), and a tip held at the base leaves it a point (`v₃ = 0`).
+/// Half of `E A` is an answer (`v₃ = 0.5` exactly, the closed form of the linear law).
+#[test]
+fn a_rod_compressed_through_zero_length_is_refused_by_name() {
+    let r = rod();
+    let ea = 1e7 * std::f64::consts::PI * 0.002f64.powi(2);
+    let axial = |f: f64| {
+        let m = Arc::new(
+            softrod::RobotModel::rod_only(r.clone(), Loads::tip_force(Vector3::new(0.0, 0.0, f)))
+                .unwrap(),
+        );
+        softrod::solve_statics(&m, &softrod::Actuation::default(), &SolveOptions::default())
+    };
+    let half = axial(-0.5 * ea).unwrap();
+    for v in &half.v {
+        assert!((v[2] - 0.5).abs() < 1e-12, "stretch {}", v[2]);
+    }
+    assert_eq!(name_of(axial(-1.5 * ea)), "loads");
+    let m = Arc::new(softrod::RobotModel::rod_only(r, Loads::default()).unwrap());
+    let pinned = softrod::solve_constrained(
+        &m,
+        &softrod::Actuation::default(),
+        &SolveOptions::default(),
+        Some(&softrod::TipConstraint::pin([0.0; 3]).unwrap()),
+        &[],
+    );
+    assert_eq!(name_of(pinned), "tip_constraint");
+}

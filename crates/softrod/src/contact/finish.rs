@@ -441,6 +441,12 @@ pub(super) fn finish(
     let fs = model.force_scale();
     let l = model.length();
     let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
+    if sol.stats.converged {
+        let name = if p.tip.is_some() { "tip_constraint" } else { "loads" };
+        if let Some(e) = crate::cosserat::collapse::compressed_through_zero(&sol, name) {
+            return Err(e);
+        }
+    }
     sol.actuation = actuation.clone();
     sol.options = *options;
     let tangential = p.tangential_forces(x, &forces);

@@ -7,6 +7,7 @@
 //! negative once the tensions reach the axial stiffness `E A(s)`: no configuration exists, and
 //! the solve says which tension and which stiffness instead of a bare non-convergence.
 
+use super::solution::StaticsSolution;
 use crate::error::Error;
 use crate::model::RobotModel;
 
@@ -55,4 +56,39 @@ pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option
         }
     }
     None
+}
+
+/// The least stretch `v₃` of a solution accepted: below it the rod is compressed to (or
+/// through) zero length.
+const LEAST_STRETCH: f64 = 1e-9;
+
+/// An [`Error::InvalidParameter`] naming `name` (what loaded the rod: `loads`, or
+/// `tip_constraint` for a held tip) if the stretch `v₃` of `sol` falls below [`LEAST_STRETCH`]
+/// anywhere: a linear law solves a rod compressed through zero length (an inverted rod,
+/// negative stretch) or held at zero length (the tip held at the base) without complaint, and
+/// no rod is either. `None` otherwise.
+pub(crate) fn compressed_through_zero(sol: &StaticsSolution, name: &str) -> Option<Error> {
+    let (j, v3) = sol
+        .v
+        .iter()
+        .enumerate()
+        .map(|(j, v)| (j, v[2]))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    if v3 >= LEAST_STRETCH {
+        return None;
+    }
+    let rod = sol.model.rod();
+    let s = sol.s[j];
+    let c = rod
+        .material()
+        .compliance(&rod.section_at(s), rod.shear_coefficient(), false);
+    Some(Error::invalid(
+        name,
+        format!("an axial force of {:.4e} N at s = {s:.4} m", sol.n_body[j][2]),
+        format!(
+            "loads that leave the rod a positive stretch (there its stretch v3 is {v3:.4e}: the \
+             rod is compressed to or through zero length; its axial stiffness E A is {:.4e} N)",
+            1.0 / c[2]
+        ),
+    ))
 }

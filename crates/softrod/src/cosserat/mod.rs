@@ -4,7 +4,7 @@
 //! sensitivities of an equilibrium from the linearised boundary-value problem
 //! ([`sensitivity`]: actuation Jacobians, parameter sensitivities).
 
-mod collapse;
+pub(crate) mod collapse;
 mod columns;
 pub mod displacement;
 pub(crate) mod equations;

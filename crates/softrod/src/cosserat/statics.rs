@@ -759,6 +759,11 @@ fn solve_with(
         sol.stats.converged = false;
     }
     sol.stats.function_evaluations = p.evaluations;
+    if sol.stats.converged {
+        if let Some(e) = super::collapse::compressed_through_zero(&sol, "loads") {
+            return Err(super::collapse::compressed_to_zero(model, &tensions).unwrap_or(e));
+        }
+    }
     if !stats.converged && opts.throw {
         let non_finite = !finite || !strains_finite;
         return Err(not_converged(
