@@ -85,3 +85,13 @@ def test_an_output_on_a_measurements_csv_is_refused_even_with_overwrite(
     kept = p.read_bytes()
     assert main(args) == 2
     assert "--measurements" in capsys.readouterr().err and p.read_bytes() == kept
+
+
+@pytest.mark.parametrize("text", ["x,y,z\n", "keep\n"])
+def test_a_measurements_csv_without_data_rows_is_bad_input(tmp_path, capsys, text):
+    meas = tmp_path / "hdr.csv"
+    meas.write_text(text)
+    argv = ["calibrate", "niti_two_segment", "--measurements", f"1,0,0,0,0.5,0:{meas}"]
+    assert main([*argv, "--parameters", "rod.material.youngs_modulus"]) == 2
+    err = capsys.readouterr().err
+    assert "`path`" in err and "no data rows" in err and "internal error" not in err
