@@ -95,3 +95,13 @@ def test_a_measurements_csv_without_data_rows_is_bad_input(tmp_path, capsys, tex
     assert main([*argv, "--parameters", "rod.material.youngs_modulus"]) == 2
     err = capsys.readouterr().err
     assert "`path`" in err and "no data rows" in err and "internal error" not in err
+
+
+def test_a_misspelt_parameter_suggests_the_key(tmp_path, capsys):
+    niti = softrod.examples.load("niti_two_segment")
+    meas = tmp_path / "meas.csv"
+    np.savetxt(meas, niti.solve(tensions=[1, 0, 0, 0, 0.5, 0]).position, delimiter=",")
+    argv = ["calibrate", "niti_two_segment", "--measurements", f"1,0,0,0,0.5,0:{meas}"]
+    assert main([*argv, "--parameters", "rod.material.youngs_modulu"]) == 2
+    err = capsys.readouterr().err
+    assert "did you mean `youngs_modulus`?" in err and "stiffness_scale" not in err
