@@ -188,3 +188,19 @@ def test_bad_input_is_a_named_error(niti, args, match):
     kwargs.update(args)
     with pytest.raises(softrod.ParameterError, match=match):
         softrod.calibrate(niti, kwargs.pop("measurements"), kwargs.pop("parameters"), **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("name", "hint"),
+    [
+        ("rod.material.youngs_modulu", "youngs_modulus"),
+        ("rod.materal.youngs_modulus", "material"),
+        ("tendons[0].distanc", "distance"),
+    ],
+)
+def test_a_misspelt_parameter_path_is_an_unknown_key_with_a_suggestion(niti, name, hint):
+    data = [(TENSIONS[0], niti.solve(TENSIONS[0], s_out=S).position)]
+    with pytest.raises(softrod.ParameterError, match=f"did you mean `{hint}`") as info:
+        softrod.calibrate(niti, data, [name])
+    assert info.value.parameter == "parameters" and name in str(info.value)
+    assert "stiffness_scale" not in str(info.value)

@@ -59,3 +59,49 @@ def test_not_identifiable_is_a_warning_line(csvs, capsys):
     assert main(args) == 0
     err = capsys.readouterr().err
     assert "softrod: warning: the measurements cannot determine" in err
+
+
+def test_an_output_on_a_measurements_csv_is_refused_even_with_overwrite(
+    csvs, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    niti = softrod.examples.load("niti_two_segment")
+    meas = tmp_path / "meas.csv"
+    np.savetxt(meas, niti.solve(tensions=[1, 0, 0, 0, 0.5, 0]).position, delimiter=",")
+    before = meas.read_bytes()
+    base = ["calibrate", "niti_two_segment", "--measurements", f"1,0,0,0,0.5,0:{meas}"]
+    base += ["--parameters", "rod.material.youngs_modulus", "--overwrite"]
+    for option in ("--json", "--write-robot"):
+        # the second spelling reaches the same file through another path
+        for value in (str(meas), f"{tmp_path}/./meas.csv"):
+            assert main([*base, option, value]) == 2
+            out, err = capsys.readouterr()
+            assert option in err and "--measurements" in err and out == ""
+            assert meas.read_bytes() == before
+    # any one of several measurements, and the planar arm's CSVs too
+    p = csvs[1][1]
+    args = ["calibrate", "planar", "--measurements", *(f"{t}:{p}" for t, p in csvs)]
+    args += ["--parameters", "E", "--unit-scale", "1e-3", "--json", str(p), "--overwrite"]
+    kept = p.read_bytes()
+    assert main(args) == 2
+    assert "--measurements" in capsys.readouterr().err and p.read_bytes() == kept
+
+
+@pytest.mark.parametrize("text", ["x,y,z\n", "keep\n"])
+def test_a_measurements_csv_without_data_rows_is_bad_input(tmp_path, capsys, text):
+    meas = tmp_path / "hdr.csv"
+    meas.write_text(text)
+    argv = ["calibrate", "niti_two_segment", "--measurements", f"1,0,0,0,0.5,0:{meas}"]
+    assert main([*argv, "--parameters", "rod.material.youngs_modulus"]) == 2
+    err = capsys.readouterr().err
+    assert "`path`" in err and "no data rows" in err and "internal error" not in err
+
+
+def test_a_misspelt_parameter_suggests_the_key(tmp_path, capsys):
+    niti = softrod.examples.load("niti_two_segment")
+    meas = tmp_path / "meas.csv"
+    np.savetxt(meas, niti.solve(tensions=[1, 0, 0, 0, 0.5, 0]).position, delimiter=",")
+    argv = ["calibrate", "niti_two_segment", "--measurements", f"1,0,0,0,0.5,0:{meas}"]
+    assert main([*argv, "--parameters", "rod.material.youngs_modulu"]) == 2
+    err = capsys.readouterr().err
+    assert "did you mean `youngs_modulus`?" in err and "stiffness_scale" not in err

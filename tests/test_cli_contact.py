@@ -87,3 +87,16 @@ def test_the_figure_draws_the_robots_obstacles(tmp_path):
     png = tmp_path / "wall.png"
     assert main(["solve", str(_robot_with_wall(tmp_path)), "--plot", str(png)]) == 0
     assert png.stat().st_size > 0
+
+
+def test_a_mesh_file_of_an_unreadable_format_is_bad_input(tmp_path, capsys):
+    (tmp_path / "mesh2.toml").write_text("[rod]\n")
+    robot = tmp_path / "r.toml"
+    robot.write_text(
+        "[rod]\nlength = 0.3\n[rod.section]\nradius = 1e-3\n[rod.material]\n"
+        "youngs_modulus = 1e9\npoisson_ratio = 0.3\n"
+        "[[obstacles]]\ntype = 'mesh'\nfile = 'mesh2.toml'\n"
+    )
+    assert main(["solve", str(robot)]) == 2
+    err = capsys.readouterr().err
+    assert "obstacles[0].mesh.file" in err and "stl" in err and "internal error" not in err

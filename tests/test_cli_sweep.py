@@ -93,6 +93,7 @@ def test_sweep_on_a_local_cluster_equals_in_process(tmp_path, capsys):
         (["--scheduler", "local:0"], "local:N"),
         (["--block", "0"], "block"),
         (["--tensions", "0=-1"], "tensions >= 0"),
+        (["--design", "rod.length=0.3:0.4:2", "--arc-lengths", "0.35"], "`arc_lengths`"),
     ],
 )
 def test_bad_input_is_one_line(extra, needle, tmp_path, capsys):

@@ -58,3 +58,12 @@ def test_read_backbone_csv_errors(tmp_path):
         read_backbone_csv(f)
     with pytest.raises(ParameterError):
         read_backbone_csv(f, scale=-1)
+
+
+@pytest.mark.parametrize("text", ["", "# only a comment\n", "x,y,z\n", "keep\n"])
+def test_read_backbone_csv_without_data_rows_names_the_path(tmp_path, text):
+    f = tmp_path / "hdr.csv"
+    f.write_text(text)
+    with pytest.raises(ParameterError, match="no data rows") as info:
+        read_backbone_csv(f)
+    assert info.value.parameter == "path" and str(f) in str(info.value)

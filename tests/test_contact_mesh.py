@@ -158,3 +158,30 @@ def test_mesh_tables_name_their_errors(tmp_path):
         with pytest.raises(sr.ParameterError) as info:
             sr.load_robot(path)
         assert info.value.parameter == where, (table, str(info.value))
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "why"),
+    [
+        ("mesh.toml", "[rod]\n", "obj"),  # an extension trimesh does not read: the formats
+        ("noext", "v 0 0 0\n", "obj"),
+        ("empty.stl", "", "no triangles"),
+        ("junk.stl", "hello\n", "no triangles"),
+        ("points.obj", "v 0 0 0\nv 1 0 0\n", "no triangles"),
+    ],
+)
+def test_a_mesh_file_trimesh_cannot_read_is_named_at_file(tmp_path, name, content, why):
+    path = tmp_path / name
+    path.write_text(content)
+    with pytest.raises(sr.ParameterError, match=why) as info:
+        sr.Mesh.from_file(path)
+    assert info.value.parameter == "file" and name in str(info.value)
+    robot = tmp_path / "r.toml"
+    robot.write_text(
+        "[rod]\nlength = 1.0\nsection = { type = 'circular', radius = 1e-3 }\n"
+        "material = { type = 'linear', youngs_modulus = 2e9, poisson_ratio = 0.3 }\n"
+        f"[[obstacles]]\ntype = 'mesh'\nfile = '{name}'\n"
+    )
+    with pytest.raises(sr.ParameterError, match=why) as info:
+        sr.load_robot(robot)
+    assert info.value.parameter == "obstacles[0].mesh.file"

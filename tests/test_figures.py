@@ -190,6 +190,30 @@ def test_compliance_ellipsoids_legend_and_scale_bar():
         plot_compliance_ellipsoids(sol, comp, s=[0.5])
 
 
+def test_a_zero_compliance_is_a_point_in_the_legend_not_an_error(tmp_path, capsys):
+    sol = softrod.load_robot(NITI).solve()
+    comp = softrod.compliance(sol)
+    assert not np.any(comp.world[0])  # the clamped base: exactly zero
+    fig = plot_compliance_ellipsoids(sol, comp, s=[0.0, 0.2, 0.4])
+    ax = fig.axes[0]
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert len(texts) == 3 and "zero" in texts[0] and "zero" not in texts[1]
+    assert len(ax.softrod_ellipsoids) == 2 and ax.softrod_scale is not None
+    (point,) = _by_gid(ax, "zero-compliance-0")
+    np.testing.assert_allclose(np.ravel(point.get_data_3d()), sol.position[0] * 1e3, atol=1e-9)
+    # only the base: the points and a legend, no scale bar
+    fig = plot_compliance_ellipsoids(sol, comp, s=[0.0])
+    ax = fig.axes[0]
+    assert ax.softrod_ellipsoids == [] and ax.softrod_scale is None
+    assert not _by_gid(ax, "scale-bar") and "zero" in ax.get_legend().get_texts()[0].get_text()
+    from softrod.cli import main
+
+    png = tmp_path / "c3.png"
+    assert main(["compliance", str(NITI), "--at", "0", "--plot", str(png)]) == 0
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    capsys.readouterr()
+
+
 def test_gamma_c_panels():
     sol = softrod.load_robot(NITI).solve()
     fig = plot_gamma_c([softrod.compliance(sol)], labels=["4 N"], size=(9, 3))

@@ -140,6 +140,29 @@ def test_a_robot_built_in_code_names_what_cannot_be_written(niti):
         pickle.dumps(robot)
 
 
+def test_a_robot_built_in_code_that_cannot_be_described_pickles_to_an_equal_robot():
+    # A TableSection does not expose its rows: no description, yet the robot pickles (its
+    # objects do), and the copy is equal to it and solves identically.
+    def rod(e):
+        section = softrod.TableSection(
+            [0.0, 0.1, 0.3], [3e-6, 3e-6, 2e-6], [1e-12, 1e-12, 5e-13], [1e-12, 1e-12, 6e-13],
+            [2e-12, 2e-12, 1e-12],
+        )  # fmt: skip
+        return softrod.Rod(0.3, section, softrod.LinearElastic(e, 0.3))
+
+    def robot_of(e=1e9, tension=0.3):
+        return Robot(rod(e), tendons=[softrod.Tendon((1e-3, 0.0), tension)], loads=softrod.Loads())
+
+    robot = robot_of()
+    with pytest.raises(softrod.ParameterError):
+        robot.to_toml()
+    copy = pickle.loads(pickle.dumps(robot))
+    assert copy == robot and robot == copy
+    np.testing.assert_array_equal(copy.solve().position, robot.solve().position)
+    assert robot_of() == robot  # equal objects, built twice
+    assert robot_of(e=2e9) != robot and robot_of(tension=0.4) != robot
+
+
 def test_parameters_by_file_path(niti):
     assert niti.parameter("rod.material.youngs_modulus") == 54e9
     assert niti.parameter("tendons[2].distance") == 0.01

@@ -313,3 +313,39 @@ def test_killing_a_dask_worker_loses_no_sample():
     ds = result["ds"]
     assert (ds["status"] >= 0).all() and int((ds["status"] == 0).sum()) > 0
     xr.testing.assert_identical(local, ds)
+
+
+def test_arc_lengths_are_checked_against_the_design_lengths():
+    robot = niti()  # 0.4 m long
+    # beyond the shortest design rod: refused before any solve, naming the shortest length
+    for design in ({"rod.length": [0.3, 0.4]}, softrod.samples({"rod.length": [0.4, 0.3]})):
+        with pytest.raises(softrod.ParameterError, match=r"rod.length = 0\.3 m") as info:
+            softrod.sweep(
+                robot, design=design, outputs=["backbone"], arc_lengths=[0.35], progress=False
+            )
+        assert info.value.parameter == "arc_lengths" and "0.35" in str(info.value)
+    # within every design rod, though beyond the robot's own 0.4 m: solved
+    ds = softrod.sweep(
+        robot,
+        design={"rod.length": [0.45, 0.5]},
+        outputs=["backbone"],
+        arc_lengths=[0.42],
+        progress=False,
+    )
+    assert (ds["status"] == 0).all() and np.isfinite(ds["backbone_position"]).all()
+
+
+def test_a_sample_whose_arc_length_is_beyond_its_rod_is_failed_not_converged():
+    # A design point whose rod is shorter than an arc length (a path the up-front check does
+    # not see): every sample fails, naming arc_lengths; never status 0 with NaN outputs.
+    from softrod.analysis import _sweep_run as run
+
+    spec = run.TaskSpec(axes=(), outputs=("backbone",), arc_lengths=(0.35,), arm_index=(), block=4)
+    pieces = [
+        run.Piece(0, {"rod.length": 0.3}, 0, 2, np.zeros((2, 0))),
+        run.Piece(1, {"rod.length": 0.4}, 0, 2, np.zeros((2, 0))),
+    ]
+    short, long = run.run_task(niti(), spec, pieces, False)
+    assert list(short["status"]) == [STATUS["failed"]] * 2
+    assert all("arc_lengths" in e for e in short["error"])
+    assert list(long["status"]) == [0, 0] and np.isfinite(long["backbone_position"]).all()

@@ -670,15 +670,15 @@ class Robot:
         return (
             self._name == other._name
             and self._description == other._description
-            and self._rod is other._rod
+            and _same_object(self._rod, other._rod)
             and len(self._tendons) == len(other._tendons)
-            and all(x is y for x, y in zip(self._tendons, other._tendons, strict=True))
+            and all(map(_same_object, self._tendons, other._tendons))
             and len(self._chambers) == len(other._chambers)
-            and all(x is y for x, y in zip(self._chambers, other._chambers, strict=True))
-            and self._loads is other._loads
+            and all(map(_same_object, self._chambers, other._chambers))
+            and _same_object(self._loads, other._loads)
             and self._solver == other._solver
             and self._obstacles == other._obstacles
-            and self._tip_constraint is other._tip_constraint
+            and _same_object(self._tip_constraint, other._tip_constraint)
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -719,6 +719,21 @@ class Robot:
             except ParameterError as exc:
                 raise pickle.PicklingError(f"cannot pickle this Robot: {exc}") from None
         return (Robot, parts)
+
+
+def _same_object(a: Any, b: Any) -> bool:
+    """Whether two model objects of the core (which compare by identity) are one object or
+    hold the same data: the same type and equal pickles (their constructor arguments; a
+    Python callable by its qualified name). An object that does not pickle (a lambda) equals
+    itself only."""
+    if a is b:
+        return True
+    if type(a) is not type(b):
+        return False
+    try:
+        return pickle.dumps(a) == pickle.dumps(b)
+    except (TypeError, pickle.PicklingError, AttributeError):
+        return False
 
 
 def _rebuild(parts: tuple, obstacles: tuple, tip_constraint: Any) -> Robot:

@@ -106,6 +106,13 @@ class CosseratModel:
         if name == "chamber_area_scale" and self.chambers:
             if all("area" in c or "radius" in c for c in self.chambers):
                 return name
+        if "." in name or "[" in name:
+            try:  # a path of the robot file: an unknown key is named with a suggestion
+                self.robot0.parameter(name)
+            except ParameterError as exc:
+                raise _args.value_error(
+                    where, repr(name), str(exc).split(": must be ", 1)[-1]
+                ) from None
         if name.startswith("rod.material."):
             field = name.split(".", 2)[2]
             if field in _SCALE_FIELDS and _law_scale(self.material, field):

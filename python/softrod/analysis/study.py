@@ -27,6 +27,7 @@ import numpy as np
 from .._core import ConvergenceError, ParameterError, UniaxialLaw
 from ..io.objects import build_material
 from ..robot import Robot, load_robot
+from ._sweep_run import STATUS
 
 __all__ = ["StudyResult", "compliance_study", "seed001_study"]
 
@@ -45,6 +46,10 @@ class StudyResult:
         gamma_c_pressures: Pressures of the ``gamma_c`` curves (Pa, P1 = P2).
         gamma_c_tip: ``gamma_c`` at the tip per curve, shape (k, 3).
         elongation: Tip height at equal pressures over the unpressurised one, per grid level.
+        status: Per pressure set, how its solve ended: 0 converged, 1 not converged, 2 failed
+            with an error (the values of a sweep's ``status``); NaN values unless 0.
+        error: Per pressure set, the error (class and message) of a set that did not
+            converge, "" if it did.
     """
 
     material: str
@@ -56,6 +61,13 @@ class StudyResult:
     gamma_c_tip: np.ndarray
     compliances: list[Any]
     elongation: np.ndarray
+    status: np.ndarray
+    error: np.ndarray
+
+    @property
+    def failures(self) -> int:
+        """Number of pressure sets that did not converge (status not 0)."""
+        return int(np.count_nonzero(self.status))
 
 
 def _linear_twin(robot: Robot) -> tuple[Robot, float]:
@@ -85,6 +97,8 @@ def _run(
     grid = np.array(list(itertools.product(levels, repeat=3)))
     tips = np.full((len(grid), 3), np.nan)
     cmax = np.full(len(grid), np.nan)
+    status = np.zeros(len(grid), dtype=np.int8)
+    error = np.full(len(grid), "", dtype=object)
     from tqdm.auto import tqdm
 
     bar = tqdm(
@@ -97,15 +111,18 @@ def _run(
     for i, p in enumerate(bar):
         try:
             sol = robot.with_pressures(_pair_pressures(tuple(p))).solve()
-        except (ConvergenceError, ParameterError):
+        except (ConvergenceError, ParameterError) as exc:
+            status[i] = STATUS["not_converged" if isinstance(exc, ConvergenceError) else "failed"]
+            error[i] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
             continue
         screws = eigenscrews(compliance(sol).tip_world, "compliance")
         tips[i] = sol.tip_position
         cmax[i] = float(np.max(screws.translational_axes))
     r = np.hypot(tips[:, 0], tips[:, 1])
     ok = np.isfinite(cmax)
-    centre = cmax[ok][np.argmin(r[ok])]
-    edge = cmax[ok][np.argmax(r[ok])]
+    two = np.count_nonzero(ok) >= 2  # a ratio needs a centre and a periphery
+    centre = cmax[ok][np.argmin(r[ok])] if two else np.nan
+    edge = cmax[ok][np.argmax(r[ok])] if two else np.nan
     comps = [
         compliance(robot.with_pressures(_pair_pressures((p, p, 0.0))).solve()) for p in gamma_p
     ]
@@ -121,6 +138,8 @@ def _run(
         gamma_c_tip=np.array([c.gamma_c[-1] for c in comps]),
         compliances=comps,
         elongation=tips[equal, 2] / tips[base, 2],
+        status=status,
+        error=error,
     )
 
 
@@ -156,7 +175,9 @@ def compliance_study(
             default), an open text file, or ``None`` (silent).
 
     Returns:
-        The results by material, ``"hyperelastic"`` and ``"linear"``.
+        The results by material, ``"hyperelastic"`` and ``"linear"``. A pressure set whose
+        solve fails is counted (``StudyResult.failures``, printed), recorded (``status``,
+        ``error``) and NaN; the study goes on.
 
     Raises:
         ParameterError: A robot without exactly six chambers, or bad arguments.
@@ -197,18 +218,26 @@ def compliance_study(
                 f"x {res.centre_periphery_ratio:.2f}",
                 file=log,
             )
+            if res.failures:
+                not_converged = int(np.count_nonzero(res.status == STATUS["not_converged"]))
+                print(
+                    f"  {res.failures} of {len(res.pressures)} pressure sets failed "
+                    f"({not_converged} not converged, {res.failures - not_converged} with an "
+                    "error): NaN in the map, the ratios that need them and the data",
+                    file=log,
+                )
             for p, g in zip(res.gamma_c_pressures, res.gamma_c_tip, strict=True):
                 print(
                     f"  P1 = P2 = {p / 1e3:4.0f} kPa: gamma_c at the tip (body x, y, z) = "
                     f"{np.array2string(g, precision=4)}",
                     file=log,
                 )
-            print(
-                f"  equal pressures 0 -> {max_pressure / 1e3:.0f} kPa: tip height x "
-                f"{res.elongation[-1]:.3f}, largest compliance x "
-                f"{_equal_ratio(res, grid):.3f}",
-                file=log,
-            )
+            ratio = _equal_ratio(res, grid)
+            if np.isfinite(res.elongation[-1]) and np.isfinite(ratio):
+                change = f"tip height x {res.elongation[-1]:.3f}, largest compliance x {ratio:.3f}"
+            else:
+                change = "not computed (a pressure set it needs failed)"
+            print(f"  equal pressures 0 -> {max_pressure / 1e3:.0f} kPa: {change}", file=log)
     if out_dir is not None:
         _figures(out, grid, out_dir, log)
     return out

@@ -56,7 +56,7 @@ OUTPUTS = (
 )
 
 #: Values of the ``status`` variable.
-STATUS = {"converged": 0, "not_converged": 1, "failed": 2, "infeasible_design": 3}
+STATUS = run.STATUS
 
 _AT_ARCS = (
     "backbone",
@@ -122,7 +122,19 @@ def _floats(name: str, value: Any) -> np.ndarray:
         raise _bad(name, value, "a 1-D sequence of numbers") from None
 
 
-def _arcs(robot, arc_lengths, arm_index) -> tuple[tuple[float, ...] | None, tuple[float, ...]]:
+def _shortest_rod(robot, points: list[dict[str, float]]) -> tuple[float, str]:
+    """The shortest rod the sweep solves (m) and what it is: the robot's, or with ``rod.length``
+    a design axis the shortest of its values > 0 (a length <= 0 is an infeasible design)."""
+    lengths = [p["rod.length"] for p in points if p.get("rod.length", 0.0) > 0.0]
+    if lengths:
+        shortest = min(lengths)
+        return shortest, f"the shortest rod of the design, rod.length = {shortest} m"
+    return robot.rod.length, "the rod"
+
+
+def _arcs(
+    robot, arc_lengths, arm_index, shortest: tuple[float, str]
+) -> tuple[tuple[float, ...] | None, tuple[float, ...]]:
     if arc_lengths is not None and arm_index is not None:
         exc = ParameterError(
             f"invalid parameters `arc_lengths` = {arc_lengths!r} and `arm_index` = "
@@ -132,11 +144,11 @@ def _arcs(robot, arc_lengths, arm_index) -> tuple[tuple[float, ...] | None, tupl
         raise exc
     if arc_lengths is not None:
         a = _floats("arc_lengths", arc_lengths)
-        length = robot.rod.length
+        length, what = shortest
         if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)):
             raise _bad("arc_lengths", arc_lengths, "a non-empty 1-D sequence of finite m")
         if np.any(a < 0) or np.any(a > length):
-            raise _bad("arc_lengths", arc_lengths, f"in [0, {length}] m (the rod)")
+            raise _bad("arc_lengths", arc_lengths, f"in [0, {length}] m ({what})")
         return tuple(float(x) for x in a), ()
     u = _floats("arm_index", 1.0 if arm_index is None else arm_index)
     if u.ndim != 1 or u.size == 0 or not np.all((u >= 0) & (u <= 1)):
@@ -200,7 +212,9 @@ def sweep(
             ``convergence`` (iterations, residual, load factor, load steps, evaluations).
             ``status`` and ``error`` are always recorded.
         arc_lengths: Arc lengths (m, in [0, L]) of the per-arc-length outputs (dimension
-            ``s``).
+            ``s``); with ``rod.length`` a design axis, L is its shortest value. A design point
+            whose rod is shorter than an arc length all the same fails (status 2, error
+            ``ParameterError: arc_lengths ...``).
         arm_index: Instead, fractions of each design's length (dimension ``arm_index``;
             default ``[1.0]``, the tip).
         scheduler: None: this process, all cores. A ``distributed.Client``, a cluster (e.g.
@@ -223,7 +237,9 @@ def sweep(
 
     Raises:
         ParameterError: An unknown path or output, an actuation path in the wrong place, a
-            grid that is not 1-D or not finite, a bad tension or pressure (named by its path).
+            grid that is not 1-D or not finite, a bad tension or pressure (named by its path),
+            an arc length beyond the rod (the shortest design rod with ``rod.length`` a design
+            axis).
     """
     import xarray as xr
 
@@ -271,7 +287,8 @@ def sweep(
             raise _bad(f"design[{p!r}]", p, str(exc).split(": must be ", 1)[-1]) from None
         if des.kind == "grid" and not np.all(np.isfinite(des.values[i])):
             raise _bad(f"design[{p!r}]", des.values[i], "finite")
-    arcs, arm = _arcs(robot, arc_lengths, arm_index)
+    points = design_points(des)
+    arcs, arm = _arcs(robot, arc_lengths, arm_index, _shortest_rod(robot, points))
     core_outputs = tuple(o for o in names if o not in ("convergence", "stability"))
     spec = run.TaskSpec(
         axes=tuple((a.kind, a.index) for a in axes),
@@ -280,7 +297,6 @@ def sweep(
         arm_index=arm,
         block=block,
     )
-    points = design_points(des)
     n_design, n_act = len(points), act.size
     client = owned = None
     if scheduler is not None:

@@ -1,12 +1,14 @@
 """Helpers shared by the command modules: robot arguments, output files, number formats.
 
-Each subcommand declares its file arguments with :func:`files`: ``inputs`` (read), ``outputs``
-(written) and, among them, ``figures`` (written by matplotlib). :func:`check_files` runs on
-them before any work: an output equal to an input or to another output, an existing file
-without ``--overwrite`` (every command with outputs has it), a figure with an extension
-matplotlib cannot write, or an output in a folder that does not exist is refused with a named
-error. The one exception is the figure of ``softrod demo``: a PNG that an earlier demo wrote
-(it carries :data:`DEMO_MARK` in its metadata) is replaced, any other file is not.
+Each subcommand declares its file arguments with :func:`files`: ``inputs`` (read; or
+``input_paths``, a function finding the files an argument names, e.g. the FILE of each
+TENSIONS:FILE), ``outputs`` (written) and, among them, ``figures`` (written by matplotlib).
+:func:`check_files` runs on them before any work: an output equal to an input or to another
+output, an existing file without ``--overwrite`` (every command with outputs has it), a figure
+with an extension matplotlib cannot write, or an output in a folder that does not exist is
+refused with a named error. The one exception is the figure of ``softrod demo``: a PNG that an
+earlier demo wrote (it carries :data:`DEMO_MARK` in its metadata) is replaced, any other file
+is not.
 """
 
 from __future__ import annotations
@@ -42,11 +44,19 @@ def bad(option: str, value: object, expected: str) -> ParameterError:
 
 
 def files(
-    parser: argparse.ArgumentParser, *, inputs=(), outputs=(), figures=(), folders=("out",)
+    parser: argparse.ArgumentParser,
+    *,
+    inputs=(),
+    outputs=(),
+    figures=(),
+    folders=("out",),
+    input_paths=None,
 ) -> None:
     """Declares which destinations of ``parser`` are input and output files (``folders``:
     the outputs that are folders, by default ``out``) and, for a command with output files,
-    adds ``--overwrite`` (unless the command declared it already)."""
+    adds ``--overwrite`` (unless the command declared it already). ``input_paths``, a function
+    of the parsed arguments, yields ``(option, path)`` for the input files that no destination
+    holds as a plain path (checked like ``inputs``)."""
     if any(d not in folders for d in outputs) and "--overwrite" not in getattr(
         parser, "_option_string_actions", {}
     ):
@@ -58,6 +68,7 @@ def files(
         _outputs=tuple(outputs),
         _figures=tuple(figures),
         _folders=tuple(folders),
+        _input_paths=input_paths,
     )
 
 
@@ -125,7 +136,14 @@ def check_files(args: argparse.Namespace) -> None:
             a figure extension matplotlib cannot write, an output that is a folder or whose
             folder does not exist.
     """
-    inputs = [(d, getattr(args, d)) for d in getattr(args, "_inputs", ()) if getattr(args, d, None)]
+    inputs = [
+        (option_name(d), getattr(args, d))
+        for d in getattr(args, "_inputs", ())
+        if getattr(args, d, None)
+    ]
+    more = getattr(args, "_input_paths", None)
+    if more is not None:
+        inputs += list(more(args))
     outputs = [
         (d, getattr(args, d)) for d in getattr(args, "_outputs", ()) if getattr(args, d, None)
     ]
@@ -135,11 +153,9 @@ def check_files(args: argparse.Namespace) -> None:
     for dest, path in outputs:
         name = option_name(dest)
         path = os.fspath(path)
-        for in_dest, in_path in inputs:
+        for in_name, in_path in inputs:
             if _same(path, os.fspath(in_path)):
-                raise bad(
-                    name, path, f"is the input {option_name(in_dest)}; refusing to overwrite it"
-                )
+                raise bad(name, path, f"is the input {in_name}; refusing to overwrite it")
         for other, other_path in seen:
             if _same(path, other_path):
                 raise bad(name, path, f"is also the output of {option_name(other)}")

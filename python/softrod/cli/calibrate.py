@@ -51,6 +51,19 @@ def resolve(args) -> None:
     args.robot_file = None if args.robot in PLANAR else resolve_robot(args.robot)
 
 
+def _input_paths(args):
+    """The files calibrate reads: ROBOT (unless the planar arm) and the FILE of every
+    TENSIONS:FILE, for the output checks every command shares (an output equal to any of them
+    is refused, even with --overwrite)."""
+    resolve(args)
+    if args.robot_file:
+        yield "ROBOT", args.robot_file
+    for item in args.measurements or ():
+        path = item.rpartition(":")[2]
+        if path:
+            yield "--measurements", path
+
+
 def _cmd_calibrate(args) -> int:
     import numpy as np
 
@@ -58,17 +71,6 @@ def _cmd_calibrate(args) -> int:
     from ..robot import load_robot
 
     resolve(args)
-    for flag in ("json", "write_robot"):
-        path = getattr(args, flag)
-        if path and args.robot_file and os.path.exists(path):
-            if os.path.samefile(path, args.robot_file):
-                raise bad(f"--{flag.replace('_', '-')}", path, "is ROBOT; refusing to overwrite it")
-    for flag in ("json", "write_robot"):
-        path = getattr(args, flag)
-        if path and not args.overwrite and os.path.exists(path):
-            raise bad(
-                f"--{flag.replace('_', '-')}", path, "exists (pass --overwrite to replace it)"
-            )
     planar = args.robot in PLANAR
     robot = PlanarCableArm.published_arm() if planar else load_robot(args.robot_file)
     if planar and args.write_robot:
@@ -186,4 +188,4 @@ def register(sub) -> None:
     p.add_argument("--write-robot", metavar="FILE", help="write the calibrated robot file")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
     p.set_defaults(func=_cmd_calibrate, robot_file=None)
-    files(p, outputs=("json", "write_robot"))
+    files(p, outputs=("json", "write_robot"), input_paths=_input_paths)

@@ -46,11 +46,18 @@ def _cmd_study(args) -> int:
     if args.csv:
         header = ["material", "p1", "p2", "p3", "x", "y", "z", "max_translational_compliance"]
         rows = [
-            [material, *map(float, p), *map(float, tip), float(c)]
+            [material, *map(float, p), *map(float, tip), float(c), int(st), err]
             for material, res in results.items()
-            for p, tip, c in zip(res.pressures, res.tip_position, res.max_compliance, strict=True)
+            for p, tip, c, st, err in zip(
+                res.pressures,
+                res.tip_position,
+                res.max_compliance,
+                res.status,
+                res.error,
+                strict=True,
+            )
         ]
-        write_csv(args.csv, header, rows)
+        write_csv(args.csv, [*header, "status", "error"], rows)
     if args.json:
         write_json(
             args.json,
@@ -63,6 +70,8 @@ def _cmd_study(args) -> int:
                     "gamma_c_pressures": res.gamma_c_pressures,
                     "gamma_c_tip": res.gamma_c_tip,
                     "elongation": res.elongation,
+                    "status": res.status,
+                    "error": res.error,
                 }
                 for material, res in results.items()
             },

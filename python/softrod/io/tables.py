@@ -45,7 +45,9 @@ def read_backbone_csv(
         Points, shape (n, 2) or (n, 3), multiplied by ``scale``.
 
     Raises:
-        ParameterError: Unreadable numbers, fewer than two points, or a bad ``scale``.
+        ParameterError: No data rows (an empty file, a header alone), unreadable numbers,
+            fewer than two points, or a bad ``scale`` (``.parameter``: ``path`` for the file's
+            content).
     """
     scale = _args.number(scale, "scale", positive=True)
     if columns is not None:
@@ -56,7 +58,7 @@ def read_backbone_csv(
         text = fh.read()
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
-        raise ParameterError(f"invalid parameter `path` = {os.fspath(path)!r}: no data rows")
+        raise _bad_file(path, "no data rows")
     try:
         dialect = csv.Sniffer().sniff(lines[0], delimiters=",;\t ")
         delim = dialect.delimiter
@@ -77,12 +79,11 @@ def read_backbone_csv(
     if parsed and parsed[0] is None:  # header
         parsed = parsed[1:]
         rows = rows[1:]
+    if not parsed:  # a header (or one line of text) alone
+        raise _bad_file(path, "no data rows")
     bad = [i for i, p in enumerate(parsed) if p is None]
     if bad:
-        raise ParameterError(
-            f"invalid parameter `path` = {os.fspath(path)!r}: row {bad[0] + 1} of data is not "
-            f"numeric: {rows[bad[0]]!r}"
-        )
+        raise _bad_file(path, f"row {bad[0] + 1} of data is not numeric: {rows[bad[0]]!r}")
     width = min(len(p) for p in parsed if p is not None)
     if columns is None:
         columns = (0, 1, 2) if width >= 3 else (0, 1)
@@ -93,12 +94,17 @@ def read_backbone_csv(
         )
     pts = np.array([[p[c] for c in cols] for p in parsed if p is not None], dtype=np.float64)
     if pts.shape[0] < 2:
-        raise ParameterError(
-            f"invalid parameter `path` = {os.fspath(path)!r}: {pts.shape[0]} points, need >= 2"
-        )
+        raise _bad_file(path, f"{pts.shape[0]} points, need >= 2")
     if not np.all(np.isfinite(pts)):
-        raise ParameterError(f"invalid parameter `path` = {os.fspath(path)!r}: non-finite value")
+        raise _bad_file(path, "non-finite value")
     return pts * scale
+
+
+def _bad_file(path: str | os.PathLike[str], why: str) -> ParameterError:
+    """A ParameterError at ``path``: what is wrong with the file's content."""
+    exc = ParameterError(f"invalid parameter `path` = {os.fspath(path)!r}: {why}")
+    exc.parameter = "path"
+    return exc
 
 
 def solution_to_dict(sol: PlanarSolution) -> dict[str, Any]:

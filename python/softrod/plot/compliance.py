@@ -80,7 +80,13 @@ def plot_compliance_ellipsoids(
 
     Returns:
         The matplotlib figure (axes in millimetres). The 3-D axes carries
-        ``ax.softrod_scale`` = (compliance of the bar, its length in mm, mm per unit).
+        ``ax.softrod_scale`` = (compliance of the bar, its length in mm, mm per unit), None
+        when every chosen compliance is zero. A zero block (the clamped base, ``s = 0``) has
+        no ellipsoid: it is drawn as a point, so noted in the legend.
+
+    Raises:
+        ParameterError: An arc length outside the rod, a bad ``which``, or a block that is
+            neither zero nor positive.
     """
     from .._core import compliance as _compliance
     from .views import _draw_robot_3d, _light_dir, bending_view
@@ -97,16 +103,21 @@ def plot_compliance_ellipsoids(
     comp_s = np.asarray(comp.s)
     idx = _nodes(comp_s, s, nodes)
     world = np.asarray(comp.world)
+    # A block exactly zero (the clamped base) has no ellipsoid: it is drawn as a point.
+    zero = [not np.any(world[k][blk, blk]) for k in idx]
     eig = [np.linalg.eigh(0.5 * (world[k][blk, blk] + world[k][blk, blk].T)) for k in idx]
-    largest = max(float(w.max()) for w, _ in eig)
-    if not largest > 0:
-        raise ParameterError("invalid parameter `compliance`: its blocks are not positive")
+    drawn = [float(w.max()) for (w, _), z in zip(eig, zero, strict=True) if not z]
+    if not all(np.isfinite(c) and c > 0 for c in drawn):
+        raise ParameterError(
+            "invalid parameter `compliance`: its blocks at the chosen arc lengths are not "
+            "positive (nor zero)"
+        )
     mm = 1e3
     p_sol = np.asarray(solution.position)
     p = np.column_stack([np.interp(comp_s, np.asarray(solution.s), p_sol[:, k]) for k in range(3)])
     p *= mm
     extent = max(float(np.ptp(p_sol * mm, axis=0).max()), 1e-9)
-    mm_per_unit = 0.2 * extent / largest
+    mm_per_unit = 0.2 * extent / max(drawn) if drawn else None
     with figure_style(style):
         import matplotlib.pyplot as plt
         from matplotlib.colors import LightSource
@@ -137,13 +148,32 @@ def plot_compliance_ellipsoids(
             )
         else:
             ax.plot(p_sol[:, 0] * mm, p_sol[:, 1] * mm, p_sol[:, 2] * mm, color="0.2", lw=2.0)
+        from matplotlib.lines import Line2D
+
         cmap = plt.get_cmap("viridis")
         pts = [p_sol * mm]
         handles = []
         ax.softrod_ellipsoids = []
         for j, (k, (w, v)) in enumerate(zip(idx, eig, strict=True)):
-            x, y, z = _ellipsoid_mesh(p[k], np.clip(w, 0, None) * mm_per_unit, v.T)
             color = cmap(0.1 + 0.8 * j / max(len(idx) - 1, 1))
+            if zero[j] or mm_per_unit is None:
+                (dot,) = ax.plot(*p[k][:, None], "o", color=color, ms=6, mec="k", mew=0.6)
+                dot.set_gid(f"zero-compliance-{j}")
+                pts.append(p[k][None, :])
+                handles.append(
+                    Line2D(
+                        [],
+                        [],
+                        ls="",
+                        marker="o",
+                        color=color,
+                        mec="k",
+                        mew=0.6,
+                        label=f"s = {comp_s[k] * mm:.0f} mm: zero compliance (a point)",
+                    )
+                )
+                continue
+            x, y, z = _ellipsoid_mesh(p[k], np.clip(w, 0, None) * mm_per_unit, v.T)
             surf = ax.plot_surface(
                 x,
                 y,
@@ -168,6 +198,16 @@ def plot_compliance_ellipsoids(
                 )
             )
         limits = set_equal_3d(ax, np.vstack(pts))
+        ax.softrod_view = chosen
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("y (mm)")
+        ax.set_zlabel("z (mm)")
+        ax.legend(handles=handles, loc="upper left", fontsize="small", title="arc length")
+        head = title or f"{which} compliance ellipsoids"
+        if mm_per_unit is None:  # nothing to scale: every chosen compliance is zero
+            ax.softrod_scale = None
+            ax.set_title(f"{head}\nzero compliance at every chosen arc length", fontsize="medium")
+            return fig
         # Scale bar along the screen's horizontal (in the view plane: seen at full length).
         azim = np.radians(ax.azim)
         elev = np.radians(ax.elev)
@@ -191,12 +231,6 @@ def plot_compliance_ellipsoids(
         )
         label.set_gid("scale-bar-label")
         ax.softrod_scale = (bar_value, bar_mm, mm_per_unit)
-        ax.softrod_view = chosen
-        ax.set_xlabel("x (mm)")
-        ax.set_ylabel("y (mm)")
-        ax.set_zlabel("z (mm)")
-        ax.legend(handles=handles, loc="upper left", fontsize="small", title="arc length")
-        head = title or f"{which} compliance ellipsoids"
         ax.set_title(
             f"{head}\nsemi-axes: principal compliances; bar = {fmt_quantity(bar_value, unit)}"
             f" = {bar_mm:.3g} mm on the axes",

@@ -7,6 +7,7 @@ attributes (e.g. a contact model's obstacles).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -183,19 +184,47 @@ class Mesh:
 
     @classmethod
     def from_file(cls, path, friction: float = 0.0) -> Mesh:
-        """A mesh read by trimesh from ``path`` (STL, OBJ, PLY, ...; coordinates in m), with
-        Coulomb coefficient ``friction``."""
+        """A mesh read by trimesh from ``path`` (coordinates in m; the format from the
+        extension: trimesh's mesh formats, ``glb``, ``obj``, ``ply``,
+        ``stl`` ...), with Coulomb coefficient ``friction``.
+
+        Raises:
+            ParameterError: At ``file``: no such file, an extension trimesh does not read (the
+                message lists the formats), a file trimesh cannot parse, or one without a
+                triangle (empty, junk, a point cloud).
+        """
         import trimesh
 
+        name = str(path)
+        if not os.path.isfile(name):
+            raise _field_error("file", name, "is not a file")
         try:
-            m = trimesh.load_mesh(str(path), process=False)
-        except (OSError, ValueError) as exc:
-            raise _field_error("file", str(path), f"could not be read as a mesh ({exc})") from None
-        return cls(
-            np.asarray(m.vertices, dtype=float),
-            np.asarray(m.faces, dtype=np.int64),
-            friction,
-        )
+            m = trimesh.load_mesh(name, process=False)
+        except NotImplementedError:  # trimesh has no loader for the extension
+            ext = os.path.splitext(name)[1] or "(none)"
+            raise _field_error(
+                "file",
+                name,
+                f"its extension {ext} is not a mesh format trimesh reads: "
+                f"{', '.join(_mesh_formats())}",
+            ) from None
+        except Exception as exc:  # any failure of trimesh's parsers on the user's file
+            raise _field_error(
+                "file", name, f"could not be read as a mesh ({type(exc).__name__}: {exc})"
+            ) from None
+        faces = np.asarray(getattr(m, "faces", np.zeros((0, 3))), dtype=np.int64)
+        if faces.ndim != 2 or len(faces) == 0:
+            raise _field_error(
+                "file", name, "no triangles read (an empty file, or not a mesh in its format)"
+            )
+        return cls(np.asarray(m.vertices, dtype=float), faces, friction)
+
+
+def _mesh_formats() -> list[str]:
+    """The mesh formats (file extensions) that :meth:`Mesh.from_file` reads: trimesh's."""
+    from trimesh.exchange.load import mesh_formats as formats
+
+    return sorted(formats())
 
 
 def _mesh_of(fields: dict) -> Mesh:
