@@ -410,32 +410,45 @@ fn contact_stability_holds_the_contact() {
 #[test]
 fn an_obstacle_the_rod_lies_in_at_rest_is_refused_by_name() {
     let radius = 1e-3;
-    let model = RobotModel::rod_only(
-        rod(radius),
-        Loads::tip_force(Vector3::new(0.005, 0.0, 0.0)),
-    )
-    .unwrap();
+    let model =
+        RobotModel::rod_only(rod(radius), Loads::tip_force(Vector3::new(0.005, 0.0, 0.0))).unwrap();
     let opts = options(40);
-    let refused = |obstacles: &[Obstacle], index: usize| {
-        match solve_constrained(&model, &Actuation::default(), &opts, None, obstacles) {
-            Err(softrod::Error::InvalidParameter { name, expected, .. }) => {
-                assert_eq!(name, format!("obstacles[{index}]"));
-                assert!(expected.contains("clear of the rod at rest"), "{expected}");
-            }
-            Ok(sol) => panic!(
-                "obstacles[{index}] accepted: tip {:?}",
-                sol.solution.tip_position()
-            ),
-            Err(e) => panic!("obstacles[{index}]: {e}"),
+    let refused = |obstacles: &[Obstacle], index: usize| match solve_constrained(
+        &model,
+        &Actuation::default(),
+        &opts,
+        None,
+        obstacles,
+    ) {
+        Err(softrod::Error::InvalidParameter { name, expected, .. }) => {
+            assert_eq!(name, format!("obstacles[{index}]"));
+            assert!(expected.contains("clear of the rod at rest"), "{expected}");
         }
+        Ok(sol) => panic!(
+            "obstacles[{index}] accepted: tip {:?}",
+            sol.solution.tip_position()
+        ),
+        Err(e) => panic!("obstacles[{index}]: {e}"),
     };
     let far = Obstacle::sphere([0.5, 0.5, 0.5], 0.01).unwrap();
-    refused(&[Obstacle::plane([0.0, 0.0, 0.5], [0.0, 0.0, 1.0]).unwrap()], 0);
+    refused(
+        &[Obstacle::plane([0.0, 0.0, 0.5], [0.0, 0.0, 1.0]).unwrap()],
+        0,
+    );
     refused(&[Obstacle::sphere([0.0, 0.0, 0.0], 0.01).unwrap()], 0);
-    refused(&[far.clone(), Obstacle::sphere([0.0, 0.0, 0.5125], 1e-3).unwrap()], 1);
+    refused(
+        &[
+            far.clone(),
+            Obstacle::sphere([0.0, 0.0, 0.5125], 1e-3).unwrap(),
+        ],
+        1,
+    );
     let mount = Obstacle::plane([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]).unwrap();
     let mounted = solve_constrained(&model, &Actuation::default(), &opts, None, &[mount]).unwrap();
     let free = softrod::solve_statics(&model, &Actuation::default(), &opts).unwrap();
     let (a, b) = (mounted.solution.tip_position(), free.tip_position());
-    assert!((Vector3::from(a) - Vector3::from(b)).norm() < 1e-12, "{a:?} vs {b:?}");
+    assert!(
+        (Vector3::from(a) - Vector3::from(b)).norm() < 1e-12,
+        "{a:?} vs {b:?}"
+    );
 }

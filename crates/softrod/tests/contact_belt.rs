@@ -222,7 +222,11 @@ fn a_rod_pulled_onto_a_cylinder_wraps_it_on_its_load_path() {
     assert!(belt_length(&path[0]) < belt_length(&path[1]));
     assert!(belt_length(&path[1]) < belt_length(&path[2]));
     let (p, sol) = (0.5, &path[1]);
-    assert!(sol.solution.stable, "margin {}", sol.solution.stability_margin());
+    assert!(
+        sol.solution.stable,
+        "margin {}",
+        sol.solution.stability_margin()
+    );
     let (a, b) = belt(sol).unwrap();
     assert!(b - a > 0.002, "[{a}, {b}]");
     let st = &sol.solution;

@@ -171,8 +171,7 @@ fn a_rod_pulled_into_a_sphere_stops_on_its_near_side() {
     let sphere = Obstacle::sphere([0.0, 0.0, l + 2.0 * radius + 0.01], 0.01).unwrap();
     for f in [30.0, 60.0, 94.0, 100.0, 120.0, 150.0] {
         let model = Arc::new(
-            RobotModel::rod_only(rod.clone(), Loads::tip_force(Vector3::new(0.0, 0.0, f)))
-                .unwrap(),
+            RobotModel::rod_only(rod.clone(), Loads::tip_force(Vector3::new(0.0, 0.0, f))).unwrap(),
         );
         let sol = solve_constrained(
             &model,

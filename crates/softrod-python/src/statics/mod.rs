@@ -79,9 +79,15 @@ fn report_unstable(
     } else {
         "and no stable equilibrium was found from it"
     };
+    let why = if margin > -softrod::cosserat::NEUTRAL_MARGIN {
+        "the mesh does not resolve the rod's buckling under its compression: raise the RK4 \
+         steps"
+    } else {
+        "the tip tangent stiffness is not positive definite"
+    };
     let msg = format!(
-        "the equilibrium returned is unstable (stability margin {margin:.4e}: the tip \
-         tangent stiffness is not positive definite) {after}; see docs/stability.md"
+        "the equilibrium returned is unstable (stability margin {margin:.4e}: {why}) {after}; \
+         see docs/stability.md"
     );
     if mode == OnUnstable::Warn {
         let category = py.get_type::<StabilityWarning>();

@@ -323,7 +323,12 @@ pub(super) fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) ->
         y[6 * c..6 * c + 6].copy_from_slice(&j[n * c..n * c + 6]);
     }
     let tw: [Vector6<f64>; 6] = std::array::from_fn(|k| twists[k]);
-    tip_stability(&y, &tw, p.model.length())
+    tip_stability(
+        &y,
+        &tw,
+        p.model.length(),
+        crate::cosserat::Resolution::default(),
+    )
 }
 
 /// With a free tip and frictionless point contacts ([`held_contacts`]), the stability with
@@ -442,7 +447,11 @@ pub(super) fn finish(
     let l = model.length();
     let mut sol = assemble(&mut sh, &cm, scaled_back(model, &x[..6]), stats, &[]);
     if sol.stats.converged {
-        let name = if p.tip.is_some() { "tip_constraint" } else { "loads" };
+        let name = if p.tip.is_some() {
+            "tip_constraint"
+        } else {
+            "loads"
+        };
         if let Some(e) = crate::cosserat::collapse::compressed_through_zero(&sol, name) {
             return Err(e);
         }

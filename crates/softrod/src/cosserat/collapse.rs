@@ -84,7 +84,10 @@ pub(crate) fn compressed_through_zero(sol: &StaticsSolution, name: &str) -> Opti
         .compliance(&rod.section_at(s), rod.shear_coefficient(), false);
     Some(Error::invalid(
         name,
-        format!("an axial force of {:.4e} N at s = {s:.4} m", sol.n_body[j][2]),
+        format!(
+            "an axial force of {:.4e} N at s = {s:.4} m",
+            sol.n_body[j][2]
+        ),
         format!(
             "loads that leave the rod a positive stretch (there its stretch v3 is {v3:.4e}: the \
              rod is compressed to or through zero length; its axial stiffness E A is {:.4e} N)",

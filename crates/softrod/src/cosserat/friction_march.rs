@@ -777,7 +777,7 @@ fn finish(
         }
         let stability = p
             .tip_twist
-            .and_then(|tw| tip_stability(&j, &tw, model.length()));
+            .and_then(|tw| tip_stability(&j, &tw, model.length(), p.resolution));
         linear = Some((Matrix6::from_column_slice(&j), stability));
         p.stops.clear();
     }

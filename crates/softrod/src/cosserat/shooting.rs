@@ -23,7 +23,7 @@ use super::equations::{
     STATE,
 };
 use super::sensitivity::{integrate, scheme_of, Request, Seed};
-use super::stability::{certifies, tip_stability, Stability};
+use super::stability::{certifies, tip_stability, Resolution, Stability};
 use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Scheme};
@@ -74,6 +74,7 @@ struct ExactPass {
     lambda: f64,
     jacobian: [f64; 36],
     tip_twist: [Vector6<f64>; 6],
+    resolution: Resolution,
     stability: Option<Option<Stability>>,
 }
 
@@ -96,6 +97,9 @@ pub(crate) struct Shooting<'a> {
     /// Tip twist `[δp; δθ]` (m, rad; world) along each base-wrench column of the last pass,
     /// if it integrated the columns (`None` after a pass without them).
     pub tip_twist: Option<[Vector6<f64>; 6]>,
+    /// Whether the last pass resolved its columns (see [`Resolution`]; resolved after a pass
+    /// without them).
+    pub resolution: Resolution,
     /// The residual's derivative columns (column-major 6×6) of the last pass with columns.
     pub columns: Option<[f64; 36]>,
     /// Whether the continuation's safeguard also refuses an unstable state (judged from the
@@ -146,6 +150,7 @@ impl<'a> Shooting<'a> {
             stops: Vec::new(),
             nodes: Vec::new(),
             tip_twist: None,
+            resolution: Resolution::default(),
             columns: None,
             require_stable: false,
             lengths: Vec::new(),
@@ -205,6 +210,7 @@ impl<'a> Shooting<'a> {
             ws: &mut self.ws,
         };
         let nodes = &mut self.nodes;
+        let mut resolution = Resolution::default();
         let result = march(
             &mut ev,
             breaks,
@@ -217,8 +223,18 @@ impl<'a> Shooting<'a> {
                     interval,
                     y: head(y),
                 });
+                if N >= FULL {
+                    let rod = eq.model.rod();
+                    let c = rod.material().compliance(
+                        &rod.section_at(s),
+                        rod.shear_coefficient(),
+                        rod.inextensible(),
+                    );
+                    resolution.node(s, y, c[3].max(c[4]));
+                }
             },
         );
+        self.resolution = resolution;
         self.evaluations += std::mem::take(&mut self.ws.evaluations);
         self.tip_twist = None;
         let y = result?;
@@ -255,6 +271,7 @@ impl<'a> Shooting<'a> {
                 lambda,
                 jacobian: j,
                 tip_twist: tw,
+                resolution: self.resolution,
                 stability: None,
             });
         }
@@ -360,9 +377,9 @@ impl<'a> Shooting<'a> {
         }
         let length = self.eq.model.length();
         let e = self.exact.as_mut().filter(|e| e.lambda == lambda)?;
-        let s = (*e
-            .stability
-            .get_or_insert_with(|| tip_stability(&e.jacobian, &e.tip_twist, length)))?;
+        let s = (*e.stability.get_or_insert_with(|| {
+            tip_stability(&e.jacobian, &e.tip_twist, length, e.resolution)
+        }))?;
         let distance = (0..6).map(|k| (x[k] - e.x[k]).abs()).fold(0.0, f64::max);
         certifies(&s, distance).then_some((s, e.jacobian))
     }
@@ -562,7 +579,9 @@ impl Problem for Shooting<'_> {
             return false;
         }
         match (self.require_stable, &self.columns, &self.tip_twist) {
-            (true, Some(j), Some(tw)) => tip_stability(j, tw, length).is_some_and(|s| s.stable),
+            (true, Some(j), Some(tw)) => {
+                tip_stability(j, tw, length, self.resolution).is_some_and(|s| s.stable)
+            }
             _ => true,
         }
     }

@@ -40,6 +40,7 @@
 
 use nalgebra::{Matrix6, SymmetricEigen, Vector6};
 
+use super::equations::{rot, v3};
 use crate::math::linalg::Lu6;
 
 /// Margin within which an equilibrium counts as neutral and is reported stable: a rod with
@@ -124,7 +125,15 @@ pub(crate) fn compliance_stability(c: &Matrix6<f64>, length: f64, force: f64) ->
 /// The stability from the scaled shooting Jacobian `y` (column-major 6×6) and the tip twist
 /// of each base-wrench column `x` (m, rad per scaled unit), for a rod of length `length`.
 /// `None` if the Jacobian is not finite.
-pub(crate) fn tip_stability(y: &[f64], x: &[Vector6<f64>; 6], length: f64) -> Option<Stability> {
+///
+/// `resolution`: whether the march of the columns resolved them ([`Resolution`]); if not, the
+/// equilibrium is reported not stable whatever the tip's margin.
+pub(crate) fn tip_stability(
+    y: &[f64],
+    x: &[Vector6<f64>; 6],
+    length: f64,
+    resolution: Resolution,
+) -> Option<Stability> {
     let ym = Matrix6::from_column_slice(y);
     if !ym.iter().all(|v| v.is_finite()) || !x.iter().all(|c| c.iter().all(|v| v.is_finite())) {
         return None;
@@ -148,7 +157,7 @@ pub(crate) fn tip_stability(y: &[f64], x: &[Vector6<f64>; 6], length: f64) -> Op
         }
     }
     let (eig, margin, softest) = softest(&c)?;
-    let stable = margin > -NEUTRAL_MARGIN;
+    let stable = margin > -NEUTRAL_MARGIN && !resolution.unresolved;
     let mode = match softest {
         Some(k) if !stable => {
             // The base-wrench change of the unit tip wrench ζ: Y δx = ζ.
@@ -163,6 +172,40 @@ pub(crate) fn tip_stability(y: &[f64], x: &[Vector6<f64>; 6], length: f64) -> Op
         margin,
         mode,
     })
+}
+
+/// Whether a march of the base-wrench columns resolves them: a compressed rod's Jacobi fields
+/// oscillate with its buckling wavenumber `k = √(N/EI)` (axial compression `N` of the state's
+/// force, rod and tendons: the tendons' own pull does not buckle the rod; `EI` the softer
+/// bending stiffness), and RK4 follows them only while `k h` (`h` the step) stays below
+/// [`RESOLVED_TURN`]; beyond it the columns are neither accurate nor bounded (a straight
+/// column at 10⁴ times its Euler load on 40 steps: `k h = 3.9`, tip margin -2.7e-30), and no
+/// verdict is drawn from them: the equilibrium is reported not stable.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct Resolution {
+    last: Option<f64>,
+    /// Whether a step was too long for the compressed rod's buckling wavenumber.
+    pub unresolved: bool,
+}
+
+/// The largest `k h` (rad: buckling wavenumber times step) at which a march's columns count
+/// as resolved (RK4's stability limit on the imaginary axis is `2√2`; at 1 its error in one
+/// step is about 1e-3 of the field).
+pub const RESOLVED_TURN: f64 = 1.0;
+
+impl Resolution {
+    /// Adds the node at `s` (m) with state `y` (position, rotation, force, moment), where the
+    /// rod's softer bending compliance is `bending` (1/(N m²)).
+    pub fn node(&mut self, s: f64, y: &[f64], bending: f64) {
+        let compression = -v3(y, 12).dot(&(rot(y) * nalgebra::Vector3::z()));
+        let k = (compression.max(0.0) * bending).sqrt();
+        if let Some(before) = self.last {
+            if k * (s - before).abs() > RESOLVED_TURN {
+                self.unresolved = true;
+            }
+        }
+        self.last = Some(s);
+    }
 }
 
 #[cfg(test)]
@@ -189,16 +232,16 @@ mod tests {
         x[3][3] = 1.0;
         x[2][2] = 1e-3;
         x[5][5] = 1.0;
-        let s = tip_stability(&y, &x, 1.0).unwrap();
+        let s = tip_stability(&y, &x, 1.0, Resolution::default()).unwrap();
         let exact = 8.0 - 2.0 * 13f64.sqrt();
         assert!(s.stable && (s.margin - exact).abs() < 1e-12, "{s:?}");
         // The same with the axis constrained (zero axial compliance).
         x[2][2] = 0.0;
-        let s = tip_stability(&y, &x, 1.0).unwrap();
+        let s = tip_stability(&y, &x, 1.0, Resolution::default()).unwrap();
         assert!(s.stable && (s.margin - exact).abs() < 1e-12, "{s:?}");
         // A negative bending compliance: unstable, with a mode.
         x[0][0] = -1.0;
-        let s = tip_stability(&y, &x, 1.0).unwrap();
+        let s = tip_stability(&y, &x, 1.0, Resolution::default()).unwrap();
         assert!(!s.stable && s.margin < 0.0 && s.mode.is_some(), "{s:?}");
     }
 
@@ -261,6 +304,37 @@ mod tests {
         let above = solve_statics(&column(1.03, 0.0), &none, &opts).unwrap();
         assert!(above.stats.converged && !above.stable);
         assert!(above.margin.get().is_some_and(|m| *m < -NEUTRAL_MARGIN));
+    }
+
+    /// A straight column far past Euler's load, on meshes that cannot resolve its buckling
+    /// modes: at 10⁴ and 10⁵ times the load the wavenumber `k = (π/2L)√ratio` times the step
+    /// of 40 RK4 steps is 3.9 and 12.4 (of 400 steps, 0.39 and 1.24): the columns overflow
+    /// the tip criterion (margins -2.7e-30 and -2.1e-118 on 40 steps, reported stable
+    /// before), and the verdict is not stable. Where the mesh resolves them (10⁴ on 400 steps)
+    /// the tip criterion decides, with a margin of the closed form's size. Resolved or not,
+    /// below the load it is stable.
+    #[test]
+    fn a_column_past_its_buckling_loads_is_not_stable_on_any_mesh() {
+        let none = Actuation::default();
+        let on = |steps: usize, seek: bool| SolveOptions {
+            integrator: crate::cosserat::statics::Integrator::Rk4 { steps },
+            seek_stable: seek,
+            ..SolveOptions::default()
+        };
+        for ratio in [1e4, 1e5] {
+            for steps in [40, 200] {
+                let sol = solve_statics(&column(ratio, 0.0), &none, &on(steps, false)).unwrap();
+                assert!(
+                    sol.stats.converged && !sol.stable,
+                    "{ratio} P_cr on {steps} steps: stable, margin {}",
+                    sol.stability_margin()
+                );
+            }
+        }
+        let resolved = solve_statics(&column(1e4, 0.0), &none, &on(400, false)).unwrap();
+        assert!(!resolved.stable && resolved.stability_margin() < -1.0);
+        let below = solve_statics(&column(0.5, 0.0), &none, &on(40, false)).unwrap();
+        assert!(below.stable);
     }
 
     /// Far from critical, a solution certified stable by the exact columns of the predicted
