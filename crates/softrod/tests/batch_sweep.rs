@@ -451,3 +451,43 @@ fn bad_tables_are_named_before_any_solve() {
     .unwrap();
     assert!(out[0][0].arcs[0].position[0].is_nan());
 }
+
+/// An arc length beyond a job's rod (a design shorter than the arc lengths asked) fails every
+/// sample of that job by name (`arc_lengths[i]`), no solve made; it returned status converged
+/// with NaN outputs. The other job, whose rod reaches it, measures there as a sweep of it alone.
+#[test]
+fn an_arc_length_beyond_a_jobs_rod_fails_its_samples_by_name() {
+    let long = loaded_model();
+    let rod = Rod::new(
+        0.3,
+        Section::circular(0.7e-3).unwrap(),
+        LinearElastic::new(54e9, 0.3).unwrap(),
+    )
+    .unwrap();
+    let short = RobotModel::new(
+        rod,
+        long.tendons().to_vec(),
+        Vec::new(),
+        long.loads().clone(),
+    )
+    .unwrap();
+    let rows = tension_rows(3);
+    let s = [0.1, 0.35];
+    let jobs = [
+        job(&long, rk4(40), table(3, &rows), &s),
+        job(&short, rk4(40), table(3, &rows), &s),
+    ];
+    let out = sweep(&jobs, &all(), 2, false).unwrap();
+    let alone = sweep(&jobs[..1], &all(), 2, false).unwrap();
+    for (a, b) in out[0].iter().zip(&alone[0]) {
+        assert!(same(a, b));
+        assert_eq!(a.status, SampleStatus::Converged);
+    }
+    for sample in &out[1] {
+        assert_eq!(sample.status, SampleStatus::Failed);
+        match &sample.error {
+            Some(Error::InvalidParameter { name, .. }) => assert_eq!(name, "arc_lengths[1]"),
+            other => panic!("{other:?}"),
+        }
+    }
+}

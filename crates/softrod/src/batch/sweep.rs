@@ -317,6 +317,30 @@ fn solve_block(
     end: usize,
     request: &SweepRequest,
 ) -> Vec<SweepSample> {
+    let length = job.model.length();
+    let beyond = job
+        .arc_lengths
+        .iter()
+        .enumerate()
+        .find(|(_, &s)| request.needs_arcs() && !(0.0..=length).contains(&s));
+    if let Some((i, &s)) = beyond {
+        // A design whose rod is shorter than an arc length asked: nothing to measure there.
+        let e = Error::invalid(
+            format!("arc_lengths[{i}]"),
+            s,
+            format!("in [0, {length}] m, the rod of this job"),
+        );
+        return (start..end)
+            .map(|_| {
+                SweepSample::failed(
+                    SampleStatus::Failed,
+                    Some(e.clone()),
+                    SolverStats::default(),
+                    job,
+                )
+            })
+            .collect();
+    }
     let mut quiet = job.options;
     quiet.newton.throw = false;
     quiet.warm_start = None;
