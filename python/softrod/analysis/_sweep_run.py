@@ -149,9 +149,6 @@ def run_task(robot, spec: TaskSpec, pieces: Sequence[Piece], parallel: bool) -> 
         if message is not None:
             results[k] = {"infeasible": message}
             continue
-        if spec.arc_lengths is not None and max(spec.arc_lengths) > r.rod.length:
-            results[k] = _beyond_the_rod(piece.a1 - piece.a0, r.rod.length)
-            continue
         jobs.append(_job(r, piece.rows, spec))
         where.append(k)
     if jobs:
@@ -159,15 +156,6 @@ def run_task(robot, spec: TaskSpec, pieces: Sequence[Piece], parallel: bool) -> 
         for k, arrays in zip(where, out, strict=True):
             results[k] = arrays
     return results
-
-
-def _beyond_the_rod(n: int, length: float) -> dict:
-    """The result of ``n`` samples of a design point whose rod (``length``, m) is shorter than
-    an asked arc length: failed, naming ``arc_lengths`` (the core would return NaN values)."""
-    return {
-        "status": np.full(n, STATUS["failed"], dtype=np.int8),
-        "error": np.full(n, f"ParameterError: arc_lengths (beyond the {length:g} m rod)", object),
-    }
 
 
 def _progress(total: int, progress: bool | None, desc: str):
