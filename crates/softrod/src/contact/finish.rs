@@ -327,7 +327,7 @@ pub(super) fn jacobian_stability(p: &Constrained<'_>, pass: &Pass, x: &[f64]) ->
         &y,
         &tw,
         p.model.length(),
-        crate::cosserat::Resolution::default(),
+        crate::cosserat::JacobiCheck::default(),
     )
 }
 

@@ -17,36 +17,12 @@ use nalgebra::{Complex, Matrix3, Matrix6, SymmetricEigen};
 use super::problem::{Constrained, Site};
 use super::ContactState;
 
-use crate::cosserat::equations::{
-    col_rot, rot, rotation_variation, v3, Column, Evaluator, COLUMN, DM, DN, FULL, STATE,
-};
+use crate::cosserat::blocks;
+use crate::cosserat::equations::{Column, Evaluator, FULL, STATE};
 use crate::cosserat::shooting::Shooting;
 use crate::cosserat::statics::Integrator;
 use crate::cosserat::{compliance_stability, Stability, NEUTRAL_MARGIN};
 use crate::integrate::march::{march, Scheme};
-
-/// The scaled pose and wrench blocks of the six base-wrench columns of a state, in
-/// canonical coordinates: the moment variation is `δM + M × δθ / 2` (world), which makes
-/// `XᵀY` symmetric (the term `M · (δθ₁ × δθ₂)` of the symplectic form on the rotations).
-fn blocks(y: &[f64; FULL], length: f64, force: f64) -> (Matrix6<f64>, Matrix6<f64>) {
-    let r = rot(y);
-    let m = v3(y, 15) / (force * length);
-    let (mut x, mut w) = (Matrix6::zeros(), Matrix6::zeros());
-    for k in 0..6 {
-        let b = STATE + COLUMN * k;
-        let dp = v3(y, b) / length;
-        let th = rotation_variation(&r, &col_rot(y, b));
-        let dn = v3(y, b + DN) / force;
-        let dm = v3(y, b + DM) / (force * length) + m.cross(&th) * 0.5;
-        for i in 0..3 {
-            x[(i, k)] = dp[i];
-            x[(i + 3, k)] = th[i];
-            w[(i, k)] = dn[i];
-            w[(i + 3, k)] = dm[i];
-        }
-    }
-    (x, w)
-}
 
 /// Sorted arguments (rad, in (-π, π]) of the eigenvalues of `(X - iY)(X + iY)⁻¹`.
 fn angles(x: &Matrix6<f64>, y: &Matrix6<f64>) -> Option<[f64; 6]> {

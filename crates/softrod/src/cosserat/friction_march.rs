@@ -777,7 +777,7 @@ fn finish(
         }
         let stability = p
             .tip_twist
-            .and_then(|tw| tip_stability(&j, &tw, model.length(), p.resolution));
+            .and_then(|tw| tip_stability(&j, &tw, model.length(), p.jacobi));
         linear = Some((Matrix6::from_column_slice(&j), stability));
         p.stops.clear();
     }

@@ -23,7 +23,7 @@ use super::equations::{
     STATE,
 };
 use super::sensitivity::{integrate, scheme_of, Request, Seed};
-use super::stability::{certifies, tip_stability, Resolution, Stability};
+use super::stability::{certifies, tip_stability, JacobiCheck, Stability};
 use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Scheme};
@@ -74,7 +74,7 @@ struct ExactPass {
     lambda: f64,
     jacobian: [f64; 36],
     tip_twist: [Vector6<f64>; 6],
-    resolution: Resolution,
+    jacobi: JacobiCheck,
     stability: Option<Option<Stability>>,
 }
 
@@ -97,9 +97,9 @@ pub(crate) struct Shooting<'a> {
     /// Tip twist `[δp; δθ]` (m, rad; world) along each base-wrench column of the last pass,
     /// if it integrated the columns (`None` after a pass without them).
     pub tip_twist: Option<[Vector6<f64>; 6]>,
-    /// Whether the last pass resolved its columns (see [`Resolution`]; resolved after a pass
-    /// without them).
-    pub resolution: Resolution,
+    /// The conjugate points and resolution of the last pass's columns (see [`JacobiCheck`];
+    /// clear after a pass without them).
+    pub jacobi: JacobiCheck,
     /// The residual's derivative columns (column-major 6×6) of the last pass with columns.
     pub columns: Option<[f64; 36]>,
     /// Whether the continuation's safeguard also refuses an unstable state (judged from the
@@ -150,7 +150,7 @@ impl<'a> Shooting<'a> {
             stops: Vec::new(),
             nodes: Vec::new(),
             tip_twist: None,
-            resolution: Resolution::default(),
+            jacobi: JacobiCheck::default(),
             columns: None,
             require_stable: false,
             lengths: Vec::new(),
@@ -210,7 +210,8 @@ impl<'a> Shooting<'a> {
             ws: &mut self.ws,
         };
         let nodes = &mut self.nodes;
-        let mut resolution = Resolution::default();
+        let (length, force) = (eq.model.length(), eq.model.force_scale());
+        let mut jacobi = JacobiCheck::default();
         let result = march(
             &mut ev,
             breaks,
@@ -223,18 +224,21 @@ impl<'a> Shooting<'a> {
                     interval,
                     y: head(y),
                 });
-                if N >= FULL {
+                if let Ok(full) = <&[f64; FULL]>::try_from(&y[..]) {
                     let rod = eq.model.rod();
-                    let c = rod.material().compliance(
-                        &rod.section_at(s),
-                        rod.shear_coefficient(),
-                        rod.inextensible(),
-                    );
-                    resolution.node(s, y, c[3].max(c[4]));
+                    let c = match eq.model.uniform_compliance() {
+                        Some(c) => *c,
+                        None => rod.material().compliance(
+                            &rod.section_at(s),
+                            rod.shear_coefficient(),
+                            rod.inextensible(),
+                        ),
+                    };
+                    jacobi.node(s, full, (length, force), c[3].max(c[4]));
                 }
             },
         );
-        self.resolution = resolution;
+        self.jacobi = jacobi;
         self.evaluations += std::mem::take(&mut self.ws.evaluations);
         self.tip_twist = None;
         let y = result?;
@@ -271,7 +275,7 @@ impl<'a> Shooting<'a> {
                 lambda,
                 jacobian: j,
                 tip_twist: tw,
-                resolution: self.resolution,
+                jacobi: self.jacobi,
                 stability: None,
             });
         }
@@ -377,9 +381,9 @@ impl<'a> Shooting<'a> {
         }
         let length = self.eq.model.length();
         let e = self.exact.as_mut().filter(|e| e.lambda == lambda)?;
-        let s = (*e.stability.get_or_insert_with(|| {
-            tip_stability(&e.jacobian, &e.tip_twist, length, e.resolution)
-        }))?;
+        let s = (*e
+            .stability
+            .get_or_insert_with(|| tip_stability(&e.jacobian, &e.tip_twist, length, e.jacobi)))?;
         let distance = (0..6).map(|k| (x[k] - e.x[k]).abs()).fold(0.0, f64::max);
         certifies(&s, distance).then_some((s, e.jacobian))
     }
@@ -580,7 +584,7 @@ impl Problem for Shooting<'_> {
         }
         match (self.require_stable, &self.columns, &self.tip_twist) {
             (true, Some(j), Some(tw)) => {
-                tip_stability(j, tw, length, self.resolution).is_some_and(|s| s.stable)
+                tip_stability(j, tw, length, self.jacobi).is_some_and(|s| s.stable)
             }
             _ => true,
         }

@@ -15,9 +15,10 @@
 //! `n₋` the number of negative eigenvalues. The first term counts the conjugate points of the
 //! doubly clamped problem along the rod (Jacobi's condition; Till & Rucker's test on the
 //! determinant of the pose block of the shooting Jacobian); it vanishes unless the rod, with
-//! its tip clamped in the solved pose, would buckle on its own. The second is what a user
-//! feels at the tip: a direction in which the tip moves against an extra push. softrod
-//! reports the tip condition, which is exact whenever `H_c` is positive definite:
+//! its tip clamped in the solved pose, would buckle on its own; it is counted along the march of
+//! the columns ([`JacobiCheck`]). The second is what a user feels at the tip: a direction in
+//! which the tip moves against an extra push. softrod reports the tip condition as the margin,
+//! and stability when both terms vanish:
 //!
 //! * `stability_margin` = the smallest eigenvalue of the symmetric part of the dimensionless
 //!   tip stiffness `K̂ = D C⁻¹ D / (E I(0)/L)`, `D = diag(L, L, L, 1, 1, 1)`; computed as
@@ -27,7 +28,8 @@
 //!   march at the solution. Directions of zero compliance (the axis of a straight
 //!   inextensible, unshearable rod: constraints, not degrees of freedom) are left out.
 //! * `stable` = `stability_margin > -1e-8` ([`NEUTRAL_MARGIN`]: a neutral mode, such as the
-//!   rotation of a buckled round column about its load axis, counts as stable).
+//!   rotation of a buckled round column about its load axis, counts as stable), no conjugate
+//!   point, and a march that resolved the columns ([`JacobiCheck`]).
 //!
 //! Follower (body-frame) loads are not conservative: the margin is then that of the
 //! symmetric part of the tangent stiffness (loss of it is divergence; flutter is not
@@ -40,7 +42,7 @@
 
 use nalgebra::{Matrix6, SymmetricEigen, Vector6};
 
-use super::equations::{rot, v3};
+use super::equations::{col_rot, rot, rotation_variation, v3, COLUMN, DM, DN, FULL, STATE};
 use crate::math::linalg::Lu6;
 
 /// Margin within which an equilibrium counts as neutral and is reported stable: a rod with
@@ -126,13 +128,14 @@ pub(crate) fn compliance_stability(c: &Matrix6<f64>, length: f64, force: f64) ->
 /// of each base-wrench column `x` (m, rad per scaled unit), for a rod of length `length`.
 /// `None` if the Jacobian is not finite.
 ///
-/// `resolution`: whether the march of the columns resolved them ([`Resolution`]); if not, the
-/// equilibrium is reported not stable whatever the tip's margin.
+/// `jacobi`: the conjugate points and resolution of the march of the columns
+/// ([`JacobiCheck`]); unless it is clear, the equilibrium is reported not stable whatever the
+/// tip's margin.
 pub(crate) fn tip_stability(
     y: &[f64],
     x: &[Vector6<f64>; 6],
     length: f64,
-    resolution: Resolution,
+    jacobi: JacobiCheck,
 ) -> Option<Stability> {
     let ym = Matrix6::from_column_slice(y);
     if !ym.iter().all(|v| v.is_finite()) || !x.iter().all(|c| c.iter().all(|v| v.is_finite())) {
@@ -157,7 +160,7 @@ pub(crate) fn tip_stability(
         }
     }
     let (eig, margin, softest) = softest(&c)?;
-    let stable = margin > -NEUTRAL_MARGIN && !resolution.unresolved;
+    let stable = margin > -NEUTRAL_MARGIN && jacobi.clear();
     let mode = match softest {
         Some(k) if !stable => {
             // The base-wrench change of the unit tip wrench ζ: Y δx = ζ.
@@ -174,16 +177,55 @@ pub(crate) fn tip_stability(
     })
 }
 
-/// Whether a march of the base-wrench columns resolves them: a compressed rod's Jacobi fields
-/// oscillate with its buckling wavenumber `k = √(N/EI)` (axial compression `N` of the state's
-/// force, rod and tendons: the tendons' own pull does not buckle the rod; `EI` the softer
-/// bending stiffness), and RK4 follows them only while `k h` (`h` the step) stays below
-/// [`RESOLVED_TURN`]; beyond it the columns are neither accurate nor bounded (a straight
-/// column at 10⁴ times its Euler load on 40 steps: `k h = 3.9`, tip margin -2.7e-30), and no
-/// verdict is drawn from them: the equilibrium is reported not stable.
+/// The scaled pose and wrench blocks of the six base-wrench columns of a state, in
+/// canonical coordinates: the moment variation is `δM + M × δθ / 2` (world), which makes
+/// `XᵀY` symmetric (the term `M · (δθ₁ × δθ₂)` of the symplectic form on the rotations).
+pub(crate) fn blocks(y: &[f64; FULL], length: f64, force: f64) -> (Matrix6<f64>, Matrix6<f64>) {
+    let r = rot(y);
+    let m = v3(y, 15) / (force * length);
+    let (mut x, mut w) = (Matrix6::zeros(), Matrix6::zeros());
+    for k in 0..6 {
+        let b = STATE + COLUMN * k;
+        let dp = v3(y, b) / length;
+        let th = rotation_variation(&r, &col_rot(y, b));
+        let dn = v3(y, b + DN) / force;
+        let dm = v3(y, b + DM) / (force * length) + m.cross(&th) * 0.5;
+        for i in 0..3 {
+            x[(i, k)] = dp[i];
+            x[(i + 3, k)] = th[i];
+            w[(i, k)] = dn[i];
+            w[(i + 3, k)] = dm[i];
+        }
+    }
+    (x, w)
+}
+
+/// What a march of the six base-wrench columns says beyond the tip: the conjugate points of the
+/// rod with its tip clamped too (Jacobi's condition), and whether the march resolved the
+/// columns at all.
+///
+/// **Conjugate points.** At every node the columns give the pose variations `X(s)` and the
+/// wrench variations `Y(s)` per base wrench, in the canonical coordinates of [`blocks`]
+/// (`XᵀY` symmetric). `X Y⁻¹` is then symmetric (the tip compliance of the rod cut at `s`):
+/// one of its eigenvalues rises through zero where `X` is singular (a conjugate point) and one
+/// jumps from `+∞` to `-∞` where `Y` is (a focal point). Every drop in its count of negative
+/// eigenvalues from one node to the next is a conjugate point passed, with its multiplicity (a
+/// round column's two bending planes at once); a conjugate and a focal point within one step
+/// cancel. With any, `n₋(H) = n₋(H_c) + n₋(C)` has its first term and the equilibrium is not
+/// stable whatever the tip's margin (a column with a compressive load at mid-length between
+/// 31 and 35 times its Euler load: the tip criterion alone found it stable).
+///
+/// **Resolution.** A compressed rod's Jacobi fields oscillate with its buckling wavenumber
+/// `k = √(N/EI)` (axial compression `N` of the state's force, rod and tendons: the tendons' own
+/// pull does not buckle the rod; `EI` the softer bending stiffness), and RK4 follows them only
+/// while `k h` (`h` the step) stays below [`RESOLVED_TURN`]; beyond it the columns are neither
+/// accurate nor bounded (a straight column at 10⁴ times its Euler load on 40 steps: `k h =
+/// 3.9`, tip margin -2.7e-30), and no verdict is drawn from them: not stable.
 #[derive(Debug, Default, Clone, Copy)]
-pub(crate) struct Resolution {
-    last: Option<f64>,
+pub(crate) struct JacobiCheck {
+    last: Option<(f64, Option<usize>)>,
+    /// Conjugate points passed so far.
+    pub conjugate: usize,
     /// Whether a step was too long for the compressed rod's buckling wavenumber.
     pub unresolved: bool,
 }
@@ -193,19 +235,53 @@ pub(crate) struct Resolution {
 /// step is about 1e-3 of the field).
 pub const RESOLVED_TURN: f64 = 1.0;
 
-impl Resolution {
-    /// Adds the node at `s` (m) with state `y` (position, rotation, force, moment), where the
-    /// rod's softer bending compliance is `bending` (1/(N m²)).
-    pub fn node(&mut self, s: f64, y: &[f64], bending: f64) {
+impl JacobiCheck {
+    /// Adds the node at `s` (m) with full state `y` (the state, then the six columns), of a
+    /// rod of length `length` (m) and force scale `force` (N), whose softer bending compliance
+    /// there is `bending` (1/(N m²)).
+    pub fn node(&mut self, s: f64, y: &[f64; FULL], (length, force): (f64, f64), bending: f64) {
         let compression = -v3(y, 12).dot(&(rot(y) * nalgebra::Vector3::z()));
         let k = (compression.max(0.0) * bending).sqrt();
-        if let Some(before) = self.last {
+        let neg = negatives_at(y, length, force);
+        if let Some((before, last)) = self.last {
             if k * (s - before).abs() > RESOLVED_TURN {
                 self.unresolved = true;
             }
+            if let (Some(last), Some(neg)) = (last, neg) {
+                self.conjugate += last.saturating_sub(neg);
+            }
         }
-        self.last = Some(s);
+        self.last = Some((s, neg.or(self.last.and_then(|l| l.1))));
     }
+
+    /// No conjugate point, and a march that resolves them.
+    pub fn clear(&self) -> bool {
+        self.conjugate == 0 && !self.unresolved
+    }
+}
+
+/// The number of negative eigenvalues of `X Y⁻¹` at a node (see [`JacobiCheck`]), as those of
+/// the congruent `Yᵀ X` (symmetric in these coordinates; the same inertia wherever `Y` is
+/// invertible, and no solve), directions of zero compliance left out; `None` where it is not
+/// defined (the base, where `X = 0`; non-finite columns).
+fn negatives_at(y: &[f64; FULL], length: f64, force: f64) -> Option<usize> {
+    let (xm, ym) = blocks(y, length, force);
+    let m = ym.tr_mul(&xm);
+    let sym = (m + m.transpose()) * 0.5;
+    if !sym.iter().all(|v| v.is_finite()) || sym.amax() == 0.0 {
+        return None;
+    }
+    if sym.cholesky().is_some() {
+        return Some(0);
+    }
+    let eig = SymmetricEigen::new(sym);
+    let big = eig.eigenvalues.amax();
+    Some(
+        eig.eigenvalues
+            .iter()
+            .filter(|&&mu| mu < -CONSTRAINT_COMPLIANCE * big)
+            .count(),
+    )
 }
 
 #[cfg(test)]
@@ -232,16 +308,16 @@ mod tests {
         x[3][3] = 1.0;
         x[2][2] = 1e-3;
         x[5][5] = 1.0;
-        let s = tip_stability(&y, &x, 1.0, Resolution::default()).unwrap();
+        let s = tip_stability(&y, &x, 1.0, JacobiCheck::default()).unwrap();
         let exact = 8.0 - 2.0 * 13f64.sqrt();
         assert!(s.stable && (s.margin - exact).abs() < 1e-12, "{s:?}");
         // The same with the axis constrained (zero axial compliance).
         x[2][2] = 0.0;
-        let s = tip_stability(&y, &x, 1.0, Resolution::default()).unwrap();
+        let s = tip_stability(&y, &x, 1.0, JacobiCheck::default()).unwrap();
         assert!(s.stable && (s.margin - exact).abs() < 1e-12, "{s:?}");
         // A negative bending compliance: unstable, with a mode.
         x[0][0] = -1.0;
-        let s = tip_stability(&y, &x, 1.0, Resolution::default()).unwrap();
+        let s = tip_stability(&y, &x, 1.0, JacobiCheck::default()).unwrap();
         assert!(!s.stable && s.margin < 0.0 && s.mode.is_some(), "{s:?}");
     }
 

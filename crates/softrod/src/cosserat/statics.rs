@@ -360,7 +360,7 @@ fn coarse_first(
 /// here).
 fn clearly_stable(c: &Shooting<'_>, j: &[f64], distance: f64) -> Option<Stability> {
     c.tip_twist
-        .and_then(|tw| tip_stability(j, &tw, c.eq.model.length(), c.resolution))
+        .and_then(|tw| tip_stability(j, &tw, c.eq.model.length(), c.jacobi))
         .filter(|s| certifies(s, distance))
         .map(|_| Stability {
             stable: true,
@@ -410,7 +410,7 @@ fn stability_at(
 ) -> Option<(Stability, Vec<f64>)> {
     let length = p.eq.model.length();
     if let (true, Some(j), Some(tw)) = (fresh, jacobian, p.tip_twist) {
-        return tip_stability(j, &tw, length, p.resolution).map(|s| (s, j.to_vec()));
+        return tip_stability(j, &tw, length, p.jacobi).map(|s| (s, j.to_vec()));
     }
     if let Some((_, exact)) = p.certificate(x, 1.0) {
         // Stable, certified by exact columns near x: the margin at x is computed when first
@@ -428,7 +428,7 @@ fn stability_at(
         j[6 * c..6 * c + 6].copy_from_slice(col.as_slice());
     }
     let tw = p.tip_twist?;
-    tip_stability(&j, &tw, length, p.resolution).map(|s| (s, j))
+    tip_stability(&j, &tw, length, p.jacobi).map(|s| (s, j))
 }
 
 /// Size of the imperfection of `seek_stable` (see [`SolveOptions::seek_stable`]): a dead tip wrench of `IMPERFECTION` times the
