@@ -80,8 +80,9 @@ fn report_unstable(
         "and no stable equilibrium was found from it"
     };
     let why = if margin > -softrod::cosserat::NEUTRAL_MARGIN {
-        "the mesh does not resolve the rod's buckling under its compression: raise the RK4 \
-         steps"
+        "the tip stiffness is positive, but the rod would buckle between its ends (a conjugate \
+         point of the rod with its tip clamped too), or the mesh does not resolve its buckling \
+         under its compression (raise the RK4 steps)"
     } else {
         "the tip tangent stiffness is not positive definite"
     };
