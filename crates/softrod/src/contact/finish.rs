@@ -12,7 +12,7 @@ use super::obstacle::Obstacle;
 use super::problem::{mesh_of, Active, Constrained, Pass, Site};
 use super::rows::Forces;
 use super::solve::coarse_mesh;
-use super::stability::{conjugate_points, constrained_stability, free_stiffness, held_contacts};
+use super::stability::{constrained_stability, free_stiffness, held_contacts};
 use super::{Contact, ContactCompliance, ContactSolution, ContactState};
 use crate::cosserat::equations::{Equations, FULL, STATE};
 use crate::cosserat::shooting::Shooting;
@@ -282,8 +282,7 @@ fn report_belt(
 /// margin (the free directions' smallest stiffness; `+inf` for a full clamp, minus the
 /// number of conjugate points when there are some) and the conjugate points.
 fn held_stability(
-    sh: &mut Shooting<'_>,
-    x: &[f64],
+    sh: &Shooting<'_>,
     c: &TipConstraint,
     cols: &[Vector6<f64>],
     tw: &[Vector6<f64>; 6],
@@ -297,7 +296,8 @@ fn held_stability(
             xt[(i, k)] = tw[k][i] / if i < 3 { l } else { 1.0 };
         }
     }
-    let count = conjugate_points(sh, x).map(|c| c.0);
+    // (Counted along the final march with the columns, at these unknowns.)
+    let count = Some(sh.jacobi.conjugate);
     let free: Vec<usize> = (0..6).filter(|k| !c.held[*k]).collect();
     let stiff = free_stiffness(&y, &xt, &c.pose.rotation(), &free);
     let (stable, margin) = match (count, stiff) {
@@ -471,7 +471,7 @@ pub(super) fn finish(
     // other contacts as dead loads).
     let mut conjugate = None;
     if let (Some(c), Some(tw)) = (p.tip, tip_twist) {
-        let (stable, margin, count) = held_stability(&mut sh, &x[..6], &c, &cols, &tw);
+        let (stable, margin, count) = held_stability(&sh, &c, &cols, &tw);
         conjugate = count;
         sol.stable = stable && sol.stats.converged;
         let _ = sol.margin.set(margin);

@@ -6,113 +6,17 @@
 //! leaves free, the inertia of a Schur complement gives `n₋(H) = n₋(H_c) + n₋(K_ff)` for the
 //! constrained rod. `n₋(H_c)` is the number of conjugate points on `(0, L)` (Jacobi's
 //! condition, counted with multiplicity): the arc lengths where the pose block `X(s)` of the
-//! base-wrench columns is singular. They are counted as the passages through `-1` of the
-//! eigenvalues of the unitary `U = (X - iY)(X + iY)⁻¹` (`Y(s)` the wrench block; `X, Y`
-//! scaled as the shooting unknowns), which start at `-1` at the base and turn one way
-//! (Legendre's condition): a symmetric rod whose conjugate point is double (a round rod
-//! under torque) changes the sign of `det X` twice at once, and is counted right.
+//! base-wrench columns is singular, counted along the final march with the columns by the
+//! shooting's [`JacobiCheck`](crate::cosserat::JacobiCheck) (drops in the inertia of
+//! `Yᵀ X`): a symmetric rod whose conjugate point is double (a round rod under torque)
+//! changes the sign of `det X` twice at once, and is counted right.
 
-use nalgebra::{Complex, Matrix3, Matrix6, SymmetricEigen};
+use nalgebra::{Matrix3, Matrix6, SymmetricEigen};
 
 use super::problem::{Constrained, Site};
 use super::ContactState;
 
-use crate::cosserat::blocks;
-use crate::cosserat::equations::{Column, Evaluator, FULL, STATE};
-use crate::cosserat::shooting::Shooting;
-use crate::cosserat::statics::Integrator;
 use crate::cosserat::{compliance_stability, Stability, NEUTRAL_MARGIN};
-use crate::integrate::march::{march, Scheme};
-
-/// Sorted arguments (rad, in (-π, π]) of the eigenvalues of `(X - iY)(X + iY)⁻¹`.
-fn angles(x: &Matrix6<f64>, y: &Matrix6<f64>) -> Option<[f64; 6]> {
-    let z: Matrix6<Complex<f64>> = Matrix6::from_fn(|i, j| Complex::new(x[(i, j)], y[(i, j)]));
-    let zi = z.try_inverse()?;
-    let u = z.conjugate() * zi;
-    let ev = u.schur().eigenvalues()?;
-    let mut a: [f64; 6] = std::array::from_fn(|k| ev[k].arg());
-    if !a.iter().all(|v| v.is_finite()) {
-        return None;
-    }
-    a.sort_by(f64::total_cmp);
-    Some(a)
-}
-
-fn wrap(a: f64) -> f64 {
-    let t = std::f64::consts::TAU;
-    let mut d = a % t;
-    if d > std::f64::consts::PI {
-        d -= t;
-    } else if d <= -std::f64::consts::PI {
-        d += t;
-    }
-    d
-}
-
-/// Number of passages through `π` between consecutive sorted angle sets, with the sign of
-/// the passage (+1 upward), matching the sets by the cyclic shift of least motion.
-fn passages(a: &[f64; 6], b: &[f64; 6]) -> i32 {
-    let mut best = (f64::INFINITY, 0usize);
-    for shift in 0..6 {
-        let cost: f64 = (0..6).map(|k| wrap(b[(k + shift) % 6] - a[k]).abs()).sum();
-        if cost < best.0 {
-            best = (cost, shift);
-        }
-    }
-    let mut n = 0;
-    for k in 0..6 {
-        let d = wrap(b[(k + best.1) % 6] - a[k]);
-        let end = a[k] + d;
-        if end > std::f64::consts::PI {
-            n += 1;
-        } else if end <= -std::f64::consts::PI {
-            n -= 1;
-        }
-    }
-    n
-}
-
-/// Conjugate points on `(0, L)` of the rod of `sh` at the scaled base wrench `x`, and the
-/// scaled tip pose block `X(L)`; `None` if the march fails.
-pub(crate) fn conjugate_points(sh: &mut Shooting<'_>, x: &[f64]) -> Option<(usize, Matrix6<f64>)> {
-    let model = sh.eq.model;
-    let (length, force) = (model.length(), model.force_scale());
-    sh.eq.load_factor = 1.0;
-    sh.ws.set_columns(&[Column::Free; 6], &[]);
-    let y0: [f64; FULL] = sh.eq.initial(x);
-    let scheme = match sh.integrator {
-        Integrator::Rk4 { .. } => Scheme::Rk4(&sh.plan),
-        Integrator::Adaptive(options) => Scheme::Adaptive {
-            options,
-            controlled: STATE,
-        },
-    };
-    let eq = sh.eq;
-    let mut ev = Evaluator { eq, ws: &mut sh.ws };
-    let mut sets: Vec<[f64; 6]> = Vec::new();
-    let mut failed = false;
-    let mut tip = Matrix6::zeros();
-    march(&mut ev, model.breaks(), &[], y0, scheme, |_, s, _, y| {
-        if s <= 0.0 {
-            return;
-        }
-        let (xb, yb) = blocks(y, length, force);
-        tip = xb;
-        match angles(&xb, &yb) {
-            Some(a) => sets.push(a),
-            None => failed = true,
-        }
-    })
-    .ok()?;
-    if failed || sets.is_empty() {
-        return None;
-    }
-    // The direction the angles leave -1 from the base.
-    let first: f64 = sets[0].iter().map(|a| a.signum()).sum();
-    let direction = if first > 0.0 { -1 } else { 1 };
-    let net: i32 = sets.windows(2).map(|w| passages(&w[0], &w[1])).sum();
-    Some(((net * direction).max(0) as usize, tip))
-}
 
 /// The free-direction tip stiffness check: the smallest eigenvalue of the symmetric part of
 /// the dimensionless tip stiffness `K̂ = Y X̂⁻¹` restricted to the directions `free` of the

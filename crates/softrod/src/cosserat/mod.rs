@@ -33,7 +33,7 @@ pub use sensitivity::{
     actuation_jacobian, actuation_jacobians, actuation_parameters, directional_actuation_jacobian,
     sensitivities, Linearisation, Parameter, Sensitivities,
 };
-pub(crate) use stability::{blocks, compliance_stability, tip_stability, JacobiCheck, Stability};
+pub(crate) use stability::{compliance_stability, tip_stability, JacobiCheck, Stability};
 pub use stability::{CONSTRAINT_COMPLIANCE, NEUTRAL_MARGIN};
 pub use statics::{
     solve_statics, solve_statics_at, Integrator, SolveOptions, StaticsSolution, WarmStart,

@@ -180,7 +180,7 @@ pub(crate) fn tip_stability(
 /// The scaled pose and wrench blocks of the six base-wrench columns of a state, in
 /// canonical coordinates: the moment variation is `δM + M × δθ / 2` (world), which makes
 /// `XᵀY` symmetric (the term `M · (δθ₁ × δθ₂)` of the symplectic form on the rotations).
-pub(crate) fn blocks(y: &[f64; FULL], length: f64, force: f64) -> (Matrix6<f64>, Matrix6<f64>) {
+fn blocks(y: &[f64; FULL], length: f64, force: f64) -> (Matrix6<f64>, Matrix6<f64>) {
     let r = rot(y);
     let m = v3(y, 15) / (force * length);
     let (mut x, mut w) = (Matrix6::zeros(), Matrix6::zeros());
