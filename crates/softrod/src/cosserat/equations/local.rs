@@ -65,22 +65,29 @@ impl Evaluator<'_, '_> {
             self.passive_speeds(s, props, &out.v, &out.u);
             return out;
         }
-        self.load_offsets(s, props);
+        let offsets_kept = self.load_offsets(s, props);
         let cd = Vector6::from_column_slice(&c);
         let xs = Vector6::new(vs.x, vs.y, vs.z, us.x, us.y, us.z);
         let wv = Vector6::from_column_slice(&wb);
         let mut warm = self.ws.guess;
+        // The tendon sums at the warm start are those the last solve ended with when the
+        // offsets and tensions are the same (a straight routing within an interval).
+        let mut known = match (warm, self.ws.guess_sums) {
+            (Some(g), Some((at, t))) if offsets_kept && at == g => Some(t),
+            _ => None,
+        };
         let x = loop {
             let start = match warm {
                 Some(g) => g,
                 None => self.straight_guess(&xs, &cd, &wv),
             };
-            match self.local_iteration(start, &xs, &cd, &wv, &c) {
+            match self.local_iteration(start, known, &xs, &cd, &wv, &c) {
                 Some(x) => break x,
                 // The warm start failed (a jump across a break, a far stage): from the
                 // straight-tendon guess with a fresh Newton iteration, as without one.
                 None if warm.is_some() => {
                     warm = None;
+                    known = None;
                     self.ws.last_lu = None;
                 }
                 None => return Local::nan(),
@@ -88,15 +95,8 @@ impl Evaluator<'_, '_> {
         };
         let mut out = Local::strains(&x);
         if tangent {
-            // (I + C D)⁻¹ C at the solution: by Cholesky of the similar I + C^½ D C^½
-            // (D is symmetric positive semi-definite), else by Gauss–Jordan.
-            let mut d = [[0.0; 6]; 6];
-            self.tendon_sums_into(&x, &c, true, Some(&mut d));
-            let lu = Inverse6::of_compliance_stiffness(&c, &d).or_else(|| {
-                let (_, h) = self.tendon_sums(&x, &c, true);
-                h.as_ref().and_then(Inverse6::new)
-            });
-            let Some(lu) = lu else {
+            // (I + C D)⁻¹ C at the solution.
+            let Some((_, lu)) = self.local_inverse(&x, &c) else {
                 return Local::nan();
             };
             self.ws.tangent = Tangent {
@@ -105,9 +105,23 @@ impl Evaluator<'_, '_> {
             };
             self.ws.last_lu = Some(lu);
         }
-        self.finish_tendons(s, props, &mut out, &fluid);
+        let sums = self.finish_tendons(s, props, &mut out, &fluid);
         self.ws.guess = Some(x);
+        self.ws.guess_sums = Some((x, sums));
         out
+    }
+
+    /// The tendon sums at the strains `x` and the inverse of the local Jacobian `I + C D`
+    /// there: by Cholesky of the similar `I + C^½ D C^½` (`D` is symmetric positive
+    /// semi-definite), else by Gauss–Jordan; `None` if it is singular.
+    fn local_inverse(&self, x: &Vector6<f64>, c: &[f64; 6]) -> Option<(Vector6<f64>, Inverse6)> {
+        let mut d = [[0.0; 6]; 6];
+        let (tw, _) = self.tendon_sums_into(x, c, true, Some(&mut d));
+        let lu = Inverse6::of_compliance_stiffness(c, &d).or_else(|| {
+            let (_, h) = self.tendon_sums(x, c, true);
+            h.as_ref().and_then(Inverse6::new)
+        })?;
+        Some((tw, lu))
     }
 
     /// The strains with straight tendons (`t_i = e_z`): `x* + C (W - T_straight)`, the start
@@ -127,12 +141,13 @@ impl Evaluator<'_, '_> {
         xs + cd.component_mul(&(wv - Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)))
     }
 
-    /// The local Newton (or chord) iteration on `G(x) = x - x* - C (W - T(x)) = 0` from `x`;
-    /// `None` if it fails.
+    /// The local Newton (or chord) iteration on `G(x) = x - x* - C (W - T(x)) = 0` from `x`
+    /// (`known`: `T(x)` if already evaluated); `None` if it fails.
     #[inline]
     fn local_iteration(
         &mut self,
         mut x: Vector6<f64>,
+        mut known: Option<Vector6<f64>>,
         xs: &Vector6<f64>,
         cd: &Vector6<f64>,
         wv: &Vector6<f64>,
@@ -142,21 +157,29 @@ impl Evaluator<'_, '_> {
         let mut chord = self.ws.last_lu.is_some();
         for _ in 0..LOCAL_MAX_ITERATIONS {
             let tw = if chord {
-                self.tendon_load(&x)
+                known.take().unwrap_or_else(|| self.tendon_load(&x))
             } else {
-                let (tw, h) = self.tendon_sums(&x, c, true);
-                self.ws.last_lu = Some(Inverse6::new(&h?)?);
+                let (tw, lu) = self.local_inverse(&x, c)?;
+                self.ws.last_lu = Some(lu);
                 tw
             };
             let g = x - xs - cd.component_mul(&(wv - tw));
             let lu = self.ws.last_lu.as_ref()?;
             let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
             x -= dx;
-            if !x.iter().all(|v| v.is_finite()) {
+            // The largest step and strain in one sweep; a non-finite step makes the sum of
+            // the step's magnitudes non-finite (the start is finite).
+            let (mut step, mut size, mut total) = (0.0_f64, 0.0_f64, 0.0);
+            for k in 0..6 {
+                let (a, b) = (dx[k].abs(), x[k].abs());
+                step = if a > step { a } else { step };
+                size = if b > size { b } else { size };
+                total += a;
+            }
+            if !total.is_finite() {
                 return None;
             }
-            let step = dx.amax();
-            let tol = LOCAL_TOLERANCE * (1.0 + x.amax());
+            let tol = LOCAL_TOLERANCE * (1.0 + size);
             if step <= tol {
                 return Some(x);
             }
@@ -183,7 +206,8 @@ impl Evaluator<'_, '_> {
         None
     }
 
-    /// Tendon loads and speeds `|p_i'|` at the local solution `out`, plus the fluid's share.
+    /// Tendon loads and speeds `|p_i'|` at the local solution `out`, plus the fluid's share;
+    /// returns the tendon sums alone, as [`Self::tendon_load`] computes them.
     #[inline]
     pub(crate) fn finish_tendons(
         &mut self,
@@ -191,20 +215,21 @@ impl Evaluator<'_, '_> {
         props: &SectionProperties,
         out: &mut Local,
         fluid: &[f64; 6],
-    ) {
+    ) -> Vector6<f64> {
         let (mut tf, mut tm) = (Vector3::zeros(), Vector3::zeros());
         for (k, &i) in self.ws.active.iter().enumerate() {
             let (r, rp, tau) = &self.ws.offsets[k];
             let w = out.v + out.u.cross(r) + rp;
             let len = w.norm();
-            let a = *tau / len;
-            tf += w * a;
-            tm += r.cross(&w) * a;
+            let t = w * (*tau / len);
+            tf += t;
+            tm += r.cross(&t);
             self.ws.tendon_speed[i] = len;
         }
         out.tendon_force = tf + Vector3::new(fluid[0], fluid[1], fluid[2]);
         out.tendon_moment = tm + Vector3::new(fluid[3], fluid[4], fluid[5]);
         let (v, u) = (out.v, out.u);
         self.passive_speeds(s, props, &v, &u);
+        Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)
     }
 }

@@ -215,8 +215,16 @@ pub(crate) struct Workspace {
     pub passive: Vec<usize>,
     /// Offsets `(r, r', τ)` of the active tendons at the current `s`.
     pub offsets: Vec<(Vector3<f64>, Vector3<f64>, f64)>,
+    /// Whether `offsets` (and `passive_offsets`) hold for the whole current interval
+    /// (constant routings and tensions).
+    pub fixed_offsets: bool,
+    /// Offsets `r` of the passive tendons, with `fixed_offsets`.
+    pub passive_offsets: Vec<Vector3<f64>>,
     /// Last local solution `(v, u)`, the warm start of the next local Newton iteration.
     pub guess: Option<Vector6<f64>>,
+    /// The tendon sums `T(x)` at the strains `x` a linear local solve last ended with (its
+    /// first chord step from there needs no evaluation if the offsets are unchanged).
+    pub guess_sums: Option<(Vector6<f64>, Vector6<f64>)>,
     /// Inverted local Jacobian of the last local Newton iteration (chord steps).
     pub last_lu: Option<Inverse6>,
     /// `|p_i'|` of every tendon at the last evaluation (zero for tendons not in the interval).
@@ -260,7 +268,10 @@ impl Workspace {
             active: Vec::with_capacity(n_tendons),
             passive: Vec::with_capacity(n_tendons),
             offsets: Vec::with_capacity(n_tendons),
+            fixed_offsets: false,
+            passive_offsets: Vec::with_capacity(n_tendons),
             guess: None,
+            guess_sums: None,
             last_lu: None,
             tendon_speed: vec![0.0; n_tendons],
             evaluations: 0,
@@ -288,7 +299,10 @@ impl Workspace {
         self.active.clear();
         self.passive.clear();
         self.offsets.clear();
+        self.fixed_offsets = false;
+        self.passive_offsets.clear();
         self.guess = None;
+        self.guess_sums = None;
         self.last_lu = None;
         self.tendon_speed.clear();
         self.tendon_speed.resize(n_tendons, 0.0);

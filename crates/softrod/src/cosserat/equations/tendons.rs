@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use super::Evaluator;
 use crate::math::so3::hat;
 use crate::model::section::SectionProperties;
+use crate::model::tendon::Routing;
 
 impl Evaluator<'_, '_> {
     /// Selects the tendons and chambers active on interval `k`.
@@ -28,6 +29,7 @@ impl Evaluator<'_, '_> {
         }
         self.ws.guess = None;
         self.ws.last_lu = None;
+        self.fix_offsets();
         self.ws.chambers.clear();
         for i in 0..nc {
             if self.chamber_acts(i, a, b) {
@@ -96,24 +98,71 @@ impl Evaluator<'_, '_> {
         w
     }
 
-    /// Offsets `(r, r', τ)` of the active tendons at `s` into the workspace.
-    #[inline]
-    pub(crate) fn load_offsets(&mut self, s: f64, props: &SectionProperties) {
+    /// With constant tension along the tendons and every tendon of the interval routed at a
+    /// constant offset, the offsets of the interval, once (the evaluations then only check
+    /// the tensions in [`Self::load_offsets`] and read the passive offsets as they are).
+    fn fix_offsets(&mut self) {
         let tendons = self.eq.model.tendons();
-        self.ws.offsets.clear();
-        for &i in &self.ws.active {
+        let ws = &mut *self.ws;
+        ws.fixed_offsets = false;
+        ws.offsets.clear();
+        ws.passive_offsets.clear();
+        let constant = |i: &usize| matches!(tendons[*i].routing(), Routing::Constant(_));
+        if self.eq.profile.is_some() || !ws.active.iter().chain(&ws.passive).all(constant) {
+            return;
+        }
+        for &i in &ws.active {
+            if let Routing::Constant(r) = tendons[i].routing() {
+                let r = Vector3::new(r[0], r[1], 0.0);
+                ws.offsets.push((r, Vector3::zeros(), self.eq.tensions[i]));
+            }
+        }
+        for &i in &ws.passive {
+            if let Routing::Constant(r) = tendons[i].routing() {
+                ws.passive_offsets.push(Vector3::new(r[0], r[1], 0.0));
+            }
+        }
+        ws.fixed_offsets = true;
+    }
+
+    /// Offsets `(r, r', τ)` of the active tendons at `s` into the workspace; whether they are
+    /// those already held (then the tendon sums at given strains are too).
+    #[inline]
+    pub(crate) fn load_offsets(&mut self, s: f64, props: &SectionProperties) -> bool {
+        if self.ws.fixed_offsets {
+            // The tensions are read afresh: an evaluator with other tensions may carry on in
+            // the interval (a march resumed at a break keeps the interval's warm start).
+            let ws = &mut *self.ws;
+            let mut kept = true;
+            for (&i, o) in ws.active.iter().zip(ws.offsets.iter_mut()) {
+                if o.2 != self.eq.tensions[i] {
+                    o.2 = self.eq.tensions[i];
+                    kept = false;
+                }
+            }
+            return kept;
+        }
+        let tendons = self.eq.model.tendons();
+        let ws = &mut *self.ws;
+        let mut kept = ws.offsets.len() == ws.active.len();
+        ws.offsets
+            .resize(ws.active.len(), (Vector3::zeros(), Vector3::zeros(), 0.0));
+        for (k, &i) in ws.active.iter().enumerate() {
             let (r, rp) = tendons[i].routing().offset(s, props);
             let tau = self
                 .eq
                 .profile
                 .and_then(|p| p.at(i, s))
                 .unwrap_or(self.eq.tensions[i]);
-            self.ws.offsets.push((
+            let new = (
                 Vector3::new(r[0], r[1], 0.0),
                 Vector3::new(rp[0], rp[1], 0.0),
                 tau,
-            ));
+            );
+            kept &= ws.offsets[k] == new;
+            ws.offsets[k] = new;
         }
+        kept
     }
 
     /// Records `|p_i'|` of the tension-free tendons for the strains `(v, u)`.
@@ -126,6 +175,13 @@ impl Evaluator<'_, '_> {
         u: &Vector3<f64>,
     ) {
         if !self.ws.track_lengths {
+            return;
+        }
+        if self.ws.fixed_offsets {
+            let ws = &mut *self.ws;
+            for (&i, r) in ws.passive.iter().zip(&ws.passive_offsets) {
+                ws.tendon_speed[i] = (v + u.cross(r)).norm();
+            }
             return;
         }
         let tendons = self.eq.model.tendons();
