@@ -167,14 +167,14 @@ impl Evaluator<'_, '_> {
             let lu = self.ws.last_lu.as_ref()?;
             let dx = Vector6::from(lu.solve(&[g[0], g[1], g[2], g[3], g[4], g[5]]));
             x -= dx;
-            // The largest step and strain in one sweep; a non-finite step makes the sum of
-            // the step's magnitudes non-finite (the start is finite).
+            // The largest step and strain in one sweep; a non-finite step or strain makes the
+            // sum of the magnitudes non-finite.
             let (mut step, mut size, mut total) = (0.0_f64, 0.0_f64, 0.0);
             for k in 0..6 {
                 let (a, b) = (dx[k].abs(), x[k].abs());
                 step = if a > step { a } else { step };
                 size = if b > size { b } else { size };
-                total += a;
+                total += a + b;
             }
             if !total.is_finite() {
                 return None;
