@@ -298,6 +298,8 @@ fn coarse_first(
         return None;
     };
     let mut c = Shooting::new(p.eq, coarse, rk4_plan(p.eq.model.breaks(), steps));
+    // (No tendon is held here: the tension-free tendons' lengths are not needed.)
+    c.passive_lengths = false;
     let defect = options
         .warm_start
         .and_then(|w| w.coarse_defect)
@@ -378,6 +380,7 @@ fn stable_on_coarse(p: &mut Shooting<'_>, x: &[f64]) -> Option<Stability> {
         return None;
     };
     let mut c = Shooting::new(p.eq, coarse, rk4_plan(p.eq.model.breaks(), steps));
+    c.passive_lengths = false;
     let (mut j, mut r) = ([0.0; 36], [0.0; 6]);
     let marched = c.evaluate(x, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian;
     p.evaluations += c.evaluations;
