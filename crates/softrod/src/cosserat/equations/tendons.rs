@@ -129,6 +129,9 @@ impl Evaluator<'_, '_> {
     /// those already held (then the tendon sums at given strains are too).
     #[inline]
     pub(crate) fn load_offsets(&mut self, s: f64, props: &SectionProperties) -> bool {
+        // (An evaluator with a tension profile may carry on in the interval: then as for any
+        // routing.)
+        self.ws.fixed_offsets &= self.eq.profile.is_none();
         if self.ws.fixed_offsets {
             // The tensions are read afresh: an evaluator with other tensions may carry on in
             // the interval (a march resumed at a break keeps the interval's warm start).
