@@ -296,6 +296,51 @@ fn constant_offset_tendon_gives_constant_curvature_and_strain() {
     assert!((sol.n_body[0][2] + tau).abs() < 1e-12);
 }
 
+/// Composite Simpson's rule of `f` over `[a, b]` with `n` (even) panels.
+fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+    let h = (b - a) / n as f64;
+    let inner: f64 = (1..n)
+        .map(|i| f(a + i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
+        .sum();
+    (f(a) + f(b) + inner) * h / 3.0
+}
+
+#[test]
+fn tendon_on_a_tapered_rod_bends_with_the_local_stiffness() {
+    // A straight tendon at a constant offset d carries no total wrench with the rod: at every
+    // s the tendon runs along e_z (v + u x r = (0, 0, 1 + eps - kappa d)), so
+    // kappa(s) = tau d / EI(s) and eps(s) = -tau / EA(s) section by section. The shape is the
+    // planar curve of those strains, integrated here by quadrature.
+    let (l, r0, r1, e, nu): (f64, f64, f64, f64, f64) = (0.25, 0.004, 0.002, 3e6, 0.45);
+    let (tau, d) = (0.4, 0.0015);
+    let radius = |s: f64| r0 + (r1 - r0) * s / l;
+    let kappa = |s: f64| tau * d / (e * PI * radius(s).powi(4) / 4.0);
+    let eps = |s: f64| -tau / (e * PI * radius(s).powi(2));
+    let mat = LinearElastic::new(e, nu).unwrap();
+    let rod = Rod::new(l, Section::tapered_circular(r0, r1).unwrap(), mat).unwrap();
+    let tendon = common::tendon([d, 0.0], tau, None).unwrap();
+    let sol = common::solve(&rod, &[tendon], &Loads::default(), &rk4(400)).unwrap();
+    for ((s, u), v) in sol.s.iter().zip(&sol.u).zip(&sol.v) {
+        let (k, ep) = (kappa(*s), eps(*s));
+        assert!((u[1] - k).abs() <= 1e-10 * k, "s {s}: u {u:?} vs {k}");
+        assert!(u[0].abs() < 1e-12 * k && u[2].abs() < 1e-12 * k);
+        assert!((v[2] - 1.0 - ep).abs() < 1e-10 * ep.abs(), "s {s}: v {v:?}");
+    }
+    let theta = |s: f64| simpson(kappa, 0.0, s, 200);
+    let x = simpson(|s| (1.0 + eps(s)) * theta(s).sin(), 0.0, l, 400);
+    let z = simpson(|s| (1.0 + eps(s)) * theta(s).cos(), 0.0, l, 400);
+    let err = dist(sol.tip_position(), [x, 0.0, z]);
+    println!(
+        "tapered tendon arc: tip angle {:.4} rad, tip error {err:.3e} m",
+        theta(l)
+    );
+    assert!(err < 1e-10, "tip {:?} vs [{x}, 0, {z}]", sol.tip_position());
+    // The tendon runs at distance d from the backbone: its length is the integral of
+    // 1 + eps - kappa d.
+    let lt = simpson(|s| 1.0 + eps(s) - kappa(s) * d, 0.0, l, 400);
+    assert!((sol.tendon_lengths[0] - lt).abs() < 1e-12);
+}
+
 #[test]
 fn base_pose_rotation_rotates_the_solution() {
     use softrod::{Pose, Routing};

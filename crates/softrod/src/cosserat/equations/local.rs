@@ -4,7 +4,7 @@
 
 use nalgebra::{Vector3, Vector6};
 
-use super::{Evaluator, Local, Tangent, LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
+use super::{Evaluator, Local, LocalMemo, Tangent, LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 use crate::math::linalg::Inverse6;
 use crate::model::section::SectionProperties;
 
@@ -68,35 +68,28 @@ impl Evaluator<'_, '_> {
         let offsets_kept = self.load_offsets(s, props);
         let cd = Vector6::from_column_slice(&c);
         let xs = Vector6::new(vs.x, vs.y, vs.z, us.x, us.y, us.z);
-        let wv = Vector6::from_column_slice(&wb);
-        let mut warm = self.ws.guess;
-        // The tendon sums at the warm start are those the last solve ended with when the
-        // offsets and tensions are the same (a straight routing within an interval).
-        let mut known = match (warm, self.ws.guess_sums) {
-            (Some(g), Some((at, t))) if offsets_kept && at == g => Some(t),
-            _ => None,
-        };
-        let x = loop {
-            let start = match warm {
-                Some(g) => g,
-                None => self.straight_guess(&xs, &cd, &wv),
-            };
-            match self.local_iteration(start, known, &xs, &cd, &wv, &c) {
-                Some(x) => break x,
-                // The warm start failed (a jump across a break, a far stage): from the
-                // straight-tendon guess with a fresh Newton iteration, as without one.
-                None if warm.is_some() => {
-                    warm = None;
-                    known = None;
-                    self.ws.last_lu = None;
-                }
-                None => return Local::nan(),
+        // The rod and the tendons carry no wrench together (exactly so on a robot loaded by
+        // its actuators only): the equations of the last such solve may be met again.
+        let unloaded = wb.iter().all(|w| *w == 0.0);
+        if unloaded && offsets_kept {
+            if let Some(out) = self
+                .ws
+                .memo
+                .and_then(|m| m.solves(&fluid, &xs, &c, tangent, self.ws.track_lengths))
+            {
+                return out;
             }
+        }
+        let wv = Vector6::from_column_slice(&wb);
+        let Some(x) = self.strains(offsets_kept, &xs, &cd, &wv, &c) else {
+            self.ws.memo = None;
+            return Local::nan();
         };
         let mut out = Local::strains(&x);
         if tangent {
             // (I + C D)⁻¹ C at the solution.
             let Some((_, lu)) = self.local_inverse(&x, &c) else {
+                self.ws.memo = None;
                 return Local::nan();
             };
             self.ws.tangent = Tangent {
@@ -108,7 +101,55 @@ impl Evaluator<'_, '_> {
         let sums = self.finish_tendons(s, props, &mut out, &fluid);
         self.ws.guess = Some(x);
         self.ws.guess_sums = Some((x, sums));
+        if unloaded && self.ws.fixed_offsets {
+            self.ws.memo = Some(LocalMemo::new(
+                fluid,
+                xs,
+                c,
+                out,
+                tangent,
+                self.ws.track_lengths,
+            ));
+        } else if self.ws.memo.is_some() {
+            self.ws.memo = None;
+        }
         out
+    }
+
+    /// The strains solving the local equations: from the last solution (and its tendon sums
+    /// when the offsets are kept), else from the straight-tendon guess; `None` if both fail.
+    fn strains(
+        &mut self,
+        offsets_kept: bool,
+        xs: &Vector6<f64>,
+        cd: &Vector6<f64>,
+        wv: &Vector6<f64>,
+        c: &[f64; 6],
+    ) -> Option<Vector6<f64>> {
+        let mut warm = self.ws.guess;
+        // The tendon sums at the warm start are those the last solve ended with when the
+        // offsets and tensions are the same (a straight routing within an interval).
+        let mut known = match (warm, self.ws.guess_sums) {
+            (Some(g), Some((at, t))) if offsets_kept && at == g => Some(t),
+            _ => None,
+        };
+        loop {
+            let start = match warm {
+                Some(g) => g,
+                None => self.straight_guess(xs, cd, wv),
+            };
+            match self.local_iteration(start, known, xs, cd, wv, c) {
+                Some(x) => return Some(x),
+                // The warm start failed (a jump across a break, a far stage): from the
+                // straight-tendon guess with a fresh Newton iteration, as without one.
+                None if warm.is_some() => {
+                    warm = None;
+                    known = None;
+                    self.ws.last_lu = None;
+                }
+                None => return None,
+            }
+        }
     }
 
     /// The tendon sums at the strains `x` and the inverse of the local Jacobian `I + C D`
@@ -231,5 +272,166 @@ impl Evaluator<'_, '_> {
         let (v, u) = (out.v, out.u);
         self.passive_speeds(s, props, &v, &u);
         Vector6::new(tf.x, tf.y, tf.z, tm.x, tm.y, tm.z)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use std::sync::Arc;
+
+    use nalgebra::Vector3;
+
+    use super::super::{Equations, Evaluator, Workspace};
+    use crate::model::chamber::{Chamber, ChamberArea};
+    use crate::model::loads::Loads;
+    use crate::model::material::LinearElastic;
+    use crate::model::rod::{Profile, Rod};
+    use crate::model::section::Section;
+    use crate::model::tendon::Tendon;
+    use crate::model::RobotModel;
+
+    /// One local solve: where, the body wrench, and whether the tangent and the tension-free
+    /// tendons' speeds are asked for.
+    type Call = (f64, [f64; 6], bool, bool);
+
+    /// Strains and sums, the tangent applied to the six unit wrenches, and every tendon speed
+    /// of the call `c` in the workspace of `ev`.
+    fn outcome(ev: &mut Evaluator<'_, '_>, c: &Call) -> Vec<f64> {
+        let (s, w, tangent, lengths) = *c;
+        ev.ws.track_lengths = lengths;
+        let props = ev.eq.model.rod().section_at(s);
+        let nb = Vector3::new(w[0], w[1], w[2]);
+        let mb = Vector3::new(w[3], w[4], w[5]);
+        let out = ev.local(s, &props, &nb, &mb, tangent);
+        let mut all: Vec<f64> = [out.v, out.u, out.tendon_force, out.tendon_moment]
+            .iter()
+            .flat_map(|x| x.iter().copied())
+            .collect();
+        if tangent {
+            for k in 0..6 {
+                let mut e = [0.0; 6];
+                e[k] = 1.0;
+                all.extend(ev.ws.tangent.apply(&e));
+            }
+        }
+        if lengths {
+            all.extend(ev.ws.tendon_speed.iter().copied());
+        }
+        all
+    }
+
+    /// Every call of `calls`, made in turn on one workspace, gives what the same call gives
+    /// on a fresh workspace: the last solve's memo (and warm start) never changes a result.
+    fn history_free(model: &RobotModel, tensions: &[f64], pressures: &[f64], calls: &[Call]) {
+        let eq = Equations {
+            model,
+            tensions,
+            pressures,
+            load_factor: 1.0,
+            profile: None,
+        };
+        let nt = model.tendons().len();
+        let mut ws = Workspace::new(nt);
+        let mut ev = Evaluator { eq, ws: &mut ws };
+        ev.set_interval(0);
+        for (i, c) in calls.iter().enumerate() {
+            let got = outcome(&mut ev, c);
+            let mut fresh_ws = Workspace::new(nt);
+            let mut fresh = Evaluator {
+                eq,
+                ws: &mut fresh_ws,
+            };
+            fresh.set_interval(0);
+            let want = outcome(&mut fresh, c);
+            for (a, b) in got.iter().zip(&want) {
+                let tol = 1e-12 * (1.0 + b.abs());
+                assert!(
+                    (a - b).abs() <= tol,
+                    "call {i} {c:?}: {got:?}\n vs {want:?}"
+                );
+            }
+        }
+    }
+
+    fn tendons() -> Vec<Tendon> {
+        vec![
+            Tendon::constant([0.004, 0.0], None).unwrap(),
+            Tendon::constant([0.0, 0.004], None).unwrap(),
+            Tendon::constant([-0.004, 0.0], None).unwrap(),
+        ]
+    }
+
+    const ZERO: [f64; 6] = [0.0; 6];
+
+    /// Zero body wrench at one `s` after another (RK4 stages and nodes), where the rest
+    /// curvature, the section or the chamber's area differs, then the same `s` again.
+    fn along(tangent: bool) -> Vec<Call> {
+        [0.0, 0.05, 0.05, 0.1, 0.1, 0.0, 0.1]
+            .iter()
+            .map(|&s| (s, ZERO, tangent, true))
+            .collect()
+    }
+
+    fn rod(section: Section) -> Rod {
+        Rod::new(0.1, section, LinearElastic::new(2e6, 0.45).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn a_rest_curvature_along_the_rod_is_solved_at_every_s() {
+        let curved = rod(Section::circular(0.006).unwrap())
+            .with_rest_curvature(Profile::Function(Arc::new(|s| {
+                Vector3::new(0.0, 2.0 + 30.0 * s, 0.0)
+            })))
+            .unwrap();
+        let m = RobotModel::new(curved, tendons(), vec![], Loads::default()).unwrap();
+        history_free(&m, &[1.0, 0.5, 0.0], &[], &along(false));
+        history_free(&m, &[1.0, 0.5, 0.0], &[], &along(true));
+    }
+
+    #[test]
+    fn a_taper_is_solved_at_every_s() {
+        let tapered = rod(Section::tapered_circular(0.006, 0.004).unwrap());
+        let m = RobotModel::new(tapered, tendons(), vec![], Loads::default()).unwrap();
+        history_free(&m, &[1.0, 0.5, 0.0], &[], &along(false));
+        history_free(&m, &[1.0, 0.5, 0.0], &[], &along(true));
+    }
+
+    #[test]
+    fn a_chamber_of_varying_area_is_solved_at_every_s() {
+        // The total wrench equal to the fluid's at each s: the rod and the tendons carry none.
+        let area = ChamberArea::Function(Arc::new(|s| 4e-6 * (1.0 + 5.0 * s)));
+        let chamber = Chamber::new(area, [0.0, -0.003], 0.0, None).unwrap();
+        let fluid = |c: Call| (c.0, chamber.fluid_wrench(c.0, 2e4), c.2, c.3);
+        let calls: Vec<Vec<Call>> = [false, true]
+            .iter()
+            .map(|&t| along(t).into_iter().map(fluid).collect())
+            .collect();
+        let uniform = rod(Section::circular(0.006).unwrap());
+        let m =
+            RobotModel::new(uniform, tendons(), vec![chamber.clone()], Loads::default()).unwrap();
+        for c in &calls {
+            history_free(&m, &[1.0, 0.5, 0.0], &[2e4], c);
+        }
+    }
+
+    #[test]
+    fn the_tangent_and_the_speeds_are_those_of_the_call() {
+        // A loaded solve leaves its tangent and speeds in the workspace; an unloaded one at
+        // the same s that asks for neither must not hand them to one that asks for them.
+        let uniform = rod(Section::circular(0.006).unwrap());
+        let m = RobotModel::new(uniform, tendons(), vec![], Loads::default()).unwrap();
+        let w = [0.3, -0.2, 1.5, 0.01, 0.02, 0.0];
+        let calls = [
+            (0.05, w, true, true),
+            (0.05, ZERO, false, false),
+            (0.05, ZERO, true, false),
+            (0.05, w, true, true),
+            (0.05, ZERO, false, false),
+            (0.05, ZERO, false, true),
+            (0.05, ZERO, true, true),
+            (0.05, ZERO, true, true),
+        ];
+        history_free(&m, &[1.0, 0.5, 0.0], &[], &calls);
     }
 }

@@ -157,6 +157,72 @@ impl Local {
     }
 }
 
+/// A linear local solve of an interval whose offsets and tensions are fixed
+/// ([`Workspace::fixed_offsets`]) at a zero body wrench (the rod and the tendons carry no
+/// load together; on a robot loaded by its actuators only the shooting starts from a zero
+/// base wrench and the total wrench stays exactly zero), with the other inputs that
+/// determine it: the fluid's share of the wrench, the rest strains and the compliance at `s`.
+/// An evaluation that repeats them exactly has the same solution, so on a uniform rod every
+/// evaluation of an interval after its first is a look-up. Any other local solve replaces or
+/// clears it, so that the workspace's tangent and tendon speeds are always those of the
+/// memo's solve when it is read.
+#[derive(Clone, Copy)]
+pub(crate) struct LocalMemo {
+    pub fluid: [f64; 6],
+    pub rest: Vector6<f64>,
+    pub compliance: [f64; 6],
+    /// The solution (strains, tendon and fluid sums).
+    pub out: Local,
+    /// Whether the tangent at the solution was left in [`Workspace::tangent`].
+    pub tangent: bool,
+    /// Whether the tension-free tendons' speeds were recorded.
+    pub lengths: bool,
+}
+
+impl LocalMemo {
+    /// The memo of a solve at a zero body wrench with these other inputs (the offsets and
+    /// tensions of the workspace).
+    #[cold]
+    #[inline(never)]
+    pub fn new(
+        fluid: [f64; 6],
+        rest: Vector6<f64>,
+        compliance: [f64; 6],
+        out: Local,
+        tangent: bool,
+        lengths: bool,
+    ) -> Self {
+        Self {
+            fluid,
+            rest,
+            compliance,
+            out,
+            tangent,
+            lengths,
+        }
+    }
+
+    /// The solution of the equations of these inputs (at a zero body wrench, with the
+    /// offsets and tensions the memo was made with), if the memo holds it, with the tangent
+    /// and the tension-free tendons' speeds if they are asked for.
+    #[inline]
+    pub fn solves(
+        &self,
+        fluid: &[f64; 6],
+        rest: &Vector6<f64>,
+        compliance: &[f64; 6],
+        tangent: bool,
+        lengths: bool,
+    ) -> Option<Local> {
+        (self.fluid == *fluid
+            && self.rest == *rest
+            && self.compliance == *compliance
+            && (self.tangent || !tangent)
+            && (self.lengths || !lengths))
+            .then_some(self.out)
+    }
+}
+
 /// The equations of one configuration: the model, the tendon tensions (N) and chamber
 /// pressures (Pa) of the actuation, and the load factor `λ` that scales the external loads
 /// (the actuation is always applied in full).
@@ -227,6 +293,8 @@ pub(crate) struct Workspace {
     pub guess_sums: Option<(Vector6<f64>, Vector6<f64>)>,
     /// Inverted local Jacobian of the last local Newton iteration (chord steps).
     pub last_lu: Option<Inverse6>,
+    /// The last local solve, if it was one at a zero body wrench (see [`LocalMemo`]).
+    pub memo: Option<LocalMemo>,
     /// `|p_i'|` of every tendon at the last evaluation (zero for tendons not in the interval).
     pub tendon_speed: Vec<f64>,
     /// Right-hand-side evaluations so far.
@@ -273,6 +341,7 @@ impl Workspace {
             guess: None,
             guess_sums: None,
             last_lu: None,
+            memo: None,
             tendon_speed: vec![0.0; n_tendons],
             evaluations: 0,
             chambers: Vec::new(),
@@ -304,6 +373,7 @@ impl Workspace {
         self.guess = None;
         self.guess_sums = None;
         self.last_lu = None;
+        self.memo = None;
         self.tendon_speed.clear();
         self.tendon_speed.resize(n_tendons, 0.0);
         self.evaluations = 0;

@@ -29,6 +29,7 @@ impl Evaluator<'_, '_> {
         }
         self.ws.guess = None;
         self.ws.last_lu = None;
+        self.ws.memo = None;
         self.fix_offsets();
         self.ws.chambers.clear();
         for i in 0..nc {
