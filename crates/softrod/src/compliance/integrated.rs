@@ -132,36 +132,55 @@ pub fn element_compliance(solution: &StaticsSolution) -> Vec<[f64; 6]> {
 /// Nodes and weights (`m` of them) of the fourth-order integral over the panel
 /// `[x_j, x_{j+1}]` of the cubic through the (up to) four nearest nodes.
 fn panel_weights(x: &[f64], j: usize) -> ([usize; 4], [f64; 4], usize) {
+    let n = x.len();
+    let m = n.min(4);
+    let start = j.saturating_sub(1).min(n - m);
+    let mut nodes = [0usize; 4];
+    for k in 0..m {
+        nodes[k] = start + k;
+    }
+    let (a, b) = (x[j], x[j + 1]);
+    let mut weights = [0.0f64; 4];
+    let at = |k: usize| x[start + k];
+    match m {
+        4 => weights = lagrange_integrals([at(0), at(1), at(2), at(3)], a, b),
+        3 => weights[..3].copy_from_slice(&lagrange_integrals([at(0), at(1), at(2)], a, b)),
+        _ => weights[..2].copy_from_slice(&lagrange_integrals([at(0), at(1)], a, b)),
+    }
+    (nodes, weights, m)
+}
+
+/// The integrals over `[a, b]` of the Lagrange polynomials of the nodes `xs` (exact up to
+/// cubics: three-point Gauss–Legendre), `prod (t - x_q) / prod (x_i - x_q)` over `q != i`.
+fn lagrange_integrals<const M: usize>(xs: [f64; M], a: f64, b: f64) -> [f64; M] {
     const G: [(f64, f64); 3] = [
         (0.112_701_665_379_258_31, 5.0 / 18.0),
         (0.5, 8.0 / 18.0),
         (0.887_298_334_620_741_7, 5.0 / 18.0),
     ];
-    let n = x.len();
-    let m = n.min(4);
-    let start = j.saturating_sub(1).min(n - m);
-    let mut nodes = [0usize; 4];
-    let mut weights = [0.0f64; 4];
-    for k in 0..m {
-        nodes[k] = start + k;
-    }
-    let (a, b) = (x[j], x[j + 1]);
-    for k in 0..m {
-        let i = nodes[k];
-        let mut w = 0.0;
-        for (c, g) in G {
-            let t = a + c * (b - a);
+    let mut w = [0.0; M];
+    for (c, g) in G {
+        let t = a + c * (b - a);
+        for i in 0..M {
             let mut l = 1.0;
-            for &q in &nodes[..m] {
+            for q in 0..M {
                 if q != i {
-                    l *= (t - x[q]) / (x[i] - x[q]);
+                    l *= t - xs[q];
                 }
             }
-            w += g * (b - a) * l;
+            w[i] += g * l;
         }
-        weights[k] = w;
     }
-    (nodes, weights, m)
+    for i in 0..M {
+        let mut denominator = 1.0;
+        for q in 0..M {
+            if q != i {
+                denominator *= xs[i] - xs[q];
+            }
+        }
+        w[i] *= (b - a) / denominator;
+    }
+    w
 }
 
 /// `blockdiag(Rᵀ, Rᵀ) M blockdiag(R, R)` (world to body components of a 6×6 compliance or
@@ -404,7 +423,8 @@ fn compliance_matrices(config: &Configuration, tip_only: bool) -> Result<WorldBo
         })
         .collect();
     // Cumulative Q over the intervals (a repeated s starts a new interval; Q is continuous).
-    let mut q = vec![Matrix6::zeros(); n];
+    let mut q: Vec<Matrix6<f64>> = Vec::with_capacity(n);
+    q.push(Matrix6::zeros());
     let mut start = 0;
     while start < n {
         let mut end = start + 1;
@@ -412,7 +432,7 @@ fn compliance_matrices(config: &Configuration, tip_only: bool) -> Result<WorldBo
             end += 1;
         }
         if start > 0 {
-            q[start] = q[start - 1];
+            q.push(q[start - 1]);
         }
         let x = &config.s[start..end];
         for j in 0..x.len() - 1 {
@@ -421,7 +441,7 @@ fn compliance_matrices(config: &Configuration, tip_only: bool) -> Result<WorldBo
             for k in 0..m {
                 acc += integrand[start + nodes[k]] * weights[k];
             }
-            q[start + j + 1] = acc;
+            q.push(acc);
         }
         start = end;
     }
@@ -435,7 +455,8 @@ fn transport(
     p0: &Vector3<f64>,
     nodes: impl Iterator<Item = (Vector3<f64>, Matrix3<f64>, Matrix6<f64>)>,
 ) -> WorldBody {
-    let (mut world, mut body) = (Vec::new(), Vec::new());
+    let n = nodes.size_hint().0;
+    let (mut world, mut body) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for (p, r, qi) in nodes {
         let p = hat(&(p0 - p));
         let qtt = qi.fixed_view::<3, 3>(0, 0).into_owned();
