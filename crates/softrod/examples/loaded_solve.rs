@@ -3,7 +3,10 @@
 //!
 //! Cases: `cold` / `warm` (the two-segment NiTi robot with a 0.05 N tip force, cold and
 //! warm-started after +2 % tension), `unloaded` (tendons only), `gravity` (the 1 m
-//! four-tendon robot under gravity, cold), `cantilever` (the soft cantilever, 0.02 N tip force).
+//! four-tendon robot under gravity, cold), `cantilever` (the soft cantilever, 0.02 N tip force);
+//! and, after one tendons-only solve, `COUNT` of `compliance` (along the arm), `tangent` /
+//! `tangent_length` (tip, tensions or lengths held) or `workspace` (100 configurations of the
+//! compliance bench's workspace map, per count).
 //!
 //! Run: `valgrind --tool=callgrind target/release/examples/loaded_solve cold 20`.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -13,6 +16,8 @@ mod robot;
 
 use std::sync::Arc;
 
+use softrod::batch::workspace::{workspace_map, DEFAULT_CHUNK};
+use softrod::compliance::{compliance, tangent_compliance, TendonControl};
 use softrod::nalgebra::Vector3;
 use softrod::{
     solve_statics, Actuation, LinearElastic, Loads, RobotModel, Rod, Section, SolveOptions,
@@ -32,6 +37,10 @@ fn main() {
     let act = Actuation::tensions(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
     let changed = Actuation::tensions(&[4.08, 0.0, 0.0, 0.0, 2.04, 0.0]);
     let tip = Loads::tip_force(Vector3::new(0.05, 0.0, 0.0));
+    if let Some(done) = after_solve(&case, count, &act, &opts) {
+        println!("{case}: {done}");
+        return;
+    }
     let (model, act, opts) = match case.as_str() {
         "cold" => (niti(tip), act, opts),
         "unloaded" => (niti(Loads::default()), act, opts),
@@ -75,4 +84,60 @@ fn main() {
         s.stable,
         s.tip_position()
     );
+}
+
+/// The cases that work on a tendons-only solution: what the last call returned, or `None`
+/// for a solve case.
+fn after_solve(case: &str, count: usize, act: &Actuation, opts: &SolveOptions) -> Option<String> {
+    let model = niti(Loads::default());
+    let sol = solve_statics(&model, act, opts).unwrap();
+    let ctl = match case {
+        "compliance" => {
+            let mut c = None;
+            for _ in 0..count {
+                c = Some(compliance(&sol).unwrap());
+            }
+            let c = c.unwrap();
+            let sum = |m: &[softrod::nalgebra::Matrix6<f64>]| -> f64 {
+                m.iter().map(|x| x.abs().sum()).sum()
+            };
+            return Some(format!(
+                "sums of |C| along the arm, world {:e}, body {:e}",
+                sum(&c.world),
+                sum(&c.body)
+            ));
+        }
+        "workspace" => {
+            let tensions: Vec<f64> = (0..100 * count)
+                .flat_map(|i| [4.0 * (i % 100) as f64 / 99.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+                .collect();
+            let map = workspace_map(
+                &model,
+                &Actuation::default(),
+                &tensions,
+                opts,
+                DEFAULT_CHUNK,
+                None,
+            )
+            .unwrap();
+            let tips: Vec<[f64; 3]> = map.iter().map(|m| m.tip_position).collect();
+            let last = map.last().unwrap();
+            return Some(format!(
+                "{} configurations, first and last tips {:?} {:?}, last compliances {:e} {:e}",
+                map.len(),
+                tips[0],
+                tips[tips.len() - 1],
+                last.max_translational_compliance,
+                last.min_translational_compliance
+            ));
+        }
+        "tangent" => TendonControl::Tension,
+        "tangent_length" => TendonControl::Length,
+        _ => return None,
+    };
+    let mut c = None;
+    for _ in 0..count {
+        c = Some(tangent_compliance(&sol, ctl, None).unwrap());
+    }
+    Some(format!("{:?}", c.unwrap().world.diagonal()))
 }
