@@ -424,13 +424,7 @@ pub(super) fn finish(
     let belts = held.iter().any(Option::is_some);
     let cm = Arc::clone(&pass.model);
     let (plan, stops) = mesh_of(&cm, options.integrator);
-    let eq = Equations {
-        model: &cm,
-        tensions: &p.tensions,
-        pressures: &p.pressures,
-        load_factor: 1.0,
-        profile: None,
-    };
+    let eq = Equations::new(&cm, &p.tensions, &p.pressures);
     let mut sh = Shooting::new(eq, options.integrator, plan);
     sh.stops = stops;
     let (res, cols) = final_march(p, &mut sh, pass, x)?;

@@ -115,13 +115,7 @@ pub(super) fn equations<'a>(
     tensions: &'a [f64],
     pressures: &'a [f64],
 ) -> Equations<'a> {
-    Equations {
-        model,
-        tensions,
-        pressures,
-        load_factor: 1.0,
-        profile: None,
-    }
+    Equations::new(model, tensions, pressures)
 }
 
 /// The RK4 steps per step of the uniform mesh on a belt (see [`mesh_of`]).

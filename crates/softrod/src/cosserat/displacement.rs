@@ -459,13 +459,7 @@ fn solve_held_on_mesh(
     st.taut = hp.first_taut(&plan, &pressures, &mut st.tensions);
     let rounds = MAX_ACTIVE_SET_ROUNDS_PER_TENDON * hp.all_held.len() + 4;
     let inputs = actuation.tension_values(nt);
-    let eq = super::equations::Equations {
-        model,
-        tensions: &inputs,
-        pressures: &pressures,
-        load_factor: 1.0,
-        profile: None,
-    };
+    let eq = super::equations::Equations::new(model, &inputs, &pressures);
     let mut p = Shooting::new(eq, options.integrator, plan);
     // A tension or slack counts as negative beyond the shooting tolerance.
     let eps = 10.0 * options.newton.tolerance;

@@ -227,13 +227,7 @@ struct Marcher<'f, 'a, 'i> {
 impl Marcher<'_, '_, '_> {
     /// The equations at the solution's base tensions (no profile).
     fn eq(&self) -> Equations<'_> {
-        Equations {
-            model: self.fr.model,
-            tensions: &self.fr.base,
-            pressures: &self.fr.pressures,
-            load_factor: 1.0,
-            profile: None,
-        }
+        Equations::new(self.fr.model, &self.fr.base, &self.fr.pressures)
     }
 
     /// A chamber's pressure change (per Pa) along column `c`.

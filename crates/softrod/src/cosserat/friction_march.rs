@@ -254,13 +254,7 @@ impl<'m> Fixed<'m> {
 
     /// The equations at the base tensions (no profile).
     fn eq(&self) -> Equations<'_> {
-        Equations {
-            model: self.setup.model,
-            tensions: self.setup.base,
-            pressures: &self.pressures,
-            load_factor: 1.0,
-            profile: None,
-        }
+        Equations::new(self.setup.model, self.setup.base, &self.pressures)
     }
 
     /// The evaluator of the equations on the tension profile `cell`.

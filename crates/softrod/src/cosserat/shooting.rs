@@ -644,13 +644,7 @@ mod tests {
         };
         let model = RobotModel::new(rod, tendons, chambers, loads).unwrap();
         let (tensions, pressures) = ([2.0], [60e3, 30e3]);
-        let eq = Equations {
-            model: &model,
-            tensions: &tensions,
-            pressures: &pressures,
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = Equations::new(&model, &tensions, &pressures);
         let plan = crate::integrate::march::rk4_plan(model.breaks(), 40 * 6);
         let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 240 }, plan);
         let x = [0.3, -0.2, 0.5, 0.1, -0.15, 0.05];
@@ -702,13 +696,7 @@ mod taper_tests {
         let tendons = vec![Tendon::constant([0.00341796875, 0.0], None).unwrap(); 2];
         let model = RobotModel::new(rod, tendons, vec![], Loads::default()).unwrap();
         let tensions = [0.7069281979685804; 2];
-        let eq = Equations {
-            model: &model,
-            tensions: &tensions,
-            pressures: &[],
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = Equations::new(&model, &tensions, &[]);
         let plan = crate::integrate::march::rk4_plan(model.breaks(), 40);
         let mut p = Shooting::new(eq, Integrator::Rk4 { steps: 40 }, plan);
         let x = [0.01, -0.02, 0.03, 0.01, -0.015, 0.005];

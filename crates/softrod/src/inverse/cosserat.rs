@@ -163,13 +163,7 @@ impl CosseratForward {
         let model = &self.model;
         let nt = model.tendons().len();
         let (tensions, pressures) = (&a[..nt], &a[nt..]);
-        let eq = Equations {
-            model,
-            tensions,
-            pressures,
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = Equations::new(model, tensions, pressures);
         let mut plan = Vec::new();
         let _ = scheme_of(&self.options.integrator, model, &mut plan);
         let mut p = Shooting::new(eq, self.options.integrator, plan);
@@ -221,13 +215,7 @@ impl CosseratForward {
                 return Ok(ev);
             }
         }
-        let eq = Equations {
-            model: &self.model,
-            tensions: &a[..nt],
-            pressures: &a[nt..],
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = Equations::new(&self.model, &a[..nt], &a[nt..]);
         let seeds: Vec<Seed> = if jacobian {
             (0..nt)
                 .map(|i| Seed::Forced(Column::Tension(i)))

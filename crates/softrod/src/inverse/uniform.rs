@@ -178,13 +178,7 @@ pub(super) fn tip(
     };
     let nt = model.tendons().len();
     let plan = rk4_plan(model.breaks(), steps);
-    let eq = Equations {
-        model,
-        tensions: a,
-        pressures: &[],
-        load_factor: 1.0,
-        profile: None,
-    };
+    let eq = Equations::new(model, a, &[]);
     ws.renew(nt);
     let mut ev = Evaluator { eq, ws };
     let base = model.rod().base_pose();

@@ -324,13 +324,7 @@ mod tests {
     /// Every call of `calls`, made in turn on one workspace, gives what the same call gives
     /// on a fresh workspace: the last solve's memo (and warm start) never changes a result.
     fn history_free(model: &RobotModel, tensions: &[f64], pressures: &[f64], calls: &[Call]) {
-        let eq = Equations {
-            model,
-            tensions,
-            pressures,
-            load_factor: 1.0,
-            profile: None,
-        };
+        let eq = Equations::new(model, tensions, pressures);
         let nt = model.tendons().len();
         let mut ws = Workspace::new(nt);
         let mut ev = Evaluator { eq, ws: &mut ws };

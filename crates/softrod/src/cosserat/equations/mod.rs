@@ -237,6 +237,20 @@ pub(crate) struct Equations<'a> {
     pub profile: Option<&'a TensionProfile>,
 }
 
+impl<'a> Equations<'a> {
+    /// The equations of a configuration under its full external loads (`λ = 1`), with
+    /// `tensions` over each tendon's whole length.
+    pub fn new(model: &'a RobotModel, tensions: &'a [f64], pressures: &'a [f64]) -> Self {
+        Self {
+            model,
+            tensions,
+            pressures,
+            load_factor: 1.0,
+            profile: None,
+        }
+    }
+}
+
 /// What a sensitivity column is a derivative with respect to: its forcing along the rod
 /// (see `cosserat/sensitivity.rs`, where the parameters are documented).
 #[derive(Clone, Copy, Debug, PartialEq)]
