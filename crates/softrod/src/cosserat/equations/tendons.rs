@@ -112,16 +112,15 @@ impl Evaluator<'_, '_> {
         if self.eq.profile.is_some() || !ws.active.iter().chain(&ws.passive).all(constant) {
             return;
         }
+        let a = self.eq.model.breaks()[ws.interval];
+        let props = self.eq.model.rod().section_at(a);
         for &i in &ws.active {
-            if let Routing::Constant(r) = tendons[i].routing() {
-                let r = Vector3::new(r[0], r[1], 0.0);
-                ws.offsets.push((r, Vector3::zeros(), self.eq.tensions[i]));
-            }
+            let (r, rp) = body_offset(tendons[i].routing(), a, &props);
+            ws.offsets.push((r, rp, self.eq.tensions[i]));
         }
         for &i in &ws.passive {
-            if let Routing::Constant(r) = tendons[i].routing() {
-                ws.passive_offsets.push(Vector3::new(r[0], r[1], 0.0));
-            }
+            let (r, _) = body_offset(tendons[i].routing(), a, &props);
+            ws.passive_offsets.push(r);
         }
         ws.fixed_offsets = true;
     }
@@ -152,17 +151,13 @@ impl Evaluator<'_, '_> {
         ws.offsets
             .resize(ws.active.len(), (Vector3::zeros(), Vector3::zeros(), 0.0));
         for (k, &i) in ws.active.iter().enumerate() {
-            let (r, rp) = tendons[i].routing().offset(s, props);
+            let (r, rp) = body_offset(tendons[i].routing(), s, props);
             let tau = self
                 .eq
                 .profile
                 .and_then(|p| p.at(i, s))
                 .unwrap_or(self.eq.tensions[i]);
-            let new = (
-                Vector3::new(r[0], r[1], 0.0),
-                Vector3::new(rp[0], rp[1], 0.0),
-                tau,
-            );
+            let new = (r, rp, tau);
             kept &= ws.offsets[k] == new;
             ws.offsets[k] = new;
         }
@@ -190,9 +185,7 @@ impl Evaluator<'_, '_> {
         }
         let tendons = self.eq.model.tendons();
         for &i in &self.ws.passive {
-            let (r, rp) = tendons[i].routing().offset(s, props);
-            let r = Vector3::new(r[0], r[1], 0.0);
-            let rp = Vector3::new(rp[0], rp[1], 0.0);
+            let (r, rp) = body_offset(tendons[i].routing(), s, props);
             self.ws.tendon_speed[i] = (v + u.cross(&r) + rp).norm();
         }
     }
@@ -206,9 +199,8 @@ impl Evaluator<'_, '_> {
         v: &Vector3<f64>,
         u: &Vector3<f64>,
     ) -> Vector6<f64> {
-        let (r, rp) = self.eq.model.tendons()[i].routing().offset(s, props);
-        let r = Vector3::new(r[0], r[1], 0.0);
-        let w = v + u.cross(&r) + Vector3::new(rp[0], rp[1], 0.0);
+        let (r, rp) = body_offset(self.eq.model.tendons()[i].routing(), s, props);
+        let w = v + u.cross(&r) + rp;
         let t = w / w.norm();
         let q = r.cross(&t);
         Vector6::new(t.x, t.y, t.z, q.x, q.y, q.z)
@@ -320,4 +312,18 @@ impl Evaluator<'_, '_> {
         }
         (sums, Some(h))
     }
+}
+
+/// A tendon's offset `r` and its derivative `r'` at `s` as body-frame 3-vectors (m, m/m).
+#[inline]
+fn body_offset(
+    routing: &Routing,
+    s: f64,
+    props: &SectionProperties,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let (r, rp) = routing.offset(s, props);
+    (
+        Vector3::new(r[0], r[1], 0.0),
+        Vector3::new(rp[0], rp[1], 0.0),
+    )
 }
