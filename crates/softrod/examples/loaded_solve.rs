@@ -86,61 +86,62 @@ fn main() {
     );
 }
 
-/// The cases that work on a tendons-only solution: what the last call returned, or `None`
-/// for a solve case.
+/// The cases that work on the tendons-only robot after a solve (the workspace map makes its
+/// own): what the last call returned, or `None` for a solve case.
 fn after_solve(case: &str, count: usize, act: &Actuation, opts: &SolveOptions) -> Option<String> {
-    if !["compliance", "workspace", "tangent", "tangent_length"].contains(&case) {
-        return None;
-    }
-    let model = niti(Loads::default());
-    let sol = solve_statics(&model, act, opts).unwrap();
-    let ctl = match case {
-        "compliance" => {
-            let mut c = None;
-            for _ in 0..count {
-                c = Some(compliance(&sol).unwrap());
-            }
-            let c = c.unwrap();
-            let sum = |m: &[softrod::nalgebra::Matrix6<f64>]| -> f64 {
-                m.iter().map(|x| x.abs().sum()).sum()
-            };
-            return Some(format!(
-                "sums of |C| along the arm, world {:e}, body {:e}",
-                sum(&c.world),
-                sum(&c.body)
-            ));
-        }
-        "workspace" => {
-            let tensions: Vec<f64> = (0..100 * count)
-                .flat_map(|i| [4.0 * (i % 100) as f64 / 99.0, 0.0, 0.0, 0.0, 1.0, 0.0])
-                .collect();
-            let map = workspace_map(
-                &model,
-                &Actuation::default(),
-                &tensions,
-                opts,
-                DEFAULT_CHUNK,
-                None,
-            )
-            .unwrap();
-            let tips: Vec<[f64; 3]> = map.iter().map(|m| m.tip_position).collect();
-            let last = map.last().unwrap();
-            return Some(format!(
-                "{} configurations, first and last tips {:?} {:?}, last compliances {:e} {:e}",
-                map.len(),
-                tips[0],
-                tips[tips.len() - 1],
-                last.max_translational_compliance,
-                last.min_translational_compliance
-            ));
-        }
-        "tangent" => TendonControl::Tension,
-        "tangent_length" => TendonControl::Length,
+    let held = match case {
+        "workspace" => return Some(workspace(count, opts)),
+        "compliance" => None,
+        "tangent" => Some(TendonControl::Tension),
+        "tangent_length" => Some(TendonControl::Length),
         _ => return None,
+    };
+    let sol = solve_statics(&niti(Loads::default()), act, opts).unwrap();
+    let Some(ctl) = held else {
+        let mut c = None;
+        for _ in 0..count {
+            c = Some(compliance(&sol).unwrap());
+        }
+        let c = c.unwrap();
+        let sum = |m: &[softrod::nalgebra::Matrix6<f64>]| -> f64 {
+            m.iter().map(|x| x.abs().sum()).sum()
+        };
+        return Some(format!(
+            "sums of |C| along the arm, world {:e}, body {:e}",
+            sum(&c.world),
+            sum(&c.body)
+        ));
     };
     let mut c = None;
     for _ in 0..count {
         c = Some(tangent_compliance(&sol, ctl, None).unwrap());
     }
     Some(format!("{:?}", c.unwrap().world.diagonal()))
+}
+
+/// `100 count` configurations of the compliance bench's workspace map: the first and last
+/// tips and the last configuration's translational compliances.
+fn workspace(count: usize, opts: &SolveOptions) -> String {
+    let tensions: Vec<f64> = (0..100 * count)
+        .flat_map(|i| [4.0 * (i % 100) as f64 / 99.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+        .collect();
+    let model = niti(Loads::default());
+    let map = workspace_map(
+        &model,
+        &Actuation::default(),
+        &tensions,
+        opts,
+        DEFAULT_CHUNK,
+        None,
+    )
+    .unwrap();
+    let (first, last) = (&map[0], &map[map.len() - 1]);
+    format!(
+        "{} configurations, first and last tips {:?} {:?}, last compliances {:e} {:e}",
+        map.len(),
+        first.tip_position,
+        last.tip_position,
+        last.max_translational_compliance,
+        last.min_translational_compliance
+    )
 }
