@@ -11,8 +11,9 @@ use std::sync::Arc;
 use common::niti_model;
 use softrod::nalgebra::Vector3;
 use softrod::{
-    reference_lengths, solve_statics, tangent_compliance, Actuation, Loads, RobotModel,
-    SolveOptions, StaticsSolution, TendonControl, TendonInput,
+    reference_lengths, solve_statics, tangent_compliance, Actuation, Integrator, LinearElastic,
+    Loads, RobotModel, Rod, Section, SolveOptions, StaticsSolution, Tendon, TendonControl,
+    TendonInput,
 };
 
 fn niti(loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
@@ -96,6 +97,101 @@ fn displacement_round_trip_under_tip_load_and_gravity() {
         &[0, 1, 2, 3, 4, 5],
         "tip load and gravity, all held",
     );
+}
+
+/// One-tendon rods under a tip force (from a random scan of loaded robots), on 100 or 200 RK4
+/// steps: the displacement-controlled solve returns the tensions whose displacements it was
+/// given. Its held row resolves the slack to the round-off of a path length, which grows with
+/// the steps (up to 55 `ε ℓ` at 200 steps on these robots, above a floor of 16).
+#[test]
+fn displacement_round_trip_on_fine_meshes_under_a_tip_force() {
+    // (length m, radius m, E Pa, offset m, tension N, tip force N, steps)
+    let cases: [(f64, f64, f64, [f64; 2], f64, [f64; 3], usize); 4] = [
+        (
+            0.290_461_133_727_983_7,
+            8.036_425_822_873_156e-4,
+            28_712_537.814_615_168,
+            [5.154_783_088_027_37e-4, -1.111_961_982_070_262_4e-4],
+            0.082_140_848_997_903_37,
+            [
+                9.245_232_368_372_612e-5,
+                -4.032_236_429_738_654e-5,
+                4.922_756_306_136_093e-6,
+            ],
+            100,
+        ),
+        (
+            0.753_407_227_769_765_2,
+            1.810_123_779_742_184_7e-3,
+            1_848_072_859.516_309_5,
+            [1.357_819_368_359_375_2e-3, -3.965_236_030_419_608e-4],
+            12.768_370_268_905_455,
+            [
+                -0.018_357_345_147_867_337,
+                0.006_757_292_223_863_014,
+                -0.013_213_456_131_952_354,
+            ],
+            200,
+        ),
+        (
+            0.838_522_038_379_504_5,
+            1.376_958_585_316_411_2e-3,
+            863_181_175.986_151_5,
+            [5.173_193_378_602_569e-4, -5.394_182_513_851_974_4e-5],
+            2.965_723_914_842_062,
+            [
+                7.752_654_778_960_421e-4,
+                1.990_521_690_596_541e-3,
+                -9.980_902_039_457_334e-4,
+            ],
+            100,
+        ),
+        (
+            0.579_934_534_922_227_9,
+            4.795_898_034_807_645e-3,
+            931_106_341.718_693_4,
+            [2.102_026_435_130_346e-3, -4.040_647_421_997_539_5e-4],
+            120.487_302_870_451_15,
+            [
+                -0.270_189_714_188_004_6,
+                -0.337_154_990_823_631_04,
+                -0.510_528_195_414_220_1,
+            ],
+            100,
+        ),
+    ];
+    for (k, (l, r, e, offset, tension, force, steps)) in cases.into_iter().enumerate() {
+        let rod = Rod::new(
+            l,
+            Section::circular(r).unwrap(),
+            LinearElastic::new(e, 0.4).unwrap(),
+        )
+        .unwrap();
+        let tendons = vec![Tendon::constant(offset, None).unwrap()];
+        let loads = Loads::tip_force(Vector3::from(force));
+        let model = RobotModel::new(rod, tendons, Vec::new(), loads).unwrap();
+        let o = SolveOptions {
+            integrator: Integrator::Rk4 { steps },
+            ..SolveOptions::default()
+        };
+        let forward = solve_statics(&model, &Actuation::tensions(&[tension]), &o).unwrap();
+        let zero = reference_lengths(&model, &o).unwrap();
+        let act = Actuation {
+            tendons: vec![TendonInput::displacement(
+                zero[0] - forward.tendon_lengths[0],
+            )],
+            ..Actuation::default()
+        };
+        let back = solve_statics(&model, &act, &o)
+            .unwrap_or_else(|err| panic!("case {k} ({steps} steps): {err}"));
+        let got = back.tendon_tensions[0];
+        assert!(
+            (got - tension).abs() <= 1e-8 * tension,
+            "case {k}: {got} N vs {tension} N"
+        );
+        let d = shape_distance(&forward, &back);
+        assert!(d <= 1e-10 * l, "case {k}: shape distance {d:e} m");
+    }
 }
 
 #[test]
