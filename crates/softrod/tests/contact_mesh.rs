@@ -244,3 +244,62 @@ fn the_mesh_distance_is_the_least_over_its_triangles() {
     }
     assert!(worst < 1e-15, "{worst:e}");
 }
+
+/// A soft rod bent by its tendon into the front face of a closed box (12 triangles, 0.4 m
+/// deep): the actuated rod without the box would lie 0.1 m inside it, nearer its side faces
+/// than its front face, so the contacts are found with the actuation stepped from the
+/// unactuated rod. The same solution as with the plane of the front face, to 1e-9.
+#[test]
+fn a_closed_box_is_the_plane_of_the_face_the_rod_enters_by() {
+    let (l, r, e) = (0.3, 2e-3, 1e6);
+    let rod = softrod::Rod::new(
+        l,
+        softrod::Section::circular(r).unwrap(),
+        softrod::LinearElastic::new(e, 0.4).unwrap(),
+    )
+    .unwrap();
+    // The tension that bends the free rod by 2 rad (offset 1 mm).
+    let tension = 2.0 / l * e * std::f64::consts::PI * r.powi(4) / 4.0 / 1e-3;
+    let tendon = softrod::Tendon::constant([1e-3, 0.0], None).unwrap();
+    let model = RobotModel::new(rod, vec![tendon], Vec::new(), Loads::default()).unwrap();
+    let xw = 0.1055;
+    let plane = Obstacle::plane([xw, 0.0, 0.0], [-1.0, 0.0, 0.0]).unwrap();
+    let mut v = Vec::new();
+    for x in [xw, xw + 0.4] {
+        for y in [-0.1, 0.1] {
+            for z in [-0.05, 0.35] {
+                v.push([x, y, z]);
+            }
+        }
+    }
+    // Counter-clockwise seen from outside.
+    let f = vec![
+        [0, 1, 3],
+        [0, 3, 2],
+        [4, 6, 7],
+        [4, 7, 5],
+        [0, 4, 5],
+        [0, 5, 1],
+        [2, 3, 7],
+        [2, 7, 6],
+        [0, 2, 6],
+        [0, 6, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+    ];
+    let boxed = Obstacle::mesh(v, f).unwrap();
+    let act = Actuation::tensions(&[tension]);
+    let solve = |o: &Obstacle| {
+        solve_constrained(&model, &act, &options(40), None, std::slice::from_ref(o)).unwrap()
+    };
+    let (a, b) = (solve(&plane), solve(&boxed));
+    assert_eq!(a.contacts.len(), 1);
+    let worst = difference(&a, &b);
+    println!(
+        "tip {:?}, contact at s = {} m, {} N; box vs plane {worst:.2e}",
+        b.solution.tip_position(),
+        b.contacts[0].s,
+        b.contacts[0].normal_force
+    );
+    assert!(worst <= 1e-9, "box vs plane {worst:e}");
+}
