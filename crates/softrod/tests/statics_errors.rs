@@ -358,3 +358,39 @@ fn a_rod_compressed_through_zero_length_is_refused_by_name() {
     );
     assert_eq!(name_of(pinned), "tip_constraint");
 }
+
+/// One tendon pulled with the rod's axial stiffness `E A` (computed here, as a user would, so
+/// it may differ from the core's `1 / c` in the last place), or so little below it that the
+/// stretch left is below the least accepted, compresses the rod to zero length: refused
+/// naming the tension, on the axis and off it, as for any larger tension; 0.9 `E A` is an
+/// answer on the axis (stretch `1 - τ / (E A)`).
+#[test]
+fn a_tendon_pulled_with_the_axial_stiffness_is_named() {
+    let ea = 1e7 * std::f64::consts::PI * 0.002f64.powi(2);
+    let solve = |offset: f64, tension: f64| {
+        let tendon = softrod::Tendon::constant([offset, 0.0], None).unwrap();
+        let m =
+            softrod::RobotModel::new(rod(), vec![tendon], Vec::new(), Loads::default()).unwrap();
+        softrod::solve_statics(
+            &m,
+            &softrod::Actuation::tensions(&[tension]),
+            &SolveOptions::default(),
+        )
+    };
+    // `E A`, one unit in the last place below it, 1e-12 below it (a stretch under the least
+    // accepted, 1e-9) and above it.
+    let below = f64::from_bits(ea.to_bits() - 1);
+    for offset in [0.0, 1e-4, 5e-4] {
+        for tension in [ea, below, (1.0 - 1e-12) * ea, 1.5 * ea] {
+            assert_eq!(
+                name_of(solve(offset, tension)),
+                "tensions[0]",
+                "{tension} N"
+            );
+        }
+    }
+    let near = solve(0.0, 0.9 * ea).unwrap();
+    for v in &near.v {
+        assert!((v[2] - 0.1).abs() < 1e-12, "stretch {}", v[2]);
+    }
+}

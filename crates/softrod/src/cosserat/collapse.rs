@@ -16,7 +16,7 @@ const SAMPLES: usize = 64;
 
 /// An [`Error::InvalidParameter`] naming the largest tendon tension if the tensions reach the
 /// axial stiffness `E A(s)` of an extensible, linear elastic rod at some section (the rod would
-/// be compressed to zero length); `None` otherwise.
+/// be compressed to zero length: a stretch below [`LEAST_STRETCH`]); `None` otherwise.
 pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option<Error> {
     let rod = model.rod();
     if rod.inextensible() || !rod.material().is_linear() {
@@ -39,7 +39,9 @@ pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option
             .material()
             .compliance(&rod.section_at(s), rod.shear_coefficient(), false);
         let ea = 1.0 / c[2];
-        if reach > 0.0 && reach >= ea {
+        // (The stretch `1 - Σ τ / (E A)` at or below the least accepted, not `Σ τ >= E A`:
+        // tensions of exactly `E A` computed elsewhere differ from it in the last place.)
+        if reach > 0.0 && 1.0 - reach * c[2] < LEAST_STRETCH {
             let (i, tau) = tensions
                 .iter()
                 .enumerate()
