@@ -1,6 +1,7 @@
 """Robots as objects: built in code or from a file, actuation as input, round trip through
 TOML, pickling, design parameters by file path, example robots by name."""
 
+import math
 import pickle
 
 import numpy as np
@@ -239,6 +240,22 @@ def test_a_robot_built_in_code_round_trips_through_toml_and_pickle():
     expected = robot.solve().position
     np.testing.assert_array_equal(again.solve().position, expected)
     np.testing.assert_array_equal(pickle.loads(pickle.dumps(robot)).solve().position, expected)
+
+
+def test_angles_given_in_radians_read_back_exactly_from_degrees():
+    # math.degrees of this phase does not read back to it; another float in degrees does.
+    phase = 5.604932768334122
+    assert math.radians(math.degrees(phase)) != phase
+    rod = softrod.Rod(0.3, softrod.CircularSection(2e-3), softrod.LinearElastic(1e8, 0.3))
+    tendons = [
+        softrod.Tendon.helical(1e-3, 0.5, 20.0, phase=phase),
+        softrod.Tendon.radius_proportional(0.5, phase, 2.0),
+    ]
+    robot = Robot(rod, tendons=tendons)
+    again = Robot.from_toml(robot.to_toml())
+    assert again.tendons[0].parameters["phase"] == phase
+    assert again.tendons[1].parameters["angle"] == phase
+    np.testing.assert_array_equal(again.solve().position, robot.solve().position)
 
 
 def test_a_misspelt_option_names_the_method_called(niti):

@@ -87,6 +87,22 @@ def _attempt(errors: list[FieldError], location: str, make: Callable[[], Any]) -
         return None
 
 
+def _degrees(angle: float) -> float:
+    """The angle (rad) in degrees, as the float that reads back (``math.radians``) to the
+    same radians where one exists (for about ten in eleven angles; else the nearest, one unit
+    in the last place off)."""
+    d = math.degrees(angle)
+    best, err = d, abs(math.radians(d) - angle)
+    up = down = d
+    for _ in range(4):
+        up, down = math.nextafter(up, math.inf), math.nextafter(down, -math.inf)
+        for c in (up, down):
+            e = abs(math.radians(c) - angle)
+            if e < err:
+                best, err = c, e
+    return best
+
+
 def _polar(distance: float, angle_deg: float | None) -> list[float]:
     a = math.radians(angle_deg or 0.0)
     return [distance * math.cos(a), distance * math.sin(a)]
@@ -479,7 +495,7 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
             **out,
             "routing": routing,
             "ratio": p["ratio"],
-            "angle_deg": math.degrees(p["angle"]),
+            "angle_deg": _degrees(p["angle"]),
         }
     if routing == "helical":
         return {
@@ -487,7 +503,7 @@ def _describe_tendon(t: Tendon, i: int, r: _Reader) -> dict[str, Any] | None:
             "routing": routing,
             "radius": p["radius"],
             "pitch": p["pitch"],
-            "phase_deg": math.degrees(p["phase"]),
+            "phase_deg": _degrees(p["phase"]),
         }
     r.unserialisable.append(f"tendons[{i}] (routing {routing!r} with a Python function)")
     return None
