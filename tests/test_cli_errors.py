@@ -150,6 +150,19 @@ def test_sweep_options_are_named(argv, option, capsys):
     assert status == 2 and f"`{option}`" in line and "tensions[" not in line
 
 
+def test_compliance_ellipsoid_arc_lengths_are_checked_before_the_solve(tmp_path, capsys):
+    plot = tmp_path / "c.png"
+    for argv, needle in [
+        (["--at", "0.1"], "needs `--plot FILE`"),
+        (["--at", "nan", "--plot", plot], "in [0, 0.4] m"),
+        (["--at", "0.1", "0.5", "--plot", plot], "in [0, 0.4] m"),
+    ]:
+        status, out, err = _run(["compliance", "niti_two_segment", *argv], capsys)
+        line = _one_error_line(err)
+        assert status == 2 and "`--at`" in line and needle in line, line
+        assert out == "" and not plot.exists()
+
+
 def test_pressures_beside_tensions(capsys):
     p = ["--pressures", *["10e3"] * 6]
     status, out, _ = _run(["solve", "pneumatic_arm", *p], capsys)

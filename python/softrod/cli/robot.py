@@ -111,7 +111,13 @@ def _print_contacts(robot, sol) -> None:
 def _cmd_compliance(args) -> int:
     from .. import compliance, eigenscrews, tangent_compliance
 
+    if args.at is not None and not args.plot:
+        raise bad("--at", args.at, "arc lengths of the ellipsoids: needs `--plot FILE`")
     robot = load_actuated(args)
+    length = float(robot.rod.length)
+    for s in args.at or ():
+        if not 0.0 <= s <= length:
+            raise bad("--at", s, f"must be an arc length in [0, {length:g}] m")
     sol = robot.solve()
     # Everything is computed before anything is printed: an error leaves no half report.
     comp = compliance(sol)
