@@ -276,7 +276,7 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
     if constrained && !s_values.is_empty() {
         return Err(crate::errors::param_err(
             "s_out",
-            format!("{s_values:?}"),
+            format!("{} arc lengths", s_values.len()),
             "None with obstacles or a tip constraint (the solution is at the integration mesh)",
         ));
     }
