@@ -321,3 +321,59 @@ fn a_column_against_a_rough_wall_is_pinned_and_against_a_smooth_one_slides() {
         assert!((margin - closed).abs() < 1e-3, "{margin:e} vs {closed:e}");
     }
 }
+
+/// A heavy soft rod, one tendon pulled and a small tip force, solved by the adaptive
+/// integrator with a sphere on its load path that it leaves without contact: the contact solve
+/// lands on a bent-over equilibrium whose tip margin is large (about 1.87) but past which a
+/// conjugate point lies along the rod. Its verdict must be the one `solve_statics` gives the
+/// same equilibrium (warm-started there, without the sphere): unstable, counting the conjugate
+/// points along the march, not the tip margin alone.
+#[test]
+fn a_contact_solve_without_contacts_counts_the_conjugate_points_too() {
+    use softrod::{solve_statics, AdaptiveOptions, Integrator, SolveOptions, WarmStart};
+    let rod = Rod::new(
+        0.3,
+        Section::circular(2e-3).unwrap(),
+        LinearElastic::new(1e6, 0.45).unwrap(),
+    )
+    .unwrap()
+    .with_density(1100.0)
+    .unwrap();
+    let tendons = vec![
+        Tendon::constant([1e-3, 0.0], None).unwrap(),
+        Tendon::constant([0.0, 1e-3], Some(0.15)).unwrap(),
+    ];
+    let loads = Loads {
+        tip_force: Vector3::new(0.0, 1e-3, 0.0),
+        gravity: Vector3::new(0.0, 0.0, -9.81),
+        ..Default::default()
+    };
+    let model = RobotModel::new(rod, tendons, Vec::new(), loads).unwrap();
+    let act = Actuation::tensions(&[0.05, 0.0]);
+    let opts = SolveOptions {
+        integrator: Integrator::Adaptive(AdaptiveOptions::default()),
+        ..SolveOptions::default()
+    };
+    let sphere = Obstacle::sphere([0.1, 0.0, 0.25], 0.03).unwrap();
+    let c = solve_constrained(&model, &act, &opts, None, std::slice::from_ref(&sphere)).unwrap();
+    assert!(c.contacts.is_empty());
+    let free = SolveOptions {
+        warm_start: Some(WarmStart::wrench(c.solution.base_wrench)),
+        seek_stable: false,
+        ..opts
+    };
+    let f = solve_statics(&model, &act, &free).unwrap();
+    let tip = (Vector3::from(f.tip_position()) - Vector3::from(c.solution.tip_position())).norm();
+    println!(
+        "tip {:?}, margin {} / {}, stable {} / {}",
+        c.solution.tip_position(),
+        c.solution.stability_margin(),
+        f.stability_margin(),
+        c.solution.stable,
+        f.stable
+    );
+    assert!(tip < 1e-9, "the same equilibrium: tips {tip:e} m apart");
+    assert!(c.solution.stability_margin() > 1.0);
+    assert!(!f.stable);
+    assert_eq!(c.solution.stable, f.stable);
+}

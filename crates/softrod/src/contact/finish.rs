@@ -479,8 +479,14 @@ pub(super) fn finish(
         // Clear on the coarse mesh; the margin itself is computed on the mesh asked when
         // read.
         sol.stable = st.stable;
+    } else if let Some(st) = stability_on(&sol, options.integrator).filter(|_| sol.stats.converged)
+    {
+        // One march with the columns on the mesh asked: the tip criterion and the conjugate
+        // points along the rod (a tip margin alone passes a rod past one).
+        let _ = sol.margin.set(st.margin);
+        sol.stable = st.stable;
     } else {
-        sol.stable = sol.stats.converged && sol.stability_margin() > -NEUTRAL_MARGIN;
+        sol.stable = false;
     }
     if !sol.stats.converged && options.newton.throw {
         return fail(
