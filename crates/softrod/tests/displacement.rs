@@ -99,14 +99,17 @@ fn displacement_round_trip_under_tip_load_and_gravity() {
     );
 }
 
+/// A one-tendon rod under a tip force: length (m), radius (m), E (Pa), offset (m), tension
+/// (N), tip force (N), RK4 steps.
+type Case = (f64, f64, f64, [f64; 2], f64, [f64; 3], usize);
+
 /// One-tendon rods under a tip force (from a random scan of loaded robots), on 100 or 200 RK4
 /// steps: the displacement-controlled solve returns the tensions whose displacements it was
 /// given. Its held row resolves the slack to the round-off of a path length, which grows with
 /// the steps (up to 55 `ε ℓ` at 200 steps on these robots, above a floor of 16).
 #[test]
 fn displacement_round_trip_on_fine_meshes_under_a_tip_force() {
-    // (length m, radius m, E Pa, offset m, tension N, tip force N, steps)
-    let cases: [(f64, f64, f64, [f64; 2], f64, [f64; 3], usize); 4] = [
+    let cases: [Case; 4] = [
         (
             0.290_461_133_727_983_7,
             8.036_425_822_873_156e-4,
