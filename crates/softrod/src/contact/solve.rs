@@ -239,13 +239,14 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
     if !p.pathless {
         let reached = reach(p, options, effort);
         if !p.pathless
+            && options.newton.continuation
             && !p.obstacles.is_empty()
             && matches!(reached, Reach::Stopped { lambda, .. } if lambda == 0.0)
         {
             // The contacts of the actuated rod were not found (it lies deep in an obstacle
             // whose nearest surface is not the one it entered by, as in a closed mesh): the
             // actuation stepped with the loads from the unactuated rod meets the obstacle
-            // where the rod enters it.
+            // where the rod enters it (a continuation: not without one).
             return match step_actuation(p, (options.integrator, false), &options.newton, effort) {
                 Ok(x) => Reach::Stepped(x),
                 Err(x) => Reach::Stopped {
