@@ -252,12 +252,7 @@ fn the_mesh_distance_is_the_least_over_its_triangles() {
 #[test]
 fn a_closed_box_is_the_plane_of_the_face_the_rod_enters_by() {
     let (l, r, e) = (0.3, 2e-3, 1e6);
-    let rod = softrod::Rod::new(
-        l,
-        softrod::Section::circular(r).unwrap(),
-        softrod::LinearElastic::new(e, 0.4).unwrap(),
-    )
-    .unwrap();
+    let rod = common::circular_rod(l, r, e, 0.4);
     // The tension that bends the free rod by 2 rad (offset 1 mm).
     let tension = 2.0 / l * e * std::f64::consts::PI * r.powi(4) / 4.0 / 1e-3;
     let tendon = softrod::Tendon::constant([1e-3, 0.0], None).unwrap();

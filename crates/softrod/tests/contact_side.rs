@@ -160,12 +160,7 @@ fn the_niti_robot_snaps_around_a_sphere_as_on_its_load_path() {
 #[test]
 fn a_rod_pulled_into_a_sphere_stops_on_its_near_side() {
     let (l, radius, e) = (1.0, 1e-3, 2e9);
-    let rod = softrod::Rod::new(
-        l,
-        softrod::Section::circular(radius).unwrap(),
-        softrod::LinearElastic::new(e, 0.3).unwrap(),
-    )
-    .unwrap();
+    let rod = common::circular_rod(l, radius, e, 0.3);
     let ea = e * std::f64::consts::PI * radius * radius;
     let delta = 1e-3;
     let sphere = Obstacle::sphere([0.0, 0.0, l + 2.0 * radius + 0.01], 0.01).unwrap();

@@ -331,14 +331,9 @@ fn a_column_against_a_rough_wall_is_pinned_and_against_a_smooth_one_slides() {
 #[test]
 fn a_contact_solve_without_contacts_counts_the_conjugate_points_too() {
     use softrod::{solve_statics, AdaptiveOptions, Integrator, SolveOptions, WarmStart};
-    let rod = Rod::new(
-        0.3,
-        Section::circular(2e-3).unwrap(),
-        LinearElastic::new(1e6, 0.45).unwrap(),
-    )
-    .unwrap()
-    .with_density(1100.0)
-    .unwrap();
+    let rod = common::circular_rod(0.3, 2e-3, 1e6, 0.45)
+        .with_density(1100.0)
+        .unwrap();
     let tendons = vec![
         Tendon::constant([1e-3, 0.0], None).unwrap(),
         Tendon::constant([0.0, 1e-3], Some(0.15)).unwrap(),

@@ -11,9 +11,8 @@ use std::sync::Arc;
 use common::niti_model;
 use softrod::nalgebra::Vector3;
 use softrod::{
-    reference_lengths, solve_statics, tangent_compliance, Actuation, Integrator, LinearElastic,
-    Loads, RobotModel, Rod, Section, SolveOptions, StaticsSolution, Tendon, TendonControl,
-    TendonInput,
+    reference_lengths, solve_statics, tangent_compliance, Actuation, Integrator, Loads, RobotModel,
+    SolveOptions, StaticsSolution, Tendon, TendonControl, TendonInput,
 };
 
 fn niti(loads: Loads, density: Option<f64>) -> Arc<RobotModel> {
@@ -164,12 +163,7 @@ fn displacement_round_trip_on_fine_meshes_under_a_tip_force() {
         ),
     ];
     for (k, (l, r, e, offset, tension, force, steps)) in cases.into_iter().enumerate() {
-        let rod = Rod::new(
-            l,
-            Section::circular(r).unwrap(),
-            LinearElastic::new(e, 0.4).unwrap(),
-        )
-        .unwrap();
+        let rod = common::circular_rod(l, r, e, 0.4);
         let tendons = vec![Tendon::constant(offset, None).unwrap()];
         let loads = Loads::tip_force(Vector3::from(force));
         let model = RobotModel::new(rod, tendons, Vec::new(), loads).unwrap();

@@ -206,10 +206,16 @@ pub const BEAM_NU: f64 = 0.3;
 
 /// That beam with a solid circular section of `radius` (m).
 pub fn beam(radius: f64) -> Rod {
+    circular_rod(BEAM_LENGTH, radius, BEAM_E, BEAM_NU)
+}
+
+/// A linear elastic rod of `length` (m) with a solid circular section of `radius` (m),
+/// Young's modulus `e` (Pa) and Poisson's ratio `nu`.
+pub fn circular_rod(length: f64, radius: f64, e: f64, nu: f64) -> Rod {
     Rod::new(
-        BEAM_LENGTH,
+        length,
         Section::circular(radius).expect("radius"),
-        LinearElastic::new(BEAM_E, BEAM_NU).expect("material"),
+        LinearElastic::new(e, nu).expect("material"),
     )
     .expect("rod")
 }
