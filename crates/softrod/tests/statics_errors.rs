@@ -394,3 +394,47 @@ fn a_tendon_pulled_with_the_axial_stiffness_is_named() {
         assert!((v[2] - 0.1).abs() < 1e-12, "stretch {}", v[2]);
     }
 }
+
+/// A user routing's derivative is checked against the offset it goes with: a helix whose
+/// derivative forgot the chain rule's `2 pi / pitch`, or has the wrong sign, is refused naming
+/// `tendons[0].derivative(s)`; the exact one passes, and so does a routing with a kink at a
+/// check point (mid-length) whose derivative is one of the kink's one-sided slopes.
+#[test]
+fn a_user_routing_whose_derivative_is_not_its_offsets_is_named() {
+    let (radius, pitch) = (1e-3, 0.05);
+    let w = 2.0 * std::f64::consts::PI / pitch;
+    let helix = move |scale: f64| {
+        common::tendon_with(
+            Routing::Function {
+                offset: Arc::new(move |s| [radius * (w * s).cos(), radius * (w * s).sin()]),
+                derivative: Arc::new(move |s| {
+                    [
+                        -scale * radius * (w * s).sin(),
+                        scale * radius * (w * s).cos(),
+                    ]
+                }),
+            },
+            1.0,
+            None,
+        )
+        .unwrap()
+    };
+    let solve = |t| common::solve(&rod(), &[t], &Loads::default(), &SolveOptions::default());
+    assert!(solve(helix(w)).is_ok());
+    for wrong in [1.0, -w, 1.01 * w] {
+        let name = name_of(solve(helix(wrong)));
+        assert!(name.starts_with("tendons[0].derivative"), "{wrong}: {name}");
+    }
+    // A kink at s = L/2 (a check point): the offset moves out at slope 0.002 after it.
+    let half = 0.15;
+    let kinked = common::tendon_with(
+        Routing::Function {
+            offset: Arc::new(move |s| [1e-3 + 2e-3 * (s - half).max(0.0), 0.0]),
+            derivative: Arc::new(move |s| [if s < half { 0.0 } else { 2e-3 }, 0.0]),
+        },
+        1.0,
+        None,
+    )
+    .unwrap();
+    assert!(solve(kinked).is_ok());
+}

@@ -463,9 +463,63 @@ fn check_routing(i: usize, tendon: &Tendon, rod: &Rod, end: f64) -> Result<f64> 
                 ),
             ));
         }
+        if let Routing::Function { offset, .. } = tendon.routing() {
+            check_derivative(i, offset.as_ref(), (s, end), (r, rp))?;
+        }
         reach = reach.max(d);
     }
     Ok(reach)
+}
+
+/// Step of the differences that check a user routing's derivative, relative to the length
+/// it is checked on.
+const DERIVATIVE_STEP: f64 = 1e-6;
+/// Largest difference accepted between a user routing's derivative and the differences of its
+/// offset, relative to `|r'| + |r| / end`: far above the differences' own error (round-off
+/// `ε |r| / h`, truncation `h² |r'''|` inside and at the ends), far below a missing factor or
+/// sign.
+const DERIVATIVE_TOLERANCE: f64 = 1e-4;
+
+/// Checks that the derivative `rp` a user routing gives at `s` (of `[0, end]`) is that of its
+/// offset `r`: second-order differences of the offset (central inside, one-sided at the ends);
+/// at a kink, the first-order difference of either side.
+fn check_derivative(
+    i: usize,
+    offset: &(dyn Fn(f64) -> [f64; 2] + Send + Sync),
+    (s, end): (f64, f64),
+    (r, rp): ([f64; 2], [f64; 2]),
+) -> Result<()> {
+    let h = DERIVATIVE_STEP * end;
+    let tol =
+        DERIVATIVE_TOLERANCE * (rp[0].hypot(rp[1]) + r[0].hypot(r[1]) / end) + f64::MIN_POSITIVE;
+    let close = |d: [f64; 2]| (d[0] - rp[0]).hypot(d[1] - rp[1]) <= tol;
+    let slope = |a: f64, b: f64| {
+        let (ra, rb) = (offset(a), offset(b));
+        [(rb[0] - ra[0]) / (b - a), (rb[1] - ra[1]) / (b - a)]
+    };
+    // `(-3 r(s) + 4 r(s ± h) - r(s ± 2h)) / (± 2h)` at an end.
+    let one_sided = |dir: f64| {
+        let (r1, r2) = (offset(s + dir * h), offset(s + 2.0 * dir * h));
+        [0, 1].map(|k| (-3.0 * r[k] + 4.0 * r1[k] - r2[k]) / (2.0 * dir * h))
+    };
+    let second = if s - h < 0.0 {
+        one_sided(1.0)
+    } else if s + h > end {
+        one_sided(-1.0)
+    } else {
+        slope(s - h, s + h)
+    };
+    if close(second)
+        || (s - h >= 0.0 && close(slope(s - h, s)))
+        || (s + h <= end && close(slope(s, s + h)))
+    {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        format!("tendons[{i}].derivative({s})"),
+        format!("{rp:?}"),
+        format!("the derivative of the offset function (its differences there give {second:?})"),
+    ))
 }
 
 /// Checks every external load against [`MAX_LOAD_NUMBER`](crate::limits::MAX_LOAD_NUMBER) with the force scale `EI / L²`.
