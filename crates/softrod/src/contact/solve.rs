@@ -231,34 +231,23 @@ fn restart(p: &mut Constrained<'_>, integrator: Integrator) {
 }
 
 /// [`reach`] on the mesh asked. If it meets a contact with friction made by the actuation
-/// ([`Constrained::pathless`]), the solve with the actuation
-/// stepped with the loads from the unactuated rod ([`ramp::stepped`]), so that its first
-/// touch is on that path; failing that, [`reach`] again with that contact's reference where
-/// the actuated rod without it touches it.
+/// ([`Constrained::pathless`]), or finds no contact set at load factor 0 (the actuated rod deep
+/// in an obstacle whose nearest surface is not the one it entered by, as in a closed mesh; with
+/// continuation allowed), the solve with the actuation stepped with the loads from the
+/// unactuated rod ([`ramp::stepped`]), so that its first touch is on that path; failing that,
+/// for the contact with friction, [`reach`] again with that contact's reference where the
+/// actuated rod without it touches it.
 fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Effort) -> Reach {
+    let mut unfound = false;
     if !p.pathless {
         let reached = reach(p, options, effort);
-        if !p.pathless
-            && options.newton.continuation
-            && !p.obstacles.is_empty()
-            && matches!(reached, Reach::Stopped { lambda, .. } if lambda == 0.0)
-        {
-            // The contacts of the actuated rod were not found (it lies deep in an obstacle
-            // whose nearest surface is not the one it entered by, as in a closed mesh): the
-            // actuation stepped with the loads from the unactuated rod meets the obstacle
-            // where the rod enters it (a continuation: not without one).
-            return match step_actuation(p, (options.integrator, false), &options.newton, effort) {
-                Ok(x) => Reach::Stepped(x),
-                Err(x) => Reach::Stopped {
-                    x,
-                    lambda: p.from,
-                    why: "no contact set at load factor 0, and the actuation stepped with the \
-                          loads from the unactuated rod stops",
-                },
-            };
-        }
         if !p.pathless {
-            return reached;
+            unfound = options.newton.continuation
+                && !p.obstacles.is_empty()
+                && matches!(reached, Reach::Stopped { lambda, .. } if lambda == 0.0);
+            if !unfound {
+                return reached;
+            }
         }
     }
     p.pathless = false;
@@ -266,12 +255,17 @@ fn reach_asked(p: &mut Constrained<'_>, options: &SolveOptions, effort: &mut Eff
         Ok(x) => return Reach::Stepped(x),
         Err(x) => x,
     };
-    if p.crossing {
+    if unfound || p.crossing {
         return Reach::Stopped {
             x,
             lambda: p.from,
-            why: "the actuated rod runs past the middle of an obstacle, and the load path \
-                  stepped toward it stops",
+            why: if unfound {
+                "no contact set at load factor 0, and the actuation stepped with the loads \
+                 from the unactuated rod stops"
+            } else {
+                "the actuated rod runs past the middle of an obstacle, and the load path \
+                 stepped toward it stops"
+            },
         };
     }
     *effort = Effort::default();
