@@ -217,6 +217,30 @@ def test_displacement_arguments_are_named():
         robot.solve(tendon_stiffness=1e4)
 
 
+
+def test_held_tendons_that_pull_against_each_other_are_named():
+    """Four inextensible tendons 90 degrees apart, all held: their displacements leave the
+    tensions [1, -1, 1, -1] free (they move nothing), so the solve names `displacements` and
+    the way out; with a tendon stiffness the tensions the displacements came from (oracle)."""
+    rod = softrod.Rod(
+        length=0.3,
+        section=softrod.CircularSection(radius=1e-3),
+        material=softrod.LinearElastic(youngs_modulus=54e9, poisson_ratio=0.3),
+    )
+    angles = 0.3 + np.arange(4) * np.pi / 2
+    tendons = [softrod.Tendon((0.01 * np.cos(a), 0.01 * np.sin(a)), 0.0) for a in angles]
+    robot = softrod.Robot(rod, tendons=tendons, loads=softrod.Loads(tip_force=(0.02, 0.01, 0)))
+    tensions = np.array([3.0, 1.5, 1.0, 0.5])
+    delta = robot.solve(tensions).tendon_displacements
+    with pytest.raises(softrod.ParameterError, match="displacements") as err:
+        robot.solve(displacements=list(delta))
+    assert "tendon_stiffness" in str(err.value)
+    assert "[0, 1, 2, 3]" in str(err.value)
+    k = 1e4
+    soft = robot.solve(displacements=list(delta + tensions / k), tendon_stiffness=k)
+    np.testing.assert_allclose(soft.tendon_tensions, tensions, rtol=1e-8)
+
+
 # ----------------------------------------------------------------------------- inverse statics
 
 

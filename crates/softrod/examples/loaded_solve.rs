@@ -3,7 +3,9 @@
 //!
 //! Cases: `cold` / `warm` (the two-segment NiTi robot with a 0.05 N tip force, cold and
 //! warm-started after +2 % tension), `unloaded` (tendons only), `gravity` (the 1 m
-//! four-tendon robot under gravity, cold), `cantilever` (the soft cantilever, 0.02 N tip force);
+//! four-tendon robot under gravity, cold), `cantilever` (the soft cantilever, 0.02 N tip force),
+//! `held` (the NiTi robot under the tip force, every tendon held at the displacements of the
+//! `cold` tensions, the zero of the displacements given);
 //! and, after one tendons-only solve, `COUNT` of `compliance` (along the arm), `tangent` /
 //! `tangent_length` (tip, tensions or lengths held) or `workspace` (100 configurations of the
 //! compliance bench's workspace map, per count).
@@ -58,6 +60,17 @@ fn main() {
             Actuation::tensions(&[2.0, 0.0, 1.0, 0.0]),
             opts,
         ),
+        "held" => {
+            let model = niti(tip);
+            let forward = solve_statics(&model, &act, &opts).unwrap();
+            let zero = softrod::reference_lengths(&model, &opts).unwrap();
+            let mut held = act.clone();
+            for (i, t) in held.tendons.iter_mut().enumerate() {
+                *t = softrod::TendonInput::displacement(zero[i] - forward.tendon_lengths[i]);
+            }
+            held.reference_lengths = Some(zero);
+            (model, held, opts)
+        }
         "cantilever" => {
             let soft = Rod::new(
                 0.27,

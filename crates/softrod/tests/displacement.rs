@@ -191,6 +191,94 @@ fn displacement_round_trip_on_fine_meshes_under_a_tip_force() {
     }
 }
 
+/// A rod of `length` (m), radius 1 mm, E = 54 GPa, with `n` tendons 10 mm from the axis,
+/// equally spaced from the angle `phase` (rad), ending at the tip, under a tip force (N).
+fn ring_of_tendons(
+    n: usize,
+    phase: f64,
+    tip_force: [f64; 3],
+    inextensible: bool,
+) -> Arc<RobotModel> {
+    let rod = common::circular_rod(0.3, 1e-3, 54e9, 0.3).with_inextensible(inextensible);
+    let tendons = (0..n)
+        .map(|i| {
+            let a = phase + std::f64::consts::TAU * i as f64 / n as f64;
+            Tendon::constant([0.01 * a.cos(), 0.01 * a.sin()], None).unwrap()
+        })
+        .collect();
+    let loads = Loads {
+        tip_force: Vector3::from(tip_force),
+        ..Default::default()
+    };
+    RobotModel::new(rod, tendons, Vec::new(), loads).unwrap()
+}
+
+/// Every tendon of `model` held at the displacements of `tensions`, inextensible or with
+/// `stiffness` (N/m): the solve's result.
+fn held_at_displacements_of(
+    model: &Arc<RobotModel>,
+    tensions: &[f64],
+    stiffness: f64,
+) -> softrod::Result<StaticsSolution> {
+    let o = options();
+    let forward = solve_statics(model, &Actuation::tensions(tensions), &o).unwrap();
+    let zero = reference_lengths(model, &o).unwrap();
+    let mut act = Actuation::tensions(tensions);
+    for (i, t) in act.tendons.iter_mut().enumerate() {
+        // A compliant tendon stretched by its tension: its base end pulled that much further.
+        *t = TendonInput::Displacement {
+            displacement: zero[i] - forward.tendon_lengths[i] + tensions[i] / stiffness,
+            stiffness,
+        };
+    }
+    solve_statics(model, &act, &o)
+}
+
+/// Held inextensible tendons whose displacements do not determine their tensions are named,
+/// with the tensions that pull against each other: four tendons 90° apart (the pattern
+/// `[1, -1, 1, -1]` moves neither the rod nor the tendons' lengths), six 60° apart, and three
+/// on a rod that cannot stretch (equal tensions only compress it). They were answered with
+/// one of the many tensions silently, or with a `ConvergenceError` at a residual of 1e-11.
+/// The same tendons with a stiffness (or fewer of them held) determine the tensions: the ones
+/// the displacements came from (the oracle).
+#[test]
+fn held_tendons_pulling_against_each_other_without_moving_the_rod_are_named() {
+    let four = ring_of_tendons(4, 0.3, [0.02, 0.01, 0.0], false);
+    let six = ring_of_tendons(6, 0.3, [0.02, 0.01, 0.0], false);
+    let stiff = ring_of_tendons(3, 0.3, [0.02, 0.01, 0.0], true);
+    let symmetric = ring_of_tendons(4, 0.0, [0.02, 0.0, 0.0], false);
+    let cases: [(&Arc<RobotModel>, &[f64], &str); 4] = [
+        (&four, &[3.0, 1.5, 1.0, 0.5], "four tendons"),
+        (&symmetric, &[3.0, 1.0, 1.0, 1.0], "four tendons, planar"),
+        (&six, &[3.0, 2.0, 1.5, 1.0, 0.7, 0.5], "six tendons"),
+        (&stiff, &[3.0, 1.0, 0.5], "three tendons, inextensible rod"),
+    ];
+    for (model, tensions, what) in cases {
+        match held_at_displacements_of(model, tensions, f64::INFINITY) {
+            Err(softrod::Error::InvalidParameter { name, expected, .. }) => {
+                println!("{what}: {expected}");
+                assert_eq!(name, "displacements", "{what}");
+                assert!(expected.contains("tendon_stiffness"), "{what}: {expected}");
+            }
+            other => panic!("{what}: {other:?}"),
+        }
+        let back = held_at_displacements_of(model, tensions, 1e4).unwrap();
+        for (a, b) in tensions.iter().zip(&back.tendon_tensions) {
+            assert!(
+                (a - b).abs() <= 1e-8 * 3.0,
+                "{what}, compliant: {b} N vs {a} N"
+            );
+        }
+    }
+    // Three of the four held: determined (the rod's axial stiffness separates them).
+    round_trip(
+        &four,
+        &[3.0, 1.5, 1.0, 0.5],
+        &[0, 1, 2],
+        "four tendons, three held",
+    );
+}
+
 #[test]
 fn a_paid_out_tendon_goes_slack_and_changes_nothing() {
     let model = niti(Loads::default(), None);

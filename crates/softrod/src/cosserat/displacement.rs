@@ -20,8 +20,17 @@
 //!
 //! The zero of the displacements, `ℓ_ref`, is the tendons' path lengths at zero actuation under
 //! the model's external loads ([`reference_lengths`]), unless the actuation gives it.
+//!
+//! Inextensible held tendons can leave their tensions undetermined: four tendons 90° apart
+//! take on tension in the proportions `[1, -1, 1, -1]` without moving the rod or changing their
+//! lengths, and any tendons on a rod that cannot stretch take on equal tensions. The solve
+//! then names `displacements` with the tendons and the pattern (a singular value of the held
+//! problem's Jacobian below [`UNDETERMINED`] of the largest), rather than returning one of the
+//! many tensions or failing to converge; a tendon stiffness determines them.
 
 use std::sync::Arc;
+
+use nalgebra::DMatrix;
 
 use super::sensitivity::slack_scale;
 use super::shooting::{Held, Shooting};
@@ -249,6 +258,8 @@ struct HeldState {
     warm: bool,
     /// Accumulated solver statistics.
     stats: SolverStats,
+    /// The scaled base wrench and the tensions the last round started from.
+    start: ([f64; 6], Vec<f64>),
 }
 
 /// The scaled base wrench of `options`' warm start (zero without).
@@ -324,6 +335,7 @@ impl HeldProblem<'_> {
             }
         }
         p.tensions.clone_from(&st.tensions);
+        st.start = (st.x0, st.tensions.clone());
         let mut z0 = st.x0.to_vec();
         z0.extend(p.held.iter().map(|h| st.tensions[h.tendon] / f_ref));
         let mut round_stats = SolverStats::default();
@@ -389,6 +401,12 @@ impl HeldProblem<'_> {
             if let Some(e) = p.ws.material_error.take() {
                 return Err(e);
             }
+            // Judged where the last round started: a Newton iteration on undetermined tensions
+            // wanders along them (to tensions of 1e6 force scales, where the rod collapses).
+            let (x0, tensions) = &st.start;
+            if let Some(e) = self.undetermined(p, &st.taut, (x0, tensions), 1.0, false) {
+                return Err(e);
+            }
             let what = if out.converged {
                 format!(
                     "active set of the displacement-controlled tendons ({} rounds)",
@@ -417,13 +435,129 @@ impl HeldProblem<'_> {
             x0[5] * fm,
         ];
         let mut sol = assemble(p, self.model, base_wrench, st.stats, &[]);
+        if settled {
+            let at = (&st.x0, &st.tensions[..]);
+            if let Some(e) = self.undetermined(p, &st.taut, at, st.stats.load_factor, true) {
+                return Err(e);
+            }
+        }
         let mut act = self.actuation.clone();
         act.reference_lengths = Some(self.reference);
         sol.actuation = act;
         sol.options = *self.options;
         Ok(sol)
     }
+
+    /// The error naming `displacements` when they do not determine the tensions of the held
+    /// tendons `taut` at the scaled base wrench and tensions `at` (load factor `lambda`; with
+    /// `at_zero_slack`, the slack tendons with no slack left at the last evaluation of `p` count
+    /// as held too): a pattern of their tensions that changes neither the
+    /// tip's balance nor their slacks, within [`UNDETERMINED`] of the largest singular value
+    /// of the held problem's Jacobian, and that keeps the slack ones' tensions non-negative in
+    /// one direction. Such tendons pull against each other without moving the rod (four 90°
+    /// apart, or any three on a rod that cannot stretch): only their stiffness decides how.
+    fn undetermined(
+        &self,
+        p: &Shooting<'_>,
+        taut: &[bool],
+        (x0, tensions): (&[f64; 6], &[f64]),
+        lambda: f64,
+        at_zero_slack: bool,
+    ) -> Option<Error> {
+        let f_ref = self.model.force_scale();
+        let eps = 10.0 * self.options.newton.tolerance;
+        // The held tendons at zero slack, and which of them are slack (tension 0).
+        let (mut zero, mut slack) = (Vec::new(), Vec::new());
+        for (h, &taut) in self.all_held.iter().zip(taut) {
+            let gap = h.target - p.lengths[h.tendon] + h.compliance * tensions[h.tendon];
+            if taut || (at_zero_slack && gap <= eps * h.scale) {
+                zero.push(*h);
+                slack.push(!taut);
+            }
+        }
+        if zero.is_empty() {
+            return None;
+        }
+        let dim = 6 + zero.len();
+        let mut z = x0.to_vec();
+        z.extend(zero.iter().map(|h| tensions[h.tendon] / f_ref));
+        // On the coarse mesh when there is one (a fifth of the cost): a pattern that moves
+        // nothing does so on any mesh, and a determined one is far above the threshold.
+        let (integrator, plan) = match self.options.integrator.coarse() {
+            Some(Integrator::Rk4 { steps }) => (
+                Integrator::Rk4 { steps },
+                rk4_plan(self.model.breaks(), steps),
+            ),
+            _ => (p.integrator, p.plan.clone()),
+        };
+        let mut q = Shooting::new(p.eq, integrator, plan);
+        q.tensions = tensions.to_vec();
+        q.held = zero;
+        let (mut jac, mut r) = (vec![0.0; dim * dim], vec![0.0; dim]);
+        let ev = q.evaluate(&z, lambda, Some(&mut jac), &mut r);
+        let zero = q.held;
+        if ev != Evaluated::Jacobian {
+            return None;
+        }
+        let svd = DMatrix::from_column_slice(dim, dim, &jac).svd(false, true);
+        let v_t = svd.v_t?;
+        let largest = svd.singular_values.max();
+        let pattern = svd
+            .singular_values
+            .iter()
+            .zip(v_t.row_iter())
+            .filter(|(sv, _)| **sv <= UNDETERMINED * largest)
+            .map(|(_, row)| row.columns(6, dim - 6).transpose())
+            .find_map(|t| {
+                // Largest entry 1 in size, the first sizeable one positive.
+                let big = t.amax();
+                let first = t
+                    .iter()
+                    .find(|v| v.abs() > 1e-6 * big)
+                    .map_or(1.0, |v| v.signum());
+                let t = &t / (big * first);
+                // Tensions of slack tendons may only grow: one sign on all of them.
+                let on_slack = || t.iter().zip(&slack).filter(|(_, s)| **s).map(|(v, _)| *v);
+                if on_slack().all(|v| v >= -1e-6) {
+                    Some(t)
+                } else if on_slack().all(|v| v <= 1e-6) {
+                    Some(-t)
+                } else {
+                    None
+                }
+            })?;
+        let tendons: Vec<usize> = zero.iter().map(|h| h.tendon).collect();
+        let shown: Vec<String> = pattern.iter().map(|v| format!("{v:.3}")).collect();
+        let displacements: Vec<String> = self
+            .actuation
+            .tendons
+            .iter()
+            .map(|t| match t {
+                TendonInput::Displacement { displacement, .. } => format!("{displacement:.4e}"),
+                TendonInput::Tension(_) => "None".into(),
+            })
+            .collect();
+        Some(Error::invalid(
+            "displacements",
+            format!("[{}]", displacements.join(", ")),
+            format!(
+                "displacements that determine the held tendons' tensions: the tendons {tendons:?} \
+                 can take on tension in the proportions [{}] without moving the rod or \
+                 changing their lengths (they pull against each other or against a rod that \
+                 cannot stretch); give them a tendon_stiffness (N/m) or hold fewer of them",
+                shown.join(", ")
+            ),
+        ))
+    }
 }
+
+/// Singular values of the held problem's Jacobian (scaled: base wrench and tensions per force
+/// scale, tip rows per force scale, slacks per their scale) below this fraction of the
+/// largest leave a tension pattern undetermined: a change of the pattern by the force scale
+/// moves the tendons' lengths by less than 1e-8 of the slack scale. Tendons that pull against
+/// each other exactly come out at round-off (1e-15); the nearest determined patterns (the
+/// axial stretch of a rod whose tendons sit 10 radii out) near 1e-3.
+const UNDETERMINED: f64 = 1e-8;
 
 /// [`solve_held`] on the integration mesh: the rounds of the active set.
 fn solve_held_on_mesh(
@@ -455,6 +589,7 @@ fn solve_held_on_mesh(
         x0: scaled_base_wrench(model, options),
         warm: options.warm_start.is_some(),
         stats: SolverStats::default(),
+        start: ([0.0; 6], Vec::new()),
     };
     st.taut = hp.first_taut(&plan, &pressures, &mut st.tensions);
     let rounds = MAX_ACTIVE_SET_ROUNDS_PER_TENDON * hp.all_held.len() + 4;
