@@ -65,16 +65,17 @@ fn cell_candidates(
     forces: &Forces,
     penetration: f64,
 ) -> Vec<(usize, Site, f64)> {
-    let l = p.model.length();
     let mut added = Vec::new();
     for o in 0..p.obstacles.len() {
         let g = p.gaps(o);
         for i in 1..g.len() {
             let (s0, s1) = (g[i - 1].1, g[i].1);
-            let near = |s: f64| s >= s0 - 1e-12 * l && s <= s1 + 1e-12 * l;
-            let covered = forces.iter().zip(&p.active).any(|(f, a)| {
-                a.obstacle == o && (near(f.2) || (a.site == Site::Interval && s1 >= f.2))
-            });
+            // A cell next to a point contact is checked too: the rod can cross the obstacle
+            // between its contact and a node just clear of it (a rod across a small sphere).
+            let covered = forces
+                .iter()
+                .zip(&p.active)
+                .any(|(f, a)| a.obstacle == o && a.site == Site::Interval && s1 >= f.2);
             let covered = covered || belt::covers(p, o, (s0, s1));
             if covered || g[i - 1].2 < -penetration || g[i].2 < -penetration {
                 continue;
