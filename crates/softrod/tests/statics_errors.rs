@@ -395,6 +395,57 @@ fn a_tendon_pulled_with_the_axial_stiffness_is_named() {
     }
 }
 
+/// A tendon pulled hard enough to bend the rod tighter than its own distance from the
+/// backbone has no equilibrium: its path `p' = v + u × r` would turn back on itself
+/// (`u d >= v₃`). It was a bare `ConvergenceError` ("the actuated rod without external loads
+/// could not be integrated"); the solve names the tension, on a rod that can stretch and one
+/// that cannot, with the limit `τ* = v₃ E I / d²` (`v₃ = 1 - τ / (E A)`). Below it, the
+/// single straight tendon's closed form: a constant curvature `τ d / (E I)`.
+#[test]
+fn a_tendon_that_would_bend_the_rod_inside_its_own_offset_is_named() {
+    let (e, radius, d) = (1e7, 0.002, 0.01);
+    let area = std::f64::consts::PI * radius * radius;
+    let ei = e * area * radius * radius / 4.0;
+    for inextensible in [true, false] {
+        let solve = |tension: f64| {
+            let tendon = softrod::Tendon::constant([d, 0.0], None).unwrap();
+            let rod = rod().with_inextensible(inextensible);
+            let m =
+                softrod::RobotModel::new(rod, vec![tendon], Vec::new(), Loads::default()).unwrap();
+            softrod::solve_statics(
+                &m,
+                &softrod::Actuation::tensions(&[tension]),
+                &SolveOptions::default(),
+            )
+        };
+        // The limit: τ d² / (E I) = v₃.
+        let limit = if inextensible {
+            ei / (d * d)
+        } else {
+            1.0 / (d * d / ei + 1.0 / (e * area))
+        };
+        for factor in [1.01, 2.0, 10.0] {
+            match solve(factor * limit) {
+                Err(Error::InvalidParameter { name, expected, .. }) => {
+                    assert_eq!(name, "tensions[0]");
+                    assert!(expected.contains("radius of curvature"), "{expected}");
+                    println!("{factor} x the limit: {expected}");
+                }
+                other => panic!("{factor} x the limit, inextensible {inextensible}: {other:?}"),
+            }
+        }
+        let tension = 0.9 * limit;
+        let sol = solve(tension).unwrap();
+        for u in &sol.u {
+            let exact = tension * d / ei;
+            assert!(
+                (u[1].abs() - exact).abs() <= 1e-10 * exact,
+                "{u:?} vs {exact}"
+            );
+        }
+    }
+}
+
 /// A user routing's derivative is checked against the offset it goes with: a helix whose
 /// derivative forgot the chain rule's `2 pi / pitch`, or has the wrong sign, is refused naming
 /// `tendons[0].derivative(s)`; the exact one passes, and so does a routing with a kink at a

@@ -1,11 +1,14 @@
 //! The named cause of an actuated rod that cannot be integrated: tendons that compress an
-//! extensible rod to zero length.
+//! extensible rod to zero length, or that bend it tighter than their own distance from the
+//! backbone.
 //!
 //! Without external loads the rod carries the tendons' pull as compression: at a section
 //! reached by the tendons `i` the axial force is about `Σ τ_i` (exactly for tendons parallel to
 //! the backbone). A linear elastic rod's stretch there is `1 - Σ τ_i / (E A(s))`, zero or
 //! negative once the tensions reach the axial stiffness `E A(s)`: no configuration exists, and
 //! the solve says which tension and which stiffness instead of a bare non-convergence.
+
+use nalgebra::Vector3;
 
 use super::solution::StaticsSolution;
 use crate::error::Error;
@@ -53,6 +56,74 @@ pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option
                     "tensions summing to less than the rod's axial stiffness E A = {ea:.4e} N at \
                      s = {s:.4} m (they total {reach:.4e} N there: the rod would be compressed \
                      to zero length; raise youngs_modulus or lower the tensions)"
+                ),
+            ));
+        }
+    }
+    None
+}
+
+/// An [`Error::InvalidParameter`] naming the tension of a tendon whose path would turn back on
+/// itself on the actuated rod of a linear elastic model without chambers: at a section, the
+/// strains of straight tendons (the rod's wrench balancing the tendons' pull along the
+/// backbone: `v = v* - C Σ τ e₃`, `u = u* - C Σ τ r × e₃`, exact for one straight tendon and
+/// for any on a rod that cannot shear or twist) give the tendon's path a speed
+/// `(v + u × r + r')·e₃ <= 0`: the rod is bent to a radius of curvature inside the tendon's
+/// distance from the backbone, and no configuration exists. `None` otherwise.
+pub(crate) fn bent_inside_a_tendon(model: &RobotModel, tensions: &[f64]) -> Option<Error> {
+    let rod = model.rod();
+    if !rod.material().is_linear() || !model.chambers().is_empty() {
+        return None;
+    }
+    let length = rod.length();
+    let tendons = model.tendons();
+    let mut points: Vec<f64> = (0..=SAMPLES)
+        .map(|k| length * k as f64 / SAMPLES as f64)
+        .collect();
+    points.extend(tendons.iter().filter_map(|t| t.end()));
+    for s in points {
+        let props = rod.section_at(s);
+        let reaching: Vec<(usize, Vector3<f64>, Vector3<f64>, f64)> = tendons
+            .iter()
+            .zip(tensions)
+            .enumerate()
+            .filter(|(_, (t, tau))| **tau > 0.0 && t.end().is_none_or(|e| s <= e))
+            .map(|(i, (t, &tau))| {
+                let (r, rp) = t.routing().offset(s, &props);
+                (
+                    i,
+                    Vector3::new(r[0], r[1], 0.0),
+                    Vector3::new(rp[0], rp[1], 0.0),
+                    tau,
+                )
+            })
+            .collect();
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for (_, r, _, tau) in &reaching {
+            force.z += tau;
+            moment += r.cross(&Vector3::z()) * *tau;
+        }
+        let c = rod
+            .material()
+            .compliance(&props, rod.shear_coefficient(), rod.inextensible());
+        let v = rod.rest_strain().at(s) - Vector3::new(c[0], c[1], c[2]).component_mul(&force);
+        let u = rod.rest_curvature().at(s) - Vector3::new(c[3], c[4], c[5]).component_mul(&moment);
+        for (i, r, rp, tau) in &reaching {
+            if (v + u.cross(r) + rp).z > 0.0 {
+                continue;
+            }
+            // The deformed backbone's curvature: `|u⊥|` per unit of stretched length `v₃`.
+            let bend = u.x.hypot(u.y) / v.z;
+            return Some(Error::invalid(
+                format!("tensions[{i}]"),
+                tau,
+                format!(
+                    "tensions that bend the rod to a radius of curvature larger than the \
+                     tendons' distance from the backbone (at s = {s:.4} m they bend it to a \
+                     radius of curvature of {:.4e} m, inside tendon {i}'s distance {:.4e} m: its \
+                     path would turn back on itself; lower the tensions or raise youngs_modulus)",
+                    1.0 / bend,
+                    r.norm()
                 ),
             ));
         }

@@ -863,7 +863,9 @@ fn not_converged(
         return e;
     }
     if matches!(reached.stopped, Some(Stopped::StartFailed)) {
-        if let Some(e) = super::collapse::compressed_to_zero(p.eq.model, tensions) {
+        if let Some(e) = super::collapse::compressed_to_zero(p.eq.model, tensions)
+            .or_else(|| super::collapse::bent_inside_a_tendon(p.eq.model, tensions))
+        {
             return e;
         }
     }
