@@ -17,6 +17,16 @@ use crate::model::RobotModel;
 /// Sections checked along the rod (uniformly, plus the tendon ends).
 const SAMPLES: usize = 64;
 
+/// The sections checked: [`SAMPLES`] uniform ones and the tendons' ends (m).
+fn sections(model: &RobotModel) -> Vec<f64> {
+    let length = model.length();
+    let mut points: Vec<f64> = (0..=SAMPLES)
+        .map(|k| length * k as f64 / SAMPLES as f64)
+        .collect();
+    points.extend(model.tendons().iter().filter_map(|t| t.end()));
+    points
+}
+
 /// An [`Error::InvalidParameter`] naming the largest tendon tension if the tensions reach the
 /// axial stiffness `E A(s)` of an extensible, linear elastic rod at some section (the rod would
 /// be compressed to zero length: a stretch below [`LEAST_STRETCH`]); `None` otherwise.
@@ -25,12 +35,8 @@ pub(crate) fn compressed_to_zero(model: &RobotModel, tensions: &[f64]) -> Option
     if rod.inextensible() || !rod.material().is_linear() {
         return None;
     }
-    let length = rod.length();
     let tendons = model.tendons();
-    let mut points: Vec<f64> = (0..=SAMPLES)
-        .map(|k| length * k as f64 / SAMPLES as f64)
-        .collect();
-    points.extend(tendons.iter().filter_map(|t| t.end()));
+    let points = sections(model);
     for s in points {
         let reach: f64 = tendons
             .iter()
@@ -75,12 +81,8 @@ pub(crate) fn bent_inside_a_tendon(model: &RobotModel, tensions: &[f64]) -> Opti
     if !rod.material().is_linear() || !model.chambers().is_empty() {
         return None;
     }
-    let length = rod.length();
     let tendons = model.tendons();
-    let mut points: Vec<f64> = (0..=SAMPLES)
-        .map(|k| length * k as f64 / SAMPLES as f64)
-        .collect();
-    points.extend(tendons.iter().filter_map(|t| t.end()));
+    let points = sections(model);
     for s in points {
         let props = rod.section_at(s);
         let reaching: Vec<(usize, Vector3<f64>, Vector3<f64>, f64)> = tendons
