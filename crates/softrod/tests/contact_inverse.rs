@@ -94,7 +94,7 @@ fn targets_pressed_on_a_sphere_are_reached_or_reported() {
 }
 
 /// The sample (run with `--ignored`): on the plane 359 of 359 touching samples are
-/// reached; pressed on a sphere, 65 of 95 and 207 of 256 (most misses stop where the
+/// reached; pressed on a sphere, 64 of 95 and 208 of 256 (most misses stop where the
 /// contact-free shape passes through the sphere's centre and the solve from a straight rod
 /// jumps to another side of the sphere, the others where the contact is released: see
 /// `examples/contact_inverse_misses.rs` and docs/command.md): below the 99 % asked.
