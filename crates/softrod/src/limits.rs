@@ -14,7 +14,7 @@
 //!   nine orders of magnitude above that, so no physical load is refused, while the scaled
 //!   residual of the solvers (loads over `EI / L²` and `EI / L`), its square and its
 //!   Jacobian stay far from overflow.
-//! - Materials: [`MAX_MODULUS`].
+//! - Materials: [`MAX_MODULUS`], [`MAX_DENSITY`].
 //! - Geometry: [`MAX_LENGTH`], [`MAX_BENDING_ANGLE`], and for tendon routings
 //!   [`MAX_OFFSET_RATIO`].
 
@@ -45,6 +45,9 @@ pub const MAX_BENDING_ANGLE: f64 = 1e6;
 /// diamond. Softer materials span nine orders of magnitude below it; the stiffness of a
 /// section (a modulus times a fourth power of its radius) stays finite.
 pub const MAX_MODULUS: f64 = 1e13;
+
+/// Largest mass density of a rod (kg/m³): 44 times that of osmium, the densest element.
+pub const MAX_DENSITY: f64 = 1e6;
 
 /// Largest distance of a tendon (or a PCC chamber) from the backbone, as a fraction of the rod
 /// length.

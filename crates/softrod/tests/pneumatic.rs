@@ -421,3 +421,136 @@ fn tangent_compliance_of_a_pressurised_hyperelastic_arm_matches_finite_differenc
     println!("tangent compliance vs finite differences: {worst:e}");
     assert!(worst < 1e-6, "relative difference {worst:e}");
 }
+
+/// A tapered Neo-Hookean arm (0.4 m, radius 5.5 mm to 1.3 mm, one chamber at 2.3 MPa) that
+/// curls 3.7 turns, to 660 1/m at its thin tip: the default 40 RK4 steps turn by up to 6.6 rad
+/// a step there, where RK4's rotations are meaningless, and the solve reported a tip 30 L
+/// from the base as converged. Under error control the default mesh is refined when its
+/// estimated tip error (`Σ θ⁵/120 (L - s)/L`) exceeds 1e-4; a chosen mesh estimated off by
+/// more than a tenth of the length is refused naming `steps`, and 320 steps (estimated
+/// 2.7e-4, off by 5.7e-5 L) are kept. Oracle: the tip on 640 steps and with the adaptive
+/// integrator (they agree to 2e-6 m).
+#[test]
+fn a_curl_the_default_mesh_cannot_resolve_is_solved_on_a_finer_one() {
+    let (l, radius, tip_radius) = (0.4, 0.0055, 0.0013);
+    let rod = Rod::new(
+        l,
+        Section::tapered_circular(radius, tip_radius).unwrap(),
+        Material::from(UniaxialModel::from(NeoHookean::new(0.25e6).unwrap())),
+    )
+    .unwrap();
+    let area = PI * (0.3 * tip_radius).powi(2);
+    let chamber = softrod::Chamber::new(
+        ChamberArea::Constant(area),
+        [0.5 * tip_radius, 0.0],
+        0.0,
+        None,
+    )
+    .unwrap();
+    let model = softrod::RobotModel::new(rod, Vec::new(), vec![chamber], Loads::default()).unwrap();
+    let act = softrod::Actuation::pressures(&[2.3e6]);
+    let solve = |o: &SolveOptions| softrod::compliance::solve_at_output(&model, &act, o, &[]);
+    let fine = solve(&rk4(640)).unwrap();
+    let adaptive = SolveOptions {
+        integrator: Integrator::Adaptive(softrod::AdaptiveOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..Default::default()
+        }),
+        ..SolveOptions::default()
+    };
+    let reference = solve(&adaptive).unwrap();
+    let tip = |s: &StaticsSolution| Vector3::from(s.tip_position());
+    println!("640 steps {:?}, adaptive {:?}", tip(&fine), tip(&reference));
+    assert!((tip(&fine) - tip(&reference)).norm() <= 1e-5);
+    let default = solve(&SolveOptions::default()).unwrap();
+    let error = (tip(&default) - tip(&reference)).norm();
+    println!(
+        "default: {} steps, tip {:?}, {error:.2e} m from the adaptive one",
+        match default.options.integrator {
+            Integrator::Rk4 { steps } => steps,
+            Integrator::Adaptive(_) => 0,
+        },
+        tip(&default)
+    );
+    assert!(default.stats.converged);
+    assert!(error <= 1e-4 * l, "{error:e} m");
+    let kept = solve(&rk4(320)).unwrap();
+    let off = (tip(&kept) - tip(&reference)).norm();
+    let estimate = softrod::compliance::rk4_position_error(&kept);
+    assert!(
+        off <= estimate * l && estimate < 1e-3,
+        "{off:e} m, estimated {estimate:e} L"
+    );
+    match solve(&rk4(50)) {
+        Err(Error::InvalidParameter { name, .. }) => assert_eq!(name, "steps"),
+        other => panic!("50 steps: {:?}", other.map(|s| s.tip_position())),
+    }
+}
+
+/// A tapered Mooney–Rivlin arm (0.12 m, radius 5 mm to 2 mm) whose three chambers curl it
+/// tight, under a small tip force and gravity: on 20 to 80 RK4 steps the march of the curl
+/// goes wild (moments of 1e18 N m at the base), and the default solve raised a
+/// `ParameterError` naming a fibre `stretch` of 1.0 as "must be > 0". A default mesh that fails
+/// is tried again on one eight times finer (here it converges, stable, and is refined once
+/// more to meet the default mesh's estimated accuracy, 1e-4 L); a chosen mesh fails honestly,
+/// naming no parameter of the user's. Oracle: the adaptive integrator's tip (rtol 1e-10),
+/// within the refined solve's own estimate of its error.
+#[test]
+fn a_pneumatic_curl_the_default_mesh_fails_on_is_solved_on_a_finer_one() {
+    let rod = Rod::new(
+        0.1223,
+        Section::tapered_circular(0.005, 0.002).unwrap(),
+        Material::from(UniaxialModel::from(
+            MooneyRivlin::new(25.6e3, 13.3e3).unwrap(),
+        )),
+    )
+    .unwrap()
+    .with_density(1198.0)
+    .unwrap();
+    let chambers = [
+        (1.447e6, [0.0001, -0.00094]),
+        (0.398e6, [0.00076, 0.00055]),
+        (0.154e6, [-0.00086, 0.00038]),
+    ];
+    let list = chambers
+        .iter()
+        .map(|(_, o)| {
+            softrod::Chamber::new(ChamberArea::Constant(1.333e-6), *o, 0.0, None).unwrap()
+        })
+        .collect();
+    let loads = Loads {
+        tip_force: Vector3::new(-9.8e-5, 8.7e-5, 4.7e-4),
+        gravity: Vector3::new(8.459, -3.767, -3.239),
+        ..Default::default()
+    };
+    let model = softrod::RobotModel::new(rod, Vec::new(), list, loads).unwrap();
+    let act = softrod::Actuation::pressures(&chambers.map(|c| c.0));
+    let solve = |o: &SolveOptions| softrod::compliance::solve_at_output(&model, &act, o, &[]);
+    let adaptive = SolveOptions {
+        integrator: Integrator::Adaptive(softrod::AdaptiveOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..Default::default()
+        }),
+        ..SolveOptions::default()
+    };
+    let reference = Vector3::from(solve(&adaptive).unwrap().tip_position());
+    let default = solve(&SolveOptions::default()).unwrap();
+    let off = (Vector3::from(default.tip_position()) - reference).norm();
+    println!(
+        "default: {:?}, {off:.2e} m from the adaptive tip",
+        default.options.integrator
+    );
+    let estimate = softrod::compliance::rk4_position_error(&default);
+    assert!(default.stats.converged && default.stable);
+    assert!(
+        off <= estimate * 0.1223 && estimate <= softrod::compliance::DEFAULT_MESH_POSITION_LIMIT,
+        "{off:e} m, estimated {estimate:e} L"
+    );
+    // (40 steps are the default mesh, whichever way they are asked for.)
+    match solve(&rk4(41)) {
+        Err(Error::NotConverged { .. }) => {}
+        other => panic!("41 chosen steps: {:?}", other.map(|s| s.tip_position())),
+    }
+}

@@ -489,3 +489,41 @@ fn a_user_routing_whose_derivative_is_not_its_offsets_is_named() {
     .unwrap();
     assert!(solve(kinked).is_ok());
 }
+
+/// Absurd values are named as themselves: a density of 1e30 kg/m³ was blamed on
+/// `loads.gravity` (its load number), a chamber area of 1e30 m² on `chambers[0].pressure`, and
+/// a tolerance of 1 or more was accepted (a residual as large as the loads counted as
+/// converged: a tip 20 % of the length off the solve at the default tolerance).
+#[test]
+fn an_absurd_density_chamber_area_or_tolerance_is_named_as_itself() {
+    assert_eq!(name_of(rod().with_density(1e30)), "density");
+    assert!(rod().with_density(2e4).is_ok());
+    let chamber = softrod::Chamber::new(
+        softrod::ChamberArea::Constant(1e30),
+        [0.005, 0.0],
+        0.0,
+        None,
+    )
+    .unwrap();
+    let name = name_of(softrod::RobotModel::new(
+        rod(),
+        Vec::new(),
+        vec![chamber],
+        Loads::default(),
+    ));
+    assert!(name.starts_with("chambers[0].area("), "{name}");
+    let model = softrod::RobotModel::rod_only(
+        rod(),
+        Loads::tip_force(softrod::nalgebra::Vector3::new(0.01, 0.0, 0.0)),
+    )
+    .unwrap();
+    for tolerance in [1.0, 1e30] {
+        let mut o = SolveOptions::default();
+        o.newton.tolerance = tolerance;
+        let got = softrod::solve_statics(&model, &softrod::Actuation::default(), &o);
+        assert_eq!(name_of(got), "tolerance", "{tolerance}");
+    }
+    let mut o = SolveOptions::default();
+    o.newton.tolerance = 0.5;
+    assert!(softrod::solve_statics(&model, &softrod::Actuation::default(), &o).is_ok());
+}

@@ -50,6 +50,25 @@ pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
         .sum()
 }
 
+/// Estimated truncation error of the tip position of the RK4 march of `solution`, relative
+/// to the rod's length: the rotation error of each step ([`rk4_rotation_error`]'s terms)
+/// times the length after the step's start, over `L`. A turn that RK4 misses at the tip of a
+/// thin, tightly curled rod moves little of it; one near the base moves all of it. NaN if a
+/// curvature is not finite.
+pub fn rk4_position_error(solution: &StaticsSolution) -> f64 {
+    let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    let length = solution.model.length();
+    solution
+        .s
+        .windows(2)
+        .zip(solution.u.windows(2))
+        .map(|(s, u)| {
+            let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1]));
+            theta.powi(5) / 120.0 * (length - s[0]) / length
+        })
+        .sum()
+}
+
 /// The solution re-solved on a finer RK4 mesh that contains its nodes, with, for each node of
 /// `solution`, its index in the finer one; `None` where no refinement is needed (an adaptive
 /// solution, an estimate below [`MESH_ROTATION_TARGET`]), wanted (RK4 steps other than
@@ -118,11 +137,15 @@ pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
 /// mesh: the problem is solved on the default mesh, its rotational truncation error estimated
 /// ([`rk4_rotation_error`]) and, above [`OUTPUT_ROTATION_TARGET`], solved again with `s_out` on
 /// a mesh `m` times finer (warm-started; `m` from the fourth-order convergence, at most 32),
-/// whose steps the returned solution's options record. Other integrators and meshes, an
-/// empty `s_out` and a default solve that fails are [`solve_statics_at`] as they are.
+/// whose steps the returned solution's options record. Other integrators and meshes and a
+/// default solve that fails are [`solve_statics_at`] as they are. Without `s_out`, an RK4
+/// solution whose mesh cannot resolve its shape is refined or refused ([`resolved`]), and a
+/// solve that fails on the default mesh is tried again on one eight times finer (its
+/// solution, if it converges, is returned; else the default mesh's error).
 ///
 /// # Errors
-/// As [`solve_statics_at`].
+/// As [`solve_statics_at`]; [`Error::InvalidParameter`] naming `steps` for a chosen RK4 mesh
+/// whose estimated tip-position error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
 pub fn solve_at_output(
     model: &std::sync::Arc<crate::model::RobotModel>,
     actuation: &crate::model::Actuation,
@@ -131,7 +154,24 @@ pub fn solve_at_output(
 ) -> crate::error::Result<StaticsSolution> {
     let default =
         matches!(options.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
-    if !default || s_out.is_empty() {
+    if s_out.is_empty() {
+        let first = solve_statics_at(model, actuation, options, s_out);
+        if default && !first.as_ref().is_ok_and(|s| s.stats.converged) {
+            // A shape the default mesh cannot march (a tight curl: its RK4 rotations grow and
+            // the iterates go wild) may converge on a finer one.
+            let mut fine = *options;
+            fine.integrator = Integrator::Rk4 {
+                steps: RETRY_REFINEMENT * DEFAULT_RK4_STEPS,
+            };
+            if let Ok(sol) = solve_statics_at(model, actuation, &fine, s_out) {
+                if sol.stats.converged {
+                    return resolved(model, actuation, &fine, sol, true);
+                }
+            }
+        }
+        return resolved(model, actuation, options, first?, default);
+    }
+    if !default {
         return solve_statics_at(model, actuation, options, s_out);
     }
     let mut quiet = *options;
@@ -152,4 +192,72 @@ pub fn solve_at_output(
     // The branch was settled (and a stable equilibrium sought) on the default mesh.
     fine.seek_stable = false;
     solve_statics_at(model, actuation, &fine, s_out)
+}
+
+/// Estimated tip-position error ([`rk4_position_error`], relative to the length) of a
+/// solution on the default RK4 mesh above which it is solved again on a finer one
+/// ([`resolved`]): a shape the default mesh does not resolve (a curl of two turns or more, a
+/// thin tapered tip curled tight). A 40-step solution of a stress-free arc of `2π` estimates
+/// 1.6e-5.
+pub const DEFAULT_MESH_POSITION_LIMIT: f64 = 1e-4;
+
+/// Estimated tip-position error ([`rk4_position_error`]) of a solution on a chosen RK4 mesh
+/// above which the solve is refused naming `steps`: a tenth of the length, where the shape is
+/// meaningless (steps that turn the rod by two radians or more: RK4's rotations grow).
+pub const CHOSEN_MESH_POSITION_LIMIT: f64 = 0.1;
+
+/// Refinement of the default mesh on which a solve that fails there is tried again.
+const RETRY_REFINEMENT: usize = 8;
+
+/// Target of [`rk4_position_error`] for the finer mesh of [`resolved`].
+const RESOLVED_POSITION_TARGET: f64 = 1e-8;
+
+/// A converged RK4 solution `sol` of `options` checked against its own mesh: on a mesh the
+/// solve chose (`ours`: the default one or its refinement), above
+/// [`DEFAULT_MESH_POSITION_LIMIT`] the problem is solved again (cold) on a mesh `m` times
+/// finer (`m` from the fourth-order convergence toward 1e-8, up to 32 times the default
+/// mesh) and that solution returned, with more nodes; on a chosen mesh, above
+/// [`CHOSEN_MESH_POSITION_LIMIT`] an error naming `steps`. Otherwise (and for the adaptive
+/// integrator or a solution that did not converge) `sol` as it is.
+///
+/// # Errors
+/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as above;
+/// the finer solve's errors.
+fn resolved(
+    model: &std::sync::Arc<crate::model::RobotModel>,
+    actuation: &crate::model::Actuation,
+    options: &crate::cosserat::statics::SolveOptions,
+    sol: StaticsSolution,
+    ours: bool,
+) -> crate::error::Result<StaticsSolution> {
+    let Integrator::Rk4 { steps } = options.integrator else {
+        return Ok(sol);
+    };
+    let error = rk4_position_error(&sol);
+    if !sol.stats.converged || error.is_nan() {
+        return Ok(sol);
+    }
+    let refinement = (error / RESOLVED_POSITION_TARGET).powf(0.25).ceil();
+    let most = MAX_REFINEMENT * DEFAULT_RK4_STEPS;
+    if ours && error > DEFAULT_MESH_POSITION_LIMIT && steps < most {
+        let finer = ((steps as f64 * refinement) as usize).clamp(2 * steps, most);
+        let mut fine = *options;
+        fine.integrator = Integrator::Rk4 { steps: finer };
+        return solve_statics_at(model, actuation, &fine, &[]);
+    }
+    if !ours && error > CHOSEN_MESH_POSITION_LIMIT {
+        return Err(crate::error::Error::invalid(
+            "steps",
+            steps,
+            format!(
+                "enough RK4 steps to resolve the shape: on these the tip's position errs by \
+                 about {error:.2e} of the length (Σ θ⁵/120 (L - s)/L over the steps, θ the \
+                 turn of a step), and the shape is meaningless; about {:.0} steps resolve it \
+                 to 1e-8 (or use the default mesh, which refines itself, or the adaptive \
+                 integrator)",
+                steps as f64 * refinement
+            ),
+        ));
+    }
+    Ok(sol)
 }

@@ -19,6 +19,11 @@ use crate::math::linalg::{Inverse6, Lu6};
 use crate::model::material::hyperelastic::UniaxialLaw;
 use crate::model::section::SectionProperties;
 
+/// Least fibre stretch below which a local iteration that halved its steps to keep the
+/// stretches positive, and failed, is reported as the rod compressed to zero length (a
+/// `ParameterError`); above it, as a failed section solve.
+const ZERO_LENGTH_STRETCH: f64 = 0.01;
+
 /// Most step halvings of the local Newton iteration (keeping every fibre stretch positive).
 const MAX_HALVINGS: usize = 40;
 
@@ -160,8 +165,10 @@ fn check_fibres(
     if converged {
         return Ok(());
     }
-    if hit_zero {
-        let least = stretch.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+    let least = stretch.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+    // A stretch still far from zero where the iteration stopped is no compression to zero
+    // length (the iteration failed at a wild wrench, e.g. a march its mesh cannot follow).
+    if hit_zero && least < ZERO_LENGTH_STRETCH {
         return Err(Error::invalid(
             "stretch",
             format!("{least:.3e}"),

@@ -176,7 +176,8 @@ impl Chamber {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `chambers[i].start` / `chambers[i].end` outside
-/// `[0, L]`, `chambers[i].area(s)` (a function returning a non-positive or non-finite value) or
+/// `[0, L]`, `chambers[i].area(s)` (non-positive, non-finite, or wider than a disk of radius
+/// [`MAX_OFFSET_RATIO`](crate::limits::MAX_OFFSET_RATIO) `L`) or
 /// `chambers[i].offset` for a chamber not inside the section: the disk of area `A_c` at the
 /// offset must fit in the outer radius `sqrt(R(s)² + Σ A_c/π)`, with `R(s)` the section's radius
 /// (its outer radius for circles and tubes, that of the circle of its area for tables and
@@ -212,6 +213,18 @@ pub(crate) fn validate(chambers: &[Chamber], rod: &Rod) -> Result<Vec<(f64, f64)
                     format!("chambers[{i}].area({s})"),
                     area,
                     "finite and > 0 m^2",
+                ));
+            }
+            let widest = std::f64::consts::PI * (crate::limits::MAX_OFFSET_RATIO * l).powi(2);
+            if area > widest {
+                return Err(Error::invalid(
+                    format!("chambers[{i}].area({s})"),
+                    area,
+                    format!(
+                        "<= pi ({} L)^2 = {widest:.4e} m^2 (a chamber wider than the rod is long \
+                         is no slender robot's)",
+                        crate::limits::MAX_OFFSET_RATIO
+                    ),
                 ));
             }
             let props = rod.section_at(s);

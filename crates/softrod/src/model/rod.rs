@@ -236,9 +236,20 @@ impl Rod {
     /// Sets the mass density (kg/m³), used by gravity loads (`rho A(s) g` per unit length).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `density` unless finite and > 0.
+    /// [`Error::InvalidParameter`] naming `density` unless finite, > 0 and at most
+    /// [`MAX_DENSITY`](crate::limits::MAX_DENSITY).
     pub fn with_density(mut self, density: f64) -> Result<Self> {
         check_positive("density", density, "kg/m^3")?;
+        if density > crate::limits::MAX_DENSITY {
+            return Err(Error::invalid(
+                "density",
+                density,
+                format!(
+                    "<= {:e} kg/m^3 (44 times the densest element's)",
+                    crate::limits::MAX_DENSITY
+                ),
+            ));
+        }
         self.density = Some(density);
         Ok(self)
     }

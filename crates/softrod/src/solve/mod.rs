@@ -35,7 +35,7 @@ pub struct NewtonOptions {
 }
 
 impl NewtonOptions {
-    /// Checks the options: a finite `tolerance` >= the machine epsilon, at least one iteration
+    /// Checks the options: a `tolerance` in `[ε, 1)` (ε the machine epsilon), at least one iteration
     /// and one load step, caps at most [`crate::limits::MAX_ITERATIONS`].
     ///
     /// # Errors
@@ -43,11 +43,15 @@ impl NewtonOptions {
     pub fn validate(&self) -> Result<()> {
         // The scaled residual is O(1) at the scale of the loads: below the machine epsilon a
         // tolerance asks for digits a double does not have.
-        if !(self.tolerance.is_finite() && self.tolerance >= f64::EPSILON) {
+        // At 1 or above, a residual as large as the loads would count as converged.
+        if !(self.tolerance.is_finite() && self.tolerance >= f64::EPSILON && self.tolerance < 1.0) {
             return Err(Error::invalid(
                 "tolerance",
                 self.tolerance,
-                format!("finite and >= {:e} (the machine epsilon)", f64::EPSILON),
+                format!(
+                    "in [{:e}, 1): at least the machine epsilon, below the scale of the loads",
+                    f64::EPSILON
+                ),
             ));
         }
         use crate::limits::{check_count, MAX_ITERATIONS};
