@@ -173,8 +173,10 @@ def test_failed_samples_are_recorded_not_dropped():
     assert 0 < int(failed.sum()) < 31
     assert set(ds["error"].values[failed.values]) == {"ConvergenceError"}
     assert np.isnan(ds["tip_position"].values[failed.values]).all()
-    # The same solve alone, without raising, does not panic either.
-    t = float(ds["tendons[0].tension"][failed.values][0])
+    # The same solve alone, without raising, does not panic either. (A sweep solves on the
+    # mesh given; the first failing tension, 2.7 N, converges alone: a failure of the default
+    # mesh is tried again on a finer one. The largest fails on every mesh.)
+    t = float(ds["tendons[0].tension"][failed.values][-1])
     assert not arm.solve(tensions=[t], throw=False).converged
 
 
