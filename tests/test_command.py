@@ -217,7 +217,6 @@ def test_displacement_arguments_are_named():
         robot.solve(tendon_stiffness=1e4)
 
 
-
 def test_held_tendons_that_pull_against_each_other_are_named():
     """Four inextensible tendons 90 degrees apart, all held: their displacements leave the
     tensions [1, -1, 1, -1] free (they move nothing), so the solve names `displacements` and

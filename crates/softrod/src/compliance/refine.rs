@@ -139,12 +139,14 @@ pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
 /// a mesh `m` times finer (warm-started; `m` from the fourth-order convergence, at most 32),
 /// whose steps the returned solution's options record. Other integrators and meshes and a
 /// default solve that fails are [`solve_statics_at`] as they are. Without `s_out`, an RK4
-/// solution whose mesh cannot resolve its shape is refined or refused ([`resolved`]), and a
+/// solution whose mesh cannot resolve its shape is refined or refused (on the default mesh,
+/// above [`DEFAULT_MESH_POSITION_LIMIT`]; on another, above [`CHOSEN_MESH_POSITION_LIMIT`]), and a
 /// solve that fails on the default mesh is tried again on one eight times finer (its
 /// solution, if it converges, is returned; else the default mesh's error).
 ///
 /// # Errors
-/// As [`solve_statics_at`]; [`Error::InvalidParameter`] naming `steps` for a chosen RK4 mesh
+/// As [`solve_statics_at`]; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter)
+/// naming `steps` for a chosen RK4 mesh
 /// whose estimated tip-position error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
 pub fn solve_at_output(
     model: &std::sync::Arc<crate::model::RobotModel>,
@@ -196,7 +198,7 @@ pub fn solve_at_output(
 
 /// Estimated tip-position error ([`rk4_position_error`], relative to the length) of a
 /// solution on the default RK4 mesh above which it is solved again on a finer one
-/// ([`resolved`]): a shape the default mesh does not resolve (a curl of two turns or more, a
+/// ([`solve_at_output`]): a shape the default mesh does not resolve (a curl of two turns or more, a
 /// thin tapered tip curled tight). A 40-step solution of a stress-free arc of `2π` estimates
 /// 1.6e-5.
 pub const DEFAULT_MESH_POSITION_LIMIT: f64 = 1e-4;

@@ -25,7 +25,7 @@
 //! take on tension in the proportions `[1, -1, 1, -1]` without moving the rod or changing their
 //! lengths, and any tendons on a rod that cannot stretch take on equal tensions. The solve
 //! then names `displacements` with the tendons and the pattern (a singular value of the held
-//! problem's Jacobian below [`UNDETERMINED`] of the largest), rather than returning one of the
+//! problem's Jacobian below 1e-8 of the largest), rather than returning one of the
 //! many tensions or failing to converge; a tendon stiffness determines them.
 
 use std::sync::Arc;
