@@ -422,6 +422,18 @@ fn tangent_compliance_of_a_pressurised_hyperelastic_arm_matches_finite_differenc
     assert!(worst < 1e-6, "relative difference {worst:e}");
 }
 
+/// The adaptive integrator at rtol 1e-10, atol 1e-12: the reference of the mesh checks.
+fn tight_adaptive() -> SolveOptions {
+    SolveOptions {
+        integrator: Integrator::Adaptive(softrod::AdaptiveOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..Default::default()
+        }),
+        ..SolveOptions::default()
+    }
+}
+
 /// A tapered Neo-Hookean arm (0.4 m, radius 5.5 mm to 1.3 mm, one chamber at 2.3 MPa) that
 /// curls 3.7 turns, to 660 1/m at its thin tip: the default 40 RK4 steps turn by up to 6.6 rad
 /// a step there, where RK4's rotations are meaningless, and the solve reported a tip 30 L
@@ -451,15 +463,7 @@ fn a_curl_the_default_mesh_cannot_resolve_is_solved_on_a_finer_one() {
     let act = softrod::Actuation::pressures(&[2.3e6]);
     let solve = |o: &SolveOptions| softrod::compliance::solve_at_output(&model, &act, o, &[]);
     let fine = solve(&rk4(640)).unwrap();
-    let adaptive = SolveOptions {
-        integrator: Integrator::Adaptive(softrod::AdaptiveOptions {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..Default::default()
-        }),
-        ..SolveOptions::default()
-    };
-    let reference = solve(&adaptive).unwrap();
+    let reference = solve(&tight_adaptive()).unwrap();
     let tip = |s: &StaticsSolution| Vector3::from(s.tip_position());
     println!("640 steps {:?}, adaptive {:?}", tip(&fine), tip(&reference));
     assert!((tip(&fine) - tip(&reference)).norm() <= 1e-5);
@@ -527,15 +531,7 @@ fn a_pneumatic_curl_the_default_mesh_fails_on_is_solved_on_a_finer_one() {
     let model = softrod::RobotModel::new(rod, Vec::new(), list, loads).unwrap();
     let act = softrod::Actuation::pressures(&chambers.map(|c| c.0));
     let solve = |o: &SolveOptions| softrod::compliance::solve_at_output(&model, &act, o, &[]);
-    let adaptive = SolveOptions {
-        integrator: Integrator::Adaptive(softrod::AdaptiveOptions {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..Default::default()
-        }),
-        ..SolveOptions::default()
-    };
-    let reference = Vector3::from(solve(&adaptive).unwrap().tip_position());
+    let reference = Vector3::from(solve(&tight_adaptive()).unwrap().tip_position());
     let default = solve(&SolveOptions::default()).unwrap();
     let off = (Vector3::from(default.tip_position()) - reference).norm();
     println!(
