@@ -141,8 +141,8 @@ pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
 /// default solve that fails are [`solve_statics_at`] as they are. Without `s_out`, an RK4
 /// solution whose mesh cannot resolve its shape is refined or refused (on the default mesh,
 /// above [`DEFAULT_MESH_POSITION_LIMIT`]; on another, above [`CHOSEN_MESH_POSITION_LIMIT`]), and a
-/// solve that fails on the default mesh is tried again on one eight times finer (its
-/// solution, if it converges, is returned; else the default mesh's error).
+/// solve that does not converge on the default mesh is tried again on one eight times finer
+/// (its solution, if it converges, is returned; else the default mesh's outcome).
 ///
 /// # Errors
 /// As [`solve_statics_at`]; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter)
@@ -158,7 +158,13 @@ pub fn solve_at_output(
         matches!(options.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
     if s_out.is_empty() {
         let first = solve_statics_at(model, actuation, options, s_out);
-        if default && !first.as_ref().is_ok_and(|s| s.stats.converged) {
+        // (Only a solve that did not converge: a named error of the input is the same on any
+        // mesh.)
+        let failed = match &first {
+            Ok(s) => !s.stats.converged,
+            Err(e) => matches!(e, crate::error::Error::NotConverged { .. }),
+        };
+        if default && failed {
             // A shape the default mesh cannot march (a tight curl: its RK4 rotations grow and
             // the iterates go wild) may converge on a finer one.
             let mut fine = *options;
