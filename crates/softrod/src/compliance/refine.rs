@@ -38,16 +38,21 @@ const SAME_BRANCH: f64 = 1e-3;
 /// over its steps of `θ⁵ / 120`, `θ = h max(|u_i|, |u_{i+1}|)` the step's turning angle.
 /// NaN if a curvature is not finite.
 pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
+    step_errors(solution).map(|(_, e)| e).sum()
+}
+
+/// Per step of the RK4 march of `solution`: its start (m) and its rotation error `θ⁵ / 120`
+/// (rad), `θ = h max(|u_i|, |u_{i+1}|)`.
+fn step_errors(solution: &StaticsSolution) -> impl Iterator<Item = (f64, f64)> + '_ {
     let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     solution
         .s
         .windows(2)
         .zip(solution.u.windows(2))
-        .map(|(s, u)| {
+        .map(move |(s, u)| {
             let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1]));
-            theta.powi(5) / 120.0
+            (s[0], theta.powi(5) / 120.0)
         })
-        .sum()
 }
 
 /// Estimated truncation error of the tip position of the RK4 march of `solution`, relative
@@ -56,16 +61,9 @@ pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
 /// thin, tightly curled rod moves little of it; one near the base moves all of it. NaN if a
 /// curvature is not finite.
 pub fn rk4_position_error(solution: &StaticsSolution) -> f64 {
-    let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     let length = solution.model.length();
-    solution
-        .s
-        .windows(2)
-        .zip(solution.u.windows(2))
-        .map(|(s, u)| {
-            let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1]));
-            theta.powi(5) / 120.0 * (length - s[0]) / length
-        })
+    step_errors(solution)
+        .map(|(s, e)| e * (length - s) / length)
         .sum()
 }
 
@@ -248,7 +246,9 @@ fn resolved(
     let refinement = (error / RESOLVED_POSITION_TARGET).powf(0.25).ceil();
     let most = MAX_REFINEMENT * DEFAULT_RK4_STEPS;
     if ours && error > DEFAULT_MESH_POSITION_LIMIT && steps < most {
-        let finer = ((steps as f64 * refinement) as usize).clamp(2 * steps, most);
+        let finer = ((steps as f64 * refinement) as usize)
+            .max(2 * steps)
+            .min(most);
         let mut fine = *options;
         fine.integrator = Integrator::Rk4 { steps: finer };
         return solve_statics_at(model, actuation, &fine, &[]);
