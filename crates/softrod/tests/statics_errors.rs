@@ -493,7 +493,7 @@ fn a_user_routing_whose_derivative_is_not_its_offsets_is_named() {
 /// Absurd values are named as themselves: a density of 1e30 kg/m³ was blamed on
 /// `loads.gravity` (its load number), a chamber area of 1e30 m² on `chambers[0].pressure`, and
 /// a tolerance of 1 or more was accepted (a residual as large as the loads counted as
-/// converged: a tip 20 % of the length off the solve at the default tolerance).
+/// converged: a tip 11 % of the length off the solve at the default tolerance).
 #[test]
 fn an_absurd_density_chamber_area_or_tolerance_is_named_as_itself() {
     assert_eq!(name_of(rod().with_density(1e30)), "density");
