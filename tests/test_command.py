@@ -313,6 +313,75 @@ def test_the_actuation_is_the_minimum_norm_one_of_an_independent_qp():
     np.testing.assert_allclose(inv.tensions, qp.x, rtol=0, atol=1e-8)
 
 
+def _two_segment_silicone(l1, l2, radius, tip_radius, e, phase, tip_force):
+    """A silicone arm (E in Pa, nu 0.5) with three tendons per segment at half the tip radius
+    (the first segment's end at l1), under a tip force (N) or none."""
+    section = (
+        softrod.CircularSection(radius)
+        if tip_radius is None
+        else softrod.TaperedCircularSection(radius, tip_radius)
+    )
+    rod = softrod.Rod(l1 + l2, section, softrod.LinearElastic(e, 0.5))
+    d = 0.5 * (radius if tip_radius is None else 0.5 * radius)
+    angles = phase + np.arange(3) * 2 * np.pi / 3
+    tendons = [
+        softrod.Tendon((d * np.cos(a), d * np.sin(a)), 0.0, end)
+        for end in (l1, None)
+        for a in angles
+    ]
+    loads = None if tip_force is None else softrod.Loads(tip_force=tip_force)
+    return softrod.Robot(rod, tendons=tendons, loads=loads)
+
+
+@pytest.mark.parametrize("bound_active", [False, True], ids=["bound-inactive", "bound-active"])
+def test_a_target_reached_inside_an_upper_bound_is_found(bound_active):
+    """Targets made by tensions inside `tension_bounds=(0, 1.01 max T)` (the witness): the
+    inverse reported them out of reach (1.4e-5 m and 8.5e-7 m short after 60 iterations) when
+    the dual iteration of a linearised program failed from the last multipliers and the
+    program was taken as infeasible; it is run again cold. Oracles: the witness (the target is
+    met within the bounds, with a norm no larger), and with the bound inactive the unbounded
+    inverse's tensions."""
+    if bound_active:
+        robot = _two_segment_silicone(
+            0.1940962194884582,
+            0.2756887687207363,
+            0.017375265981406304,
+            None,
+            2435439.3491865923,
+            2.538608798122681,
+            None,
+        )
+        witness = np.array(
+            [0.0, 36.53285062436377, 2.1727590978488256, 47.693915723990074, 0.0, 48.47055959961735]
+        )
+    else:
+        robot = _two_segment_silicone(
+            0.10165199044139686,
+            0.20320876887443937,
+            0.018708692016577495,
+            0.018600751697570223,
+            3087137.8757673684,
+            5.6602911189269305,
+            (-0.053359530520512476, 0.3908863873881362, 0.1024917636587863),
+        )
+        witness = np.array(
+            [0.0, 99.92929411217524, 166.6044986779066, 0.0, 82.46263232793662, 48.512770598355075]
+        )
+    target = robot.solve(witness).tip_position
+    upper = 1.01 * witness.max()
+    inv = softrod.inverse_statics(robot, target, tension_bounds=(0.0, upper))
+    assert inv.converged and inv.reached
+    assert np.linalg.norm(robot.solve(inv.tensions).tip_position - target) <= 1e-9
+    assert inv.tensions.min() >= 0.0 and inv.tensions.max() <= upper
+    assert np.linalg.norm(inv.tensions) <= np.linalg.norm(witness) + 1e-9
+    free = softrod.inverse_statics(robot, target)
+    if bound_active:
+        assert free.tensions.max() > upper
+        assert inv.tensions.max() == pytest.approx(upper, rel=1e-12)
+    else:
+        np.testing.assert_allclose(inv.tensions, free.tensions, rtol=1e-8, atol=1e-8)
+
+
 def test_a_target_out_of_reach_is_named_with_its_distance():
     robot = _niti()
     with pytest.raises(softrod.TargetUnreachableError) as e:

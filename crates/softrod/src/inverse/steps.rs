@@ -179,7 +179,10 @@ pub(super) fn solve_qp(
     let feasible = if p.shape {
         None
     } else {
+        // The last program's multipliers only speed the dual iteration up: where it fails from
+        // them it is run again cold before the target is declared out of the bounds' reach.
         qp::min_norm_from(jac, b, bounds, p.tol_qp, start)
+            .or_else(|| start.and_then(|_| qp::min_norm_from(jac, b, bounds, p.tol_qp, None)))
     };
     match feasible {
         Some((y_w, l_w)) if curved => curved_qp(p, jac, a, hess, (y_w, l_w)),
