@@ -434,13 +434,13 @@ impl HeldProblem<'_> {
             x0[4] * fm,
             x0[5] * fm,
         ];
-        let mut sol = assemble(p, self.model, base_wrench, st.stats, &[]);
         if settled {
             let at = (&st.x0, &st.tensions[..]);
             if let Some(e) = self.undetermined(p, &st.taut, at, st.stats.load_factor, true) {
                 return Err(e);
             }
         }
+        let mut sol = assemble(p, self.model, base_wrench, st.stats, &[]);
         let mut act = self.actuation.clone();
         act.reference_lengths = Some(self.reference);
         sol.actuation = act;
@@ -483,14 +483,9 @@ impl HeldProblem<'_> {
         z.extend(zero.iter().map(|h| tensions[h.tendon] / f_ref));
         // On the coarse mesh when there is one (a fifth of the cost): a pattern that moves
         // nothing does so on any mesh, and a determined one is far above the threshold.
-        let (integrator, plan) = match self.options.integrator.coarse() {
-            Some(Integrator::Rk4 { steps }) => (
-                Integrator::Rk4 { steps },
-                rk4_plan(self.model.breaks(), steps),
-            ),
-            _ => (p.integrator, p.plan.clone()),
-        };
-        let mut q = Shooting::new(p.eq, integrator, plan);
+        let mut q = p
+            .coarse()
+            .unwrap_or_else(|| Shooting::new(p.eq, p.integrator, p.plan.clone()));
         q.tensions = tensions.to_vec();
         q.held = zero;
         let (mut jac, mut r) = (vec![0.0; dim * dim], vec![0.0; dim]);

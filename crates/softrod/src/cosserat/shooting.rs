@@ -26,7 +26,7 @@ use super::sensitivity::{integrate, scheme_of, Request, Seed};
 use super::stability::{certifies, tip_stability, JacobiCheck, Stability};
 use super::statics::{Integrator, MAX_LOAD_STEP_TURN};
 use crate::error::{Error, Result};
-use crate::integrate::march::{march, Scheme};
+use crate::integrate::march::{march, rk4_plan, Scheme};
 use crate::math::so3::hat;
 use crate::model::loads::Frame;
 use crate::solve::{Evaluated, Problem};
@@ -125,6 +125,17 @@ pub(crate) struct Shooting<'a> {
 }
 
 impl<'a> Shooting<'a> {
+    /// The same equations on the coarse mesh of this problem's integrator
+    /// ([`Integrator::coarse`]); `None` where there is none.
+    pub fn coarse(&self) -> Option<Shooting<'a>> {
+        let coarse = self.integrator.coarse()?;
+        let Integrator::Rk4 { steps } = coarse else {
+            return None;
+        };
+        let plan = rk4_plan(self.eq.model.breaks(), steps);
+        Some(Shooting::new(self.eq, coarse, plan))
+    }
+
     pub fn new(eq: Equations<'a>, integrator: Integrator, plan: Vec<usize>) -> Self {
         Self::with_workspace(
             eq,

@@ -290,14 +290,13 @@ fn coarse_first(
     options: &SolveOptions,
     x0: &[f64; 6],
 ) -> Option<(Reached, Option<Stability>)> {
-    let coarse = options.integrator.coarse()?;
     if !p.held.is_empty() || p.require_stable {
         return None;
     }
-    let Integrator::Rk4 { steps } = coarse else {
+    let mut c = p.coarse()?;
+    let Integrator::Rk4 { steps } = c.integrator else {
         return None;
     };
-    let mut c = Shooting::new(p.eq, coarse, rk4_plan(p.eq.model.breaks(), steps));
     // (No tendon is held here: the tension-free tendons' lengths are not needed.)
     c.passive_lengths = false;
     let defect = options
@@ -375,11 +374,7 @@ fn clearly_stable(c: &Shooting<'_>, j: &[f64], distance: f64) -> Option<Stabilit
 /// the coarse mesh certifies it ([`clearly_stable`]); `None` otherwise (and without a coarse
 /// mesh), when the columns are marched on the mesh asked.
 fn stable_on_coarse(p: &mut Shooting<'_>, x: &[f64]) -> Option<Stability> {
-    let coarse = p.integrator.coarse()?;
-    let Integrator::Rk4 { steps } = coarse else {
-        return None;
-    };
-    let mut c = Shooting::new(p.eq, coarse, rk4_plan(p.eq.model.breaks(), steps));
+    let mut c = p.coarse()?;
     c.passive_lengths = false;
     let (mut j, mut r) = ([0.0; 36], [0.0; 6]);
     let marched = c.evaluate(x, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian;
