@@ -351,3 +351,38 @@ def test_a_sample_whose_arc_length_is_beyond_its_rod_is_failed_not_converged():
     assert list(short["status"]) == [STATUS["failed"]] * 2
     assert all("arc_lengths" in e for e in short["error"])
     assert list(long["status"]) == [0, 0] and np.isfinite(long["backbone_position"]).all()
+
+
+CURLED_ARM = """
+name = "curled"
+[rod]
+length = 0.4
+[rod.section]
+type = "tapered"
+base_radius = 0.0055
+tip_radius = 0.0013
+[rod.material]
+type = "neo_hookean"
+mu = 0.25e6
+[[chambers]]
+pressure = 2.3e6
+area = 1.5205308443374597e-07
+offset = [0.00065, 0.0]
+"""
+
+
+def test_a_curl_the_default_mesh_cannot_resolve_is_swept_on_a_finer_one():
+    # A tapered Neo-Hookean arm curled one to two turns by its chamber, to several hundred
+    # 1/m at its thin tip: the default 40 RK4 steps turn by radians a step there. Swept, each
+    # sample was solved on the default mesh alone and reported converged 2.5e-4 m (2.3 MPa)
+    # to 1.0e-2 m (5 MPa) from the tip; `Robot.solve` refines such a mesh. Oracle: the
+    # adaptive integrator at rtol 1e-10; bound: the default mesh's accuracy, 1e-4 L.
+    robot = softrod.Robot.from_toml(CURLED_ARM)
+    pressures = [2.3e6, 3e6, 4e6, 5e6]
+    ds = softrod.sweep(robot, actuation={"chambers[0].pressure": pressures}, progress=False)
+    for i, p in enumerate(pressures):
+        arm = robot.with_pressures([p])
+        ref = arm.solve(integrator="adaptive", rtol=1e-10, atol=1e-12).tip_position
+        got = ds["tip_position"].values[i]
+        assert int(ds["status"][i]) == STATUS["converged"]
+        assert np.linalg.norm(got - ref) <= 1e-4 * 0.4, (p, got, ref)

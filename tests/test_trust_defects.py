@@ -513,3 +513,27 @@ def test_tangent_compliance_is_the_derivative_of_the_solve_on_a_soft_tapered_rod
     fd = _fd_tip_compliance(rod, tendons, sol, 1e-4 * ei / length**2, 1e-4 * ei / length, steps=80)
     tangent = np.asarray(softrod.tangent_compliance(sol, "tension").world)
     assert block_relative_error(tangent, fd) < 1e-5
+
+
+def test_a_curl_the_default_mesh_cannot_resolve_is_mapped_on_a_finer_one():
+    # A tapered silicone-like arm (0.4 m, radius 8 mm to 3 mm) whose one tendon curls it more
+    # than a turn: the workspace map solved each row on the default 40 RK4 steps alone and
+    # reported tips up to 7e-4 m off (1.7e-3 L) as converged; `Robot.solve` refines such a
+    # mesh. Oracle: the adaptive integrator at rtol 1e-10; bound: the default mesh's accuracy,
+    # 1e-4 L.
+    rod = softrod.Rod(
+        0.4, softrod.TaperedCircularSection(0.008, 0.003), softrod.LinearElastic(1e6, 0.5)
+    )
+    tendons = [softrod.Tendon((0.002, 0.0), 0.0)]
+    tensions = np.array([[1.0], [5.0], [6.0], [7.0]])
+    wmap = softrod.workspace_map(rod, tendons, tensions)
+    for row, tip, ok in zip(tensions, wmap.tip_position, wmap.converged, strict=True):
+        ref = softrod.solve_statics(
+            rod,
+            [tendons[0].with_tension(float(row[0]))],
+            integrator="adaptive",
+            rtol=1e-10,
+            atol=1e-12,
+        )
+        assert ok
+        assert np.linalg.norm(tip - ref.tip_position) <= 1e-4 * 0.4, (row, tip)

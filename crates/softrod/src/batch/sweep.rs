@@ -6,7 +6,9 @@
 //! [`SweepRequest`] asks for: the tip pose, tendon path lengths, and at chosen arc lengths the
 //! backbone pose, the integrated compliance and stiffness (world frame), `γ_c`, the
 //! eigenstiffnesses and the principal translational compliances ([`super::arc`] gives the
-//! values between mesh nodes). The convergence of every sample is recorded; a sample that
+//! values between mesh nodes). Every sample is solved under the mesh control of
+//! [`solve_at_output`] (a default mesh too coarse for the shape is refined, a chosen one too
+//! coarse fails the sample naming `steps`). The convergence of every sample is recorded; a sample that
 //! fails is reported with its status and error, never dropped.
 //!
 //! # Determinism: the warm-start rule
@@ -24,10 +26,10 @@ use nalgebra::{Matrix6, Vector3};
 use rayon::prelude::*;
 
 use super::arc::{pose_at, ComplianceAt};
-use crate::compliance::compliance;
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::compliance::gamma_c;
-use crate::cosserat::statics::{solve_statics, SolveOptions, StaticsSolution};
+use crate::compliance::{compliance, solve_at_output};
+use crate::cosserat::statics::{SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_spd;
 use crate::model::chamber::check_pressure;
@@ -351,8 +353,8 @@ fn solve_block(
             warm_start: warm.take(),
             ..quiet
         };
-        let result =
-            sample_problem(job, i).and_then(|(model, act)| solve_statics(&model, &act, &opts));
+        let result = sample_problem(job, i)
+            .and_then(|(model, act)| solve_at_output(&model, &act, &opts, &[]));
         let sample = match result {
             Ok(sol) if sol.stats.converged => {
                 warm = Some(sol.warm_start());

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
-use crate::compliance::{tangent_compliance, tip_compliance_world, TendonControl};
+use crate::compliance::{solve_at_output, tangent_compliance, tip_compliance_world, TendonControl};
 use crate::cosserat::statics::{solve_statics, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_spd;
@@ -57,7 +57,9 @@ impl WorkspaceSample {
 
 /// Solves `model` for every row of `tensions` (row-major, `n_samples × n_tendons`, N), with
 /// the chamber pressures of `base` (Pa) in every sample, and measures the tip compliance.
-/// `chunk` samples (>= 1) are solved in order per thread with warm starts. With `tangent`, the
+/// `chunk` samples (>= 1) are solved in order per thread with warm starts, each under the mesh
+/// control of [`solve_at_output`] (a default mesh too coarse for the shape is refined; a
+/// chosen one too coarse is a failed sample). With `tangent`, the
 /// exact tangent tip compliance (tendons at fixed tension or length) is computed too.
 /// Non-converged samples are reported with `converged == false`.
 ///
@@ -112,7 +114,7 @@ pub fn workspace_map(
                     warm_start: warm,
                     ..quiet
                 };
-                let sample = match solve_statics(model, &actuation(row), &opts) {
+                let sample = match solve_at_output(model, &actuation(row), &opts, &[]) {
                     Ok(sol) if sol.stats.converged => {
                         warm = Some(sol.warm_start());
                         let mut m = measure(&sol);
