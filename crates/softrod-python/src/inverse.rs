@@ -256,9 +256,7 @@ pub(crate) fn _inverse_statics<'py>(
             let stability = at_answer.map(|s| (s.solution.stable, s.solution.stability_margin()));
             return Ok((inv, stability));
         }
-        let mut fwd = softrod::CosseratForward::new(model, &solve, target.s.as_deref())
-            .map_err(actuator_names)?;
-        softrod::solve_inverse(&mut fwd, &target, &o, warm.as_deref())
+        softrod::inverse_actuation(model, &target, &o, &solve, warm.as_deref())
             .map(|inv| (inv, None))
             .map_err(actuator_names)
     })?;

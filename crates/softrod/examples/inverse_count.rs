@@ -2,7 +2,8 @@
 //! two-segment NiTi tendon robot (default RK4 options), cold from zero tensions (mode 0), warm
 //! from the solution at a target 1 mm away (mode 1), or N forward evaluations with the
 //! actuation Jacobian (mode 2) or N probes (the tip pose alone, mode 5), or N times the ten 1 mm steps of a
-//! tracked path (mode 6); the PCC inverse of the same robot (two arcs) cold (mode 3)
+//! tracked path (mode 6), a call as Python makes it without and with the check of the answer's
+//! mesh (modes 7 and 8 cold, 9 and 10 warm); the PCC inverse of the same robot (two arcs) cold (mode 3)
 //! and warm, target moved 1 mm (mode 4). Prints the iterations and evaluations of each case
 //! on stderr.
 //!
@@ -19,8 +20,8 @@ use softrod::nalgebra::Vector3;
 use softrod::pcc::statics::{solve_pcc_statics, PccLoads, PccRobot, PccSolveOptions};
 use softrod::pcc::{ElasticSegment, PccTendons};
 use softrod::{
-    pcc_inverse_statics, solve_inverse, CosseratForward, Forward, InverseOptions, InverseWarmStart,
-    Loads, RobotModel, SolveOptions, Target,
+    inverse_actuation, pcc_inverse_statics, solve_inverse, CosseratForward, Forward,
+    InverseOptions, InverseWarmStart, Loads, RobotModel, SolveOptions, Target,
 };
 
 fn niti() -> Arc<RobotModel> {
@@ -53,6 +54,29 @@ fn track(
         w = InverseWarmStart::from(&solve_inverse(fwd, &p, io, Some(&w)).unwrap());
     }
     w.actuation[0]
+}
+
+/// A call as Python makes it: a fresh forward model and the inverse alone (mode 7 cold at
+/// `targets.0`, 9 warm from `w` at `targets.1`), or `inverse_actuation`, the inverse with the
+/// check of the answer's mesh (8 cold, 10 warm).
+fn python_call(
+    mode: usize,
+    model: &Arc<RobotModel>,
+    targets: (&Target, &Target),
+    io: &InverseOptions,
+    o: &SolveOptions,
+    w: &InverseWarmStart,
+) -> f64 {
+    let (t, warm) = if mode <= 8 {
+        (targets.0, None)
+    } else {
+        (targets.1, Some(w))
+    };
+    if mode == 7 || mode == 9 {
+        let mut fresh = CosseratForward::new(model, o, None).unwrap();
+        return solve_inverse(&mut fresh, t, io, warm).unwrap().actuation[0];
+    }
+    inverse_actuation(model, t, io, o, warm).unwrap().actuation[0]
 }
 
 fn main() {
@@ -147,6 +171,7 @@ fn main() {
             }
             5 => fwd.probe(&t).unwrap().positions[0].x,
             6 => track(&mut fwd, tip, &io, &w),
+            7..=10 => python_call(mode, &model, (&target, &moved), &io, &o, &w),
             _ => fwd.evaluate(&t, true).unwrap().positions[0].x,
         };
     }

@@ -71,8 +71,8 @@ pub use error::{Error, Result};
 pub use integrate::{AdaptiveOptions, IntegrationStats};
 pub use inverse::pcc::{pcc_inverse_statics, PccForward};
 pub use inverse::{
-    inverse_statics, inverse_statics_path, solve_inverse, CosseratForward, Evaluation, Forward,
-    InverseOptions, InverseSolution, InverseWarmStart, Target,
+    inverse_actuation, inverse_statics, inverse_statics_path, solve_inverse, CosseratForward,
+    Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target,
 };
 pub use model::actuation::TensionProfile;
 pub use model::chamber::{Chamber, ChamberArea};

@@ -218,17 +218,13 @@ const RETRY_REFINEMENT: usize = 8;
 /// Target of [`rk4_position_error`] for the finer mesh of [`resolved`].
 const RESOLVED_POSITION_TARGET: f64 = 1e-8;
 
-/// A converged RK4 solution `sol` of `options` checked against its own mesh: on a mesh the
-/// solve chose (`ours`: the default one or its refinement), above
-/// [`DEFAULT_MESH_POSITION_LIMIT`] the problem is solved again (cold) on a mesh `m` times
-/// finer (`m` from the fourth-order convergence toward 1e-8, up to 32 times the default
-/// mesh) and that solution returned, with more nodes; on a chosen mesh, above
-/// [`CHOSEN_MESH_POSITION_LIMIT`] an error naming `steps`. Otherwise (and for the adaptive
-/// integrator or a solution that did not converge) `sol` as it is.
+/// A converged RK4 solution `sol` of `options` checked against its own mesh
+/// ([`finer_steps`]): solved again (cold) on the finer mesh that returns, else `sol` as it is
+/// (also for the adaptive integrator or a solution that did not converge).
 ///
 /// # Errors
-/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as above;
-/// the finer solve's errors.
+/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as in
+/// [`finer_steps`]; the finer solve's errors.
 fn resolved(
     model: &std::sync::Arc<crate::model::RobotModel>,
     actuation: &crate::model::Actuation,
@@ -236,12 +232,47 @@ fn resolved(
     sol: StaticsSolution,
     ours: bool,
 ) -> crate::error::Result<StaticsSolution> {
-    let Integrator::Rk4 { steps } = options.integrator else {
-        return Ok(sol);
-    };
-    let error = rk4_position_error(&sol);
-    if !sol.stats.converged || error.is_nan() {
-        return Ok(sol);
+    match finer_steps(&sol, ours)? {
+        Some(steps) => {
+            let mut fine = *options;
+            fine.integrator = Integrator::Rk4 { steps };
+            solve_statics_at(model, actuation, &fine, &[])
+        }
+        None => Ok(sol),
+    }
+}
+
+/// The RK4 steps on which the problem of the converged `sol` must be solved again for its
+/// mesh to resolve its shape ([`mesh_verdict`] of its [`rk4_position_error`]), `None` if it
+/// does (or `sol` is adaptive or did not converge).
+///
+/// # Errors
+/// As [`mesh_verdict`].
+fn finer_steps(sol: &StaticsSolution, ours: bool) -> crate::error::Result<Option<usize>> {
+    match sol.options.integrator {
+        Integrator::Rk4 { steps } if sol.stats.converged => {
+            mesh_verdict(rk4_position_error(sol), steps, ours)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// The RK4 steps on which a problem solved on `steps` with the estimated tip error `error`
+/// ([`rk4_position_error`], relative to the length) must be solved again, `None` if the mesh
+/// resolves the shape (or `error` is NaN). On a mesh the solve chose (`ours`: the default
+/// one or its refinement), above [`DEFAULT_MESH_POSITION_LIMIT`]: a mesh `m` times finer (`m`
+/// from the fourth-order convergence toward 1e-8, at least 2, up to 32 times the default
+/// mesh); on a chosen mesh, above [`CHOSEN_MESH_POSITION_LIMIT`], an error naming `steps`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as above.
+pub(crate) fn mesh_verdict(
+    error: f64,
+    steps: usize,
+    ours: bool,
+) -> crate::error::Result<Option<usize>> {
+    if error.is_nan() {
+        return Ok(None);
     }
     let refinement = (error / RESOLVED_POSITION_TARGET).powf(0.25).ceil();
     let most = MAX_REFINEMENT * DEFAULT_RK4_STEPS;
@@ -249,9 +280,7 @@ fn resolved(
         let finer = ((steps as f64 * refinement) as usize)
             .max(2 * steps)
             .min(most);
-        let mut fine = *options;
-        fine.integrator = Integrator::Rk4 { steps: finer };
-        return solve_statics_at(model, actuation, &fine, &[]);
+        return Ok(Some(finer));
     }
     if !ours && error > CHOSEN_MESH_POSITION_LIMIT {
         return Err(crate::error::Error::invalid(
@@ -267,5 +296,5 @@ fn resolved(
             ),
         ));
     }
-    Ok(sol)
+    Ok(None)
 }

@@ -8,12 +8,16 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
 use super::{uniform, InverseWarmStart, Target};
+use crate::compliance::refine::{mesh_verdict, rk4_position_error};
 use crate::cosserat::equations::{Column, Equations, Workspace};
 use crate::cosserat::sensitivity::{
     actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
 };
 use crate::cosserat::shooting::{Node, Shooting};
-use crate::cosserat::statics::{assemble, solve_statics, SolveOptions, StaticsSolution, WarmStart};
+use crate::cosserat::statics::{
+    assemble, solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart,
+    DEFAULT_RK4_STEPS,
+};
 use crate::error::{Error, Result};
 use crate::model::loads::{Frame, PointLoad};
 use crate::model::{Actuation, RobotModel};
@@ -151,6 +155,38 @@ impl CosseratForward {
             ..self.options
         };
         solve_statics(&self.model, &self.actuation(a), &opts)
+    }
+}
+
+impl CosseratForward {
+    /// The estimated tip error of the RK4 mesh at the actuation `a`, relative to the length
+    /// ([`rk4_position_error`](crate::compliance::rk4_position_error)): from the last solution
+    /// or the closed form of a uniform unloaded robot when they apply, else from the solution
+    /// at `a`; NaN for the adaptive integrator.
+    ///
+    /// # Errors
+    /// As [`CosseratForward::solve`].
+    pub fn mesh_error(&mut self, a: &[f64]) -> Result<f64> {
+        if !matches!(self.options.integrator, Integrator::Rk4 { .. }) {
+            return Ok(f64::NAN);
+        }
+        let (nt, _) = self.dims();
+        let at_a = |s: &&StaticsSolution| s.tensions() == a[..nt] && s.pressures() == a[nt..];
+        if let Some(sol) = self.solution.as_ref().filter(at_a) {
+            return Ok(rk4_position_error(sol));
+        }
+        if self.uniform && a.len() == nt {
+            let closed = uniform::position_error(
+                &self.model,
+                &self.options.integrator,
+                a,
+                &mut self.uniform_ws,
+            );
+            if let Some(e) = closed {
+                return Ok(e);
+            }
+        }
+        Ok(rk4_position_error(&self.solve(a)?))
     }
 }
 
@@ -349,12 +385,84 @@ impl Forward for CosseratForward {
     }
 }
 
-/// The inverse statics of a Cosserat robot `model` (solved with `options`) for `target`
-/// (see the module documentation); returns the result and the statics solution at the
-/// actuation found.
+/// The inverse statics of a Cosserat robot `model` (solved with `solve`) for `target` (see
+/// the module documentation), under the mesh control of a forward solve
+/// ([`solve_at_output`](crate::compliance::solve_at_output)): on the default RK4 mesh, an
+/// answer whose estimated tip error ([`CosseratForward::mesh_error`]) exceeds
+/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::compliance::DEFAULT_MESH_POSITION_LIMIT) makes the
+/// inverse run again on a finer mesh from the answer (its actuation and Hessian), and that
+/// result is returned; on a chosen mesh, one above
+/// [`CHOSEN_MESH_POSITION_LIMIT`](crate::compliance::CHOSEN_MESH_POSITION_LIMIT) is an error
+/// naming `steps`. [`inverse_statics`] also returns the solution at the answer.
 ///
 /// # Errors
-/// As [`solve_inverse`]; the forward solve's errors.
+/// As [`solve_inverse`]; the forward solve's errors; `steps` as above.
+pub fn inverse_actuation(
+    model: &Arc<RobotModel>,
+    target: &Target,
+    options: &InverseOptions,
+    solve: &SolveOptions,
+    warm: Option<&InverseWarmStart>,
+) -> Result<InverseSolution> {
+    inverse_resolved(model, target, options, solve, warm).map(|(out, _)| out)
+}
+
+/// [`inverse_actuation`] and the forward model on the mesh of its answer.
+fn inverse_resolved(
+    model: &Arc<RobotModel>,
+    target: &Target,
+    options: &InverseOptions,
+    solve: &SolveOptions,
+    warm: Option<&InverseWarmStart>,
+) -> Result<(InverseSolution, CosseratForward)> {
+    let mut fwd = CosseratForward::new(model, solve, target.s.as_deref())?;
+    let first = solve_inverse(&mut fwd, target, options, warm);
+    let Integrator::Rk4 { steps } = solve.integrator else {
+        return first.map(|out| (out, fwd));
+    };
+    // A target missed on a mesh too coarse for the shape may be the mesh's verdict: the mesh
+    // is judged where the iteration stopped (found again without the error).
+    let (out, mut fwd, missed) = match first {
+        Ok(out) => (out, fwd, None),
+        Err(e @ (Error::TargetUnreachable { .. } | Error::NotConverged { .. })) => {
+            let quiet = InverseOptions {
+                throw: false,
+                ..options.clone()
+            };
+            let mut again = CosseratForward::new(model, solve, target.s.as_deref())?;
+            match solve_inverse(&mut again, target, &quiet, warm) {
+                Ok(last) => (last, again, Some(e)),
+                Err(_) => return Err(e),
+            }
+        }
+        Err(e) => return Err(e),
+    };
+    let error = fwd.mesh_error(&out.actuation).unwrap_or(f64::NAN);
+    let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
+        return match missed {
+            Some(e) => Err(e),
+            None => Ok((out, fwd)),
+        };
+    };
+    let fine = SolveOptions {
+        integrator: Integrator::Rk4 { steps: finer },
+        ..*solve
+    };
+    // (The answer's evaluation is of the coarser mesh: the finer one evaluates it again.)
+    let from = InverseWarmStart {
+        evaluation: None,
+        ..InverseWarmStart::from(&out)
+    };
+    let mut fwd = CosseratForward::new(model, &fine, target.s.as_deref())?;
+    let out = solve_inverse(&mut fwd, target, options, Some(&from))?;
+    Ok((out, fwd))
+}
+
+/// [`inverse_actuation`] and the statics solution at the actuation found (on the mesh of the
+/// answer); the position error is that of the solution's tip for a tip target.
+///
+/// # Errors
+/// As [`inverse_actuation`].
 pub fn inverse_statics(
     model: &Arc<RobotModel>,
     target: &Target,
@@ -362,8 +470,7 @@ pub fn inverse_statics(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, StaticsSolution)> {
-    let mut fwd = CosseratForward::new(model, solve, target.s.as_deref())?;
-    let mut out = solve_inverse(&mut fwd, target, options, warm)?;
+    let (mut out, mut fwd) = inverse_resolved(model, target, options, solve, warm)?;
     let sol = match fwd.solution.take() {
         Some(s) if s.tensions() == out.tensions() && s.pressures() == out.pressures() => s,
         _ => fwd.solve(&out.actuation)?,

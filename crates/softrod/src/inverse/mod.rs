@@ -87,7 +87,7 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use crate::error::Result;
 
-pub use cosserat::{inverse_statics, CosseratForward};
+pub use cosserat::{inverse_actuation, inverse_statics, CosseratForward};
 pub(crate) use problem::{check_options, check_target};
 pub use sqp::{inverse_statics_path, solve_inverse};
 pub(crate) use steps::{objective_change, trust_radius};

@@ -163,6 +163,40 @@ fn interval(
     })
 }
 
+/// The estimated tip error of the RK4 march of the unloaded `model` at the tensions `a` (N)
+/// on `integrator` ([`applies`]), relative to the length: on each interval the strains are
+/// those of every stage, so [`rk4_position_error`](crate::compliance::rk4_position_error)'s
+/// sum `Σ θ⁵/120 (L - s)/L` over its `n` steps from `s₀` with `θ = h |u|` is
+/// `θ⁵/120 (n (L - s₀) - h n (n - 1)/2)/L`. `None` if a local solve fails.
+pub(super) fn position_error(
+    model: &RobotModel,
+    integrator: &Integrator,
+    a: &[f64],
+    ws: &mut Workspace,
+) -> Option<f64> {
+    let Integrator::Rk4 { steps } = *integrator else {
+        return None;
+    };
+    let plan = rk4_plan(model.breaks(), steps);
+    let eq = Equations::new(model, a, &[]);
+    ws.renew(model.tendons().len());
+    let mut ev = Evaluator { eq, ws };
+    let (breaks, length) = (model.breaks(), model.length());
+    let zero = Vector3::zeros();
+    let mut error = 0.0;
+    for (k, &n) in plan.iter().enumerate() {
+        let lo = breaks[k];
+        ev.set_interval(k);
+        let props = model.rod().section_at(lo);
+        let u = ev.local(lo, &props, &zero, &zero, false).u;
+        let h = (breaks[k + 1] - lo) / n.max(1) as f64;
+        let n = n as f64;
+        error +=
+            (h * u.norm()).powi(5) / 120.0 * (n * (length - lo) - h * n * (n - 1.0) / 2.0) / length;
+    }
+    error.is_finite().then_some(error)
+}
+
 /// The tip pose of the unloaded `model` at the tensions `a` (N) marched with `integrator`
 /// (RK4, [`applies`]), and if `jacobian` its actuation Jacobian (6 × n_tendons, `[δp; δθ]`,
 /// world). `None` if a local solve fails (the march reports why).
