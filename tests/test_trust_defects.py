@@ -537,3 +537,54 @@ def test_a_curl_the_default_mesh_cannot_resolve_is_mapped_on_a_finer_one():
         )
         assert ok
         assert np.linalg.norm(tip - ref.tip_position) <= 1e-4 * 0.4, (row, tip)
+
+
+def _curled_rod():
+    return softrod.Rod(
+        0.4, softrod.TaperedCircularSection(0.008, 0.003), softrod.LinearElastic(1e6, 0.5)
+    )
+
+
+_ADAPTIVE = {"integrator": "adaptive", "rtol": 1e-10, "atol": 1e-12}
+
+
+def test_a_curl_the_default_mesh_cannot_resolve_is_solved_on_a_finer_one_with_obstacles():
+    # The tapered arm above, curled by 7 N: with an obstacle the solve went through the
+    # contact path on the default 40 RK4 steps alone, 0.7 mm (1.8e-3 L) from the tip, with the
+    # obstacle far away or touched. Oracles: the adaptive integrator without contact (a plane
+    # 1 m away), and a chosen fine mesh (1,280 steps; 640 agree with it to 2.5e-8 m) against a
+    # plane the arm presses on. Bound: the default mesh's accuracy, 1e-4 L.
+    tendons = [softrod.Tendon((0.002, 0.0), 7.0)]
+    far = softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))
+    near = softrod.Plane((0.12, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    free = softrod.Robot(_curled_rod(), tendons=tendons, name="curl")
+    ref = free.solve(**_ADAPTIVE).tip_position
+    away = softrod.Robot(_curled_rod(), tendons=tendons, name="curl", obstacles=[far])
+    assert np.linalg.norm(away.solve().tip_position - ref) <= 1e-4 * 0.4
+    pressed = softrod.Robot(_curled_rod(), tendons=tendons, name="curl", obstacles=[near])
+    fine, finer = (pressed.solve(steps=n) for n in (640, 1280))
+    assert len(finer.contacts) == 1 and finer.contacts[0]["normal_force"] > 0.01
+    assert np.linalg.norm(fine.tip_position - finer.tip_position) <= 1e-7
+    got = pressed.solve()
+    assert len(got.contacts) == 1
+    assert np.linalg.norm(got.tip_position - finer.tip_position) <= 1e-4 * 0.4
+
+
+def test_a_curl_the_default_mesh_cannot_resolve_is_solved_on_a_finer_one_with_friction():
+    # The same arm with tendon friction (mu 0.05), pulled to 6 N from rest, then to 7 N from
+    # that state: the frictional solve ran on the default 40 RK4 steps alone, 9.4e-5 m and
+    # 1.3e-4 m from the adaptive integrator's tip; the history's state now sets the mesh of
+    # the next solve. Oracle: the same two solves with the adaptive integrator. Bound: 1e-4 L.
+    def robot(tension):
+        tendon = softrod.Tendon((0.002, 0.0), tension, friction=0.05)
+        return softrod.Robot(_curled_rod(), tendons=[tendon], name="curl")
+
+    first, first_ref = robot(6.0).solve(), robot(6.0).solve(**_ADAPTIVE)
+    then = robot(7.0).solve(previous=first)
+    then_ref = robot(7.0).solve(previous=first_ref, **_ADAPTIVE)
+    for got, ref in ((first, first_ref), (then, then_ref)):
+        assert np.linalg.norm(got.tip_position - ref.tip_position) <= 1e-4 * 0.4
+    # A history on the default mesh cannot carry this shape: named, not solved on that mesh.
+    with pytest.raises(softrod.ParameterError) as info:
+        robot(7.0).solve(previous=robot(1.0).solve())
+    assert info.value.parameter == "previous"

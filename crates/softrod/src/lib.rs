@@ -56,8 +56,9 @@ pub use contact::{
 };
 pub use cosserat::displacement::reference_lengths;
 pub use cosserat::friction::{
-    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideMethod,
-    GuideState, Slip, GUIDE_FIXED_POINT_BUDGET, GUIDE_FORCE_TOLERANCE,
+    friction_mesh, solve_frictional, solve_frictional_checked, solve_path, FrictionOptions,
+    FrictionalSolution, GuideMethod, GuideState, Slip, GUIDE_FIXED_POINT_BUDGET,
+    GUIDE_FORCE_TOLERANCE,
 };
 pub use cosserat::friction_linear::{frictional_tip_compliance, Direction};
 pub use cosserat::sensitivity::{

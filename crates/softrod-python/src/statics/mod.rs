@@ -340,7 +340,8 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
             ..Default::default()
         };
         let f = run(py, "solve_statics", || {
-            softrod::solve_frictional(&model, act, &fo, prev_state.as_deref()).map_err(rename)
+            softrod::solve_frictional_checked(&model, act, &fo, prev_state.as_deref())
+                .map_err(rename)
         })?;
         (
             f.statics.clone(),
@@ -350,9 +351,14 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
     } else {
         let (r, c) = run(py, "solve_statics", || {
             if constrained {
-                let c =
-                    softrod::solve_constrained(&model, act, &options, tip.as_ref(), &obstacle_list)
-                        .map_err(rename)?;
+                let default = options.integrator == softrod::SolveOptions::default().integrator;
+                let c = softrod::compliance::with_mesh_control(
+                    &options,
+                    default,
+                    |o| softrod::solve_constrained(&model, act, o, tip.as_ref(), &obstacle_list),
+                    |c| &c.solution,
+                )
+                .map_err(rename)?;
                 let data = crate::contact::ContactData::from_solution(&c);
                 Ok((c.solution, data))
             } else {

@@ -10,8 +10,9 @@ mod tangent;
 pub use controlled::{COMPLIANCE_ATOL, COMPLIANCE_RTOL};
 pub use integrated::*;
 pub use refine::{
-    rk4_position_error, rk4_rotation_error, solve_at_output, CHOSEN_MESH_POSITION_LIMIT,
-    DEFAULT_MESH_POSITION_LIMIT, MESH_ROTATION_TARGET, OUTPUT_ROTATION_TARGET,
+    rk4_position_error, rk4_rotation_error, solve_at_output, with_mesh_control,
+    CHOSEN_MESH_POSITION_LIMIT, DEFAULT_MESH_POSITION_LIMIT, MESH_ROTATION_TARGET,
+    OUTPUT_ROTATION_TARGET,
 };
 pub use tangent::{
     frictional_tangent_compliance, tangent_compliance, tangent_compliance_held, TangentCompliance,

@@ -257,6 +257,39 @@ fn finer_steps(sol: &StaticsSolution, ours: bool) -> crate::error::Result<Option
     }
 }
 
+/// `solve` on the mesh of `options` under the mesh control of [`solve_at_output`], for the
+/// solves that hold a statics solution (`statics` of the result: a contact or a frictional
+/// solution): when the converged solution's mesh does not resolve its shape
+/// ([`mesh_verdict`]; `ours`: the mesh is the default one or the solve's refinement of it,
+/// else chosen), `solve` is called again on the finer mesh, whose result returns.
+///
+/// # Errors
+/// `solve`'s; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming
+/// `steps` for a chosen mesh whose estimated tip error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
+pub fn with_mesh_control<T>(
+    options: &crate::cosserat::statics::SolveOptions,
+    ours: bool,
+    mut solve: impl FnMut(&crate::cosserat::statics::SolveOptions) -> crate::error::Result<T>,
+    statics: impl Fn(&T) -> &StaticsSolution,
+) -> crate::error::Result<T> {
+    let first = solve(options)?;
+    let Integrator::Rk4 { steps } = options.integrator else {
+        return Ok(first);
+    };
+    let sol = statics(&first);
+    if !sol.stats.converged {
+        return Ok(first);
+    }
+    match mesh_verdict(rk4_position_error(sol), steps, ours)? {
+        Some(finer) => {
+            let mut fine = *options;
+            fine.integrator = Integrator::Rk4 { steps: finer };
+            solve(&fine)
+        }
+        None => Ok(first),
+    }
+}
+
 /// The RK4 steps on which a problem solved on `steps` with the estimated tip error `error`
 /// ([`rk4_position_error`], relative to the length) must be solved again, `None` if the mesh
 /// resolves the shape (or `error` is NaN). On a mesh the solve chose (`ours`: the default

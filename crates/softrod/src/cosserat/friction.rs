@@ -46,6 +46,7 @@ pub use super::guides::{GuideMethod, GuideState, GUIDE_FIXED_POINT_BUDGET, GUIDE
 use crate::cosserat::equations::{Equations, Evaluator, Workspace, STATE};
 use crate::cosserat::statics::{
     interior, scaled, solve_statics_at, Integrator, SolveOptions, StaticsSolution,
+    DEFAULT_RK4_STEPS,
 };
 use crate::error::{Error, Result};
 use crate::integrate::march::{march, Scheme};
@@ -420,6 +421,55 @@ fn previous_profile<'p>(
         ));
     }
     Ok(Some(p.tension.as_slice()))
+}
+
+/// [`solve_frictional`] under the mesh control of a forward solve
+/// ([`with_mesh_control`](crate::compliance::with_mesh_control)): on the default RK4 mesh, a
+/// shape it does not resolve is solved again on a finer one (from rest, as asked); a `previous`
+/// state on a finer RK4 mesh (one this control chose) sets the mesh, since the history of
+/// stick and slip lives on it.
+///
+/// # Errors
+/// As [`solve_frictional`]; [`Error::InvalidParameter`] naming `steps` for a chosen mesh that
+/// cannot resolve the shape, or `previous` when the shape needs a mesh finer than the one its
+/// history is on.
+pub fn solve_frictional_checked(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &FrictionOptions,
+    previous: Option<&FrictionalSolution>,
+) -> Result<FrictionalSolution> {
+    let default = matches!(options.statics.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
+    let mut statics = options.statics;
+    if let Some(Integrator::Rk4 { steps }) = previous.map(|p| p.statics.options.integrator) {
+        if default && steps > DEFAULT_RK4_STEPS {
+            statics.integrator = Integrator::Rk4 { steps };
+        }
+    }
+    let on = statics.integrator;
+    crate::compliance::with_mesh_control(
+        &statics,
+        default,
+        |o| {
+            if o.integrator != on && previous.is_some() {
+                return Err(Error::invalid(
+                    "previous",
+                    format!("a state on {on:?}"),
+                    format!(
+                        "a state on a mesh that resolves this shape ({:?}: solve the history \
+                         on it with steps=, or start from rest)",
+                        o.integrator
+                    ),
+                ));
+            }
+            let fo = FrictionOptions {
+                statics: *o,
+                ..*options
+            };
+            solve_frictional(model, actuation, &fo, previous)
+        },
+        |f| &f.statics,
+    )
 }
 
 /// Solves the statics of `model` under `actuation` with capstan friction along the tendons

@@ -25,8 +25,9 @@ pub mod statics;
 pub use displacement::reference_lengths;
 pub use equations::{LOCAL_MAX_ITERATIONS, LOCAL_TOLERANCE};
 pub use friction::{
-    friction_mesh, solve_frictional, solve_path, FrictionOptions, FrictionalSolution, GuideMethod,
-    GuideState, Slip, GUIDE_FIXED_POINT_BUDGET, GUIDE_FORCE_TOLERANCE,
+    friction_mesh, solve_frictional, solve_frictional_checked, solve_path, FrictionOptions,
+    FrictionalSolution, GuideMethod, GuideState, Slip, GUIDE_FIXED_POINT_BUDGET,
+    GUIDE_FORCE_TOLERANCE,
 };
 pub use friction_linear::{frictional_tip_compliance, Direction};
 pub use sensitivity::{
