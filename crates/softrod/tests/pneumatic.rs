@@ -549,4 +549,22 @@ fn a_pneumatic_curl_the_default_mesh_fails_on_is_solved_on_a_finer_one() {
         Err(Error::NotConverged { .. }) => {}
         other => panic!("41 chosen steps: {:?}", other.map(|s| s.tip_position())),
     }
+    // Asked at chosen arc lengths, the solve that fails on the default mesh is tried on the
+    // finer one too (it raised the default mesh's `ConvergenceError`), refined toward the
+    // output target up to the largest mesh (32 times the default, as above), and the values
+    // there are the adaptive integrator's at the same arc lengths, within the estimate.
+    let s_out = [0.03, 0.0611, 0.1223];
+    let at = softrod::compliance::solve_at_output(&model, &act, &SolveOptions::default(), &s_out)
+        .unwrap();
+    let reference =
+        softrod::compliance::solve_at_output(&model, &act, &tight_adaptive(), &s_out).unwrap();
+    assert!(at.stats.converged && at.s == s_out.to_vec());
+    assert_eq!(at.options.integrator, default.options.integrator);
+    for (p, q) in at.position.iter().zip(&reference.position) {
+        let off = (Vector3::from(*p) - Vector3::from(*q)).norm();
+        assert!(
+            off <= estimate * 0.1223,
+            "{off:e} m at the chosen arc lengths, estimated {estimate:e} L"
+        );
+    }
 }

@@ -135,8 +135,9 @@ pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
 /// mesh: the problem is solved on the default mesh, its rotational truncation error estimated
 /// ([`rk4_rotation_error`]) and, above [`OUTPUT_ROTATION_TARGET`], solved again with `s_out` on
 /// a mesh `m` times finer (warm-started; `m` from the fourth-order convergence, at most 32),
-/// whose steps the returned solution's options record. Other integrators and meshes and a
-/// default solve that fails are [`solve_statics_at`] as they are. Without `s_out`, an RK4
+/// whose steps the returned solution's options record; a default solve that does not
+/// converge is tried on a mesh eight times finer, and refined from there the same way. Other
+/// integrators and meshes are [`solve_statics_at`] as they are. Without `s_out`, an RK4
 /// solution whose mesh cannot resolve its shape is refined or refused (on the default mesh,
 /// above [`DEFAULT_MESH_POSITION_LIMIT`]; on another, above [`CHOSEN_MESH_POSITION_LIMIT`]), and a
 /// solve that does not converge on the default mesh is tried again on one eight times finer
@@ -182,20 +183,34 @@ pub fn solve_at_output(
     }
     let mut quiet = *options;
     quiet.newton.throw = true;
-    let Ok(mesh) = solve_statics_at(model, actuation, &quiet, &[]) else {
-        return solve_statics_at(model, actuation, options, s_out);
+    // The shape on the default mesh, or on the finer one a failed default solve is tried on.
+    let (mesh, steps) = match solve_statics_at(model, actuation, &quiet, &[]) {
+        Ok(mesh) => (mesh, DEFAULT_RK4_STEPS),
+        Err(crate::error::Error::NotConverged { .. }) => {
+            let steps = RETRY_REFINEMENT * DEFAULT_RK4_STEPS;
+            quiet.integrator = Integrator::Rk4 { steps };
+            match solve_statics_at(model, actuation, &quiet, &[]) {
+                Ok(mesh) => (mesh, steps),
+                Err(_) => return solve_statics_at(model, actuation, options, s_out),
+            }
+        }
+        Err(_) => return solve_statics_at(model, actuation, options, s_out),
     };
     let error = rk4_rotation_error(&mesh);
-    if error.is_nan() || error <= OUTPUT_ROTATION_TARGET {
+    let m = if error.is_nan() || error <= OUTPUT_ROTATION_TARGET {
+        1
+    } else {
+        ((error / OUTPUT_ROTATION_TARGET).powf(0.25).ceil() as usize).clamp(2, MAX_REFINEMENT)
+    };
+    if m == 1 && steps == DEFAULT_RK4_STEPS {
         return solve_statics_at(model, actuation, options, s_out);
     }
-    let m = ((error / OUTPUT_ROTATION_TARGET).powf(0.25).ceil() as usize).clamp(2, MAX_REFINEMENT);
     let mut fine = *options;
     fine.integrator = Integrator::Rk4 {
-        steps: m * DEFAULT_RK4_STEPS,
+        steps: (m * steps).min(MAX_REFINEMENT * DEFAULT_RK4_STEPS),
     };
     fine.warm_start = Some(mesh.warm_start());
-    // The branch was settled (and a stable equilibrium sought) on the default mesh.
+    // The branch was settled (and a stable equilibrium sought) on the mesh of `mesh`.
     fine.seek_stable = false;
     solve_statics_at(model, actuation, &fine, s_out)
 }
