@@ -531,14 +531,18 @@ def test_a_shape_target_recovers_the_tensions_of_a_measured_backbone():
 
 
 @pytest.mark.parametrize("tension", [6.0, 7.0])
-def test_an_inverse_whose_answer_curls_beyond_the_default_mesh_is_solved_on_a_finer_one(tension):
+@pytest.mark.parametrize("obstacle", [False, True])
+def test_an_inverse_whose_answer_curls_beyond_the_default_mesh_is_solved_on_a_finer_one(
+    tension, obstacle
+):
     """A tapered silicone-like arm (0.4 m, radius 8 mm to 3 mm) with two antagonistic tendons
     at 2 mm, curled more than a turn: the inverse ran on the default 40 RK4 steps alone and
     reported targets reached (error 1e-12 m or less) with tensions 2.7 % off and a solution
-    whose tip missed the target by 0.28 mm and 0.51 mm. The answer's mesh is now checked like
-    a forward solve's and the inverse run again on a finer one. Oracle: the target is the
-    adaptive integrator's tip (rtol 1e-10) at known tensions; they are found again, and the
-    adaptive tip at the tensions found is on the target."""
+    whose tip missed the target by 0.28 mm and 0.51 mm, the same with an obstacle (a plane
+    1 m away: the contact inverse). The answer's mesh is now checked like a forward solve's
+    and the inverse run again on a finer one. Oracle: the target is the adaptive integrator's
+    tip (rtol 1e-10) at known tensions; they are found again, and the adaptive tip at the
+    tensions found is on the target."""
     rod = softrod.Rod(
         0.4, softrod.TaperedCircularSection(0.008, 0.003), softrod.LinearElastic(1e6, 0.5)
     )
@@ -547,7 +551,9 @@ def test_an_inverse_whose_answer_curls_beyond_the_default_mesh_is_solved_on_a_fi
     adaptive = {"integrator": "adaptive", "rtol": 1e-10, "atol": 1e-12}
     truth = np.array([tension, 0.5])
     target = robot.solve(tensions=truth, **adaptive).tip_position
-    inv = softrod.inverse_statics(robot, target)
+    far = [softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))] if obstacle else []
+    solved = softrod.Robot(rod, tendons=tendons, name="curl", obstacles=far)
+    inv = softrod.inverse_statics(solved, target)
     assert inv.reached
     assert np.allclose(inv.tensions, truth, rtol=1e-5, atol=0.0), inv.tensions
     back = robot.solve(tensions=inv.tensions, **adaptive).tip_position

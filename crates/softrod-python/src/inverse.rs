@@ -240,9 +240,15 @@ pub(crate) fn _inverse_statics<'py>(
                     "None with obstacles (the contact inverse aims at the tip)",
                 ));
             }
-            let mut fwd = softrod::ContactForward::new(model, &solve, &obstacles)?;
-            let inv = softrod::solve_contact_inverse(&mut fwd, &target, &o, warm.as_deref())
-                .map_err(actuator_names)?;
+            let (inv, mut fwd) = softrod::contact_inverse_resolved(
+                model,
+                &obstacles,
+                &target,
+                &o,
+                &solve,
+                warm.as_deref(),
+            )
+            .map_err(actuator_names)?;
             // The stability of the contact solution at the answer (the last one solved, or
             // solved again) when the target was reached.
             let last = fwd.solution.take().filter(|s| {

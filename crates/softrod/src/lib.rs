@@ -51,8 +51,9 @@ pub use compliance::{
     TendonControl,
 };
 pub use contact::{
-    contact_inverse_statics, solve_constrained, solve_contact_inverse, Contact, ContactCompliance,
-    ContactForward, ContactSolution, ContactState, Obstacle, TipConstraint, TriangleMesh,
+    contact_inverse_resolved, contact_inverse_statics, solve_constrained, solve_contact_inverse,
+    Contact, ContactCompliance, ContactForward, ContactSolution, ContactState, Obstacle,
+    TipConstraint, TriangleMesh,
 };
 pub use cosserat::displacement::reference_lengths;
 pub use cosserat::friction::{

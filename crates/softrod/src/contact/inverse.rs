@@ -17,7 +17,8 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use super::{solve_constrained, ContactSolution, Obstacle};
-use crate::cosserat::statics::SolveOptions;
+use crate::compliance::refine::{mesh_verdict, rk4_position_error};
+use crate::cosserat::statics::{Integrator, SolveOptions, DEFAULT_RK4_STEPS};
 use crate::error::{Error, Result};
 use crate::inverse::{
     solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target,
@@ -242,13 +243,72 @@ fn restore(
     out.reached.then_some(out)
 }
 
+/// [`solve_contact_inverse`] on a new [`ContactForward`] of `model` among `obstacles`, under
+/// the mesh control of a forward solve at its answer (as
+/// [`inverse_actuation`](crate::inverse::inverse_actuation): on the default RK4 mesh, an
+/// answer whose contact solution's estimated tip error exceeds
+/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::compliance::DEFAULT_MESH_POSITION_LIMIT) is sought
+/// again on a finer mesh from the answer; on a chosen mesh, one above
+/// [`CHOSEN_MESH_POSITION_LIMIT`](crate::compliance::CHOSEN_MESH_POSITION_LIMIT) is an error
+/// naming `steps`); returns the result and the forward model on the mesh of the answer (its
+/// `solution` the last contact solve).
+///
+/// # Errors
+/// As [`solve_contact_inverse`] and [`ContactForward::new`]; `steps` as above.
+pub fn contact_inverse_resolved(
+    model: &Arc<RobotModel>,
+    obstacles: &[Obstacle],
+    target: &Target,
+    options: &InverseOptions,
+    solve: &SolveOptions,
+    warm: Option<&InverseWarmStart>,
+) -> Result<(InverseSolution, ContactForward)> {
+    let mut fwd = ContactForward::new(model, solve, obstacles)?;
+    let out = solve_contact_inverse(&mut fwd, target, options, warm)?;
+    let Integrator::Rk4 { steps } = solve.integrator else {
+        return Ok((out, fwd));
+    };
+    let last = fwd
+        .solution
+        .as_ref()
+        .filter(|s| s.solution.tensions() == out.tensions())
+        .filter(|s| s.solution.pressures() == out.pressures());
+    let error = match last {
+        Some(s) => rk4_position_error(&s.solution),
+        None => match fwd.solve(&out.actuation) {
+            Ok(s) => {
+                let e = rk4_position_error(&s.solution);
+                fwd.solution = Some(s);
+                e
+            }
+            Err(_) => f64::NAN,
+        },
+    };
+    let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
+        return Ok((out, fwd));
+    };
+    let fine = SolveOptions {
+        integrator: Integrator::Rk4 { steps: finer },
+        ..*solve
+    };
+    // (The answer's evaluation is of the coarser mesh: the finer one evaluates it again.)
+    let from = InverseWarmStart {
+        evaluation: None,
+        ..InverseWarmStart::from(&out)
+    };
+    let mut fwd = ContactForward::new(model, &fine, obstacles)?;
+    let out = solve_contact_inverse(&mut fwd, target, options, Some(&from))?;
+    Ok((out, fwd))
+}
+
 /// The inverse statics of `model` among the frictionless `obstacles` for a tip `target` (the
-/// objective, options and result of [`crate::inverse`]), and the contact solution at the
-/// actuation found.
+/// objective, options and result of [`crate::inverse`]) under the mesh control of
+/// [`contact_inverse_resolved`], and the contact solution at the actuation found.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `target_s` for a shape target (the contact inverse aims
-/// at the tip) or an obstacle with friction; as [`solve_inverse`]; the contact solve's.
+/// at the tip) or an obstacle with friction; as [`contact_inverse_resolved`]; the contact
+/// solve's.
 pub fn contact_inverse_statics(
     model: &Arc<RobotModel>,
     obstacles: &[Obstacle],
@@ -264,8 +324,7 @@ pub fn contact_inverse_statics(
             "None with obstacles (the contact inverse aims at the tip)",
         ));
     }
-    let mut fwd = ContactForward::new(model, solve, obstacles)?;
-    let out = solve_contact_inverse(&mut fwd, target, options, warm)?;
+    let (out, mut fwd) = contact_inverse_resolved(model, obstacles, target, options, solve, warm)?;
     let sol = match fwd.solution.take() {
         Some(s)
             if s.solution.tensions() == out.tensions()

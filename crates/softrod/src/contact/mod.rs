@@ -34,7 +34,9 @@ use nalgebra::Vector3;
 
 pub use active_set::MAX_ACTIVE_SET_ROUNDS;
 pub use constraint::TipConstraint;
-pub use inverse::{contact_inverse_statics, solve_contact_inverse, ContactForward};
+pub use inverse::{
+    contact_inverse_resolved, contact_inverse_statics, solve_contact_inverse, ContactForward,
+};
 pub use obstacle::{Obstacle, TriangleMesh};
 pub use solve::solve_constrained;
 
