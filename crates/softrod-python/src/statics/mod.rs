@@ -352,7 +352,7 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
         let (r, c) = run(py, "solve_statics", || {
             if constrained {
                 let default = options.integrator == softrod::SolveOptions::default().integrator;
-                let c = softrod::compliance::with_mesh_control(
+                let c = softrod::cosserat::mesh::with_mesh_control(
                     &options,
                     default,
                     |o| softrod::solve_constrained(&model, act, o, tip.as_ref(), &obstacle_list),
@@ -362,7 +362,7 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
                 let data = crate::contact::ContactData::from_solution(&c);
                 Ok((c.solution, data))
             } else {
-                softrod::compliance::solve_at_output(&model, act, &options, &s_values)
+                softrod::cosserat::mesh::solve_at_output(&model, act, &options, &s_values)
                     .map_err(rename)
                     .map(|r| (r, crate::contact::ContactData::default()))
             }

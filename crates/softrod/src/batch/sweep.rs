@@ -26,9 +26,10 @@ use nalgebra::{Matrix6, Vector3};
 use rayon::prelude::*;
 
 use super::arc::{pose_at, ComplianceAt};
+use crate::compliance::compliance;
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::compliance::gamma_c;
-use crate::compliance::{compliance, solve_at_output};
+use crate::cosserat::mesh::solve_at_output;
 use crate::cosserat::statics::{SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_spd;

@@ -11,7 +11,8 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
-use crate::compliance::{solve_at_output, tangent_compliance, tip_compliance_world, TendonControl};
+use crate::compliance::{tangent_compliance, tip_compliance_world, TendonControl};
+use crate::cosserat::mesh::solve_at_output;
 use crate::cosserat::statics::{solve_statics, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_spd;

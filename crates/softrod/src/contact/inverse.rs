@@ -17,7 +17,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use super::{solve_constrained, ContactSolution, Obstacle};
-use crate::compliance::refine::{mesh_verdict, rk4_position_error};
+use crate::cosserat::mesh::{mesh_verdict, rk4_position_error};
 use crate::cosserat::statics::{Integrator, SolveOptions, DEFAULT_RK4_STEPS};
 use crate::error::{Error, Result};
 use crate::inverse::{
@@ -247,9 +247,9 @@ fn restore(
 /// the mesh control of a forward solve at its answer (as
 /// [`inverse_actuation`](crate::inverse::inverse_actuation): on the default RK4 mesh, an
 /// answer whose contact solution's estimated tip error exceeds
-/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::compliance::DEFAULT_MESH_POSITION_LIMIT) is sought
+/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::cosserat::mesh::DEFAULT_MESH_POSITION_LIMIT) is sought
 /// again on a finer mesh from the answer; on a chosen mesh, one above
-/// [`CHOSEN_MESH_POSITION_LIMIT`](crate::compliance::CHOSEN_MESH_POSITION_LIMIT) is an error
+/// [`CHOSEN_MESH_POSITION_LIMIT`](crate::cosserat::mesh::CHOSEN_MESH_POSITION_LIMIT) is an error
 /// naming `steps`); returns the result and the forward model on the mesh of the answer (its
 /// `solution` the last contact solve).
 ///

@@ -424,7 +424,7 @@ fn previous_profile<'p>(
 }
 
 /// [`solve_frictional`] under the mesh control of a forward solve
-/// ([`with_mesh_control`](crate::compliance::with_mesh_control)): on the default RK4 mesh, a
+/// ([`with_mesh_control`](super::mesh::with_mesh_control)): on the default RK4 mesh, a
 /// shape it does not resolve is solved again on a finer one (from rest, as asked); a `previous`
 /// state on a finer RK4 mesh (one this control chose) sets the mesh, since the history of
 /// stick and slip lives on it.
@@ -447,7 +447,7 @@ pub fn solve_frictional_checked(
         }
     }
     let on = statics.integrator;
-    crate::compliance::with_mesh_control(
+    super::mesh::with_mesh_control(
         &statics,
         default,
         |o| {

@@ -15,6 +15,7 @@ pub mod friction_linear;
 mod friction_march;
 mod guides;
 mod hyperelastic_local;
+pub mod mesh;
 mod options;
 pub mod sensitivity;
 pub(crate) mod shooting;

@@ -8,8 +8,8 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
 use super::{uniform, InverseWarmStart, Target};
-use crate::compliance::refine::{mesh_verdict, rk4_position_error};
 use crate::cosserat::equations::{Column, Equations, Workspace};
+use crate::cosserat::mesh::{mesh_verdict, rk4_position_error};
 use crate::cosserat::sensitivity::{
     actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
 };
@@ -160,7 +160,7 @@ impl CosseratForward {
 
 impl CosseratForward {
     /// The estimated tip error of the RK4 mesh at the actuation `a`, relative to the length
-    /// ([`rk4_position_error`](crate::compliance::rk4_position_error)): from the last solution
+    /// ([`rk4_position_error`](crate::cosserat::mesh::rk4_position_error)): from the last solution
     /// or the closed form of a uniform unloaded robot when they apply, else from the solution
     /// at `a`; NaN for the adaptive integrator.
     ///
@@ -387,12 +387,12 @@ impl Forward for CosseratForward {
 
 /// The inverse statics of a Cosserat robot `model` (solved with `solve`) for `target` (see
 /// the module documentation), under the mesh control of a forward solve
-/// ([`solve_at_output`](crate::compliance::solve_at_output)): on the default RK4 mesh, an
+/// ([`solve_at_output`](crate::cosserat::mesh::solve_at_output)): on the default RK4 mesh, an
 /// answer whose estimated tip error ([`CosseratForward::mesh_error`]) exceeds
-/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::compliance::DEFAULT_MESH_POSITION_LIMIT) makes the
+/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::cosserat::mesh::DEFAULT_MESH_POSITION_LIMIT) makes the
 /// inverse run again on a finer mesh from the answer (its actuation and Hessian), and that
 /// result is returned; on a chosen mesh, one above
-/// [`CHOSEN_MESH_POSITION_LIMIT`](crate::compliance::CHOSEN_MESH_POSITION_LIMIT) is an error
+/// [`CHOSEN_MESH_POSITION_LIMIT`](crate::cosserat::mesh::CHOSEN_MESH_POSITION_LIMIT) is an error
 /// naming `steps`. [`inverse_statics`] also returns the solution at the answer.
 ///
 /// # Errors

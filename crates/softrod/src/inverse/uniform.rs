@@ -165,7 +165,7 @@ fn interval(
 
 /// The estimated tip error of the RK4 march of the unloaded `model` at the tensions `a` (N)
 /// on `integrator` ([`applies`]), relative to the length: on each interval the strains are
-/// those of every stage, so [`rk4_position_error`](crate::compliance::rk4_position_error)'s
+/// those of every stage, so [`rk4_position_error`](crate::cosserat::mesh::rk4_position_error)'s
 /// sum `Σ θ⁵/120 (L - s)/L` over its `n` steps from `s₀` with `θ = h |u|` is
 /// `θ⁵/120 (n (L - s₀) - h n (n - 1)/2)/L`. `None` if a local solve fails.
 pub(super) fn position_error(

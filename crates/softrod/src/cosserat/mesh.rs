@@ -1,0 +1,269 @@
+//! The RK4 mesh checked against the shape it solves: an a-posteriori estimate of the
+//! truncation error, and the refinement or refusal every solve a user calls goes through.
+//!
+//! Classical RK4 applied to `R' = R û` replaces `exp(h û)` by its Taylor polynomial of degree
+//! four, so a step that turns by `θ = h |u|` errs by `θ⁵ / 120` rad
+//! ([`rk4_rotation_error`]); a turn missed at `s` moves the rest of the rod, so the tip's
+//! position errs by about `Σ θ⁵/120 (L - s)/L` of the length ([`rk4_position_error`]).
+//! [`solve_at_output`] (the statics solve of the Python API, sweeps and workspace maps),
+//! [`with_mesh_control`] (solves with obstacles or tendon friction) and the inverse statics
+//! judge the mesh by [`mesh_verdict`]: the default mesh is refined above
+//! [`DEFAULT_MESH_POSITION_LIMIT`], a chosen one refused above [`CHOSEN_MESH_POSITION_LIMIT`].
+
+use crate::cosserat::statics::{solve_statics_at, Integrator, StaticsSolution, DEFAULT_RK4_STEPS};
+
+/// Largest refinement factor of the default mesh.
+pub(crate) const MAX_REFINEMENT: usize = 32;
+
+/// Estimated truncation error of the rotations of the RK4 march of `solution` (rad): the sum
+/// over its steps of `θ⁵ / 120`, `θ = h max(|u_i|, |u_{i+1}|)` the step's turning angle.
+/// NaN if a curvature is not finite.
+pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
+    step_errors(solution).map(|(_, e)| e).sum()
+}
+
+/// Per step of the RK4 march of `solution`: its start (m) and its rotation error `θ⁵ / 120`
+/// (rad), `θ = h max(|u_i|, |u_{i+1}|)`.
+fn step_errors(solution: &StaticsSolution) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    solution
+        .s
+        .windows(2)
+        .zip(solution.u.windows(2))
+        .map(move |(s, u)| {
+            let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1]));
+            (s[0], theta.powi(5) / 120.0)
+        })
+}
+
+/// Estimated truncation error of the tip position of the RK4 march of `solution`, relative
+/// to the rod's length: the rotation error of each step ([`rk4_rotation_error`]'s terms)
+/// times the length after the step's start, over `L`. A turn that RK4 misses at the tip of a
+/// thin, tightly curled rod moves little of it; one near the base moves all of it. NaN if a
+/// curvature is not finite.
+pub fn rk4_position_error(solution: &StaticsSolution) -> f64 {
+    let length = solution.model.length();
+    step_errors(solution)
+        .map(|(s, e)| e * (length - s) / length)
+        .sum()
+}
+/// Target of [`rk4_rotation_error`] (rad) for a solve reported at chosen arc lengths
+/// ([`solve_at_output`]): positions there within about `1e-9 L` on stress-free arcs up to
+/// `2π`.
+pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
+
+/// [`solve_statics_at`] with the values at `s_out` under error control at the default RK4
+/// mesh: the problem is solved on the default mesh, its rotational truncation error estimated
+/// ([`rk4_rotation_error`]) and, above [`OUTPUT_ROTATION_TARGET`], solved again with `s_out` on
+/// a mesh `m` times finer (warm-started; `m` from the fourth-order convergence, at most 32),
+/// whose steps the returned solution's options record; a default solve that does not
+/// converge is tried on a mesh eight times finer, and refined from there the same way. Other
+/// integrators and meshes are [`solve_statics_at`] as they are. Without `s_out`, an RK4
+/// solution whose mesh cannot resolve its shape is refined or refused (on the default mesh,
+/// above [`DEFAULT_MESH_POSITION_LIMIT`]; on another, above [`CHOSEN_MESH_POSITION_LIMIT`]), and a
+/// solve that does not converge on the default mesh is tried again on one eight times finer
+/// (its solution, if it converges, is returned; else the default mesh's outcome).
+///
+/// # Errors
+/// As [`solve_statics_at`]; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter)
+/// naming `steps` for a chosen RK4 mesh
+/// whose estimated tip-position error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
+pub fn solve_at_output(
+    model: &std::sync::Arc<crate::model::RobotModel>,
+    actuation: &crate::model::Actuation,
+    options: &crate::cosserat::statics::SolveOptions,
+    s_out: &[f64],
+) -> crate::error::Result<StaticsSolution> {
+    let default =
+        matches!(options.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
+    if s_out.is_empty() {
+        let first = solve_statics_at(model, actuation, options, s_out);
+        // (Only a solve that did not converge: a named error of the input is the same on any
+        // mesh.)
+        let failed = match &first {
+            Ok(s) => !s.stats.converged,
+            Err(e) => matches!(e, crate::error::Error::NotConverged { .. }),
+        };
+        if default && failed {
+            // A shape the default mesh cannot march (a tight curl: its RK4 rotations grow and
+            // the iterates go wild) may converge on a finer one.
+            let mut fine = *options;
+            fine.integrator = Integrator::Rk4 {
+                steps: RETRY_REFINEMENT * DEFAULT_RK4_STEPS,
+            };
+            if let Ok(sol) = solve_statics_at(model, actuation, &fine, s_out) {
+                if sol.stats.converged {
+                    return resolved(model, actuation, &fine, sol, true);
+                }
+            }
+        }
+        return resolved(model, actuation, options, first?, default);
+    }
+    if !default {
+        return solve_statics_at(model, actuation, options, s_out);
+    }
+    let mut quiet = *options;
+    quiet.newton.throw = true;
+    // The shape on the default mesh, or on the finer one a failed default solve is tried on.
+    let (mesh, steps) = match solve_statics_at(model, actuation, &quiet, &[]) {
+        Ok(mesh) => (mesh, DEFAULT_RK4_STEPS),
+        Err(crate::error::Error::NotConverged { .. }) => {
+            let steps = RETRY_REFINEMENT * DEFAULT_RK4_STEPS;
+            quiet.integrator = Integrator::Rk4 { steps };
+            match solve_statics_at(model, actuation, &quiet, &[]) {
+                Ok(mesh) => (mesh, steps),
+                Err(_) => return solve_statics_at(model, actuation, options, s_out),
+            }
+        }
+        Err(_) => return solve_statics_at(model, actuation, options, s_out),
+    };
+    let error = rk4_rotation_error(&mesh);
+    let m = if error.is_nan() || error <= OUTPUT_ROTATION_TARGET {
+        1
+    } else {
+        ((error / OUTPUT_ROTATION_TARGET).powf(0.25).ceil() as usize).clamp(2, MAX_REFINEMENT)
+    };
+    if m == 1 && steps == DEFAULT_RK4_STEPS {
+        return solve_statics_at(model, actuation, options, s_out);
+    }
+    let mut fine = *options;
+    fine.integrator = Integrator::Rk4 {
+        steps: (m * steps).min(MAX_REFINEMENT * DEFAULT_RK4_STEPS),
+    };
+    fine.warm_start = Some(mesh.warm_start());
+    // The branch was settled (and a stable equilibrium sought) on the mesh of `mesh`.
+    fine.seek_stable = false;
+    solve_statics_at(model, actuation, &fine, s_out)
+}
+
+/// Estimated tip-position error ([`rk4_position_error`], relative to the length) of a
+/// solution on the default RK4 mesh above which it is solved again on a finer one
+/// ([`solve_at_output`]): a shape the default mesh does not resolve (a curl of two turns or more, a
+/// thin tapered tip curled tight). A 40-step solution of a stress-free arc of `2π` estimates
+/// 1.6e-5.
+pub const DEFAULT_MESH_POSITION_LIMIT: f64 = 1e-4;
+
+/// Estimated tip-position error ([`rk4_position_error`]) of a solution on a chosen RK4 mesh
+/// above which the solve is refused naming `steps`: a tenth of the length, where the shape is
+/// meaningless (steps that turn the rod by two radians or more: RK4's rotations grow).
+pub const CHOSEN_MESH_POSITION_LIMIT: f64 = 0.1;
+
+/// Refinement of the default mesh on which a solve that fails there is tried again.
+const RETRY_REFINEMENT: usize = 8;
+
+/// Target of [`rk4_position_error`] for the finer mesh of [`resolved`].
+const RESOLVED_POSITION_TARGET: f64 = 1e-8;
+
+/// A converged RK4 solution `sol` of `options` checked against its own mesh
+/// ([`finer_steps`]): solved again (cold) on the finer mesh that returns, else `sol` as it is
+/// (also for the adaptive integrator or a solution that did not converge).
+///
+/// # Errors
+/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as in
+/// [`finer_steps`]; the finer solve's errors.
+fn resolved(
+    model: &std::sync::Arc<crate::model::RobotModel>,
+    actuation: &crate::model::Actuation,
+    options: &crate::cosserat::statics::SolveOptions,
+    sol: StaticsSolution,
+    ours: bool,
+) -> crate::error::Result<StaticsSolution> {
+    match finer_steps(&sol, ours)? {
+        Some(steps) => {
+            let mut fine = *options;
+            fine.integrator = Integrator::Rk4 { steps };
+            solve_statics_at(model, actuation, &fine, &[])
+        }
+        None => Ok(sol),
+    }
+}
+
+/// The RK4 steps on which the problem of the converged `sol` must be solved again for its
+/// mesh to resolve its shape ([`mesh_verdict`] of its [`rk4_position_error`]), `None` if it
+/// does (or `sol` is adaptive or did not converge).
+///
+/// # Errors
+/// As [`mesh_verdict`].
+fn finer_steps(sol: &StaticsSolution, ours: bool) -> crate::error::Result<Option<usize>> {
+    match sol.options.integrator {
+        Integrator::Rk4 { steps } if sol.stats.converged => {
+            mesh_verdict(rk4_position_error(sol), steps, ours)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// `solve` on the mesh of `options` under the mesh control of [`solve_at_output`], for the
+/// solves that hold a statics solution (`statics` of the result: a contact or a frictional
+/// solution): when the converged solution's mesh does not resolve its shape
+/// ([`mesh_verdict`]; `ours`: the mesh is the default one or the solve's refinement of it,
+/// else chosen), `solve` is called again on the finer mesh, whose result returns.
+///
+/// # Errors
+/// `solve`'s; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming
+/// `steps` for a chosen mesh whose estimated tip error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
+pub fn with_mesh_control<T>(
+    options: &crate::cosserat::statics::SolveOptions,
+    ours: bool,
+    mut solve: impl FnMut(&crate::cosserat::statics::SolveOptions) -> crate::error::Result<T>,
+    statics: impl Fn(&T) -> &StaticsSolution,
+) -> crate::error::Result<T> {
+    let first = solve(options)?;
+    let Integrator::Rk4 { steps } = options.integrator else {
+        return Ok(first);
+    };
+    let sol = statics(&first);
+    if !sol.stats.converged {
+        return Ok(first);
+    }
+    match mesh_verdict(rk4_position_error(sol), steps, ours)? {
+        Some(finer) => {
+            let mut fine = *options;
+            fine.integrator = Integrator::Rk4 { steps: finer };
+            solve(&fine)
+        }
+        None => Ok(first),
+    }
+}
+
+/// The RK4 steps on which a problem solved on `steps` with the estimated tip error `error`
+/// ([`rk4_position_error`], relative to the length) must be solved again, `None` if the mesh
+/// resolves the shape (or `error` is NaN). On a mesh the solve chose (`ours`: the default
+/// one or its refinement), above [`DEFAULT_MESH_POSITION_LIMIT`]: a mesh `m` times finer (`m`
+/// from the fourth-order convergence toward 1e-8, at least 2, up to 32 times the default
+/// mesh); on a chosen mesh, above [`CHOSEN_MESH_POSITION_LIMIT`], an error naming `steps`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as above.
+pub fn mesh_verdict(
+    error: f64,
+    steps: usize,
+    ours: bool,
+) -> crate::error::Result<Option<usize>> {
+    if error.is_nan() {
+        return Ok(None);
+    }
+    let refinement = (error / RESOLVED_POSITION_TARGET).powf(0.25).ceil();
+    let most = MAX_REFINEMENT * DEFAULT_RK4_STEPS;
+    if ours && error > DEFAULT_MESH_POSITION_LIMIT && steps < most {
+        let finer = ((steps as f64 * refinement) as usize)
+            .max(2 * steps)
+            .min(most);
+        return Ok(Some(finer));
+    }
+    if !ours && error > CHOSEN_MESH_POSITION_LIMIT {
+        return Err(crate::error::Error::invalid(
+            "steps",
+            steps,
+            format!(
+                "enough RK4 steps to resolve the shape: on these the tip's position errs by \
+                 about {error:.2e} of the length (Σ θ⁵/120 (L - s)/L over the steps, θ the \
+                 turn of a step), and the shape is meaningless; about {:.0} steps resolve it \
+                 to 1e-8 (or use the default mesh, which refines itself, or the adaptive \
+                 integrator)",
+                steps as f64 * refinement
+            ),
+        ));
+    }
+    Ok(None)
+}
