@@ -21,7 +21,8 @@ use crate::cosserat::mesh::{mesh_verdict, rk4_position_error};
 use crate::cosserat::statics::{Integrator, SolveOptions, DEFAULT_RK4_STEPS};
 use crate::error::{Error, Result};
 use crate::inverse::{
-    solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Target,
+    on_finer_mesh, solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution,
+    InverseWarmStart, Target,
 };
 use crate::model::{Actuation, RobotModel};
 
@@ -287,15 +288,7 @@ pub fn contact_inverse_resolved(
     let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
         return Ok((out, fwd));
     };
-    let fine = SolveOptions {
-        integrator: Integrator::Rk4 { steps: finer },
-        ..*solve
-    };
-    // (The answer's evaluation is of the coarser mesh: the finer one evaluates it again.)
-    let from = InverseWarmStart {
-        evaluation: None,
-        ..InverseWarmStart::from(&out)
-    };
+    let (fine, from) = on_finer_mesh(solve, finer, &out);
     let mut fwd = ContactForward::new(model, &fine, obstacles)?;
     let out = solve_contact_inverse(&mut fwd, target, options, Some(&from))?;
     Ok((out, fwd))

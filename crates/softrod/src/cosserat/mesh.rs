@@ -235,11 +235,7 @@ pub fn with_mesh_control<T>(
 ///
 /// # Errors
 /// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as above.
-pub fn mesh_verdict(
-    error: f64,
-    steps: usize,
-    ours: bool,
-) -> crate::error::Result<Option<usize>> {
+pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> crate::error::Result<Option<usize>> {
     if error.is_nan() {
         return Ok(None);
     }

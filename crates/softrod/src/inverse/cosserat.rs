@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
+use super::{on_finer_mesh, uniform, InverseWarmStart, Target};
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
-use super::{uniform, InverseWarmStart, Target};
 use crate::cosserat::equations::{Column, Equations, Workspace};
 use crate::cosserat::mesh::{mesh_verdict, rk4_position_error};
 use crate::cosserat::sensitivity::{
@@ -444,15 +444,7 @@ fn inverse_resolved(
             None => Ok((out, fwd)),
         };
     };
-    let fine = SolveOptions {
-        integrator: Integrator::Rk4 { steps: finer },
-        ..*solve
-    };
-    // (The answer's evaluation is of the coarser mesh: the finer one evaluates it again.)
-    let from = InverseWarmStart {
-        evaluation: None,
-        ..InverseWarmStart::from(&out)
-    };
+    let (fine, from) = on_finer_mesh(solve, finer, &out);
     let mut fwd = CosseratForward::new(model, &fine, target.s.as_deref())?;
     let out = solve_inverse(&mut fwd, target, options, Some(&from))?;
     Ok((out, fwd))

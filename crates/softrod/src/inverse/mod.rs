@@ -85,6 +85,7 @@ mod uniform;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
+use crate::cosserat::statics::{Integrator, SolveOptions};
 use crate::error::Result;
 
 pub use cosserat::{inverse_actuation, inverse_statics, CosseratForward};
@@ -302,6 +303,25 @@ impl From<InverseSolution> for InverseWarmStart {
             hessian: Some(s.hessian),
         }
     }
+}
+
+/// The solve options on `steps` RK4 steps and the warm start from the answer `out` with which
+/// the inverse runs again on a finer mesh (its evaluation, of the coarser mesh, dropped: the
+/// finer one evaluates the answer again).
+pub(crate) fn on_finer_mesh(
+    solve: &SolveOptions,
+    steps: usize,
+    out: &InverseSolution,
+) -> (SolveOptions, InverseWarmStart) {
+    let fine = SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        ..*solve
+    };
+    let from = InverseWarmStart {
+        evaluation: None,
+        ..InverseWarmStart::from(out)
+    };
+    (fine, from)
 }
 
 impl From<&InverseSolution> for InverseWarmStart {
