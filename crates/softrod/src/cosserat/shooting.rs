@@ -122,6 +122,11 @@ pub(crate) struct Shooting<'a> {
     /// Subtracted from the tip rows of every residual: a coarse mesh's residual at a nearby
     /// solution on a finer mesh (see `statics::coarse_first`), zero otherwise.
     pub defect: [f64; 6],
+    /// The scaled tip residual of the last pass (the tip rows, [`Self::defect`] subtracted).
+    pub residual: [f64; 6],
+    /// Whether [`Problem::certified`] may answer from the exact columns of an earlier pass
+    /// (`false`: the columns at the solution are needed anyway, e.g. on a coarse mesh).
+    pub certify: bool,
 }
 
 impl<'a> Shooting<'a> {
@@ -173,6 +178,8 @@ impl<'a> Shooting<'a> {
             reference: Vec::new(),
             evaluations: 0,
             defect: [0.0; 6],
+            residual: [0.0; 6],
+            certify: true,
         }
     }
 
@@ -269,6 +276,7 @@ impl<'a> Shooting<'a> {
         let (mut r, cols) = eq.residual(&y, columns.len());
         for k in 0..6 {
             r[k] -= self.defect[k];
+            self.residual[k] = r[k];
         }
         self.columns = None;
         if N >= FULL {
@@ -586,7 +594,7 @@ impl Problem for Shooting<'_> {
     }
 
     fn certified(&mut self, x: &[f64], lambda: f64) -> bool {
-        self.certificate(x, lambda).is_some()
+        self.certify && self.certificate(x, lambda).is_some()
     }
 
     fn commit(&mut self) {

@@ -253,7 +253,17 @@ fn step_loads(
 
 /// The direct solve, then continuation if it fails or is refused.
 fn attempt(p: &mut Shooting<'_>, options: &SolveOptions, x0: &[f64; 6], exact: bool) -> Reached {
-    let (result, j0, first_step) = direct(p, options, x0, exact);
+    attempt_exact(p, options, x0, (exact, exact))
+}
+
+/// [`attempt`], the direct solve and the continuation ending on an exact Jacobian as asked.
+fn attempt_exact(
+    p: &mut Shooting<'_>,
+    options: &SolveOptions,
+    x0: &[f64; 6],
+    (exact_direct, exact): (bool, bool),
+) -> Reached {
+    let (result, j0, first_step) = direct(p, options, x0, exact_direct);
     if result.converged || !options.newton.continuation {
         return Reached::direct(result);
     }
@@ -318,11 +328,25 @@ fn coarse_first(
         },
         ..*options
     };
-    let reached = attempt(&mut c, &start, x0, false);
+    // The direct solve ends on the columns at the coarse solution (needed below): a step
+    // predicted to converge is taken with them, saving the march that would evaluate them
+    // after it; continuation's load steps do not (their columns would be wasted).
+    c.certify = false;
+    let reached = attempt_exact(&mut c, &start, x0, (true, false));
     let xc = reached.outcome.x.clone();
+    let o = &reached.outcome;
     let (mut j, mut r) = (vec![0.0; 36], [0.0; 6]);
-    let jacobian = reached.outcome.converged
-        && c.evaluate(&xc, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian;
+    // The columns at the coarse solution: those of its last pass when it ended on them.
+    let jacobian = match (&o.jacobian, &c.columns) {
+        (Some(oj), Some(cj))
+            if o.converged && o.exact && o.at_x && c.tip_twist.is_some() && oj[..] == cj[..] =>
+        {
+            j.copy_from_slice(oj);
+            r = c.residual;
+            true
+        }
+        _ => o.converged && c.evaluate(&xc, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian,
+    };
     p.evaluations += c.evaluations;
     if !jacobian {
         return None;
