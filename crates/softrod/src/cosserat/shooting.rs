@@ -127,6 +127,12 @@ pub(crate) struct Shooting<'a> {
     /// Whether [`Problem::certified`] may answer from the exact columns of an earlier pass
     /// (`false`: the columns at the solution are needed anyway, e.g. on a coarse mesh).
     pub certify: bool,
+    /// How many of the next passes with the columns skip the Jacobi check along the rod
+    /// (columns only wanted at the tip, e.g. a Newton direction; see [`Self::jacobi_checked`]).
+    pub skip_jacobi: usize,
+    /// Whether the last pass had its columns checked along the rod ([`Self::jacobi`]): a pass
+    /// without is no stability evidence (no certificate is kept from it).
+    pub jacobi_checked: bool,
 }
 
 impl<'a> Shooting<'a> {
@@ -180,6 +186,8 @@ impl<'a> Shooting<'a> {
             defect: [0.0; 6],
             residual: [0.0; 6],
             certify: true,
+            skip_jacobi: 0,
+            jacobi_checked: false,
         }
     }
 
@@ -233,6 +241,10 @@ impl<'a> Shooting<'a> {
         let nodes = &mut self.nodes;
         let (length, force) = (eq.model.length(), eq.model.force_scale());
         let mut jacobi = JacobiCheck::default();
+        let check = N >= FULL && self.skip_jacobi == 0;
+        if N >= FULL && !check {
+            self.skip_jacobi -= 1;
+        }
         let result = march(
             &mut ev,
             breaks,
@@ -245,7 +257,7 @@ impl<'a> Shooting<'a> {
                     interval,
                     y: head(y),
                 });
-                if let Ok(full) = <&[f64; FULL]>::try_from(&y[..]) {
+                if let (true, Ok(full)) = (check, <&[f64; FULL]>::try_from(&y[..])) {
                     let rod = eq.model.rod();
                     let c = match eq.model.uniform_compliance() {
                         Some(c) => *c,
@@ -260,6 +272,7 @@ impl<'a> Shooting<'a> {
             },
         );
         self.jacobi = jacobi;
+        self.jacobi_checked = check;
         self.evaluations += std::mem::take(&mut self.ws.evaluations);
         self.tip_twist = None;
         let y = result?;
@@ -292,14 +305,16 @@ impl<'a> Shooting<'a> {
                 Vector6::new(dp.x, dp.y, dp.z, w.x, w.y, w.z)
             });
             self.tip_twist = Some(tw);
-            self.exact = Some(ExactPass {
-                x: std::array::from_fn(|k| x[k]),
-                lambda,
-                jacobian: j,
-                tip_twist: tw,
-                jacobi: self.jacobi,
-                stability: None,
-            });
+            if check {
+                self.exact = Some(ExactPass {
+                    x: std::array::from_fn(|k| x[k]),
+                    lambda,
+                    jacobian: j,
+                    tip_twist: tw,
+                    jacobi: self.jacobi,
+                    stability: None,
+                });
+            }
         }
         let chord = v3(&y, 0) - eq.model.rod().base_pose().position();
         Ok((r, cols, chord))
@@ -609,7 +624,7 @@ impl Problem for Shooting<'_> {
             return false;
         }
         match (self.require_stable, &self.columns, &self.tip_twist) {
-            (true, Some(j), Some(tw)) => {
+            (true, Some(j), Some(tw)) if self.jacobi_checked => {
                 tip_stability(j, tw, length, self.jacobi).is_some_and(|s| s.stable)
             }
             _ => true,

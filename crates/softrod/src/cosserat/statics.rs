@@ -332,6 +332,11 @@ fn coarse_first(
     // predicted to converge is taken with them, saving the march that would evaluate them
     // after it; continuation's load steps do not (their columns would be wasted).
     c.certify = false;
+    // Cold, the first columns are those of Newton's direction at the predicted point, which
+    // judge no stability (the solution's columns do): marched without the Jacobi check.
+    if options.warm_start.is_none() {
+        c.skip_jacobi = 1;
+    }
     let reached = attempt_exact(&mut c, &start, x0, (true, false));
     let xc = reached.outcome.x.clone();
     let o = &reached.outcome;
@@ -339,13 +344,22 @@ fn coarse_first(
     // The columns at the coarse solution: those of its last pass when it ended on them.
     let jacobian = match (&o.jacobian, &c.columns) {
         (Some(oj), Some(cj))
-            if o.converged && o.exact && o.at_x && c.tip_twist.is_some() && oj[..] == cj[..] =>
+            if o.converged
+                && o.exact
+                && o.at_x
+                && c.jacobi_checked
+                && c.tip_twist.is_some()
+                && oj[..] == cj[..] =>
         {
             j.copy_from_slice(oj);
             r = c.residual;
             true
         }
-        _ => o.converged && c.evaluate(&xc, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian,
+        _ => {
+            // (Checked along the rod whatever pass came before: these columns judge.)
+            c.skip_jacobi = 0;
+            o.converged && c.evaluate(&xc, 1.0, Some(&mut j), &mut r) == Evaluated::Jacobian
+        }
     };
     p.evaluations += c.evaluations;
     if !jacobian {
@@ -385,6 +399,7 @@ fn coarse_first(
 /// here).
 fn clearly_stable(c: &Shooting<'_>, j: &[f64], distance: f64) -> Option<Stability> {
     c.tip_twist
+        .filter(|_| c.jacobi_checked)
         .and_then(|tw| tip_stability(j, &tw, c.eq.model.length(), c.jacobi))
         .filter(|s| certifies(s, distance))
         .map(|_| Stability {

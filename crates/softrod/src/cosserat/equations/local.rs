@@ -88,15 +88,14 @@ impl Evaluator<'_, '_> {
         let mut out = Local::strains(&x);
         if tangent {
             // (I + C D)⁻¹ C at the solution.
-            let Some((_, lu)) = self.local_inverse(&x, &c) else {
+            if self.local_inverse(&x, &c).is_none() {
                 self.ws.memo = None;
                 return Local::nan();
-            };
+            }
             self.ws.tangent = Tangent {
                 diag: c,
-                lu: Some(lu),
+                lu: self.ws.last_lu,
             };
-            self.ws.last_lu = Some(lu);
         }
         let sums = self.finish_tendons(s, props, &mut out, &fluid);
         self.ws.guess = Some(x);
@@ -152,17 +151,19 @@ impl Evaluator<'_, '_> {
         }
     }
 
-    /// The tendon sums at the strains `x` and the inverse of the local Jacobian `I + C D`
-    /// there: by Cholesky of the similar `I + C^½ D C^½` (`D` is symmetric positive
-    /// semi-definite), else by Gauss–Jordan; `None` if it is singular.
-    fn local_inverse(&self, x: &Vector6<f64>, c: &[f64; 6]) -> Option<(Vector6<f64>, Inverse6)> {
+    /// The tendon sums at the strains `x`, with the inverse of the local Jacobian `I + C D`
+    /// there into [`super::Workspace::last_lu`]: by Cholesky of the similar `I + C^½ D C^½`
+    /// (`D` is symmetric positive semi-definite), else by Gauss–Jordan; `None` (and the last
+    /// inverse kept) if it is singular.
+    fn local_inverse(&mut self, x: &Vector6<f64>, c: &[f64; 6]) -> Option<Vector6<f64>> {
         let mut d = [[0.0; 6]; 6];
         let (tw, _) = self.tendon_sums_into(x, c, true, Some(&mut d));
         let lu = Inverse6::of_compliance_stiffness(c, &d).or_else(|| {
             let (_, h) = self.tendon_sums(x, c, true);
             h.as_ref().and_then(Inverse6::new)
         })?;
-        Some((tw, lu))
+        self.ws.last_lu = Some(lu);
+        Some(tw)
     }
 
     /// The strains with straight tendons (`t_i = e_z`): `x* + C (W - T_straight)`, the start
@@ -200,9 +201,7 @@ impl Evaluator<'_, '_> {
             let tw = if chord {
                 known.take().unwrap_or_else(|| self.tendon_load(&x))
             } else {
-                let (tw, lu) = self.local_inverse(&x, c)?;
-                self.ws.last_lu = Some(lu);
-                tw
+                self.local_inverse(&x, c)?
             };
             let g = x - xs - cd.component_mul(&(wv - tw));
             let lu = self.ws.last_lu.as_ref()?;
