@@ -10,7 +10,10 @@
 //! judge the mesh by [`mesh_verdict`]: the default mesh is refined above
 //! [`DEFAULT_MESH_POSITION_LIMIT`], a chosen one refused above [`CHOSEN_MESH_POSITION_LIMIT`].
 
-use crate::cosserat::statics::{solve_statics_at, Integrator, StaticsSolution, DEFAULT_RK4_STEPS};
+use crate::cosserat::statics::{
+    solve_statics_at, Integrator, SolveOptions, StaticsSolution, DEFAULT_RK4_STEPS,
+};
+use crate::error::{Error, Result};
 
 /// Largest refinement factor of the default mesh.
 pub(crate) const MAX_REFINEMENT: usize = 32;
@@ -77,27 +80,12 @@ pub fn solve_at_output(
     let default =
         matches!(options.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
     if s_out.is_empty() {
-        let first = solve_statics_at(model, actuation, options, s_out);
-        // (Only a solve that did not converge: a named error of the input is the same on any
-        // mesh.)
-        let failed = match &first {
-            Ok(s) => !s.stats.converged,
-            Err(e) => matches!(e, crate::error::Error::NotConverged { .. }),
-        };
-        if default && failed {
-            // A shape the default mesh cannot march (a tight curl: its RK4 rotations grow and
-            // the iterates go wild) may converge on a finer one.
-            let mut fine = *options;
-            fine.integrator = Integrator::Rk4 {
-                steps: RETRY_REFINEMENT * DEFAULT_RK4_STEPS,
-            };
-            if let Ok(sol) = solve_statics_at(model, actuation, &fine, s_out) {
-                if sol.stats.converged {
-                    return resolved(model, actuation, &fine, sol, true);
-                }
-            }
-        }
-        return resolved(model, actuation, options, first?, default);
+        return with_mesh_control(
+            options,
+            default,
+            |o| solve_statics_at(model, actuation, o, &[]),
+            |s| s,
+        );
     }
     if !default {
         return solve_statics_at(model, actuation, options, s_out);
@@ -151,78 +139,58 @@ pub const CHOSEN_MESH_POSITION_LIMIT: f64 = 0.1;
 /// Refinement of the default mesh on which a solve that fails there is tried again.
 const RETRY_REFINEMENT: usize = 8;
 
-/// Target of [`rk4_position_error`] for the finer mesh of [`resolved`].
+/// Target of [`rk4_position_error`] for the finer mesh of [`mesh_verdict`].
 const RESOLVED_POSITION_TARGET: f64 = 1e-8;
 
-/// A converged RK4 solution `sol` of `options` checked against its own mesh
-/// ([`finer_steps`]): solved again (cold) on the finer mesh that returns, else `sol` as it is
-/// (also for the adaptive integrator or a solution that did not converge).
-///
-/// # Errors
-/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as in
-/// [`finer_steps`]; the finer solve's errors.
-fn resolved(
-    model: &std::sync::Arc<crate::model::RobotModel>,
-    actuation: &crate::model::Actuation,
-    options: &crate::cosserat::statics::SolveOptions,
-    sol: StaticsSolution,
-    ours: bool,
-) -> crate::error::Result<StaticsSolution> {
-    match finer_steps(&sol, ours)? {
-        Some(steps) => {
-            let mut fine = *options;
-            fine.integrator = Integrator::Rk4 { steps };
-            solve_statics_at(model, actuation, &fine, &[])
-        }
-        None => Ok(sol),
-    }
-}
-
-/// The RK4 steps on which the problem of the converged `sol` must be solved again for its
-/// mesh to resolve its shape ([`mesh_verdict`] of its [`rk4_position_error`]), `None` if it
-/// does (or `sol` is adaptive or did not converge).
-///
-/// # Errors
-/// As [`mesh_verdict`].
-fn finer_steps(sol: &StaticsSolution, ours: bool) -> crate::error::Result<Option<usize>> {
-    match sol.options.integrator {
-        Integrator::Rk4 { steps } if sol.stats.converged => {
-            mesh_verdict(rk4_position_error(sol), steps, ours)
-        }
-        _ => Ok(None),
-    }
-}
-
-/// `solve` on the mesh of `options` under the mesh control of [`solve_at_output`], for the
-/// solves that hold a statics solution (`statics` of the result: a contact or a frictional
-/// solution): when the converged solution's mesh does not resolve its shape
-/// ([`mesh_verdict`]; `ours`: the mesh is the default one or the solve's refinement of it,
-/// else chosen), `solve` is called again on the finer mesh, whose result returns.
+/// `solve` on the mesh of `options` under the mesh control of [`solve_at_output`], for every
+/// solve that holds a statics solution (`statics` of the result: the solution itself, a
+/// contact or a frictional solution). On a mesh the solve chose (`ours`: the default one or
+/// its refinement), a solve that does not converge is tried again on a mesh
+/// [`RETRY_REFINEMENT`] times finer (a tight curl the mesh cannot march may converge there; its
+/// result if it converges, else the first outcome); then the converged solution's mesh is
+/// judged ([`mesh_verdict`]): too coarse for the shape, `solve` is called again on the finer
+/// mesh, whose result returns; a chosen mesh that is meaningless is an error naming `steps`.
 ///
 /// # Errors
 /// `solve`'s; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming
 /// `steps` for a chosen mesh whose estimated tip error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
 pub fn with_mesh_control<T>(
-    options: &crate::cosserat::statics::SolveOptions,
+    options: &SolveOptions,
     ours: bool,
-    mut solve: impl FnMut(&crate::cosserat::statics::SolveOptions) -> crate::error::Result<T>,
+    mut solve: impl FnMut(&SolveOptions) -> Result<T>,
     statics: impl Fn(&T) -> &StaticsSolution,
-) -> crate::error::Result<T> {
-    let first = solve(options)?;
+) -> Result<T> {
     let Integrator::Rk4 { steps } = options.integrator else {
-        return Ok(first);
+        return solve(options);
     };
-    let sol = statics(&first);
+    let on = |steps: usize| SolveOptions {
+        integrator: Integrator::Rk4 { steps },
+        ..*options
+    };
+    let most = MAX_REFINEMENT * DEFAULT_RK4_STEPS;
+    let first = solve(options);
+    // (Only a solve that did not converge: a named error of the input is the same on any mesh.)
+    let failed = match &first {
+        Ok(t) => !statics(t).stats.converged,
+        Err(e) => matches!(e, Error::NotConverged { .. }),
+    };
+    let (outcome, steps) = match first {
+        _ if ours && failed && steps < most => {
+            let retry = (RETRY_REFINEMENT * steps).min(most);
+            match solve(&on(retry)) {
+                Ok(t) if statics(&t).stats.converged => (t, retry),
+                _ => return first,
+            }
+        }
+        first => (first?, steps),
+    };
+    let sol = statics(&outcome);
     if !sol.stats.converged {
-        return Ok(first);
+        return Ok(outcome);
     }
     match mesh_verdict(rk4_position_error(sol), steps, ours)? {
-        Some(finer) => {
-            let mut fine = *options;
-            fine.integrator = Integrator::Rk4 { steps: finer };
-            solve(&fine)
-        }
-        None => Ok(first),
+        Some(finer) => solve(&on(finer)),
+        None => Ok(outcome),
     }
 }
 
