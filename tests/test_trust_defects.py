@@ -624,3 +624,51 @@ offset = [0.0003565590886614968, 9.684793183689941e-05]
     got = walled.solve()
     assert got.converged and not got.contacts
     assert np.linalg.norm(got.tip_position - ref) <= 1e-4 * 0.4
+
+
+def test_a_chosen_mesh_too_coarse_for_the_shape_is_named_with_s_out_and_when_it_fails():
+    # 8 RK4 steps turning a curled tendon arm by radians each: refused naming `steps` without
+    # `s_out`, but with `s_out` returned converged with its tip 5.8 % of L off; and on a
+    # Neo-Hookean arm curled 4.8 turns, 8 to 32 chosen steps failed as a `ParameterError`
+    # naming the fibre `stretch` (blaming the loads) or a bare `ConvergenceError`. A chosen
+    # mesh is now judged with `s_out` too, and one that fails is judged on the shape the
+    # default mesh solves. Oracle: that shape's estimate on the chosen steps (tens of lengths).
+    length = 0.41848084366072713
+    rod = softrod.Rod(
+        length,
+        softrod.TaperedCircularSection(0.002165276355285291, 0.0018418191265751084),
+        softrod.LinearElastic(6605524.798050307, 0.4458993121967997),
+    )
+    tendons = [
+        softrod.Tendon((0.001308284336688203, -0.0005526508050886761), 2.5855007558402927),
+        softrod.Tendon((-0.0005131067589266444, -0.00030090944448719795), 0.7749053195187314),
+    ]
+    for s_out in (None, [length / 2, length]):
+        with pytest.raises(softrod.ParameterError) as info:
+            softrod.solve_statics(rod, tendons, steps=8, s_out=s_out)
+        assert info.value.parameter == "steps"
+    curled = softrod.Robot.from_toml(
+        """
+name = "curl"
+[rod]
+length = 0.2831734577160381
+[rod.section]
+type = "tapered"
+base_radius = 0.0085319168760092
+tip_radius = 0.004841603762263498
+[rod.material]
+type = "neo_hookean"
+mu = 598896.9547114645
+[[chambers]]
+pressure = 17966908.641343933
+area = 3.336685073973283e-06
+offset = [-0.0021274781941819534, -0.0007711551929593986]
+[loads]
+tip_force = [0.0046825961503964425, 0.008368720958967861, -0.002364326514424756]
+"""
+    )
+    assert curled.solve().converged
+    for steps in (8, 12, 24):
+        with pytest.raises(softrod.ParameterError) as info:
+            curled.solve(steps=steps)
+        assert info.value.parameter == "steps", str(info.value)

@@ -14,6 +14,7 @@ use crate::cosserat::statics::{
     solve_statics_at, Integrator, SolveOptions, StaticsSolution, DEFAULT_RK4_STEPS,
 };
 use crate::error::{Error, Result};
+use crate::integrate::march::rk4_plan;
 
 /// Largest refinement factor of the default mesh.
 pub(crate) const MAX_REFINEMENT: usize = 32;
@@ -88,7 +89,31 @@ pub fn solve_at_output(
         );
     }
     if !default {
-        return solve_statics_at(model, actuation, options, s_out);
+        if !matches!(options.integrator, Integrator::Rk4 { .. }) {
+            return solve_statics_at(model, actuation, options, s_out);
+        }
+        // A chosen mesh is judged on the shape solved at its nodes, then the values at `s_out`
+        // are solved from that solution (one or two Newton iterations).
+        let mut quiet = *options;
+        quiet.newton.throw = true;
+        let judged = with_mesh_control(
+            &quiet,
+            false,
+            |o| solve_statics_at(model, actuation, o, &[]),
+            |s| s,
+        );
+        let mut warm = *options;
+        match judged {
+            Err(e) if matches!(&e, Error::InvalidParameter { name, .. } if name == "steps") => {
+                return Err(e)
+            }
+            Ok(mesh) => {
+                warm.warm_start = Some(mesh.warm_start());
+                warm.seek_stable = false;
+            }
+            Err(_) => {}
+        }
+        return solve_statics_at(model, actuation, &warm, s_out);
     }
     let mut quiet = *options;
     quiet.newton.throw = true;
@@ -160,6 +185,16 @@ pub fn with_mesh_control<T>(
     mut solve: impl FnMut(&SolveOptions) -> Result<T>,
     statics: impl Fn(&T) -> &StaticsSolution,
 ) -> Result<T> {
+    controlled(options, ours, &mut solve, &statics)
+}
+
+/// [`with_mesh_control`] on `dyn` closures (it calls itself for a chosen mesh that fails).
+fn controlled<T>(
+    options: &SolveOptions,
+    ours: bool,
+    solve: &mut dyn FnMut(&SolveOptions) -> Result<T>,
+    statics: &dyn Fn(&T) -> &StaticsSolution,
+) -> Result<T> {
     let Integrator::Rk4 { steps } = options.integrator else {
         return solve(options);
     };
@@ -169,11 +204,24 @@ pub fn with_mesh_control<T>(
     };
     let most = MAX_REFINEMENT * DEFAULT_RK4_STEPS;
     let first = solve(options);
-    // (Only a solve that did not converge: a named error of the input is the same on any mesh.)
+    // (Only a solve that did not converge, or a material failure on the way: a named error of
+    // the input is the same on any mesh.)
     let failed = match &first {
         Ok(t) => !statics(t).stats.converged,
         Err(e) => matches!(e, Error::NotConverged { .. }),
     };
+    if !ours && (failed || first.is_err()) {
+        // A chosen mesh that fails may be one too coarse for the shape: judged from the shape
+        // on the mesh the solve would choose.
+        let resolved = controlled(&on(DEFAULT_RK4_STEPS), true, solve, statics);
+        if let Ok(t) = resolved {
+            let error = rk4_position_error_on(statics(&t), steps);
+            if error > CHOSEN_MESH_POSITION_LIMIT {
+                return Err(meaningless(steps, error));
+            }
+        }
+        return first;
+    }
     let (outcome, steps) = match first {
         _ if ours && failed && steps < most => {
             let retry = (RETRY_REFINEMENT * steps).min(most);
@@ -192,6 +240,37 @@ pub fn with_mesh_control<T>(
         Some(finer) => solve(&on(finer)),
         None => Ok(outcome),
     }
+}
+
+/// The estimated tip error ([`rk4_position_error`], relative to the length) of an RK4 march
+/// on `steps` steps of the shape of `solution` (solved on another mesh): each step's turn
+/// from the largest curvature of the solution's nodes on it (and its ends).
+fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
+    let model = &solution.model;
+    let (breaks, length) = (model.breaks(), model.length());
+    let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    let curvature: Vec<f64> = solution.u.iter().map(norm).collect();
+    let slack = 1e-12 * length;
+    let mut error = 0.0;
+    let mut first = 0;
+    for (k, &n) in rk4_plan(breaks, steps).iter().enumerate() {
+        let h = (breaks[k + 1] - breaks[k]) / n.max(1) as f64;
+        for j in 0..n {
+            let a = breaks[k] + j as f64 * h;
+            while first + 1 < solution.s.len() && solution.s[first + 1] < a - slack {
+                first += 1;
+            }
+            // The nodes on [a, a + h] and the one before it (the curvature at a lies between).
+            let most = solution.s[first..]
+                .iter()
+                .zip(&curvature[first..])
+                .take_while(|(s, _)| **s <= a + h + slack)
+                .map(|(_, u)| *u)
+                .fold(0.0, f64::max);
+            error += (h * most).powi(5) / 120.0 * (length - a) / length;
+        }
+    }
+    error
 }
 
 /// The RK4 steps on which a problem solved on `steps` with the estimated tip error `error`
@@ -216,18 +295,24 @@ pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> crate::error::Resul
         return Ok(Some(finer));
     }
     if !ours && error > CHOSEN_MESH_POSITION_LIMIT {
-        return Err(crate::error::Error::invalid(
-            "steps",
-            steps,
-            format!(
-                "enough RK4 steps to resolve the shape: on these the tip's position errs by \
-                 about {error:.2e} of the length (Σ θ⁵/120 (L - s)/L over the steps, θ the \
-                 turn of a step), and the shape is meaningless; about {:.0} steps resolve it \
-                 to 1e-8 (or use the default mesh, which refines itself, or the adaptive \
-                 integrator)",
-                steps as f64 * refinement
-            ),
-        ));
+        return Err(meaningless(steps, error));
     }
     Ok(None)
+}
+
+/// The error naming `steps` for a chosen RK4 mesh whose estimated tip error `error` (relative
+/// to the length) exceeds [`CHOSEN_MESH_POSITION_LIMIT`], with the steps that resolve it.
+fn meaningless(steps: usize, error: f64) -> Error {
+    let refinement = (error / RESOLVED_POSITION_TARGET).powf(0.25).ceil();
+    Error::invalid(
+        "steps",
+        steps,
+        format!(
+            "enough RK4 steps to resolve the shape: on these the tip's position errs by about \
+             {error:.2e} of the length (Σ θ⁵/120 (L - s)/L over the steps, θ the turn of a \
+             step), and the shape is meaningless; about {:.0} steps resolve it to 1e-8 (or use \
+             the default mesh, which refines itself, or the adaptive integrator)",
+            steps as f64 * refinement
+        ),
+    )
 }
