@@ -559,3 +559,46 @@ def test_an_inverse_whose_answer_curls_beyond_the_default_mesh_is_solved_on_a_fi
     back = robot.solve(tensions=inv.tensions, **adaptive).tip_position
     assert np.linalg.norm(back - target) <= 1e-8, back - target
     assert np.linalg.norm(inv.solution.tip_position - target) <= 1e-8
+
+
+def test_a_target_missed_by_the_contact_inverse_on_a_coarse_mesh_is_judged_on_a_finer_one():
+    """A tapered Neo-Hookean arm (0.18 m, 5.7 mm to 1.1 mm) curled 1.3 turns by its one
+    chamber at 14 MPa, and the adaptive integrator's tip as the target: one pressure cannot
+    meet a point exactly, so both inverses miss it, but with a plane 1 m away (the contact
+    inverse) the verdict was the default mesh's, 2.6e-4 m (1.4e-3 L) short. A missed target
+    is now judged where the iteration stopped, and sought again on a finer mesh. Oracles: the
+    plain inverse's verdict (8.8e-10 m) and the contact inverse's on 1,280 chosen steps."""
+    robot = softrod.Robot.from_toml(
+        """
+name = "curl"
+[rod]
+length = 0.18036061661600392
+[rod.section]
+type = "tapered"
+base_radius = 0.005680292969901653
+tip_radius = 0.00114526615809169
+[rod.material]
+type = "neo_hookean"
+mu = 968931.9312573951
+[[chambers]]
+pressure = 14063751.582675714
+area = 2.1858839179201836e-07
+offset = [7.943667500113832e-05, 0.0005177715291846196]
+"""
+    )
+    target = robot.solve(integrator="adaptive", rtol=1e-10, atol=1e-12).tip_position
+    far = softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))
+
+    def miss(solver=None):
+        walled = softrod.Robot(
+            robot.rod, chambers=list(robot.chambers), obstacles=[far], solver=solver or {}
+        )
+        with pytest.raises(softrod.TargetUnreachableError) as info:
+            softrod.inverse_statics(walled, target)
+        return info.value.distance
+
+    with pytest.raises(softrod.TargetUnreachableError) as plain:
+        softrod.inverse_statics(robot, target)
+    fine = miss({"steps": 1280})
+    assert plain.value.distance < 1e-8 and fine < 1e-8
+    assert miss() < 1e-8

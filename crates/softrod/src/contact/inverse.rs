@@ -17,11 +17,11 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use super::{solve_constrained, ContactSolution, Obstacle};
-use crate::cosserat::mesh::{mesh_verdict, rk4_position_error};
-use crate::cosserat::statics::{Integrator, SolveOptions, DEFAULT_RK4_STEPS};
+use crate::cosserat::mesh::rk4_position_error;
+use crate::cosserat::statics::SolveOptions;
 use crate::error::{Error, Result};
 use crate::inverse::{
-    on_finer_mesh, solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution,
+    mesh_controlled, solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution,
     InverseWarmStart, Target,
 };
 use crate::model::{Actuation, RobotModel};
@@ -264,34 +264,40 @@ pub fn contact_inverse_resolved(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, ContactForward)> {
-    let mut fwd = ContactForward::new(model, solve, obstacles)?;
-    let out = solve_contact_inverse(&mut fwd, target, options, warm)?;
-    let Integrator::Rk4 { steps } = solve.integrator else {
-        return Ok((out, fwd));
-    };
-    let last = fwd
-        .solution
-        .as_ref()
-        .filter(|s| s.solution.tensions() == out.tensions())
-        .filter(|s| s.solution.pressures() == out.pressures());
-    let error = match last {
-        Some(s) => rk4_position_error(&s.solution),
-        None => match fwd.solve(&out.actuation) {
+    mesh_controlled(
+        solve,
+        options,
+        warm,
+        |so, io, w| {
+            let mut fwd = ContactForward::new(model, so, obstacles)?;
+            let out = solve_contact_inverse(&mut fwd, target, io, w)?;
+            Ok((out, fwd))
+        },
+        |fwd, a| fwd.mesh_error(a),
+    )
+}
+
+impl ContactForward {
+    /// The estimated tip error of the RK4 mesh at the actuation `a`, relative to the length
+    /// ([`rk4_position_error`] of the contact solution there: the last one, else solved and
+    /// kept); NaN where it cannot be solved.
+    pub fn mesh_error(&mut self, a: &[f64]) -> f64 {
+        let at_a = |s: &&ContactSolution| {
+            let nt = s.solution.tensions().len();
+            s.solution.tensions() == a[..nt] && s.solution.pressures() == a[nt..]
+        };
+        if let Some(s) = self.solution.as_ref().filter(at_a) {
+            return rk4_position_error(&s.solution);
+        }
+        match self.solve(a) {
             Ok(s) => {
                 let e = rk4_position_error(&s.solution);
-                fwd.solution = Some(s);
+                self.solution = Some(s);
                 e
             }
             Err(_) => f64::NAN,
-        },
-    };
-    let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
-        return Ok((out, fwd));
-    };
-    let (fine, from) = on_finer_mesh(solve, finer, &out);
-    let mut fwd = ContactForward::new(model, &fine, obstacles)?;
-    let out = solve_contact_inverse(&mut fwd, target, options, Some(&from))?;
-    Ok((out, fwd))
+        }
+    }
 }
 
 /// The inverse statics of `model` among the frictionless `obstacles` for a tip `target` (the

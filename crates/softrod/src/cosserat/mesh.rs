@@ -69,7 +69,7 @@ pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
 /// (its solution, if it converges, is returned; else the default mesh's outcome).
 ///
 /// # Errors
-/// As [`solve_statics_at`]; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter)
+/// As [`solve_statics_at`]; [`Error::InvalidParameter`]
 /// naming `steps` for a chosen RK4 mesh
 /// whose estimated tip-position error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
 pub fn solve_at_output(
@@ -171,13 +171,13 @@ const RESOLVED_POSITION_TARGET: f64 = 1e-8;
 /// solve that holds a statics solution (`statics` of the result: the solution itself, a
 /// contact or a frictional solution). On a mesh the solve chose (`ours`: the default one or
 /// its refinement), a solve that does not converge is tried again on a mesh
-/// [`RETRY_REFINEMENT`] times finer (a tight curl the mesh cannot march may converge there; its
+/// eight times finer (a tight curl the mesh cannot march may converge there; its
 /// result if it converges, else the first outcome); then the converged solution's mesh is
 /// judged ([`mesh_verdict`]): too coarse for the shape, `solve` is called again on the finer
 /// mesh, whose result returns; a chosen mesh that is meaningless is an error naming `steps`.
 ///
 /// # Errors
-/// `solve`'s; [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming
+/// `solve`'s; [`Error::InvalidParameter`] naming
 /// `steps` for a chosen mesh whose estimated tip error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
 pub fn with_mesh_control<T>(
     options: &SolveOptions,
@@ -281,7 +281,7 @@ fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
 /// mesh); on a chosen mesh, above [`CHOSEN_MESH_POSITION_LIMIT`], an error naming `steps`.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`](crate::error::Error::InvalidParameter) naming `steps` as above.
+/// [`Error::InvalidParameter`] naming `steps` as above.
 pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> crate::error::Result<Option<usize>> {
     if error.is_nan() {
         return Ok(None);

@@ -6,17 +6,16 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use super::{on_finer_mesh, uniform, InverseWarmStart, Target};
+use super::{mesh_controlled, uniform, InverseWarmStart, Target};
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
 use crate::cosserat::equations::{Column, Equations, Workspace};
-use crate::cosserat::mesh::{mesh_verdict, rk4_position_error};
+use crate::cosserat::mesh::rk4_position_error;
 use crate::cosserat::sensitivity::{
     actuation_jacobians, integrate, scheme_of, Linearisation, Request, Seed,
 };
 use crate::cosserat::shooting::{Node, Shooting};
 use crate::cosserat::statics::{
     assemble, solve_statics, Integrator, SolveOptions, StaticsSolution, WarmStart,
-    DEFAULT_RK4_STEPS,
 };
 use crate::error::{Error, Result};
 use crate::model::loads::{Frame, PointLoad};
@@ -415,39 +414,17 @@ fn inverse_resolved(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, CosseratForward)> {
-    let mut fwd = CosseratForward::new(model, solve, target.s.as_deref())?;
-    let first = solve_inverse(&mut fwd, target, options, warm);
-    let Integrator::Rk4 { steps } = solve.integrator else {
-        return first.map(|out| (out, fwd));
-    };
-    // A target missed on a mesh too coarse for the shape may be the mesh's verdict: the mesh
-    // is judged where the iteration stopped (found again without the error).
-    let (out, mut fwd, missed) = match first {
-        Ok(out) => (out, fwd, None),
-        Err(e @ (Error::TargetUnreachable { .. } | Error::NotConverged { .. })) => {
-            let quiet = InverseOptions {
-                throw: false,
-                ..options.clone()
-            };
-            let mut again = CosseratForward::new(model, solve, target.s.as_deref())?;
-            match solve_inverse(&mut again, target, &quiet, warm) {
-                Ok(last) => (last, again, Some(e)),
-                Err(_) => return Err(e),
-            }
-        }
-        Err(e) => return Err(e),
-    };
-    let error = fwd.mesh_error(&out.actuation).unwrap_or(f64::NAN);
-    let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
-        return match missed {
-            Some(e) => Err(e),
-            None => Ok((out, fwd)),
-        };
-    };
-    let (fine, from) = on_finer_mesh(solve, finer, &out);
-    let mut fwd = CosseratForward::new(model, &fine, target.s.as_deref())?;
-    let out = solve_inverse(&mut fwd, target, options, Some(&from))?;
-    Ok((out, fwd))
+    mesh_controlled(
+        solve,
+        options,
+        warm,
+        |so, io, w| {
+            let mut fwd = CosseratForward::new(model, so, target.s.as_deref())?;
+            let out = solve_inverse(&mut fwd, target, io, w)?;
+            Ok((out, fwd))
+        },
+        |fwd, a| fwd.mesh_error(a).unwrap_or(f64::NAN),
+    )
 }
 
 /// [`inverse_actuation`] and the statics solution at the actuation found (on the mesh of the

@@ -85,8 +85,9 @@ mod uniform;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use crate::cosserat::statics::{Integrator, SolveOptions};
-use crate::error::Result;
+use crate::cosserat::mesh::mesh_verdict;
+use crate::cosserat::statics::{Integrator, SolveOptions, DEFAULT_RK4_STEPS};
+use crate::error::{Error, Result};
 
 pub use cosserat::{inverse_actuation, inverse_statics, CosseratForward};
 pub(crate) use problem::{check_options, check_target};
@@ -169,8 +170,8 @@ pub struct InverseOptions {
     pub rotation_weight: Option<f64>,
     /// Cap on the iterations.
     pub max_iterations: usize,
-    /// `true`: a target out of reach is [`Error::TargetUnreachable`](crate::Error::TargetUnreachable); non-convergence is
-    /// [`Error::NotConverged`](crate::Error::NotConverged). `false`: returned with `converged == false`.
+    /// `true`: a target out of reach is [`Error::TargetUnreachable`]; non-convergence is
+    /// [`Error::NotConverged`]. `false`: returned with `converged == false`.
     pub throw: bool,
 }
 
@@ -305,23 +306,65 @@ impl From<InverseSolution> for InverseWarmStart {
     }
 }
 
-/// The solve options on `steps` RK4 steps and the warm start from the answer `out` with which
-/// the inverse runs again on a finer mesh (its evaluation, of the coarser mesh, dropped: the
-/// finer one evaluates the answer again).
-pub(crate) fn on_finer_mesh(
+/// An inverse statics `run` (on the solve options, with the inverse options and warm start
+/// given; it returns the result and its forward model) under the mesh control of a forward
+/// solve at its answer: on the default RK4 mesh, an answer whose estimated tip error
+/// (`mesh_error` of the forward model there, relative to the length) exceeds
+/// [`DEFAULT_MESH_POSITION_LIMIT`](crate::cosserat::mesh::DEFAULT_MESH_POSITION_LIMIT) makes
+/// the inverse run again on a finer mesh from the answer (its actuation and Hessian; its
+/// evaluation, of the coarser mesh, dropped), whose result returns; on a chosen mesh, one
+/// above [`CHOSEN_MESH_POSITION_LIMIT`](crate::cosserat::mesh::CHOSEN_MESH_POSITION_LIMIT) is
+/// an error naming `steps`. A target missed (`TargetUnreachable`, `NotConverged`) is judged
+/// where the iteration stopped (run again without the error), since the verdict may be the
+/// coarse mesh's.
+///
+/// # Errors
+/// `run`'s; `steps` as above.
+pub(crate) fn mesh_controlled<F>(
     solve: &SolveOptions,
-    steps: usize,
-    out: &InverseSolution,
-) -> (SolveOptions, InverseWarmStart) {
+    options: &InverseOptions,
+    warm: Option<&InverseWarmStart>,
+    mut run: impl FnMut(
+        &SolveOptions,
+        &InverseOptions,
+        Option<&InverseWarmStart>,
+    ) -> Result<(InverseSolution, F)>,
+    mut mesh_error: impl FnMut(&mut F, &[f64]) -> f64,
+) -> Result<(InverseSolution, F)> {
+    let first = run(solve, options, warm);
+    let Integrator::Rk4 { steps } = solve.integrator else {
+        return first;
+    };
+    let (out, mut fwd, missed) = match first {
+        Ok((out, fwd)) => (out, fwd, None),
+        Err(e @ (Error::TargetUnreachable { .. } | Error::NotConverged { .. })) => {
+            let quiet = InverseOptions {
+                throw: false,
+                ..options.clone()
+            };
+            match run(solve, &quiet, warm) {
+                Ok((last, again)) => (last, again, Some(e)),
+                Err(_) => return Err(e),
+            }
+        }
+        Err(e) => return Err(e),
+    };
+    let error = mesh_error(&mut fwd, &out.actuation);
+    let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
+        return match missed {
+            Some(e) => Err(e),
+            None => Ok((out, fwd)),
+        };
+    };
     let fine = SolveOptions {
-        integrator: Integrator::Rk4 { steps },
+        integrator: Integrator::Rk4 { steps: finer },
         ..*solve
     };
     let from = InverseWarmStart {
         evaluation: None,
-        ..InverseWarmStart::from(out)
+        ..InverseWarmStart::from(&out)
     };
-    (fine, from)
+    run(&fine, options, Some(&from))
 }
 
 impl From<&InverseSolution> for InverseWarmStart {
