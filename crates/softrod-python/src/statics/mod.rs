@@ -351,7 +351,7 @@ fn solve<'py>(py: Python<'py>, source: Source<'py>, k: Keywords<'py>) -> PyResul
     } else {
         let (r, c) = run(py, "solve_statics", || {
             if constrained {
-                let default = options.integrator == softrod::SolveOptions::default().integrator;
+                let default = options.integrator.is_default_mesh();
                 let c = softrod::cosserat::mesh::with_mesh_control(
                     &options,
                     default,

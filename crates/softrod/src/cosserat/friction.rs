@@ -439,7 +439,7 @@ pub fn solve_frictional_checked(
     options: &FrictionOptions,
     previous: Option<&FrictionalSolution>,
 ) -> Result<FrictionalSolution> {
-    let default = matches!(options.statics.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
+    let default = options.statics.integrator.is_default_mesh();
     let mut statics = options.statics;
     if let Some(Integrator::Rk4 { steps }) = previous.map(|p| p.statics.options.integrator) {
         if default && steps > DEFAULT_RK4_STEPS {
@@ -452,13 +452,17 @@ pub fn solve_frictional_checked(
         default,
         |o| {
             if o.integrator != on && previous.is_some() {
+                let steps = |i: &Integrator| match i {
+                    Integrator::Rk4 { steps } => format!("{steps} RK4 steps"),
+                    Integrator::Adaptive(_) => "the adaptive mesh".to_owned(),
+                };
                 return Err(Error::invalid(
                     "previous",
-                    format!("a state on {on:?}"),
+                    format!("a state on {}", steps(&on)),
                     format!(
-                        "a state on a mesh that resolves this shape ({:?}: solve the history \
-                         on it with steps=, or start from rest)",
-                        o.integrator
+                        "a state on a mesh that resolves this shape ({}: solve the history on \
+                         it with steps=, or start from rest)",
+                        steps(&o.integrator)
                     ),
                 ));
             }

@@ -56,87 +56,54 @@ pub fn rk4_position_error(solution: &StaticsSolution) -> f64 {
 /// `2π`.
 pub const OUTPUT_ROTATION_TARGET: f64 = 1e-9;
 
-/// [`solve_statics_at`] with the values at `s_out` under error control at the default RK4
-/// mesh: the problem is solved on the default mesh, its rotational truncation error estimated
-/// ([`rk4_rotation_error`]) and, above [`OUTPUT_ROTATION_TARGET`], solved again with `s_out` on
-/// a mesh `m` times finer (warm-started; `m` from the fourth-order convergence, at most 32),
-/// whose steps the returned solution's options record; a default solve that does not
-/// converge is tried on a mesh eight times finer, and refined from there the same way. Other
-/// integrators and meshes are [`solve_statics_at`] as they are. Without `s_out`, an RK4
-/// solution whose mesh cannot resolve its shape is refined or refused (on the default mesh,
-/// above [`DEFAULT_MESH_POSITION_LIMIT`]; on another, above [`CHOSEN_MESH_POSITION_LIMIT`]), and a
-/// solve that does not converge on the default mesh is tried again on one eight times finer
-/// (its solution, if it converges, is returned; else the default mesh's outcome).
+/// [`solve_statics_at`] under the mesh control of [`with_mesh_control`]: an RK4 solution
+/// whose mesh cannot resolve its shape is refined (the default mesh, above
+/// [`DEFAULT_MESH_POSITION_LIMIT`], and a default solve that does not converge is tried on
+/// one eight times finer) or refused (a chosen mesh, above [`CHOSEN_MESH_POSITION_LIMIT`]).
+/// With `s_out`, the shape is solved at the mesh's nodes first; at the default mesh its
+/// rotational truncation error ([`rk4_rotation_error`]) is estimated there and, above
+/// [`OUTPUT_ROTATION_TARGET`], the values at `s_out` are solved on a mesh `m` times finer
+/// (warm-started; `m` from the fourth-order convergence, up to 32 times the default mesh),
+/// whose steps the returned solution's options record. The adaptive integrator is
+/// [`solve_statics_at`] as it is.
 ///
 /// # Errors
-/// As [`solve_statics_at`]; [`Error::InvalidParameter`]
-/// naming `steps` for a chosen RK4 mesh
+/// As [`solve_statics_at`]; [`Error::InvalidParameter`] naming `steps` for a chosen RK4 mesh
 /// whose estimated tip-position error exceeds [`CHOSEN_MESH_POSITION_LIMIT`].
 pub fn solve_at_output(
     model: &std::sync::Arc<crate::model::RobotModel>,
     actuation: &crate::model::Actuation,
-    options: &crate::cosserat::statics::SolveOptions,
+    options: &SolveOptions,
     s_out: &[f64],
-) -> crate::error::Result<StaticsSolution> {
-    let default =
-        matches!(options.integrator, Integrator::Rk4 { steps } if steps == DEFAULT_RK4_STEPS);
+) -> Result<StaticsSolution> {
+    let ours = options.integrator.is_default_mesh();
+    let solve_on = |o: &SolveOptions| solve_statics_at(model, actuation, o, &[]);
     if s_out.is_empty() {
-        return with_mesh_control(
-            options,
-            default,
-            |o| solve_statics_at(model, actuation, o, &[]),
-            |s| s,
-        );
+        return with_mesh_control(options, ours, solve_on, |s| s);
     }
-    if !default {
-        if !matches!(options.integrator, Integrator::Rk4 { .. }) {
-            return solve_statics_at(model, actuation, options, s_out);
-        }
-        // A chosen mesh is judged on the shape solved at its nodes, then the values at `s_out`
-        // are solved from that solution (one or two Newton iterations).
-        let mut quiet = *options;
-        quiet.newton.throw = true;
-        let judged = with_mesh_control(
-            &quiet,
-            false,
-            |o| solve_statics_at(model, actuation, o, &[]),
-            |s| s,
-        );
-        let mut warm = *options;
-        match judged {
-            Err(e) if matches!(&e, Error::InvalidParameter { name, .. } if name == "steps") => {
-                return Err(e)
-            }
-            Ok(mesh) => {
-                warm.warm_start = Some(mesh.warm_start());
-                warm.seek_stable = false;
-            }
-            Err(_) => {}
-        }
-        return solve_statics_at(model, actuation, &warm, s_out);
+    if !matches!(options.integrator, Integrator::Rk4 { .. }) {
+        return solve_statics_at(model, actuation, options, s_out);
     }
+    // The shape at the mesh's nodes, under the mesh control.
     let mut quiet = *options;
     quiet.newton.throw = true;
-    // The shape on the default mesh, or on the finer one a failed default solve is tried on.
-    let (mesh, steps) = match solve_statics_at(model, actuation, &quiet, &[]) {
-        Ok(mesh) => (mesh, DEFAULT_RK4_STEPS),
-        Err(crate::error::Error::NotConverged { .. }) => {
-            let steps = RETRY_REFINEMENT * DEFAULT_RK4_STEPS;
-            quiet.integrator = Integrator::Rk4 { steps };
-            match solve_statics_at(model, actuation, &quiet, &[]) {
-                Ok(mesh) => (mesh, steps),
-                Err(_) => return solve_statics_at(model, actuation, options, s_out),
-            }
+    let mesh = match with_mesh_control(&quiet, ours, solve_on, |s| s) {
+        Ok(mesh) => mesh,
+        Err(e) if matches!(&e, Error::InvalidParameter { name, .. } if name == "steps") => {
+            return Err(e)
         }
         Err(_) => return solve_statics_at(model, actuation, options, s_out),
     };
+    let Integrator::Rk4 { steps } = mesh.options.integrator else {
+        return solve_statics_at(model, actuation, options, s_out);
+    };
     let error = rk4_rotation_error(&mesh);
-    let m = if error.is_nan() || error <= OUTPUT_ROTATION_TARGET {
+    let m = if !ours || error.is_nan() || error <= OUTPUT_ROTATION_TARGET {
         1
     } else {
         ((error / OUTPUT_ROTATION_TARGET).powf(0.25).ceil() as usize).clamp(2, MAX_REFINEMENT)
     };
-    if m == 1 && steps == DEFAULT_RK4_STEPS {
+    if m == 1 && mesh.options.integrator == options.integrator {
         return solve_statics_at(model, actuation, options, s_out);
     }
     let mut fine = *options;
@@ -282,7 +249,7 @@ fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `steps` as above.
-pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> crate::error::Result<Option<usize>> {
+pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> Result<Option<usize>> {
     if error.is_nan() {
         return Ok(None);
     }

@@ -67,6 +67,12 @@ impl Integrator {
             _ => None,
         }
     }
+
+    /// Whether this is the default mesh ([`DEFAULT_RK4_STEPS`] RK4 steps), which a solve under
+    /// mesh control refines itself (see [`crate::cosserat::mesh`]); any other is chosen.
+    pub fn is_default_mesh(&self) -> bool {
+        *self == Integrator::default()
+    }
 }
 
 impl Default for Integrator {

@@ -161,18 +161,15 @@ impl CosseratForward {
     /// The estimated tip error of the RK4 mesh at the actuation `a`, relative to the length
     /// ([`rk4_position_error`](crate::cosserat::mesh::rk4_position_error)): from the last solution
     /// or the closed form of a uniform unloaded robot when they apply, else from the solution
-    /// at `a`; NaN for the adaptive integrator.
-    ///
-    /// # Errors
-    /// As [`CosseratForward::solve`].
-    pub fn mesh_error(&mut self, a: &[f64]) -> Result<f64> {
+    /// at `a`; NaN for the adaptive integrator or where it cannot be solved.
+    pub fn mesh_error(&mut self, a: &[f64]) -> f64 {
         if !matches!(self.options.integrator, Integrator::Rk4 { .. }) {
-            return Ok(f64::NAN);
+            return f64::NAN;
         }
         let (nt, _) = self.dims();
         let at_a = |s: &&StaticsSolution| s.tensions() == a[..nt] && s.pressures() == a[nt..];
         if let Some(sol) = self.solution.as_ref().filter(at_a) {
-            return Ok(rk4_position_error(sol));
+            return rk4_position_error(sol);
         }
         if self.uniform && a.len() == nt {
             let closed = uniform::position_error(
@@ -182,10 +179,11 @@ impl CosseratForward {
                 &mut self.uniform_ws,
             );
             if let Some(e) = closed {
-                return Ok(e);
+                return e;
             }
         }
-        Ok(rk4_position_error(&self.solve(a)?))
+        self.solve(a)
+            .map_or(f64::NAN, |sol| rk4_position_error(&sol))
     }
 }
 
@@ -423,7 +421,7 @@ fn inverse_resolved(
             let out = solve_inverse(&mut fwd, target, io, w)?;
             Ok((out, fwd))
         },
-        |fwd, a| fwd.mesh_error(a).unwrap_or(f64::NAN),
+        |fwd, a| fwd.mesh_error(a),
     )
 }
 

@@ -86,7 +86,7 @@ mod uniform;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use crate::cosserat::mesh::mesh_verdict;
-use crate::cosserat::statics::{Integrator, SolveOptions, DEFAULT_RK4_STEPS};
+use crate::cosserat::statics::{Integrator, SolveOptions};
 use crate::error::{Error, Result};
 
 pub use cosserat::{inverse_actuation, inverse_statics, CosseratForward};
@@ -350,7 +350,7 @@ pub(crate) fn mesh_controlled<F>(
         Err(e) => return Err(e),
     };
     let error = mesh_error(&mut fwd, &out.actuation);
-    let Some(finer) = mesh_verdict(error, steps, steps == DEFAULT_RK4_STEPS)? else {
+    let Some(finer) = mesh_verdict(error, steps, solve.integrator.is_default_mesh())? else {
         return match missed {
             Some(e) => Err(e),
             None => Ok((out, fwd)),
