@@ -626,6 +626,95 @@ offset = [0.0003565590886614968, 9.684793183689941e-05]
     assert np.linalg.norm(got.tip_position - ref) <= 1e-4 * 0.4
 
 
+_CURL_TOML = """
+name = "curl"
+[rod]
+length = 0.4004321480925477
+[rod.section]
+type = "tapered"
+base_radius = 0.005336149340969354
+tip_radius = 0.0012293510470560262
+[rod.material]
+type = "neo_hookean"
+mu = 35686.90457170585
+[[chambers]]
+pressure = 357086.2514575653
+area = 6.126080114978979e-07
+offset = [0.0003565590886614968, 9.684793183689941e-05]
+"""
+
+
+def _frictional_curl(scale):
+    """The tapered Neo-Hookean arm of `_CURL_TOML`, its chamber and a tendon with friction
+    (mu 0.05) scaled together: 0.4 turns at 0.15, 3.7 turns at 1."""
+    base = softrod.Robot.from_toml(_CURL_TOML)
+    tendon = softrod.Tendon(
+        (0.0004101559602322555, 0.00027241087980608915),
+        0.02775249556468293 * scale,
+        friction=0.05,
+    )
+    robot = softrod.Robot(base.rod, tendons=[tendon], chambers=list(base.chambers))
+    return robot.with_pressures([357086.2514575653 * scale])
+
+
+@pytest.mark.parametrize("scale", [0.15, 0.5, 1.0])
+def test_the_adaptive_friction_mesh_follows_the_curl(scale):
+    # With the adaptive integrator the friction mesh was 32 cells per interval whatever the
+    # shape: the capstan rule of a cell turning 9.3 rad (more than pi: its end tangents' angle
+    # aliases) put the tip 1.5e-3 L off and its tension 61 % high, reported converged; 0.76
+    # rad per cell (scale 0.15) 8.9e-6 L. Cells now turn by 0.25 rad at most. Oracle: RK4 on
+    # 10,240 steps (its friction mesh its nodes; 5,120 steps agree to 2.1e-8 L at scale 1,
+    # second order). Bound: 1e-5 L (measured 3.8e-6 to 4.2e-6 L, the second-order error of
+    # the 32 cells of the straighter part).
+    robot = _frictional_curl(scale)
+    length = 0.4004321480925477
+    ref = robot.solve(steps=10240)
+    got = robot.solve(**_ADAPTIVE)
+    assert got.converged
+    assert np.linalg.norm(got.tip_position - ref.tip_position) <= 1e-5 * length
+    tip = lambda sol: np.asarray(sol.tendon_tension)[-1, 0]  # noqa: E731
+    assert abs(tip(got) - tip(ref)) <= 1e-3 * tip(ref)
+    # Every cell turns by at most 0.25 rad on the returned shape (|u| at the cell's ends).
+    k = np.linalg.norm(np.asarray(got.u), axis=1)
+    assert (np.diff(got.s) * np.maximum(k[1:], k[:-1])).max() <= 0.25
+
+
+def test_a_displacement_controlled_frictional_curl_is_solved_on_the_chosen_mesh():
+    # The whole curl with its tendon held at the displacement the tension gives: the base
+    # tension is solved for, every evaluation a frictional solve on one mesh, and the mesh
+    # refined between such solves. Oracle: RK4 on 5,120 steps; bound 1e-5 L (measured 1.2e-6).
+    robot = _frictional_curl(1.0)
+    pulled = robot.solve(steps=5120)
+    d = list(pulled.tendon_displacements)
+    got = robot.solve(displacements=d, **_ADAPTIVE)
+    ref = robot.solve(displacements=d, steps=5120)
+    assert np.linalg.norm(got.tip_position - ref.tip_position) <= 1e-5 * 0.4004321480925477
+    assert abs(got.tensions[0] - ref.tensions[0]) <= 1e-4 * ref.tensions[0]
+
+
+def test_a_history_on_an_adaptive_friction_mesh_is_carried_onto_a_finer_one():
+    # Loaded from rest to 0.5 of the curl, then to the whole curl from that state: the second
+    # shape needs a finer friction mesh than the first state's; the history (the tension
+    # profile, read between the nodes as the solve reads it) is carried onto it. Oracle: the
+    # same two solves on RK4 with 5,120 steps (its friction mesh its nodes). Bound: 1e-5 L.
+    length = 0.4004321480925477
+    first = _frictional_curl(0.5).solve(**_ADAPTIVE)
+    first_ref = _frictional_curl(0.5).solve(steps=5120)
+    then = _frictional_curl(1.0).solve(previous=first, **_ADAPTIVE)
+    then_ref = _frictional_curl(1.0).solve(previous=first_ref, steps=5120)
+    assert len(then.s) > len(first.s)
+    assert np.linalg.norm(then.tip_position - then_ref.tip_position) <= 1e-5 * length
+    # And back down to 0.5 from the curled state, slipping toward the tip where it unloads.
+    # This state converges slowly with the mesh: RK4 on 640, 1,280 and 2,560 steps is 1.3e-5,
+    # 1.3e-5 and 2.6e-5 L from 10,240 steps (5,120 agree with them to 3.8e-9 L); bound 5e-5 L
+    # (measured 3.6e-5 L on the 135 nodes the history carries).
+    back = _frictional_curl(0.5).solve(previous=then, **_ADAPTIVE)
+    back_ref = _frictional_curl(0.5).solve(previous=then_ref, steps=5120)
+    assert np.linalg.norm(back.tip_position - back_ref.tip_position) <= 5e-5 * length
+    # Hysteresis: the unloaded state is not the loaded one.
+    assert np.linalg.norm(back.tip_position - first.tip_position) > 1e-4 * length
+
+
 def test_a_chosen_mesh_too_coarse_for_the_shape_is_named_with_s_out_and_when_it_fails():
     # 8 RK4 steps turning a curled tendon arm by radians each: refused naming `steps` without
     # `s_out`, but with `s_out` returned converged with its tip 5.8 % of L off; and on a

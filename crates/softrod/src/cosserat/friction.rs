@@ -128,8 +128,9 @@ impl Slip {
 /// the tension, the slip state, the path tangent and the friction force on the rod.
 #[derive(Debug, Clone)]
 pub struct FrictionalSolution {
-    /// The rod's solution, at the nodes of the friction mesh ([`friction_mesh`]); its
-    /// actuation carries the tension profile.
+    /// The rod's solution, at the nodes of the friction mesh ([`friction_mesh`], or the one
+    /// the adaptive integrator chose: `cosserat::friction_mesh`); its actuation carries the
+    /// tension profile.
     pub statics: StaticsSolution,
     /// Tension (N) per node and tendon, `[node][tendon]`; `0` beyond a tendon's termination.
     pub tension: Vec<Vec<f64>>,
@@ -151,10 +152,11 @@ pub struct FrictionalSolution {
     pub guides: Vec<Vec<GuideState>>,
     /// Marches: 1 for an unloaded model, one per quasi-Newton iterate of a loaded one; the
     /// rod solves of the fixed point when it was used (summed over the rod solves of the
-    /// guide fixed point with guided tendons).
+    /// guide fixed point with guided tendons; over the meshes the adaptive integrator tried).
     pub iterations: usize,
     /// Integration steps over the cells of the friction mesh, all rod solves and repeated
-    /// cells together (a rod solve without friction takes one per cell and Newton iteration).
+    /// cells together (a rod solve without friction takes one per cell and Newton iteration;
+    /// over the meshes the adaptive integrator tried).
     pub cell_steps: usize,
     /// Last relative change of the profile.
     pub change: f64,
@@ -409,18 +411,22 @@ fn previous_profile<'p>(
     let Some(p) = previous else {
         return Ok(None);
     };
-    if p.statics.s != mesh || p.tension.first().map_or(0, Vec::len) != nt {
-        return Err(Error::invalid(
-            "previous",
-            format!("a solution on {} nodes", p.statics.s.len()),
-            format!(
-                "a frictional solution of the same robot and integrator ({} nodes, {nt} \
-                 tendons)",
-                mesh.len()
-            ),
-        ));
+    if p.tension.len() != mesh.len() || p.tension.first().map_or(0, Vec::len) != nt {
+        return Err(wrong_previous(p, mesh.len(), nt));
     }
     Ok(Some(p.tension.as_slice()))
+}
+
+/// The error of a `previous` state that is not of this robot and integrator (`nodes` on its
+/// mesh, `nt` tendons).
+fn wrong_previous(p: &FrictionalSolution, nodes: usize, nt: usize) -> Error {
+    Error::invalid(
+        "previous",
+        format!("a solution on {} nodes", p.statics.s.len()),
+        format!(
+            "a frictional solution of the same robot and integrator ({nodes} nodes, {nt} tendons)"
+        ),
+    )
 }
 
 /// [`solve_frictional`] under the mesh control of a forward solve
@@ -479,36 +485,109 @@ pub fn solve_frictional_checked(
 /// Solves the statics of `model` under `actuation` with capstan friction along the tendons
 /// (see the module documentation), from the state `previous` (a solution of the same model
 /// and options: the history of stick and slip) or from rest (`None`: every element slides
-/// toward the base).
+/// toward the base). With the adaptive integrator the friction mesh is chosen by the shape's
+/// turning (`friction_mesh` module): it starts from that of `previous` (whose history is
+/// carried onto any finer one) or from [`ADAPTIVE_FRICTION_NODES`] cells per interval.
 ///
 /// # Errors
 /// What [`solve_statics_at`] reports; [`Error::InvalidParameter`] naming `previous` if it is
 /// on another mesh, or `friction.tolerance` / `friction.max_iterations`;
 /// [`Error::NotConverged`] if the fixed point does not converge (`what` says so, `iterations`
-/// are the rod solves, `residual` the last relative change of the profile).
+/// are the rod solves, `residual` the last relative change of the profile), or if the
+/// adaptive friction mesh still has a cell turning by more than
+/// [`ADAPTIVE_FRICTION_TURN`](super::friction_mesh::ADAPTIVE_FRICTION_TURN) after
+/// [`MAX_FRICTION_MESH_ROUNDS`](super::friction_mesh::MAX_FRICTION_MESH_ROUNDS) refinements
+/// (`residual` that turn, rad).
 pub fn solve_frictional(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
     options: &FrictionOptions,
     previous: Option<&FrictionalSolution>,
 ) -> Result<FrictionalSolution> {
+    use super::friction_mesh::{
+        finer_mesh, history_on, is_friction_mesh, ADAPTIVE_FRICTION_TURN, MAX_FRICTION_MESH_ROUNDS,
+    };
     check_inputs(model, actuation, options)?;
+    if model.tendons().iter().any(Tendon::is_guided) {
+        // Its rod solves (the guide forces point loads, breaks of their own) choose their
+        // meshes themselves.
+        let mesh = friction_mesh(model, &options.statics.integrator);
+        return solve_on(model, actuation, options, previous, &mesh);
+    }
+    let adaptive = matches!(options.statics.integrator, Integrator::Adaptive(_));
+    let frictional = model.tendons().iter().any(|t| t.friction() > 0.0);
+    let mut mesh = match previous {
+        Some(p) if adaptive && is_friction_mesh(model, &p.statics.s) => p.statics.s.clone(),
+        _ => friction_mesh(model, &options.statics.integrator),
+    };
+    if let Some(p) = previous.filter(|p| p.statics.s != mesh) {
+        return Err(wrong_previous(p, mesh.len(), model.tendons().len()));
+    }
+    if !(adaptive && frictional) {
+        return solve_on(model, actuation, options, previous, &mesh);
+    }
+    let (mut largest, mut iterations, mut cell_steps) = (f64::NAN, 0, 0);
+    for round in 0..=MAX_FRICTION_MESH_ROUNDS {
+        // The history on a finer mesh than its own: its profile read at the new nodes.
+        let carried = previous.filter(|p| p.statics.s != mesh).map(|p| {
+            let mut q = p.clone();
+            q.tension = history_on(p, &mesh);
+            q
+        });
+        let history = carried.as_ref().or(previous);
+        let mut sol = solve_on(model, actuation, options, history, &mesh)?;
+        // (The effort of every round is reported.)
+        iterations += sol.iterations;
+        cell_steps += sol.cell_steps;
+        let (finer, turn) = finer_mesh(model, &sol.statics, &mesh);
+        largest = turn;
+        match finer {
+            None => {
+                (sol.iterations, sol.cell_steps) = (iterations, cell_steps);
+                return Ok(sol);
+            }
+            Some(f) if round < MAX_FRICTION_MESH_ROUNDS => mesh = f,
+            Some(_) => {}
+        }
+    }
+    Err(Error::NotConverged {
+        what: format!(
+            "friction: a cell of the adaptive friction mesh ({} nodes) still turns by \
+             {largest:.3} rad > {ADAPTIVE_FRICTION_TURN} after {MAX_FRICTION_MESH_ROUNDS} \
+             refinements",
+            mesh.len()
+        ),
+        iterations,
+        residual: largest,
+        load_factor: 1.0,
+    })
+}
+
+/// [`solve_frictional`] on the friction mesh `mesh` (m), `previous` (if any) on it.
+pub(super) fn solve_on(
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &FrictionOptions,
+    previous: Option<&FrictionalSolution>,
+    mesh: &[f64],
+) -> Result<FrictionalSolution> {
     if actuation.has_held() {
-        return super::friction_held::solve_held_frictional(model, actuation, options, previous);
+        return super::friction_held::solve_held_frictional(
+            model, actuation, options, previous, mesh,
+        );
     }
     if model.tendons().iter().any(Tendon::is_guided) {
         return super::guides::solve_guided(model, actuation, options, previous);
     }
     let nt = model.tendons().len();
     let base = actuation.tension_values(nt);
-    let mesh = friction_mesh(model, &options.statics.integrator);
-    let prev = previous_profile(previous, &mesh, nt)?;
+    let prev = previous_profile(previous, mesh, nt)?;
     if options.single_march {
         let setup = Setup {
             model,
             actuation,
             options,
-            mesh: &mesh,
+            mesh,
             base: &base,
             prev,
         };
@@ -522,11 +601,13 @@ pub fn solve_frictional(
         .max(f64::MIN_POSITIVE);
     // The first profile: the rule on the previous shape, or the base tensions.
     let mut tau = match previous {
+        // (A history carried onto a finer mesh starts from its own profile there.)
+        Some(p) if p.statics.s != mesh => p.tension.clone(),
         Some(p) => {
             let dirs = tangents(model, &p.statics);
             profile_on(model, &p.statics, &dirs, &base, prev).0
         }
-        None => base_profile(model, &mesh, &base),
+        None => base_profile(model, mesh, &base),
     };
     let mut statics_options = options.statics;
     // Without external loads the zero base wrench is exact (docs/statics.md): no warm start.
@@ -538,8 +619,8 @@ pub fn solve_frictional(
     let mut anderson = Anderson::new(true);
     loop {
         let mut act = actuation.clone();
-        act.profile = Some(Arc::new(to_profile(model, &mesh, &tau)));
-        let sol = solve_statics_at(model, &act, &statics_options, &mesh)?;
+        act.profile = Some(Arc::new(to_profile(model, mesh, &tau)));
+        let sol = solve_statics_at(model, &act, &statics_options, mesh)?;
         iterations += 1;
         let dirs = tangents(model, &sol);
         let (next, slip) = profile_on(model, &sol, &dirs, &base, prev);
@@ -555,7 +636,7 @@ pub fn solve_frictional(
         if delta <= options.tolerance {
             let forces = friction_forces(&sol.s, &next, &dirs);
             let tangent = tangent_rows(&dirs);
-            let path_length = node_path_lengths(model, &act, &statics_options, &mesh, &sol)?;
+            let path_length = node_path_lengths(model, &act, &statics_options, mesh, &sol)?;
             return Ok(FrictionalSolution {
                 guides: vec![Vec::new(); nt],
                 path_length,

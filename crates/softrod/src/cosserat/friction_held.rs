@@ -23,7 +23,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector};
 
 use super::displacement::held_of;
-use super::friction::{solve_frictional, FrictionOptions, FrictionalSolution};
+use super::friction::{solve_on, FrictionOptions, FrictionalSolution};
 use super::shooting::Held;
 use crate::error::{Error, Result};
 use crate::model::{Actuation, RobotModel, TendonInput};
@@ -52,16 +52,18 @@ fn first_tensions(
 }
 
 /// Solves the frictional statics of `model` with displacement-controlled tendons (see the
-/// module documentation), from the state `previous` or from rest.
+/// module documentation) on the friction mesh `mesh` (m), from the state `previous` (on it)
+/// or from rest.
 ///
 /// # Errors
-/// What [`solve_frictional`] reports; [`Error::NotConverged`] if the base tensions do not
+/// What [`solve_on`] reports; [`Error::NotConverged`] if the base tensions do not
 /// settle in [`HELD_MAX_ITERATIONS`] iterations.
 pub(super) fn solve_held_frictional(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
     options: &FrictionOptions,
     previous: Option<&FrictionalSolution>,
+    mesh: &[f64],
 ) -> Result<FrictionalSolution> {
     let nt = model.tendons().len();
     let reference = match &actuation.reference_lengths {
@@ -78,7 +80,7 @@ pub(super) fn solve_held_frictional(
         }
         let mut act = actuation.clone();
         act.tendons = t.iter().map(|&x| TendonInput::Tension(x)).collect();
-        let sol = solve_frictional(model, &act, options, previous)?;
+        let sol = solve_on(model, &act, options, previous, mesh)?;
         let g = DVector::from_fn(held.len(), |k, _| {
             let h = &held[k];
             h.target - sol.statics.tendon_lengths[h.tendon] + h.compliance * tau[k]

@@ -13,6 +13,7 @@ mod friction_cell;
 mod friction_held;
 pub mod friction_linear;
 mod friction_march;
+pub mod friction_mesh;
 mod guides;
 mod hyperelastic_local;
 pub mod mesh;
