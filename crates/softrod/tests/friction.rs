@@ -30,8 +30,13 @@ fn options(steps: usize) -> FrictionOptions {
 /// A stiff precurved rod (steel, 5 mm radius, rest curvature κ0 about body y) with one tendon
 /// on the inside of the curve; tensions of 0.1 mN keep the shape within 1e-9 of the arc.
 fn arc_model(mu: f64) -> Arc<RobotModel> {
+    arc_model_of(mu, LENGTH)
+}
+
+/// [`arc_model`] of another `length` (m).
+fn arc_model_of(mu: f64, length: f64) -> Arc<RobotModel> {
     let rod = Rod::new(
-        LENGTH,
+        length,
         Section::circular(0.005).unwrap(),
         LinearElastic::new(2e11, 0.3).unwrap(),
     )
@@ -338,7 +343,7 @@ fn bad_friction_is_a_named_error() {
             .unwrap_err();
         assert!(e.to_string().contains("friction"), "{e}");
     }
-    // A previous state of another robot is refused by name.
+    // A previous state of another robot (shorter, or with another tendon) is refused by name.
     let a = solve_frictional(
         &arc_model(0.1),
         &Actuation::tensions(&[1e-4]),
@@ -346,14 +351,18 @@ fn bad_friction_is_a_named_error() {
         None,
     )
     .unwrap();
-    let e = solve_frictional(
-        &arc_model(0.1),
-        &Actuation::tensions(&[1e-4]),
-        &options(60),
-        Some(&a),
-    )
-    .unwrap_err();
-    assert!(e.to_string().contains("previous"), "{e}");
+    let shorter = arc_model_of(0.1, 0.8 * LENGTH);
+    let two = {
+        let m = arc_model(0.1);
+        let mut tendons = m.tendons().to_vec();
+        tendons.push(Tendon::constant([-0.004, 0.0], None).unwrap());
+        RobotModel::new(m.rod().clone(), tendons, Vec::new(), Loads::default()).unwrap()
+    };
+    for (other, t) in [(shorter, vec![1e-4]), (two, vec![1e-4, 0.0])] {
+        let e =
+            solve_frictional(&other, &Actuation::tensions(&t), &options(50), Some(&a)).unwrap_err();
+        assert!(e.to_string().contains("previous"), "{e}");
+    }
     let _ = SolveOptions::default();
 }
 

@@ -431,14 +431,13 @@ fn wrong_previous(p: &FrictionalSolution, nodes: usize, nt: usize) -> Error {
 
 /// [`solve_frictional`] under the mesh control of a forward solve
 /// ([`with_mesh_control`](super::mesh::with_mesh_control)): on the default RK4 mesh, a
-/// shape it does not resolve is solved again on a finer one (from rest, as asked); a `previous`
-/// state on a finer RK4 mesh (one this control chose) sets the mesh, since the history of
-/// stick and slip lives on it.
+/// shape it does not resolve is solved again on a finer one, from the same history (carried
+/// onto it: the profile of `previous` read at its nodes as the solve reads it); a `previous`
+/// state on a finer RK4 mesh (one this control chose) sets the mesh.
 ///
 /// # Errors
 /// As [`solve_frictional`]; [`Error::InvalidParameter`] naming `steps` for a chosen mesh that
-/// cannot resolve the shape, or `previous` when the shape needs a mesh finer than the one its
-/// history is on.
+/// cannot resolve the shape.
 pub fn solve_frictional_checked(
     model: &Arc<RobotModel>,
     actuation: &Actuation,
@@ -452,26 +451,10 @@ pub fn solve_frictional_checked(
             statics.integrator = Integrator::Rk4 { steps };
         }
     }
-    let on = statics.integrator;
     super::mesh::with_mesh_control(
         &statics,
         default,
         |o| {
-            if o.integrator != on && previous.is_some() {
-                let steps = |i: &Integrator| match i {
-                    Integrator::Rk4 { steps } => format!("{steps} RK4 steps"),
-                    Integrator::Adaptive(_) => "the adaptive mesh".to_owned(),
-                };
-                return Err(Error::invalid(
-                    "previous",
-                    format!("a state on {}", steps(&on)),
-                    format!(
-                        "a state on a mesh that resolves this shape ({}: solve the history on \
-                         it with steps=, or start from rest)",
-                        steps(&o.integrator)
-                    ),
-                ));
-            }
             let fo = FrictionOptions {
                 statics: *o,
                 ..*options
@@ -485,13 +468,15 @@ pub fn solve_frictional_checked(
 /// Solves the statics of `model` under `actuation` with capstan friction along the tendons
 /// (see the module documentation), from the state `previous` (a solution of the same model
 /// and options: the history of stick and slip) or from rest (`None`: every element slides
-/// toward the base). With the adaptive integrator the friction mesh is chosen by the shape's
-/// turning (`friction_mesh` module): it starts from that of `previous` (whose history is
-/// carried onto any finer one) or from [`ADAPTIVE_FRICTION_NODES`] cells per interval.
+/// toward the base). A `previous` state on another mesh (other RK4 steps) has its history,
+/// the tension profile read as the solve reads it, carried onto this one. With the adaptive
+/// integrator the friction mesh is chosen by the shape's turning (`friction_mesh` module): it
+/// starts from that of `previous` or from [`ADAPTIVE_FRICTION_NODES`] cells per interval.
 ///
 /// # Errors
 /// What [`solve_statics_at`] reports; [`Error::InvalidParameter`] naming `previous` if it is
-/// on another mesh, or `friction.tolerance` / `friction.max_iterations`;
+/// not a state of this robot (its nodes not a friction mesh of it, other tendons), or
+/// `friction.tolerance` / `friction.max_iterations`;
 /// [`Error::NotConverged`] if the fixed point does not converge (`what` says so, `iterations`
 /// are the rod solves, `residual` the last relative change of the profile), or if the
 /// adaptive friction mesh still has a cell turning by more than
@@ -516,24 +501,36 @@ pub fn solve_frictional(
     }
     let adaptive = matches!(options.statics.integrator, Integrator::Adaptive(_));
     let frictional = model.tendons().iter().any(|t| t.friction() > 0.0);
-    let mut mesh = match previous {
-        Some(p) if adaptive && is_friction_mesh(model, &p.statics.s) => p.statics.s.clone(),
-        _ => friction_mesh(model, &options.statics.integrator),
-    };
-    if let Some(p) = previous.filter(|p| p.statics.s != mesh) {
+    if let Some(p) = previous.filter(|p| !is_friction_mesh(model, &p.statics.s)) {
+        let mesh = friction_mesh(model, &options.statics.integrator);
         return Err(wrong_previous(p, mesh.len(), model.tendons().len()));
     }
+    let mut mesh = match previous {
+        Some(p) if adaptive => p.statics.s.clone(),
+        _ => friction_mesh(model, &options.statics.integrator),
+    };
+    // The history on another mesh than its own (RK4 steps other than the state's, a finer
+    // adaptive mesh): its profile read at the nodes of this one.
+    let on = |mesh: &[f64]| {
+        previous.filter(|p| p.statics.s != mesh).map(|p| {
+            let mut q = p.clone();
+            q.tension = history_on(p, mesh);
+            q
+        })
+    };
     if !(adaptive && frictional) {
-        return solve_on(model, actuation, options, previous, &mesh);
+        let carried = on(&mesh);
+        return solve_on(
+            model,
+            actuation,
+            options,
+            carried.as_ref().or(previous),
+            &mesh,
+        );
     }
     let (mut largest, mut iterations, mut cell_steps) = (f64::NAN, 0, 0);
     for round in 0..=MAX_FRICTION_MESH_ROUNDS {
-        // The history on a finer mesh than its own: its profile read at the new nodes.
-        let carried = previous.filter(|p| p.statics.s != mesh).map(|p| {
-            let mut q = p.clone();
-            q.tension = history_on(p, &mesh);
-            q
-        });
+        let carried = on(&mesh);
         let history = carried.as_ref().or(previous);
         let mut sol = solve_on(model, actuation, options, history, &mesh)?;
         // (The effort of every round is reported.)
