@@ -729,6 +729,48 @@ def test_a_history_on_an_adaptive_friction_mesh_is_carried_onto_a_finer_one():
     assert np.linalg.norm(back.tip_position - first.tip_position) > 1e-4 * length
 
 
+def test_a_soft_arm_pressed_onto_a_plane_is_solved_on_the_mesh_its_curl_needs():
+    # A soft arm (0.37 m, E 10.5 MPa) curled by two tendons and pressed onto a plane: the
+    # default solve refines its mesh for the curl, and on meshes finer than 1.2 mm the contact
+    # solve failed (its check between the nodes added contacts in one cell next to the kink of
+    # the shearable backbone without end): a ConvergenceError after 5.6 s, while 320 and 640
+    # steps converged in milliseconds. Oracle: 640 chosen steps; bound 1e-4 L (the mesh
+    # control's); measured 2.5e-7 m.
+    robot = softrod.Robot.from_toml(
+        """
+name = "pressed"
+[rod]
+length = 0.3690821757359716
+[rod.section]
+type = "tapered"
+base_radius = 0.005744967655878824
+tip_radius = 0.0056872651556404315
+[rod.material]
+type = "linear"
+youngs_modulus = 10543184.136131344
+poisson_ratio = 0.36599269107709165
+[[tendons]]
+tension = 108.754920214864
+offset = [0.0008529250982936978, 0.0010378918948175035]
+[[tendons]]
+tension = 0.0
+offset = [-0.00103524000042526, 0.000551268967112326]
+[[tendons]]
+tension = 92.4270689031148
+offset = [0.000565454170044816, -0.004225781057125604]
+[[obstacles]]
+type = "plane"
+point = [0.019468490651460453, -0.037279679141238094, 0.0]
+normal = [-0.462906559550684, 0.8864070831874872, 0.0]
+"""
+    )
+    ref = robot.solve(steps=640)
+    got = robot.solve()
+    assert got.converged and len(got.s) > 41 and got.contacts
+    assert np.linalg.norm(got.tip_position - ref.tip_position) <= 1e-4 * 0.3690821757359716
+    assert all(c["normal_force"] > 0 for c in got.contacts)
+
+
 def test_a_chosen_mesh_too_coarse_for_the_shape_is_named_with_s_out_and_when_it_fails():
     # 8 RK4 steps turning a curled tendon arm by radians each: refused naming `steps` without
     # `s_out`, but with `s_out` returned converged with its tip 5.8 % of L off; and on a

@@ -132,6 +132,11 @@ fn merge_plane(
         if a >= l {
             continue;
         }
+        // An interval reaches the tip: where the rod leaves the plane beyond the contacts
+        // they stay points.
+        if !belt::on_obstacle(p, o, (a, l), belt::clearance(p)) {
+            continue;
+        }
         let mu = p.obstacles[o].friction();
         if mu > 0.0 {
             p.refused = Some(mu);
@@ -300,6 +305,12 @@ pub(super) fn active_set(
     let fs = p.model.force_scale();
     let penetration = 10.0 * opts.tolerance * l;
     let mut x = correct(p, x, opts, effort)?;
+    // Where contacts were added from the check between the nodes: a cell is checked once
+    // (next to the kink of a shearable backbone at a contact, the arc interpolated through it
+    // dips below the obstacle again after every contact added there: docs/contact.md).
+    let mut tried: Vec<(usize, f64)> = Vec::new();
+    let cell = belt::clearance(p) * 1e3;
+    let near = |a: f64, b: f64| (a - b).abs() <= cell;
     for _ in 0..MAX_ACTIVE_SET_ROUNDS {
         // Release the most negative contact force (a sticking one slides first, below).
         let forces = p.normal_forces(&x);
@@ -338,8 +349,10 @@ pub(super) fn active_set(
             continue;
         }
         let mut added = candidates(p, &forces, penetration);
-        if added.is_empty() {
+        let in_cells = added.is_empty();
+        if in_cells {
             added = cell_candidates(p, &forces, penetration);
+            added.retain(|&(o, _, s)| !tried.iter().any(|&(to, ts)| to == o && near(ts, s)));
         }
         // Next to a contact on a curved obstacle, with the rod on it in between: a belt.
         if let Some(plan) = belt::plan(p, &forces, &added, belt::clearance(p)) {
@@ -380,6 +393,9 @@ pub(super) fn active_set(
         }
         if added.is_empty() {
             return Some(x);
+        }
+        if in_cells {
+            tried.extend(added.iter().map(|&(o, _, s)| (o, s)));
         }
         x = add_contacts(p, x, added, opts, effort)?;
     }

@@ -213,7 +213,7 @@ pub(super) struct Plan {
 
 /// Whether the rod lies on obstacle `o` between the arc lengths `s0` and `s1` in the last
 /// pass: no node strictly between them is clear of it by more than `clear` (m).
-fn on_obstacle(p: &Constrained<'_>, o: usize, (s0, s1): (f64, f64), clear: f64) -> bool {
+pub(super) fn on_obstacle(p: &Constrained<'_>, o: usize, (s0, s1): (f64, f64), clear: f64) -> bool {
     let (lo, hi) = (s0.min(s1), s0.max(s1));
     p.gaps(o)
         .iter()
