@@ -18,6 +18,11 @@ use crate::solve::{
 /// Most rounds of the active-set loop (contacts added or released) per load step.
 pub const MAX_ACTIVE_SET_ROUNDS: usize = 40;
 
+/// Most contacts on one obstacle: a rod lying along a plane away from its tip (not modelled:
+/// an interval reaches the tip) would otherwise take a point contact at every node it
+/// touches.
+pub const MAX_POINT_CONTACTS: usize = 16;
+
 /// Most continuation steps tried (accepted or halved) when new contacts' gaps are relaxed to
 /// zero ([`relax`]). Over the contact tests, the relaxations that succeed take 1 to 12 (174 of
 /// 207 one); those that fail took 14 to 36, halving from the full relaxation to the smallest
@@ -396,6 +401,15 @@ pub(super) fn active_set(
         }
         if in_cells {
             tried.extend(added.iter().map(|&(o, _, s)| (o, s)));
+        }
+        // A stretch lying on an obstacle away from the tip is not modelled (see `merge_plane`):
+        // it would take a point contact at every node it touches.
+        let crowded = (0..p.obstacles.len()).any(|o| {
+            let here = p.active.iter().filter(|a| a.obstacle == o).count();
+            here + added.iter().filter(|a| a.0 == o).count() > MAX_POINT_CONTACTS
+        });
+        if crowded {
+            return None;
         }
         x = add_contacts(p, x, added, opts, effort)?;
     }
