@@ -3,14 +3,15 @@
 //! The capstan rule of a cell is exact on an arc whose tangent turns by less than π; where
 //! the curvature varies along the cell (a tapered curl) the tension inside the cell errs by
 //! the square of the cell's length, and the turning taken between its end tangents (their
-//! angle, which cannot exceed π) aliases once the cell turns further. With RK4 the friction mesh is the integrator's nodes, and
-//! the mesh control refines both together; with the adaptive integrator the friction mesh
-//! starts at [`ADAPTIVE_FRICTION_NODES`](super::friction::ADAPTIVE_FRICTION_NODES) cells per
-//! interval and every cell a frictional tendon runs through that turns by more than
+//! angle, which cannot exceed π) aliases once the cell turns further. With RK4 the friction
+//! mesh is the integrator's nodes, and the mesh control refines both together; with the
+//! adaptive integrator the friction mesh starts at
+//! [`ADAPTIVE_FRICTION_NODES`](super::friction::ADAPTIVE_FRICTION_NODES) cells per interval
+//! and every cell a frictional tendon runs through that turns by more than
 //! [`ADAPTIVE_FRICTION_TURN`] on the solved shape is divided, and the robot solved again on
-//! the finer mesh, until none does. A finer mesh keeps every node of the coarser one, so a
-//! previous state's tension profile (interpolated geometrically between its nodes, as the
-//! solve reads it) carries its history onto it exactly.
+//! the finer mesh, until none does. A previous state's history, its tension profile read
+//! between its nodes as the solve reads it, is carried onto another mesh ([`history_on`]):
+//! exactly onto a finer adaptive one, which keeps every node of the coarser.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -109,10 +110,10 @@ pub fn is_friction_mesh(model: &RobotModel, mesh: &[f64]) -> bool {
             .all(|b| mesh.binary_search_by(|m| m.total_cmp(b)).is_ok())
 }
 
-/// The tension profile of `previous` (on its own mesh) at the nodes of `mesh`, a mesh
-/// holding all of its nodes: read between them as the solve reads a profile
-/// ([`TensionProfile::at`]: geometrically, linearly next to a zero tension where a tendon
-/// ends).
+/// The tension profile of `previous` (on its own mesh) at the nodes of `mesh`: read between
+/// its nodes as the solve reads a profile ([`TensionProfile::at`]: geometrically, linearly
+/// next to a zero tension where a tendon ends); the same profile where `mesh` holds all of
+/// its nodes.
 pub fn history_on(previous: &FrictionalSolution, mesh: &[f64]) -> Vec<Vec<f64>> {
     let s = &previous.statics.s;
     let nt = previous.tension.first().map_or(0, Vec::len);
