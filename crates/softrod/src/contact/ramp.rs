@@ -455,7 +455,14 @@ pub(super) fn stepped(
     // Tip contacts about to close on the next step, from the tip's gaps at the last two.
     let mut near: Vec<(usize, Site, f64)> = Vec::new();
     let mut tip_gaps: Vec<f64> = Vec::new();
+    let mut attempts = 0;
     while lambda < 1.0 {
+        // (The load steps of the options bound the steps tried, accepted or halved.)
+        attempts += 1;
+        if attempts > opts.max_load_steps {
+            (p.path, p.approach) = (None, None);
+            return Err(x);
+        }
         let next = (lambda + step).min(1.0);
         let sig = signature(p);
         let along = secant.as_ref().filter(|(_, xb, _)| xb.len() == x.len());
