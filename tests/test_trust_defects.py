@@ -604,42 +604,6 @@ def test_a_curl_the_default_mesh_cannot_resolve_is_solved_on_a_finer_one_with_fr
         assert np.linalg.norm(a.tip_position - b.tip_position) <= 1e-4 * 0.4
 
 
-def test_a_curl_the_default_mesh_cannot_march_is_tried_on_a_finer_one_with_obstacles():
-    # A tapered Neo-Hookean arm (0.4 m, 5.3 to 1.2 mm) curled 3.8 turns by a chamber and a
-    # tendon (740 1/m at the tip): on the default mesh the free solve fails and is tried on one
-    # eight times finer; with a plane 1 m away (never touched) the contact path made no such
-    # retry and raised a ConvergenceError. Oracle: the adaptive integrator; bound 1e-4 L.
-    robot = softrod.Robot.from_toml(
-        """
-name = "curl"
-[rod]
-length = 0.4004321480925477
-[rod.section]
-type = "tapered"
-base_radius = 0.005336149340969354
-tip_radius = 0.0012293510470560262
-[rod.material]
-type = "neo_hookean"
-mu = 35686.90457170585
-[[tendons]]
-tension = 0.02775249556468293
-offset = [0.0004101559602322555, 0.00027241087980608915]
-[[chambers]]
-pressure = 357086.2514575653
-area = 6.126080114978979e-07
-offset = [0.0003565590886614968, 9.684793183689941e-05]
-"""
-    )
-    far = softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))
-    walled = softrod.Robot(
-        robot.rod, tendons=list(robot.tendons), chambers=list(robot.chambers), obstacles=[far]
-    )
-    ref = robot.solve(**_ADAPTIVE).tip_position
-    got = walled.solve()
-    assert got.converged and not got.contacts
-    assert np.linalg.norm(got.tip_position - ref) <= 1e-4 * 0.4
-
-
 _CURL_TOML = """
 name = "curl"
 [rod]
@@ -658,17 +622,36 @@ offset = [0.0003565590886614968, 9.684793183689941e-05]
 """
 
 
-def _frictional_curl(scale):
-    """The tapered Neo-Hookean arm of `_CURL_TOML`, its chamber and a tendon with friction
-    (mu 0.05) scaled together: 0.4 turns at 0.15, 3.7 turns at 1."""
+def _curl(scale, friction=0.0, obstacles=None):
+    """The tapered Neo-Hookean arm of `_CURL_TOML`, its chamber and a tendon (with `friction`)
+    scaled together: 0.4 turns at 0.15, 3.7 turns at 1."""
     base = softrod.Robot.from_toml(_CURL_TOML)
     tendon = softrod.Tendon(
         (0.0004101559602322555, 0.00027241087980608915),
         0.02775249556468293 * scale,
-        friction=0.05,
+        friction=friction,
     )
-    robot = softrod.Robot(base.rod, tendons=[tendon], chambers=list(base.chambers))
+    robot = softrod.Robot(
+        base.rod, tendons=[tendon], chambers=list(base.chambers), obstacles=obstacles or []
+    )
     return robot.with_pressures([357086.2514575653 * scale])
+
+
+def _frictional_curl(scale):
+    """`_curl` with a tendon friction of 0.05."""
+    return _curl(scale, friction=0.05)
+
+
+def test_a_curl_the_default_mesh_cannot_march_is_tried_on_a_finer_one_with_obstacles():
+    # The tapered Neo-Hookean arm of `_CURL_TOML` curled 3.7 turns by its chamber and a tendon
+    # (740 1/m at the tip): on the default mesh the free solve fails and is tried on one
+    # eight times finer; with a plane 1 m away (never touched) the contact path made no such
+    # retry and raised a ConvergenceError. Oracle: the adaptive integrator; bound 1e-4 L.
+    far = softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))
+    ref = _curl(1.0).solve(**_ADAPTIVE).tip_position
+    got = _curl(1.0, obstacles=[far]).solve()
+    assert got.converged and not got.contacts
+    assert np.linalg.norm(got.tip_position - ref) <= 1e-4 * 0.4
 
 
 @pytest.mark.parametrize("scale", [0.15, 0.5, 1.0])
