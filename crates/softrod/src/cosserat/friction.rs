@@ -509,34 +509,27 @@ pub fn solve_frictional(
         Some(p) if adaptive => p.statics.s.clone(),
         _ => friction_mesh(model, &options.statics.integrator),
     };
-    // The history on another mesh than its own (RK4 steps other than the state's, a finer
-    // adaptive mesh): its profile read at the nodes of this one.
-    let on = |mesh: &[f64]| {
-        previous.filter(|p| p.statics.s != mesh).map(|p| {
-            let mut q = p.clone();
-            q.tension = history_on(p, mesh);
-            q
-        })
-    };
-    if !(adaptive && frictional) {
-        let carried = on(&mesh);
-        return solve_on(
-            model,
-            actuation,
-            options,
-            carried.as_ref().or(previous),
-            &mesh,
-        );
-    }
+    // The mesh is the shape's to choose with the adaptive integrator and a frictional tendon.
+    let chooses = adaptive && frictional;
     let (mut largest, mut iterations, mut cell_steps) = (f64::NAN, 0, 0);
     for round in 0..=MAX_FRICTION_MESH_ROUNDS {
-        let carried = on(&mesh);
+        // The history on another mesh than its own (RK4 steps other than the state's, a finer
+        // adaptive mesh): its profile read at the nodes of this one.
+        let carried = previous.filter(|p| p.statics.s != mesh).map(|p| {
+            let mut q = p.clone();
+            q.tension = history_on(p, &mesh);
+            q
+        });
         let history = carried.as_ref().or(previous);
         let mut sol = solve_on(model, actuation, options, history, &mesh)?;
         // (The effort of every round is reported.)
         iterations += sol.iterations;
         cell_steps += sol.cell_steps;
-        let (finer, turn) = finer_mesh(model, &sol.statics, &mesh);
+        let (finer, turn) = if chooses {
+            finer_mesh(model, &sol.statics, &mesh)
+        } else {
+            (None, 0.0)
+        };
         largest = turn;
         match finer {
             None => {
