@@ -6,6 +6,7 @@ abort the interpreter today run in a subprocess (``harness/fuzz.py``).
 """
 
 import math
+import re
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
@@ -800,3 +801,70 @@ tip_force = [0.0046825961503964425, 0.008368720958967861, -0.002364326514424756]
         with pytest.raises(softrod.ParameterError) as info:
             curled.solve(steps=steps)
         assert info.value.parameter == "steps", str(info.value)
+
+
+def _helix_rod() -> softrod.Rod:
+    return softrod.Rod(0.4, softrod.CircularSection(5e-3), softrod.LinearElastic(5e6, 0.3))
+
+
+@pytest.mark.parametrize("pitch", [0.02, 0.005])
+def test_a_helical_tendon_the_default_mesh_cannot_follow_is_solved_on_a_finer_one(pitch):
+    # A helix of 20 or 80 turns on a 0.4 m rod: on the 40-step mesh each step turns the routing
+    # by pi or 4 pi and RK4 misses its loads (tip 4e-5 m and 2.3e-2 m off, reported converged);
+    # the mesh control counts the routing's turn as it counts the backbone's. Oracle: the
+    # adaptive integrator (error-controlled Dormand-Prince).
+    tendon = [softrod.Tendon.helical(2e-3, pitch, 1.0)]
+    got = softrod.solve_statics(_helix_rod(), tendon)
+    ref = softrod.solve_statics(_helix_rod(), tendon, integrator="adaptive", rtol=1e-10, atol=1e-12)
+    assert len(got.s) > 41
+    assert np.linalg.norm(got.tip_position - ref.tip_position) < 1e-7 * 0.4
+    assert np.isfinite(got.tendon_displacements).all()
+
+
+@pytest.mark.parametrize("pitch", [1e-6, 1e-300])
+def test_a_helix_no_rk4_mesh_can_follow_is_refused_naming_steps(pitch):
+    # 4e5 turns and more (1e-300: an infinite tendon, whose displacement was NaN, reported
+    # converged): refused on the default mesh and on a chosen one.
+    tendon = [softrod.Tendon.helical(2e-3, pitch, 1.0)]
+    for kw in ({}, {"steps": 640}):
+        with pytest.raises(softrod.ParameterError, match="steps") as e:
+            softrod.solve_statics(_helix_rod(), tendon, **kw)
+        assert e.value.parameter == "steps"
+        assert "adaptive" in str(e.value)
+
+
+@pytest.mark.parametrize("scale", [1e-30, 1e-20, 1e20])
+def test_the_inverse_depends_on_the_ratios_of_its_weights_only(scale):
+    # Minimising sum w_i a_i^2 has the same minimiser for every common factor of the weights;
+    # with [1e-20] * 6 the step test, in the weighted norm, stopped the iteration early and a
+    # reachable target was reported unreachable (1.6e-9 m; 0.2 m with 1e-30).
+    robot = softrod.examples.load("niti_two_segment")
+    target = 0.9 * robot.solve().tip_position
+    weights = [1.0, 2.0, 1.0, 3.0, 1.0, 2.0]
+    ref = softrod.inverse_statics(robot, target, weights=weights)
+    got = softrod.inverse_statics(robot, target, weights=[scale * w for w in weights])
+    assert got.position_error < 1e-9
+    np.testing.assert_allclose(got.tensions, ref.tensions, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("radius", [3e-4, 5e-4, 6e-4, 6.5e-4, 7e-4])
+@pytest.mark.parametrize("z", [0.05, 0.1234])
+def test_a_sphere_around_the_rod_at_rest_is_refused_whatever_its_size(radius, z):
+    # The check sampled the rest backbone at points about 1.6 mm apart: a sphere of radius
+    # 0.6 mm centred on it fell between two samples, and the solve went on (a bare
+    # ConvergenceError unactuated, a converged answer through the sphere actuated). The
+    # backbone's arcs between the nodes are now searched for their least gap.
+    robot = softrod.examples.load("niti_two_segment")
+    sphere = softrod.Sphere((0.0, 0.0, z), radius)
+    for tensions in (np.zeros(6), None):
+        with pytest.raises(softrod.ParameterError, match="clear of the rod at rest") as e:
+            robot.solve(tensions, obstacles=[sphere])
+        assert e.value.parameter == "obstacles[0]"
+        # The depth reported is the sphere's radius (its centre is on the backbone) where the
+        # backbone passes its centre.
+        depth, s = (
+            float(v)
+            for v in re.search(r"lies (\S+) m inside it at s = (\S+) m", str(e.value)).groups()
+        )
+        assert depth == pytest.approx(radius, rel=1e-3)
+        assert s == pytest.approx(z, abs=1e-4)

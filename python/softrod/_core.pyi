@@ -494,6 +494,10 @@ class StaticsSolution:
     ) -> dict[str, Any]:
         """Exact derivatives of the equilibrium (pose per unit of each parameter, world)."""
     @property
+    def steps(self) -> int | None:
+        """RK4 steps of the mesh solved on (a refined default solve: its finer mesh); None
+        with the adaptive integrator."""
+    @property
     def stats(self) -> dict[str, float | int | bool]: ...
     def __len__(self) -> int: ...
 

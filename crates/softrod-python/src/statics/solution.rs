@@ -376,6 +376,16 @@ impl StaticsSolution {
         }
         py.detach(|| self.inner.stability_margin())
     }
+    /// The RK4 steps of the mesh this solution was solved on (a default solve refined for a
+    /// shape the default 40 steps cannot resolve reports its finer mesh); `None` with the
+    /// adaptive integrator.
+    #[getter]
+    fn steps(&self) -> Option<usize> {
+        match self.inner.options.integrator {
+            softrod::Integrator::Rk4 { steps } => Some(steps),
+            _ => None,
+        }
+    }
     /// Solver statistics: iterations, residual, function_evaluations, load_steps, load_factor,
     /// converged.
     #[getter]

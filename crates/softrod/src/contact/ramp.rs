@@ -246,9 +246,10 @@ pub(super) fn rest_nodes<'a>(p: &'a mut Constrained<'_>) -> Option<&'a [Node]> {
 
 /// The rod must start clear of every obstacle: an obstacle its unactuated, unloaded backbone
 /// lies in (the base in a plane's solid side, a sphere around the rod) leaves no load path
-/// out of it, and no contact set at load factor 0. Checked at the nodes of `p`'s mesh and at
-/// the crossing check's samples (between the nodes, for obstacles thinner than a cell); the
-/// backbone may lie on a surface (a rod mounted on a plane through its base).
+/// out of it, and no contact set at load factor 0. Checked at the nodes of `p`'s mesh and
+/// along the arcs between them (the least gap of each cell's cubic arc, so that an obstacle
+/// of any size the backbone runs through is found); the backbone may lie on a surface (a rod
+/// mounted on a plane through its base).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `obstacles[i]`, with the depth and where.
@@ -256,41 +257,59 @@ pub(super) fn check_rest_clear(p: &mut Constrained<'_>) -> crate::error::Result<
     if p.obstacles.is_empty() {
         return Ok(());
     }
-    let (s, _) = samples(p);
     let depth = 1e-9 * p.model.length();
     let obstacles = p.obstacles;
     let Some(nodes) = rest_nodes(p) else {
         // Not integrable: the solve reports that.
         return Ok(());
     };
-    let points = nodes
-        .iter()
-        .map(|n| (n.s, v3(&n.y, 0)))
-        .chain(s.iter().copied().zip(positions_on(nodes, &s)));
-    for (sk, x) in points {
-        for (i, o) in obstacles.iter().enumerate() {
-            let d = o.distance(&x).0;
-            if d < -depth {
-                let kind = match o.shape() {
-                    Obstacle::Plane { .. } => "a plane",
-                    Obstacle::Sphere { .. } => "a sphere",
-                    Obstacle::Capsule { .. } => "a capsule",
-                    Obstacle::Cylinder { .. } => "a cylinder",
-                    _ => "a mesh",
-                };
-                return Err(Error::invalid(
-                    format!("obstacles[{i}]"),
-                    kind,
-                    format!(
-                        "clear of the rod at rest (its unactuated, unloaded backbone lies \
-                         {:.3e} m inside it at s = {sk:.4} m, ({:.4}, {:.4}, {:.4}) m)",
-                        -d, x.x, x.y, x.z
-                    ),
-                ));
-            }
+    for (i, o) in obstacles.iter().enumerate() {
+        if let Some((sk, x, d)) = deepest_at_rest(o, nodes, depth) {
+            let kind = match o.shape() {
+                Obstacle::Plane { .. } => "a plane",
+                Obstacle::Sphere { .. } => "a sphere",
+                Obstacle::Capsule { .. } => "a capsule",
+                Obstacle::Cylinder { .. } => "a cylinder",
+                _ => "a mesh",
+            };
+            return Err(Error::invalid(
+                format!("obstacles[{i}]"),
+                kind,
+                format!(
+                    "clear of the rod at rest (its unactuated, unloaded backbone lies \
+                     {:.3e} m inside it at s = {sk:.4} m, ({:.4}, {:.4}, {:.4}) m)",
+                    -d, x.x, x.y, x.z
+                ),
+            ));
         }
     }
     Ok(())
+}
+
+/// The first place (arc length, m; point, m; gap, m) where the backbone through `nodes` lies
+/// deeper than `depth` (m) in `o`: a node, or the least gap of the cubic arc of a cell.
+fn deepest_at_rest(o: &Obstacle, nodes: &[Node], depth: f64) -> Option<(f64, Vector3<f64>, f64)> {
+    let gap = |n: &Node| o.distance(&v3(&n.y, 0)).0;
+    if let Some(n) = nodes.first().filter(|n| gap(n) < -depth) {
+        return Some((n.s, v3(&n.y, 0), gap(n)));
+    }
+    nodes.windows(2).find_map(|w| {
+        let (a, b) = (&w[0], &w[1]);
+        let (ga, gb) = (gap(a), gap(b));
+        if gb < -depth {
+            return Some((b.s, v3(&b.y, 0), gb));
+        }
+        let h = b.s - a.s;
+        if h <= 0.0 {
+            return None;
+        }
+        let (ea, eb) = (
+            CellEnd::at_node(&a.y, h, 0.0),
+            CellEnd::at_node(&b.y, h, 0.0),
+        );
+        let (t, g) = least_gap_in_cell(o, (&ea, ga), (&eb, gb), -depth)?;
+        Some((a.s + t * h, arc_point(&ea, &eb, t), g))
+    })
 }
 
 /// Whether one of the contacts `added` (obstacle, site, arc length) to `p`'s last pass lies

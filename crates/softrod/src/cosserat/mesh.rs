@@ -8,7 +8,10 @@
 //! [`solve_at_output`] (the statics solve of the Python API, sweeps and workspace maps),
 //! [`with_mesh_control`] (solves with obstacles or tendon friction) and the inverse statics
 //! judge the mesh by [`mesh_verdict`]: the default mesh is refined above
-//! [`DEFAULT_MESH_POSITION_LIMIT`], a chosen one refused above [`CHOSEN_MESH_POSITION_LIMIT`].
+//! [`DEFAULT_MESH_POSITION_LIMIT`], a chosen one (or the finest default refinement) refused
+//! above [`CHOSEN_MESH_POSITION_LIMIT`]. The turn of a step is the backbone's or, where it is
+//! faster, that of a helical tendon's routing (RK4 integrates its loads as it integrates the
+//! rotations).
 
 use crate::cosserat::statics::{
     solve_statics_at, Integrator, SolveOptions, StaticsSolution, DEFAULT_RK4_STEPS,
@@ -27,7 +30,8 @@ pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
 }
 
 /// Per step of the RK4 march of `solution`: its start (m) and its rotation error `θ⁵ / 120`
-/// (rad), `θ = h max(|u_i|, |u_{i+1}|)`.
+/// (rad), `θ = h max(|u_i|, |u_{i+1}|, ω)` with `ω` the fastest turn rate of a loaded tendon's
+/// routing on the step ([`routing_rate`]).
 fn step_errors(solution: &StaticsSolution) -> impl Iterator<Item = (f64, f64)> + '_ {
     let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     solution
@@ -35,9 +39,25 @@ fn step_errors(solution: &StaticsSolution) -> impl Iterator<Item = (f64, f64)> +
         .windows(2)
         .zip(solution.u.windows(2))
         .map(move |(s, u)| {
-            let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1]));
+            let rate = routing_rate(solution, s[0]);
+            let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1])).max(rate);
             (s[0], theta.powi(5) / 120.0)
         })
+}
+
+/// The fastest turn rate (rad/m) at `s` (m) of the routing of a tendon of `solution` that
+/// carries tension there ([`Tendon::turn_rate`](crate::model::Tendon::turn_rate): a helix's
+/// `2π / |pitch|`): RK4 integrates the loads of a helical tendon as it integrates the
+/// rotations, and misses them as badly where a step turns the helix by a radian or more.
+fn routing_rate(solution: &StaticsSolution, s: f64) -> f64 {
+    solution
+        .model
+        .tendons()
+        .iter()
+        .zip(&solution.tendon_tensions)
+        .filter(|(t, &tension)| tension != 0.0 && t.end().is_none_or(|e| s < e))
+        .map(|(t, _)| t.turn_rate())
+        .fold(0.0, f64::max)
 }
 
 /// Estimated truncation error of the tip position of the RK4 march of `solution`, relative
@@ -203,10 +223,16 @@ fn controlled<T>(
     if !sol.stats.converged {
         return Ok(outcome);
     }
-    match mesh_verdict(rk4_position_error(sol), steps, ours)? {
-        Some(finer) => solve(&on(finer)),
-        None => Ok(outcome),
+    let Some(finer) = mesh_verdict(rk4_position_error(sol), steps, ours)? else {
+        return Ok(outcome);
+    };
+    let refined = solve(&on(finer))?;
+    let sol = statics(&refined);
+    if sol.stats.converged {
+        // (One refinement: the finest mesh only judged whether it resolves the shape at all.)
+        mesh_verdict(rk4_position_error(sol), most, ours)?;
     }
+    Ok(refined)
 }
 
 /// The estimated tip error ([`rk4_position_error`], relative to the length) of an RK4 march
@@ -233,7 +259,7 @@ fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
                 .zip(&curvature[first..])
                 .take_while(|(s, _)| **s <= a + h + slack)
                 .map(|(_, u)| *u)
-                .fold(0.0, f64::max);
+                .fold(routing_rate(solution, a), f64::max);
             error += (h * most).powi(5) / 120.0 * (length - a) / length;
         }
     }
@@ -245,7 +271,8 @@ fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
 /// resolves the shape (or `error` is NaN). On a mesh the solve chose (`ours`: the default
 /// one or its refinement), above [`DEFAULT_MESH_POSITION_LIMIT`]: a mesh `m` times finer (`m`
 /// from the fourth-order convergence toward 1e-8, at least 2, up to 32 times the default
-/// mesh); on a chosen mesh, above [`CHOSEN_MESH_POSITION_LIMIT`], an error naming `steps`.
+/// mesh); on a chosen mesh, and on the finest the solve chooses, above
+/// [`CHOSEN_MESH_POSITION_LIMIT`], an error naming `steps`.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `steps` as above.
@@ -261,7 +288,9 @@ pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> Result<Option<usize
             .min(most);
         return Ok(Some(finer));
     }
-    if !ours && error > CHOSEN_MESH_POSITION_LIMIT {
+    // (Also the finest mesh the solve would choose: a shape it cannot resolve either, such as
+    // a helical tendon of thousands of turns, is as meaningless.)
+    if error > CHOSEN_MESH_POSITION_LIMIT {
         return Err(meaningless(steps, error));
     }
     Ok(None)
@@ -271,15 +300,24 @@ pub fn mesh_verdict(error: f64, steps: usize, ours: bool) -> Result<Option<usize
 /// to the length) exceeds [`CHOSEN_MESH_POSITION_LIMIT`], with the steps that resolve it.
 fn meaningless(steps: usize, error: f64) -> Error {
     let refinement = (error / RESOLVED_POSITION_TARGET).powf(0.25).ceil();
+    let needed = steps as f64 * refinement;
+    let remedy = if needed <= 1e7 {
+        format!(
+            "about {needed:.0} steps resolve it to 1e-8 (or use the default mesh, which \
+             refines itself up to {} steps, or the adaptive integrator)",
+            MAX_REFINEMENT * DEFAULT_RK4_STEPS
+        )
+    } else {
+        "no RK4 mesh of a sensible size resolves it (use the adaptive integrator)".to_owned()
+    };
     Error::invalid(
         "steps",
         steps,
         format!(
             "enough RK4 steps to resolve the shape: on these the tip's position errs by about \
              {error:.2e} of the length (Σ θ⁵/120 (L - s)/L over the steps, θ the turn of a \
-             step), and the shape is meaningless; about {:.0} steps resolve it to 1e-8 (or use \
-             the default mesh, which refines itself, or the adaptive integrator)",
-            steps as f64 * refinement
+             step of the backbone or of a helical tendon's routing), and the shape is \
+             meaningless; {remedy}"
         ),
     )
 }

@@ -150,8 +150,9 @@ impl Target {
 /// Options of the inverse statics (keyword arguments in Python).
 #[derive(Debug, Clone, PartialEq)]
 pub struct InverseOptions {
-    /// Weights `w_i > 0` of the actuation norm, one per tendon then per chamber (1/N², 1/Pa²);
-    /// `None`: the actuator-force norm (see the module documentation).
+    /// Weights `w_i > 0` of the actuation norm, one per tendon then per chamber (1/N², 1/Pa²;
+    /// only their ratios matter); `None`: the actuator-force norm (see the module
+    /// documentation).
     pub weights: Option<Vec<f64>>,
     /// Reference actuation `a_ref` (N, Pa); `None`: zero.
     pub reference: Option<Vec<f64>>,

@@ -70,11 +70,19 @@ impl<'a> Program<'a> {
             ));
         }
         let areas = forward.chamber_areas();
-        let weights: Vec<f64> = match &options.weights {
-            Some(w) => w.clone(),
-            None => (0..n)
-                .map(|i| if i < nt { 1.0 } else { areas[i - nt].powi(2) })
-                .collect(),
+        // (Only the ratios of given weights matter to the minimiser; scaled so that the
+        // largest equals the largest default weight, the step and stopping tests, which
+        // measure in the weighted norm, are those of the default weights.)
+        let default: Vec<f64> = (0..n)
+            .map(|i| if i < nt { 1.0 } else { areas[i - nt].powi(2) })
+            .collect();
+        let weights = match &options.weights {
+            Some(w) => {
+                let largest = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+                let k = largest(&default) / largest(w);
+                w.iter().map(|v| v * k).collect()
+            }
+            None => default,
         };
         let mut lo = vec![options.tension_bounds.0; nt];
         lo.extend(vec![options.pressure_bounds.0; nc]);

@@ -269,4 +269,14 @@ impl Tendon {
     pub fn end(&self) -> Option<f64> {
         self.end
     }
+
+    /// How fast the routing turns about the backbone (rad/m): `2π / |pitch|` for a helix, 0
+    /// for the other routings (a user function's rate is not known). The RK4 mesh must
+    /// follow it as it follows the backbone's curvature (`cosserat::mesh`).
+    pub fn turn_rate(&self) -> f64 {
+        match self.routing {
+            Routing::Helical { pitch, .. } => std::f64::consts::TAU / pitch.abs(),
+            _ => 0.0,
+        }
+    }
 }
