@@ -130,3 +130,22 @@ def test_non_convergence_raises_with_iterations_and_residual():
 def test_exceptions_are_exported():
     assert issubclass(softrod.ParameterError, ValueError)
     assert issubclass(softrod.ConvergenceError, RuntimeError)
+
+
+@pytest.mark.parametrize("ratio", [0.5, 0.6])
+def test_the_ode_method_refuses_tensions_whose_strain_it_cannot_resolve(ratio):
+    # From a = 1/2 the strain stays above -1 at every tension (it tends to -1/(4 a^2)), so no
+    # tension is refused by the model; but q = T (a R k - 1)/(E pi R^2) cancels, and the ODE's
+    # strain at 1e12 N was -153 (closed form: -0.69) with its tip 4.3 cm away.
+    arm = PlanarCableArm(0.27, 0.015, 0.0074, ratio, 110e3)
+    assert arm.max_tension == float("inf")
+    exact = arm.solve(1e12)
+    assert exact.strain.min() > -1.0
+    assert exact.strain.min() == pytest.approx(-1.0 / (4 * ratio**2), rel=1e-6)
+    with pytest.raises(ParameterError, match="tension") as e:
+        arm.solve(1e12, method="ode")
+    assert e.value.parameter == "tension"
+    assert "closed form" in str(e.value)
+    # Below the bound the ODE's strain is the closed form's to its tolerance.
+    ode, closed = arm.solve(1e3, method="ode"), arm.solve(1e3)
+    np.testing.assert_allclose(ode.strain, closed.strain, rtol=1e-4)

@@ -54,6 +54,10 @@ pub struct PlanarCableArm {
     taper: f64,
 }
 
+/// Largest relative error of the strain that the ODE method may inherit from its curvature
+/// ([`PlanarCableArm::check_ode_tension`]).
+pub const ODE_STRAIN_ERROR: f64 = 1e-3;
+
 /// How the curvature profile `k(s)` is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PlanarMethod {
@@ -322,6 +326,34 @@ impl PlanarCableArm {
             ));
         }
         Ok(tension)
+    }
+
+    /// The tension checked for the ODE method at the relative tolerance `rtol`: the strain
+    /// `q = T (a R k - 1) / (E pi R^2)` is a difference that cancels as `T` grows (`a R k`
+    /// tends to 1), so `k`'s relative error reaches `q` multiplied by `4 T a^2 / (E pi R^2)`;
+    /// above [`ODE_STRAIN_ERROR`] at the thinnest loaded section the strain, and the shape,
+    /// would be digits of the integration error (at `a = 0.6` and `T = 1e12` N the ODE's strain
+    /// was -153). The closed form has no such limit.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `tension` above that bound.
+    pub fn check_ode_tension(&self, tension: f64, rtol: f64) -> Result<()> {
+        let r = self.min_loaded_radius();
+        let a2 = self.offset_ratio * self.offset_ratio;
+        let amplification = 4.0 * tension * a2 / (self.youngs_modulus * PI * r * r);
+        if amplification * rtol <= ODE_STRAIN_ERROR {
+            return Ok(());
+        }
+        let limit = ODE_STRAIN_ERROR / rtol * self.youngs_modulus * PI * r * r / (4.0 * a2);
+        Err(Error::invalid(
+            "tension",
+            tension,
+            format!(
+                "<= {limit:.6e} N for the ODE method at rtol = {rtol:e} (its strain \
+                 T (a R k - 1) / (E pi R^2) cancels: k's error is multiplied by \
+                 4 T a^2 / (E pi R^2) = {amplification:.3e}); the closed form has no such limit"
+            ),
+        ))
     }
 
     /// Supremum of the tension for which `1 + q > 0` along the loaded part (N);
@@ -685,6 +717,7 @@ fn solve_into(
             Ok((tip, None))
         }
         PlanarMethod::Ode(options) => {
+            arm.check_ode_tension(tension, options.rtol)?;
             let mut rhs = FnSystem(|s: f64, k: &[f64; 1]| [arm.curvature_rate(s, k[0], tension)]);
             let sol = adaptive_dense(
                 &BS3,
