@@ -162,3 +162,44 @@ def test_inverse_solutions_pickle_and_warm_start_identically():
     path = softrod.inverse_statics_path(robot, [target, moved])
     again = pickle.loads(pickle.dumps(path))
     assert np.array_equal(again.tensions, path.tensions)
+
+
+def _too_few_steps(_=None):
+    # A 5 N side force on the NiTi wire with one load step of one iteration: a
+    # ConvergenceError (iterations, residual, load factor).
+    rod = softrod.examples.load("niti_two_segment").rod
+    loads = softrod.Loads(tip_force=(5.0, 0.0, 0.0))
+    return softrod.solve_statics(rod, [], loads, max_load_steps=1, max_iterations=1)
+
+
+def test_errors_pickle_with_what_they_carry_and_reach_a_parent_process():
+    errors = []
+    for call in (
+        lambda: softrod.Rod(-1.0, softrod.CircularSection(1e-3), softrod.LinearElastic(1e9, 0.3)),
+        _too_few_steps,
+    ):
+        with pytest.raises(softrod.ParameterError if not errors else softrod.ConvergenceError) as e:
+            call()
+        errors.append(e.value)
+    for err in errors:
+        back = round_trip(err)
+        assert type(back) is type(err)
+        assert str(back) == str(err)
+        assert vars(back) == vars(err)
+    assert errors[0].parameter == "length"
+    assert errors[1].iterations == 1 and errors[1].load_factor < 1.0
+    for cls in (
+        softrod.ParameterError,
+        softrod.ConvergenceError,
+        softrod.TargetUnreachableError,
+        softrod.StabilityError,
+        softrod._core.InternalError,
+        softrod.StabilityWarning,
+    ):
+        assert type(round_trip(cls("x"))) is cls
+    import multiprocessing
+
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        with pytest.raises(softrod.ConvergenceError) as e:
+            pool.map(_too_few_steps, [0])
+    assert e.value.iterations >= 1

@@ -17,14 +17,14 @@ use pyo3::types::{PyDict, PyTuple, PyType};
 use softrod::Error;
 
 create_exception!(
-    _core,
+    softrod._core,
     ParameterError,
     PyValueError,
     "A parameter is outside its valid range; the message names it, its value and the range.\n\n\
      `parameter` is the name (e.g. `tip_force`); values are in SI units (m, N, Pa, rad)."
 );
 create_exception!(
-    _core,
+    softrod._core,
     ConvergenceError,
     PyRuntimeError,
     "A solver or integrator did not converge; carries `iterations`, `residual` and \
@@ -34,7 +34,7 @@ create_exception!(
 );
 
 create_exception!(
-    _core,
+    softrod._core,
     TargetUnreachableError,
     ConvergenceError,
     "Inverse statics: the target is out of reach within the actuation bounds; carries \
@@ -43,7 +43,7 @@ create_exception!(
 );
 
 create_exception!(
-    _core,
+    softrod._core,
     StabilityWarning,
     PyUserWarning,
     "The equilibrium returned is unstable (its tip tangent stiffness, in N/m and N m/rad, \
@@ -53,7 +53,7 @@ create_exception!(
      L in m); docs/stability.md."
 );
 create_exception!(
-    _core,
+    softrod._core,
     StabilityError,
     PyRuntimeError,
     "The equilibrium reached is unstable and no stable one was found \
@@ -61,7 +61,7 @@ create_exception!(
      tangent stiffness per EI(0)/L, EI in N m^2, L in m) and the unstable `solution`."
 );
 create_exception!(
-    _core,
+    softrod._core,
     InternalError,
     PyRuntimeError,
     "A defect of softrod caught at the binding (it would have been a crash); please report it.\n\n\
