@@ -18,6 +18,7 @@ import numpy as np
 from ._core import MAX_ITERATIONS, MAX_SAMPLES, ParameterError, ParameterTypeError
 
 __all__ = [
+    "MAX_GRID_VALUES",
     "MAX_ITERATIONS",
     "MAX_SAMPLES",
     "count",
@@ -29,6 +30,11 @@ __all__ = [
     "type_error",
     "value_error",
 ]
+
+
+#: Most values a grid of samples holds: the tensions of a workspace map (rows x tendons) and
+#: the points of a sweep (design points x actuation samples); 10,000,000.
+MAX_GRID_VALUES = 100 * MAX_SAMPLES
 
 
 def describe(value: Any) -> str:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .plot.obstacles import Capsule, Cylinder, Mesh, Plane, Sphere, _field_error, _vector
+from .plot.obstacles import Capsule, Cylinder, Mesh, Plane, Sphere, _field_error, _unit, _vector
 
 __all__ = ["Capsule", "Clamp", "Cylinder", "Mesh", "Pin", "Plane", "Slide", "Sphere"]
 
@@ -71,7 +71,4 @@ class Slide:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "point", _vector("point", self.point))
-        n = np.asarray(_vector("normal", self.normal))
-        if not np.linalg.norm(n) > 0:
-            raise _field_error("normal", self.normal, "must be a nonzero vector")
-        object.__setattr__(self, "normal", tuple(float(x) for x in n))
+        object.__setattr__(self, "normal", _unit("normal", _vector("normal", self.normal)))

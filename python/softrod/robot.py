@@ -14,6 +14,7 @@ back, and it pickles.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 import pickle
 import re
@@ -73,6 +74,63 @@ def _parse_path(path: str) -> list[str | int]:
         out.append(m.group(1))
         out.extend(int(i) for i in re.findall(r"\[(\d+)\]", m.group(2)))
     return out
+
+
+def canonical_path(path: str) -> str:
+    """The canonical spelling of a parameter path: ``"tendons[02].tension"`` ->
+    ``"tendons[2].tension"`` (indices without leading zeros).
+
+    Raises:
+        ParameterError: Not a path (see :func:`_parse_path`).
+    """
+    return _rf.format_location(_parse_path(path))
+
+
+def _parts_or_none(path: Any) -> tuple[str | int, ...] | None:
+    try:
+        return tuple(_parse_path(path))
+    except ParameterError:
+        return None
+
+
+def _conflict(pa: tuple[str | int, ...], pb: tuple[str | int, ...]) -> str | None:
+    short, long = sorted((pa, pb), key=len)
+    if long[: len(short)] != short:
+        return None
+    where = _rf.format_location(short)
+    if len(short) == len(long):
+        return f"both name `{where}`"
+    return f"`{_rf.format_location(long)}` is inside `{where}`"
+
+
+def path_conflict(a: str, b: str) -> str | None:
+    """Why the paths ``a`` and ``b`` name the same parameter, or None if they do not (or one
+    does not parse): the same path spelt two ways (``tendons[0].tension``,
+    ``tendons[00].tension``: "both name `tendons[0].tension`") or one inside the other
+    (``rod.material``, ``rod.material.youngs_modulus``)."""
+    pa, pb = _parts_or_none(a), _parts_or_none(b)
+    return None if pa is None or pb is None else _conflict(pa, pb)
+
+
+def same_parameter(paths: Sequence[str], name: str) -> None:
+    """Refuses two paths of ``paths`` that name the same parameter (see
+    :func:`path_conflict`). Paths that do not parse are left to the caller's own check.
+
+    Raises:
+        ParameterError: Naming ``name`` and both paths.
+    """
+    seen: list[tuple[Any, tuple[str | int, ...]]] = []
+    for path in paths:
+        parts = _parts_or_none(path)
+        if parts is None:
+            continue
+        for other, known in seen:
+            why = _conflict(known, parts)
+            if why is not None:
+                raise _args.value_error(
+                    name, [other, path], f"paths naming different parameters ({why})"
+                )
+        seen.append((path, parts))
 
 
 def _bad_path(path: Any, expected: str) -> ParameterError:
@@ -171,7 +229,10 @@ class Robot:
             name: A label.
             description: Free text.
             source: A description (the file's tables) to adopt as the robot's ``spec``
-                instead of reading one back from the objects; it must describe them.
+                instead of reading one back from the objects; it must describe them: the
+                robot it describes has the same rod, tendons, chambers, loads, solver
+                options, obstacles and tip constraint (numbers equal to a relative 1e-9 of
+                their vector; its ``name`` is replaced by ``name``).
             obstacles: Rigid obstacles the rod's surface touches (``softrod.Plane``,
                 ``Sphere``, ``Capsule``, ``Cylinder`` or dicts with ``type``), passed to
                 :func:`softrod.solve_statics` as ``obstacles=``.
@@ -180,7 +241,9 @@ class Robot:
 
         Raises:
             TypeError: An argument of the wrong type (named).
-            ParameterError: Bad solver options (located, e.g. ``solver.steps``).
+            ParameterError: Bad solver options (located, e.g. ``solver.steps``); a
+                ``source`` that is invalid or does not describe the objects (naming
+                ``source``, the first field that differs and both values).
         """
         if not isinstance(rod, Rod):
             raise TypeError(f"invalid parameter `rod` = {rod!r}: must be a softrod.Rod")
@@ -224,6 +287,7 @@ class Robot:
         if source:
             with _argument("source"):
                 spec = _rf.validate_robot_dict(_plain(dict(source)))
+            _check_source(self, spec)
             object.__setattr__(self, "_spec", spec.model_copy(update={"name": name}))
 
     def _set(self, name, description, rod, tendons, chambers, loads, given, solver, spec):
@@ -469,11 +533,39 @@ class Robot:
         return self._replace(**{field: items, "spec": spec})
 
     def with_tensions(self, tensions: Sequence[float] | np.ndarray) -> Robot:
-        """The same robot with new tendon tensions (N), one per tendon."""
+        """The same robot with new tendon tensions.
+
+        Args:
+            tensions: Tensions (N), one per tendon: a 1-D list, tuple or array of real
+                numbers (NumPy scalars included).
+
+        Returns:
+            The new robot, its description updated.
+
+        Raises:
+            ParameterTypeError: Not 1-D (naming ``tensions``, the shape given and the one
+                expected), or an entry that is a string, a boolean or None (naming
+                ``tensions[i]``).
+            ParameterError: Another count than one per tendon, or a tension out of range.
+        """
         return self._with_actuation("tendons", "tension", self._tensioned(tensions))
 
     def with_pressures(self, pressures: Sequence[float] | np.ndarray) -> Robot:
-        """The same robot with new chamber pressures (Pa, gauge), one per chamber."""
+        """The same robot with new chamber pressures.
+
+        Args:
+            pressures: Gauge pressures (Pa), one per chamber: a 1-D list, tuple or array of
+                real numbers (NumPy scalars included).
+
+        Returns:
+            The new robot, its description updated.
+
+        Raises:
+            ParameterTypeError: Not 1-D (naming ``pressures``, the shape given and the one
+                expected), or an entry that is a string, a boolean or None (naming
+                ``pressures[i]``).
+            ParameterError: Another count than one per chamber, or a pressure out of range.
+        """
         return self._with_actuation("chambers", "pressure", self._pressurised(pressures))
 
     def with_disk_guides(
@@ -606,10 +698,14 @@ class Robot:
 
         Raises:
             ParameterError: Any invalid value, unknown key (with a suggestion) or index out
-                of range, all reported at once at their paths.
+                of range, all reported at once at their paths; two paths naming the same
+                parameter (``tendons[0].tension`` and ``tendons[00].tension``, or a table
+                and a value inside it), both named.
         """
         if not isinstance(values, Mapping):
             raise _args.type_error("values", values, "a dict: parameter path -> value")
+        if len(values) > 1:
+            same_parameter(list(values), "values")
         data = self.spec.model_dump(mode="python", exclude_unset=True, exclude_none=True)
         errors: list[FieldError] = []
         for path, value in values.items():
@@ -736,6 +832,146 @@ def _same_object(a: Any, b: Any) -> bool:
         return False
 
 
+# Relative difference (to the largest magnitude of the vector) within which a number of a
+# ``source`` equals the objects' (the degrees and polar offsets of a file round to it).
+_SOURCE_RTOL = 1e-9
+
+# The arguments of ``Robot`` each top-level table of a description describes.
+_SOURCE_TABLES = ("rod", "tendons", "chambers", "loads", "solver", "obstacles", "tip_constraint")
+
+
+def _described_objects(parts: Sequence[Any]) -> dict[str, Any]:
+    """The tables of a robot's objects (rod, tendons, chambers, loads, solver, obstacles,
+    tip constraint), read back from the objects and filled with defaults.
+
+    Raises:
+        ParameterError: Objects a robot file cannot describe (``missing``,
+            ``unserialisable``).
+    """
+    rod, tendons, chambers, loads, solver, obstacles, tip = parts
+    spec = _objects.describe(rod, tendons, chambers, loads, solver, "robot", "")
+    tables = spec.model_dump(mode="python", exclude_none=True)
+    out = {k: tables.get(k) for k in _SOURCE_TABLES}
+    out["obstacles"] = [_objects.obstacle_spec(o) for o in obstacles]
+    out["tip_constraint"] = None if tip is None else _objects.tip_constraint_spec(tip)
+    return out
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _is_numeric(v: Any) -> bool:
+    if isinstance(v, list):
+        return bool(v) and all(_is_numeric(x) for x in v)
+    return _is_number(v)
+
+
+def _first_difference(a: Any, b: Any, where: list[str | int]) -> tuple | None:
+    """The first location where two described tables differ, and both values there."""
+    if isinstance(a, dict) or isinstance(b, dict):
+        if (a is None or isinstance(a, dict)) and (b is None or isinstance(b, dict)):
+            a, b = a or {}, b or {}
+            for key in [*a, *(k for k in b if k not in a)]:
+                found = _first_difference(a.get(key), b.get(key), [*where, key])
+                if found is not None:
+                    return found
+            return None
+        return where, a, b
+    if _is_numeric(a) and _is_numeric(b):
+        try:
+            x, y = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        except ValueError:  # ragged
+            return None if a == b else (where, a, b)
+        if x.shape != y.shape:
+            return where, a, b
+        scale = max(float(np.max(np.abs(x))), float(np.max(np.abs(y))))
+        return None if np.all(np.abs(x - y) <= _SOURCE_RTOL * scale) else (where, a, b)
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return where, _Count(len(a)), _Count(len(b))
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            found = _first_difference(x, y, [*where, i])
+            if found is not None:
+                return found
+        return None
+    return None if a == b else (where, a, b)
+
+
+class _Count(int):
+    def __repr__(self) -> str:
+        return f"{int(self)} {'entry' if self == 1 else 'entries'}"
+
+
+def _shown(value: Any) -> str:
+    if value is None:
+        return "not given"
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _source_error(detail: str) -> ParameterError:
+    exc = ParameterError(
+        f"invalid parameter `source`: must describe the objects given with it; {detail} "
+        "(Robot.from_dict(source) builds the robot a description describes)"
+    )
+    exc.parameter = "source"
+    return exc
+
+
+def _check_source(robot: Robot, spec: RobotFile) -> None:
+    """Refuses a ``source`` that does not describe the robot's objects: the robot it
+    describes is built and both sets of objects are read back as tables, then compared.
+
+    Raises:
+        ParameterError: Naming ``source``, the first field that differs and both values.
+    """
+    with _argument("source"):
+        parts = _objects.build(spec)
+    ours = (
+        robot._rod,
+        robot._tendons,
+        robot._chambers,
+        robot._loads,
+        robot._solver,
+        robot._obstacles,
+        robot._tip_constraint,
+    )
+    theirs = (
+        parts.rod,
+        parts.tendons,
+        parts.chambers,
+        parts.loads,
+        parts.solver,
+        parts.obstacles,
+        parts.tip_constraint,
+    )
+    try:
+        want = _described_objects(theirs)
+        have = _described_objects(ours)
+    except ParameterError as exc:
+        if getattr(exc, "unserialisable", None) or not getattr(exc, "missing", None):
+            why = str(exc).split(": ", 1)[-1]
+            raise _source_error(f"a robot file cannot describe these objects: {why}") from None
+        # Properties the objects do not expose: compare the objects themselves.
+        for key, a, b in zip(_SOURCE_TABLES, theirs, ours, strict=True):
+            if isinstance(a, tuple):
+                same = len(a) == len(b) and all(map(_same_object, a, b))
+            else:
+                same = a == b if isinstance(a, dict) else _same_object(a, b)
+            if not same:
+                raise _source_error(f"its `{key}` is not the `{key}` given") from None
+        return
+    for key in _SOURCE_TABLES:
+        found = _first_difference(want[key], have[key], [key])
+        if found is not None:
+            where, a, b = found
+            raise _source_error(
+                f"`{_rf.format_location(where)}` is {_shown(a)} in `source` but {_shown(b)} "
+                f"in `{key}`"
+            )
+
+
 def _rebuild(parts: tuple, obstacles: tuple, tip_constraint: Any) -> Robot:
     robot = Robot(*parts)
     object.__setattr__(robot, "_obstacles", obstacles)
@@ -757,18 +993,65 @@ _MINIMAL_ROD = {
 }
 
 
-def _actuation(values: Any, n: int, name: str, what: str) -> list[float]:
+_UNITS = {"tendon": "N", "chamber": "Pa"}
+
+
+def _shape_text(values: Any) -> str:
     try:
-        out = [float(v) for v in np.asarray(values, dtype=float).ravel()]
-    except (TypeError, ValueError):
-        raise TypeError(f"invalid parameter `{name}` = {values!r}: must be numbers") from None
-    if len(out) != n:
+        return str(np.shape(values))
+    except ValueError:  # ragged nesting
+        return "a ragged nesting"
+
+
+def _nested(v: Any) -> bool:
+    if isinstance(v, np.ndarray):
+        return v.ndim > 0
+    return isinstance(v, Sequence) and not isinstance(v, (str, bytes))
+
+
+def _actuation(values: Any, n: int, name: str, what: str) -> list[float]:
+    """One real number per tendon or chamber (``what``), as floats: a 1-D list, tuple or
+    array of ints and floats (NumPy scalars included).
+
+    Raises:
+        ParameterTypeError: Not a 1-D sequence (naming ``name``, the shape given and the one
+            expected), or an entry that is a string, a boolean, None or not real (naming
+            ``name[i]``).
+        ParameterError: A 1-D sequence of another length.
+    """
+    unit = _UNITS.get(what, "")
+    expected = f"one number per {what} ({unit}), shape ({n},)"
+    if values is None or isinstance(values, (str, bytes, Mapping)):
+        raise _args.type_error(name, values, expected)
+    if isinstance(values, np.ndarray):
+        if values.ndim != 1:
+            raise _args.type_error(name, values, f"{expected}, not shape {values.shape}")
+        items: list[Any] = values.tolist() if values.dtype.kind in "iuf" else list(values)
+    else:
+        try:
+            items = list(values)
+        except TypeError:
+            raise _args.type_error(
+                name, values, f"{expected}, not shape {_shape_text(values)}"
+            ) from None
+        if any(_nested(v) for v in items):
+            raise _args.type_error(name, values, f"{expected}, not shape {_shape_text(values)}")
+    for i, v in enumerate(items):
+        if isinstance(v, np.ndarray) and v.dtype.kind in "iuf":  # 0-d
+            items[i] = v = v.item()
+        if (
+            v is None
+            or isinstance(v, (bool, np.bool_, str, bytes))
+            or not isinstance(v, numbers.Real)
+        ):
+            raise _args.type_error(f"{name}[{i}]", v, f"a number ({unit})")
+    if len(items) != n:
         exc = ParameterError(
-            f"invalid parameter `{name}` with {len(out)} values: must have one per {what} ({n})"
+            f"invalid parameter `{name}` = {len(items)} values: must be one value per {what} ({n})"
         )
         exc.parameter = name
         raise exc
-    return out
+    return [float(v) for v in items]
 
 
 def _set_path(data: dict[str, Any], parts: list[str | int], value: Any) -> None:

@@ -825,7 +825,15 @@ def _define_targets() -> None:
         )
     )
     t("Robot(source)")(
-        lambda d: (sr.Robot, dict(rod=_niti().rod, tendons=_niti().tendons, source=_niti().source))
+        lambda d: (
+            sr.Robot,
+            dict(
+                rod=_niti().rod,
+                tendons=_niti().tendons,
+                solver=_niti().solver,
+                source=_niti().source,
+            ),
+        )
     )
     t("Robot.from_spec")(
         lambda d: (sr.Robot.from_spec, dict(spec=_niti().spec, name="r", source="file.toml"))

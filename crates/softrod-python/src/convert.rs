@@ -200,46 +200,73 @@ pub(crate) fn float_array(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyR
     Ok(r.as_array().to_owned())
 }
 
-/// Numbers of any shape flattened, as `numpy.asarray(obj, dtype=float).ravel()` gives them,
-/// without NumPy for the common cases (a float64 array, a list or tuple of numbers).
-pub(crate) fn raveled(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyResult<Vec<f64>> {
+/// One number or a 1-d sequence or array of them (ints or floats; not bools, strings or
+/// `None`), without NumPy for the common cases (a float64 array, a list or tuple of numbers).
+/// An item that is not a number is named `name[i]`; another shape names `name`.
+pub(crate) fn numbers_1d(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
+    let what = "a number or a 1-d sequence or array of numbers";
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
         if let Ok(r) = a.try_readonly() {
-            return Ok(r.as_array().iter().copied().collect());
+            let a = r.as_array();
+            if a.ndim() > 1 {
+                return Err(shape_err(name, obj, a.shape(), what));
+            }
+            return Ok(a.iter().copied().collect());
         }
     }
-    let listed = if let Ok(l) = obj.cast::<PyList>() {
-        numbers(l.iter())
+    let items: Option<Vec<Bound<'_, PyAny>>> = if let Ok(l) = obj.cast::<PyList>() {
+        Some(l.iter().collect())
     } else if let Ok(t) = obj.cast::<PyTuple>() {
-        numbers(t.iter())
+        Some(t.iter().collect())
     } else {
         None
     };
-    if let Some(v) = listed {
-        return Ok(v);
+    if let Some(items) = items {
+        return items
+            .iter()
+            .enumerate()
+            .map(|(i, x)| {
+                real(x).ok_or_else(|| type_err(&format!("{name}[{i}]"), x, "a real number"))
+            })
+            .collect();
     }
-    let np = obj.py().import("numpy")?;
-    let a = np
+    let a = float_array(obj, name, what)?;
+    let kind: String = obj
+        .py()
+        .import("numpy")?
         .getattr("asarray")?
-        .call1((obj, np.getattr("float64")?))
-        .and_then(|a| a.call_method0("ravel"))
-        .map_err(|_| type_err(name, obj, what))?;
-    let a = a
-        .cast_into::<PyArrayDyn<f64>>()
-        .map_err(|_| type_err(name, obj, what))?;
-    let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
-    Ok(r.as_array().iter().copied().collect())
+        .call1((obj,))
+        .and_then(|a| a.getattr("dtype")?.getattr("kind")?.extract())
+        .unwrap_or_default();
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(type_err(name, obj, what));
+    }
+    if a.ndim() > 1 {
+        return Err(shape_err(name, obj, a.shape(), what));
+    }
+    Ok(a.iter().copied().collect())
 }
 
-/// The values of items that are all Python floats or ints (None if one is not, or does not
-/// convert).
-fn numbers<'py>(items: impl Iterator<Item = Bound<'py, PyAny>>) -> Option<Vec<f64>> {
-    items
-        .map(|x| {
-            let number = x.is_instance_of::<PyFloat>() || x.is_instance_of::<PyInt>();
-            number.then(|| x.extract::<f64>().ok()).flatten()
-        })
-        .collect()
+/// The value of a Python or NumPy int or float (`None` for a bool, a string, `None` or
+/// anything else).
+fn real(x: &Bound<'_, PyAny>) -> Option<f64> {
+    if not_numeric(x) || x.is_instance_of::<PyBool>() {
+        return None;
+    }
+    if x.is_instance_of::<PyFloat>() || x.is_instance_of::<PyInt>() {
+        return x.extract::<f64>().ok();
+    }
+    // NumPy scalars: integer or floating kinds only (not numpy.bool_).
+    let kind: String = x
+        .getattr("dtype")
+        .ok()?
+        .getattr("kind")
+        .ok()?
+        .extract()
+        .ok()?;
+    matches!(kind.as_str(), "i" | "u" | "f")
+        .then(|| x.extract::<f64>().ok())
+        .flatten()
 }
 
 /// Numbers of any shape, for element-wise functions: a number gives a 0-d array.
@@ -509,6 +536,7 @@ pub(crate) mod arg {
         nominal_stress,
         nonnegative,
         offset_ratio,
+        on_unstable,
         panels,
         phase,
         pitch,

@@ -113,6 +113,9 @@ class CosseratModel:
                 raise _args.value_error(
                     where, repr(name), str(exc).split(": must be ", 1)[-1]
                 ) from None
+            from ..robot import canonical_path
+
+            name = canonical_path(name)  # `tendons[00].distance` is `tendons[0].distance`
         if name.startswith("rod.material."):
             field = name.split(".", 2)[2]
             if field in _SCALE_FIELDS and _law_scale(self.material, field):

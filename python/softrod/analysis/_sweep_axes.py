@@ -10,6 +10,7 @@ samples are neighbours and warm starts help; results are stored back in grid ord
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -17,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _args
 from .._core import ParameterError
 
 #: Actuation paths: tendon tensions, chamber pressures, components of the tip load.
@@ -151,10 +153,15 @@ class Axes:
     shape: tuple[int, ...]
     rows: np.ndarray
     order: np.ndarray
+    given: tuple[str, ...] = ()
 
     @property
     def size(self) -> int:
         return len(self.rows)
+
+    def spelling(self, path: str) -> str:
+        """The path as the caller spelt it (``path`` is canonical)."""
+        return dict(zip(self.paths, self.given or self.paths, strict=True))[path]
 
 
 def boustrophedon(shape: tuple[int, ...]) -> np.ndarray:
@@ -174,14 +181,41 @@ def boustrophedon(shape: tuple[int, ...]) -> np.ndarray:
     return np.ravel_multi_index(tuple(snake.T), shape)
 
 
-def parse_axes(spec: Any, what: str, table_dim: str) -> Axes:
-    """Parses ``actuation=`` or ``design=`` (``what``) into :class:`Axes`.
+@dataclass(frozen=True)
+class _Columns:
+    """An axis set checked but not expanded: its kind, paths (canonical, and as given) and
+    values; ``shape`` the sizes of its dimensions."""
 
-    Raises:
-        ParameterError: Not a mapping or table, an empty or non-1-D grid, non-finite values.
-    """
+    kind: str
+    paths: tuple[str, ...]
+    given: tuple[str, ...]
+    values: tuple[np.ndarray, ...]
+    shape: tuple[int, ...]
+
+    @property
+    def points(self) -> int:
+        return math.prod(self.shape)
+
+
+def _canonical(paths: tuple[str, ...], what: str) -> tuple[str, ...]:
+    """The paths spelt canonically (``tendons[00]`` -> ``tendons[0]``; a path that does not
+    parse is kept, for the caller's check to name); two naming one parameter are refused."""
+    from ..robot import canonical_path, same_parameter
+
+    same_parameter(paths, what)
+    out = []
+    for p in paths:
+        try:
+            out.append(canonical_path(p))
+        except ParameterError:
+            out.append(p)
+    return tuple(out)
+
+
+def _columns(spec: Any, what: str) -> _Columns:
+    """Checks ``actuation=`` or ``design=`` (``what``) without expanding a grid."""
     if spec is None:
-        return Axes("none", (), (), (), (), np.zeros((1, 0)), np.zeros(1, dtype=np.int64))
+        return _Columns("none", (), (), (), ())
     if not isinstance(spec, (Mapping, SampleTable)):
         mod = type(spec).__module__.split(".")[0]
         if mod not in ("pandas", "xarray"):
@@ -192,27 +226,102 @@ def parse_axes(spec: Any, what: str, table_dim: str) -> Axes:
             )
         spec = samples(spec)
     if isinstance(spec, SampleTable):
-        paths = tuple(spec)
-        values = tuple(spec[p] for p in paths)
-        for p, v in zip(paths, values, strict=True):
+        given = tuple(spec)
+        values = tuple(spec[p] for p in given)
+        for p, v in zip(given, values, strict=True):
             _float_array(v, f"{what}[{p!r}]")
-        rows = np.column_stack(values)
-        n = spec.rows
-        return Axes("table", paths, values, (table_dim,), (n,), rows, np.arange(n))
+        return _Columns("table", _canonical(given, what), given, values, (spec.rows,))
     if not spec:
         raise _bad(what, spec, "a non-empty dict of path -> 1-D grid")
-    paths = tuple(str(p) for p in spec)
+    given = tuple(str(p) for p in spec)
     values = []
-    for p in paths:
-        a = _float_array(spec[p], f"{what}[{p!r}]")
+    for key, p in zip(spec, given, strict=True):
+        a = _float_array(spec[key], f"{what}[{p!r}]")
         if a.ndim != 1 or a.size == 0:
             raise _bad(f"{what}[{p!r}]", f"shape {a.shape}", "a non-empty 1-D grid")
         values.append(a)
     shape = tuple(len(v) for v in values)
-    order = boustrophedon(shape)
-    idx = np.unravel_index(order, shape)
-    rows = np.column_stack([v[i] for v, i in zip(values, idx, strict=True)])
-    return Axes("grid", paths, tuple(values), paths, shape, rows, order)
+    return _Columns("grid", _canonical(given, what), given, tuple(values), shape)
+
+
+def _too_many(name: str, count: str) -> ParameterError:
+    """The error of a sweep beyond :data:`softrod._args.MAX_GRID_VALUES` points (worded like
+    the workspace map's)."""
+    noun = "parameters" if " and " in name else "parameter"
+    exc = ParameterError(
+        f"invalid {noun} {name}: {count}: must be at most {_args.MAX_GRID_VALUES} points"
+    )
+    exc.parameter = name.split("`")[1]
+    return exc
+
+
+def check_points(actuation: _Columns, design: _Columns) -> None:
+    """Refuses a sweep of more than :data:`softrod._args.MAX_GRID_VALUES` points (design
+    points x actuation samples), before anything of that size is allocated.
+
+    Raises:
+        ParameterError: Naming ``actuation``, ``design`` or both, the number of points and
+            the limit.
+    """
+    limit = _args.MAX_GRID_VALUES
+    for what, cols in (("actuation", actuation), ("design", design)):
+        if cols.points > limit:
+            shape = "x".join(str(n) for n in cols.shape)
+            raise _too_many(f"`{what}`", f"{cols.points} points ({cols.kind} {shape})")
+    total = actuation.points * design.points
+    if total > limit:
+        raise _too_many(
+            "`design` and `actuation`",
+            f"{design.points} design points x {actuation.points} actuation samples = "
+            f"{total} points",
+        )
+
+
+def _expand(cols: _Columns, table_dim: str) -> Axes:
+    """The :class:`Axes` of checked columns: the rows in solve order."""
+    if cols.kind == "none":
+        return Axes("none", (), (), (), (), np.zeros((1, 0)), np.zeros(1, dtype=np.int64))
+    if cols.kind == "table":
+        rows = np.column_stack(cols.values)
+        (n,) = cols.shape
+        return Axes(
+            "table", cols.paths, cols.values, (table_dim,), (n,), rows, np.arange(n), cols.given
+        )
+    order = boustrophedon(cols.shape)
+    idx = np.unravel_index(order, cols.shape)
+    rows = np.column_stack([v[i] for v, i in zip(cols.values, idx, strict=True)])
+    return Axes("grid", cols.paths, cols.values, cols.paths, cols.shape, rows, order, cols.given)
+
+
+def parse_axes(spec: Any, what: str, table_dim: str) -> Axes:
+    """Parses ``actuation=`` or ``design=`` (``what``) into :class:`Axes`.
+
+    Paths are spelt canonically (``tendons[00].tension`` is ``tendons[0].tension``, and so
+    labelled).
+
+    Raises:
+        ParameterError: Not a mapping or table, an empty or non-1-D grid, non-finite values,
+            two paths naming one parameter, more than :data:`softrod._args.MAX_GRID_VALUES`
+            points.
+    """
+    cols = _columns(spec, what)
+    none = _Columns("none", (), (), (), ())
+    check_points(cols, none)
+    return _expand(cols, table_dim)
+
+
+def parse_axis_sets(actuation: Any, design: Any) -> tuple[Axes, Axes]:
+    """The actuation and design axes of a sweep (dimensions ``sample`` and ``design`` for
+    tables), checked together: at most :data:`softrod._args.MAX_GRID_VALUES` points in all,
+    refused before any grid is expanded.
+
+    Raises:
+        ParameterError: As :func:`parse_axes`; the product beyond the limit (naming both).
+    """
+    act = _columns(actuation, "actuation")
+    des = _columns(design, "design")
+    check_points(act, des)
+    return _expand(act, "sample"), _expand(des, "design")
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ from ._sweep_axes import (
     SampleTable,
     actuation_axis,
     design_points,
-    parse_axes,
+    parse_axis_sets,
     samples,
     units_of,
 )
@@ -203,7 +203,12 @@ def sweep(
         design: Design axes: any robot-file path (``rod.section.tip_radius``,
             ``tendons[2].distance``, ``rod.material.youngs_modulus``, ...), as grids or a table
             (one ``design`` dimension). A design the robot file rejects (a tip radius <= 0, a
-            tendon outside the section) is marked infeasible, not raised.
+            tendon outside the section) is marked infeasible, not raised. Paths are labelled
+            in their canonical spelling (``tendons[02].distance`` is ``tendons[2].distance``);
+            two axes may not name one parameter (in two spellings, or one inside the other),
+            in ``design`` and ``actuation`` alike. At most
+            :data:`softrod._args.MAX_GRID_VALUES` (10,000,000) points in all: design points x
+            actuation samples.
         outputs: What to record, from :data:`OUTPUTS`: ``tip_pose`` (tip position and
             quaternion), ``tendon_lengths``, and at the chosen arc lengths ``backbone``
             (position, quaternion), ``compliance`` and ``stiffness`` (6x6, world frame, the
@@ -239,7 +244,8 @@ def sweep(
         ParameterError: An unknown path or output, an actuation path in the wrong place, a
             grid that is not 1-D or not finite, a bad tension or pressure (named by its path),
             an arc length beyond the rod (the shortest design rod with ``rod.length`` a design
-            axis).
+            axis), two axes naming one parameter (both named), more points than the limit
+            (the number of points and the limit named; refused before any allocation).
     """
     import xarray as xr
 
@@ -253,8 +259,7 @@ def sweep(
         raise _bad("progress", progress, "True, False or None")
     if chunk is not None:
         chunk = _positive_int("chunk", chunk)
-    act = parse_axes(actuation, "actuation", "sample")
-    des = parse_axes(design, "design", "design")
+    act, des = parse_axis_sets(actuation, design)
     axes = [actuation_axis(p, len(robot.tendons), len(robot.chambers)) for p in act.paths]
     if any(a.kind == "displacement" for a in axes):
         raise _bad(
@@ -278,15 +283,15 @@ def sweep(
                 "axes of a robot a robot file describes (design points are built with "
                 f"Robot.with_parameters); this one is not: {' '.join(str(exc).split())}",
             ) from None
+    _same_parameter_in_both(act, des)
     for i, p in enumerate(des.paths):
-        if p in act.paths:
-            raise _bad(f"design[{p!r}]", p, "a path not also swept in `actuation`")
+        spelt = des.spelling(p)
         try:
             robot.parameter(p)  # an unknown path is the user's error, raised here
         except ParameterError as exc:
-            raise _bad(f"design[{p!r}]", p, str(exc).split(": must be ", 1)[-1]) from None
+            raise _bad(f"design[{spelt!r}]", spelt, str(exc).split(": must be ", 1)[-1]) from None
         if des.kind == "grid" and not np.all(np.isfinite(des.values[i])):
-            raise _bad(f"design[{p!r}]", des.values[i], "finite")
+            raise _bad(f"design[{spelt!r}]", des.values[i], "finite")
     points = design_points(des)
     arcs, arm = _arcs(robot, arc_lengths, arm_index, _shortest_rod(robot, points))
     core_outputs = tuple(o for o in names if o not in ("convergence", "stability"))
@@ -328,6 +333,23 @@ def sweep(
         if owned:
             client.close()
     return store.dataset(xr, act, des, robot, arcs, arm, names, block)
+
+
+def _same_parameter_in_both(act: Axes, des: Axes) -> None:
+    """Refuses a design axis naming a parameter an actuation axis also names (in any
+    spelling, or one inside the other), naming both."""
+    from ..robot import path_conflict
+
+    for p in des.paths:
+        for q in act.paths:
+            why = path_conflict(q, p) if p != q else f"both name `{p}`"
+            if why is not None:
+                raise _bad(
+                    f"design[{des.spelling(p)!r}]",
+                    [act.spelling(q), des.spelling(p)],
+                    f"a path not also swept in `actuation` (`actuation` has "
+                    f"{act.spelling(q)!r}; {why})",
+                )
 
 
 def _solve_parameters(robot) -> set[str]:

@@ -70,10 +70,10 @@ def tension_grid(n_tendons: int, axes: dict[int, np.ndarray]) -> np.ndarray:
         _args.finite_array(axes[k], f"axes[{k}]", ndim=1) if k is not None else np.zeros(1)
         for k in (keys[0], keys[1] if len(keys) == 2 else None)
     )
-    if a.size * b.size * n_tendons > 100 * _args.MAX_SAMPLES:
+    if a.size * b.size * n_tendons > _args.MAX_GRID_VALUES:
         raise ParameterError(
             f"invalid parameter `axes`: {a.size * b.size} rows of {n_tendons} tensions: must be "
-            f"at most {100 * _args.MAX_SAMPLES} values"
+            f"at most {_args.MAX_GRID_VALUES} values"
         )
     rows = []
     for i, ta in enumerate(a):

@@ -15,6 +15,7 @@ import os
 import sys
 import time
 
+from .. import _args
 from ._common import bad, files, finite_float
 
 _GRID_HELP = "GRID: start:stop:count, v1,v2,... or one value"
@@ -25,53 +26,76 @@ def parse_grid(option: str, text: str) -> tuple[str, list[float]]:
 
     Raises:
         ParameterError: Naming the option: no ``=``, an empty path, a grid that is not
-            numbers, a count < 1.
+            numbers, a count < 1 or more than :data:`softrod._args.MAX_GRID_VALUES` points
+            (refused before the grid is built).
     """
     if "=" not in text:
         raise bad(option, text, f"PATH=GRID ({_GRID_HELP})")
     path, grid = (part.strip() for part in text.split("=", 1))
     if not path:
         raise bad(option, text, "a path before `=`")
+    span: tuple[float, float, int] | None = None
     try:
         if ":" in grid:
             start, stop, count = grid.split(":")
-            n = int(count)
-            a, b = float(start), float(stop)
-            if n < 1:
-                raise bad(option, text, "a count >= 1 after the second `:`")
-            values = [a] if n == 1 else [a + (b - a) * k / (n - 1) for k in range(n)]
+            span = (float(start), float(stop), int(count))
         else:
             values = [float(v) for v in grid.split(",")]
     except ValueError:
         raise bad(option, text, f"PATH=GRID with numbers ({_GRID_HELP})") from None
+    if span is not None:
+        a, b, n = span
+        if n < 1:
+            raise bad(option, text, "a count >= 1 after the second `:`")
+        if n > _args.MAX_GRID_VALUES:  # before the grid is built
+            raise bad(option, text, _too_many(f"a grid of {n} points"))
+        values = [a] if n == 1 else [a + (b - a) * k / (n - 1) for k in range(n)]
     if not all(math.isfinite(v) for v in values):
         raise bad(option, text, "finite numbers")
     return path, values
 
 
+def _too_many(count: str) -> str:
+    """Worded like the library's refusal (``softrod.sweep``, ``softrod workspace``)."""
+    return f"{count}: must be at most {_args.MAX_GRID_VALUES} points"
+
+
 def _axes(args) -> tuple[dict, dict]:
+    """The actuation and design grids of the options, each path given once, at most
+    :data:`softrod._args.MAX_GRID_VALUES` points in all (checked as each grid is read)."""
+    from ..robot import path_conflict
+
     actuation: dict[str, list[float]] = {}
     design: dict[str, list[float]] = {}
+    given: list[tuple[str, str]] = []  # (option, path as given)
+    points = 1
 
-    def add(target: dict, option: str, path: str, values: list[float]) -> None:
-        if path in actuation or path in design:
-            raise bad(option, path, "a path given once")
+    def add(target: dict, option: str, text: str, path: str, values: list[float]) -> None:
+        nonlocal points
+        for first_option, first in given:
+            why = path_conflict(first, path) if first != path else f"both name `{path}`"
+            if why is not None:
+                raise bad(option, path, f"a path given once ({first_option} gave {first!r}: {why})")
+        points *= len(values)
+        if points > _args.MAX_GRID_VALUES:
+            raise bad(option, text, _too_many(f"{points} points with the grids before it"))
+        given.append((option, path))
         target[path] = values
 
     for text in args.tensions or ():
         key, values = parse_grid("--tensions", text)
         if not key.isdigit():
             raise bad("--tensions", text, "I=GRID with a tendon index I (0, 1, ...)")
-        add(actuation, "--tensions", f"tendons[{int(key)}].tension", values)
+        add(actuation, "--tensions", text, f"tendons[{int(key)}].tension", values)
     for text in args.pressures or ():
         key, values = parse_grid("--pressures", text)
         if not key.isdigit():
             raise bad("--pressures", text, "I=GRID with a chamber index I (0, 1, ...)")
-        add(actuation, "--pressures", f"chambers[{int(key)}].pressure", values)
+        add(actuation, "--pressures", text, f"chambers[{int(key)}].pressure", values)
     for text in args.actuation or ():
-        add(actuation, "--actuation", *parse_grid("--actuation", text))
+        add(actuation, "--actuation", text, *parse_grid("--actuation", text))
     for text in args.design or ():
-        add(design, "--design", *parse_grid("--design", text))
+        add(design, "--design", text, *parse_grid("--design", text))
     return actuation, design
 
 

@@ -32,6 +32,17 @@ def _field_error(name: str, value: object, why: str) -> ParameterError:
     return err
 
 
+def _unit(name: str, value: Sequence[float]) -> tuple[float, float, float]:
+    """The direction of the finite vector ``value`` (shape (3,)) as a unit vector; scaled by its
+    largest component first, so that 1e-300 and 1e300 have the direction they give."""
+    n = np.asarray(value, dtype=float)
+    largest = float(np.max(np.abs(n)))
+    if not largest > 0:
+        raise _field_error(name, value, "must be a nonzero vector")
+    n = n / largest
+    return tuple(float(x) for x in n / np.linalg.norm(n))
+
+
 def _vector(name: str, value: object) -> tuple[float, float, float]:
     try:
         v = np.asarray(value, dtype=float)
@@ -85,11 +96,7 @@ class Plane:
 
     def __post_init__(self) -> None:
         _check(self, ("point", "normal"), False)
-        n = np.asarray(self.normal)
-        length = float(np.linalg.norm(n))
-        if not (np.isfinite(length) and length > 0):
-            raise _field_error("normal", self.normal, "must be a nonzero vector")
-        object.__setattr__(self, "normal", tuple(float(x) for x in n / length))
+        object.__setattr__(self, "normal", _unit("normal", self.normal))
 
 
 @dataclass(frozen=True)

@@ -135,7 +135,7 @@ pub(crate) fn solve_statics<'py>(
     #[pyo3(from_py_with = arg::chambers)] chambers: Vec<Bound<'py, Chamber>>,
     s_out: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
-    on_unstable: Option<&'py str>,
+    #[pyo3(from_py_with = arg::on_unstable)] on_unstable: Option<&'py str>,
     previous: Option<Bound<'py, PyAny>>,
     displacements: Option<Bound<'py, PyAny>>,
     tendon_stiffness: Option<Bound<'py, PyAny>>,

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 
 use super::options::{Given, Names, Problem};
 use super::{solve, Keywords, Source, StaticsSolution};
-use crate::convert::{arg, raveled};
+use crate::convert::{arg, numbers_1d};
 use crate::errors::{param_err, to_py_err};
 use crate::model::{Chamber, Loads, Rod, Tendon};
 
@@ -75,7 +75,8 @@ impl RobotModel {
     }
 }
 
-/// One value per actuator: `name` (numbers of any shape, flattened) must have `n`.
+/// One value per actuator: `name` (a number or a 1-d sequence or array of numbers) must have
+/// `n`.
 pub(crate) fn per_actuator(
     obj: Option<&Bound<'_, PyAny>>,
     name: &str,
@@ -85,7 +86,7 @@ pub(crate) fn per_actuator(
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(None);
     };
-    let v = raveled(obj, name, "numbers")?;
+    let v = numbers_1d(obj, name)?;
     if v.len() != n {
         let given = match v.len() {
             1 => "1 value".to_string(),
@@ -129,7 +130,7 @@ pub(crate) fn _solve_robot<'py>(
     #[pyo3(from_py_with = arg::throw)] throw: Option<bool>,
     s_out: Option<Bound<'py, PyAny>>,
     #[pyo3(from_py_with = arg::seek_stable)] seek_stable: Option<bool>,
-    on_unstable: Option<&'py str>,
+    #[pyo3(from_py_with = arg::on_unstable)] on_unstable: Option<&'py str>,
     previous: Option<Bound<'py, PyAny>>,
     displacements: Option<Bound<'py, PyAny>>,
     tendon_stiffness: Option<Bound<'py, PyAny>>,

@@ -80,15 +80,17 @@ fn finite3(name: &str, v: [f64; 3]) -> Result<Vector3<f64>> {
 /// [`Error::InvalidParameter`] naming `normal` if it is zero or its length not finite.
 pub(super) fn unit_normal(normal: [f64; 3]) -> Result<Vector3<f64>> {
     let n = Vector3::from(normal);
-    let l = n.norm();
-    if !(l.is_finite() && l > 0.0) {
+    // (Scaled by its largest component first: a vector of 1e-300 or 1e300 has a length that
+    // underflows or overflows, and a direction.)
+    let largest = n.amax();
+    if !(largest.is_finite() && largest > 0.0) {
         return Err(Error::invalid(
             "normal",
             format!("{normal:?}"),
             "a non-zero vector",
         ));
     }
-    Ok(n / l)
+    Ok((n / largest).normalize())
 }
 
 fn positive(name: &str, r: f64) -> Result<f64> {

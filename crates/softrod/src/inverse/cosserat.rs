@@ -341,7 +341,18 @@ impl Forward for CosseratForward {
 
     fn evaluate(&mut self, a: &[f64], jacobian: bool) -> Result<Evaluation> {
         if no_external_loads(&self.model) && jacobian {
-            return self.unloaded(a, true);
+            return self.unloaded(a, true).map_err(|e| {
+                // A march that fails where the tendons compress the rod to nothing or bend it
+                // inside a tendon's path: the tension named, as a solve names it.
+                let nt = self.model.tendons().len();
+                let tensions = &a[..nt.min(a.len())];
+                crate::cosserat::collapse::compressed_to_zero(&self.model, tensions)
+                    .or_else(|| {
+                        crate::cosserat::collapse::bent_inside_a_tendon(&self.model, tensions)
+                    })
+                    .filter(|_| matches!(e, Error::NotConverged { .. }))
+                    .unwrap_or(e)
+            });
         }
         let sol = self.solve(a)?;
         self.last = Some(sol.warm_start());

@@ -191,7 +191,48 @@ fn start<F: Forward + ?Sized>(
         Some(w) => w.actuation.clone(),
         None => p.bounds.centre.clone(),
     };
+    let given = a.clone();
     p.clamp(&mut a);
+    // The input that put an actuator where the robot cannot be solved: the bounds that moved
+    // it there, else the warm start or the reference it was taken from.
+    let source = |i: usize| {
+        if a[i] != given[i] {
+            if i < p.nt {
+                "tension_bounds"
+            } else {
+                "pressure_bounds"
+            }
+        } else if warm.is_some() {
+            "warm_start"
+        } else {
+            "reference"
+        }
+    };
+    let named = |e: Error| match e {
+        Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => {
+            let i = name
+                .strip_prefix("tensions[")
+                .and_then(|r| r.strip_suffix(']'))
+                .and_then(|k| k.parse::<usize>().ok());
+            match i {
+                Some(i) if i < n => Error::invalid(
+                    source(i),
+                    format!("{name} = {value} at the start"),
+                    expected,
+                ),
+                _ => Error::InvalidParameter {
+                    name,
+                    value,
+                    expected,
+                },
+            }
+        }
+        e => e,
+    };
     let mut evaluations = 0;
     let reuse = warm.and_then(|w| {
         (w.actuation == a)
@@ -203,7 +244,7 @@ fn start<F: Forward + ?Sized>(
         Some(e) => e,
         None => {
             evaluations += 1;
-            forward.evaluate(&a, true)?
+            forward.evaluate(&a, true).map_err(named)?
         }
     };
     let probes_available = forward.has_probes();

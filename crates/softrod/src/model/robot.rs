@@ -63,7 +63,9 @@ impl RobotModel {
     /// # Errors
     /// [`Error::InvalidParameter`] naming the offending field: `tendons[i].end` outside
     /// `(0, L]`, `tendons[i].offset(s)` not finite, `chambers[i].start`/`.end`/`.offset`/
-    /// `.area(s)`, `loads.*`, `density` (gravity without it), `section(0)`.
+    /// `.area(s)`, `loads.*`, `density` (gravity without it), `section(0).*` (a property
+    /// not finite and positive: a radius of 1e100 m), `rod` (a force scale `E I(0) / L²` out of
+    /// double precision).
     pub fn new(
         rod: Rod,
         tendons: Vec<Tendon>,
@@ -207,15 +209,8 @@ impl RobotModel {
         }
         breaks.sort_by(f64::total_cmp);
         breaks.dedup();
+        let force_scale = force_scale(&rod)?;
         let props0 = rod.section_at(0.0);
-        let force_scale = rod.material().bending_stiffness(&props0) / (l * l);
-        if !(force_scale.is_finite() && force_scale > 0.0) {
-            return Err(Error::invalid(
-                "section(0)",
-                format!("{props0:?}"),
-                "positive and finite",
-            ));
-        }
         check_load_limits(&loads, &rod, force_scale)?;
         let chamber_area_max = chambers
             .iter()
@@ -579,4 +574,26 @@ fn check_load_limits(loads: &Loads, rod: &Rod, force_scale: f64) -> Result<()> {
         check_load("loads.gravity", g, g, f0 / (l * rho * area), "m/s^2")?;
     }
     Ok(())
+}
+
+/// The force scale `E I(0) / L²` (N) of `rod`, checked.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `section(0).*` (a property not finite and positive) or
+/// `rod` (a scale that is not a positive, normal double: each input was checked, but together
+/// they leave double precision, as a modulus of 1e-300 Pa or a rod 1e-300 m long).
+fn force_scale(rod: &Rod) -> Result<f64> {
+    let l = rod.length();
+    let props0 = rod.section_at(0.0).validated("section(0)")?;
+    let bending = rod.material().bending_stiffness(&props0);
+    let force_scale = bending / (l * l);
+    if force_scale.is_normal() && force_scale > 0.0 {
+        return Ok(force_scale);
+    }
+    Err(Error::invalid(
+        "rod",
+        format!("E I(0) / L^2 = {force_scale:e} N (E I(0) = {bending:e} N m^2, L = {l:e} m)"),
+        "a force scale that is a positive, normal double-precision number (the length, \
+         section and modulus together are out of range)",
+    ))
 }
