@@ -97,7 +97,9 @@ def design_robot(robot, values: dict):
         r = robot.with_parameters(values) if values else robot
         _core._sweep([_job(r, np.zeros((0, 0)), TaskSpec((), (), (), (), 1))], outputs=[])
     except (ParameterError, ConvergenceError) as exc:
-        return None, " ".join(str(exc).split())
+        # (The design's values are the axes' own, not an argument `values` of the user's.)
+        message = " ".join(str(exc).split()).removeprefix("`values`: ")
+        return None, message
     return r, None
 
 
