@@ -386,3 +386,28 @@ def test_a_curl_the_default_mesh_cannot_resolve_is_swept_on_a_finer_one():
         got = ds["tip_position"].values[i]
         assert int(ds["status"][i]) == STATUS["converged"]
         assert np.linalg.norm(got - ref) <= 1e-4 * 0.4, (p, got, ref)
+
+
+def test_an_adaptive_robot_s_compliance_is_marched_to_the_arc_lengths():
+    # The adaptive integrator's compliance is a controlled march; the sweep stops it at the arc
+    # lengths asked (as compliance(sol, s_out=...)), not at every node of the solution (which
+    # made the compliance 4x the solve on the tapered arm).
+    arm = softrod.examples.load("tapered_cable_arm")
+    s = [0.1, 0.2, 0.27]
+    ds = softrod.sweep(
+        arm,
+        actuation={"tendons[0].tension": [0.5, 2.0]},
+        outputs=("compliance", "gamma_c", "translational_compliance"),
+        arc_lengths=s,
+        block=1,
+        progress=False,
+    )
+    for t in (0.5, 2.0):
+        sol = arm.solve([t])
+        c = softrod.compliance(sol, s_out=s)
+        got = ds.sel({"tendons[0].tension": t})
+        assert np.array_equal(got["compliance"].values, np.asarray(c.world))
+        assert np.array_equal(got["gamma_c"].values, np.asarray(c.gamma_c))
+        # Against the compliance at every node: the same to the march's tolerance.
+        every = softrod.compliance(sol)
+        np.testing.assert_allclose(got["compliance"].values[-1], every.world[-1], rtol=1e-6, atol=0)

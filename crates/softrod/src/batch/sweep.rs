@@ -26,11 +26,11 @@ use nalgebra::{Matrix6, Vector3};
 use rayon::prelude::*;
 
 use super::arc::{pose_at, ComplianceAt};
-use crate::compliance::compliance;
+use crate::compliance::{compliance, compliance_at};
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::compliance::gamma_c;
 use crate::cosserat::mesh::solve_at_output;
-use crate::cosserat::statics::{SolveOptions, StaticsSolution};
+use crate::cosserat::statics::{Integrator, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_spd;
 use crate::model::chamber::check_pressure;
@@ -418,26 +418,36 @@ fn measure(sol: &StaticsSolution, job: &SweepJob<'_>, request: &SweepRequest) ->
     if !request.needs_arcs() || job.arc_lengths.is_empty() {
         return sample;
     }
-    let comp = if request.needs_compliance() {
-        compliance(sol).ok()
-    } else {
-        None
+    // An adaptive solution's compliance is marched under step-size control, with a stop at
+    // each arc length asked (its value there exact); an RK4 solution's is the quadrature at
+    // its nodes, interpolated between them.
+    let adaptive = matches!(sol.options.integrator, Integrator::Adaptive(_));
+    let (stops, nodes) = match request.needs_compliance() {
+        false => (None, None),
+        true if adaptive => (compliance_at(sol, &job.arc_lengths).ok(), None),
+        true => (None, compliance(sol).ok()),
     };
-    let at = comp.as_ref().map(|c| ComplianceAt::new(sol, c));
+    let at = nodes.as_ref().map(|c| ComplianceAt::new(sol, c));
     let rod = sol.model.rod();
-    for (arc, &s) in sample.arcs.iter_mut().zip(&job.arc_lengths) {
+    for (i, (arc, &s)) in sample.arcs.iter_mut().zip(&job.arc_lengths).enumerate() {
         let (p, q) = pose_at(sol, s);
         if request.backbone {
             arc.position = p;
             arc.quaternion = q;
         }
-        let Some(at) = &at else { continue };
-        let c = at.world(s, &p);
+        let (c, body) = match (&stops, &at) {
+            (Some(stops), _) => (stops.world[i], stops.body[i]),
+            (None, Some(at)) => {
+                let c = at.world(s, &p);
+                (c, at.body(s, &c, &q))
+            }
+            (None, None) => continue,
+        };
         if request.compliance {
             arc.compliance = c;
         }
         if request.gamma_c {
-            arc.gamma_c = gamma_c(rod, &at.body(s, &c, &q));
+            arc.gamma_c = gamma_c(rod, &body);
         }
         if request.translational_compliance && c.iter().all(|v| v.is_finite()) {
             arc.translational_compliance = principal(&c.fixed_view::<3, 3>(0, 0).into_owned());
