@@ -239,6 +239,17 @@ def _sweep_axes(specs: list[str], n_tendons: int, n: int) -> dict[int, np.ndarra
     return axes
 
 
+def _why_not(robot, tensions, opts: dict) -> str:
+    """The tensions (N) of a configuration a map did not converge at, and what a solve of it
+    alone says."""
+    shown = "[" + ", ".join(f"{t:.4g}" for t in tensions) + "] N"
+    try:
+        robot.solve(tensions=list(tensions), **opts)
+    except Exception as exc:  # a named error or a ConvergenceError: shown as it is
+        return f"tensions {shown}: {type(exc).__name__}: {' '.join(str(exc).split())}"
+    return f"tensions {shown} (a solve of it alone converges)"
+
+
 def _cmd_workspace(args) -> int:
     from ..analysis.workspace import tension_grid, workspace_map
 
@@ -288,6 +299,8 @@ def _cmd_workspace(args) -> int:
             )
     print(f"robot: {robot.name} ({args.robot}); {len(grid)} configurations in {dt:.3f} s")
     print(f"converged: {int(ok.sum())}/{len(grid)}")
+    if not ok.all():
+        print(f"  the first that did not: {_why_not(robot, grid[int(np.argmin(ok))], opts)}")
     # Centre: the tip closest to the rod's base axis; periphery: the farthest.
     r = np.linalg.norm(wmap.tip_position[:, :2], axis=1)
     r[~ok] = np.nan
