@@ -170,6 +170,40 @@ pub fn solve_inverse<F: Forward + ?Sized>(
     }
 }
 
+/// An error of the first evaluation at `a` (clamped from `given`) that names a tension
+/// (`tensions[i]`: the robot cannot be solved there), renamed after the input that put the
+/// actuator there: the bounds that moved it, else the warm start or the reference it was
+/// taken from.
+fn at_start(e: Error, p: &Program<'_>, (given, a): (&[f64], &[f64]), warm: bool) -> Error {
+    let Error::InvalidParameter {
+        name,
+        value,
+        expected,
+    } = e
+    else {
+        return e;
+    };
+    let index = name
+        .strip_prefix("tensions[")
+        .and_then(|r| r.strip_suffix(']'))
+        .and_then(|k| k.parse::<usize>().ok())
+        .filter(|&i| i < a.len());
+    let Some(i) = index else {
+        return Error::InvalidParameter {
+            name,
+            value,
+            expected,
+        };
+    };
+    let source = match (a[i] != given[i], i < p.nt, warm) {
+        (true, true, _) => "tension_bounds",
+        (true, false, _) => "pressure_bounds",
+        (false, _, true) => "warm_start",
+        (false, _, false) => "reference",
+    };
+    Error::invalid(source, format!("{name} = {value} at the start"), expected)
+}
+
 /// The first iterate: the warm start's actuation (its evaluation and Hessian if they fit) or
 /// the reference, clamped into the bounds.
 fn start<F: Forward + ?Sized>(
@@ -193,46 +227,6 @@ fn start<F: Forward + ?Sized>(
     };
     let given = a.clone();
     p.clamp(&mut a);
-    // The input that put an actuator where the robot cannot be solved: the bounds that moved
-    // it there, else the warm start or the reference it was taken from.
-    let source = |i: usize| {
-        if a[i] != given[i] {
-            if i < p.nt {
-                "tension_bounds"
-            } else {
-                "pressure_bounds"
-            }
-        } else if warm.is_some() {
-            "warm_start"
-        } else {
-            "reference"
-        }
-    };
-    let named = |e: Error| match e {
-        Error::InvalidParameter {
-            name,
-            value,
-            expected,
-        } => {
-            let i = name
-                .strip_prefix("tensions[")
-                .and_then(|r| r.strip_suffix(']'))
-                .and_then(|k| k.parse::<usize>().ok());
-            match i {
-                Some(i) if i < n => Error::invalid(
-                    source(i),
-                    format!("{name} = {value} at the start"),
-                    expected,
-                ),
-                _ => Error::InvalidParameter {
-                    name,
-                    value,
-                    expected,
-                },
-            }
-        }
-        e => e,
-    };
     let mut evaluations = 0;
     let reuse = warm.and_then(|w| {
         (w.actuation == a)
@@ -244,7 +238,9 @@ fn start<F: Forward + ?Sized>(
         Some(e) => e,
         None => {
             evaluations += 1;
-            forward.evaluate(&a, true).map_err(named)?
+            forward
+                .evaluate(&a, true)
+                .map_err(|e| at_start(e, p, (&given, &a), warm.is_some()))?
         }
     };
     let probes_available = forward.has_probes();
