@@ -26,9 +26,9 @@ use nalgebra::{Matrix6, Vector3};
 use rayon::prelude::*;
 
 use super::arc::{pose_at, ComplianceAt};
-use crate::compliance::{compliance, compliance_at};
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::compliance::gamma_c;
+use crate::compliance::{compliance, compliance_at};
 use crate::cosserat::mesh::solve_at_output;
 use crate::cosserat::statics::{Integrator, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};

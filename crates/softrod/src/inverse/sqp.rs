@@ -174,7 +174,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
 /// (`tensions[i]`: the robot cannot be solved there), renamed after the input that put the
 /// actuator there: the bounds that moved it, else the warm start or the reference it was
 /// taken from.
-fn at_start(e: Error, p: &Program<'_>, (given, a): (&[f64], &[f64]), warm: bool) -> Error {
+fn at_start(e: Error, (given, a): (&[f64], &[f64]), warm: bool) -> Error {
     let Error::InvalidParameter {
         name,
         value,
@@ -195,11 +195,10 @@ fn at_start(e: Error, p: &Program<'_>, (given, a): (&[f64], &[f64]), warm: bool)
             expected,
         };
     };
-    let source = match (a[i] != given[i], i < p.nt, warm) {
-        (true, true, _) => "tension_bounds",
-        (true, false, _) => "pressure_bounds",
-        (false, _, true) => "warm_start",
-        (false, _, false) => "reference",
+    let source = match (a[i] != given[i], warm) {
+        (true, _) => "tension_bounds",
+        (false, true) => "warm_start",
+        (false, false) => "reference",
     };
     Error::invalid(source, format!("{name} = {value} at the start"), expected)
 }
@@ -240,7 +239,7 @@ fn start<F: Forward + ?Sized>(
             evaluations += 1;
             forward
                 .evaluate(&a, true)
-                .map_err(|e| at_start(e, p, (&given, &a), warm.is_some()))?
+                .map_err(|e| at_start(e, (&given, &a), warm.is_some()))?
         }
     };
     let probes_available = forward.has_probes();
