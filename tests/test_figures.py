@@ -326,3 +326,18 @@ def test_cli_figure_options(tmp_path, capsys):
     err = captured.err.strip().splitlines()
     assert len(err) == 1 and "`--plot`" in err[0] and "configurations" not in captured.out
     assert main(["solve", str(NITI), "--plot", str(svg), "--dpi", "0"]) == 2
+
+
+def test_a_robot_is_drawn_at_the_tensions_of_the_solution_given():
+    # plot_robot(robot, sol) coloured and labelled the tendons with the robot's own tensions
+    # (0.5 N on tendon 0 drawn solid while the solution pulled tendon 1 alone).
+    robot = softrod.examples.load("niti_two_segment")
+    sol = robot.solve([0.0, 0.3, 0.0, 0.0, 0.0, 0.0])
+    fig = softrod.plot.plot_robot(robot, sol)
+    labels = [lab for ax in fig.axes for lab in ax.get_legend_handles_labels()[1]]
+    assert "tendon 1 (0.3 N)" in labels and "tendon 0 (0 N)" in labels
+    assert not any("(4 N)" in lab for lab in labels)
+    # Its own solution: the robot's tensions.
+    fig = softrod.plot.plot_robot(robot)
+    labels = [lab for ax in fig.axes for lab in ax.get_legend_handles_labels()[1]]
+    assert f"tendon 0 ({robot.tendons[0].tension:.3g} N)" in labels

@@ -430,12 +430,17 @@ def plot_rod(
         raise ParameterError(
             "invalid parameter `projections` = True: needs a new figure (do not pass `ax`)"
         )
-    if geometry is None and (robot is not None or radius is not None):
-        base = robot if robot is not None else None
-        if base is not None:
-            geometry = robot_geometry(base, radius=radius, disks=disks)
+    given = geometry
+    if geometry is None and robot is not None:
+        geometry = robot_geometry(robot, radius=radius, disks=disks)
     geoms: list[RobotGeometry | None] = []
-    for _ in sols:
+    for sol in sols:
+        if given is None and robot is not None:
+            # Each solution's tendons and chambers drawn at its own tensions and pressures.
+            actuated = _actuated(robot, sol)
+            if actuated is not robot:
+                geoms.append(robot_geometry(actuated, radius=radius, disks=disks))
+                continue
         if geometry is None and radius is not None:
             from .geometry import _as_radius_fn
 
@@ -562,6 +567,32 @@ def plot_rod(
         if title:
             (fig.suptitle if projections else ax.set_title)(title)
     return fig
+
+
+def _actuated(robot, solution):
+    """``robot`` at the tensions and pressures of ``solution`` (its tendons' colours and
+    legend), or ``robot`` itself when they are its own or cannot be read."""
+
+    def differ(objects, values, attr):
+        return (
+            values is not None
+            and len(values) == len(objects) > 0
+            and any(
+                float(getattr(o, attr)) != float(v) for o, v in zip(objects, values, strict=True)
+            )
+        )
+
+    out = robot
+    try:
+        tensions = getattr(solution, "tendon_tensions", None)
+        if differ(robot.tendons, tensions, "tension"):
+            out = out.with_tensions(list(tensions))
+        pressures = getattr(solution, "pressures", None)
+        if differ(robot.chambers, pressures, "pressure"):
+            out = out.with_pressures(list(pressures))
+    except (AttributeError, TypeError, ValueError):
+        return robot
+    return out
 
 
 def plot_robot(robot, solution=None, **options):
