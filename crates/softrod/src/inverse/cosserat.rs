@@ -22,6 +22,13 @@ use crate::model::loads::{Frame, PointLoad};
 use crate::model::{Actuation, RobotModel};
 use crate::solve::SolverStats;
 
+/// Newton tolerance (scaled residual) of the forward solves of the inverse, at most: at the
+/// statics default (1e-10) the tips of warm-started solves scatter by about 1e-10 m, the
+/// inverse's own default tolerance, and the iteration wandered there (a tapered silicone arm
+/// under gravity met its target to 4e-11 m, then 1.2e-10 m, and raised after 60 iterations at
+/// 1.9e-10 m).
+pub const FORWARD_TOLERANCE: f64 = 1e-12;
+
 /// Whether no external load acts (zero point loads only mark integration breaks).
 fn no_external_loads(model: &RobotModel) -> bool {
     let l = model.loads();
@@ -73,6 +80,13 @@ impl CosseratForward {
     /// [`Error::InvalidParameter`] naming `target_s[k]` outside `(0, L]`, or the model's.
     pub fn new(model: &Arc<RobotModel>, options: &SolveOptions, s: Option<&[f64]>) -> Result<Self> {
         options.validate()?;
+        let options = &SolveOptions {
+            newton: crate::solve::NewtonOptions {
+                tolerance: options.newton.tolerance.min(FORWARD_TOLERANCE),
+                ..options.newton
+            },
+            ..*options
+        };
         let mut me = Self {
             model: Arc::clone(model),
             options: *options,
