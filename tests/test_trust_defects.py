@@ -911,3 +911,30 @@ def test_an_inverse_meets_its_default_tolerance_on_a_loaded_arm():
     assert inv.iterations < 20
     tip = robot.solve(inv.tensions).tip_position
     assert np.linalg.norm(tip - target) < 1e-10
+
+
+@pytest.mark.parametrize("p", [0.0, -0.5e-3, -0.999e-3])
+def test_a_plane_cutting_the_rod_s_surface_at_rest_is_refused(p):
+    # The backbone outside the plane, the rod's surface (radius 1 mm) inside it: answers
+    # "converged" with the surface still 1 mm through the plane, or a ConvergenceError after 0
+    # iterations unloaded. A plate through the base, normal to the rod, stays allowed.
+    rod = softrod.Rod(1.0, softrod.CircularSection(1e-3), softrod.LinearElastic(2e9, 0.3))
+    plane = softrod.Plane((p, 0.0, 0.0), (1.0, 0.0, 0.0))
+    for loads in (softrod.Loads(), softrod.Loads(tip_force=(-1e-6, 0.0, 0.0))):
+        with pytest.raises(softrod.ParameterError, match="surface lies") as e:
+            softrod.solve_statics(rod, loads=loads, obstacles=[plane])
+        assert e.value.parameter == "obstacles[0]"
+    plate = softrod.Plane((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    pushed = softrod.Loads(tip_force=(1e-3, 0.0, 0.0))
+    sol = softrod.solve_statics(rod, loads=pushed, obstacles=[plate])
+    assert sol.converged and not sol.contacts
+
+
+def test_a_failed_march_of_a_constrained_solve_is_said_once():
+    # A slide plane 4 m beyond a 1 m rod's tip: "... did not converge after 38 iterations
+    # (residual inf) did not converge after 0 iterations (residual inf)".
+    rod = softrod.Rod(1.0, softrod.CircularSection(1e-3), softrod.LinearElastic(2e9, 0.3))
+    with pytest.raises(softrod.ConvergenceError) as e:
+        softrod.solve_statics(rod, tip_constraint=softrod.Slide((0.0, 0.0, 5.0), (0.0, 0.0, 1.0)))
+    assert str(e.value).count("did not converge") == 1
+    assert "constrained shooting" in str(e.value)

@@ -384,8 +384,22 @@ fn final_march(
     } else {
         sh.pass::<FULL>(&x[..6], 1.0)
     };
-    let (res, cols, _) = marched.map_err(|e| {
-        Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY)
+    let (res, cols, _) = marched.map_err(|e| match e {
+        // (The march's own failure, said once: its message is not wrapped in another.)
+        Error::NotConverged {
+            what,
+            iterations,
+            residual,
+            load_factor,
+        } => Error::NotConverged {
+            what: format!(
+                "constrained shooting: the march of the last state ({what}, {iterations} steps)"
+            ),
+            iterations: 0,
+            residual,
+            load_factor,
+        },
+        e => Error::not_converged(format!("constrained shooting: {e}"), 0, f64::INFINITY),
     })?;
     Ok((res, cols))
 }

@@ -25,7 +25,7 @@ use super::newton::Effort;
 use super::obstacle::Obstacle;
 use super::problem::{Active, Constrained, Pass, Site};
 use super::sweep::{arc_point, least_gap_in_cell, CellEnd};
-use crate::cosserat::equations::v3;
+use crate::cosserat::equations::{rot, v3};
 use crate::cosserat::shooting::Node;
 use crate::error::Error;
 use crate::solve::{NewtonOptions, MIN_LOAD_INCREMENT};
@@ -259,12 +259,19 @@ pub(super) fn check_rest_clear(p: &mut Constrained<'_>) -> crate::error::Result<
     }
     let depth = 1e-9 * p.model.length();
     let obstacles = p.obstacles;
+    let model = p.model;
     let Some(nodes) = rest_nodes(p) else {
         // Not integrable: the solve reports that.
         return Ok(());
     };
+    let radius = |s: f64| model.rod().section_at(s).radius;
     for (i, o) in obstacles.iter().enumerate() {
-        if let Some((sk, x, d)) = deepest_at_rest(o, nodes, depth) {
+        let found = deepest_at_rest(o, nodes, depth)
+            .map(|(sk, x, d)| (sk, x, d, "backbone"))
+            .or_else(|| {
+                surface_at_rest(o, nodes, &radius, depth).map(|(sk, x, d)| (sk, x, d, "surface"))
+            });
+        if let Some((sk, x, d, part)) = found {
             let kind = match o.shape() {
                 Obstacle::Plane { .. } => "a plane",
                 Obstacle::Sphere { .. } => "a sphere",
@@ -276,7 +283,7 @@ pub(super) fn check_rest_clear(p: &mut Constrained<'_>) -> crate::error::Result<
                 format!("obstacles[{i}]"),
                 kind,
                 format!(
-                    "clear of the rod at rest (its unactuated, unloaded backbone lies \
+                    "clear of the rod at rest (its unactuated, unloaded {part} lies \
                      {:.3e} m inside it at s = {sk:.4} m, ({:.4}, {:.4}, {:.4}) m)",
                     -d, x.x, x.y, x.z
                 ),
@@ -309,6 +316,26 @@ fn deepest_at_rest(o: &Obstacle, nodes: &[Node], depth: f64) -> Option<(f64, Vec
         );
         let (t, g) = least_gap_in_cell(o, (&ea, ga), (&eb, gb), -depth)?;
         Some((a.s + t * h, arc_point(&ea, &eb, t), g))
+    })
+}
+
+/// The first node (arc length, m; backbone point, m; gap, m) of `nodes` whose cross-section
+/// (a disc of radius `radius(s)`, m, normal to the tangent) reaches deeper than `depth` (m)
+/// into `o` while its backbone is outside: the gap `d - r |n × t|`, `n` the obstacle's normal
+/// at the backbone and `t` the tangent (a plane along the rod cutting its surface; a base
+/// plate through the base, whose normal is the tangent, does not).
+fn surface_at_rest(
+    o: &Obstacle,
+    nodes: &[Node],
+    radius: &dyn Fn(f64) -> f64,
+    depth: f64,
+) -> Option<(f64, Vector3<f64>, f64)> {
+    nodes.iter().find_map(|n| {
+        let x = v3(&n.y, 0);
+        let (d, normal) = o.distance(&x);
+        let tangent = rot(&n.y) * Vector3::z();
+        let g = d - radius(n.s) * normal.cross(&tangent).norm();
+        (g < -depth).then_some((n.s, x, g))
     })
 }
 
