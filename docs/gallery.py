@@ -29,7 +29,7 @@ def main(out: Path) -> list[Path]:
 
     def save(fig, name: str) -> None:
         path = out / name
-        plot.save_figure(fig, path, dpi=100)
+        plot.save_figure(fig, path, dpi=100, overwrite=True)  # regenerates the docs
         plt.close(fig)
         written.append(path)
 

@@ -79,7 +79,7 @@ def main(out: Path) -> None:
     ax.set_aspect("equal")
     ax.set_title("tip path, cable tension 0-4 N, offset ratio 0.35")
     ax.legend(loc="lower left", fontsize=8)
-    plot.save_figure(fig, out / "sweep_tips.png", dpi=110)
+    plot.save_figure(fig, out / "sweep_tips.png", dpi=110, overwrite=True)
     plt.close(fig)
 
     # Figure 2: workspace area and median tip stiffness over the two design ratios.
@@ -96,7 +96,7 @@ def main(out: Path) -> None:
         ax.set_ylabel("taper ratio (tip / base radius)")
     axes[0].set_title("reachable workspace")
     axes[1].set_title("stiffness over the workspace")
-    plot.save_figure(fig, out / "sweep_maps.png", dpi=110)
+    plot.save_figure(fig, out / "sweep_maps.png", dpi=110, overwrite=True)
     plt.close(fig)
 
     # Figure 3: the Pareto front of workspace area and stiffness (both better larger).
@@ -122,7 +122,7 @@ def main(out: Path) -> None:
     ax.set_ylabel("median tip stiffness (N/m)")
     ax.set_title("workspace vs stiffness of 195 feasible designs")
     ax.legend(fontsize=8)
-    plot.save_figure(fig, out / "sweep_pareto.png", dpi=110)
+    plot.save_figure(fig, out / "sweep_pareto.png", dpi=110, overwrite=True)
     plt.close(fig)
 
     print("Pareto front (taper ratio, offset ratio, area cm^2, median stiffness N/m, ratio):")

@@ -1,6 +1,7 @@
 """Backbone extraction against photos rendered from known solutions (``arm_photos``)."""
 
 import pickle
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -369,6 +370,40 @@ def test_bad_arguments_raise_named_errors(kwargs, name, backbone):
     with pytest.raises(ParameterError) as exc:
         softrod.extract_backbone(photo.image, **kwargs)
     assert exc.value.parameter == name
+
+
+def _bar_image():
+    img = np.zeros((100, 100))  # diagonal 141.42 px; the arm: columns 10-89, rows 45-54
+    img[45:55, 10:90] = 1.0
+    return img
+
+
+@pytest.mark.parametrize("base", [(1e6, 1e6), (1e15, 1e15), (-142.0, 49.5), (49.5, 241.0)])
+def test_a_base_far_outside_the_image_is_refused_before_allocating(base):
+    # The hidden part is extrapolated one point per pixel out to the base: a base more than
+    # one image diagonal outside the image is refused, naming it and the range.
+    tracemalloc.start()
+    with pytest.raises(ParameterError) as exc:
+        softrod.extract_backbone(_bar_image(), base=base)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 20e6
+    text = str(exc.value)
+    assert exc.value.parameter == "base" and repr(base) in text
+    assert "col in [-141.4, 240.4]" in text and "row in [-141.4, 240.4]" in text
+
+
+def test_a_base_within_one_diagonal_of_the_image_is_extrapolated_to():
+    for base in [(-141.0, 49.5), (-100.0, 240.0)]:  # hidden: the curve starts there
+        bb = softrod.extract_backbone(_bar_image(), base=base)
+        np.testing.assert_allclose(bb.base, base)
+        np.testing.assert_allclose(bb.pixels[0], base, atol=1e-9)
+    on_arm = softrod.extract_backbone(_bar_image(), base=(30.0, 49.5))
+    assert not on_arm.quality.base_extrapolated
+    np.testing.assert_allclose(on_arm.pixels[0], (30.0, 49.5), atol=1.0)
+    far = softrod.extract_backbone(_bar_image(), base=(-141.0, 49.5))
+    assert far.quality.base_extrapolated
+    np.testing.assert_allclose(far.quality.extrapolated_length, 151.0, atol=1.0)
 
 
 def test_shipped_sample_photo_lands_on_the_model():

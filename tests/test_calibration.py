@@ -208,3 +208,57 @@ def test_bad_input_is_a_named_error(kwargs, match):
     args.update(kwargs)
     with pytest.raises(softrod.ParameterError, match=match):
         softrod.calibrate(START, args.pop("measurements"), args.pop("parameters"), **args)
+
+
+def _partial_backbone():
+    """The first 10 of 50 points of the published arm at 2 N (a fuzz run's input): fitting E
+    to it makes the optimiser try moduli at which 2 N would compress the arm to zero length."""
+    arm = softrod.PlanarCableArm(0.27, 0.015, 0.0074, 0.25, 70e3)
+    sol = START.solve(2.0, 50)
+    return arm, [(2.0, np.column_stack([sol.x, sol.y])[:10])]
+
+
+def test_a_trial_modulus_that_cannot_carry_the_tension_is_rejected_not_blamed_on_it():
+    arm, data = _partial_backbone()
+    assert 2.0 < arm.max_tension  # the user's tension is valid at the robot's modulus
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", cal.IdentifiabilityWarning)
+        fit = softrod.calibrate(arm, data, ["E"])
+    # The fit ends at a modulus where the measured tension is valid, and says trials were
+    # rejected there.
+    assert fit.robot.max_tension > 2.0 and np.isfinite(fit.rms)
+    assert "rejected" in fit.message and "youngs_modulus" in fit.message
+    assert np.all(np.isfinite(fit.residuals[0]))
+    # The residual at the result is the model's at that modulus.
+    again = softrod.calibrate(fit.robot, data, ["E"], max_evaluations=1)
+    np.testing.assert_allclose(again.residuals[0], fit.residuals[0], rtol=1e-9, atol=1e-15)
+
+
+def test_starting_values_at_which_the_tension_is_invalid_are_named():
+    arm, data = _partial_backbone()
+    with pytest.raises(softrod.ParameterError) as info:
+        softrod.calibrate(arm, data, ["E"], initial={"E": 1e3})
+    text = str(info.value)
+    assert info.value.parameter == "initial"
+    assert "youngs_modulus = 1000" in text and "starting value" in text
+    assert "`tension` = 2" in text  # the model's refusal, at that modulus
+
+
+def test_a_fit_whose_every_trial_is_rejected_names_the_trial_value(monkeypatch):
+    # A model that can be evaluated at the start and nowhere else: the fit cannot proceed,
+    # and the error says the fitted parameter's trial value makes the tension invalid.
+    arm, data = _partial_backbone()
+    evaluate = cal._PlanarModel.evaluate
+
+    def only_at_the_start(self, values, names, m, metric):
+        if values["youngs_modulus"] != 70e3:
+            raise softrod.ParameterError("invalid parameter `tension` = 2: must be < 1 N")
+        return evaluate(self, values, names, m, metric)
+
+    monkeypatch.setattr(cal._PlanarModel, "evaluate", only_at_the_start)
+    with pytest.raises(softrod.ConvergenceError) as info:
+        softrod.calibrate(arm, data, ["E"])
+    text = str(info.value)
+    assert "starting values (youngs_modulus = 70000)" in text
+    assert "every trial value" in text and "trial value youngs_modulus = " in text
+    assert "`tension` = 2" in text

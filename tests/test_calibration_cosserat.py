@@ -204,3 +204,16 @@ def test_a_misspelt_parameter_path_is_an_unknown_key_with_a_suggestion(niti, nam
         softrod.calibrate(niti, data, [name])
     assert info.value.parameter == "parameters" and name in str(info.value)
     assert "stiffness_scale" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "pose",
+    [2.0 * np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0]), np.vstack([np.eye(4)[:3], [0, 0, 1, 1]])],
+)
+def test_a_tip_pose_that_is_not_rigid_is_refused(pose):
+    # 2 I was accepted and the fit went on to a modulus of 1.3e13 Pa (an optimiser trial),
+    # blamed on `rod.material.youngs_modulus`.
+    robot = softrod.examples.load("niti_two_segment")
+    with pytest.raises(softrod.ParameterError, match="rigid transform") as e:
+        softrod.calibrate(robot, [([1, 0, 0, 0, 0.5, 0], pose)], ["rod.material.youngs_modulus"])
+    assert "measurements[0]" in str(e.value)

@@ -113,6 +113,23 @@ def test_bad_arguments_exit_2(photo, tmp_path, capsys):
         assert len(err) == 1 and f"`{name}`" in err[0]
 
 
+def test_a_base_far_outside_the_photo_is_refused(tmp_path, capsys):
+    img = np.zeros((100, 100), np.uint8)  # diagonal 141.42 px
+    img[45:55, 10:90] = 255
+    shot = tmp_path / "bar.png"
+    io.imsave(shot, img, check_contrast=False)
+    out = tmp_path / "b.csv"
+    argv = ["backbone", str(shot), "--base", "1e6", "1e6", "--csv", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "`--base` = [1000000.0, 1000000.0]" in err[0]
+    assert "col in [-141.4, 240.4]" in err[0] and "row in [-141.4, 240.4]" in err[0]
+    assert not out.exists()
+    assert main(["backbone", str(shot), "--base", "-141", "49.5", "--csv", str(out)]) == 0
+    assert "extrapolated over" in capsys.readouterr().out
+    np.testing.assert_allclose(softrod.Backbone.read_csv(out).pixels[0], [-141.0, 49.5])
+
+
 def test_console_script_from_another_directory(photo, tmp_path):
     shot, path = photo
     r = subprocess.run(

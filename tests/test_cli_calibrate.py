@@ -97,6 +97,35 @@ def test_a_measurements_csv_without_data_rows_is_bad_input(tmp_path, capsys, tex
     assert "`path`" in err and "no data rows" in err and "internal error" not in err
 
 
+@pytest.mark.parametrize(("text", "width"), [("x,y\n0,0\n0.1,0\n0.2,0.01\n", 2), ("0\n1\n", 1)])
+def test_a_measurements_csv_with_too_few_columns_names_the_file(tmp_path, capsys, text, width):
+    meas = tmp_path / "okc.csv"
+    meas.write_text(text)
+    item = f"1,0,0,0,0.5,0:{meas}"
+    argv = ["calibrate", "niti_two_segment", "--measurements", item]
+    assert main([*argv, "--parameters", "rod.material.youngs_modulus"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "`columns`" not in err[0] and "internal error" not in err[0]
+    assert str(meas) in err[0] and f"{width} column" in err[0]
+    assert "3 (x, y, z)" in err[0] or "2 or 3" in err[0]
+
+
+def test_a_planar_measurements_csv_with_three_columns_reads_the_first_two(csvs, tmp_path, capsys):
+    # x, y and a third column (e.g. half-widths): the planar arm's fit reads x and y, as before.
+    wide = []
+    for t, p in csvs:
+        xy = np.loadtxt(p, delimiter=",")
+        q = tmp_path / f"wide-{t}.csv"
+        np.savetxt(q, np.column_stack([xy, np.full(len(xy), 7.0)]), delimiter=",")
+        wide.append((t, q))
+    runs = []
+    for paths in (csvs, wide):
+        args = ["calibrate", "planar", "--measurements", *(f"{t}:{p}" for t, p in paths)]
+        assert main([*args, "--parameters", "E", "--unit-scale", "1e-3"]) == 0
+        runs.append(capsys.readouterr().out)
+    assert runs[0] == runs[1]
+
+
 def test_a_misspelt_parameter_suggests_the_key(tmp_path, capsys):
     niti = softrod.examples.load("niti_two_segment")
     meas = tmp_path / "meas.csv"

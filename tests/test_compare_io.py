@@ -67,3 +67,20 @@ def test_read_backbone_csv_without_data_rows_names_the_path(tmp_path, text):
     with pytest.raises(ParameterError, match="no data rows") as info:
         read_backbone_csv(f)
     assert info.value.parameter == "path" and str(f) in str(info.value)
+
+
+def test_read_backbone_csv_too_few_columns_names_the_file_and_its_columns(tmp_path):
+    f = tmp_path / "one.csv"
+    f.write_text("0\n1\n2\n")
+    with pytest.raises(ParameterError) as info:
+        read_backbone_csv(f)  # the default columns: a content error of the file
+    text = str(info.value)
+    assert info.value.parameter == "path" and str(f) in text and "1 column" in text
+    g = tmp_path / "two.csv"
+    g.write_text("x,y\n0,0\n1,2\n")
+    with pytest.raises(ParameterError) as info:
+        read_backbone_csv(g, columns=(0, 1, 2))  # the caller's columns: named, with the file's
+    text = str(info.value)
+    assert info.value.parameter == "columns" and "[0, 1, 2]" in text
+    assert str(g) in text and "has 2 columns" in text
+    np.testing.assert_array_equal(read_backbone_csv(g, columns=(1, 0)), [[0, 0], [2, 1]])

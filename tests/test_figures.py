@@ -309,6 +309,34 @@ def test_bad_figure_options_name_the_parameter(tmp_path):
         save_figure(fig, tmp_path / "f.bmp")
 
 
+def test_save_figure_refuses_an_existing_file_without_overwrite(tmp_path):
+    # A user's file under the figure's name survives; overwrite=True replaces it.
+    fig = softrod.plot.plot_rod(softrod.load_robot(NITI).solve())
+    mine = tmp_path / "mine.png"
+    mine.write_bytes(b"user data")
+    with pytest.raises(softrod.ParameterError) as info:
+        save_figure(fig, mine)
+    text = str(info.value)
+    assert info.value.parameter == "path" and str(mine) in text and "overwrite=True" in text
+    assert mine.read_bytes() == b"user data"
+    assert save_figure(fig, mine, overwrite=True) == str(mine)
+    assert mine.read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(softrod._core.ParameterTypeError) as info:
+        save_figure(fig, tmp_path / "new.png", overwrite="yes")
+    assert info.value.parameter == "overwrite" and "'yes'" in str(info.value)
+    assert not (tmp_path / "new.png").exists()
+
+
+@pytest.mark.parametrize("draw", ["plot_rod", "plot_planar_rod", "bending_view"])
+def test_an_array_of_points_is_no_solution(draw):
+    # An array of backbone points instead of a solution: a named type error.
+    with pytest.raises(softrod._core.ParameterTypeError) as info:
+        getattr(softrod.plot, draw)(np.zeros((5, 3)))
+    text = str(info.value)
+    assert info.value.parameter == "solutions" and "ndarray" in text
+    assert "StaticsSolution" in text and "sequence of them" in text
+
+
 def test_cli_figure_options(tmp_path, capsys):
     from softrod.cli import main
 

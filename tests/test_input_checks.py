@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import softrod
-from softrod import _args
+from softrod import _args, _core
 from softrod.cli import main
 
 
@@ -242,6 +242,49 @@ def test_cli_sweep_refuses_grids_whose_product_is_beyond_the_limit(tmp_path, cap
     )
     assert status == 2 and "--design" in line
     assert "100000000 points" in line and str(_args.MAX_GRID_VALUES) in line
+
+
+def test_study_refuses_levels_beyond_the_grid_limit_before_allocating():
+    from softrod.analysis.study import compliance_study
+
+    robot = softrod.examples.load("pneumatic_arm")
+    tracemalloc.start()
+    with pytest.raises(softrod.ParameterError) as info:
+        compliance_study(robot, levels=100000, log=None)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 20e6  # refused before the 1e15 pressure sets are listed
+    text = str(info.value)
+    assert info.value.parameter == "levels" and "`levels` = 100000" in text
+    assert str(100000**3) in text and str(_args.MAX_GRID_VALUES) in text
+
+
+def test_study_levels_limit_is_the_sweeps_and_inclusive():
+    from softrod.analysis.study import compliance_study, levels_beyond_limit
+
+    assert _args.MAX_GRID_VALUES == 10_000_000
+    assert levels_beyond_limit(2) is None and levels_beyond_limit(215) is None  # 9,938,375
+    reason = levels_beyond_limit(216)  # 10,077,696 points
+    assert reason is not None and "10077696" in reason and "at most 215 levels" in reason
+    with pytest.raises(softrod.ParameterError, match="10077696") as info:
+        compliance_study(softrod.examples.load("pneumatic_arm"), levels=216, log=None)
+    assert info.value.parameter == "levels"
+    with pytest.raises(_core.ParameterTypeError) as info:
+        compliance_study(softrod.examples.load("pneumatic_arm"), levels=2.5, log=None)
+    assert info.value.parameter == "levels" and "2.5" in str(info.value)
+
+
+@pytest.mark.parametrize("levels", [216, 100000])
+def test_cli_study_refuses_levels_beyond_the_grid_limit(levels, tmp_path, capsys):
+    out = tmp_path / "figs"
+    tracemalloc.start()
+    status, line = _error_line(["study", "--levels", levels, "--out", out], capsys)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 20e6
+    assert status == 2 and "`--levels` = " + str(levels) in line
+    assert str(levels**3) in line and str(_args.MAX_GRID_VALUES) in line
+    assert not out.exists()
 
 
 # ----------------------------------------------------------------------------- Robot(source=)

@@ -444,6 +444,50 @@ def test_cli_fit_bad_input_exits_2_with_one_line(argv, name, capsys):
     assert len(err) == 1 and err[0].startswith("softrod: error:") and f"`{name}`" in err[0]
 
 
+# Three valid points whose least-squares Yeoh fit has c10 < 0 (a fuzz run's file).
+FLAT_START = "strain,stress\n0,0\n0.1,0.0\n0.2,0.01\n"
+
+
+def test_a_non_physical_fitted_coefficient_is_named_as_a_result(tmp_path):
+    path = tmp_path / "curve.csv"
+    path.write_text(FLAT_START)
+    curve = read_tensile_csv(path)
+    with pytest.raises(ParameterError) as exc:
+        curve.fit("yeoh")
+    text = str(exc.value)
+    assert "invalid parameter `c10`" not in text and exc.value.parameter == "data"
+    assert "yeoh law" in text and "fitted coefficient c10 = -0.00175" in text
+    assert "3 points" in text and "more data" in text and "another law" in text
+    with pytest.raises(ParameterError, match=r"fitted coefficient c10 \+ c01 = -0\.0118"):
+        curve.fit("mooney-rivlin")
+    # A law the data can be fitted with is unchanged.
+    fit = curve.fit("neo-hookean")
+    direct = fit_uniaxial(curve.strain, curve.stress, "neo-hookean")
+    assert fit.parameters == direct.parameters
+    # Errors about the caller's own arguments still name them.
+    with pytest.raises(ParameterError) as exc:
+        curve.fit("ogden")
+    assert exc.value.parameter == "data" and "at least 4 points" in str(exc.value)
+    with pytest.raises(ParameterError) as exc:
+        curve.fit("yeoh", terms=7)
+    assert exc.value.parameter == "terms"
+
+
+def test_cli_fit_names_a_non_physical_fitted_coefficient(tmp_path, capsys):
+    path = tmp_path / "curve.csv"
+    path.write_text(FLAT_START)
+    assert main(["fit", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("softrod: error:")
+    assert "`c10`" not in err[0] and "fitted coefficient c10 = -0.00175" in err[0]
+    assert "yeoh law" in err[0] and str(path) in err[0] and "another law" in err[0]
+    # With several models the failing one is reported and the others are fitted.
+    assert main(["fit", str(path), "-m", "yeoh", "neo-hookean"]) == 0
+    out = capsys.readouterr().out
+    assert "yeoh: fit failed:" in out and "fitted coefficient c10" in out
+    assert "NeoHookean: mu = " in out
+
+
 def test_cli_fit_bad_file_has_no_traceback(tmp_path):
     p = tmp_path / "bad.csv"
     p.write_text("0.1, 1\n0.2, oops\n")

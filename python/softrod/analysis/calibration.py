@@ -39,7 +39,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from .. import _args
-from .._core import ParameterError, PlanarCableArm
+from .._core import ConvergenceError, ParameterError, PlanarCableArm
 
 __all__ = ["Calibration", "IdentifiabilityWarning", "calibrate"]
 
@@ -89,7 +89,8 @@ class Calibration:
             ``values``.
         metric: The residual metric.
         success: Whether the solver met its tolerances.
-        message: The solver's message.
+        message: The solver's message, and the number of rejected trial values (where the
+            model cannot be evaluated) with the last one, if any.
         evaluations: Number of residual evaluations.
     """
 
@@ -193,6 +194,18 @@ def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
             f"invalid parameter `{where}`: values must be finite coordinates below 1e9 m"
         )
     if arr.ndim == 2 and arr.shape == (4, 4) and dim == 3:
+        r = arr[:3, :3]
+        rigid = (
+            np.allclose(r.T @ r, np.eye(3), atol=1e-6)
+            and np.linalg.det(r) > 0
+            and np.array_equal(arr[3], [0.0, 0.0, 0.0, 1.0])
+        )
+        if not rigid:
+            raise ParameterError(
+                f"invalid parameter `{where}` = {' '.join(repr(arr.tolist()).split())}: a 4x4 "
+                "tip pose must be a rigid transform (rotation block orthonormal to 1e-6 with "
+                "determinant +1, last row [0, 0, 0, 1])"
+            )
         return "tip", arr
     if arr.ndim == 1 and (arr.shape[0] == dim or (dim == 2 and arr.shape[0] == 3)):
         return "tip", arr
@@ -596,6 +609,36 @@ def _errors_in_variables(jac, pinv, parts, meas, infos, metric) -> np.ndarray:
     return b.T @ b
 
 
+def _fmt_values(values: Mapping[str, float]) -> str:
+    """``youngs_modulus = 31234.5, offset_ratio = 0.3`` (the fitted parameters' values)."""
+    return ", ".join(f"{k} = {v:.6g}" for k, v in values.items())
+
+
+def _evaluates(model, names: Sequence[str], meas, metric: str) -> bool:
+    """Whether the model can be evaluated at the robot's own values of the parameters."""
+    own = {n: model.initial(n) for n in names}
+    try:
+        _stack(model, own, names, meas, metric)
+    except (ParameterError, ConvergenceError):
+        return False
+    return True
+
+
+def _at_start(exc: Exception, values: Mapping[str, float]) -> Exception:
+    """The error of a model that cannot be evaluated at the caller's ``initial`` values (and
+    can at the robot's own): the model's refusal, said to hold at those values."""
+    text = " ".join(str(exc).split())
+    why = (
+        "the model cannot be evaluated at the starting value(s) of the fitted parameters, "
+        f"{_fmt_values(values)}: {text}"
+    )
+    if isinstance(exc, ConvergenceError):
+        return ConvergenceError(f"`initial`: {why}")
+    err = ParameterError(f"invalid parameter `initial`: {why}")
+    err.parameter = "initial"
+    return err
+
+
 def calibrate(
     robot: Any,
     measurements: Sequence[Any],
@@ -641,10 +684,18 @@ def calibrate(
             are reported not identifiable.
 
     Returns:
-        The :class:`Calibration`.
+        The :class:`Calibration`. A trial value of the fitted parameters at which the model
+        cannot be evaluated (e.g. a modulus at which a measured tension would compress the
+        arm to zero length, or a solve that does not converge) is rejected: the optimiser
+        shrinks its step and stays where the model is valid; ``message`` counts the rejected
+        trials and quotes the last one.
 
     Raises:
-        ParameterError: Unknown parameters, bad measurements, bounds or options (named).
+        ParameterError: Unknown parameters, bad measurements, bounds or options (named);
+            ``initial`` values at which the model cannot be evaluated (named, with the
+            model's reason at those values).
+        ConvergenceError: Every trial value was rejected: the fit cannot move from its start
+            (the message quotes a trial value and why the model refused it).
 
     Warns:
         IdentifiabilityWarning: The data cannot determine a combination of the parameters
@@ -680,13 +731,30 @@ def calibrate(
     scale = np.array([model.typical(n, v) for n, v in zip(names, p0, strict=True)])
 
     cache: dict[str, Any] = {}
+    rejected: list[tuple[dict[str, float], Exception]] = []
 
     def evaluate(z: np.ndarray):
         key = z.tobytes()
         if cache.get("key") != key:
             values = dict(zip(names, (z * scale).tolist(), strict=True))
             infos: list[Any] = []
-            r, j, parts = _stack(model, values, names, meas, metric, infos)
+            try:
+                r, j, parts = _stack(model, values, names, meas, metric, infos)
+            except (ParameterError, ConvergenceError) as exc:
+                if "parts" not in cache:  # the starting point: nothing to fall back on
+                    if not init or not _evaluates(model, names, meas, metric):
+                        raise  # not the caller's starting values: the error stands
+                    raise _at_start(exc, values) from exc
+                # A trial the model cannot be evaluated at (e.g. a modulus at which a
+                # measured tension would compress the arm to zero length): non-finite
+                # residuals make the trust-region solver reject it and shrink its step.
+                rejected.append((values, exc))
+                size = int(sum(cache["parts"]))
+                r, j = np.full(size, np.nan), np.full((size, len(names)), np.nan)
+                parts, infos = cache["parts"], cache["infos"]
+            else:  # trials other than the start that could be evaluated
+                cache.setdefault("start", key)
+                cache["evaluated"] = cache.get("evaluated", 0) + (key != cache["start"])
             cache.update(key=key, r=r, j=j * scale[None, :], parts=parts, infos=infos)
         return cache
 
@@ -706,8 +774,26 @@ def calibrate(
         loss=loss,
         max_nfev=max_evaluations,
     )
+    evaluated = cache.get("evaluated", 0)
     z = res.x
     final = evaluate(z)
+    message = str(res.message)
+    if rejected:
+        at, exc = rejected[-1]
+        message += (
+            f"; {len(rejected)} trial value(s) rejected where the model cannot be evaluated "
+            f"(last: {_fmt_values(at)}: {' '.join(str(exc).split())})"
+        )
+        if evaluated == 0:  # no trial other than the start could be evaluated
+            at, exc = rejected[0]  # the first, largest step
+            raise ConvergenceError(
+                "calibrate could not move from the starting values "
+                f"({_fmt_values(dict(zip(names, p0.tolist(), strict=True)))}): every trial "
+                "value of the fitted parameters was rejected, the model cannot be evaluated "
+                f"there (e.g. at the trial value {_fmt_values(at)}: "
+                f"{' '.join(str(exc).split())}); give `initial` values or `bounds` of the "
+                "fitted parameters where it can"
+            )
     r, jz, parts = final["r"], final["j"], final["parts"]
     p = z * scale
     values = dict(zip(names, p.tolist(), strict=True))
@@ -787,7 +873,7 @@ def calibrate(
         robot=model.robot(values),
         metric=metric,
         success=bool(res.success),
-        message=str(res.message),
+        message=message,
         evaluations=int(res.nfev),
         extra={"weak": weak},
     )

@@ -24,12 +24,40 @@ from typing import Any, Literal, TextIO
 
 import numpy as np
 
+from .. import _args
 from .._core import ConvergenceError, ParameterError, UniaxialLaw
 from ..io.objects import build_material
 from ..robot import Robot, load_robot
 from ._sweep_run import STATUS
 
-__all__ = ["StudyResult", "compliance_study", "seed001_study"]
+__all__ = ["StudyResult", "compliance_study", "levels_beyond_limit", "seed001_study"]
+
+
+def levels_beyond_limit(levels: int) -> str | None:
+    """Why ``levels`` pressure levels per pair make too large a study, or None if they do not.
+
+    The study's grid holds ``levels**3`` pressure sets per material; like a sweep's, it may
+    hold at most :data:`softrod._args.MAX_GRID_VALUES` (10,000,000) points, so at most 215
+    levels. Checked before anything is built.
+
+    Args:
+        levels: Pressure levels per pair (an integer >= 2).
+
+    Returns:
+        The reason, worded like a sweep's refusal (the number of points and the limit), or
+        None for a grid within the limit.
+    """
+    limit = _args.MAX_GRID_VALUES
+    points = int(levels) ** 3
+    if points <= limit:
+        return None
+    most = round(limit ** (1 / 3))
+    most -= most**3 > limit
+    most += (most + 1) ** 3 <= limit
+    return (
+        f"{levels}**3 = {points} pressure sets per material: must be at most {limit} points "
+        f"(at most {most} levels)"
+    )
 
 
 @dataclass
@@ -162,7 +190,8 @@ def compliance_study(
         robot_path: A robot, or its description file, with six chambers (pairs 0-1, 2-3, 4-5) and a
             hyperelastic (or linear) material.
         levels: Pressure levels per pair on ``[0, max_pressure]`` (``levels**3`` configurations
-            per material).
+            per material, at most :data:`softrod._args.MAX_GRID_VALUES` (10,000,000): 2 to
+            215 levels).
         max_pressure: Largest pair pressure (Pa).
         gamma_pressures: P1 = P2 pressures (Pa) of the ``gamma_c(s)`` curves.
         out_dir: Folder for the figures (``pneumatic_workspace_<material>.png``,
@@ -180,13 +209,22 @@ def compliance_study(
         ``error``) and NaN; the study goes on.
 
     Raises:
-        ParameterError: A robot without exactly six chambers, or bad arguments.
+        ParameterError: A robot without exactly six chambers, or bad arguments (``levels``
+            beyond the grid-size limit is refused before anything is built).
+        ParameterTypeError: ``levels`` is not an integer.
         FileExistsError: A figure exists in ``out_dir`` and ``overwrite`` is false.
     """
     if isinstance(log, str) and log == "stdout":
         log = sys.stdout
+    if not _args._is_int(levels):
+        raise _args.type_error("levels", levels, "an integer >= 2")
     if levels < 2:
         raise ParameterError(f"invalid parameter `levels` = {levels}: must be >= 2")
+    too_many = levels_beyond_limit(levels)
+    if too_many is not None:  # before the levels**3 grid is built
+        exc = ParameterError(f"invalid parameter `levels` = {levels}: {too_many}")
+        exc.parameter = "levels"
+        raise exc
     if not (np.isfinite(max_pressure) and max_pressure > 0):
         raise ParameterError(
             f"invalid parameter `max_pressure` = {max_pressure}: must be finite and > 0 Pa"

@@ -189,7 +189,8 @@ DEFAULT_DPI = 130
 def save_figure(fig, path: str, dpi: float | None = DEFAULT_DPI, args=None) -> None:
     """Writes ``fig`` to ``path`` (format from the extension: png, pdf, svg) and says so on
     stderr; ``args`` with ``--dpi`` overrides ``dpi``; the demo's PNG carries
-    :data:`DEMO_MARK`."""
+    :data:`DEMO_MARK`. An existing file is replaced only with the command's ``--overwrite``
+    (which :func:`check_files` has checked, before any work, against the same file)."""
     from ..plot import save_figure as _save
 
     if args is not None and getattr(args, "dpi", None) is not None:
@@ -198,7 +199,7 @@ def save_figure(fig, path: str, dpi: float | None = DEFAULT_DPI, args=None) -> N
     if demo and os.fspath(path).lower().endswith(".png"):
         fig.savefig(path, format="png", dpi=dpi, metadata={"Source": DEMO_MARK})
     else:
-        _save(fig, path, dpi=dpi)
+        _save(fig, path, dpi=dpi, overwrite=bool(getattr(args, "overwrite", False)))
     print(f"wrote {path}", file=sys.stderr)
 
 

@@ -6,6 +6,8 @@ import json
 import os
 import sys
 
+import numpy as np
+
 from ._common import add_figure_options, bad, figure_options, files, save_figure, use_agg
 
 
@@ -56,6 +58,12 @@ def _cmd_backbone(args) -> int:
         raise bad("PHOTO", args.photo, "is not a file")
     _check_outputs(args)
     image = read_image(args.photo)
+    if args.base is not None and np.all(np.isfinite(args.base)):  # NaN: named by the library
+        from ..vision.extract import base_out_of_reach
+
+        why = base_out_of_reach(np.asarray(args.base, dtype=float), image.shape)
+        if why is not None:
+            raise bad("--base", args.base, why)
     bb = extract_backbone(
         image,
         scale=args.scale,
@@ -101,7 +109,8 @@ def register(sub) -> None:
         type=float,
         nargs=2,
         metavar=("COL", "ROW"),
-        help="base point in pixels (default: the end at the image border, else the wider end)",
+        help="base point in pixels, within one image diagonal outside the photo (default: the "
+        "end at the image border, else the wider end)",
     )
     p.add_argument(
         "--direction",

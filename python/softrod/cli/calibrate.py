@@ -41,8 +41,15 @@ def _measurements(items, unit_scale: float, dim: int):
             raise bad("--measurements", item, "tensions must be comma-separated numbers") from None
         if not os.path.isfile(path):
             raise bad("--measurements", item, f"{path!r} is not a file")
-        points = read_backbone_csv(path, scale=unit_scale, columns=tuple(range(dim)))
-        data.append((tensions, points))
+        points = read_backbone_csv(path, scale=unit_scale)  # 2 or 3 columns (x, y[, z])
+        if points.shape[1] < dim:
+            raise bad(
+                "--measurements",
+                item,
+                f"{path!r} has {points.shape[1]} columns: a robot file's backbone needs "
+                f"{dim} (x, y, z) per point",
+            )
+        data.append((tensions, points[:, :dim]))
     return data
 
 

@@ -106,7 +106,11 @@ def _cmd_fit(args) -> int:
             )
         except (ParameterError, ConvergenceError) as exc:
             if len(args.model) == 1:
-                raise
+                if getattr(exc, "coefficient", None) is None:
+                    raise
+                err = ParameterError(f"{args.file}: {one_line(exc)}")  # the data, named
+                err.parameter = "FILE"
+                raise err from exc
             print(f"\n{model}: fit failed: {one_line(exc)}")
             rows.append({"model": model, "ok": False, "error": one_line(exc)})
             continue

@@ -24,12 +24,14 @@ from ._common import (
 
 
 def _cmd_study(args) -> int:
-    from ..analysis.study import compliance_study
+    from ..analysis.study import _figure_paths, compliance_study, levels_beyond_limit
     from ..robot import load_robot
 
     if args.levels < 2:
         raise bad("--levels", args.levels, "must be >= 2")
-    from ..analysis.study import _figure_paths
+    too_many = levels_beyond_limit(args.levels)
+    if too_many is not None:  # before the levels**3 grid is built
+        raise bad("--levels", args.levels, too_many)
 
     for path in _figure_paths(args.out):
         if os.path.exists(path) and not args.overwrite:
@@ -157,7 +159,8 @@ def register(sub) -> None:
         "--levels",
         type=_positive_int,
         default=13,
-        help="pressure levels per pair (default: %(default)s)",
+        help="pressure levels per pair, 2 to 215: levels**3 pressure sets per material, at "
+        "most 10,000,000 (default: %(default)s)",
     )
     st.add_argument(
         "--max-pressure",

@@ -46,8 +46,9 @@ def read_backbone_csv(
 
     Raises:
         ParameterError: No data rows (an empty file, a header alone), unreadable numbers,
-            fewer than two points, or a bad ``scale`` (``.parameter``: ``path`` for the file's
-            content).
+            fewer than two points or two columns, or a bad ``scale`` (``.parameter``: ``path``
+            for the file's content); ``columns`` beyond the file's columns (named, with the
+            file and its number of columns).
     """
     scale = _args.number(scale, "scale", positive=True)
     if columns is not None:
@@ -86,12 +87,22 @@ def read_backbone_csv(
         raise _bad_file(path, f"row {bad[0] + 1} of data is not numeric: {rows[bad[0]]!r}")
     width = min(len(p) for p in parsed if p is not None)
     if columns is None:
+        if width < 2:
+            raise _bad_file(
+                path,
+                f"a row of {width} column{'s' if width != 1 else ''}: needs 2 or 3 numeric "
+                "columns (x, y[, z])",
+            )
         columns = (0, 1, 2) if width >= 3 else (0, 1)
     cols = list(columns)
     if len(cols) not in (2, 3) or max(cols) >= width or min(cols) < 0:
-        raise ParameterError(
-            f"invalid parameter `columns` = {cols}: must be 2 or 3 indices < {width}"
+        exc = ParameterError(
+            f"invalid parameter `columns` = {cols}: must be 2 or 3 indices < {width} (the "
+            f"file {os.fspath(path)!r} has {width} column{'s' if width != 1 else ''}"
+            f"{' in its shortest row' if any(len(p) != width for p in parsed) else ''})"
         )
+        exc.parameter = "columns"
+        raise exc
     pts = np.array([[p[c] for c in cols] for p in parsed if p is not None], dtype=np.float64)
     if pts.shape[0] < 2:
         raise _bad_file(path, f"{pts.shape[0]} points, need >= 2")

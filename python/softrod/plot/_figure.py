@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _args
 from .._core import ParameterError
 
 #: Output formats of :func:`save_figure`, chosen from the file's extension.
@@ -119,22 +120,32 @@ def new_figure(size, default: tuple[float, float], dpi=None, **kwargs):
     return fig
 
 
-def save_figure(fig, path: str | os.PathLike[str], *, dpi: float | None = None) -> str:
+def save_figure(
+    fig, path: str | os.PathLike[str], *, dpi: float | None = None, overwrite: bool = False
+) -> str:
     """Writes a figure; the format (png, pdf, svg) comes from the extension.
 
     Args:
         fig: The matplotlib figure.
         path: Output file (``.png``, ``.pdf`` or ``.svg``).
         dpi: Resolution of raster output (dots per inch; default: the figure's).
+        overwrite: Replace an existing file at ``path`` (default: refuse).
 
     Returns:
         The path written, as a string.
 
     Raises:
-        ParameterError: Unknown extension or missing folder (checked before writing).
+        ParameterError: Unknown extension, missing folder, or ``path`` exists and
+            ``overwrite`` is false (checked before writing; the file is left as it was).
+        ParameterTypeError: ``overwrite`` is not True or False.
     """
     fmt = check_figure_path(path)
     dpi = check_dpi(dpi)
+    overwrite = _args.flag(overwrite, "overwrite")
+    if os.path.isdir(path):
+        raise _bad("path", os.fspath(path), "is a folder (give a file name)")
+    if not overwrite and os.path.exists(path):
+        raise _bad("path", os.fspath(path), "exists (pass overwrite=True to replace it)")
     fig.savefig(path, format=fmt, **({"dpi": dpi} if dpi else {}))
     return os.fspath(path)
 
@@ -192,6 +203,25 @@ def apply_limits_3d(ax, limits: np.ndarray) -> None:
     ax.set_box_aspect((1, 1, 1))
 
 
-def as_list(solutions) -> list:
-    """A solution or a sequence of them, as a list."""
-    return [solutions] if hasattr(solutions, "position") else list(solutions)
+def as_list(solutions, name: str = "solutions") -> list:
+    """A solution or a sequence of them, as a list.
+
+    Raises:
+        ParameterTypeError: Naming ``name``: neither a solution (an object with a
+            ``position``) nor a sequence of them, e.g. an array of backbone points.
+    """
+    if hasattr(solutions, "position"):
+        return [solutions]
+    expected = "a statics solution (softrod.StaticsSolution) or a sequence of them"
+    if isinstance(solutions, (str, bytes, dict)):
+        raise _args.type_error(name, solutions, expected)
+    try:
+        sols = list(solutions)
+    except TypeError:
+        raise _args.type_error(name, solutions, expected) from None
+    for i, sol in enumerate(sols):
+        if not hasattr(sol, "position"):
+            raise _args.type_error(
+                name, solutions, f"{expected} (item {i} is a {type(sol).__name__})"
+            )
+    return sols

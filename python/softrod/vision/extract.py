@@ -15,13 +15,15 @@ from .backbone import Backbone, BackboneQuality, parameter_error
 from .centreline import fit_centreline
 from .segment import mask_segmentation, read_image, segment, to_grey
 
-__all__ = ["extract_backbone"]
+__all__ = ["base_out_of_reach", "extract_backbone"]
 
 #: Output point spacing along the centreline when ``n_points`` is not given (px).
 POINT_SPACING = 1.0
 #: A given base within max(this (px), a quarter half-width) of the visible end, along the
 #: arm's axis, is taken as the end itself (no extrapolation, no trimming).
 BASE_TOLERANCE = 1.0
+#: A given base may lie at most this many image diagonals outside the image (px, per axis).
+BASE_REACH = 1.0
 #: Smallest knot spacing of the centreline spline (px): closer knots fit pixel noise.
 MIN_KNOT_SPACING = 1.0
 #: Ends whose half-widths differ by less than this ratio cannot tell base from tip.
@@ -52,6 +54,36 @@ def _positive(name: str, value: Any) -> float | None:
     if not (np.isfinite(v) and v > 0):
         raise parameter_error(name, f"{value!r} must be finite and > 0")
     return v
+
+
+def base_out_of_reach(base: np.ndarray, shape: tuple[int, ...]) -> str | None:
+    """Why a base point is too far from the image, or None if it is within reach.
+
+    The base is where the arm is clamped: on the image, or hidden just beside it (under a
+    clamp), and the curve is extrapolated to it one point per pixel. A base more than one
+    image diagonal (:data:`BASE_REACH`) outside the image, along either axis, would be a
+    hidden part longer than anything the image can show, so it is refused.
+
+    Args:
+        base: Base point (col, row) in pixels, finite.
+        shape: The image's shape, (rows, cols, ...).
+
+    Returns:
+        The reason with the valid range (``"must be within ... col in [lo, hi], row in
+        [lo, hi] px"``), or None.
+    """
+    rows, cols = int(shape[0]), int(shape[1])
+    reach = BASE_REACH * float(np.hypot(rows, cols))
+    col_range = (-reach, cols - 1 + reach)
+    row_range = (-reach, rows - 1 + reach)
+    col, row = float(base[0]), float(base[1])
+    if col_range[0] <= col <= col_range[1] and row_range[0] <= row <= row_range[1]:
+        return None
+    return (
+        f"must be within one image diagonal ({reach:.1f} px) of the {cols} x {rows} px image "
+        f"(cols x rows): col in [{col_range[0]:.1f}, {col_range[1]:.1f}], row in "
+        f"[{row_range[0]:.1f}, {row_range[1]:.1f}] px"
+    )
 
 
 def _resample(pts: np.ndarray, hw: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -132,8 +164,10 @@ def extract_backbone(
             the base, x along ``direction``, y turned +90 degrees from x as seen on the image,
             i.e. toward the top of the image for a rightward direction); without it, pixels.
         base: Base point (col, row) in pixels. Sets which end is the base, and the curve is
-            extrapolated to it when the base is hidden (e.g. under a clamp). Default: the end
-            at the image border, else the wider end.
+            extrapolated to it when the base is hidden (e.g. under a clamp). It must lie
+            within one image diagonal outside the image: col in [-D, cols - 1 + D], row in
+            [-D, rows - 1 + D] with D = hypot(rows, cols) px. Default: the end at the image
+            border, else the wider end.
         direction: The unloaded arm's direction in the image, (d_col, d_row) in pixels (any
             length). Default: the curve's tangent at the base (a clamped base keeps its
             direction under load).
@@ -150,8 +184,9 @@ def extract_backbone(
         The backbone, base first, with its quality report.
 
     Raises:
-        ParameterError: Unreadable or ill-shaped image, a bad argument (named), or no arm in
-            the image.
+        ParameterError: Unreadable or ill-shaped image, a bad argument (named; e.g. a
+            ``base`` farther than one image diagonal outside the image, checked before any
+            work), or no arm in the image.
     """
     arr = read_image(image)
     grey = to_grey(arr)
@@ -159,6 +194,10 @@ def extract_backbone(
     if scale is not None and scale > MAX_LENGTH:
         raise parameter_error("scale", f"{scale!r} must be <= {MAX_LENGTH:g} m per pixel")
     base_px = _pair("base", base)
+    if base_px is not None:
+        why = base_out_of_reach(base_px, grey.shape)
+        if why is not None:
+            raise parameter_error("base", f"{base!r} {why}")
     dir_px = _pair("direction", direction)
     if dir_px is not None and np.hypot(*dir_px) == 0:
         raise parameter_error("direction", f"{direction!r} must be non-zero")
