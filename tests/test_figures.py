@@ -369,3 +369,11 @@ def test_a_robot_is_drawn_at_the_tensions_of_the_solution_given():
     fig = softrod.plot.plot_robot(robot)
     labels = [lab for ax in fig.axes for lab in ax.get_legend_handles_labels()[1]]
     assert f"tendon 0 ({robot.tendons[0].tension:.3g} N)" in labels
+
+
+def test_titles_show_round_off_as_zero():
+    # A pneumatic finger's tip at (-1.79e-16, ..., ...) m was titled with "-1.79e-13 mm".
+    from softrod.plot._figure import fmt_vector
+
+    assert fmt_vector([-1.79e-16, 0.15, 0.2], scale=1e3, unit="mm") == "(0, 150, 200) mm"
+    assert fmt_vector([1e-5, -2e-5, 0.0]) == "(1e-05, -2e-05, 0)"
