@@ -571,3 +571,17 @@ def test_cli_workspace_says_why_a_configuration_did_not_converge(capsys):
     assert "converged: 1/3" in out
     line = next(v for v in out.splitlines() if "the first that did not" in v)
     assert "5e+299" in line and "tensions[0]" in line and "ParameterError" in line
+
+
+def test_an_arc_from_absurd_tendon_displacements_is_refused_by_the_arc_limits():
+    # 1e300 m on a 0.1 m segment returned an arc 3.3e299 m long (that tendon_displacements
+    # then refused); the arc is checked as any given arc is.
+    from softrod import pcc
+
+    angles = [0.0, 2.0944, 4.1888]
+    with pytest.raises(softrod.ParameterError, match="computed from displacements") as e:
+        pcc.arc_from_tendon_displacements([1e300, 0.0, 0.0], [0.01] * 3, angles, 0.1)
+    assert e.value.parameter == "length"
+    arc = pcc.arc_from_tendon_displacements([0.005, 0.0, 0.0], [0.01] * 3, angles, 0.1)
+    back = pcc.tendon_displacements(arc, [0.01] * 3, angles, 0.1)
+    np.testing.assert_allclose(back, [0.005, 0.0, 0.0], atol=1e-15)

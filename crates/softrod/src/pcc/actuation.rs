@@ -442,7 +442,9 @@ fn displacement_unknowns(
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `displacements.len()`, `displacements[i]`,
-/// `rest_length`, `tendons` (degenerate layout), or `displacements` (length would be <= 0).
+/// `rest_length`, `tendons` (degenerate layout), or `displacements` (length would be <= 0);
+/// `length` or `curvature` for an arc beyond the limits of [`PccSegment::checked`] (a
+/// displacement of 1e300 m made an arc 3.3e299 m long that every other function refuses).
 pub fn arc_from_tendon_displacements(
     displacements: &[f64],
     tendons: &PccTendons,
@@ -451,7 +453,8 @@ pub fn arc_from_tendon_displacements(
 ) -> Result<PccSegment> {
     let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
     let l = rest_length + e;
-    PccSegment::from_curvature_vector(-b / l, a / l, l)
+    let arc = PccSegment::from_curvature_vector(-b / l, a / l, l)?;
+    PccSegment::checked(arc.curvature(), arc.plane_angle(), arc.length())
 }
 
 /// Converts a 3×n Jacobian into `(u_x, u_y, ℓ)` at curvature vector `(u_x, u_y)` into
