@@ -4,6 +4,8 @@ NetCDF round trips, and independence of the scheduler and the chunking, bit for 
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -252,7 +254,6 @@ def test_bad_arguments_are_named():
         (dict(actuation={"tendons[0].tension": [np.nan]}), "finite"),
         (dict(design={"rod.sectoin.radius": [1e-3]}), "did you mean `section`"),
         (dict(outputs=("tip_pos",)), "did you mean 'tip_pose'"),
-        (dict(outputs=("stability",)), "stability"),
         (dict(actuation={"tendons[0].displacement": [0.0]}), "displacement"),
         (dict(arc_lengths=[0.5]), "in \\[0, 0.4\\] m"),
         (dict(arc_lengths=[0.1], arm_index=[1.0]), "arm_index"),
@@ -411,3 +412,60 @@ def test_an_adaptive_robot_s_compliance_is_marched_to_the_arc_lengths():
         # Against the compliance at every node: the same to the march's tolerance.
         every = softrod.compliance(sol)
         np.testing.assert_allclose(got["compliance"].values[-1], every.world[-1], rtol=1e-6, atol=0)
+
+
+def test_the_stability_of_each_sample_is_the_solve_s_own_verdict():
+    # A uniform silicone column standing under its own weight: 0.25 m is past its buckling
+    # length (0.236 m for r = 6 mm, E = 2 MPa, 1100 kg/m^3), 0.2 m is not. The sweep reported
+    # every sample as converged with no flag; `stable` is now each sample's verdict, the one
+    # Robot.solve gives (oracle: the same solves, cold like block=1).
+    toml = _TRI_COLUMN
+    robot = softrod.Robot.from_toml(toml)
+    ds = softrod.sweep(
+        robot,
+        design={"rod.length": [0.2, 0.25]},
+        actuation={"tendons[0].tension": [0.0, 0.05]},
+        outputs=("tip_pose", "stability"),
+        block=1,
+        progress=False,
+    )
+    assert ds["stable"].attrs["flag_meanings"] == "not_converged unstable stable"
+    for length in (0.2, 0.25):
+        for t in (0.0, 0.05):
+            r = robot.with_parameters({"rod.length": length})
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sol = r.solve([t, 0.0, 0.0])
+            at = {"rod.length": length, "tendons[0].tension": t}
+            assert int(ds["stable"].sel(at)) == int(sol.stable), (length, t)
+            assert np.array_equal(ds["tip_position"].sel(at).values, sol.tip_position)
+    # Short of the buckling length: stable. Past it, unpulled: the straight column, unstable
+    # (no stable one found from it); pulled by 0.05 N: the buckled, stable one the solve seeks.
+    assert int(ds["stable"].sel({"rod.length": 0.2, "tendons[0].tension": 0.0})) == 1
+    assert int(ds["stable"].sel({"rod.length": 0.25, "tendons[0].tension": 0.0})) == 0
+    assert int(ds["stable"].sel({"rod.length": 0.25, "tendons[0].tension": 0.05})) == 1
+
+
+_TRI_COLUMN = """
+[rod]
+length = 0.25
+density = 1100.0
+[rod.section]
+type = "circular"
+radius = 0.006
+[rod.material]
+type = "linear"
+youngs_modulus = 2.0e6
+poisson_ratio = 0.49
+[[tendons]]
+distance = 0.004
+angle_deg = 0.0
+[[tendons]]
+distance = 0.004
+angle_deg = 120.0
+[[tendons]]
+distance = 0.004
+angle_deg = 240.0
+[loads]
+gravity = [0.0, 0.0, -9.81]
+"""

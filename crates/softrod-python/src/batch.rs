@@ -211,6 +211,12 @@ fn arrays<'py>(
         ints(&|st| st.function_evaluations).into_pyarray(py),
     )?;
     d.set_item("residual", col(&|s| s.stats.residual).into_pyarray(py))?;
+    // 1 stable, 0 unstable, -1 not converged (the solve's own verdict).
+    let stable = samples
+        .iter()
+        .map(|s| s.stable.map_or(-1_i8, i8::from))
+        .collect::<Vec<i8>>();
+    d.set_item("stable", stable.into_pyarray(py))?;
     d.set_item(
         "load_factor",
         col(&|s| s.stats.load_factor).into_pyarray(py),

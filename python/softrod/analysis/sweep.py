@@ -22,7 +22,6 @@ from typing import Any
 
 import numpy as np
 
-from .. import _core
 from .._core import ParameterError, __version__
 from . import _sweep_run as run
 from ._sweep_axes import (
@@ -41,7 +40,7 @@ __all__ = ["DEFAULT_BLOCK", "OUTPUTS", "STATUS", "SampleTable", "samples", "swee
 DEFAULT_BLOCK = 32
 
 #: Output names: those the core computes, plus "convergence" (iterations, residual, load
-#: factor, load steps, evaluations) and "stability" (needs the stability flags of the solver).
+#: factor, load steps, evaluations) and "stability" (the solve's own verdict, `stable`).
 OUTPUTS = (
     "tip_pose",
     "tendon_lengths",
@@ -98,20 +97,6 @@ def _outputs(outputs: Any) -> tuple[str, ...]:
             hint = _suggest(str(o), list(OUTPUTS))
             more = f"; did you mean {hint!r}?" if hint else f" (one of {', '.join(OUTPUTS)})"
             raise _bad(f"outputs[{i}]", o, f"an output name{more}")
-    if "stability" in names:
-        if not hasattr(_core.StaticsSolution, "stable"):
-            raise _bad(
-                "outputs",
-                "stability",
-                "an output this softrod computes: the stability flags of the solver "
-                "(StaticsSolution.stable, stability_margin) are not in this build",
-            )
-        raise _bad(
-            "outputs",
-            "stability",
-            "an output the batch core computes (stability is reported by single solves, "
-            "robot.solve(...).stable; the sweep does not record it yet)",
-        )
     return tuple(dict.fromkeys(names))
 
 
@@ -400,8 +385,10 @@ class _Store:
         self.status[d, a0:a1] = part["status"]
         self.error[d, a0:a1] = np.asarray(part["error"], dtype=object)
         for key, value in part.items():
-            if key in ("status", "error") or (
-                key in _CONVERGENCE and "convergence" not in self.names
+            if (
+                key in ("status", "error")
+                or (key in _CONVERGENCE and "convergence" not in self.names)
+                or (key == "stable" and "stability" not in self.names)
             ):
                 continue
             v = np.asarray(value)
@@ -560,4 +547,13 @@ _VARIABLES: dict[str, tuple[tuple[str, ...], dict[str, str]]] = {
     "load_factor": ((), {"units": "1", "long_name": "load factor reached"}),
     "load_steps": ((), {"units": "1", "long_name": "continuation load steps"}),
     "function_evaluations": ((), {"units": "1", "long_name": "right-hand-side evaluations"}),
+    "stable": (
+        (),
+        {
+            "units": "1",
+            "long_name": "stable equilibrium (1), unstable (0), not converged (-1)",
+            "flag_values": np.array([-1, 0, 1], dtype=np.int8),
+            "flag_meanings": "not_converged unstable stable",
+        },
+    ),
 }

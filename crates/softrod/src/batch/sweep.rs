@@ -171,6 +171,9 @@ pub struct SweepSample {
     pub tendon_lengths: Vec<f64>,
     /// One entry per arc length of the job (empty unless an arc-length output is requested).
     pub arcs: Vec<ArcSample>,
+    /// Whether the converged equilibrium is stable ([`StaticsSolution::stable`], judged by
+    /// the solve itself: always recorded, no extra cost); `None` when it did not converge.
+    pub stable: Option<bool>,
 }
 
 impl SweepSample {
@@ -189,6 +192,7 @@ impl SweepSample {
             tip_quaternion: [f64::NAN; 4],
             tendon_lengths: vec![f64::NAN; nt],
             arcs: vec![ArcSample::nan(); job.arc_lengths.len()],
+            stable: None,
         }
     }
 }
@@ -410,6 +414,7 @@ fn measure(sol: &StaticsSolution, job: &SweepJob<'_>, request: &SweepRequest) ->
             vec![f64::NAN; nt]
         },
         arcs: vec![ArcSample::nan(); job.arc_lengths.len()],
+        stable: Some(sol.stable),
     };
     if request.tip_pose {
         sample.tip_position = sol.tip_position();
