@@ -551,3 +551,13 @@ def test_study_command_runs_both_materials_and_writes_figures(tmp_path, capsys):
     )
     assert "centre -> periphery" in capsys.readouterr().out
     assert main(["study", str(robot), "--max-pressure", "-1"]) == 2
+
+
+def test_the_core_fit_names_the_data_not_a_fitted_coefficient():
+    # fit_uniaxial itself (not only TensileCurve.fit and the CLI) named a fitted `c10` as if
+    # it were an input; the refusal is now the data's, made where the law is built.
+    strain, stress = np.array([0.0, 0.1, 0.2]), np.array([0.0, 1e-4, 5e-3])
+    with pytest.raises(ParameterError) as exc:
+        fit_uniaxial(strain, stress, "yeoh")
+    assert exc.value.parameter == "data"
+    assert "yeoh law" in str(exc.value) and "fitted coefficient c10 = -" in str(exc.value)

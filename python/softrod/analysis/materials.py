@@ -144,57 +144,18 @@ class TensileCurve:
             The fit (its ``model`` is the fitted law).
 
         Raises:
-            ParameterError: A bad option (named), or data that the law cannot fit: a fitted
-                coefficient is not physical (e.g. a Yeoh ``c10 <= 0`` Pa). That error names
-                the law and the coefficient as a result, with ``parameter`` ``"data"`` and
-                ``coefficient`` the coefficient's name.
+            ParameterError: A bad option (named), or data that the law cannot fit (naming
+                ``data``: a fitted coefficient that is not physical, e.g. a Yeoh ``c10 <= 0``
+                Pa, named with its value in the message).
         """
-        try:
-            return fit_uniaxial(
-                self.strain,
-                self.stress,
-                model,
-                strain_measure=self.strain_measure,
-                stress_measure=self.stress_measure,
-                **options,
-            )
-        except ParameterError as exc:
-            coefficient = getattr(exc, "parameter", None)
-            if not _is_coefficient(coefficient):
-                raise
-            raise self._unphysical_fit(model, exc) from exc
-
-    def _unphysical_fit(self, model: object, exc: ParameterError) -> ParameterError:
-        """The error of a fit whose result is not a valid law (``exc``: the law's refusal)."""
-        name = exc.parameter
-        found = re.match(r"invalid parameter `.+?` = (.*?): must be (.*)$", str(exc))
-        value, needs = (found.group(1), found.group(2)) if found else ("?", str(exc))
-        stretch = self.stretch
-        other = "linearised" if str(model).lower() == "neo-hookean" else "neo-hookean"
-        err = ParameterError(
-            f"cannot fit the {model} law to the data ({len(self)} points, stretch "
-            f"{stretch.min():.4g} to {stretch.max():.4g}): the least-squares fitted "
-            f"coefficient {name} = {value} is not physical ({name} must be {needs}); give "
-            f"more data (more points, a wider stretch range) or fit another law (e.g. {other})"
+        return fit_uniaxial(
+            self.strain,
+            self.stress,
+            model,
+            strain_measure=self.strain_measure,
+            stress_measure=self.stress_measure,
+            **options,
         )
-        err.parameter = "data"
-        err.coefficient = name
-        return err
-
-
-#: Coefficients of the fitted laws (results of a fit, never its inputs), as the laws' own
-#: errors name them: ``c10``, ``c10 + c01``, ``mu``, ``alpha[0]``, ...
-_COEFFICIENTS = frozenset(
-    {"mu", "alpha", "c10", "c01", "c20", "c30", "secant_modulus", "reference_strain"}
-)
-
-
-def _is_coefficient(parameter: object) -> bool:
-    """Whether a law's error names a fitted coefficient (not an argument of the fit)."""
-    if not isinstance(parameter, str):
-        return False
-    names = [part.split("[", 1)[0].strip() for part in parameter.split("+")]
-    return all(n in _COEFFICIENTS for n in names)
 
 
 def _read_database(path: Path, lines: list[str], header_at: int, columns: str) -> TensileCurve:

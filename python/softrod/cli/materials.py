@@ -106,7 +106,7 @@ def _cmd_fit(args) -> int:
             )
         except (ParameterError, ConvergenceError) as exc:
             if len(args.model) == 1:
-                if getattr(exc, "coefficient", None) is None:
+                if getattr(exc, "parameter", None) != "data":
                     raise
                 err = ParameterError(f"{args.file}: {one_line(exc)}")  # the data, named
                 err.parameter = "FILE"

@@ -317,10 +317,10 @@ fn model_stress(law: &dyn UniaxialLaw, stretch: f64, measure: StressMeasure) -> 
 ///
 /// # Errors
 /// * [`Error::InvalidParameter`] naming `terms` if out of range, `data` if it has fewer points
-///   than the law has parameters, `options.max_iterations` / `options.tolerance` if invalid, or
-///   the law's own parameter (e.g. `mu`, `c10`, `c10 + c01`) if the best fit is not a valid law
-///   (e.g. data that soften so much that the initial modulus comes out negative; try
-///   `nonnegative`).
+///   than the law has parameters or if the best fit is not a valid law (the message names the
+///   fitted coefficient, e.g. `c10`, and its value: data that soften so much that the initial
+///   modulus comes out negative; try `nonnegative`), `options.max_iterations` /
+///   `options.tolerance` if invalid.
 /// * [`Error::NotConverged`] if Levenberg–Marquardt reaches `max_iterations`, or a linear
 ///   solve fails.
 pub fn fit_uniaxial(
@@ -365,55 +365,105 @@ pub fn fit_uniaxial(
     };
     // Nominal-stress basis functions of the linear-in-parameter laws.
     let g = |l: f64| 2.0 * (l - 1.0 / (l * l)); // 2 (λ − 1/λ²)
-    let (model, iterations): (UniaxialModel, usize) = match kind {
-        ModelKind::Linearised => {
-            let c = linear_fit(data, 1, options.nonnegative, |i, _| {
-                let l = data.stretch[i];
-                (l - 1.0) * measure_factor(l)
-            })?;
-            let reference = data.stretch.iter().map(|l| l - 1.0).fold(0.0_f64, |a, e| {
-                if e.abs() > a.abs() {
-                    e
-                } else {
-                    a
-                }
-            });
-            (Linearised::new(c[0], reference)?.into(), 0)
-        }
-        ModelKind::NeoHookean => {
-            let c = linear_fit(data, 1, options.nonnegative, |i, _| {
-                let l = data.stretch[i];
-                0.5 * g(l) * measure_factor(l)
-            })?;
-            (NeoHookean::new(c[0])?.into(), 0)
-        }
-        ModelKind::MooneyRivlin => {
-            let c = linear_fit(data, 2, options.nonnegative, |i, k| {
-                let l = data.stretch[i];
-                g(l) * if k == 0 { 1.0 } else { 1.0 / l } * measure_factor(l)
-            })?;
-            (MooneyRivlin::new(c[0], c[1])?.into(), 0)
-        }
-        ModelKind::Yeoh { terms } => {
-            let c = linear_fit(data, terms, options.nonnegative, |i, k| {
-                let l = data.stretch[i];
-                let x = (l - 1.0) * (l - 1.0) * (l + 2.0) / l;
-                g(l) * (k as f64 + 1.0) * x.powi(k as i32) * measure_factor(l)
-            })?;
-            let coef = |k: usize| c.get(k).copied().unwrap_or(0.0);
-            (Yeoh::new(coef(0), coef(1), coef(2))?.into(), 0)
-        }
-        ModelKind::Ogden { terms } => {
-            let (law, it) = fit_ogden(data, terms, options)?;
-            (law.into(), it)
-        }
-    };
+    let fitted: Result<(UniaxialModel, usize)> = (|| {
+        Ok(match kind {
+            ModelKind::Linearised => {
+                let c = linear_fit(data, 1, options.nonnegative, |i, _| {
+                    let l = data.stretch[i];
+                    (l - 1.0) * measure_factor(l)
+                })?;
+                let reference = data.stretch.iter().map(|l| l - 1.0).fold(0.0_f64, |a, e| {
+                    if e.abs() > a.abs() {
+                        e
+                    } else {
+                        a
+                    }
+                });
+                (Linearised::new(c[0], reference)?.into(), 0)
+            }
+            ModelKind::NeoHookean => {
+                let c = linear_fit(data, 1, options.nonnegative, |i, _| {
+                    let l = data.stretch[i];
+                    0.5 * g(l) * measure_factor(l)
+                })?;
+                (NeoHookean::new(c[0])?.into(), 0)
+            }
+            ModelKind::MooneyRivlin => {
+                let c = linear_fit(data, 2, options.nonnegative, |i, k| {
+                    let l = data.stretch[i];
+                    g(l) * if k == 0 { 1.0 } else { 1.0 / l } * measure_factor(l)
+                })?;
+                (MooneyRivlin::new(c[0], c[1])?.into(), 0)
+            }
+            ModelKind::Yeoh { terms } => {
+                let c = linear_fit(data, terms, options.nonnegative, |i, k| {
+                    let l = data.stretch[i];
+                    let x = (l - 1.0) * (l - 1.0) * (l + 2.0) / l;
+                    g(l) * (k as f64 + 1.0) * x.powi(k as i32) * measure_factor(l)
+                })?;
+                let coef = |k: usize| c.get(k).copied().unwrap_or(0.0);
+                (Yeoh::new(coef(0), coef(1), coef(2))?.into(), 0)
+            }
+            ModelKind::Ogden { terms } => {
+                let (law, it) = fit_ogden(data, terms, options)?;
+                (law.into(), it)
+            }
+        })
+    })();
+    let (model, iterations) = fitted.map_err(|e| not_physical(e, data, kind))?;
     let stats = fit_stats(model.as_law(), data);
     Ok(UniaxialFit {
         model,
         stats,
         iterations,
     })
+}
+
+/// The law's name as the Python API spells it (`"yeoh"`, `"mooney-rivlin"`, ...).
+fn law_name(kind: ModelKind) -> &'static str {
+    match kind {
+        ModelKind::Linearised => "linearised",
+        ModelKind::NeoHookean => "neo-hookean",
+        ModelKind::MooneyRivlin => "mooney-rivlin",
+        ModelKind::Yeoh { .. } => "yeoh",
+        ModelKind::Ogden { .. } => "ogden",
+    }
+}
+
+/// A law's refusal of its fitted coefficient (`InvalidParameter` naming e.g. `c10`) said as
+/// what it is: data this law cannot fit, naming `data` (the coefficient is a result, not an
+/// input); any other error unchanged.
+fn not_physical(e: Error, data: &UniaxialData, kind: ModelKind) -> Error {
+    let Error::InvalidParameter {
+        name,
+        value,
+        expected,
+    } = e
+    else {
+        return e;
+    };
+    let (lo, hi) = data
+        .stretch
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &l| {
+            (a.min(l), b.max(l))
+        });
+    let law = law_name(kind);
+    let other = if law == "neo-hookean" {
+        "linearised"
+    } else {
+        "neo-hookean"
+    };
+    Error::invalid(
+        "data",
+        format!("{} points, stretch {lo:.4} to {hi:.4}", data.len()),
+        format!(
+            "data the {law} law can fit: its least-squares fitted coefficient {name} = {value} \
+             is not physical ({name} must be {expected}); give more data (more points, a wider \
+             stretch range), fit with nonnegative coefficients, or fit another law (e.g. \
+             {other})"
+        ),
+    )
 }
 
 /// Least squares `stress_i ≈ Σ_k c_k basis(i, k)`, optionally with `c >= 0` (exact NNLS by
