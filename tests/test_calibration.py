@@ -262,3 +262,6 @@ def test_a_fit_whose_every_trial_is_rejected_names_the_trial_value(monkeypatch):
     assert "starting values (youngs_modulus = 70000)" in text
     assert "every trial value" in text and "trial value youngs_modulus = " in text
     assert "`tension` = 2" in text
+    # As every ConvergenceError: the evaluations made, the residual reached, the load factor.
+    assert info.value.iterations >= 2 and np.isfinite(info.value.residual)
+    assert info.value.load_factor == 1.0

@@ -633,7 +633,11 @@ def _at_start(exc: Exception, values: Mapping[str, float]) -> Exception:
         f"{_fmt_values(values)}: {text}"
     )
     if isinstance(exc, ConvergenceError):
-        return ConvergenceError(f"`initial`: {why}")
+        err = ConvergenceError(f"`initial`: {why}")
+        # (What the model's own solve carried, as every ConvergenceError does.)
+        for k in ("iterations", "residual", "load_factor"):
+            setattr(err, k, getattr(exc, k, 0 if k == "iterations" else float("nan")))
+        return err
     err = ParameterError(f"invalid parameter `initial`: {why}")
     err.parameter = "initial"
     return err
@@ -786,7 +790,7 @@ def calibrate(
         )
         if evaluated == 0:  # no trial other than the start could be evaluated
             at, exc = rejected[0]  # the first, largest step
-            raise ConvergenceError(
+            err = ConvergenceError(
                 "calibrate could not move from the starting values "
                 f"({_fmt_values(dict(zip(names, p0.tolist(), strict=True)))}): every trial "
                 "value of the fitted parameters was rejected, the model cannot be evaluated "
@@ -794,6 +798,11 @@ def calibrate(
                 f"{' '.join(str(exc).split())}); give `initial` values or `bounds` of the "
                 "fitted parameters where it can"
             )
+            # The optimiser's evaluations, its residual at the start (none moved), full data.
+            err.iterations = int(res.nfev)
+            err.residual = float(np.linalg.norm(cache["r"])) if "r" in cache else float("nan")
+            err.load_factor = 1.0
+            raise err
     r, jz, parts = final["r"], final["j"], final["parts"]
     p = z * scale
     values = dict(zip(names, p.tolist(), strict=True))
