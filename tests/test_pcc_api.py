@@ -172,6 +172,22 @@ def test_errors_name_the_parameter(call, parameter):
     assert err.value.parameter == parameter
 
 
+@pytest.mark.parametrize(
+    ("call", "parameter"),
+    [
+        (lambda: niti().with_tendons(0, [1e300, 0.01, 0.01], ANGLES), "distances[0]"),
+        (lambda: niti().with_tendons(0, [0.01] * 3, [np.nan, 0.0, 1.0]), "angles[0]"),
+        (lambda: niti().with_chambers(0, [-1.0] * 3, [0.004] * 3, ANGLES), "areas[0]"),
+    ],
+)
+def test_actuator_geometry_errors_name_the_input_given(call, parameter):
+    # They said "(computed from position, length)": arguments of another function.
+    with pytest.raises(ParameterError) as err:
+        call()
+    assert err.value.parameter == parameter
+    assert "computed from" not in str(err.value)
+
+
 def test_compliance_of_a_pcc_solution_is_the_cosserat_compliance_type():
     e, r, length, d = 2e9, 0.01, 0.5, 0.008
     robot = pcc.Robot.solid_circle([length], r, e, extensible=False).with_tendons(0, [d], [0.0])

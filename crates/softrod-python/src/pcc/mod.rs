@@ -165,11 +165,10 @@ fn arc_array<'py>(py: Python<'py>, s: &PccSegment) -> Bound<'py, PyArray1<f64>> 
 }
 
 fn tendons_from(distances: Floats, angles: Floats) -> PyResult<pcc::PccTendons> {
-    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?)
-        .map_err(blame(&["position", "length"]))
+    pcc::PccTendons::new(&distances.to_vec()?, &angles.to_vec()?).map_err(to_py_err)
 }
 
 fn chambers_from(areas: Floats, distances: Floats, angles: Floats) -> PyResult<pcc::PccChambers> {
     pcc::PccChambers::new(&areas.to_vec()?, &distances.to_vec()?, &angles.to_vec()?)
-        .map_err(blame(&["position", "length"]))
+        .map_err(to_py_err)
 }
