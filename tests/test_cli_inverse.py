@@ -111,3 +111,36 @@ def test_the_robot_file_is_never_overwritten(tmp_path, capsys):
     before = robot.read_bytes()
     status, _, err = _run(["inverse", robot, "--target", 0.1, 0.0, 0.3, "--csv", robot], capsys)
     assert status == 2 and "--csv" in _one_error_line(err) and robot.read_bytes() == before
+
+
+def test_several_starts_reach_a_target_beyond_a_fold(tmp_path, capsys):
+    # A curled soft arm (test_inverse_starts.py): from rest the target is reported out of
+    # reach (exit status 3); from 16 starts it is reached with the known tensions.
+    from test_inverse_starts import _curled
+
+    robot, truth, target = _curled("antagonistic")
+    path = tmp_path / "curl.toml"
+    path.write_text(robot.to_toml(), encoding="utf-8")
+    out_csv = tmp_path / "inv.csv"
+    status, _, err = _run(["inverse", path, "--target", *target], capsys)
+    assert status == 3 and "not reached" in err[-1]
+    status, out, _ = _run(
+        ["inverse", path, "--target", *target, "--starts", 16, "--csv", out_csv], capsys
+    )
+    assert status == 0 and "converged True" in out
+    with open(out_csv, encoding="utf-8") as fh:
+        (row,) = list(csv.DictReader(fh))
+    tensions = [float(row[f"tension_{i}"]) for i in range(2)]
+    assert np.allclose(tensions, truth, rtol=1e-6, atol=1e-9)
+    assert np.linalg.norm(robot.solve(tensions).tip_position - target) <= 1e-9
+
+
+@pytest.mark.parametrize(("command", "option"), [("inverse", "--starts"), ("compare", "--repeats")])
+def test_a_count_below_one_names_its_option(command, option, capsys):
+    # (It named the core's `starts` or `repeats`, not the option.)
+    argv = [command, "niti_two_segment", option, 0]
+    if command == "inverse":
+        argv += ["--target", 0.0, 0.0, 0.3]
+    status, _, err = _run(argv, capsys)
+    assert status == 2
+    assert err == [f"softrod: error: invalid option `{option}` = 0: must be >= 1"], err

@@ -600,6 +600,7 @@ def _inverse_statics(
     warm_state: _InverseWarmState | None = None,
     same_model: bool = False,
     obstacles: Sequence[Any] | None = None,
+    starts: int | Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """Inverse statics of a tip target (softrod.inverse_statics wraps it)."""
 
@@ -623,6 +624,7 @@ def _pcc_inverse_statics(
     max_iterations: int | None = None,
     warm_state: _InverseWarmState | None = None,
     same_model: bool = False,
+    starts: int | Sequence[Sequence[float]] | NDArray[np.float64] | None = None,
 ) -> dict[str, Any]:
     """Inverse statics of a PCC robot (softrod.pcc.inverse_statics wraps it)."""
 

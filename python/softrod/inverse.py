@@ -39,6 +39,8 @@ class InverseSolution:
         converged: Whether the target was reached and the actuation is the minimum-norm one.
         reached: Whether the target was reached within the tolerance (with obstacles it may be
             reached without the minimum norm being certified: ``converged`` is then False).
+        start: The start the answer came from (``starts``): 0 for the warm start or rest,
+            ``k`` for the ``k``-th later one.
     """
 
     tensions: np.ndarray
@@ -49,6 +51,7 @@ class InverseSolution:
     iterations: int
     converged: bool
     reached: bool = False
+    start: int = 0
     # What the next call warm-started from this one reuses (the last evaluation, with its
     # Jacobian, and the Lagrangian Hessian), and the model it belongs to.
     _warm_state: Any = field(default=None, repr=False, compare=False)
@@ -138,6 +141,7 @@ def _from_core(out: dict, solution: Any, warm_state: Any, key: Any) -> InverseSo
         iterations=out["iterations"],
         converged=out["converged"],
         reached=out["reached"],
+        start=out["start"],
         _warm_state=warm_state,
         _model_key=key,
     )
@@ -197,6 +201,7 @@ def inverse_statics(
     tolerance: float | None = None,
     max_iterations: int | None = None,
     target_s: Sequence[float] | np.ndarray | None = None,
+    starts: int | Sequence[Sequence[float]] | np.ndarray | None = None,
 ) -> InverseSolution:
     """The minimum-norm actuation that puts the tip of ``robot`` at ``target_position``.
 
@@ -218,6 +223,12 @@ def inverse_statics(
         max_iterations: Cap on the iterations (default 60).
         target_s: Undeformed arc lengths (m, 0..length) of the backbone points that go to the
             rows of ``target_position`` (e.g. a measured backbone), shape (k,); None: the tip.
+        starts: Run the iteration from several starts and keep the best answer (the
+            converged one of least norm, else the closest): a count ``k`` (the warm start or
+            rest, then ``k - 1`` actuations spread over those that turn the tip up to three
+            turns, a third of the actuators slack in each), or actuations, shape
+            (k, n_actuators), each a start after the first. None: one start. Each start costs
+            one inverse.
 
     Returns:
         The actuation, its forward solution and the remaining errors.
@@ -258,6 +269,7 @@ def inverse_statics(
         throw=throw,
         tolerance=tolerance,
         max_iterations=max_iterations,
+        starts=starts,
         **{k: v for k, v in robot.solver.items() if k in ("integrator", "steps", "rtol", "atol")},
         **extra,
         **({"obstacles": list(robot.obstacles)} if robot.obstacles else {}),
@@ -272,11 +284,15 @@ def inverse_statics(
             stacklevel=2,
         )
     tensions, pressures = out["tensions"], out["pressures"]
+    # Solved on the mesh of the answer: one the mesh control refined (the iteration passed
+    # where the mesh asked was too coarse) is not the one a solve at the answer would choose.
+    mesh = {} if out["refined_steps"] is None else {"steps": out["refined_steps"]}
     solution = _Deferred(
         lambda: robot.solve(
             tensions.copy() if len(tensions) else None,
             pressures.copy() if len(pressures) else None,
             on_unstable="ignore",
+            **mesh,
         )
     )
     return _from_core(out, solution, None if target_s is not None else out["warm_state"], key)
@@ -337,6 +353,7 @@ def inverse_statics_path(
     throw: bool = True,
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    starts: int | Sequence[Sequence[float]] | np.ndarray | None = None,
 ) -> InversePath:
     """Tracks a path of tip targets: :func:`inverse_statics` at each, warm-started from the last.
 
@@ -347,6 +364,8 @@ def inverse_statics_path(
         weights, tension_bounds, pressure_bounds, tolerance, max_iterations: As
             :func:`inverse_statics`.
         warm_start: Start of the first target (an :class:`InverseSolution` or an actuation).
+        starts: Starts of the first target (as :func:`inverse_statics`); the others start
+            from the last target reached.
         throw: Raise at the first target not reached; False: mark it ``converged=False`` and go
             on, the next target warm-started from the last one reached.
 
@@ -398,6 +417,7 @@ def inverse_statics_path(
             throw=throw,
             tolerance=tolerance,
             max_iterations=max_iterations,
+            starts=starts if i == 0 else None,
         )
         rows.append(inv)
         if inv.converged:  # a miss does not seed the next target: the last reached one does

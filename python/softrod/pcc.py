@@ -68,6 +68,7 @@ def inverse_statics(
     throw: bool = True,
     tolerance: float | None = None,
     max_iterations: int | None = None,
+    starts=None,
 ):
     """The minimum-norm actuation that puts the tip of the PCC ``robot`` at a target.
 
@@ -79,7 +80,7 @@ def inverse_statics(
         robot: The PCC robot.
         target_position: Tip position (m, base frame), shape (3,).
         target_rotation: Tip rotation (3x3, tip -> base), or None for a position target.
-        weights, tension_bounds, pressure_bounds, throw, tolerance, max_iterations: As
+        weights, tension_bounds, pressure_bounds, throw, tolerance, max_iterations, starts: As
             :func:`softrod.inverse_statics`.
         tip_force: Tip force (N, world), shape (3,), or None.
         tip_moment: Tip moment (N m, world), shape (3,), or None.
@@ -114,6 +115,7 @@ def inverse_statics(
         max_iterations=max_iterations,
         warm_state=state,
         same_model=same,
+        starts=starts,
     )
     tensions, pressures = out["tensions"], out["pressures"]
     # The PCC solution at the actuation found is solved when it is first read.

@@ -709,6 +709,28 @@ def _define_targets() -> None:
             ),
         )
     )
+    t("inverse_statics(starts)")(
+        lambda d: (
+            sr.inverse_statics,
+            dict(
+                robot=_niti(),
+                target_position=[0.03388176, 0.03906025, 0.3958294],
+                starts=[[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]],
+                throw=False,
+            ),
+        )
+    )
+    t("inverse_statics_path(starts)")(
+        lambda d: (
+            sr.inverse_statics_path,
+            dict(
+                robot=_niti(),
+                targets=[[0.03388176, 0.03906025, 0.3958294]],
+                starts=2,
+                throw=False,
+            ),
+        )
+    )
     t("solve_statics(chambers)")(
         lambda d: (
             sr.solve_statics,
@@ -1016,6 +1038,17 @@ def _define_targets() -> None:
                 throw=False,
                 tolerance=1e-9,
                 max_iterations=60,
+            ),
+        )
+    )
+    t("pcc.inverse_statics(starts)")(
+        lambda d: (
+            pcc.inverse_statics,
+            dict(
+                robot=_pcc_robot(),
+                target_position=np.asarray(_pcc_solution().tip_pose)[:3, 3] + [1e-3, 0.0, 0.0],
+                starts=3,
+                throw=False,
             ),
         )
     )

@@ -140,11 +140,39 @@ fn result_dict(py: Python<'_>, inv: softrod::InverseSolution) -> PyResult<Bound<
     d.set_item(intern!(py, "iterations"), inv.iterations)?;
     d.set_item(intern!(py, "converged"), inv.converged)?;
     d.set_item(intern!(py, "reached"), inv.reached)?;
+    d.set_item(intern!(py, "start"), inv.start)?;
     let state = InverseWarmState {
         inner: InverseWarmStart::from(inv),
     };
     d.set_item(intern!(py, "warm_state"), Bound::new(py, state)?)?;
     Ok(d)
+}
+
+/// The starts of an inverse call: None (one), a count, or an array of actuations (k, n).
+fn starts_from(obj: Option<&Bound<'_, PyAny>>) -> PyResult<softrod::Starts> {
+    let Some(s) = obj.filter(|s| !s.is_none()) else {
+        return Ok(softrod::Starts::One);
+    };
+    let is_int = s.is_instance_of::<pyo3::types::PyInt>()
+        || s.hasattr("__index__")? && !s.hasattr("__len__")?;
+    if is_int {
+        let k: i64 = crate::convert::Arg::from_arg(s, "starts")?;
+        let k = crate::convert::count("starts", k, 1, softrod::MAX_STARTS)?;
+        return Ok(softrod::Starts::Spread(k));
+    }
+    let m: Matrix = crate::convert::Arg::from_arg(s, "starts").map_err(|_| {
+        crate::errors::type_err(
+            "starts",
+            s,
+            "a count of starts, or a 2-d array of actuations (one start per row)",
+        )
+    })?;
+    Ok(softrod::Starts::Given(
+        m.0.rows()
+            .into_iter()
+            .map(|r| r.iter().copied().collect())
+            .collect(),
+    ))
 }
 
 /// A pair of bounds `(lo, hi)` (`hi` None: unbounded) or the default.
@@ -182,7 +210,8 @@ fn bounds(obj: Option<&Bound<'_, PyAny>>, name: &str, default: (f64, f64)) -> Py
 #[pyo3(signature = (rod, tendons, loads, chambers, target_position, *, target_rotation=None,
                     target_s=None, weights=None, tension_bounds=None, pressure_bounds=None, warm_start=None,
                     throw=true, tolerance=None, max_iterations=None, integrator=None, steps=None,
-                    rtol=None, atol=None, warm_state=None, same_model=false, obstacles=None))]
+                    rtol=None, atol=None, warm_state=None, same_model=false, obstacles=None,
+                    starts=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _inverse_statics<'py>(
     py: Python<'py>,
@@ -207,9 +236,10 @@ pub(crate) fn _inverse_statics<'py>(
     warm_state: Option<Bound<'py, InverseWarmState>>,
     same_model: bool,
     obstacles: Option<Bound<'py, PyAny>>,
+    starts: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let obstacles = crate::contact::obstacles(py, obstacles.as_ref())?;
-    let (target, o, warm) = target_and_options(
+    let (target, mut o, warm) = target_and_options(
         &target_position,
         target_s.as_ref(),
         target_rotation.as_ref(),
@@ -221,6 +251,7 @@ pub(crate) fn _inverse_statics<'py>(
         tolerance,
         max_iterations,
     )?;
+    o.starts = starts_from(starts.as_ref())?;
     let solve = solve_options(&OptionArgs {
         integrator,
         given: Given::mesh(steps, rtol, atol, None),
@@ -267,7 +298,15 @@ pub(crate) fn _inverse_statics<'py>(
             .map_err(actuator_names)
     })?;
     let (inv, stability) = inv;
+    // The mesh of the answer when the mesh control refined the one asked: the solution at
+    // the answer is solved there (its tip is the one the position error measures).
+    let asked = match solve.integrator {
+        softrod::Integrator::Rk4 { steps } => Some(steps),
+        softrod::Integrator::Adaptive(_) => None,
+    };
+    let refined = inv.steps.filter(|s| Some(*s) != asked);
     let d = result_dict(py, inv)?;
+    d.set_item(intern!(py, "refined_steps"), refined)?;
     if let Some((stable, margin)) = stability {
         d.set_item(intern!(py, "stable"), stable)?;
         d.set_item(intern!(py, "stability_margin"), margin)?;
@@ -282,7 +321,7 @@ pub(crate) fn _inverse_statics<'py>(
 #[pyo3(signature = (robot, target_position, *, target_rotation=None, weights=None,
                     tension_bounds=None, pressure_bounds=None, tip_force=None, tip_moment=None,
                     warm_start=None, throw=true, tolerance=None, max_iterations=None,
-                    warm_state=None, same_model=false))]
+                    warm_state=None, same_model=false, starts=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _pcc_inverse_statics<'py>(
     py: Python<'py>,
@@ -300,8 +339,9 @@ pub(crate) fn _pcc_inverse_statics<'py>(
     #[pyo3(from_py_with = arg::max_iterations)] max_iterations: Option<i64>,
     warm_state: Option<Bound<'py, InverseWarmState>>,
     same_model: bool,
+    starts: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (target, o, warm) = target_and_options(
+    let (target, mut o, warm) = target_and_options(
         &target_position,
         None,
         target_rotation.as_ref(),
@@ -313,6 +353,7 @@ pub(crate) fn _pcc_inverse_statics<'py>(
         tolerance,
         max_iterations,
     )?;
+    o.starts = starts_from(starts.as_ref())?;
     let vec_or_zero = |v: Option<Bound<'py, PyAny>>, name: &str| -> PyResult<Vector3<f64>> {
         match v.filter(|b| !b.is_none()) {
             None => Ok(Vector3::zeros()),

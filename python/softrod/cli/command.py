@@ -14,7 +14,15 @@ import math
 import numpy as np
 
 from .._core import ConvergenceError
-from ._common import add_data_outputs, bad, files, finite_float, write_csv, write_json
+from ._common import (
+    _positive_int,
+    add_data_outputs,
+    bad,
+    files,
+    finite_float,
+    write_csv,
+    write_json,
+)
 
 _ROBOT_HELP = "robot description file (TOML), or the name of a shipped example"
 
@@ -62,6 +70,7 @@ def _cmd_inverse(args) -> int:
         weights=args.weights,
         tolerance=args.tolerance,
         throw=False,
+        starts=args.starts,
         **kwargs,
     )
     print(f"robot: {robot.name} ({args.robot})")
@@ -213,12 +222,23 @@ def register(sub) -> None:
     inv.add_argument(
         "--tolerance", type=finite_float, help="tolerance on the distance to the target (m)"
     )
+    inv.add_argument(
+        "--starts",
+        type=_positive_int,
+        metavar="N",
+        help=(
+            "solve the (first) target from N starts and keep the best answer: the converged "
+            "one of least norm (default 1: from rest; the iteration is local)"
+        ),
+    )
     add_data_outputs(inv, "the actuation per target", "one row per target")
     files(inv, inputs=("robot",), outputs=("csv", "json"))
 
     def run(args: argparse.Namespace) -> int:
         if args.rotation is not None:
             _check_rotation(args.rotation)
+        if args.starts is not None and args.starts < 1:
+            raise bad("--starts", args.starts, "must be >= 1")
         if args.tolerance is not None and not (
             args.tolerance > 0 and math.isfinite(args.tolerance)
         ):

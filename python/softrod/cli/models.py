@@ -84,6 +84,8 @@ def _cmd_study(args) -> int:
 def _cmd_compare(args) -> int:
     from ..analysis.models import compare_models
 
+    if args.repeats < 1:
+        raise bad("--repeats", args.repeats, "must be >= 1")
     robot = load_actuated(args)
     comp = compare_models(robot, repeats=args.repeats)
     print(f"robot: {comp.robot} ({args.robot}); differences relative to Cosserat")

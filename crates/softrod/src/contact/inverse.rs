@@ -21,8 +21,8 @@ use crate::cosserat::mesh::rk4_position_error;
 use crate::cosserat::statics::SolveOptions;
 use crate::error::{Error, Result};
 use crate::inverse::{
-    mesh_controlled, solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution,
-    InverseWarmStart, Target,
+    later_starts, mesh_controlled, over_starts, solve_inverse, Evaluation, Forward, InverseOptions,
+    InverseSolution, InverseWarmStart, Target,
 };
 use crate::model::{Actuation, RobotModel};
 
@@ -251,8 +251,8 @@ fn restore(
 /// [`DEFAULT_MESH_POSITION_LIMIT`](crate::cosserat::mesh::DEFAULT_MESH_POSITION_LIMIT) is sought
 /// again on a finer mesh from the answer; on a chosen mesh, one above
 /// [`CHOSEN_MESH_POSITION_LIMIT`](crate::cosserat::mesh::CHOSEN_MESH_POSITION_LIMIT) is an error
-/// naming `steps`); returns the result and the forward model on the mesh of the answer (its
-/// `solution` the last contact solve).
+/// naming `steps`), from each start of `options.starts` (the best answer); returns the result
+/// and the forward model on the mesh of the answer (its `solution` the last contact solve).
 ///
 /// # Errors
 /// As [`solve_contact_inverse`] and [`ContactForward::new`]; `steps` as above.
@@ -264,17 +264,22 @@ pub fn contact_inverse_resolved(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, ContactForward)> {
-    mesh_controlled(
-        solve,
-        options,
-        warm,
-        |so, io, w| {
-            let mut fwd = ContactForward::new(model, so, obstacles)?;
-            let out = solve_contact_inverse(&mut fwd, target, io, w)?;
-            Ok((out, fwd))
-        },
-        |fwd, a| fwd.mesh_error(a),
-    )
+    let later = later_starts(target, options, || {
+        ContactForward::new(model, solve, obstacles)
+    })?;
+    over_starts(options, warm, later, |io, w| {
+        mesh_controlled(
+            solve,
+            io,
+            w,
+            |so, io, w| {
+                let mut fwd = ContactForward::new(model, so, obstacles)?;
+                let out = solve_contact_inverse(&mut fwd, target, io, w)?;
+                Ok((out, fwd))
+            },
+            |fwd, a| fwd.mesh_error(a),
+        )
+    })
 }
 
 impl ContactForward {

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use super::{mesh_controlled, uniform, InverseWarmStart, Target};
+use super::{later_starts, mesh_controlled, over_starts, uniform, InverseWarmStart, Target};
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
 use crate::cosserat::equations::{Column, Equations, Workspace};
 use crate::cosserat::mesh::rk4_position_error;
@@ -429,7 +429,8 @@ pub fn inverse_actuation(
     inverse_resolved(model, target, options, solve, warm).map(|(out, _)| out)
 }
 
-/// [`inverse_actuation`] and the forward model on the mesh of its answer.
+/// [`inverse_actuation`] and the forward model on the mesh of its answer (from each start of
+/// `options.starts`, the best answer: see [`Starts`](super::Starts)).
 fn inverse_resolved(
     model: &Arc<RobotModel>,
     target: &Target,
@@ -437,17 +438,22 @@ fn inverse_resolved(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, CosseratForward)> {
-    mesh_controlled(
-        solve,
-        options,
-        warm,
-        |so, io, w| {
-            let mut fwd = CosseratForward::new(model, so, target.s.as_deref())?;
-            let out = solve_inverse(&mut fwd, target, io, w)?;
-            Ok((out, fwd))
-        },
-        |fwd, a| fwd.mesh_error(a),
-    )
+    let later = later_starts(target, options, || {
+        CosseratForward::new(model, solve, target.s.as_deref())
+    })?;
+    over_starts(options, warm, later, |io, w| {
+        mesh_controlled(
+            solve,
+            io,
+            w,
+            |so, io, w| {
+                let mut fwd = CosseratForward::new(model, so, target.s.as_deref())?;
+                let out = solve_inverse(&mut fwd, target, io, w)?;
+                Ok((out, fwd))
+            },
+            |fwd, a| fwd.mesh_error(a),
+        )
+    })
 }
 
 /// [`inverse_actuation`] and the statics solution at the actuation found (on the mesh of the

@@ -80,6 +80,7 @@ mod pcc_closed;
 mod problem;
 pub mod qp;
 mod sqp;
+mod starts;
 mod steps;
 mod uniform;
 
@@ -92,6 +93,10 @@ use crate::error::{Error, Result};
 pub use cosserat::{inverse_actuation, inverse_statics, CosseratForward};
 pub(crate) use problem::{check_options, check_target};
 pub use sqp::{inverse_statics_path, solve_inverse};
+pub(crate) use starts::{check_starts, later_starts, over_starts, starts_on};
+pub use starts::{
+    Starts, MAX_STARTS, MAX_START_HALVINGS, SAME_OBJECTIVE, START_SLACK, START_TURNS,
+};
 pub(crate) use steps::{objective_change, trust_radius};
 
 /// Default tolerance on the distance to a target position (m).
@@ -174,6 +179,8 @@ pub struct InverseOptions {
     /// `true`: a target out of reach is [`Error::TargetUnreachable`]; non-convergence is
     /// [`Error::NotConverged`]. `false`: returned with `converged == false`.
     pub throw: bool,
+    /// The starts of the iteration (several: the best answer of all, see [`Starts`]).
+    pub starts: Starts,
 }
 
 impl Default for InverseOptions {
@@ -189,6 +196,7 @@ impl Default for InverseOptions {
             rotation_weight: None,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             throw: true,
+            starts: Starts::One,
         }
     }
 }
@@ -261,6 +269,12 @@ pub struct InverseSolution {
     pub evaluation: Evaluation,
     /// The quasi-Newton Hessian of the Lagrangian at the end (n × n), for a warm start.
     pub hessian: DMatrix<f64>,
+    /// The start it came from ([`Starts`]): 0 for the warm start or the reference, `k` for
+    /// the `k`-th later one.
+    pub start: usize,
+    /// The RK4 steps of the mesh the answer was found on (a Cosserat model on the RK4
+    /// integrator: more than asked where the mesh control refined it); `None` otherwise.
+    pub steps: Option<usize>,
 }
 
 impl InverseSolution {
@@ -317,7 +331,9 @@ impl From<InverseSolution> for InverseWarmStart {
 /// above [`CHOSEN_MESH_POSITION_LIMIT`](crate::cosserat::mesh::CHOSEN_MESH_POSITION_LIMIT) is
 /// an error naming `steps`. A target missed (`TargetUnreachable`, `NotConverged`) is judged
 /// where the iteration stopped (run again without the error), since the verdict may be the
-/// coarse mesh's.
+/// coarse mesh's. An answer on the finer mesh where the mesh asked suffices is found again on
+/// the mesh asked (from it), so that the answer's mesh is the one a solve there takes; the
+/// answer's `steps` say which it is.
 ///
 /// # Errors
 /// `run`'s; `steps` as above.
@@ -354,7 +370,13 @@ pub(crate) fn mesh_controlled<F>(
     let Some(finer) = mesh_verdict(error, steps, solve.integrator.is_default_mesh())? else {
         return match missed {
             Some(e) => Err(e),
-            None => Ok((out, fwd)),
+            None => Ok((
+                InverseSolution {
+                    steps: Some(steps),
+                    ..out
+                },
+                fwd,
+            )),
         };
     };
     let fine = SolveOptions {
@@ -365,7 +387,31 @@ pub(crate) fn mesh_controlled<F>(
         evaluation: None,
         ..InverseWarmStart::from(&out)
     };
-    run(&fine, options, Some(&from))
+    let (out, fine_fwd) = run(&fine, options, Some(&from))?;
+    // The finer mesh was chosen where the first iteration stopped; an answer where the mesh
+    // asked suffices (the iteration passed through a more strongly bent shape) is sought
+    // again on that mesh from there: the mesh a solve at the answer takes.
+    let mut asked_suffices = || {
+        let error = mesh_error(&mut fwd, &out.actuation);
+        matches!(
+            mesh_verdict(error, steps, solve.integrator.is_default_mesh()),
+            Ok(None)
+        )
+    };
+    if out.converged && asked_suffices() {
+        let from = InverseWarmStart {
+            evaluation: None,
+            ..InverseWarmStart::from(&out)
+        };
+        if let Ok((again, fwd)) = run(solve, options, Some(&from)) {
+            if again.converged {
+                let steps = Some(steps);
+                return Ok((InverseSolution { steps, ..again }, fwd));
+            }
+        }
+    }
+    let steps = Some(finer);
+    Ok((InverseSolution { steps, ..out }, fine_fwd))
 }
 
 impl From<&InverseSolution> for InverseWarmStart {

@@ -92,8 +92,8 @@ impl Forward for PccForward<'_> {
 
 use super::pcc_closed::closed_form;
 use super::{
-    check_options, check_target, solve_inverse, InverseOptions, InverseSolution, InverseWarmStart,
-    Target,
+    check_options, check_target, later_starts, over_starts, solve_inverse, InverseOptions,
+    InverseSolution, InverseWarmStart, Target,
 };
 
 /// The inverse statics of the PCC robot `robot` under the tip wrench of `loads` (its
@@ -101,7 +101,8 @@ use super::{
 /// same objective, iteration and result as [`solve_inverse`] on a [`PccForward`]. For an
 /// unloaded, tendon-driven robot and a tip position target it runs in closed form
 /// (`pcc_closed.rs`);
-/// otherwise, and whenever that iteration cannot decide, it is [`solve_inverse`].
+/// otherwise, and whenever that iteration cannot decide, it is [`solve_inverse`]. From each
+/// start of `options.starts`, the best answer (see [`Starts`](super::Starts)).
 ///
 /// # Errors
 /// As [`solve_inverse`].
@@ -120,17 +121,21 @@ pub fn pcc_inverse_statics(
     let unloaded = loads.tip_force == Vector3::zeros() && loads.tip_moment == Vector3::zeros();
     // Tendons only: with chambers the norm can be nearly flat along the target (pressure
     // against tension), where the generic iteration's answer is kept.
-    if unloaded
+    let closed = unloaded
         && nt > 0
         && nc == 0
         && target.s.is_none()
         && target.rotation.is_none()
-        && target.points.len() == 1
-    {
-        if let Some(out) = closed_form(robot, &target.points[0], options, warm) {
-            return Ok(out);
+        && target.points.len() == 1;
+    let later = later_starts(target, options, || Ok(PccForward::new(robot, loads, solve)))?;
+    over_starts(options, warm, later, |io, w| {
+        if closed {
+            if let Some(out) = closed_form(robot, &target.points[0], io, w) {
+                return Ok((out, ()));
+            }
         }
-    }
-    let mut fwd = PccForward::new(robot, loads, solve);
-    solve_inverse(&mut fwd, target, options, warm)
+        let mut fwd = PccForward::new(robot, loads, solve);
+        solve_inverse(&mut fwd, target, io, w).map(|out| (out, ()))
+    })
+    .map(|(out, ())| out)
 }

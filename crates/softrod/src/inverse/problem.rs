@@ -213,7 +213,7 @@ pub(crate) fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f6
         return Err(Error::invalid("max_iterations", 0, ">= 1"));
     }
     let _ = length;
-    Ok(())
+    super::check_starts(&o.starts, n)
 }
 
 pub(crate) fn check_target(target: &Target) -> Result<()> {

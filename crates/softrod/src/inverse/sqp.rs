@@ -66,6 +66,8 @@ impl Iterate {
             reached: lin.reached,
             evaluation: self.ev,
             hessian: self.hess,
+            start: 0,
+            steps: None,
         }
     }
 }
@@ -518,7 +520,8 @@ fn search<F: Forward + ?Sized>(
 }
 
 /// Follows `targets` (tip positions, m, world; with optional orientations), each inverse
-/// warm-started from the last (the first from `warm`); with `throw == false` a target that is
+/// warm-started from the last (the first from `warm`, and from each start of
+/// `options.starts`); with `throw == false` a target that is
 /// not reached is returned with `converged == false` and the path goes on from it.
 ///
 /// # Errors
@@ -531,7 +534,15 @@ pub fn inverse_statics_path<F: Forward + ?Sized>(
 ) -> Result<Vec<InverseSolution>> {
     let mut out: Vec<InverseSolution> = Vec::with_capacity(targets.len());
     let mut w = warm.cloned();
-    for t in targets {
+    if let Some(first) = targets.first() {
+        let later = super::starts_on(forward, first, options)?;
+        let (s, ()) = super::over_starts(options, warm, later, |o, w| {
+            solve_inverse(forward, first, o, w).map(|s| (s, ()))
+        })?;
+        w = Some(InverseWarmStart::from(&s));
+        out.push(s);
+    }
+    for t in targets.iter().skip(1) {
         let s = solve_inverse(forward, t, options, w.as_ref())?;
         w = Some(InverseWarmStart::from(&s));
         out.push(s);

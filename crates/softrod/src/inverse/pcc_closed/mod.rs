@@ -425,6 +425,8 @@ impl ClosedForm {
                 jacobian: Some(vec![jac]),
             },
             hessian,
+            start: 0,
+            steps: None,
         }
     }
 }

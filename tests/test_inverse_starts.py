@@ -1,0 +1,260 @@
+"""The inverse statics from several starts (``starts=``), and the mesh of its answer.
+
+Oracles: targets made by forward solves at known tensions (the answer must reach them, checked
+by a forward solve at the answer, and where the known tensions are the least norm found, be
+them); an actuation of known smaller norm reaching the same target; the closest pose of a
+straight rod to a point beyond its reach.
+"""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod import pcc
+
+# Tapered soft arms with tendons at random angles, curled by known tensions (0.1 to 5 turns):
+# from rest the iteration stops at a local minimum of the distance beyond a fold of the tip's
+# map (TargetUnreachableError for a reachable target).
+_ARM = """
+name = "curl"
+[rod]
+length = {length}
+[rod.section]
+type = "tapered"
+base_radius = {base}
+tip_radius = {tip}
+[rod.material]
+type = "linear"
+youngs_modulus = {modulus}
+poisson_ratio = 0.5
+"""
+
+_TENDON = """
+[[tendons]]
+offset = [{x}, {y}]
+"""
+
+CURLED = {
+    # three tendons, the third pulled: 2.1 turns
+    "three": (
+        dict(length=0.49888397431568443, base=0.00986584737143361, tip=0.007694171021347452,
+             modulus=1999486.8512695632),
+        [(-0.0023216761699450953, -0.0057007009300247035),
+         (0.006097789909751517, 0.0008397199224789374),
+         (-0.003776113739806415, 0.004860981007545767)],
+        [0.0, 0.0, 22.58673650678362],
+    ),
+    # two antagonistic tendons, one pulled
+    "antagonistic": (
+        dict(length=0.3937934287154917, base=0.00797800014592825, tip=0.0075985806648492344,
+             modulus=169771.68792078985),
+        [(0.0054577091041494484, -0.002676939545717354),
+         (-0.00545770910414945, 0.00267693954571735)],
+        [0.0, 5.650332047526689],
+    ),
+    # three tendons, two pulled
+    "two_pulled": (
+        dict(length=0.46547630508295557, base=0.0034568929148790398, tip=0.0030575932388536703,
+             modulus=580269.2542351008),
+        [(-0.0011179597548135033, 0.002175648614036487),
+         (-0.0013251870920572507, -0.00205600585509536),
+         (0.0024431468468707543, -0.00011964275894112841)],
+        [0.0, 1.0926250404024493, 0.5305078506258559],
+    ),
+}  # fmt: skip
+
+
+def _curled(name):
+    rod, offsets, truth = CURLED[name]
+    text = _ARM.format(**rod) + "".join(_TENDON.format(x=x, y=y) for x, y in offsets)
+    robot = softrod.Robot.from_toml(text)
+    truth = np.array(truth)
+    return robot, truth, robot.solve(truth).tip_position
+
+
+# A tapered silicone arm under gravity, three tendons at 120°: a tip is reached along a
+# near-flat valley of actuations (co-contraction compresses the rod), whose exact solutions
+# are isolated points. The target made by [0, 0.8, 0.3] N is reached from rest with
+# [0.275, 1.218, 0.585] N (½|T|² 0.950 against 0.365).
+_TRI = """
+name = "tri-tendon"
+[rod]
+length = 0.25
+density = 1100.0
+[rod.section]
+type = "tapered"
+base_radius = 0.006
+tip_radius = 0.004
+[rod.material]
+type = "linear"
+youngs_modulus = 2.0e6
+poisson_ratio = 0.49
+[[tendons]]
+distance = 0.004
+angle_deg = 0.0
+[[tendons]]
+distance = 0.004
+angle_deg = 120.0
+end = 0.125
+[[tendons]]
+distance = 0.004
+angle_deg = 240.0
+[loads]
+gravity = [0.0, 0.0, -9.81]
+"""
+
+
+def _half_norm(t):
+    return 0.5 * float(np.sum(np.asarray(t) ** 2))
+
+
+def test_several_starts_find_the_least_norm_point_of_a_co_contraction_valley():
+    robot = softrod.Robot.from_toml(_TRI)
+    known = np.array([0.0, 0.8, 0.3])
+    target = robot.solve(known).tip_position
+    one = softrod.inverse_statics(robot, target)
+    assert one.converged and one.start == 0
+    assert _half_norm(one.tensions) > 2.5 * _half_norm(known)
+    inv = softrod.inverse_statics(robot, target, starts=8)
+    assert inv.converged and inv.start > 0
+    assert np.allclose(inv.tensions, known, rtol=0.0, atol=1e-6), inv.tensions
+    assert np.linalg.norm(robot.solve(inv.tensions).tip_position - target) <= 1e-10
+
+
+@pytest.mark.parametrize("name", sorted(CURLED))
+def test_several_starts_reach_targets_beyond_a_fold_of_a_curled_arm(name):
+    robot, truth, target = _curled(name)
+    with pytest.raises(softrod.TargetUnreachableError):
+        softrod.inverse_statics(robot, target)
+    inv = softrod.inverse_statics(robot, target, starts=16)
+    assert inv.converged and inv.start > 0
+    tip = robot.solve(inv.tensions).tip_position
+    assert np.linalg.norm(tip - target) <= 1e-9
+    # The known tensions are the least-norm answer of the starts here.
+    assert np.allclose(inv.tensions, truth, rtol=1e-6, atol=1e-9), inv.tensions
+
+
+def test_the_contact_inverse_takes_starts():
+    # The same arm with a plane 1 m away: the forward model is the contact solve.
+    robot, truth, target = _curled("antagonistic")
+    far = softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))
+    walled = softrod.Robot(robot.rod, tendons=list(robot.tendons), obstacles=[far], name="w")
+    with pytest.raises(softrod.TargetUnreachableError):
+        softrod.inverse_statics(walled, target)
+    inv = softrod.inverse_statics(walled, target, starts=16)
+    assert inv.converged and inv.start > 0
+    assert np.allclose(inv.tensions, truth, rtol=1e-6, atol=1e-9)
+
+
+def test_given_starts_are_tried_after_the_first():
+    robot, truth, target = _curled("antagonistic")
+    inv = softrod.inverse_statics(robot, target, starts=[[1.0, 1.0], 1.1 * truth])
+    assert inv.converged and inv.start == 2
+    assert np.allclose(inv.tensions, truth, rtol=1e-6, atol=1e-9)
+    # A start where the rod cannot be solved (its tendon's path would turn back on itself) is
+    # halved towards rest; the others still count.
+    inv = softrod.inverse_statics(robot, target, starts=[[0.0, 1e4], 1.1 * truth])
+    assert inv.converged and np.allclose(inv.tensions, truth, rtol=1e-6, atol=1e-9)
+
+
+def test_a_target_out_of_reach_from_every_start_is_the_closest_pose():
+    # 2 L straight ahead of a rod of length L: the closest pose is the straight rod, L away.
+    robot, _, _ = _curled("antagonistic")
+    length = robot.rod.length
+    target = [0.0, 0.0, 2.0 * length]
+    with pytest.raises(softrod.TargetUnreachableError) as e:
+        softrod.inverse_statics(robot, target, starts=4)
+    assert 0.99 * length <= e.value.distance <= length
+    out = softrod.inverse_statics(robot, target, starts=4, throw=False)
+    assert not out.converged and not out.reached
+    assert out.position_error == pytest.approx(e.value.distance, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("starts", "name", "error"),
+    [
+        (0, "starts", softrod.ParameterError),
+        (-1, "starts", softrod.ParameterError),
+        (10**6, "starts", softrod.ParameterError),
+        (True, "starts", TypeError),
+        (1.5, "starts", TypeError),
+        ("4", "starts", TypeError),
+        ([[1.0, 2.0, 3.0]], "starts[0]", softrod.ParameterError),
+        ([[np.nan, 1.0]], "starts[0]", softrod.ParameterError),
+    ],
+)
+def test_bad_starts_are_named(starts, name, error):
+    robot, _, target = _curled("antagonistic")
+    with pytest.raises(error) as e:
+        softrod.inverse_statics(robot, target, starts=starts)
+    assert e.value.parameter == name
+
+
+def test_one_start_is_the_single_iteration():
+    # starts=1 and starts=None are the same call; a result pickles with its start.
+    robot = softrod.Robot.from_toml(_TRI)
+    target = robot.solve([0.3, 0.2, 0.1]).tip_position
+    a = softrod.inverse_statics(robot, target)
+    b = softrod.inverse_statics(robot, target, starts=1)
+    assert np.array_equal(a.tensions, b.tensions) and a.iterations == b.iterations
+    c = softrod.inverse_statics(robot, target, starts=[[0.0, 0.8, 0.3]])
+    back = pickle.loads(pickle.dumps(c))
+    assert back.start == c.start and np.array_equal(back.tensions, c.tensions)
+
+
+def test_the_pcc_inverse_and_a_path_take_starts():
+    # One PCC segment, three tendons at 120°, unloaded: the minimum-norm actuation is unique
+    # (the curvature is linear in the tensions; test_command.py enumerates the taut subsets)
+    # and every start finds it; with a tip load, the generic iteration from each start.
+    angles = [np.pi / 2, -np.pi / 6, 7 * np.pi / 6]
+    robot = pcc.Robot.solid_circle([0.2], 0.7e-3, 54e9, extensible=False)
+    robot = robot.with_tendons(0, [0.01] * 3, angles)
+    for force in (None, [0.0, 0.05, -0.1]):
+        target = np.asarray(pcc.solve(robot, [2.0, 0.7, 0.0], tip_force=force).tip_pose)[:3, 3]
+        one = pcc.inverse_statics(robot, target, tip_force=force)
+        many = pcc.inverse_statics(robot, target, tip_force=force, starts=6)
+        assert one.converged and many.converged
+        np.testing.assert_allclose(many.tensions, one.tensions, rtol=0, atol=1e-8)
+    # A path: the first target from several starts, the next from the last.
+    niti = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    target = niti.solve([3.0, 0.0, 1.0, 0.0, 2.0, 0.5]).tip_position
+    targets = [target, target + np.array([0.0, 0.0, -1e-3])]
+    one = softrod.inverse_statics_path(niti, targets)
+    many = softrod.inverse_statics_path(niti, targets, starts=3)
+    assert many.converged.all() and one.converged.all()
+    assert np.all(many.position_error <= 1e-10)
+    assert _half_norm(many.tensions[0]) <= _half_norm(one.tensions[0]) * (1 + 1e-6)
+
+
+def test_the_answer_s_solution_is_on_the_mesh_its_error_is_measured_on():
+    # Two antagonistic tendons on a soft, strongly tapered arm; from a start that curls it
+    # (0.15 N) the iteration stopped where the default 40 steps were too coarse, went on from
+    # there on 1,280 steps, and reached the target there: the reported error (2.8e-15 m) was
+    # the fine mesh's while `solution` (a solve at the answer, on the 40 steps a solve there
+    # takes) was 5.7e-8 m from the target. The answer is now sought again on the mesh a solve
+    # at it takes; the solution's tip is where the error says.
+    text = _ARM.format(
+        length=0.3547846749285818,
+        base=0.004888506996347092,
+        tip=0.0016067616498030856,
+        modulus=107908.40445381397,
+    ) + "".join(
+        _TENDON.format(x=x, y=y)
+        for x, y in [
+            (0.0010970687212629173, -0.0006698636729696761),
+            (-0.001097068721262918, 0.0006698636729696752),
+        ]
+    )
+    robot = softrod.Robot.from_toml(text)
+    truth = np.array([0.017443830471436488, 0.0239121490139816])
+    target = robot.solve(truth).tip_position
+    inv = softrod.inverse_statics(robot, target, warm_start=[0.15450773280980382, 0.0])
+    assert inv.converged
+    tip = inv.solution.tip_position
+    assert abs(np.linalg.norm(tip - target) - inv.position_error) <= 1e-12
+    assert inv.solution.steps == robot.solve(inv.tensions).steps == 40
+    assert np.allclose(inv.tensions, truth, rtol=1e-9)
