@@ -821,6 +821,59 @@ def test_a_helical_tendon_the_default_mesh_cannot_follow_is_solved_on_a_finer_on
     assert np.isfinite(got.tendon_displacements).all()
 
 
+def _helix_function(radius: float, pitch: float, tension: float) -> softrod.Tendon:
+    w = 2.0 * np.pi / pitch
+    return softrod.Tendon(
+        lambda s: (radius * np.cos(w * s), radius * np.sin(w * s)),
+        tension,
+        derivative=lambda s: (-radius * w * np.sin(w * s), radius * w * np.cos(w * s)),
+    )
+
+
+@pytest.mark.parametrize("pitch", [0.02, 0.005])
+def test_a_routing_function_the_default_mesh_cannot_follow_is_solved_on_a_finer_one(pitch):
+    # The same helices given as a routing function: the mesh control did not inspect it and
+    # the 40 steps came back 4.1e-5 m and 2.4e-2 m off, reported converged. Its rate
+    # |r'| / |r| is now counted on every step. Oracles: the adaptive integrator, and the
+    # closed-form helix's solve (the same routing, the same mesh chosen).
+    tendon = [_helix_function(2e-3, pitch, 1.0)]
+    got = softrod.solve_statics(_helix_rod(), tendon)
+    ref = softrod.solve_statics(_helix_rod(), tendon, integrator="adaptive", rtol=1e-10, atol=1e-12)
+    helix = softrod.solve_statics(_helix_rod(), [softrod.Tendon.helical(2e-3, pitch, 1.0)])
+    assert len(got.s) == len(helix.s) > 41
+    assert np.linalg.norm(got.tip_position - ref.tip_position) < 1e-7 * 0.4
+    assert np.linalg.norm(got.tip_position - helix.tip_position) < 1e-12
+
+
+def test_a_routing_function_crossing_the_backbone_keeps_the_default_mesh():
+    # Its rate is |r'| over its largest distance from the backbone, not over the distance
+    # where it is (infinite at the crossing: a straight tendon moved across the rod was
+    # refused on every mesh). Oracle: the adaptive integrator.
+    length, rho = 0.4, 2e-3
+    for side in (0.0, 1e-5):
+        tendon = softrod.Tendon(
+            lambda s, side=side: (rho * (1.0 - 2.0 * s / length), side),
+            1.0,
+            derivative=lambda s: (-2.0 * rho / length, 0.0),
+        )
+        got = softrod.solve_statics(_helix_rod(), [tendon])
+        ref = softrod.solve_statics(
+            _helix_rod(), [tendon], integrator="adaptive", rtol=1e-10, atol=1e-12
+        )
+        assert got.steps == 40
+        assert np.linalg.norm(got.tip_position - ref.tip_position) < 1e-8 * length
+
+
+def test_a_routing_function_no_rk4_mesh_can_follow_is_refused_naming_steps():
+    # 400 turns given as a function, which the mesh control did not inspect: refused on every
+    # mesh like a closed-form helix no mesh can follow (the test below).
+    tendon = [_helix_function(2e-3, 1e-3, 1.0)]
+    for kw in ({}, {"steps": 640}):
+        with pytest.raises(softrod.ParameterError, match="adaptive") as e:
+            softrod.solve_statics(_helix_rod(), tendon, **kw)
+        assert e.value.parameter == "steps"
+
+
 @pytest.mark.parametrize("pitch", [1e-6, 1e-300])
 def test_a_helix_no_rk4_mesh_can_follow_is_refused_naming_steps(pitch):
     # 4e5 turns and more (1e-300: an infinite tendon, whose displacement was NaN, reported

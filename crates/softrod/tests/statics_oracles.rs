@@ -706,3 +706,43 @@ fn user_routing_function_matches_the_builtin_helix() {
     assert!(dist(a.tip_position(), b.tip_position()) < 1e-14);
     assert!((a.tendon_lengths[0] - b.tendon_lengths[0]).abs() < 1e-15);
 }
+
+#[test]
+fn the_mesh_control_counts_a_routing_function_s_rate_as_the_builtin_helix_s() {
+    // A helix given as a function turns at |r'| / max |r| = 2π / pitch, the built-in helix's
+    // rate, and the estimated tip error of the RK4 mesh (which counts it) is the same for both.
+    use softrod::Routing;
+    use std::sync::Arc;
+    let (rho, pitch): (f64, f64) = (0.002, 0.02);
+    let w = 2.0 * PI / pitch;
+    let function = Routing::Function {
+        offset: Arc::new(move |s| [rho * (w * s).cos(), rho * (w * s).sin()]),
+        derivative: Arc::new(move |s| [-rho * w * (w * s).sin(), rho * w * (w * s).cos()]),
+    };
+    let helix = Routing::Helical {
+        radius: rho,
+        pitch,
+        phase: 0.0,
+    };
+    let rod = Rod::new(
+        0.4,
+        Section::circular(5e-3).unwrap(),
+        LinearElastic::new(5e6, 0.3).unwrap(),
+    )
+    .unwrap();
+    let mut errors = Vec::new();
+    for routing in [function, helix] {
+        let tendon = common::tendon_with(routing, 1.0, None).unwrap();
+        for s in [0.0, 0.013, 0.3] {
+            assert!((tendon.tendon.turn_rate_at(s, rho) - w).abs() <= 1e-12 * w);
+        }
+        let sol = common::solve(&rod, &[tendon], &Loads::default(), &rk4(40)).unwrap();
+        errors.push(softrod::cosserat::mesh::rk4_position_error(&sol));
+    }
+    // (40 steps turn this helix π each: far beyond the default limit of 1e-4 L.)
+    assert!(errors[0] > 1e-2, "{errors:?}");
+    assert!(
+        (errors[0] - errors[1]).abs() <= 1e-9 * errors[1],
+        "{errors:?}"
+    );
+}

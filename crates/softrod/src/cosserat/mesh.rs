@@ -10,14 +10,15 @@
 //! judge the mesh by [`mesh_verdict`]: the default mesh is refined above
 //! [`DEFAULT_MESH_POSITION_LIMIT`], a chosen one (or the finest default refinement) refused
 //! above [`CHOSEN_MESH_POSITION_LIMIT`]. The turn of a step is the backbone's or, where it is
-//! faster, that of a helical tendon's routing (RK4 integrates its loads as it integrates the
-//! rotations).
+//! faster, that of a loaded tendon's routing (RK4 integrates its loads as it integrates the
+//! rotations): a helix's `2π / |pitch|`, a routing function's `|r'| / max |r|`.
 
 use crate::cosserat::statics::{
     solve_statics_at, Integrator, SolveOptions, StaticsSolution, DEFAULT_RK4_STEPS,
 };
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
+use crate::model::tendon::Routing;
 
 /// Largest refinement factor of the default mesh.
 pub(crate) const MAX_REFINEMENT: usize = 32;
@@ -31,33 +32,76 @@ pub fn rk4_rotation_error(solution: &StaticsSolution) -> f64 {
 
 /// Per step of the RK4 march of `solution`: its start (m) and its rotation error `θ⁵ / 120`
 /// (rad), `θ = h max(|u_i|, |u_{i+1}|, ω)` with `ω` the fastest turn rate of a loaded tendon's
-/// routing on the step ([`routing_rate`]).
+/// routing on the step ([`Routings::rate`]).
 fn step_errors(solution: &StaticsSolution) -> impl Iterator<Item = (f64, f64)> + '_ {
     let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    let routings = Routings::new(solution);
     solution
         .s
         .windows(2)
         .zip(solution.u.windows(2))
         .map(move |(s, u)| {
-            let rate = routing_rate(solution, s[0]);
+            let rate = routings.rate(s[0], s[1]);
             let theta = (s[1] - s[0]) * norm(&u[0]).max(norm(&u[1])).max(rate);
             (s[0], theta.powi(5) / 120.0)
         })
 }
 
-/// The fastest turn rate (rad/m) at `s` (m) of the routing of a tendon of `solution` that
-/// carries tension there ([`Tendon::turn_rate`](crate::model::Tendon::turn_rate): a helix's
-/// `2π / |pitch|`): RK4 integrates the loads of a helical tendon as it integrates the
-/// rotations, and misses them as badly where a step turns the helix by a radian or more.
-fn routing_rate(solution: &StaticsSolution, s: f64) -> f64 {
-    solution
-        .model
-        .tendons()
-        .iter()
-        .zip(&solution.tendon_tensions)
-        .filter(|(t, &tension)| tension != 0.0 && t.end().is_none_or(|e| s < e))
-        .map(|(t, _)| t.turn_rate())
-        .fold(0.0, f64::max)
+/// The routings of the tendons of a solution that carry tension, for their turn rates
+/// ([`Tendon::turn_rate_at`](crate::model::Tendon::turn_rate_at)): RK4 integrates the loads
+/// of a helical tendon as it integrates the rotations, and misses them as badly where a step
+/// turns the helix by a radian or more.
+struct Routings<'a> {
+    solution: &'a StaticsSolution,
+    /// Per tendon, the largest distance (m) of a routing function's offset from the backbone
+    /// at the solution's nodes (the scale of its rate); 0 for the others and the slack ones.
+    scales: Vec<f64>,
+}
+
+impl<'a> Routings<'a> {
+    fn new(solution: &'a StaticsSolution) -> Self {
+        let scales = solution
+            .model
+            .tendons()
+            .iter()
+            .zip(&solution.tendon_tensions)
+            .map(|(t, &tension)| match t.routing() {
+                Routing::Function { offset, .. } if tension != 0.0 => solution
+                    .s
+                    .iter()
+                    .map(|&s| {
+                        let r = offset(s);
+                        r[0].hypot(r[1])
+                    })
+                    .filter(|d| d.is_finite())
+                    .fold(0.0, f64::max),
+                _ => 0.0,
+            })
+            .collect();
+        Self { solution, scales }
+    }
+
+    /// The fastest turn rate (rad/m) on the step `[a, b]` (m), at its ends and middle, of the
+    /// routing of a tendon that carries tension there.
+    fn rate(&self, a: f64, b: f64) -> f64 {
+        let tendons = self.solution.model.tendons();
+        let mut rate = 0.0_f64;
+        for ((t, &tension), &scale) in tendons
+            .iter()
+            .zip(&self.solution.tendon_tensions)
+            .zip(&self.scales)
+        {
+            if tension == 0.0 {
+                continue;
+            }
+            for s in [a, 0.5 * (a + b), b] {
+                if t.end().is_none_or(|e| s < e) {
+                    rate = rate.max(t.turn_rate_at(s, scale));
+                }
+            }
+        }
+        rate
+    }
 }
 
 /// Estimated truncation error of the tip position of the RK4 march of `solution`, relative
@@ -244,6 +288,7 @@ fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
     let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     let curvature: Vec<f64> = solution.u.iter().map(norm).collect();
     let slack = 1e-12 * length;
+    let routings = Routings::new(solution);
     let mut error = 0.0;
     let mut first = 0;
     for (k, &n) in rk4_plan(breaks, steps).iter().enumerate() {
@@ -259,7 +304,7 @@ fn rk4_position_error_on(solution: &StaticsSolution, steps: usize) -> f64 {
                 .zip(&curvature[first..])
                 .take_while(|(s, _)| **s <= a + h + slack)
                 .map(|(_, u)| *u)
-                .fold(routing_rate(solution, a), f64::max);
+                .fold(routings.rate(a, a + h), f64::max);
             error += (h * most).powi(5) / 120.0 * (length - a) / length;
         }
     }
@@ -316,7 +361,7 @@ fn meaningless(steps: usize, error: f64) -> Error {
         format!(
             "enough RK4 steps to resolve the shape: on these the tip's position errs by about \
              {error:.2e} of the length (Σ θ⁵/120 (L - s)/L over the steps, θ the turn of a \
-             step of the backbone or of a helical tendon's routing), and the shape is \
+             step of the backbone or of a tendon's routing), and the shape is \
              meaningless; {remedy}"
         ),
     )

@@ -271,12 +271,31 @@ impl Tendon {
     }
 
     /// How fast the routing turns about the backbone (rad/m): `2π / |pitch|` for a helix, 0
-    /// for the other routings (a user function's rate is not known). The RK4 mesh must
-    /// follow it as it follows the backbone's curvature (`cosserat::mesh`).
+    /// for the other routings (a user function's rate varies along the rod:
+    /// [`Tendon::turn_rate_at`]). The RK4 mesh must follow it as it follows the backbone's
+    /// curvature (`cosserat::mesh`).
     pub fn turn_rate(&self) -> f64 {
         match self.routing {
             Routing::Helical { pitch, .. } => std::f64::consts::TAU / pitch.abs(),
             _ => 0.0,
+        }
+    }
+
+    /// How fast the routing changes at `s` (m), in rad/m: [`Tendon::turn_rate`] for the
+    /// closed-form routings, and for a user function `|r'(s)| / scale`, `scale` (m) the
+    /// largest distance of its offset from the backbone (a helix's `2π / |pitch|`; an offset
+    /// whose distance oscillates, its frequency; one crossing the backbone, the slow rate of
+    /// its crossing); 0 where it is not finite.
+    pub fn turn_rate_at(&self, s: f64, scale: f64) -> f64 {
+        let Routing::Function { derivative, .. } = &self.routing else {
+            return self.turn_rate();
+        };
+        let d = derivative(s);
+        let rate = d[0].hypot(d[1]) / scale;
+        if rate.is_finite() {
+            rate
+        } else {
+            0.0
         }
     }
 }
