@@ -22,7 +22,7 @@ use softrod::nalgebra::{Matrix4, Vector3};
 use softrod::pcc::{self, ArcCoordinates, JacobianFrame, PccSegment};
 
 use crate::convert::{choice, Floats};
-use crate::errors::{blame, param_err, to_py_err, type_err};
+use crate::errors::{param_err, to_py_err, type_err};
 
 pub(crate) use actuation::{
     pcc_arc_from_pressures, pcc_arc_from_pressures_jacobian, pcc_arc_from_tendon_displacements,
