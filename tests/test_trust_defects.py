@@ -864,10 +864,13 @@ def test_a_routing_function_crossing_the_backbone_keeps_the_default_mesh():
         assert np.linalg.norm(got.tip_position - ref.tip_position) < 1e-8 * length
 
 
-def test_a_routing_function_no_rk4_mesh_can_follow_is_refused_naming_steps():
-    # 400 turns given as a function, which the mesh control did not inspect: refused on every
-    # mesh like a closed-form helix no mesh can follow (the test below).
-    tendon = [_helix_function(2e-3, 1e-3, 1.0)]
+@pytest.mark.parametrize("pitch", [1e-3, 1e-4, 1e-6])
+def test_a_routing_function_no_rk4_mesh_can_follow_is_refused_naming_steps(pitch):
+    # 400 to 4e5 turns given as a function, which the mesh control did not inspect: refused
+    # on every mesh like a closed-form helix no mesh can follow (the test below). From 4,000
+    # turns the check of the derivative refused the (right) derivative: its differences, with
+    # a step of 1e-6 of the length, could not follow the offset.
+    tendon = [_helix_function(2e-3, pitch, 1.0)]
     for kw in ({}, {"steps": 640}):
         with pytest.raises(softrod.ParameterError, match="adaptive") as e:
             softrod.solve_statics(_helix_rod(), tendon, **kw)

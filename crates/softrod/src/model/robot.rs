@@ -477,41 +477,51 @@ const DERIVATIVE_TOLERANCE: f64 = 1e-4;
 
 /// Checks that the derivative `rp` a user routing gives at `s` (of `[0, end]`) is that of its
 /// offset `r`: second-order differences of the offset (central inside, one-sided at the ends);
-/// at a kink, the first-order difference of either side. Each neighbour is evaluated once.
+/// at a kink, the first-order difference of either side. Differences that disagree are made
+/// again with steps 10, 100 and 1000 times smaller before the derivative is refused (an
+/// offset that winds a turn within a few steps, e.g. a helix of pitch 1e-4 of the length, is
+/// not differenced by the first).
 fn check_derivative(
     i: usize,
     offset: &(dyn Fn(f64) -> [f64; 2] + Send + Sync),
     (s, end): (f64, f64),
     (r, rp): ([f64; 2], [f64; 2]),
 ) -> Result<()> {
-    let h = DERIVATIVE_STEP * end;
     let tol =
         DERIVATIVE_TOLERANCE * (rp[0].hypot(rp[1]) + r[0].hypot(r[1]) / end) + f64::MIN_POSITIVE;
     let close = |d: [f64; 2]| (d[0] - rp[0]).hypot(d[1] - rp[1]) <= tol;
     let diff = |a: [f64; 2], b: [f64; 2], dt: f64| [(b[0] - a[0]) / dt, (b[1] - a[1]) / dt];
-    let below = (s - h >= 0.0).then(|| offset(s - h));
-    let above = (s + h <= end).then(|| offset(s + h));
-    // `(-3 r(s) + 4 r(s ± h) - r(s ± 2h)) / (± 2h)` at an end.
-    let one_sided = |r1: [f64; 2], dir: f64| {
-        let r2 = offset(s + 2.0 * dir * h);
-        [0, 1].map(|k| (-3.0 * r[k] + 4.0 * r1[k] - r2[k]) / (2.0 * dir * h))
-    };
-    let second = match (below, above) {
-        (Some(lo), Some(hi)) => diff(lo, hi, 2.0 * h),
-        (None, Some(hi)) => one_sided(hi, 1.0),
-        (Some(lo), None) => one_sided(lo, -1.0),
-        (None, None) => return Ok(()),
-    };
-    if close(second)
-        || below.is_some_and(|lo| close(diff(lo, r, h)))
-        || above.is_some_and(|hi| close(diff(r, hi, h)))
-    {
-        return Ok(());
+    let mut first = None;
+    for shrink in [1.0, 0.1, 0.01, 0.001] {
+        let h = shrink * DERIVATIVE_STEP * end;
+        let below = (s - h >= 0.0).then(|| offset(s - h));
+        let above = (s + h <= end).then(|| offset(s + h));
+        // `(-3 r(s) + 4 r(s ± h) - r(s ± 2h)) / (± 2h)` at an end.
+        let one_sided = |r1: [f64; 2], dir: f64| {
+            let r2 = offset(s + 2.0 * dir * h);
+            [0, 1].map(|k| (-3.0 * r[k] + 4.0 * r1[k] - r2[k]) / (2.0 * dir * h))
+        };
+        let second = match (below, above) {
+            (Some(lo), Some(hi)) => diff(lo, hi, 2.0 * h),
+            (None, Some(hi)) => one_sided(hi, 1.0),
+            (Some(lo), None) => one_sided(lo, -1.0),
+            (None, None) => return Ok(()),
+        };
+        if close(second)
+            || below.is_some_and(|lo| close(diff(lo, r, h)))
+            || above.is_some_and(|hi| close(diff(r, hi, h)))
+        {
+            return Ok(());
+        }
+        first.get_or_insert(second);
     }
     Err(Error::invalid(
         format!("tendons[{i}].derivative({s})"),
         format!("{rp:?}"),
-        format!("the derivative of the offset function (its differences there give {second:?})"),
+        format!(
+            "the derivative of the offset function (its differences there give {:?})",
+            first.unwrap_or_default()
+        ),
     ))
 }
 
