@@ -135,12 +135,19 @@ def test_several_starts_reach_a_target_beyond_a_fold(tmp_path, capsys):
     assert np.linalg.norm(robot.solve(tensions).tip_position - target) <= 1e-9
 
 
-@pytest.mark.parametrize(("command", "option"), [("inverse", "--starts"), ("compare", "--repeats")])
-def test_a_count_below_one_names_its_option(command, option, capsys):
+@pytest.mark.parametrize(
+    ("command", "option", "value", "expected"),
+    [
+        ("inverse", "--starts", 0, "must be in [1, 10000]"),
+        ("inverse", "--starts", 10001, "must be in [1, 10000]"),
+        ("compare", "--repeats", 0, "must be >= 1"),
+    ],
+)
+def test_a_count_out_of_range_names_its_option(command, option, value, expected, capsys):
     # (It named the core's `starts` or `repeats`, not the option.)
-    argv = [command, "niti_two_segment", option, 0]
+    argv = [command, "niti_two_segment", option, value]
     if command == "inverse":
         argv += ["--target", 0.0, 0.0, 0.3]
     status, _, err = _run(argv, capsys)
     assert status == 2
-    assert err == [f"softrod: error: invalid option `{option}` = 0: must be >= 1"], err
+    assert err == [f"softrod: error: invalid option `{option}` = {value}: {expected}"], err

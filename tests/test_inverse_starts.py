@@ -185,6 +185,9 @@ def test_a_target_out_of_reach_from_every_start_is_the_closest_pose():
         ("4", "starts", TypeError),
         ([[1.0, 2.0, 3.0]], "starts[0]", softrod.ParameterError),
         ([[np.nan, 1.0]], "starts[0]", softrod.ParameterError),
+        (np.zeros((0, 2)), "starts", softrod.ParameterError),
+        (np.zeros((10000, 2)), "starts", softrod.ParameterError),
+        (2**63, "starts", softrod.ParameterError),
     ],
 )
 def test_bad_starts_are_named(starts, name, error):
@@ -258,3 +261,72 @@ def test_the_answer_s_solution_is_on_the_mesh_its_error_is_measured_on():
     assert abs(np.linalg.norm(tip - target) - inv.position_error) <= 1e-12
     assert inv.solution.steps == robot.solve(inv.tensions).steps == 40
     assert np.allclose(inv.tensions, truth, rtol=1e-9)
+
+
+def test_a_start_that_cannot_be_solved_is_passed_over():
+    # Tensions bounded to [5, 5.5] N from a warm start of [5.5, 5, 5]: the reference clamped
+    # into the bounds (5 N each) cannot be solved, and that evaluation (for the rates of the
+    # spread starts) raised a ConvergenceError for the whole call, though one start returns.
+    # The rates are then taken at the first answer; a start never makes the answer worse.
+    robot, _, target = _curled("two_pulled")
+    kw = dict(warm_start=[5.5, 5.0, 5.0], tension_bounds=(5.0, 5.5), throw=False)
+    one = softrod.inverse_statics(robot, target, **kw)
+    for starts in (2, 8):
+        many = softrod.inverse_statics(robot, target, starts=starts, **kw)
+        assert many.position_error <= one.position_error
+        assert np.all((many.tensions >= 5.0) & (many.tensions <= 5.5))
+
+
+_FOUR = """
+name = "curl"
+[rod]
+length = 0.39802536067790906
+[rod.section]
+type = "tapered"
+base_radius = 0.007168813955469093
+tip_radius = 0.004502861821123197
+[rod.material]
+type = "linear"
+youngs_modulus = 1143909.8407820186
+poisson_ratio = 0.5
+[[tendons]]
+offset = [-0.0024238220324532996, -0.000961171369833091]
+[[tendons]]
+offset = [-0.001284094545310219, -0.0005865791941520101]
+[[tendons]]
+offset = [0.00018426700426936484, 0.0031287140251820915]
+[[tendons]]
+offset = [0.0014355350667176804, 0.0013361146140502048]
+"""
+
+
+def test_a_first_start_that_fails_leaves_the_others():
+    # Four tendons pulling together: the iteration from rest met, on the default mesh, an
+    # answer where the finer mesh the mesh control chose finds the rod cannot be solved (a
+    # tendon's path turning back between the coarse nodes); that finer run raised a
+    # ParameterError naming `warm_start` (not given) for one start and for every number of
+    # starts. The finer mesh now starts where the first iteration did, and a failed start is
+    # passed over. Oracle: a forward solve at each answer reached.
+    robot = softrod.Robot.from_toml(_FOUR)
+    truth = np.array([12.54941794, 5.07125875, 8.47559158, 15.08255979])
+    target = robot.solve(truth).tip_position
+    one = softrod.inverse_statics(robot, target, throw=False)
+    assert not one.reached
+    for starts in (16, [truth]):
+        inv = softrod.inverse_statics(robot, target, starts=starts)
+        assert inv.converged and inv.start > 0
+        assert np.linalg.norm(robot.solve(inv.tensions).tip_position - target) <= 1e-9
+
+
+def test_a_best_answer_not_converged_raises_what_its_start_alone_raises():
+    # At the iteration cap the start's own error is a ConvergenceError; from several starts
+    # (the first winning) it was a TargetUnreachableError for a target made by a forward
+    # solve.
+    robot = softrod.Robot.from_toml(_TRI)
+    target = robot.solve([0.0, 0.8, 0.3]).tip_position
+    errors = []
+    for starts in (None, 4):
+        with pytest.raises(softrod.ConvergenceError) as e:
+            softrod.inverse_statics(robot, target, max_iterations=2, starts=starts)
+        errors.append((type(e.value), str(e.value)))
+    assert errors[0] == errors[1] and errors[0][0] is softrod.ConvergenceError

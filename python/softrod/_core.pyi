@@ -19,6 +19,7 @@ MAX_LENGTH: float
 MAX_MODULUS: float
 MAX_BENDING_ANGLE: float
 MAX_OFFSET_RATIO: float
+MAX_STARTS: int
 
 class ParameterError(ValueError):
     """A parameter is outside its valid range; ``parameter`` names it."""

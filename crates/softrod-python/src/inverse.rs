@@ -156,7 +156,14 @@ fn starts_from(obj: Option<&Bound<'_, PyAny>>) -> PyResult<softrod::Starts> {
     let is_int = s.is_instance_of::<pyo3::types::PyInt>()
         || s.hasattr("__index__")? && !s.hasattr("__len__")?;
     if is_int {
-        let k: i64 = crate::convert::Arg::from_arg(s, "starts")?;
+        let range = format!("in [1, {}]", softrod::MAX_STARTS);
+        if s.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(crate::errors::type_err("starts", s, "an integer"));
+        }
+        let Ok(k) = s.extract::<i64>() else {
+            // (Beyond 64 bits: a count, but not one of the range.)
+            return Err(param_err("starts", crate::errors::describe(s), &range));
+        };
         let k = crate::convert::count("starts", k, 1, softrod::MAX_STARTS)?;
         return Ok(softrod::Starts::Spread(k));
     }

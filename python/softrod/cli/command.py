@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from .._core import ConvergenceError
+from .._core import MAX_STARTS, ConvergenceError
 from ._common import (
     _positive_int,
     add_data_outputs,
@@ -237,8 +237,8 @@ def register(sub) -> None:
     def run(args: argparse.Namespace) -> int:
         if args.rotation is not None:
             _check_rotation(args.rotation)
-        if args.starts is not None and args.starts < 1:
-            raise bad("--starts", args.starts, "must be >= 1")
+        if args.starts is not None and not 1 <= args.starts <= MAX_STARTS:
+            raise bad("--starts", args.starts, f"must be in [1, {MAX_STARTS}]")
         if args.tolerance is not None and not (
             args.tolerance > 0 and math.isfinite(args.tolerance)
         ):

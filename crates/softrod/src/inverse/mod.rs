@@ -387,7 +387,15 @@ pub(crate) fn mesh_controlled<F>(
         evaluation: None,
         ..InverseWarmStart::from(&out)
     };
-    let (out, fine_fwd) = run(&fine, options, Some(&from))?;
+    // An answer of the coarser mesh where the finer one finds the rod cannot be solved (a
+    // tendon's path turning back on itself between the coarse nodes) is no start: the finer
+    // mesh starts where the first iteration did.
+    let (out, fine_fwd) = match run(&fine, options, Some(&from)) {
+        Err(Error::InvalidParameter { name, .. }) if name == "warm_start" => {
+            run(&fine, options, warm)?
+        }
+        other => other?,
+    };
     // The finer mesh was chosen where the first iteration stopped; an answer where the mesh
     // asked suffices (the iteration passed through a more strongly bent shape) is sought
     // again on that mesh from there: the mesh a solve at the answer takes.

@@ -53,35 +53,50 @@ pub enum Starts {
 /// [`Error::InvalidParameter`] naming `starts` (a count outside `1..=MAX_STARTS`) or
 /// `starts[k]` (not `n` finite values).
 pub(crate) fn check_starts(starts: &Starts, n: usize) -> Result<()> {
-    let count = match starts {
-        Starts::One => return Ok(()),
-        Starts::Spread(k) => *k,
-        Starts::Given(given) => given.len() + 1,
-    };
-    if !(1..=MAX_STARTS).contains(&count) {
-        return Err(Error::invalid(
-            "starts",
-            count,
-            format!("a count of starts in 1..={MAX_STARTS}"),
-        ));
-    }
-    if let Starts::Given(given) = starts {
-        for (k, a) in given.iter().enumerate() {
-            if a.len() != n || a.iter().any(|v| !v.is_finite()) {
+    match starts {
+        Starts::One => {}
+        Starts::Spread(k) => {
+            if !(1..=MAX_STARTS).contains(k) {
                 return Err(Error::invalid(
-                    format!("starts[{k}]"),
-                    format!("{a:?}"),
-                    format!("{n} finite actuation values (tensions, then pressures)"),
+                    "starts",
+                    k,
+                    format!("a count of starts in [1, {MAX_STARTS}]"),
                 ));
+            }
+        }
+        Starts::Given(given) => {
+            if given.is_empty() || given.len() >= MAX_STARTS {
+                return Err(Error::invalid(
+                    "starts",
+                    format!("{} actuations", given.len()),
+                    format!(
+                        "1 to {} actuations (one start per row; {MAX_STARTS} starts with the \
+                         first)",
+                        MAX_STARTS - 1
+                    ),
+                ));
+            }
+            for (k, a) in given.iter().enumerate() {
+                if a.len() != n || a.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::invalid(
+                        format!("starts[{k}]"),
+                        format!("{a:?}"),
+                        format!("{n} finite actuation values (tensions, then pressures)"),
+                    ));
+                }
             }
         }
     }
     Ok(())
 }
 
-/// The starts after the first, and the bounds, weights and centre that rank the answers.
+/// The starts after the first: the given ones, and how many to spread with the tip's rates of
+/// rotation at the reference (`None` where it cannot be solved: then those at the first
+/// answer); the bounds, weights and centre that rank the answers.
 pub(crate) struct LaterStarts {
-    starts: Vec<Vec<f64>>,
+    given: Vec<Vec<f64>>,
+    spread: usize,
+    rates: Option<Vec<f64>>,
     bounds: Bounds,
 }
 
@@ -105,32 +120,51 @@ pub(crate) fn later_starts<F: Forward>(
 /// (clamped into the bounds).
 ///
 /// # Errors
-/// As [`Program::new`]; the forward evaluation's at the reference.
+/// As [`Program::new`].
 pub(crate) fn starts_on<F: Forward + ?Sized>(
     forward: &mut F,
     target: &Target,
     options: &InverseOptions,
 ) -> Result<Option<LaterStarts>> {
-    let k = match &options.starts {
+    let (given, spread) = match &options.starts {
         Starts::One | Starts::Spread(0 | 1) => return Ok(None),
-        Starts::Spread(k) => *k,
-        Starts::Given(_) => 0,
+        Starts::Spread(k) => (Vec::new(), k - 1),
+        Starts::Given(given) => (given.clone(), 0),
     };
     let p = Program::new(forward, target, options)?;
-    let starts = match &options.starts {
-        Starts::Given(given) => given.clone(),
-        _ => {
-            let mut a = p.bounds.centre.clone();
-            p.clamp(&mut a);
-            let ev = forward.evaluate(&a, true)?;
-            let rates = turn_rates(ev.jacobian.as_deref().and_then(<[_]>::last));
-            spread(&p.bounds, &rates, k - 1)
-        }
-    };
+    let rates = (spread > 0).then(|| {
+        let mut a = p.bounds.centre.clone();
+        p.clamp(&mut a);
+        forward
+            .evaluate(&a, true)
+            .ok()
+            .map(|ev| turn_rates(ev.jacobian.as_deref().and_then(<[_]>::last)))
+    });
     Ok(Some(LaterStarts {
-        starts,
+        given,
+        spread,
+        rates: rates.flatten(),
         bounds: p.bounds,
     }))
+}
+
+impl LaterStarts {
+    /// The actuations of the later starts, the spread ones with the rates at the reference,
+    /// else those at the answer of the first start (`first`), else none.
+    fn actuations(&self, first: Option<&InverseSolution>) -> Vec<Vec<f64>> {
+        let mut out = self.given.clone();
+        if self.spread > 0 {
+            let at_first = || {
+                let jacobian = first.and_then(|f| f.evaluation.jacobian.as_deref());
+                turn_rates(jacobian.and_then(<[_]>::last))
+            };
+            let rates = self.rates.clone().unwrap_or_else(at_first);
+            if !rates.is_empty() {
+                out.extend(spread(&self.bounds, &rates, self.spread));
+            }
+        }
+        out
+    }
 }
 
 /// The rate of the tip's rotation (rad per unit actuation) of each actuator, from the
@@ -239,14 +273,13 @@ fn better(a: &InverseSolution, b: &InverseSolution, bounds: &Bounds) -> bool {
 /// One inverse `run` (with the options and the warm start given; it returns the answer and
 /// what comes with it, e.g. its forward model) from each start of `options.starts`: the
 /// first from `warm`, the `later` ones each from its actuation (halved towards the
-/// reference, at most [`MAX_START_HALVINGS`] times, where the rod cannot be solved there; a
-/// start whose run fails is passed over). The best answer ([`better`]) is returned, its
+/// reference, at most [`MAX_START_HALVINGS`] times, where the rod cannot be solved there). A
+/// start whose run fails is passed over. The best answer ([`better`]) is returned, its
 /// `start` the index of its start (0: the first).
 ///
 /// # Errors
-/// The first run's errors other than a target missed; with `options.throw`, for the best
-/// answer not converged, [`Error::TargetUnreachable`] (the target not reached) or
-/// [`Error::NotConverged`] (reached, its least norm not certified).
+/// The first start's error if every start fails; with `options.throw`, for the best answer
+/// not converged, the error of its start's run with `options` (as from that start alone).
 pub(crate) fn over_starts<T>(
     options: &InverseOptions,
     warm: Option<&InverseWarmStart>,
@@ -260,53 +293,55 @@ pub(crate) fn over_starts<T>(
         throw: false,
         ..options.clone()
     };
-    let mut best = run(&quiet, warm)?;
-    for (k, start) in later.starts.into_iter().enumerate() {
-        if let Some((mut out, with)) = run_from(&mut run, &quiet, &later.bounds, start) {
-            out.start = k + 1;
-            if better(&out, &best.0, &later.bounds) {
-                best = (out, with);
-            }
+    let first = run(&quiet, warm);
+    let starts = later.actuations(first.as_ref().ok().map(|(out, _)| out));
+    // The best answer and the start it came from (`None`: `warm`).
+    let (mut best, failed) = match first {
+        Ok(out) => (Some((out, None)), None),
+        Err(e) => (None, Some(e)),
+    };
+    for (k, start) in starts.into_iter().enumerate() {
+        let Some((mut out, with, from)) = run_from(&mut run, &quiet, &later.bounds, start) else {
+            continue;
+        };
+        out.start = k + 1;
+        if best
+            .as_ref()
+            .is_none_or(|(b, _)| better(&out, &b.0, &later.bounds))
+        {
+            best = Some(((out, with), Some(from)));
         }
     }
-    let out = &best.0;
-    if options.throw && !out.converged {
-        if out.reached {
-            return Err(Error::NotConverged {
-                what: format!(
-                    "inverse statics (the target reached from start {}, its least norm not \
-                     certified)",
-                    out.start
-                ),
-                iterations: out.iterations,
-                residual: out.position_error,
-                load_factor: 1.0,
-            });
-        }
-        return Err(Error::TargetUnreachable {
-            distance: out.position_error,
-            rotation: out.rotation_error,
-            iterations: out.iterations,
-        });
+    let Some((best, from)) = best else {
+        return Err(failed.unwrap_or_else(|| Error::invalid("starts", "none solved", "a start")));
+    };
+    if options.throw && !best.0.converged {
+        // Its own error, as the call from that start alone raises it.
+        let start = best.0.start;
+        let (mut out, with) = run(options, from.as_ref().or(warm))?;
+        out.start = start;
+        return Ok((out, with));
     }
     Ok(best)
 }
 
 /// `run` from the actuation `start` (clamped into `bounds`), halved towards the reference
-/// where the rod cannot be solved there; `None` if it fails.
+/// where the rod cannot be solved there; the answer and the start it came from, `None` if it
+/// fails.
 fn run_from<T>(
     run: &mut impl FnMut(&InverseOptions, Option<&InverseWarmStart>) -> Result<(InverseSolution, T)>,
     options: &InverseOptions,
     bounds: &Bounds,
     mut start: Vec<f64>,
-) -> Option<(InverseSolution, T)> {
+) -> Option<(InverseSolution, T, InverseWarmStart)> {
     for (x, (lo, hi)) in start.iter_mut().zip(bounds.lo.iter().zip(&bounds.hi)) {
         *x = x.clamp(*lo, *hi);
     }
     let rest = at_rest(bounds);
     for _ in 0..=MAX_START_HALVINGS {
-        match run(options, Some(&InverseWarmStart::actuation(start.clone()))) {
-            Ok(out) => return Some(out),
+        let from = InverseWarmStart::actuation(start.clone());
+        match run(options, Some(&from)) {
+            Ok((out, with)) => return Some((out, with, from)),
             Err(Error::InvalidParameter { name, .. }) if name == "warm_start" => {
                 for (x, r) in start.iter_mut().zip(&rest) {
                     *x = r + 0.5 * (*x - r);
