@@ -18,7 +18,7 @@ use crate::cosserat::statics::{
 };
 use crate::error::{Error, Result};
 use crate::integrate::march::rk4_plan;
-use crate::model::tendon::Routing;
+use crate::model::tendon::{OffsetFn, Routing, Tendon};
 
 /// Largest refinement factor of the default mesh.
 pub(crate) const MAX_REFINEMENT: usize = 32;
@@ -52,48 +52,42 @@ fn step_errors(solution: &StaticsSolution) -> impl Iterator<Item = (f64, f64)> +
 /// of a helical tendon as it integrates the rotations, and misses them as badly where a step
 /// turns the helix by a radian or more.
 struct Routings<'a> {
-    solution: &'a StaticsSolution,
-    /// Per tendon, the largest distance (m) of a routing function's offset from the backbone
-    /// at the solution's nodes (the scale of its rate); 0 for the others and the slack ones.
-    scales: Vec<f64>,
+    /// The tendons that carry tension and are routed along a helix or by a function (the
+    /// others do not turn), each with the scale of its rate: the largest distance (m) of a
+    /// routing function's offset from the backbone at the solution's nodes (1 for a helix).
+    turning: Vec<(&'a Tendon, f64)>,
 }
 
 impl<'a> Routings<'a> {
     fn new(solution: &'a StaticsSolution) -> Self {
-        let scales = solution
+        let largest = |offset: &OffsetFn| {
+            let distance = |s: &f64| {
+                let r = offset(*s);
+                r[0].hypot(r[1])
+            };
+            let finite = solution.s.iter().map(distance).filter(|d| d.is_finite());
+            finite.fold(0.0, f64::max)
+        };
+        let turning = solution
             .model
             .tendons()
             .iter()
             .zip(&solution.tendon_tensions)
-            .map(|(t, &tension)| match t.routing() {
-                Routing::Function { offset, .. } if tension != 0.0 => solution
-                    .s
-                    .iter()
-                    .map(|&s| {
-                        let r = offset(s);
-                        r[0].hypot(r[1])
-                    })
-                    .filter(|d| d.is_finite())
-                    .fold(0.0, f64::max),
-                _ => 0.0,
+            .filter(|(_, &tension)| tension != 0.0)
+            .filter_map(|(t, _)| match t.routing() {
+                Routing::Function { offset, .. } => Some((t, largest(offset))),
+                Routing::Helical { .. } => Some((t, 1.0)),
+                _ => None,
             })
             .collect();
-        Self { solution, scales }
+        Self { turning }
     }
 
     /// The fastest turn rate (rad/m) on the step `[a, b]` (m), at its ends and middle, of the
     /// routing of a tendon that carries tension there.
     fn rate(&self, a: f64, b: f64) -> f64 {
-        let tendons = self.solution.model.tendons();
         let mut rate = 0.0_f64;
-        for ((t, &tension), &scale) in tendons
-            .iter()
-            .zip(&self.solution.tendon_tensions)
-            .zip(&self.scales)
-        {
-            if tension == 0.0 {
-                continue;
-            }
+        for &(t, scale) in &self.turning {
             for s in [a, 0.5 * (a + b), b] {
                 if t.end().is_none_or(|e| s < e) {
                     rate = rate.max(t.turn_rate_at(s, scale));
