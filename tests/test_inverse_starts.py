@@ -12,6 +12,7 @@ import pickle
 
 import numpy as np
 import pytest
+from harness.robots import TRI_TENDON
 
 import softrod
 from softrod import pcc
@@ -80,32 +81,7 @@ def _curled(name):
 # near-flat valley of actuations (co-contraction compresses the rod), whose exact solutions
 # are isolated points. The target made by [0, 0.8, 0.3] N is reached from rest with
 # [0.275, 1.218, 0.585] N (½|T|² 0.950 against 0.365).
-_TRI = """
-name = "tri-tendon"
-[rod]
-length = 0.25
-density = 1100.0
-[rod.section]
-type = "tapered"
-base_radius = 0.006
-tip_radius = 0.004
-[rod.material]
-type = "linear"
-youngs_modulus = 2.0e6
-poisson_ratio = 0.49
-[[tendons]]
-distance = 0.004
-angle_deg = 0.0
-[[tendons]]
-distance = 0.004
-angle_deg = 120.0
-end = 0.125
-[[tendons]]
-distance = 0.004
-angle_deg = 240.0
-[loads]
-gravity = [0.0, 0.0, -9.81]
-"""
+_TRI = TRI_TENDON
 
 
 def _half_norm(t):

@@ -15,6 +15,7 @@ import pytest
 from harness import arcs, elastica, fuzz
 from harness.balance import LoadSpec, TendonSpec, balance_error
 from harness.oracles import castigliano_arc
+from harness.robots import TRI_TENDON
 
 import softrod
 from softrod import pcc
@@ -926,32 +927,7 @@ def test_a_sphere_around_the_rod_at_rest_is_refused_whatever_its_size(radius, z)
         assert s == pytest.approx(z, abs=1e-4)
 
 
-_TRI = """
-name = "tri-tendon"
-[rod]
-length = 0.25
-density = 1100.0
-[rod.section]
-type = "tapered"
-base_radius = 0.006
-tip_radius = 0.004
-[rod.material]
-type = "linear"
-youngs_modulus = 2.0e6
-poisson_ratio = 0.49
-[[tendons]]
-distance = 0.004
-angle_deg = 0.0
-[[tendons]]
-distance = 0.004
-angle_deg = 120.0
-end = 0.125
-[[tendons]]
-distance = 0.004
-angle_deg = 240.0
-[loads]
-gravity = [0.0, 0.0, -9.81]
-"""
+_TRI = TRI_TENDON
 
 
 def test_an_inverse_meets_its_default_tolerance_on_a_loaded_arm():

@@ -21,8 +21,8 @@ use crate::cosserat::mesh::rk4_position_error;
 use crate::cosserat::statics::SolveOptions;
 use crate::error::{Error, Result};
 use crate::inverse::{
-    later_starts, mesh_controlled, over_starts, solve_inverse, Evaluation, Forward, InverseOptions,
-    InverseSolution, InverseWarmStart, Target,
+    resolved, solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution,
+    InverseWarmStart, Target,
 };
 use crate::model::{Actuation, RobotModel};
 
@@ -264,22 +264,15 @@ pub fn contact_inverse_resolved(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, ContactForward)> {
-    let later = later_starts(target, options, || {
-        ContactForward::new(model, solve, obstacles)
-    })?;
-    over_starts(options, warm, later, |io, w| {
-        mesh_controlled(
-            solve,
-            io,
-            w,
-            |so, io, w| {
-                let mut fwd = ContactForward::new(model, so, obstacles)?;
-                let out = solve_contact_inverse(&mut fwd, target, io, w)?;
-                Ok((out, fwd))
-            },
-            |fwd, a| fwd.mesh_error(a),
-        )
-    })
+    resolved(
+        target,
+        options,
+        solve,
+        warm,
+        |so| ContactForward::new(model, so, obstacles),
+        |fwd, io, w| solve_contact_inverse(fwd, target, io, w),
+        ContactForward::mesh_error,
+    )
 }
 
 impl ContactForward {

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use super::{later_starts, mesh_controlled, over_starts, uniform, InverseWarmStart, Target};
+use super::{resolved, uniform, InverseWarmStart, Target};
 use super::{solve_inverse, Evaluation, Forward, InverseOptions, InverseSolution};
 use crate::cosserat::equations::{Column, Equations, Workspace};
 use crate::cosserat::mesh::rk4_position_error;
@@ -438,22 +438,15 @@ fn inverse_resolved(
     solve: &SolveOptions,
     warm: Option<&InverseWarmStart>,
 ) -> Result<(InverseSolution, CosseratForward)> {
-    let later = later_starts(target, options, || {
-        CosseratForward::new(model, solve, target.s.as_deref())
-    })?;
-    over_starts(options, warm, later, |io, w| {
-        mesh_controlled(
-            solve,
-            io,
-            w,
-            |so, io, w| {
-                let mut fwd = CosseratForward::new(model, so, target.s.as_deref())?;
-                let out = solve_inverse(&mut fwd, target, io, w)?;
-                Ok((out, fwd))
-            },
-            |fwd, a| fwd.mesh_error(a),
-        )
-    })
+    resolved(
+        target,
+        options,
+        solve,
+        warm,
+        |so| CosseratForward::new(model, so, target.s.as_deref()),
+        |fwd, io, w| solve_inverse(fwd, target, io, w),
+        CosseratForward::mesh_error,
+    )
 }
 
 /// [`inverse_actuation`] and the statics solution at the actuation found (on the mesh of the

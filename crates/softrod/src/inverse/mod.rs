@@ -422,6 +422,38 @@ pub(crate) fn mesh_controlled<F>(
     Ok((InverseSolution { steps, ..out }, fine_fwd))
 }
 
+/// An inverse statics of `target` from each start of `options.starts` ([`over_starts`]),
+/// each under the mesh control of [`mesh_controlled`]: the forward model made by `forward`
+/// on the solve options given, solved by `inverse` (e.g. [`solve_inverse`]), its mesh judged
+/// by `mesh_error` at an answer. Returns the best answer and its forward model.
+///
+/// # Errors
+/// As [`over_starts`] and [`mesh_controlled`]; `forward`'s.
+pub(crate) fn resolved<F: Forward>(
+    target: &Target,
+    options: &InverseOptions,
+    solve: &SolveOptions,
+    warm: Option<&InverseWarmStart>,
+    forward: impl Fn(&SolveOptions) -> Result<F>,
+    inverse: impl Fn(&mut F, &InverseOptions, Option<&InverseWarmStart>) -> Result<InverseSolution>,
+    mesh_error: impl Fn(&mut F, &[f64]) -> f64,
+) -> Result<(InverseSolution, F)> {
+    let later = later_starts(target, options, || forward(solve))?;
+    over_starts(options, warm, later, |io, w| {
+        mesh_controlled(
+            solve,
+            io,
+            w,
+            |so, io, w| {
+                let mut fwd = forward(so)?;
+                let out = inverse(&mut fwd, io, w)?;
+                Ok((out, fwd))
+            },
+            &mesh_error,
+        )
+    })
+}
+
 impl From<&InverseSolution> for InverseWarmStart {
     fn from(s: &InverseSolution) -> Self {
         Self {
