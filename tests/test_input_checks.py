@@ -585,3 +585,33 @@ def test_an_arc_from_absurd_tendon_displacements_is_refused_by_the_arc_limits():
     arc = pcc.arc_from_tendon_displacements([0.005, 0.0, 0.0], [0.01] * 3, angles, 0.1)
     back = pcc.tendon_displacements(arc, [0.01] * 3, angles, 0.1)
     np.testing.assert_allclose(back, [0.005, 0.0, 0.0], atol=1e-15)
+
+
+def _niti_target():
+    robot = softrod.examples.load("niti_two_segment")
+    return robot, robot.solve([3.0, 0.0, 1.0, 0.0, 2.0, 0.5]).tip_position
+
+
+@pytest.mark.parametrize(
+    ("name", "call"),
+    [
+        ("warm_start", lambda r, t: softrod.inverse_statics(r, t, warm_start=np.ones(6) + 0j)),
+        ("warm_start", lambda r, t: softrod.inverse_statics(r, t, warm_start=np.ones(6) > 0)),
+        (
+            "starts",
+            lambda r, t: softrod.inverse_statics(r, t, starts=[["1", "0", "0", "0", "1", "0"]]),
+        ),
+        ("starts", lambda r, t: softrod.inverse_statics(r, t, starts=[[1, 0, 0, 0, 1, None]])),
+        (
+            "target_rotation",
+            lambda r, t: softrod.inverse_statics(r, t, target_rotation=np.eye(3) > 0),
+        ),
+    ],
+)
+def test_arrays_of_strings_booleans_complex_numbers_or_none_are_refused(name, call):
+    # NumPy reads "0.8" as 0.8, True as 1, 5j as 0 (a ComplexWarning) and None as NaN in an
+    # object array: they were taken as numbers (an inverse ran from them).
+    robot, target = _niti_target()
+    with pytest.raises(softrod.ParameterError) as e:
+        call(robot, target)
+    assert isinstance(e.value, TypeError) and e.value.parameter == name

@@ -191,9 +191,16 @@ pub(crate) fn float_array(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyR
     let np = obj.py().import("numpy")?;
     let a = np
         .getattr("asarray")?
-        .call1((obj, np.getattr("float64")?))
+        .call1((obj,))
         .map_err(|_| type_err(name, obj, what))?;
+    // Integers and reals only: NumPy would also read strings ("0.8"), booleans, and complex
+    // numbers (dropping their imaginary parts), and None as NaN in an object array.
+    let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(type_err(name, obj, what));
+    }
     let a = a
+        .call_method1("astype", (np.getattr("float64")?,))?
         .cast_into::<PyArrayDyn<f64>>()
         .map_err(|_| type_err(name, obj, what))?;
     let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
