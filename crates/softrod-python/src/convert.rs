@@ -199,8 +199,10 @@ pub(crate) fn float_array(obj: &Bound<'_, PyAny>, name: &str, what: &str) -> PyR
     if !matches!(kind.as_str(), "i" | "u" | "f") {
         return Err(type_err(name, obj, what));
     }
+    let no_copy = pyo3::types::PyDict::new(obj.py());
+    no_copy.set_item("copy", false)?;
     let a = a
-        .call_method1("astype", (np.getattr("float64")?,))?
+        .call_method("astype", (np.getattr("float64")?,), Some(&no_copy))?
         .cast_into::<PyArrayDyn<f64>>()
         .map_err(|_| type_err(name, obj, what))?;
     let r = a.try_readonly().map_err(|_| type_err(name, obj, what))?;
