@@ -306,3 +306,33 @@ def test_a_best_answer_not_converged_raises_what_its_start_alone_raises():
             softrod.inverse_statics(robot, target, max_iterations=2, starts=starts)
         errors.append((type(e.value), str(e.value)))
     assert errors[0] == errors[1] and errors[0][0] is softrod.ConvergenceError
+
+
+def test_a_call_of_many_starts_stops_at_a_signal():
+    # Ctrl-C was not acted on until the call returned (10,000 starts: 549 s). The signal's
+    # handler now runs between starts and its exception ends the call. (A handler of our own,
+    # so that a late signal cannot end the test session.)
+    import signal
+    import threading
+    import time
+
+    class Stop(Exception):
+        pass
+
+    def handler(signum, frame):
+        raise Stop
+
+    robot, _, target = _curled("antagonistic")
+    previous = signal.signal(signal.SIGINT, handler)
+    timer = threading.Timer(0.3, signal.raise_signal, (signal.SIGINT,))
+    try:
+        start = time.perf_counter()
+        timer.start()
+        with pytest.raises(Stop):
+            softrod.inverse_statics(robot, target, starts=10000)
+        elapsed = time.perf_counter() - start
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
+    # (10,000 starts of this arm take about 120 s, one start about 12 ms.)
+    assert elapsed < 20.0

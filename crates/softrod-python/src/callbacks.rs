@@ -134,6 +134,24 @@ impl Callback {
     }
 }
 
+/// Whether the user asked the computation running on this thread to stop: Python's signal
+/// handlers run (with the GIL); an exception one raises (`KeyboardInterrupt` for Ctrl-C) is
+/// kept in the computation's slot, raised when the core returns. For the core's
+/// [`softrod::Interrupt`] checks, made between units of work (the starts of an inverse).
+pub(crate) fn interrupted() -> bool {
+    Python::attach(|py| match py.check_signals() {
+        Ok(()) => false,
+        Err(err) => {
+            CURRENT.with(|c| {
+                if let Some(slot) = c.borrow().as_ref() {
+                    slot.keep(err);
+                }
+            });
+            true
+        }
+    })
+}
+
 /// Runs a core computation with the GIL released: callable errors are raised (see the module
 /// documentation), a panic becomes `InternalError`, a core error its Python exception.
 pub(crate) fn run<T: Send>(

@@ -100,6 +100,7 @@ fn target_and_options(
     };
     let mut o = InverseOptions {
         throw,
+        interrupt: softrod::Interrupt(Some(crate::callbacks::interrupted)),
         ..InverseOptions::default()
     };
     o.tension_bounds = bounds(tension_bounds, "tension_bounds", o.tension_bounds)?;

@@ -74,8 +74,8 @@ pub use integrate::{AdaptiveOptions, IntegrationStats};
 pub use inverse::pcc::{pcc_inverse_statics, PccForward};
 pub use inverse::{
     inverse_actuation, inverse_statics, inverse_statics_path, solve_inverse, CosseratForward,
-    Evaluation, Forward, InverseOptions, InverseSolution, InverseWarmStart, Starts, Target,
-    MAX_STARTS,
+    Evaluation, Forward, Interrupt, InverseOptions, InverseSolution, InverseWarmStart, Starts,
+    Target, MAX_STARTS,
 };
 pub use model::actuation::TensionProfile;
 pub use model::chamber::{Chamber, ChamberArea};

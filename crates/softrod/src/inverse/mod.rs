@@ -95,7 +95,7 @@ pub(crate) use problem::{check_options, check_target};
 pub use sqp::{inverse_statics_path, solve_inverse};
 pub(crate) use starts::{check_starts, later_starts, over_starts, starts_on};
 pub use starts::{
-    Starts, MAX_STARTS, MAX_START_HALVINGS, SAME_OBJECTIVE, START_SLACK, START_TURNS,
+    Interrupt, Starts, MAX_STARTS, MAX_START_HALVINGS, SAME_OBJECTIVE, START_SLACK, START_TURNS,
 };
 pub(crate) use steps::{objective_change, trust_radius};
 
@@ -181,6 +181,8 @@ pub struct InverseOptions {
     pub throw: bool,
     /// The starts of the iteration (several: the best answer of all, see [`Starts`]).
     pub starts: Starts,
+    /// Checked before each start after the first: stops a call of several starts.
+    pub interrupt: Interrupt,
 }
 
 impl Default for InverseOptions {
@@ -197,6 +199,7 @@ impl Default for InverseOptions {
             max_iterations: DEFAULT_MAX_ITERATIONS,
             throw: true,
             starts: Starts::One,
+            interrupt: Interrupt::default(),
         }
     }
 }

@@ -47,6 +47,34 @@ pub enum Starts {
     Given(Vec<Vec<f64>>),
 }
 
+/// A check made before each start after the first ([`InverseOptions::interrupt`]): `true`
+/// stops the call (e.g. a user's Ctrl-C). It is not part of the options' value: any two
+/// compare equal.
+#[derive(Clone, Copy, Default)]
+pub struct Interrupt(pub Option<fn() -> bool>);
+
+impl Interrupt {
+    fn asked(self) -> bool {
+        self.0.is_some_and(|f| f())
+    }
+}
+
+impl PartialEq for Interrupt {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for Interrupt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.is_some() {
+            "Interrupt(check)"
+        } else {
+            "Interrupt(none)"
+        })
+    }
+}
+
 /// Checks `starts` for `n` actuators.
 ///
 /// # Errors
@@ -279,7 +307,8 @@ fn better(a: &InverseSolution, b: &InverseSolution, bounds: &Bounds) -> bool {
 ///
 /// # Errors
 /// The first start's error if every start fails; with `options.throw`, for the best answer
-/// not converged, the error of its start's run with `options` (as from that start alone).
+/// not converged, the error of its start's run with `options` (as from that start alone);
+/// [`Error::NotConverged`] (interrupted) when `options.interrupt` asks to stop.
 pub(crate) fn over_starts<T>(
     options: &InverseOptions,
     warm: Option<&InverseWarmStart>,
@@ -300,7 +329,19 @@ pub(crate) fn over_starts<T>(
         Ok(out) => (Some((out, None)), None),
         Err(e) => (None, Some(e)),
     };
+    let count = starts.len() + 1;
     for (k, start) in starts.into_iter().enumerate() {
+        if options.interrupt.asked() {
+            return Err(Error::NotConverged {
+                what: format!(
+                    "inverse statics: interrupted after {} of {count} starts",
+                    k + 1
+                ),
+                iterations: best.as_ref().map_or(0, |(b, _)| b.0.iterations),
+                residual: best.as_ref().map_or(f64::NAN, |(b, _)| b.0.position_error),
+                load_factor: 1.0,
+            });
+        }
         let Some((mut out, with, from)) = run_from(&mut run, &quiet, &later.bounds, start) else {
             continue;
         };
