@@ -64,10 +64,11 @@
 //! form, `uniform.rs`: one rigid RK4 step per interval and its exact derivative).
 //!
 //! [`inverse_statics_path`] follows a sequence of targets, each warm-started from the last.
+//! The iteration is local; [`Starts`] runs it from several starts and keeps the best answer.
 //!
 //! The files: `problem.rs` (the checked program: bounds, weights, pose error rows), `sqp.rs`
 //! (the iteration), `steps.rs` (its steps: quadratic programs, Levenberg–Marquardt, curvature,
-//! trust radius), `cosserat.rs` (the Cosserat forward model), `uniform.rs` (its closed-form
+//! trust radius), `starts.rs` (several starts), `cosserat.rs` (the Cosserat forward model), `uniform.rs` (its closed-form
 //! march on uniform intervals), `pcc.rs` (the PCC forward model
 //! and its closed-form iteration), `qp.rs` (the small quadratic programs).
 //!
