@@ -78,6 +78,24 @@ impl Error {
         }
     }
 
+    /// The name, value and valid range of an [`Error::InvalidParameter`].
+    pub fn parameter(&self) -> Option<(&str, &str, &str)> {
+        match self {
+            Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => Some((name, value, expected)),
+            _ => None,
+        }
+    }
+
+    /// Whether this is an [`Error::InvalidParameter`] naming `parameter`.
+    pub fn names(&self, parameter: &str) -> bool {
+        self.parameter()
+            .is_some_and(|(name, _, _)| name == parameter)
+    }
+
     /// Builds an [`Error::InvalidParameter`] from any displayable value.
     pub fn invalid(
         name: impl Into<String>,

@@ -147,9 +147,7 @@ pub fn solve_at_output(
     quiet.newton.throw = true;
     let mesh = match with_mesh_control(&quiet, ours, solve_on, |s| s) {
         Ok(mesh) => mesh,
-        Err(e) if matches!(&e, Error::InvalidParameter { name, .. } if name == "steps") => {
-            return Err(e)
-        }
+        Err(e) if e.names("steps") => return Err(e),
         Err(_) => return solve_statics_at(model, actuation, options, s_out),
     };
     let Integrator::Rk4 { steps } = mesh.options.integrator else {

@@ -395,9 +395,7 @@ pub(crate) fn mesh_controlled<F>(
     // tendon's path turning back on itself between the coarse nodes) is no start: the finer
     // mesh starts where the first iteration did.
     let (out, fine_fwd) = match run(&fine, options, Some(&from)) {
-        Err(Error::InvalidParameter { name, .. }) if name == "warm_start" => {
-            run(&fine, options, warm)?
-        }
+        Err(e) if e.names("warm_start") => run(&fine, options, warm)?,
         other => other?,
     };
     // The finer mesh was chosen where the first iteration stopped; an answer where the mesh

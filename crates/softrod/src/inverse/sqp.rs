@@ -177,12 +177,7 @@ pub fn solve_inverse<F: Forward + ?Sized>(
 /// actuator there: the bounds that moved it, else the warm start or the reference it was
 /// taken from.
 fn at_start(e: Error, (given, a): (&[f64], &[f64]), warm: bool) -> Error {
-    let Error::InvalidParameter {
-        name,
-        value,
-        expected,
-    } = e
-    else {
+    let Some((name, value, expected)) = e.parameter() else {
         return e;
     };
     let index = name
@@ -191,11 +186,7 @@ fn at_start(e: Error, (given, a): (&[f64], &[f64]), warm: bool) -> Error {
         .and_then(|k| k.parse::<usize>().ok())
         .filter(|&i| i < a.len());
     let Some(i) = index else {
-        return Error::InvalidParameter {
-            name,
-            value,
-            expected,
-        };
+        return e;
     };
     let source = match (a[i] != given[i], warm) {
         (true, _) => "tension_bounds",

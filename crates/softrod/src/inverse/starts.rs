@@ -383,7 +383,7 @@ fn run_from<T>(
         let from = InverseWarmStart::actuation(start.clone());
         match run(options, Some(&from)) {
             Ok((out, with)) => return Some((out, with, from)),
-            Err(Error::InvalidParameter { name, .. }) if name == "warm_start" => {
+            Err(e) if e.names("warm_start") => {
                 for (x, r) in start.iter_mut().zip(&rest) {
                     *x = r + 0.5 * (*x - r);
                 }

@@ -434,12 +434,7 @@ fn law_name(kind: ModelKind) -> &'static str {
 /// what it is: data this law cannot fit, naming `data` (the coefficient is a result, not an
 /// input); any other error unchanged.
 fn not_physical(e: Error, data: &UniaxialData, kind: ModelKind) -> Error {
-    let Error::InvalidParameter {
-        name,
-        value,
-        expected,
-    } = e
-    else {
+    let Some((name, value, expected)) = e.parameter() else {
         return e;
     };
     let (lo, hi) = data
