@@ -116,9 +116,9 @@ def test_the_robot_file_is_never_overwritten(tmp_path, capsys):
 def test_several_starts_reach_a_target_beyond_a_fold(tmp_path, capsys):
     # A curled soft arm (test_inverse_starts.py): from rest the target is reported out of
     # reach (exit status 3); from 16 starts it is reached with the known tensions.
-    from test_inverse_starts import _curled
+    from harness.robots import curled
 
-    robot, truth, target = _curled("antagonistic")
+    robot, truth, target = curled("antagonistic")
     path = tmp_path / "curl.toml"
     path.write_text(robot.to_toml(), encoding="utf-8")
     out_csv = tmp_path / "inv.csv"

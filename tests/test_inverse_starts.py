@@ -12,70 +12,10 @@ import pickle
 
 import numpy as np
 import pytest
-from harness.robots import TRI_TENDON
+from harness.robots import ARM, CURLED, TENDON, TRI_TENDON, curled
 
 import softrod
 from softrod import pcc
-
-# Tapered soft arms with tendons at random angles, curled by known tensions (0.1 to 5 turns):
-# from rest the iteration stops at a local minimum of the distance beyond a fold of the tip's
-# map (TargetUnreachableError for a reachable target).
-_ARM = """
-name = "curl"
-[rod]
-length = {length}
-[rod.section]
-type = "tapered"
-base_radius = {base}
-tip_radius = {tip}
-[rod.material]
-type = "linear"
-youngs_modulus = {modulus}
-poisson_ratio = 0.5
-"""
-
-_TENDON = """
-[[tendons]]
-offset = [{x}, {y}]
-"""
-
-CURLED = {
-    # three tendons, the third pulled: 2.1 turns
-    "three": (
-        dict(length=0.49888397431568443, base=0.00986584737143361, tip=0.007694171021347452,
-             modulus=1999486.8512695632),
-        [(-0.0023216761699450953, -0.0057007009300247035),
-         (0.006097789909751517, 0.0008397199224789374),
-         (-0.003776113739806415, 0.004860981007545767)],
-        [0.0, 0.0, 22.58673650678362],
-    ),
-    # two antagonistic tendons, one pulled
-    "antagonistic": (
-        dict(length=0.3937934287154917, base=0.00797800014592825, tip=0.0075985806648492344,
-             modulus=169771.68792078985),
-        [(0.0054577091041494484, -0.002676939545717354),
-         (-0.00545770910414945, 0.00267693954571735)],
-        [0.0, 5.650332047526689],
-    ),
-    # three tendons, two pulled
-    "two_pulled": (
-        dict(length=0.46547630508295557, base=0.0034568929148790398, tip=0.0030575932388536703,
-             modulus=580269.2542351008),
-        [(-0.0011179597548135033, 0.002175648614036487),
-         (-0.0013251870920572507, -0.00205600585509536),
-         (0.0024431468468707543, -0.00011964275894112841)],
-        [0.0, 1.0926250404024493, 0.5305078506258559],
-    ),
-}  # fmt: skip
-
-
-def _curled(name):
-    rod, offsets, truth = CURLED[name]
-    text = _ARM.format(**rod) + "".join(_TENDON.format(x=x, y=y) for x, y in offsets)
-    robot = softrod.Robot.from_toml(text)
-    truth = np.array(truth)
-    return robot, truth, robot.solve(truth).tip_position
-
 
 # A tapered silicone arm under gravity, three tendons at 120°: a tip is reached along a
 # near-flat valley of actuations (co-contraction compresses the rod), whose exact solutions
@@ -103,7 +43,7 @@ def test_several_starts_find_the_least_norm_point_of_a_co_contraction_valley():
 
 @pytest.mark.parametrize("name", sorted(CURLED))
 def test_several_starts_reach_targets_beyond_a_fold_of_a_curled_arm(name):
-    robot, truth, target = _curled(name)
+    robot, truth, target = curled(name)
     with pytest.raises(softrod.TargetUnreachableError):
         softrod.inverse_statics(robot, target)
     inv = softrod.inverse_statics(robot, target, starts=16)
@@ -116,7 +56,7 @@ def test_several_starts_reach_targets_beyond_a_fold_of_a_curled_arm(name):
 
 def test_the_contact_inverse_takes_starts():
     # The same arm with a plane 1 m away: the forward model is the contact solve.
-    robot, truth, target = _curled("antagonistic")
+    robot, truth, target = curled("antagonistic")
     far = softrod.Plane((0.0, 0.0, -1.0), (0.0, 0.0, 1.0))
     walled = softrod.Robot(robot.rod, tendons=list(robot.tendons), obstacles=[far], name="w")
     with pytest.raises(softrod.TargetUnreachableError):
@@ -127,7 +67,7 @@ def test_the_contact_inverse_takes_starts():
 
 
 def test_given_starts_are_tried_after_the_first():
-    robot, truth, target = _curled("antagonistic")
+    robot, truth, target = curled("antagonistic")
     inv = softrod.inverse_statics(robot, target, starts=[[1.0, 1.0], 1.1 * truth])
     assert inv.converged and inv.start == 2
     assert np.allclose(inv.tensions, truth, rtol=1e-6, atol=1e-9)
@@ -139,7 +79,7 @@ def test_given_starts_are_tried_after_the_first():
 
 def test_a_target_out_of_reach_from_every_start_is_the_closest_pose():
     # 2 L straight ahead of a rod of length L: the closest pose is the straight rod, L away.
-    robot, _, _ = _curled("antagonistic")
+    robot, _, _ = curled("antagonistic")
     length = robot.rod.length
     target = [0.0, 0.0, 2.0 * length]
     with pytest.raises(softrod.TargetUnreachableError) as e:
@@ -167,7 +107,7 @@ def test_a_target_out_of_reach_from_every_start_is_the_closest_pose():
     ],
 )
 def test_bad_starts_are_named(starts, name, error):
-    robot, _, target = _curled("antagonistic")
+    robot, _, target = curled("antagonistic")
     with pytest.raises(error) as e:
         softrod.inverse_statics(robot, target, starts=starts)
     assert e.value.parameter == name
@@ -216,13 +156,13 @@ def test_the_answer_s_solution_is_on_the_mesh_its_error_is_measured_on():
     # the fine mesh's while `solution` (a solve at the answer, on the 40 steps a solve there
     # takes) was 5.7e-8 m from the target. The answer is now sought again on the mesh a solve
     # at it takes; the solution's tip is where the error says.
-    text = _ARM.format(
+    text = ARM.format(
         length=0.3547846749285818,
         base=0.004888506996347092,
         tip=0.0016067616498030856,
         modulus=107908.40445381397,
     ) + "".join(
-        _TENDON.format(x=x, y=y)
+        TENDON.format(x=x, y=y)
         for x, y in [
             (0.0010970687212629173, -0.0006698636729696761),
             (-0.001097068721262918, 0.0006698636729696752),
@@ -244,7 +184,7 @@ def test_a_start_that_cannot_be_solved_is_passed_over():
     # into the bounds (5 N each) cannot be solved, and that evaluation (for the rates of the
     # spread starts) raised a ConvergenceError for the whole call, though one start returns.
     # The rates are then taken at the first answer; a start never makes the answer worse.
-    robot, _, target = _curled("two_pulled")
+    robot, _, target = curled("two_pulled")
     kw = dict(warm_start=[5.5, 5.0, 5.0], tension_bounds=(5.0, 5.5), throw=False)
     one = softrod.inverse_statics(robot, target, **kw)
     for starts in (2, 8):
@@ -322,7 +262,7 @@ def test_a_call_of_many_starts_stops_at_a_signal():
     def handler(signum, frame):
         raise Stop
 
-    robot, _, target = _curled("antagonistic")
+    robot, _, target = curled("antagonistic")
     previous = signal.signal(signal.SIGINT, handler)
     timer = threading.Timer(0.3, signal.raise_signal, (signal.SIGINT,))
     try:
