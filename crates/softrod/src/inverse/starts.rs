@@ -322,23 +322,21 @@ pub(crate) fn over_starts<T>(
         throw: false,
         ..options.clone()
     };
-    let first = run(&quiet, warm);
-    let starts = later.actuations(first.as_ref().ok().map(|(out, _)| out));
-    // The best answer and the start it came from (`None`: `warm`).
-    let (mut best, failed) = match first {
-        Ok(out) => (Some((out, None)), None),
-        Err(e) => (None, Some(e)),
-    };
+    // The best answer so far and the start it came from (`None`: `warm`); the first start's
+    // error until a start is solved.
+    let mut best = run(&quiet, warm).map(|out| (out, None));
+    let starts = later.actuations(best.as_ref().ok().map(|((out, _), _)| out));
     let count = starts.len() + 1;
     for (k, start) in starts.into_iter().enumerate() {
         if options.interrupt.asked() {
+            let solved = best.as_ref().ok().map(|((b, _), _)| b);
             return Err(Error::NotConverged {
                 what: format!(
                     "inverse statics: interrupted after {} of {count} starts",
                     k + 1
                 ),
-                iterations: best.as_ref().map_or(0, |(b, _)| b.0.iterations),
-                residual: best.as_ref().map_or(f64::NAN, |(b, _)| b.0.position_error),
+                iterations: solved.map_or(0, |b| b.iterations),
+                residual: solved.map_or(f64::NAN, |b| b.position_error),
                 load_factor: 1.0,
             });
         }
@@ -348,14 +346,12 @@ pub(crate) fn over_starts<T>(
         out.start = k + 1;
         if best
             .as_ref()
-            .is_none_or(|(b, _)| better(&out, &b.0, &later.bounds))
+            .map_or(true, |((b, _), _)| better(&out, b, &later.bounds))
         {
-            best = Some(((out, with), Some(from)));
+            best = Ok(((out, with), Some(from)));
         }
     }
-    let Some((best, from)) = best else {
-        return Err(failed.unwrap_or_else(|| Error::invalid("starts", "none solved", "a start")));
-    };
+    let (best, from) = best?;
     if options.throw && !best.0.converged {
         // Its own error, as the call from that start alone raises it.
         let start = best.0.start;
