@@ -658,3 +658,36 @@ fn several_starts_reach_a_target_beyond_a_fold() {
         assert!((back - Vector3::from(tip)).norm() <= 1e-9);
     }
 }
+
+/// A forward model that forgets ([`Forward::forget`], as before each start of a path's first
+/// target) evaluates as a new one, bit for bit: a loaded robot's forward solves are
+/// warm-started from the last, so an earlier start would otherwise leave its equilibrium to
+/// the next.
+#[test]
+fn a_forward_model_that_forgets_evaluates_as_a_new_one() {
+    let loads = Loads {
+        tip_force: Vector3::new(0.02, 0.0, -0.01),
+        gravity: Vector3::new(0.0, -9.81, 0.0),
+        ..Default::default()
+    };
+    let model = niti(loads, Some(6450.0));
+    let o = SolveOptions::default();
+    let (far, near) = (
+        [0.0, 2.5, 0.0, 3.0, 0.0, 2.0],
+        [1.4, 0.0, 0.5, 0.0, 0.7, 0.0],
+    );
+    let mut fresh = CosseratForward::new(&model, &o, None).unwrap();
+    let want = fresh.evaluate(&near, true).unwrap();
+    let mut used = CosseratForward::new(&model, &o, None).unwrap();
+    used.evaluate(&far, true).unwrap();
+    let warm = used.evaluate(&near, true).unwrap();
+    used.evaluate(&far, true).unwrap();
+    used.forget();
+    let got = used.evaluate(&near, true).unwrap();
+    println!(
+        "tip from the far equilibrium: {:e} m from a new model's",
+        (warm.positions[0] - want.positions[0]).norm()
+    );
+    assert_eq!(got.positions, want.positions);
+    assert_eq!(got.jacobian, want.jacobian);
+}

@@ -329,6 +329,12 @@ impl CosseratForward {
 }
 
 impl Forward for CosseratForward {
+    fn forget(&mut self) {
+        self.last = None;
+        self.solution = None;
+        self.march = None;
+    }
+
     fn has_probes(&self) -> bool {
         // A loaded robot solves a boundary-value problem (several marches): no cheaper pass.
         no_external_loads(&self.model)

@@ -241,6 +241,10 @@ pub trait Forward {
     fn probe(&mut self, a: &[f64]) -> Result<Evaluation> {
         self.evaluate(a, false)
     }
+    /// Forgets what earlier evaluations leave for later ones (the warm start of the next
+    /// forward solve), so that the next evaluation is that of a new forward model: each start
+    /// of [`inverse_statics_path`] begins so, as each start of the inverse from a model does.
+    fn forget(&mut self) {}
     /// A length scale (m): the rod length.
     fn length(&self) -> f64;
     /// The areas (m²) of the chambers, for the default weights.

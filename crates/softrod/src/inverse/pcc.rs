@@ -44,6 +44,10 @@ impl<'r> PccForward<'r> {
 }
 
 impl Forward for PccForward<'_> {
+    fn forget(&mut self) {
+        self.solution = None;
+    }
+
     fn dims(&self) -> (usize, usize) {
         (self.robot.n_tendons(), self.robot.n_chambers())
     }

@@ -512,8 +512,9 @@ fn search<F: Forward + ?Sized>(
 
 /// Follows `targets` (tip positions, m, world; with optional orientations), each inverse
 /// warm-started from the last (the first from `warm`, and from each start of
-/// `options.starts`); with `throw == false` a target that is
-/// not reached is returned with `converged == false` and the path goes on from it.
+/// `options.starts`, each on the forward model as new: [`Forward::forget`]); with
+/// `throw == false` a target that is not reached is returned with `converged == false` and
+/// the path goes on from it.
 ///
 /// # Errors
 /// As [`solve_inverse`] (with `throw`, at the first target not reached).
@@ -527,7 +528,11 @@ pub fn inverse_statics_path<F: Forward + ?Sized>(
     let mut w = warm.cloned();
     if let Some(first) = targets.first() {
         let later = super::starts_on(forward, first, options)?;
+        let several = later.is_some();
         let (s, ()) = super::over_starts(options, warm, later, |o, w| {
+            if several {
+                forward.forget();
+            }
             solve_inverse(forward, first, o, w).map(|s| (s, ()))
         })?;
         w = Some(InverseWarmStart::from(&s));
