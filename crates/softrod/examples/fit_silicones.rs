@@ -91,16 +91,26 @@ fn params(model: &UniaxialModel) -> String {
     }
 }
 
-/// Stretch interval around 1 on which `dP/dλ > 0`, scanned on `[0.1, 50]`
-/// (`<0.1` / `>50` when stable to the scan's end).
+/// Stretch interval around 1 on which `dP/dλ > 0`: scanned on `[0.1, 50]` for the first sign
+/// change on each side, its root then bisected (`<0.1` / `>50` when stable to the scan's end).
 fn stable_range(law: &dyn UniaxialLaw) -> String {
     const STEPS: usize = 4000;
+    let stable = |l: f64| law.nominal_slope_unchecked(l) > 0.0;
     let scan = |end: f64| {
         let mut last = 1.0;
         for i in 1..=STEPS {
             let l = end.powf(i as f64 / STEPS as f64);
-            if law.nominal_slope_unchecked(l) <= 0.0 {
-                return format!("{last:.3}");
+            if !stable(l) {
+                let (mut inside, mut outside) = (last, l);
+                for _ in 0..60 {
+                    let mid = 0.5 * (inside + outside);
+                    if stable(mid) {
+                        inside = mid;
+                    } else {
+                        outside = mid;
+                    }
+                }
+                return format!("{inside:.4}");
             }
             last = l;
         }
