@@ -141,3 +141,15 @@ def test_slider_move_in_a_real_browser(view, tmp_path):
         )
     finally:
         driver.quit()
+
+
+def test_the_view_command_takes_an_example_name_as_every_command(capsys):
+    # (Port 0: any free port; the view stops after a fraction of a second.)
+    from softrod.cli import main
+
+    code = main(["view", "niti_two_segment", "--no-browser", "--port", "0", "--seconds", "0.1"])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert "softrod view: niti" in err
+    assert main(["view", "no_such_robot", "--no-browser", "--seconds", "0.1"]) != 0
+    assert "no_such_robot" in capsys.readouterr().err

@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 import time
 
+from ._common import files
+
 
 def _cmd_view(args) -> int:
     from ..plot.live import serve
@@ -50,7 +52,11 @@ def register(sub) -> None:
         "view",
         help="live 3-D view in the browser: sliders for tensions, pressures and tip force",
     )
-    v.add_argument("robot", metavar="ROBOT.toml", help="robot description file (TOML)")
+    v.add_argument(
+        "robot",
+        metavar="ROBOT",
+        help="robot description file (TOML), or the name of a shipped example",
+    )
     v.add_argument(
         "--port", type=_port, default=8080, help="port on 127.0.0.1 (default: %(default)s)"
     )
@@ -66,3 +72,4 @@ def register(sub) -> None:
         "--seconds", type=float, metavar="S", help="stop after S seconds (default: until Ctrl-C)"
     )
     v.set_defaults(func=_cmd_view)
+    files(v, inputs=("robot",))
