@@ -543,10 +543,10 @@ impl Tendon {
             );
         }
         format!(
-            "Tendon({:?}, tension={}, end={:?}{friction})",
+            "Tendon({:?}, tension={}, end={}{friction})",
             self.inner.routing(),
             self.tension,
-            self.inner.end()
+            py_option(self.inner.end())
         )
     }
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
@@ -677,11 +677,11 @@ impl Chamber {
     fn __repr__(&self) -> String {
         let [x, y] = self.inner.offset();
         format!(
-            "Chamber(pressure={}, area={:?}, offset=({x}, {y}), start={}, end={:?})",
+            "Chamber(pressure={}, area={:?}, offset=({x}, {y}), start={}, end={})",
             self.pressure,
             self.inner.area(),
             self.inner.start(),
-            self.inner.end()
+            py_option(self.inner.end())
         )
     }
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
@@ -934,4 +934,9 @@ impl Loads {
         l.distributed_force.as_ref().is_some_and(is_function)
             || l.distributed_moment.as_ref().is_some_and(is_function)
     }
+}
+
+/// An optional number as Python writes it (`None` or the number) for a `__repr__`.
+fn py_option(x: Option<f64>) -> String {
+    x.map_or_else(|| "None".to_string(), |v| v.to_string())
 }
