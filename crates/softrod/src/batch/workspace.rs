@@ -76,7 +76,7 @@ pub fn workspace_map(
     tangent: Option<TendonControl>,
 ) -> Result<Vec<WorkspaceSample>> {
     let nt = model.tendons().len();
-    if nt == 0 || tensions.len() % nt != 0 {
+    if nt == 0 || !tensions.len().is_multiple_of(nt) {
         return Err(Error::invalid(
             "tensions",
             format!("{} values for {nt} tendons", tensions.len()),
