@@ -51,12 +51,15 @@ def files(
     figures=(),
     folders=("out",),
     input_paths=None,
+    folder_files=None,
 ) -> None:
     """Declares which destinations of ``parser`` are input and output files (``folders``:
     the outputs that are folders, by default ``out``) and, for a command with output files,
     adds ``--overwrite`` (unless the command declared it already). ``input_paths``, a function
     of the parsed arguments, yields ``(option, path)`` for the input files that no destination
-    holds as a plain path (checked like ``inputs``)."""
+    holds as a plain path (checked like ``inputs``); ``folder_files``, a function of the parsed
+    arguments, yields ``(dest, path)`` for the files a command writes into its folder output
+    ``dest`` (checked like the other outputs)."""
     if any(d not in folders for d in outputs) and "--overwrite" not in getattr(
         parser, "_option_string_actions", {}
     ):
@@ -69,6 +72,7 @@ def files(
         _figures=tuple(figures),
         _folders=tuple(folders),
         _input_paths=input_paths,
+        _folder_files=folder_files,
     )
 
 
@@ -99,6 +103,35 @@ def resolve_robot(arg: str) -> str:
         return str(examples.path(arg))  # an earlier name of an example
     except ParameterError as exc:
         raise bad("ROBOT", arg, f"no such file, and {str(exc).split(': ', 1)[1]}") from None
+
+
+def referenced_inputs(args: argparse.Namespace, inputs) -> list[tuple[str, str]]:
+    """The files the inputs read in turn, as ``(name, path)``: the mesh files of a robot
+    file's obstacles (relative to the robot file) and a ``--style`` file."""
+    out: list[tuple[str, str]] = []
+    style = getattr(args, "style", None)
+    if isinstance(style, str) and os.path.isfile(style):
+        out.append(("--style", style))
+    for name, path in inputs:
+        path = os.fspath(path)
+        if name != "ROBOT" or not path.endswith(".toml") or not os.path.isfile(path):
+            continue
+        try:
+            try:
+                import tomllib
+            except ImportError:  # pragma: no cover - Python 3.10
+                import tomli as tomllib
+            with open(path, "rb") as f:
+                tables = tomllib.load(f)
+        except (OSError, ValueError):
+            continue  # (the command reports an unreadable robot file itself)
+        obstacles = tables.get("obstacles", [])
+        for k, o in enumerate(obstacles if isinstance(obstacles, list) else []):
+            mesh = o.get("file") if isinstance(o, dict) else None
+            if isinstance(mesh, str):
+                where = os.path.join(os.path.dirname(os.path.abspath(path)), mesh)
+                out.append((f"ROBOT's obstacles[{k}].file", where))
+    return out
 
 
 def _same(a: str, b: str) -> bool:
@@ -144,14 +177,19 @@ def check_files(args: argparse.Namespace) -> None:
     more = getattr(args, "_input_paths", None)
     if more is not None:
         inputs += list(more(args))
+    inputs += referenced_inputs(args, inputs)
     outputs = [
         (d, getattr(args, d)) for d in getattr(args, "_outputs", ()) if getattr(args, d, None)
     ]
     figures = set(getattr(args, "_figures", ()))
     folders = set(getattr(args, "_folders", ("out",)))
+    inside = getattr(args, "_folder_files", None)
+    if inside is not None:
+        # (A file written into a folder output is checked as a file under the folder's name.)
+        outputs += [(f"{dest}/", path) for dest, path in inside(args)]
     seen: list[tuple[str, str]] = []
     for dest, path in outputs:
-        name = option_name(dest)
+        name = option_name(dest.removesuffix("/"))
         path = os.fspath(path)
         for in_name, in_path in inputs:
             if _same(path, os.fspath(in_path)):
@@ -161,6 +199,8 @@ def check_files(args: argparse.Namespace) -> None:
                 raise bad(name, path, f"is also the output of {option_name(other)}")
         if os.path.isdir(path) and dest not in folders:
             raise bad(name, path, "is a folder (give a file name)")
+        if dest not in folders and path.endswith(("/", os.sep)):
+            raise bad(name, path, "names a folder (give a file name)")
         if (
             dest not in folders
             and os.path.exists(path)
@@ -174,7 +214,10 @@ def check_files(args: argparse.Namespace) -> None:
         else:
             folder = os.path.dirname(os.path.abspath(path))
             if not os.path.isdir(folder):
-                raise bad(name, path, f"the folder {folder!r} does not exist")
+                if not dest.endswith("/"):  # (a folder output is made by its command)
+                    raise bad(name, path, f"the folder {folder!r} does not exist")
+            elif not os.access(folder, os.W_OK):
+                raise bad(name, path, f"the folder {folder!r} is not writable")
         if dest in figures:
             from ..plot._figure import check_figure_path
 
@@ -229,10 +272,11 @@ def add_figure_options(parser: argparse.ArgumentParser, *dests: str) -> None:
     run = parser.get_default("func")
 
     def checked(args):
-        from ..plot._figure import check_dpi, check_size, check_style
+        from ..plot._figure import check_dpi, check_pixels, check_size, check_style
 
         check_size(args.size)
         check_dpi(args.dpi)
+        check_pixels(args.size, args.dpi)
         check_style(args.style)
         return run(args)
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ._common import (
@@ -23,8 +21,15 @@ from ._common import (
 )
 
 
+def _study_figures(args):
+    """The figures ``softrod study`` writes into ``--out``."""
+    from ..analysis.study import _figure_paths
+
+    return [("out", path) for path in _figure_paths(args.out)]
+
+
 def _cmd_study(args) -> int:
-    from ..analysis.study import _figure_paths, compliance_study, levels_beyond_limit
+    from ..analysis.study import compliance_study, levels_beyond_limit
     from ..robot import load_robot
 
     if args.levels < 2:
@@ -33,9 +38,6 @@ def _cmd_study(args) -> int:
     if too_many is not None:  # before the levels**3 grid is built
         raise bad("--levels", args.levels, too_many)
 
-    for path in _figure_paths(args.out):
-        if os.path.exists(path) and not args.overwrite:
-            raise bad("--out", args.out, f"holds {path!r} (pass --overwrite to replace it)")
     robot = load_robot(args.robot)
     results = compliance_study(
         robot,
@@ -182,5 +184,5 @@ def register(sub) -> None:
         help="progress bar on stderr (default: only when stderr is a terminal)",
     )
     add_data_outputs(st, "every pressure set of both materials (pressures, tip, compliance)")
-    files(st, inputs=("robot",), outputs=("csv", "json", "out"))
+    files(st, inputs=("robot",), outputs=("csv", "json", "out"), folder_files=_study_figures)
     st.set_defaults(func=_cmd_study)
