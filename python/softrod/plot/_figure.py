@@ -64,6 +64,26 @@ def check_size(size) -> tuple[float, float] | None:
     return (w, h)
 
 
+#: Largest side of a figure in pixels (`size` times `dpi`); matplotlib's raster backend stops at
+#: 2^16, and a larger image costs gigabytes of memory.
+MAX_PIXELS_SIDE = 20_000
+
+
+def check_pixels(size, dpi) -> None:
+    """Refuses a raster figure whose side (``size`` inches times ``dpi``) exceeds
+    :data:`MAX_PIXELS_SIDE` pixels; ``None`` values are the defaults."""
+    w, h = size if size is not None else (6.4, 4.8)
+    d = dpi if dpi is not None else 130.0
+    side = max(w, h) * d
+    if side > MAX_PIXELS_SIDE:
+        raise _bad(
+            "size",
+            (w, h),
+            f"at {d:g} dpi the figure is {side:.0f} pixels wide: at most "
+            f"{MAX_PIXELS_SIDE} pixels a side (lower --size or --dpi)",
+        )
+
+
 def check_dpi(dpi) -> float | None:
     """Validates a resolution in dots per inch (``None`` keeps the default)."""
     if dpi is None:
@@ -86,6 +106,15 @@ def check_style(style) -> None:
         if str(name) in plt.style.available or str(name) == "default":
             continue
         if Path(name).is_file():
+            try:
+                import matplotlib
+
+                matplotlib.rc_params_from_file(str(name), use_default_template=False)
+            except (OSError, ValueError) as exc:  # (UnicodeDecodeError is a ValueError)
+                reason = " ".join(str(exc).split())[:120]
+                raise _bad(
+                    "style", style, f"could not be read as a .mplstyle file ({reason})"
+                ) from None
             continue
         raise _bad(
             "style",
@@ -115,6 +144,7 @@ def new_figure(size, default: tuple[float, float], dpi=None, **kwargs):
 
     size = check_size(size) or default
     dpi = check_dpi(dpi)
+    check_pixels(size, dpi)
     kwargs.setdefault("layout", "constrained")
     fig = plt.figure(figsize=size, **({"dpi": dpi} if dpi else {}), **kwargs)
     return fig
@@ -141,6 +171,8 @@ def save_figure(
     """
     fmt = check_figure_path(path)
     dpi = check_dpi(dpi)
+    if dpi is not None:
+        check_pixels(tuple(fig.get_size_inches()), dpi)
     overwrite = _args.flag(overwrite, "overwrite")
     if os.path.isdir(path):
         raise _bad("path", os.fspath(path), "is a folder (give a file name)")
