@@ -33,13 +33,16 @@ def read_backbone_csv(
 
     The file has one point per row, two or three numeric columns (x, y[, z]); an optional
     header row is skipped, as are blank lines and lines starting with ``#``. Delimiters
-    ``,``, ``;``, tab or spaces are detected.
+    ``,``, ``;``, tab or spaces are detected. A header that names columns ``x`` and ``y`` (and
+    ``z``) selects them (e.g. the CSV of ``softrod backbone``, whose third column is the arc
+    length).
 
     Args:
         path: CSV file.
         scale: Factor applied to every coordinate, e.g. ``1e-3`` for a file in millimetres.
-        columns: Indices of the coordinate columns (default: the first two, or three if every
-            row has three numeric columns).
+        columns: Indices of the coordinate columns (default: those a header names ``x``,
+            ``y`` and ``z``, else the first two, or three if every row has three numeric
+            columns).
 
     Returns:
         Points, shape (n, 2) or (n, 3), multiplied by ``scale``.
@@ -77,7 +80,9 @@ def read_backbone_csv(
             return None
 
     parsed = [numeric(r) for r in rows]
+    named = None
     if parsed and parsed[0] is None:  # header
+        named = _named_columns(rows[0])
         parsed = parsed[1:]
         rows = rows[1:]
     if not parsed:  # a header (or one line of text) alone
@@ -86,6 +91,8 @@ def read_backbone_csv(
     if bad:
         raise _bad_file(path, f"row {bad[0] + 1} of data is not numeric: {rows[bad[0]]!r}")
     width = min(len(p) for p in parsed if p is not None)
+    if columns is None and named is not None:
+        columns = named
     if columns is None:
         if width < 2:
             raise _bad_file(
@@ -109,6 +116,15 @@ def read_backbone_csv(
     if not np.all(np.isfinite(pts)):
         raise _bad_file(path, "non-finite value")
     return pts * scale
+
+
+def _named_columns(header: list[str]) -> list[int] | None:
+    """The indices of the columns a header names ``x``, ``y`` (and ``z``; case and a unit in
+    brackets ignored), or None if it does not name ``x`` and ``y``."""
+    names = [c.strip().lower().split("(")[0].split("[")[0].strip() for c in header]
+    if "x" not in names or "y" not in names:
+        return None
+    return [names.index(a) for a in ("x", "y", "z") if a in names]
 
 
 def _bad_file(path: str | os.PathLike[str], why: str) -> ParameterError:
