@@ -149,3 +149,16 @@ def test_the_ode_method_refuses_tensions_whose_strain_it_cannot_resolve(ratio):
     # Below the bound the ODE's strain is the closed form's to its tolerance.
     ode, closed = arm.solve(1e3, method="ode"), arm.solve(1e3)
     np.testing.assert_allclose(ode.strain, closed.strain, rtol=1e-4)
+
+
+def test_an_ode_absolute_tolerance_that_turns_the_tip_is_refused():
+    # (atol = 1 1/m moved the tip 18 mm at 2 N, reported as a solution.)
+    arm = softrod.PlanarCableArm.published_arm()
+    for atol in (1.0, 1e308):
+        with pytest.raises(softrod.ParameterError) as e:
+            arm.solve(2.0, method="ode", atol=atol)
+        assert e.value.parameter == "atol"
+    bound = 1e-3 / arm.length
+    ode = arm.solve(2.0, method="ode", atol=bound)
+    exact = arm.solve(2.0)
+    assert np.linalg.norm(np.subtract(ode.tip, exact.tip)) <= bound * arm.length**2

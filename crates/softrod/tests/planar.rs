@@ -320,6 +320,25 @@ fn bad_input_names_the_parameter() {
     assert_eq!(name_of(e), "rtol");
 }
 
+/// An absolute tolerance of the ODE's curvature whose integral `atol L` would turn the tip by
+/// more than 1e-3 rad is refused, naming `atol` (1 1/m moved the tip 18 mm at 2 N); at the
+/// bound the tip is within `atol L²` of the closed form.
+#[test]
+fn an_ode_absolute_tolerance_that_turns_the_tip_is_refused() {
+    let arm = PlanarCableArm::published_arm();
+    let s = uniform_samples(arm.length(), 5).unwrap();
+    for atol in [1.0, 1e308] {
+        let e = solve_planar(&arm, 2.0, &s, ode(1e-10, atol)).unwrap_err();
+        assert_eq!(name_of(e), "atol");
+    }
+    let bound = softrod::planar::ODE_STRAIN_ERROR / arm.length();
+    let at = solve_planar(&arm, 2.0, &s, ode(1e-10, bound)).unwrap();
+    let exact = solve_planar(&arm, 2.0, &s, PlanarMethod::ClosedForm).unwrap();
+    let d = ((at.tip[0] - exact.tip[0]).powi(2) + (at.tip[1] - exact.tip[1]).powi(2)).sqrt();
+    println!("at the bound {bound:e} 1/m: tip {d:e} m from the closed form");
+    assert!(d <= bound * arm.length().powi(2), "{d:e}");
+}
+
 #[test]
 fn ode_non_convergence_reports_iterations() {
     let arm = PlanarCableArm::published_arm();
