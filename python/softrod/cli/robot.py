@@ -308,8 +308,12 @@ def _cmd_workspace(args) -> int:
         finite = np.isfinite(c) & np.isfinite(r)
         lo, hi = np.nanmin(c), np.nanmax(c)
         rr = np.where(finite, r, np.nan)
-        centre, edge = c[np.nanargmin(rr)], c[np.nanargmax(rr)]
         print(f"largest translational tip compliance ({name}, m/N): min {lo:.4e}, max {hi:.4e}")
+        inner, outer = np.nanargmin(rr), np.nanargmax(rr)
+        if inner == outer:
+            print("  centre and periphery: one configuration only (no ratio)")
+            continue
+        centre, edge = c[inner], c[outer]
         print(f"  centre of the workspace {centre:.4e}, periphery {edge:.4e}: x{edge / centre:.2f}")
     fields = ["max_translational_compliance", "min_translational_compliance", "condition"]
     if args.tangent:

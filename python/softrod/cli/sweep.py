@@ -15,8 +15,10 @@ import os
 import sys
 import time
 
+import numpy as np
+
 from .. import _args
-from ._common import bad, files, finite_float
+from ._common import NoResultError, bad, files, finite_float
 
 _GRID_HELP = "GRID: start:stop:count, v1,v2,... or one value"
 
@@ -168,6 +170,15 @@ def _cmd_sweep(args) -> int:
         f"{counts['failed']} failed, {counts['infeasible_design']} in {infeasible} infeasible "
         "design points"
     )
+    if counts["converged"] + counts["not_converged"] == 0:
+        errors = [str(e) for e in np.ravel(ds["design_error"].values) if e]
+        if "error" in ds:
+            errors += [str(e) for e in np.ravel(ds["error"].values) if e]
+        first = f"; the first: {errors[0]}" if errors else ""
+        raise NoResultError(
+            f"sweep of {robot.name}: no sample was solved (every one failed or is in an "
+            f"infeasible design){first}; nothing written"
+        )
     folder = os.path.dirname(os.path.abspath(args.out))
     tmp = os.path.join(folder, f".{os.path.basename(args.out)}.{os.getpid()}.tmp")
     try:
