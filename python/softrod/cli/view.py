@@ -46,6 +46,19 @@ def _port(text: str) -> int:
     return port
 
 
+def _seconds(text: str) -> float:
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text}")
+    return value
+
+
 def register(sub) -> None:
     """Adds the subcommand of this module to the ``softrod`` parser."""
     v = sub.add_parser(
@@ -69,7 +82,10 @@ def register(sub) -> None:
         "--max-force", type=float, metavar="N", help="range of the tip-force sliders (N)"
     )
     v.add_argument(
-        "--seconds", type=float, metavar="S", help="stop after S seconds (default: until Ctrl-C)"
+        "--seconds",
+        type=_seconds,
+        metavar="S",
+        help="stop after S seconds (default: until Ctrl-C)",
     )
     v.set_defaults(func=_cmd_view)
     files(v, inputs=("robot",))

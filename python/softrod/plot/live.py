@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _args
 from .._core import ConvergenceError, ParameterError
 from .geometry import RobotGeometry, robot_geometry
 from .tube import chamber_grid, disk_polygon, tendon_path, tube_grid, tube_mesh
@@ -514,7 +515,15 @@ def serve(
 
     Returns:
         The running :class:`LiveView`.
+
+    Raises:
+        ParameterError: A slider range that is not a finite number > 0 (naming it).
     """
+    units = {"max_tension": "N", "max_pressure": "Pa", "max_force": "N"}
+    given = {"max_tension": max_tension, "max_pressure": max_pressure, "max_force": max_force}
+    for name, value in given.items():
+        if value is not None:
+            _args.number(value, name, positive=True, unit=units[name])
     view = LiveView(
         robot,
         host=host,
