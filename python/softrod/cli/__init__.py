@@ -84,9 +84,24 @@ def _fail(message: str, status: int) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``softrod`` console script; returns the exit status.
 
-    Every error is one line on stderr (``softrod: error: ...``), never a traceback; set
-    ``SOFTROD_DEBUG=1`` to see the traceback of an unexpected error.
+    Every error is one line on stderr (``softrod: error: ...``), never a traceback, and every
+    warning one line (``softrod: warning: ...``); set ``SOFTROD_DEBUG=1`` to see the traceback
+    of an unexpected error.
     """
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        return _main(argv)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on stderr, without the source line that raised it."""
+    text = " ".join(str(message).split())
+    print(f"softrod: warning: {text} ({category.__name__})", file=sys.stderr)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
         if "robot" in getattr(args, "_inputs", ()) and getattr(args, "robot", None):
