@@ -1,0 +1,191 @@
+"""The command line never destroys a file a run reads, however the run reaches it: the mesh
+file of a robot file's obstacle, a ``--style`` file, an input where a command writes a figure
+into its folder; and a run that must fail does so before it writes anything (an unreadable
+style, a file name ending in a folder separator, a figure too large to draw)."""
+
+import hashlib
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+import softrod
+from softrod.cli import main
+
+PNEUMATIC = softrod.examples.path("pneumatic_arm")
+ROBOT = """[rod]
+length = 0.4
+[rod.section]
+radius = 0.0007
+[rod.material]
+youngs_modulus = 54e9
+poisson_ratio = 0.3
+[[tendons]]
+distance = 0.01
+angle_deg = 0
+tension = 2.0
+[[obstacles]]
+type = "mesh"
+file = "meshes/box.stl"
+"""
+
+
+def _digest(path) -> str:
+    return hashlib.sha256(open(path, "rb").read()).hexdigest()
+
+
+def _run(argv, capsys):
+    status = main([str(a) for a in argv])
+    cap = capsys.readouterr()
+    return status, cap.out, cap.err
+
+
+@pytest.fixture
+def arm_with_mesh(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    (tmp_path / "meshes").mkdir()
+    box = trimesh.creation.box(extents=(0.05, 0.05, 0.05))
+    box.apply_translation((0.12, 0.0, 0.3))
+    box.export(tmp_path / "meshes" / "box.stl")
+    (tmp_path / "arm.toml").write_text(ROBOT)
+    return tmp_path
+
+
+def test_the_mesh_file_a_robot_file_reads_is_an_input(arm_with_mesh, capsys, monkeypatch):
+    monkeypatch.chdir(arm_with_mesh)
+    mesh = arm_with_mesh / "meshes" / "box.stl"
+    before = _digest(mesh)
+    for argv in (
+        ["solve", "arm.toml", "--csv", "meshes/box.stl", "--overwrite"],
+        ["solve", "arm.toml", "--json", "./meshes/../meshes/box.stl", "--overwrite"],
+    ):
+        status, _, err = _run(argv, capsys)
+        assert status == 2, err
+        assert "obstacles[0].file" in err and "refusing to overwrite" in err, err
+    assert _digest(mesh) == before
+
+
+def test_a_style_file_is_an_input(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    style = tmp_path / "my.mplstyle"
+    style.write_text("lines.linewidth: 3\n")
+    argv = ["planar", "--style", "my.mplstyle", "--plot", "p.png", "--csv", "my.mplstyle"]
+    status, _, err = _run([*argv, "--overwrite"], capsys)
+    assert status == 2 and "`--csv`" in err and "--style" in err, err
+    assert style.read_text() == "lines.linewidth: 3\n"
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_study_figures_are_checked_against_the_inputs_and_the_other_outputs(tmp_path, capsys):
+    out = tmp_path / "st"
+    out.mkdir()
+    robot = out / "pneumatic_workspace_linear.png"
+    shutil.copy(PNEUMATIC, robot)
+    before = _digest(robot)
+    status, _, err = _run(["study", robot, "--levels", "2", "--out", out, "--overwrite"], capsys)
+    assert status == 2 and "refusing to overwrite" in err and "`--out`" in err, err
+    assert _digest(robot) == before
+    fresh = tmp_path / "st2"
+    fresh.mkdir()
+    figure = fresh / "pneumatic_gamma_c_linear.png"
+    status, _, err = _run(
+        ["study", PNEUMATIC, "--levels", "2", "--out", fresh, "--csv", figure], capsys
+    )
+    assert status == 2 and "is also the output of" in err, err
+    assert not figure.exists()
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--style", "bin.mplstyle"], "could not be read as a .mplstyle file"),
+        (["--json", "newdir/"], "names a folder"),
+        (["--dpi", "2400", "--size", "100", "100"], "pixels a side"),
+    ],
+)
+def test_a_run_that_must_fail_writes_nothing(tmp_path, capsys, monkeypatch, extra, words):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bin.mplstyle").write_bytes(b"\xff\xfe\x00bad")
+    argv = ["solve", "niti_two_segment", "--csv", "s.csv", "--plot", "s.png", *extra]
+    status, _, err = _run(argv, capsys)
+    assert status == 2 and words in err, err
+    assert sorted(os.listdir(tmp_path)) == ["bin.mplstyle"]
+
+
+def test_a_backbone_csv_selects_its_x_and_y_columns_by_name(tmp_path):
+    path = tmp_path / "b.csv"
+    path.write_text("# a comment\nx,y,arc_length,half_width\n0,0,0,1\n1,2,3,4\n2,4,6,8\n")
+    pts = softrod.read_backbone_csv(path)
+    np.testing.assert_array_equal(pts, [[0, 0], [1, 2], [2, 4]])
+    path.write_text("arc_length,X (m),Y (m),Z (m)\n0,0,0,1\n1,2,3,4\n")
+    np.testing.assert_array_equal(softrod.read_backbone_csv(path), [[0, 0, 1], [2, 3, 4]])
+    path.write_text("a,b,c\n0,0,1\n1,2,3\n")
+    np.testing.assert_array_equal(softrod.read_backbone_csv(path), [[0, 0, 1], [1, 2, 3]])
+
+
+def test_a_backbone_csv_of_a_photograph_is_no_3d_measurement(tmp_path, capsys):
+    path = tmp_path / "arm.csv"
+    path.write_text("x,y,arc_length,half_width\n0,0,0,0.01\n0.1,0.01,0.1,0.01\n0.2,0.03,0.2,0.01\n")
+    status, _, err = _run(
+        [
+            "calibrate",
+            "tapered_cable_arm",
+            "--measurements",
+            f"2:{path}",
+            "--parameters",
+            "rod.material.youngs_modulus",
+        ],
+        capsys,
+    )
+    assert status == 2 and "`--measurements`" in err and "needs 3 (x, y, z)" in err, err
+
+
+def test_a_sweep_that_solves_nothing_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "s.nc"
+    status, _, err = _run(
+        ["sweep", "niti_two_segment", "--tensions", "0=1e308", "--out", out], capsys
+    )
+    assert status == 3 and "no sample was solved" in err, err
+    assert not out.exists()
+
+
+def test_a_workspace_of_one_converged_configuration_gives_no_ratio(capsys):
+    status, out, err = _run(
+        ["workspace", "niti_two_segment", "--sweep", "0:1e308", "--n", "5"], capsys
+    )
+    assert status == 0, err
+    assert (
+        "converged: 1/5" in out
+        and "no ratio" in out
+        and "periphery" not in out.replace("centre and periphery", "")
+    ), out
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--seconds", "nan"], "--seconds"),
+        (["--seconds", "-1"], "--seconds"),
+        (["--max-tension", "-1", "--seconds", "0.1"], "max_tension"),
+        (["--max-force", "nan", "--seconds", "0.1"], "max_force"),
+    ],
+)
+def test_view_options_are_checked(capsys, extra, words):
+    status, _, err = _run(
+        ["view", "niti_two_segment", "--no-browser", "--port", "0", *extra], capsys
+    )
+    assert status == 2 and words in err, err
+
+
+def test_warnings_are_one_line(tmp_path, capsys):
+    path = tmp_path / "pinned.toml"
+    path.write_text(
+        open(softrod.examples.path("niti_two_segment")).read()
+        + '\n[tip_constraint]\ntype = "pin"\npoint = [0.0, 0.0, 0.0]\n'
+    )
+    # (A pin at the base: the equilibrium found is unstable, a StabilityWarning.)
+    status, _, err = _run(["solve", path], capsys)
+    lines = [ln for ln in err.splitlines() if ln]
+    assert status == 0 and lines[0].startswith("softrod: warning: the equilibrium"), err
+    assert lines[0].endswith("(StabilityWarning)") and ".py:" not in err, err
