@@ -3,7 +3,7 @@ parameters to measured shapes, models side by side,
 workspace maps, tensile curves and material fits, the compliance study of soft arms, and design
 sweeps with their summaries."""
 
-from .calibration import Calibration, IdentifiabilityWarning, calibrate
+from .calibration import Calibration, IdentifiabilityWarning, PoorFitWarning, calibrate
 from .compare import BackboneDistance, backbone_distance
 from .design import Pareto, design_summary
 from .materials import TensileCurve, read_tensile_csv
@@ -19,6 +19,7 @@ __all__ = [
     "ModelComparison",
     "ModelResult",
     "Pareto",
+    "PoorFitWarning",
     "SampleTable",
     "TensileCurve",
     "WorkspaceMap",

@@ -46,6 +46,27 @@ __all__ = ["Calibration", "IdentifiabilityWarning", "calibrate"]
 METRICS = ("arm-index", "nearest")
 
 
+#: RMS residual, as a fraction of the arm's length, above which a fit is reported as poor
+#: (:class:`PoorFitWarning`): fits to photographs leave about 1e-3 of it.
+POOR_FIT_FRACTION = 0.05
+
+
+class PoorFitWarning(UserWarning):
+    """The fit leaves residuals of a sizeable fraction of the arm's length: a local minimum
+    of the least-squares problem (e.g. from a starting value far off) or a model that does not
+    describe the measurements; its standard errors describe that minimum only.
+
+    Attributes:
+        rms: RMS residual (m).
+        length: The arm's length (m).
+    """
+
+    def __init__(self, message: str, rms: float = math.nan, length: float = math.nan):
+        super().__init__(message)
+        self.rms = rms
+        self.length = length
+
+
 class IdentifiabilityWarning(UserWarning):
     """The measurements cannot determine some combination of the fitted parameters.
 
@@ -704,6 +725,8 @@ def calibrate(
     Warns:
         IdentifiabilityWarning: The data cannot determine a combination of the parameters
             (e.g. E together with a tension scale).
+        PoorFitWarning: The RMS residual exceeds :data:`POOR_FIT_FRACTION` of the arm's
+            length (a local minimum, or a model that does not describe the data).
     """
     from scipy.optimize import least_squares
 
@@ -857,6 +880,18 @@ def calibrate(
     for j, name in enumerate(names):
         if name in weak:  # no meaningful correlation along an undetermined combination
             corr[j, :] = corr[:, j] = math.nan
+    rms = float(np.sqrt(np.mean(r * r)))
+    if rms > POOR_FIT_FRACTION * model.length:
+        warnings.warn(
+            PoorFitWarning(
+                f"the fit leaves an RMS residual of {rms:.3g} m, {100 * rms / model.length:.3g} "
+                f"% of the arm's length ({_fmt_values(values)}): a local minimum (try other "
+                "`initial` values) or a model that does not describe the measurements",
+                rms,
+                model.length,
+            ),
+            stacklevel=2,
+        )
     residuals = []
     start = 0
     for meas_i, k in zip(meas, parts, strict=True):
@@ -874,7 +909,7 @@ def calibrate(
         correlation=corr,
         residuals=residuals,
         residual_std=math.sqrt(sigma2) if sigma2 == sigma2 else math.nan,
-        rms=float(np.sqrt(np.mean(r * r))),
+        rms=rms,
         degrees_of_freedom=dof,
         jacobian=jac,
         condition=condition,
