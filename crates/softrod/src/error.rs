@@ -58,7 +58,7 @@ pub enum Error {
 /// The load factor in a convergence message, when it is not the full load.
 fn load_factor_note(load_factor: f64) -> String {
     if load_factor < 1.0 {
-        format!(", load factor {load_factor:.4}")
+        format!(" at load factor {load_factor:.4}, the last load carried")
     } else {
         String::new()
     }
@@ -158,5 +158,34 @@ pub fn check_finite(name: &str, value: f64) -> Result<f64> {
         Ok(value)
     } else {
         Err(Error::invalid(name, value, "finite"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Error;
+
+    /// Below full load, the residual is that of the last load carried (a continuation that
+    /// carried none reads "residual 0 at load factor 0", not a residual of the full load).
+    #[test]
+    fn a_convergence_message_names_the_load_its_residual_is_at() {
+        let at = |load_factor| {
+            Error::NotConverged {
+                what: "shooting Newton".into(),
+                iterations: 6,
+                residual: 0.0,
+                load_factor,
+            }
+            .to_string()
+        };
+        assert_eq!(
+            at(0.25),
+            "shooting Newton did not converge after 6 iterations (residual 0.000e0 at load \
+             factor 0.2500, the last load carried)"
+        );
+        assert_eq!(
+            at(1.0),
+            "shooting Newton did not converge after 6 iterations (residual 0.000e0)"
+        );
     }
 }
