@@ -529,7 +529,16 @@ fn check_derivative(
 fn check_load_limits(loads: &Loads, rod: &Rod, force_scale: f64) -> Result<()> {
     let l = rod.length();
     let (f0, m0) = (force_scale, force_scale * l);
-    let norm = |v: &Vector3<f64>| v.norm();
+    // (Scaled by the largest component: the plain norm of [1e300, 0, 0] overflows to inf,
+    // and an error would report that instead of the value given.)
+    let norm = |v: &Vector3<f64>| {
+        let largest = v.amax();
+        if largest > 0.0 && largest.is_finite() {
+            largest * (v / largest).norm()
+        } else {
+            largest
+        }
+    };
     check_load(
         "loads.tip_force",
         norm(&loads.tip_force),
@@ -571,7 +580,7 @@ fn check_load_limits(loads: &Loads, rod: &Rod, force_scale: f64) -> Result<()> {
     ] {
         if let Some(p) = profile {
             for (at, v) in p.check_points(l) {
-                check_load(format_args!("{name}{at}"), v.norm(), v.norm(), scale, unit)?;
+                check_load(format_args!("{name}{at}"), norm(&v), norm(&v), scale, unit)?;
             }
         }
     }
