@@ -323,7 +323,19 @@ def tip_constraint_of(t: Any) -> Any:
         pose = np.eye(4)
         pose[:3, 3] = t.position
         if t.rotation is not None:
-            pose[:3, :3] = t.rotation
+            r = np.asarray(t.rotation, dtype=float)
+            if r.shape != (3, 3) or not np.allclose(r.T @ r, np.eye(3), atol=1e-9):
+                rf.raise_errors(
+                    [
+                        FieldError(
+                            "tip_constraint.rotation",
+                            "must be a rotation matrix (orthonormal rows, 3x3)",
+                            t.rotation,
+                            kind="range",
+                        )
+                    ]
+                )
+            pose[:3, :3] = r
         return Clamp(pose, tuple(t.held) if t.held is not None else None)
     if t.type == "pin":
         return Pin(tuple(t.point))
