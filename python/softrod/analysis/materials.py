@@ -275,8 +275,33 @@ def read_tensile_csv(
         (i for i, ln in enumerate(lines[:40]) if ln.startswith(_DATABASE_HEADER)),
         None,
     )
+    # Every option checked whatever the file (a misspelt one was ignored by the other kind),
+    # and the options of the other kind of file refused rather than ignored.
+    if columns not in _DATABASE_COLUMNS:
+        raise _bad("columns", repr(columns), '"engineering" or "true"')
+    if stress_unit not in STRESS_UNITS:
+        raise _bad("stress_unit", repr(stress_unit), "one of " + ", ".join(STRESS_UNITS))
+    if strain_unit not in STRAIN_UNITS:
+        raise _bad("strain_unit", repr(strain_unit), "one of " + ", ".join(STRAIN_UNITS))
     if header_at is not None:
+        for name, value, default in (
+            ("strain_unit", strain_unit, "fraction"),
+            ("stress_unit", stress_unit, "Pa"),
+        ):
+            if value != default:
+                raise _bad(
+                    name,
+                    repr(value),
+                    f"{default!r} for a Soft Robotics Materials Database file (its units are "
+                    "its own; the option is for plain files)",
+                )
         return _read_database(path, lines, header_at, columns)
+    if columns != "engineering":
+        raise _bad(
+            "columns",
+            repr(columns),
+            '"engineering" for a plain file (the option picks a database file\'s columns)',
+        )
     return _read_plain(path, lines, strain_measure, stress_measure, strain_unit, stress_unit)
 
 
