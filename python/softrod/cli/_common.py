@@ -169,6 +169,9 @@ def check_files(args: argparse.Namespace) -> None:
             a figure extension matplotlib cannot write, an output that is a folder or whose
             folder does not exist.
     """
+    for d in (*getattr(args, "_inputs", ()), *getattr(args, "_outputs", ())):
+        if getattr(args, d, None) == "":
+            raise bad(option_name(d), "", "is an empty file name")
     inputs = [
         (option_name(d), getattr(args, d))
         for d in getattr(args, "_inputs", ())

@@ -59,10 +59,19 @@ def _cmd_inverse(args) -> int:
         r = np.array(args.rotation, dtype=float).reshape(3, 3)
         rotations = np.repeat(r[None], len(targets), axis=0)
     kwargs = {}
-    if args.tension_bounds is not None:
-        kwargs["tension_bounds"] = _bounds(args, "tension_bounds")
-    if args.pressure_bounds is not None:
-        kwargs["pressure_bounds"] = _bounds(args, "pressure_bounds")
+    for dest, actuators, kind in (
+        ("tension_bounds", robot.tendons, "tendons"),
+        ("pressure_bounds", robot.chambers, "chambers"),
+    ):
+        if getattr(args, dest) is None:
+            continue
+        if not actuators:
+            raise bad(
+                "--" + dest.replace("_", "-"),
+                " ".join(map(str, getattr(args, dest))),
+                f"bounds no actuator: {robot.name} has no {kind}",
+            )
+        kwargs[dest] = _bounds(args, dest)
     path = inverse_statics_path(
         robot,
         targets,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._core import ParameterError
 from ._common import (
     _positive_int,
     add_actuation,
@@ -39,14 +40,20 @@ def _cmd_study(args) -> int:
         raise bad("--levels", args.levels, too_many)
 
     robot = load_robot(args.robot)
-    results = compliance_study(
-        robot,
-        levels=args.levels,
-        max_pressure=args.max_pressure,
-        out_dir=args.out,
-        progress=True if args.progress else None,
-        overwrite=args.overwrite,
-    )
+    try:
+        results = compliance_study(
+            robot,
+            levels=args.levels,
+            max_pressure=args.max_pressure,
+            out_dir=args.out,
+            progress=True if args.progress else None,
+            overwrite=args.overwrite,
+        )
+    except ParameterError as exc:
+        prefix = f"invalid parameter `robot_path` = {robot.name!r}: "
+        if not str(exc).startswith(prefix):
+            raise
+        raise bad("ROBOT", args.robot, str(exc).removeprefix(prefix)) from None
     if args.csv:
         header = ["material", "p1", "p2", "p3", "x", "y", "z", "max_translational_compliance"]
         rows = [
