@@ -14,6 +14,7 @@ import softrod
 from softrod.cli import main
 
 PNEUMATIC = softrod.examples.path("pneumatic_arm")
+TENSILE = softrod.examples.DATA / "silicone-tensile" / "Dragon Skin 10 MEDIUM.csv"
 ROBOT = """[rod]
 length = 0.4
 [rod.section]
@@ -189,3 +190,48 @@ def test_warnings_are_one_line(tmp_path, capsys):
     lines = [ln for ln in err.splitlines() if ln]
     assert status == 0 and lines[0].startswith("softrod: warning: the equilibrium"), err
     assert lines[0].endswith("(StabilityWarning)") and ".py:" not in err, err
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["solve", "niti_two_segment", "--json", ""], "`--json` = '': is an empty file name"),
+        (
+            [
+                *("inverse", "niti_two_segment", "--target", "0.1", "0.1", "0.3"),
+                *("--pressure-bounds", "0", "1e5"),
+            ],
+            "`--pressure-bounds`",
+        ),
+        (
+            ["study", "niti_two_segment", "--levels", "2", "--out", "st"],
+            "`ROBOT`",
+        ),
+        (["fit", TENSILE, "--stress-unit", "bogus"], "`stress_unit` = 'bogus'"),
+        (["fit", TENSILE, "--strain-unit", "percent"], "for plain files"),
+    ],
+)
+def test_options_that_would_be_ignored_or_misnamed_are_named(
+    tmp_path, capsys, monkeypatch, argv, words
+):
+    monkeypatch.chdir(tmp_path)
+    status, _, err = _run(argv, capsys)
+    assert status == 2 and words in err, err
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_robot_file_s_values_are_named_as_given(tmp_path, capsys):
+    base = open(softrod.examples.path("niti_two_segment")).read()
+    clamp = tmp_path / "clamp.toml"
+    clamp.write_text(
+        base + '\n[tip_constraint]\ntype = "clamp"\nposition = [0.1, 0.0, 0.35]\n'
+        "rotation = [[2, 0, 0], [0, 1, 0], [0, 0, 1]]\n"
+    )
+    status, _, err = _run(["solve", clamp], capsys)
+    assert status == 2 and "`tip_constraint.rotation`" in err, err
+    huge = tmp_path / "huge.toml"
+    huge.write_text(base.replace("[loads]", "[loads]\ntip_force = [1e300, 0.0, 0.0]", 1))
+    if "[loads]" not in base:
+        huge.write_text(base + "\n[loads]\ntip_force = [1e300, 0.0, 0.0]\n")
+    status, _, err = _run(["solve", huge], capsys)
+    assert status == 2 and "`loads.tip_force` = 1e300" in err, err
