@@ -178,6 +178,17 @@ def test_modulus_with_tension_scale_is_not_identifiable(niti, truth):
         ({"measurements": [([1.0, 2.0], np.linspace([0, 0, 0], [0, 0, 0.4], 5))]}, "6 tendons"),
         ({"measurements": [(TENSIONS[0], np.zeros((5, 2)))]}, "measurements\\[0\\]"),
         ({"measurements": [(TENSIONS[0], np.ones((3, 3)), [0.1, 0.2])]}, "arc length"),
+        # A positive parameter started at or below 0: named as > 0, not as the default
+        # bounds a factor of 1000 about it (they were shown as [0.001, 1000] and (0, 0)).
+        (
+            {"initial": {"youngs_modulus": -1.0}},
+            r"initial\['rod.material.youngs_modulus'\]` = -1.0: must be > 0",
+        ),
+        ({"initial": {"youngs_modulus": 0.0}}, r"= 0.0: must be > 0"),
+        (
+            {"bounds": {"youngs_modulus": (1e9, 1e9)}},
+            r"= \(1000000000.0, 1000000000.0\): must be low",
+        ),
     ],
 )
 def test_bad_input_is_a_named_error(niti, args, match):

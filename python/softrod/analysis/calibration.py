@@ -550,8 +550,18 @@ def _bounds(bounds: Any, names: Sequence[str], model, p0: np.ndarray):
                 raise _args.type_error(f"bounds[{n!r}]", b, "a pair (low, high)") from None
         else:
             a, c = model.default_bounds(n, p0[j])
+            relative = (a, c) == (abs(p0[j]) * 1e-3, abs(p0[j]) * 1e3)
+            if relative and not p0[j] > 0.0:
+                # (A positive parameter: its default bounds are a factor of 1000 either side
+                # of the start, which must then be > 0.)
+                raise _args.value_error(
+                    f"initial[{n!r}]",
+                    float(p0[j]),
+                    "> 0 (a positive parameter; without `bounds` it is fitted within a "
+                    "factor of 1000 of its start)",
+                )
         if not (a < c) or math.isnan(a) or math.isnan(c):
-            raise _args.value_error(f"bounds[{n!r}]", (a, c), "low < high")
+            raise _args.value_error(f"bounds[{n!r}]", (float(a), float(c)), "low < high")
         if not a <= p0[j] <= c:
             raise _args.value_error(
                 f"initial[{n!r}]", p0[j], f"within its bounds [{a:.6g}, {c:.6g}]"
