@@ -153,6 +153,11 @@ def validate_robot_dict(data: Any, source: str | None = None) -> RobotFile:
     return spec
 
 
+#: Largest robot file read (bytes): the largest shipped example is a few kilobytes; tables of
+#: thousands of sections or routing points stay far below it.
+MAX_ROBOT_FILE_BYTES = 64 * 2**20
+
+
 def read_robot_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Parses a robot file into its tables (no validation).
 
@@ -161,8 +166,23 @@ def read_robot_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
         ParameterError: If it is not UTF-8 text or not valid TOML (with the line).
     """
     name = os.fspath(path)
+    # (A device or a pipe, e.g. /dev/zero, would be read, or waited for, forever: a robot
+    # file is a regular file, and far smaller than the bound below.)
+    if os.path.exists(path) and not os.path.isfile(path):
+        raise_errors([FieldError("", "not a regular file", kind="type")], name)
     with open(path, "rb") as fh:
-        raw = fh.read()
+        raw = fh.read(MAX_ROBOT_FILE_BYTES + 1)
+    if len(raw) > MAX_ROBOT_FILE_BYTES:
+        raise_errors(
+            [
+                FieldError(
+                    "",
+                    f"larger than {MAX_ROBOT_FILE_BYTES // 2**20} MiB: not a robot file",
+                    kind="type",
+                )
+            ],
+            name,
+        )
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
