@@ -20,6 +20,7 @@ MAX_MODULUS: float
 MAX_BENDING_ANGLE: float
 MAX_OFFSET_RATIO: float
 MAX_STARTS: int
+MAX_FRICTION: float
 
 class ParameterError(ValueError):
     """A parameter is outside its valid range; ``parameter`` names it."""

@@ -48,6 +48,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_BENDING_ANGLE", softrod::limits::MAX_BENDING_ANGLE)?;
     m.add("MAX_OFFSET_RATIO", softrod::limits::MAX_OFFSET_RATIO)?;
     m.add("MAX_STARTS", softrod::MAX_STARTS)?;
+    m.add("MAX_FRICTION", softrod::limits::MAX_FRICTION)?;
     m.add(
         "StabilityWarning",
         m.py().get_type::<errors::StabilityWarning>(),

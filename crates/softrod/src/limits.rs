@@ -17,6 +17,7 @@
 //! - Materials: [`MAX_MODULUS`], [`MAX_DENSITY`].
 //! - Geometry: [`MAX_LENGTH`], [`MAX_BENDING_ANGLE`], and for tendon routings
 //!   [`MAX_OFFSET_RATIO`].
+//! - Friction: [`MAX_FRICTION`].
 
 use crate::error::{Error, Result};
 
@@ -48,6 +49,28 @@ pub const MAX_MODULUS: f64 = 1e13;
 
 /// Largest mass density of a rod (kg/m³): 44 times that of osmium, the densest element.
 pub const MAX_DENSITY: f64 = 1e6;
+
+/// Largest Coulomb friction coefficient (dimensionless) of a tendon in its channel, at its
+/// guides, or at an obstacle. Measured tendon-sheath and contact coefficients lie between
+/// about 0.05 and 1; at 10 the capstan factor `e^(μθ)` of one turn is 5e27, and far larger
+/// values overflow it (a coefficient of 1e308 reported a normal force of 3e-309 N).
+pub const MAX_FRICTION: f64 = 10.0;
+
+/// Checks a Coulomb friction coefficient: finite, `>= 0` and at most [`MAX_FRICTION`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name`.
+pub fn check_friction(name: &str, mu: f64) -> Result<f64> {
+    if mu.is_finite() && (0.0..=MAX_FRICTION).contains(&mu) {
+        Ok(mu)
+    } else {
+        Err(Error::invalid(
+            name,
+            mu,
+            format!("in [0, {MAX_FRICTION}] (a Coulomb coefficient, dimensionless)"),
+        ))
+    }
+}
 
 /// Largest distance of a tendon (or a PCC chamber) from the backbone, as a fraction of the rod
 /// length.

@@ -24,7 +24,7 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
-from .._core import SILICONES
+from .._core import MAX_FRICTION, SILICONES
 
 #: Largest integration steps, Newton iterations and load steps a file may ask for (named
 #: limits rather than an allocation that fails).
@@ -243,7 +243,9 @@ def _union(key: str, default: str, members: dict[str, type], by_key=None) -> Any
 class _TendonBase(_Table):
     tension: _num("tension (N)", ge=0) = 0.0
     end: _num("arc length where the tendon ends (m); default the tip", gt=0) | None = None
-    friction: _num("friction coefficient between tendon and channel (capstan law)", ge=0) = 0.0
+    friction: _num(
+        "friction coefficient between tendon and channel (capstan law)", ge=0, le=MAX_FRICTION
+    ) = 0.0
 
 
 class ConstantTendonSpec(_TendonBase):
@@ -421,7 +423,9 @@ class PlaneSpec(_Table):
     type: Literal["plane"]
     point: _vec(3, "a point of the plane (m, world)")
     normal: _vec(3, "outward normal (world; any nonzero length)")
-    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
+    friction: _num(
+        "Coulomb friction coefficient of the surface (dimensionless)", ge=0, le=MAX_FRICTION
+    ) = 0.0
 
 
 class SphereSpec(_Table):
@@ -430,7 +434,9 @@ class SphereSpec(_Table):
     type: Literal["sphere"]
     center: _vec(3, "centre (m, world)")
     radius: _num("radius (m)", gt=0)
-    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
+    friction: _num(
+        "Coulomb friction coefficient of the surface (dimensionless)", ge=0, le=MAX_FRICTION
+    ) = 0.0
 
 
 class CapsuleSpec(_Table):
@@ -440,7 +446,9 @@ class CapsuleSpec(_Table):
     a: _vec(3, "first end of the axis (m, world)")
     b: _vec(3, "second end of the axis (m, world)")
     radius: _num("radius (m)", gt=0)
-    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
+    friction: _num(
+        "Coulomb friction coefficient of the surface (dimensionless)", ge=0, le=MAX_FRICTION
+    ) = 0.0
 
 
 class CylinderSpec(_Table):
@@ -450,7 +458,9 @@ class CylinderSpec(_Table):
     a: _vec(3, "centre of the first cap (m, world)")
     b: _vec(3, "centre of the second cap (m, world)")
     radius: _num("radius (m)", gt=0)
-    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
+    friction: _num(
+        "Coulomb friction coefficient of the surface (dimensionless)", ge=0, le=MAX_FRICTION
+    ) = 0.0
 
 
 class MeshSpec(_Table):
@@ -479,7 +489,9 @@ class MeshSpec(_Table):
         ]
         | None
     ) = None
-    friction: _num("Coulomb friction coefficient of the surface (dimensionless)", ge=0) = 0.0
+    friction: _num(
+        "Coulomb friction coefficient of the surface (dimensionless)", ge=0, le=MAX_FRICTION
+    ) = 0.0
 
     @model_validator(mode="after")
     def _one_source(self) -> MeshSpec:

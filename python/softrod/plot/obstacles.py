@@ -64,14 +64,16 @@ def _radius(value: object) -> float:
 
 
 def _friction(value: object) -> float:
-    why = "must be finite and >= 0 (Coulomb coefficient, dimensionless)"
+    from .._core import MAX_FRICTION
+
+    why = f"must be in [0, {MAX_FRICTION:g}] (a Coulomb coefficient, dimensionless)"
     if isinstance(value, bool):
         raise _field_error("friction", value, why)
     try:
         mu = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         raise _field_error("friction", value, why) from None
-    if not (np.isfinite(mu) and mu >= 0):
+    if not (np.isfinite(mu) and 0 <= mu <= MAX_FRICTION):
         raise _field_error("friction", value, why)
     return mu
 

@@ -191,15 +191,10 @@ impl Obstacle {
     /// lies along (a contact interval) is refused by the solve.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `friction` if `mu` is negative or not finite.
+    /// [`Error::InvalidParameter`] naming `friction` outside `[0,`
+    /// [`MAX_FRICTION`](crate::limits::MAX_FRICTION)`]`.
     pub fn with_friction(self, mu: f64) -> Result<Self> {
-        if !(mu.is_finite() && mu >= 0.0) {
-            return Err(Error::invalid(
-                "friction",
-                mu,
-                "finite and >= 0 (Coulomb coefficient, dimensionless)",
-            ));
-        }
+        crate::limits::check_friction("friction", mu)?;
         let shape = match self {
             Self::Frictional { shape, .. } => *shape,
             other => other,

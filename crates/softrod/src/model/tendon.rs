@@ -171,9 +171,10 @@ impl Tendon {
     /// path (see `cosserat::friction`). `0` (the default) is a frictionless tendon.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `friction` (not finite or negative).
+    /// [`Error::InvalidParameter`] naming `friction` (outside `[0,`
+    /// [`MAX_FRICTION`](crate::limits::MAX_FRICTION)`]`).
     pub fn with_friction(mut self, mu: f64) -> Result<Self> {
-        check_non_negative("friction", mu, "")?;
+        crate::limits::check_friction("friction", mu)?;
         self.friction = mu;
         Ok(self)
     }
@@ -194,8 +195,8 @@ impl Tendon {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `guides[g]` (not finite, <= 0 or not increasing) or
-    /// `guide_friction` (a length other than 1 or `guides.len()`, or a value not finite or
-    /// negative).
+    /// `guide_friction` (a length other than 1 or `guides.len()`, or a value outside `[0,`
+    /// [`MAX_FRICTION`](crate::limits::MAX_FRICTION)`]`).
     pub fn with_guides(mut self, guides: Vec<f64>, friction: &[f64]) -> Result<Self> {
         for (g, &s) in guides.iter().enumerate() {
             if !(s.is_finite() && s > 0.0) || (g > 0 && s <= guides[g - 1]) {
@@ -218,7 +219,7 @@ impl Tendon {
             }
         };
         for (g, &mu) in per.iter().enumerate() {
-            check_non_negative(&format!("guide_friction[{g}]"), mu, "")?;
+            crate::limits::check_friction(&format!("guide_friction[{g}]"), mu)?;
         }
         self.guides = guides;
         self.guide_friction = if self.guides.is_empty() {
