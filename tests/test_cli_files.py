@@ -235,3 +235,24 @@ def test_a_robot_file_s_values_are_named_as_given(tmp_path, capsys):
         huge.write_text(base + "\n[loads]\ntip_force = [1e300, 0.0, 0.0]\n")
     status, _, err = _run(["solve", huge], capsys)
     assert status == 2 and "`loads.tip_force` = 1e300" in err, err
+
+
+def test_a_robot_argument_that_is_no_regular_file_is_refused_at_once(tmp_path, capsys):
+    # (/dev/zero was read forever; a pipe without a writer waits forever when opened.)
+    fifo = tmp_path / "pipe.toml"
+    os.mkfifo(fifo)
+    for path in ("/dev/zero", fifo, tmp_path):
+        status, _, err = _run(["solve", path], capsys)
+        assert status == 2 and "not a regular file" in err, err
+
+
+@pytest.mark.parametrize("mu", [1e308, 10.5, -0.1])
+def test_a_friction_coefficient_beyond_any_measured_one_is_refused(mu):
+    # (1e308 reported a normal force of 3e-309 N.)
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.Tendon([0.004, 0.0], 1.0, friction=mu)
+    assert e.value.parameter == "friction" and "in [0, 10]" in str(e.value)
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.Plane([0, 0, 0], [0, 0, 1], friction=mu)
+    assert e.value.parameter == "friction"
+    assert softrod.Tendon([0.004, 0.0], 1.0, friction=softrod._core.MAX_FRICTION).friction == 10
