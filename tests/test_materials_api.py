@@ -561,3 +561,24 @@ def test_the_core_fit_names_the_data_not_a_fitted_coefficient():
         fit_uniaxial(strain, stress, "yeoh")
     assert exc.value.parameter == "data"
     assert "yeoh law" in str(exc.value) and "fitted coefficient c10 = -" in str(exc.value)
+
+
+def test_a_curve_beyond_any_modulus_or_without_strain_is_named(tmp_path):
+    # (1e308 Pa overflowed the fit, "initial slope inf kPa"; all-zero strains gave nan.)
+    with pytest.raises(softrod.ParameterError, match=r"`stress\[1\]` = 1e\+308"):
+        softrod.TensileCurve(np.array([0.0, 0.1, 0.2]), np.array([0.0, 1e308, 3.0]))
+    flat = softrod.TensileCurve(np.zeros(4), np.zeros(4))
+    with pytest.raises(softrod.ParameterError, match="smallest values all 0"):
+        flat.initial_slope()
+    header_only = tmp_path / "empty.csv"
+    lines = (
+        softrod.examples.DATA.joinpath("silicone-tensile", "Dragon Skin 10 MEDIUM.csv")
+        .read_text(encoding="utf-8-sig")
+        .splitlines()
+    )
+    from softrod.analysis.materials import _DATABASE_HEADER
+
+    k = next(i for i, ln in enumerate(lines) if ln.startswith(_DATABASE_HEADER))
+    header_only.write_text("\n".join(lines[: k + 1]) + "\n")
+    with pytest.raises(softrod.ParameterError, match=r"empty\.csv.*at least one row"):
+        softrod.read_tensile_csv(header_only)

@@ -21,6 +21,7 @@ MAX_BENDING_ANGLE: float
 MAX_OFFSET_RATIO: float
 MAX_STARTS: int
 MAX_FRICTION: float
+MAX_MODULUS: float
 
 class ParameterError(ValueError):
     """A parameter is outside its valid range; ``parameter`` names it."""

@@ -49,6 +49,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_OFFSET_RATIO", softrod::limits::MAX_OFFSET_RATIO)?;
     m.add("MAX_STARTS", softrod::MAX_STARTS)?;
     m.add("MAX_FRICTION", softrod::limits::MAX_FRICTION)?;
+    m.add("MAX_MODULUS", softrod::limits::MAX_MODULUS)?;
     m.add(
         "StabilityWarning",
         m.py().get_type::<errors::StabilityWarning>(),

@@ -94,6 +94,14 @@ class TensileCurve:
             )
         if self.strain_measure not in _STRAIN_MEASURES:
             raise _bad("strain_measure", repr(self.strain_measure), " or ".join(_STRAIN_MEASURES))
+        from .._core import MAX_MODULUS
+
+        # (A stress beyond any modulus overflowed the fit: "initial slope inf kPa".)
+        big = np.flatnonzero(np.abs(stress) > MAX_MODULUS)
+        if big.size:
+            raise _bad(
+                f"stress[{big[0]}]", f"{stress[big[0]]:g}", f"of magnitude <= {MAX_MODULUS:g} Pa"
+            )
         if self.stress_measure not in _STRESS_MEASURES:
             raise _bad("stress_measure", repr(self.stress_measure), " or ".join(_STRESS_MEASURES))
         if not isinstance(self.name, str):
@@ -130,6 +138,13 @@ class TensileCurve:
             pick = np.zeros(len(strain), dtype=bool)
             pick[order[:INITIAL_POINTS]] = True
         e, p = strain[pick], nominal[pick]
+        if not np.any(e != 0.0):
+            raise _bad(
+                "strain",
+                f"{e.size} smallest values all 0",
+                "some nonzero among the smallest (the initial slope is that of the stress "
+                "against them)",
+            )
         return float(np.sum(p * e) / np.sum(e * e))
 
     def fit(self, model: str = "yeoh", **options) -> UniaxialFit:
@@ -182,6 +197,8 @@ def _read_database(path: Path, lines: list[str], header_at: int, columns: str) -
             stress.append(float(parts[i_stress]) * 1e6)  # MPa -> Pa
         except (IndexError, ValueError):
             raise _bad(f"{path.name}:{number}", repr(line), "numbers in every column") from None
+    if not strain:
+        raise _bad("path", str(path), "a database file with at least one row of data")
     return TensileCurve(
         np.array(strain),
         np.array(stress),
