@@ -101,6 +101,23 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
     print(f"softrod: warning: {text} ({category.__name__})", file=sys.stderr)
 
 
+def _dash_hint(exc: Exception, argv: Sequence[str] | None) -> str:
+    """For an option that found no value where the value starts with ``-`` (argparse reads
+    ``-1:1`` as an option), how to write it."""
+    tokens = list(sys.argv[1:] if argv is None else argv)
+    if "expected" not in str(exc):
+        return ""
+    for option, value in zip(tokens, tokens[1:]):
+        if (
+            option.startswith("--")
+            and len(value) > 1
+            and value[0] == "-"
+            and value[1] in "0123456789."
+        ):
+            return f"; a value that starts with '-' is written {option}={value}"
+    return ""
+
+
 def _main(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
@@ -111,7 +128,7 @@ def _main(argv: Sequence[str] | None) -> int:
     except SystemExit as exc:  # --help and --version
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:
-        return _fail(one_line(exc), EXIT_BAD_INPUT)
+        return _fail(one_line(exc) + _dash_hint(exc, argv), EXIT_BAD_INPUT)
     except ParameterError as exc:
         return _fail(one_line(exc), EXIT_BAD_INPUT)
     except (ConvergenceError, NoResultError) as exc:
