@@ -19,6 +19,7 @@ exits with status 3.
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import sys
 from collections.abc import Sequence
@@ -107,7 +108,7 @@ def _dash_hint(exc: Exception, argv: Sequence[str] | None) -> str:
     tokens = list(sys.argv[1:] if argv is None else argv)
     if "expected" not in str(exc):
         return ""
-    for option, value in zip(tokens, tokens[1:]):
+    for option, value in itertools.pairwise(tokens):
         if (
             option.startswith("--")
             and len(value) > 1
