@@ -256,3 +256,11 @@ def test_a_friction_coefficient_beyond_any_measured_one_is_refused(mu):
         softrod.Plane([0, 0, 0], [0, 0, 1], friction=mu)
     assert e.value.parameter == "friction"
     assert softrod.Tendon([0.004, 0.0], 1.0, friction=softrod._core.MAX_FRICTION).friction == 10
+
+
+def test_a_value_that_starts_with_a_dash_is_explained(capsys):
+    # (argparse reads -1:1 as an option: "expected one argument" alone.)
+    status, _, err = _run(["workspace", "niti_two_segment", "--sweep", "-1:1"], capsys)
+    assert status == 2 and "is written --sweep=-1:1" in err, err
+    status, _, err = _run(["workspace", "niti_two_segment", "--sweep=-1:1"], capsys)
+    assert status == 2 and "`--sweep` = '-1:1'" in err, err
