@@ -117,13 +117,10 @@ def referenced_inputs(args: argparse.Namespace, inputs) -> list[tuple[str, str]]
         if name != "ROBOT" or not path.endswith(".toml") or not os.path.isfile(path):
             continue
         try:
-            try:
-                import tomllib
-            except ImportError:  # pragma: no cover - Python 3.10
-                import tomli as tomllib
-            with open(path, "rb") as f:
-                tables = tomllib.load(f)
-        except (OSError, ValueError):
+            from ..io.robot_file import read_robot_toml
+
+            tables = read_robot_toml(path)
+        except (OSError, ParameterError):
             continue  # (the command reports an unreadable robot file itself)
         obstacles = tables.get("obstacles", [])
         for k, o in enumerate(obstacles if isinstance(obstacles, list) else []):
@@ -181,18 +178,21 @@ def check_files(args: argparse.Namespace) -> None:
     if more is not None:
         inputs += list(more(args))
     inputs += referenced_inputs(args, inputs)
-    outputs = [
-        (d, getattr(args, d)) for d in getattr(args, "_outputs", ()) if getattr(args, d, None)
-    ]
-    figures = set(getattr(args, "_figures", ()))
+    # (dest, path, whether the path is a folder): the outputs, then the files a command
+    # writes into its folder output (checked as files, named by the folder's option).
     folders = set(getattr(args, "_folders", ("out",)))
+    outputs = [
+        (d, getattr(args, d), d in folders)
+        for d in getattr(args, "_outputs", ())
+        if getattr(args, d, None)
+    ]
     inside = getattr(args, "_folder_files", None)
     if inside is not None:
-        # (A file written into a folder output is checked as a file under the folder's name.)
-        outputs += [(f"{dest}/", path) for dest, path in inside(args)]
+        outputs += [(dest, path, False) for dest, path in inside(args)]
+    figures = set(getattr(args, "_figures", ()))
     seen: list[tuple[str, str]] = []
-    for dest, path in outputs:
-        name = option_name(dest.removesuffix("/"))
+    for dest, path, is_folder in outputs:
+        name = option_name(dest)
         path = os.fspath(path)
         for in_name, in_path in inputs:
             if _same(path, os.fspath(in_path)):
@@ -200,27 +200,27 @@ def check_files(args: argparse.Namespace) -> None:
         for other, other_path in seen:
             if _same(path, other_path):
                 raise bad(name, path, f"is also the output of {option_name(other)}")
-        if os.path.isdir(path) and dest not in folders:
+        if is_folder:
+            if os.path.exists(path) and not os.path.isdir(path):
+                raise bad(name, path, "is a file (give a folder)")
+            seen.append((dest, path))
+            continue
+        if os.path.isdir(path):
             raise bad(name, path, "is a folder (give a file name)")
-        if dest not in folders and path.endswith(("/", os.sep)):
+        if path.endswith(("/", os.sep)):
             raise bad(name, path, "names a folder (give a file name)")
         if (
-            dest not in folders
-            and os.path.exists(path)
+            os.path.exists(path)
             and not getattr(args, "overwrite", False)
             and not (getattr(args, "_demo", False) and written_by_demo(path))
         ):
             raise bad(name, path, "exists (pass --overwrite to replace it)")
-        if dest in folders:
-            if os.path.exists(path) and not os.path.isdir(path):
-                raise bad(name, path, "is a file (give a folder)")
-        else:
-            folder = os.path.dirname(os.path.abspath(path))
-            if not os.path.isdir(folder):
-                if not dest.endswith("/"):  # (a folder output is made by its command)
-                    raise bad(name, path, f"the folder {folder!r} does not exist")
-            elif not os.access(folder, os.W_OK):
-                raise bad(name, path, f"the folder {folder!r} is not writable")
+        folder = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(folder):
+            if dest not in folders:  # (a folder output is made by its command)
+                raise bad(name, path, f"the folder {folder!r} does not exist")
+        elif not os.access(folder, os.W_OK):
+            raise bad(name, path, f"the folder {folder!r} is not writable")
         if dest in figures:
             from ..plot._figure import check_figure_path
 
