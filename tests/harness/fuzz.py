@@ -1773,6 +1773,7 @@ NOT_CONSTRUCTED = {
     "Backbone",
     "Calibration",
     "IdentifiabilityWarning",
+    "PoorFitWarning",
     "BackboneQuality",
     "BackboneDistance",
     "Compliance",

@@ -171,8 +171,10 @@ def read_robot_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
     if os.path.exists(path) and not os.path.isfile(path):
         raise_errors([FieldError("", "not a regular file", kind="type")], name)
     with open(path, "rb") as fh:
-        raw = fh.read(MAX_ROBOT_FILE_BYTES + 1)
-    if len(raw) > MAX_ROBOT_FILE_BYTES:
+        # (Its size first: read(n) would allocate the n bytes however short the file.)
+        too_large = os.fstat(fh.fileno()).st_size > MAX_ROBOT_FILE_BYTES
+        raw = b"" if too_large else fh.read()
+    if too_large:
         raise_errors(
             [
                 FieldError(
