@@ -114,16 +114,20 @@ fn niti_round_trip_reaches_every_target_inside_the_bounds() {
     assert_eq!(reached, n);
 }
 
-#[test]
-fn niti_under_gravity_and_tip_load_reaches_targets() {
-    // A lateral tip load (an axial 0.2 N would exceed the rod's Euler load, 0.16 N: several
-    // equilibria per actuation).
+/// The NiTi robot (density 6450 kg/m³) under gravity along -y and a lateral tip load (an
+/// axial 0.2 N would exceed the rod's Euler load, 0.16 N: several equilibria per actuation).
+fn niti_under_gravity_and_tip_load() -> Arc<RobotModel> {
     let loads = Loads {
         tip_force: Vector3::new(0.02, 0.0, -0.01),
         gravity: Vector3::new(0.0, -9.81, 0.0),
         ..Default::default()
     };
-    let model = niti(loads, Some(6450.0));
+    niti(loads, Some(6450.0))
+}
+
+#[test]
+fn niti_under_gravity_and_tip_load_reaches_targets() {
+    let model = niti_under_gravity_and_tip_load();
     let o = SolveOptions::default();
     let mut g = Lcg(5);
     for _ in 0..6 {
@@ -665,12 +669,7 @@ fn several_starts_reach_a_target_beyond_a_fold() {
 /// the next.
 #[test]
 fn a_forward_model_that_forgets_evaluates_as_a_new_one() {
-    let loads = Loads {
-        tip_force: Vector3::new(0.02, 0.0, -0.01),
-        gravity: Vector3::new(0.0, -9.81, 0.0),
-        ..Default::default()
-    };
-    let model = niti(loads, Some(6450.0));
+    let model = niti_under_gravity_and_tip_load();
     let o = SolveOptions::default();
     let (far, near) = (
         [0.0, 2.5, 0.0, 3.0, 0.0, 2.0],
