@@ -140,3 +140,30 @@ def test_pareto_of_dataarrays_keeps_coordinates():
         softrod.Pareto(da, db, better=("up", "max"))
     with pytest.raises(softrod.ParameterError, match="same shape"):
         softrod.Pareto([1.0, 2.0], [1.0])
+
+
+def test_a_robot_with_obstacles_or_a_tip_constraint_is_refused():
+    # (A sweep solves the free rod: its samples went through a sphere, reported converged and
+    # stable.)
+    niti = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    kw = {"rod": niti.rod, "tendons": niti.tendons, "solver": niti.solver}
+    for extra in (
+        {"obstacles": [softrod.Sphere((0.06, 0, 0.3), 0.04)]},
+        {"tip_constraint": softrod.Pin((0.05, 0, 0.38))},
+    ):
+        with pytest.raises(softrod.ParameterError) as e:
+            softrod.sweep(softrod.Robot(**kw, **extra), progress=False)
+        assert e.value.parameter == "robot" and "robot.solve" in str(e.value)
+    with pytest.raises(TypeError, match="`robot`"):
+        softrod.sweep(None)  # (a ParameterTypeError: a TypeError naming `robot`)
+
+
+def test_an_integer_parameter_is_a_design_axis():
+    # (Grid values are floats: solver.steps = 40.0 was refused as "must be an integer".)
+    niti = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    ds = softrod.sweep(niti, design={"solver.steps": [40, 80, 10**9]}, progress=False)
+    assert list(ds["design_error"].values[:2]) == ["", ""]
+    assert "must be <= " in ds["design_error"].values[2]
+    for k, steps in enumerate((40, 80)):
+        want = niti.with_parameters({"solver.steps": steps}).solve().tip_position
+        np.testing.assert_array_equal(ds["tip_position"].values[k], want)

@@ -93,6 +93,10 @@ def plan(n_design: int, n_act: int, chunk: int, block: int) -> list[list[tuple[i
 def design_robot(robot, values: dict):
     """The robot of a design point and the message of its infeasibility (None if feasible):
     ``with_parameters`` and the core's model validation, without a solve."""
+    # (A grid is of floats: whole values go in as integers, which an integer parameter such as
+    # solver.steps needs and a float parameter reads exactly; a fractional value for an
+    # integer parameter is left for the robot file to refuse.)
+    values = {k: int(v) if float(v).is_integer() else v for k, v in values.items()}
     try:
         r = robot.with_parameters(values) if values else robot
         _core._sweep([_job(r, np.zeros((0, 0)), TaskSpec((), (), (), (), 1))], outputs=[])

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _args
 from .._core import ParameterError, __version__
 from . import _sweep_run as run
 from ._sweep_axes import (
@@ -230,14 +231,27 @@ def sweep(
             grid that is not 1-D or not finite, a bad tension or pressure (named by its path),
             an arc length beyond the rod (the shortest design rod with ``rod.length`` a design
             axis), two axes naming one parameter (both named), more points than the limit
-            (the number of points and the limit named; refused before any allocation).
+            (the number of points and the limit named; refused before any allocation); a
+            robot with obstacles or a tip constraint (named ``robot``: sweeps solve the free
+            rod).
+        ParameterTypeError: ``robot`` is not a :class:`softrod.Robot`.
     """
     import xarray as xr
 
     from ..robot import Robot
 
     if not isinstance(robot, Robot):
-        raise TypeError(f"invalid parameter `robot` = {robot!r}: must be a softrod.Robot")
+        raise _args.type_error("robot", robot, "a softrod.Robot")
+    if robot.obstacles or robot.tip_constraint is not None:
+        # (Sweeps solve the free rod: its samples went through the obstacles, reported
+        # converged.)
+        what = "obstacles" if robot.obstacles else "a tip constraint"
+        raise _args.value_error(
+            "robot",
+            robot.name,
+            f"a robot without obstacles or a tip constraint (it has {what}; a sweep solves "
+            "the free rod: solve each sample with robot.solve)",
+        )
     names = _outputs(outputs)
     block = _positive_int("block", block)
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
