@@ -602,3 +602,15 @@ offset = [7.943667500113832e-05, 0.0005177715291846196]
     fine = miss({"steps": 1280})
     assert plain.value.distance < 1e-8 and fine < 1e-8
     assert miss() < 1e-8
+
+
+def test_a_shape_target_out_of_reach_is_fitted_not_raised():
+    # A point 0.3 m up at the arc length 0.2 m: no shape reaches it; the closest any point at
+    # s = 0.2 can come is 0.1 m (the straight rod, to its axial strain). Fitted: converged,
+    # not reached, no TargetUnreachableError; the distance is the forward solve's.
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    inv = softrod.inverse_statics(robot, [[0.0, 0.0, 0.3]], target_s=[0.2])
+    assert inv.converged and not inv.reached
+    assert abs(inv.position_error - 0.1) <= 1e-6
+    back = robot.solve(inv.tensions, s_out=[0.2]).position[0]
+    assert abs(np.linalg.norm(back - [0.0, 0.0, 0.3]) - inv.position_error) <= 1e-9
