@@ -302,3 +302,20 @@ def test_a_push_on_top_of_a_sphere_slides_off_past_the_tip_stiffness(ratio, stab
     warned = [w for w in caught if issubclass(w.category, sr.StabilityWarning)]
     assert bool(warned) is not stable
     assert all("contacts held" in str(w.message) for w in warned)
+
+
+def test_a_copied_obstacle_and_too_many_obstacles_are_refused():
+    # (Two copies of one plane gave another, unstable equilibrium reported converged; 2,000
+    # copies of a sphere ran for minutes and gigabytes.)
+    rod = sr.Rod(1.0, sr.CircularSection(1e-3), sr.LinearElastic(2e9, 0.3))
+    loads = sr.Loads(tip_force=(0.05, 0, 0))
+    plane = sr.Plane((0.02, 0, 0), (-1, 0, 0))
+    one = sr.solve_statics(rod, loads=loads, obstacles=[plane])
+    assert one.stable and one.tip_position[0] <= 0.02 + 1e-9
+    with pytest.raises(sr.ParameterError) as e:
+        sr.solve_statics(rod, loads=loads, obstacles=[plane, plane])
+    assert e.value.parameter == "obstacles[1]" and "obstacles[0] again" in str(e.value)
+    sphere = sr.Sphere((0.05, 0, 0.7), 0.04)
+    with pytest.raises(sr.ParameterError) as e:
+        sr.solve_statics(rod, loads=loads, obstacles=[sphere] * 2000)
+    assert e.value.parameter == "obstacles.len()" and "[0, 256]" in str(e.value)

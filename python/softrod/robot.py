@@ -246,9 +246,9 @@ class Robot:
                 ``source``, the first field that differs and both values).
         """
         if not isinstance(rod, Rod):
-            raise TypeError(f"invalid parameter `rod` = {rod!r}: must be a softrod.Rod")
+            raise _args.type_error("rod", rod, "a softrod.Rod")
         if loads is not None and not isinstance(loads, Loads):
-            raise TypeError(f"invalid parameter `loads` = {loads!r}: must be a softrod.Loads")
+            raise _args.type_error("loads", loads, "a softrod.Loads")
         if not isinstance(name, str):
             raise _args.type_error("name", name, "a string")
         if not isinstance(description, str):

@@ -18,6 +18,7 @@
 //! - Geometry: [`MAX_LENGTH`], [`MAX_BENDING_ANGLE`], and for tendon routings
 //!   [`MAX_OFFSET_RATIO`].
 //! - Friction: [`MAX_FRICTION`].
+//! - Scenes: [`MAX_OBSTACLES`].
 
 use crate::error::{Error, Result};
 
@@ -71,6 +72,11 @@ pub fn check_friction(name: &str, mu: f64) -> Result<f64> {
         ))
     }
 }
+
+/// Most obstacles of one solve. Each is searched at every node of every march; a scene of
+/// many shapes is one triangle mesh (a mesh counts once, whatever its triangles). 2,000 copies
+/// of one sphere ran for minutes and gigabytes before this bound.
+pub const MAX_OBSTACLES: usize = 256;
 
 /// Largest distance of a tendon (or a PCC chamber) from the backbone, as a fraction of the rod
 /// length.

@@ -18,6 +18,32 @@ use crate::error::{Error, Result};
 use crate::model::{Actuation, RobotModel};
 use crate::solve::{Evaluated, NewtonOptions, Problem};
 
+/// Checks a scene: at most [`MAX_OBSTACLES`](crate::limits::MAX_OBSTACLES) obstacles, none
+/// given twice (two copies of one plane are two coincident contacts, whose reactions no
+/// equilibrium determines: a copied plane gave another, unstable equilibrium).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `obstacles.len()` (too many) or `obstacles[j]` (a copy of an
+/// earlier one).
+pub(crate) fn check_obstacles(obstacles: &[Obstacle]) -> Result<()> {
+    crate::limits::check_count(
+        "obstacles.len()",
+        obstacles.len(),
+        0,
+        crate::limits::MAX_OBSTACLES,
+    )?;
+    for (j, o) in obstacles.iter().enumerate() {
+        if let Some(i) = obstacles[..j].iter().position(|e| e == o) {
+            return Err(Error::invalid(
+                format!("obstacles[{j}]"),
+                format!("obstacles[{i}] again"),
+                "each obstacle once (a copy is a second contact at the same place)",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Solves the statics of `model` under `actuation` with the tip held by `tip` (if any) and
 /// the rod's surface kept out of `obstacles` by unilateral contact (frictionless, or with
 /// Coulomb friction at point contacts: see [`Obstacle::with_friction`] and
@@ -38,7 +64,8 @@ use crate::solve::{Evaluated, NewtonOptions, Problem};
 ///
 /// # Errors
 /// As [`solve_statics`] for the model, actuation and options; [`Error::InvalidParameter`]
-/// naming `friction` when the rod lies along a plane with friction (a contact interval:
+/// naming `obstacles.len()` beyond [`MAX_OBSTACLES`](crate::limits::MAX_OBSTACLES) or
+/// `obstacles[j]` for a copy of an earlier obstacle, and `friction` when the rod lies along a plane with friction (a contact interval:
 /// friction is modelled at point contacts only); [`Error::NotConverged`] (with
 /// the iterations, residual and load factor reached) when no equilibrium with a consistent
 /// active set is found and `options.newton.throw` is set.
@@ -51,6 +78,7 @@ pub fn solve_constrained(
 ) -> Result<ContactSolution> {
     options.validate()?;
     model.check_actuation(actuation)?;
+    check_obstacles(obstacles)?;
     if tip.is_none() && obstacles.is_empty() {
         let solution = solve_statics(model, actuation, options)?;
         let n = solution.s.len();
