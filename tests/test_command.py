@@ -614,3 +614,13 @@ def test_a_shape_target_out_of_reach_is_fitted_not_raised():
     assert abs(inv.position_error - 0.1) <= 1e-6
     back = robot.solve(inv.tensions, s_out=[0.2]).position[0]
     assert abs(np.linalg.norm(back - [0.0, 0.0, 0.3]) - inv.position_error) <= 1e-9
+
+
+def test_a_tolerance_below_the_forward_solves_precision_is_named():
+    # (tolerance = 1e-30 m was reported "out of reach" at a few 1e-12 m.)
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    target = robot.solve([0.0, 1.5, 0.4, 0.8, 0.0, 0.0]).tip_position
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.inverse_statics(robot, target, tolerance=1e-30)
+    assert e.value.parameter == "tolerance" and "precision" in str(e.value)
+    assert softrod.inverse_statics(robot, target).position_error <= 1e-10

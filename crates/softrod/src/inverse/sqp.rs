@@ -410,11 +410,7 @@ fn stopped(
     let out = it.finish(p, lin, converged);
     if !converged && p.options.throw {
         if stationary || (least_squares && !lin.reached) {
-            return Err(Error::TargetUnreachable {
-                distance: lin.dist,
-                rotation: lin.rot,
-                iterations: out.iterations,
-            });
+            return Err(unreachable(p, lin, out.iterations));
         }
         return Err(Error::NotConverged {
             what: "inverse statics (SQP)".into(),
@@ -435,13 +431,54 @@ fn stuck(p: &Program<'_>, it: Iterate, lin: &Linear) -> Result<InverseSolution> 
     let converged = p.shape && !lin.reached;
     let out = it.finish(p, lin, converged);
     if p.options.throw && !out.converged {
-        return Err(Error::TargetUnreachable {
-            distance: lin.dist,
-            rotation: lin.rot,
-            iterations: out.iterations,
-        });
+        return Err(unreachable(p, lin, out.iterations));
     }
     Ok(out)
+}
+
+/// Precision of the forward solves' poses, as a fraction of the rod length (and in rad): a
+/// tolerance below it asks for digits the forward solves do not resolve.
+const RESOLVED_FRACTION: f64 = 1e-11;
+
+/// Closest distance, as a fraction of the rod length (and in rad), within which an iteration
+/// that asked for a tolerance below [`RESOLVED_FRACTION`] is taken to have got as close as
+/// the forward solves allow.
+const NEAR_FRACTION: f64 = 1e-8;
+
+/// [`Error::TargetUnreachable`] for the closest pose of `lin`, unless a tolerance asked for
+/// less than the forward solves resolve and the pose is that close: then the tolerance is
+/// named ([`Error::InvalidParameter`]; `tolerance = 1e-30` m was reported out of reach at
+/// 8.5e-12 m).
+fn unreachable(p: &Program<'_>, lin: &Linear, iterations: usize) -> Error {
+    let o = &p.options;
+    let near = lin.dist <= NEAR_FRACTION * p.length && lin.rot <= NEAR_FRACTION;
+    let below = [
+        ("tolerance", o.tolerance, RESOLVED_FRACTION * p.length, "m"),
+        (
+            "rotation_tolerance",
+            o.rotation_tolerance,
+            RESOLVED_FRACTION,
+            "rad",
+        ),
+    ]
+    .into_iter()
+    .find(|(_, value, floor, _)| value < floor);
+    if let (true, Some((name, value, floor, unit))) = (near, below) {
+        return Error::invalid(
+            name,
+            value,
+            format!(
+                "at least about {floor:.1e} {unit} here (the forward solves' precision): the \
+                 iteration stops {:.3e} m and {:.3e} rad from the target",
+                lin.dist, lin.rot
+            ),
+        );
+    }
+    Error::TargetUnreachable {
+        distance: lin.dist,
+        rotation: lin.rot,
+        iterations,
+    }
 }
 
 /// The step from the iterate: the SQP step `step` if inside the trust region, else the
