@@ -197,8 +197,10 @@ def test_bad_input_is_a_named_error(niti, args, match):
         "parameters": ["youngs_modulus"],
     }
     kwargs.update(args)
-    with pytest.raises(softrod.ParameterError, match=match):
+    with pytest.raises(softrod.ParameterError, match=match) as e:
         softrod.calibrate(niti, kwargs.pop("measurements"), kwargs.pop("parameters"), **kwargs)
+    # (The name the message gives is the error's `parameter`: it was None for several.)
+    assert e.value.parameter and f"`{e.value.parameter}`" in str(e.value)
 
 
 @pytest.mark.parametrize(

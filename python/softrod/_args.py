@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -49,6 +50,15 @@ def _error(cls, name: str, value: Any, expected: str, described: bool):
     shown = describe(value) if described else value
     err = cls(f"invalid parameter `{name}` = {shown}: must be {expected}")
     err.parameter = name
+    return err
+
+
+def bad(message: str) -> ParameterError:
+    """A ``ParameterError`` of a message worded ``invalid parameter `name` ...``, naming
+    ``name`` (its ``parameter``) as the errors of :func:`value_error` do."""
+    err = ParameterError(message)
+    found = re.match(r"invalid parameter `([^`]+)`", message)
+    err.parameter = found.group(1) if found else None
     return err
 
 

@@ -67,7 +67,7 @@ class CosseratModel:
     def __init__(self, robot):
         self.robot0 = robot
         if robot.spec is None:
-            raise ParameterError(
+            raise _args.bad(
                 "invalid parameter `robot`: calibration changes the robot through its "
                 "description (Robot.with_parameters); this robot has none"
             )
@@ -120,7 +120,7 @@ class CosseratModel:
             field = name.split(".", 2)[2]
             if field in _SCALE_FIELDS and _law_scale(self.material, field):
                 return name
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `{where}`: {name!r} does not scale the whole "
                 f"{self.material.get('type', 'linear')} law of this robot (its exact column "
                 "is the stiffness scale's); fit `stiffness_scale` instead"
@@ -136,13 +136,13 @@ class CosseratModel:
                 except ValueError:
                     break
                 if not 0 <= idx < len(items):
-                    raise ParameterError(
+                    raise _args.bad(
                         f"invalid parameter `{where}`: {name!r}: index out of [0, {len(items)})"
                     )
                 want = fields or (_OFFSET_FIELDS.get(items[idx].get("routing", "constant")),)
                 if field in want and field in items[idx]:
                     return name
-        raise ParameterError(
+        raise _args.bad(
             f"invalid parameter `{where}`: {name!r} is not a parameter this robot can be "
             f"calibrated in (known: {known})"
         )
@@ -171,7 +171,7 @@ class CosseratModel:
         if isinstance(actuation, Mapping):
             unknown = set(actuation) - {"tensions", "pressures"}
             if unknown:
-                raise ParameterError(
+                raise _args.bad(
                     f"invalid parameter `{where}`: unknown keys {sorted(unknown)} "
                     "(tensions, pressures)"
                 )
@@ -184,7 +184,7 @@ class CosseratModel:
         t = np.atleast_1d(_args.finite_array(t, f"{where} tensions")).astype(float)
         p = np.atleast_1d(_args.finite_array(p, f"{where} pressures")).astype(float)
         if t.shape != (nt,) or p.shape != (nc,):
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `{where}`: {t.size} tensions and {p.size} pressures for a "
                 f"robot with {nt} tendons and {nc} chambers"
             )
@@ -280,7 +280,7 @@ class CosseratModel:
 
     def evaluate(self, values, names, m, metric: str):
         if metric != "arm-index" and m.kind == "shape":
-            raise ParameterError(
+            raise _args.bad(
                 "invalid parameter `metric` = 'nearest': Robot backbones are compared at "
                 "equal arm index (metric='arm-index'); 'nearest' is for the planar arm"
             )
@@ -289,7 +289,7 @@ class CosseratModel:
         act = m.actuation
         tensions = scale * act["tensions"]
         if m.kind == "markers" and m.index[-1] > self.length * (1.0 + 1e-12):
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `measurements`: marker arc length {m.index[-1]} m beyond "
                 f"the robot's length {self.length} m"
             )

@@ -178,7 +178,7 @@ def _arm_index(points: np.ndarray, where: str = "measurements") -> np.ndarray:
     chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
     u = np.concatenate([[0.0], np.cumsum(chord)])
     if u[-1] <= 0.0:
-        raise ParameterError(f"invalid parameter `{where}`: a backbone of zero length")
+        raise _args.bad(f"invalid parameter `{where}`: a backbone of zero length")
     if len(points) < 4 or np.any(chord <= 0.0):
         return u / u[-1]
     from scipy.interpolate import CubicSpline
@@ -197,7 +197,7 @@ def _arm_index(points: np.ndarray, where: str = "measurements") -> np.ndarray:
 def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
     if hasattr(obs, "points") and hasattr(obs, "arc_length"):  # a Backbone
         if getattr(obs, "unit", "m") != "m":
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `{where}`: a Backbone in pixels; extract it with `scale` "
                 "(m per pixel) to calibrate a model in metres"
             )
@@ -211,7 +211,7 @@ def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
             where, obs, "an array of points (n, dim), a tip or a Backbone"
         ) from None
     if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > 1e9):
-        raise ParameterError(
+        raise _args.bad(
             f"invalid parameter `{where}`: values must be finite coordinates below 1e9 m"
         )
     if arr.ndim == 2 and arr.shape == (4, 4) and dim == 3:
@@ -222,7 +222,7 @@ def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
             and np.array_equal(arr[3], [0.0, 0.0, 0.0, 1.0])
         )
         if not rigid:
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `{where}` = {' '.join(repr(arr.tolist()).split())}: a 4x4 "
                 "tip pose must be a rigid transform (rotation block orthonormal to 1e-6 with "
                 "determinant +1, last row [0, 0, 0, 1])"
@@ -232,7 +232,7 @@ def _observation(obs: Any, dim: int, where: str) -> tuple[str, np.ndarray]:
         return "tip", arr
     if arr.ndim == 2 and arr.shape[1] == dim and arr.shape[0] >= 2:
         return "shape", arr
-    raise ParameterError(
+    raise _args.bad(
         f"invalid parameter `{where}` with shape {arr.shape}: must be points (n >= 2, {dim}), "
         f"a tip position ({dim},)" + (", a tip (x, y, angle)" if dim == 2 else ", a 4x4 tip pose")
     )
@@ -246,7 +246,7 @@ def _measurements(
             "measurements", measurements, "a list of (actuation, points or tip) pairs"
         )
     if len(measurements) == 0:
-        raise ParameterError("invalid parameter `measurements` = []: at least one measurement")
+        raise _args.bad("invalid parameter `measurements` = []: at least one measurement")
     if actuations is not None:
         if isinstance(actuations, (str, bytes)) or not isinstance(
             actuations, (Sequence, np.ndarray)
@@ -254,7 +254,7 @@ def _measurements(
             raise _args.type_error("actuations", actuations, "a list, one per measurement")
         actuations = list(actuations)
         if len(actuations) != len(measurements):
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `actuations`: {len(actuations)} actuations for "
                 f"{len(measurements)} measurements"
             )
@@ -270,13 +270,13 @@ def _measurements(
                 s = _args.finite_array(m[2], f"measurements[{i}][2]", ndim=1)
                 kind, data = _observation(obs, dim, where)
                 if kind != "shape" or len(s) != len(data):
-                    raise ParameterError(
+                    raise _args.bad(
                         f"invalid parameter `measurements[{i}]`: an (actuation, points, s) "
                         f"triple needs one arc length per point ({len(s)} for "
                         f"{len(data) if data.ndim == 2 else 0} points)"
                     )
                 if np.any(s < 0.0) or np.any(np.diff(s) < 0.0):
-                    raise ParameterError(
+                    raise _args.bad(
                         f"invalid parameter `measurements[{i}][2]`: arc lengths must be >= 0 "
                         "and non-decreasing (m)"
                     )
@@ -333,7 +333,7 @@ class _PlanarModel:
             raise _args.type_error(where, name, "parameter names (str)")
         name = self.ALIASES.get(name, name)
         if name not in self.PARAMETERS:
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `{where}`: {name!r} is not a parameter of the planar "
                 f"arm (known: {', '.join(self.PARAMETERS)}; aliases E, a)"
             )
@@ -424,7 +424,7 @@ class _PlanarModel:
             return np.concatenate(r), np.vstack(rows)
         if m.kind == "markers":
             if m.index[-1] > L * (1.0 + 1e-12):
-                raise ParameterError(
+                raise _args.bad(
                     f"invalid parameter `measurements`: marker arc length {m.index[-1]} m "
                     f"beyond the arm's length {L} m"
                 )
@@ -537,7 +537,7 @@ def _bounds(bounds: Any, names: Sequence[str], model, p0: np.ndarray):
         given = {model.canonical(k, "bounds"): v for k, v in bounds.items()}
         unknown = set(given) - set(names)
         if unknown:
-            raise ParameterError(
+            raise _args.bad(
                 f"invalid parameter `bounds`: {sorted(unknown)} are not fitted parameters "
                 f"({', '.join(names)})"
             )
@@ -746,10 +746,10 @@ def calibrate(
     if isinstance(parameters, str) or not isinstance(parameters, Sequence):
         raise _args.type_error("parameters", parameters, "a list of parameter names")
     if len(parameters) == 0:
-        raise ParameterError("invalid parameter `parameters` = []: at least one parameter")
+        raise _args.bad("invalid parameter `parameters` = []: at least one parameter")
     names = [model.canonical(p) for p in parameters]
     if len(set(names)) != len(names):
-        raise ParameterError(f"invalid parameter `parameters` = {list(parameters)}: repeated")
+        raise _args.bad(f"invalid parameter `parameters` = {list(parameters)}: repeated")
     max_evaluations = _args.count(max_evaluations, "max_evaluations", 1, 100_000)
     condition_limit = _args.number(condition_limit, "condition_limit")
     if not condition_limit > 1.0:
