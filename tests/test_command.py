@@ -624,3 +624,11 @@ def test_a_tolerance_below_the_forward_solves_precision_is_named():
         softrod.inverse_statics(robot, target, tolerance=1e-30)
     assert e.value.parameter == "tolerance" and "precision" in str(e.value)
     assert softrod.inverse_statics(robot, target).position_error <= 1e-10
+
+
+def test_a_pull_in_of_a_tendon_s_whole_length_is_named():
+    # (10 m on a 0.2 m tendon raised a ConvergenceError at residual 3.9e4.)
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    with pytest.raises(softrod.ParameterError) as e:
+        robot.solve([4, 0, 0, 0, 2, 0], displacements=[10.0] + [None] * 5)
+    assert e.value.parameter == "displacements[0]" and "path length" in str(e.value)

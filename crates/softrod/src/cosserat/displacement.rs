@@ -566,6 +566,18 @@ fn solve_held_on_mesh(
         None => reference_lengths(model, options)?,
     };
     let all_held = held_of(model, actuation, &reference);
+    // (A pull-in of the tendon's whole length asks for a path of no length: no equilibrium.)
+    if let Some(h) = all_held.iter().find(|h| h.target <= 0.0) {
+        return Err(Error::invalid(
+            format!("displacements[{}]", h.tendon),
+            reference[h.tendon] - h.target,
+            format!(
+                "< {:.6e} m, the tendon's path length at the motor's zero (a pull-in of its \
+                 whole length leaves it no path)",
+                reference[h.tendon]
+            ),
+        ));
+    }
     let hp = HeldProblem {
         model,
         actuation,
