@@ -615,3 +615,18 @@ def test_arrays_of_strings_booleans_complex_numbers_or_none_are_refused(name, ca
     with pytest.raises(softrod.ParameterError) as e:
         call(robot, target)
     assert isinstance(e.value, TypeError) and e.value.parameter == name
+
+
+def test_errors_name_the_argument_given():
+    # (The PCC elastic segment's errors listed another function's arguments; a string radius
+    # was read as a number; an empty shape target named `target_points`, no argument.)
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.pcc.arc_from_tendon_tensions([1.0, 0, 0], [0.01] * 3, [0, 2.1, 4.2], 0.2, 0.0)
+    assert e.value.parameter == "bending_stiffness" and "computed from" not in str(e.value)
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.Sphere((0, 0, 0), "1")
+    assert e.value.parameter == "radius"
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.inverse_statics(robot, np.zeros((0, 3)), target_s=[])
+    assert e.value.parameter == "target_position"

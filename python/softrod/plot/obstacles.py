@@ -54,6 +54,8 @@ def _vector(name: str, value: object) -> tuple[float, float, float]:
 
 
 def _radius(value: object) -> float:
+    if isinstance(value, (str, bytes, bool)):  # (float("1") read a string as a radius)
+        raise _field_error("radius", value, "must be a number > 0 (m)")
     try:
         r = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):

@@ -114,13 +114,11 @@ fn body_from(
     bending_stiffness: f64,
     axial_stiffness: Option<f64>,
 ) -> PyResult<ElasticSegment> {
+    // (Its errors name its own arguments; another function's list was appended to them.)
     ElasticSegment::new(rest_length, bending_stiffness, axial_stiffness).map_err(blame(&[
-        "displacements",
-        "distances",
-        "angles",
         "rest_length",
-        "extensible",
-        "coordinates",
+        "bending_stiffness",
+        "axial_stiffness",
     ]))
 }
 
