@@ -632,3 +632,17 @@ def test_a_pull_in_of_a_tendon_s_whole_length_is_named():
     with pytest.raises(softrod.ParameterError) as e:
         robot.solve([4, 0, 0, 0, 2, 0], displacements=[10.0] + [None] * 5)
     assert e.value.parameter == "displacements[0]" and "path length" in str(e.value)
+
+
+def test_a_path_names_the_row_of_a_bad_target():
+    # (A bad rotation of the second target was named `target_rotation`, no argument of the
+    # path.)
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    sol = robot.solve([0.0, 1.5, 0.4, 0.8, 0.0, 0.0])
+    rot = np.asarray(sol.rotation[-1])
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.inverse_statics_path(
+            robot, [sol.tip_position] * 2, target_rotations=np.stack([rot, 2 * rot])
+        )
+    assert e.value.parameter == "target_rotations[1]"
+    assert "`target_rotations[1]`" in str(e.value)

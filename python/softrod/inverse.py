@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
+from . import _args, _core
 from .robot import Robot
 
 
@@ -406,19 +406,29 @@ def inverse_statics_path(
     rows: list[InverseSolution] = []
     warm = warm_start
     for i, p in enumerate(pts):
-        inv = inverse_statics(
-            robot,
-            p,
-            target_rotation=None if rots is None else rots[i],
-            weights=weights,
-            tension_bounds=tension_bounds,
-            pressure_bounds=pressure_bounds,
-            warm_start=warm,
-            throw=throw,
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            starts=starts if i == 0 else None,
-        )
+        try:
+            inv = inverse_statics(
+                robot,
+                p,
+                target_rotation=None if rots is None else rots[i],
+                weights=weights,
+                tension_bounds=tension_bounds,
+                pressure_bounds=pressure_bounds,
+                warm_start=warm,
+                throw=throw,
+                tolerance=tolerance,
+                max_iterations=max_iterations,
+                starts=starts if i == 0 else None,
+            )
+        except _core.ParameterError as exc:
+            # (The target's own arguments are rows of the path's: named so.)
+            own = {"target_position": "targets", "target_rotation": "target_rotations"}
+            name = getattr(exc, "parameter", None) or ""
+            head = name.split("[")[0]
+            if head not in own:
+                raise
+            renamed = f"{own[head]}[{i}]{name[len(head) :]}"
+            raise _args.bad(str(exc).replace(f"`{name}`", f"`{renamed}`", 1)) from None
         rows.append(inv)
         if inv.converged:  # a miss does not seed the next target: the last reached one does
             warm = inv
