@@ -218,7 +218,11 @@ pub(crate) fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f6
 
 pub(crate) fn check_target(target: &Target) -> Result<()> {
     if target.points.is_empty() {
-        return Err(Error::invalid("target_position", "[]", "at least one point"));
+        return Err(Error::invalid(
+            "target_position",
+            "[]",
+            "at least one point",
+        ));
     }
     for (k, p) in target.points.iter().enumerate() {
         // Beyond MAX_LENGTH the distance to the target would not be a number worth reporting.
