@@ -646,3 +646,15 @@ def test_a_path_names_the_row_of_a_bad_target():
         )
     assert e.value.parameter == "target_rotations[1]"
     assert "`target_rotations[1]`" in str(e.value)
+
+
+def test_weights_beyond_double_precision_of_each_other_are_named():
+    # (1e20 : 1 reported a reachable target out of reach: the small weights vanish.)
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    target = robot.solve([0.0, 1.5, 0.4, 0.8, 0.0, 0.0]).tip_position
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.inverse_statics(robot, target, weights=[1e20, 1, 1, 1, 1, 1])
+    assert e.value.parameter == "weights" and "ratio of 1e15" in str(e.value)
+    inv = softrod.inverse_statics(robot, target, weights=[1e14, 1, 1, 1, 1, 1])
+    back = robot.solve(inv.tensions).tip_position
+    assert inv.tensions[0] == 0.0 and np.linalg.norm(back - target) <= 1e-9

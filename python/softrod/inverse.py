@@ -213,7 +213,7 @@ def inverse_statics(
             target: backbone points (m, world), shape (k, 3).
         target_rotation: Tip rotation (body -> world, 3x3), or None for a position target.
         weights: Weights of the actuation norm, one per tendon then chamber (1/N², 1/Pa²;
-            only their ratios matter).
+            only their ratios matter, within 1e15 of each other).
         tension_bounds: (lo, hi) of every tension (N; hi None: unbounded).
         pressure_bounds: (lo, hi) of every pressure (Pa; default (0, None)).
         warm_start: A previous :class:`InverseSolution` or actuation (tensions then pressures).

@@ -157,8 +157,8 @@ impl Target {
 #[derive(Debug, Clone, PartialEq)]
 pub struct InverseOptions {
     /// Weights `w_i > 0` of the actuation norm, one per tendon then per chamber (1/N², 1/Pa²;
-    /// only their ratios matter); `None`: the actuator-force norm (see the module
-    /// documentation).
+    /// only their ratios matter, within 1e15 of each other); `None`: the actuator-force norm
+    /// (see the module documentation).
     pub weights: Option<Vec<f64>>,
     /// Reference actuation `a_ref` (N, Pa); `None`: zero.
     pub reference: Option<Vec<f64>>,

@@ -149,6 +149,10 @@ impl<'a> Program<'a> {
     }
 }
 
+/// Largest ratio of two actuators' weights: about the reciprocal of the machine epsilon,
+/// beyond which a sum of weighted terms loses the smaller ones entirely.
+pub(crate) const MAX_WEIGHT_RATIO: f64 = 1e15;
+
 pub(crate) fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f64) -> Result<()> {
     let n = nt + nc;
     let (tl, th) = o.tension_bounds;
@@ -179,6 +183,19 @@ pub(crate) fn check_options(o: &InverseOptions, nt: usize, nc: usize, length: f6
             if !(v.is_finite() && *v > 0.0) {
                 return Err(Error::invalid(format!("weights[{i}]"), v, "finite and > 0"));
             }
+        }
+        // Only the ratios matter; beyond double precision the smaller weights vanish from
+        // the objective's sums (1e20 : 1 on the NiTi robot: a reachable target was reported
+        // out of reach).
+        let (lo, hi) = w.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+        if hi > MAX_WEIGHT_RATIO * lo {
+            return Err(Error::invalid(
+                "weights",
+                format!("from {lo:e} to {hi:e}"),
+                format!("within a ratio of {MAX_WEIGHT_RATIO:e} (only the ratios matter)"),
+            ));
         }
     }
     if let Some(r) = &o.reference {
