@@ -151,16 +151,18 @@ def test_a_sweep_that_solves_nothing_writes_nothing(tmp_path, capsys):
     assert not out.exists()
 
 
-def test_a_workspace_of_one_converged_configuration_gives_no_ratio(capsys):
-    status, out, err = _run(
+def test_a_workspace_of_one_configuration_gives_no_ratio_and_tensions_beyond_the_limits_are_named(
+    capsys,
+):
+    # (--sweep 0:1e308 solved five samples, one converged, and printed a centre/periphery
+    # "ratio" of that one point.)
+    status, out, err = _run(["workspace", "niti_two_segment", "--sweep", "0:3", "--n", "1"], capsys)
+    assert status == 0, err
+    assert "converged: 1/1" in out and "one configuration only (no ratio)" in out, out
+    status, _, err = _run(
         ["workspace", "niti_two_segment", "--sweep", "0:1e308", "--n", "5"], capsys
     )
-    assert status == 0, err
-    assert (
-        "converged: 1/5" in out
-        and "no ratio" in out
-        and "periphery" not in out.replace("centre and periphery", "")
-    ), out
+    assert status == 2 and "`tensions[1, 0]`" in err and "load number" in err, err
 
 
 @pytest.mark.parametrize(

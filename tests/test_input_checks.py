@@ -564,13 +564,23 @@ def test_on_unstable_of_another_type_is_a_named_error():
         assert e.value.parameter == "on_unstable"
 
 
-def test_cli_workspace_says_why_a_configuration_did_not_converge(capsys):
-    # "converged: 1/3" alone, exit 0: the tension limit was not mentioned.
-    assert main(["workspace", "niti_two_segment", "--sweep", "0:1e300", "--n", "3"]) == 0
-    out = capsys.readouterr().out
-    assert "converged: 1/3" in out
-    line = next(v for v in out.splitlines() if "the first that did not" in v)
-    assert "5e+299" in line and "tensions[0]" in line and "ParameterError" in line
+def test_cli_workspace_names_a_tension_beyond_the_load_limit(capsys):
+    # "converged: 1/3" alone, exit 0: the tension limit was not mentioned; then every sample
+    # beyond it was solved to its failure: now the map is refused before any solve, naming
+    # the first row beyond the limit, its value and the limit.
+    assert main(["workspace", "niti_two_segment", "--sweep", "0:1e300", "--n", "3"]) == 2
+    err = capsys.readouterr().err
+    assert "`tensions[1, 0]` = 5e299" in err and "load number <= 1e12" in err
+
+
+def test_a_workspace_map_names_the_row_beyond_the_limit_in_any_block():
+    # (The core is called per block: its row index is the block's, renamed to the map's.)
+    robot = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+    t = np.zeros((5000, 6))
+    t[4321, 2] = 1e300
+    with pytest.raises(softrod.ParameterError) as e:
+        softrod.workspace_map(robot.rod, robot.tendons, t)
+    assert e.value.parameter == "tensions[4321, 2]"
 
 
 def test_an_arc_from_absurd_tendon_displacements_is_refused_by_the_arc_limits():

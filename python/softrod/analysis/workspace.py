@@ -10,6 +10,7 @@ each block in parallel across cores with warm starts.
 
 from __future__ import annotations
 
+import re
 import sys
 from dataclasses import dataclass
 
@@ -137,8 +138,8 @@ def workspace_map(
         file=sys.stderr,
     )
     for start in range(0, total, int(block)):
-        parts.append(
-            _workspace_map(
+        try:
+            part = _workspace_map(
                 rod,
                 tendons,
                 t[start : start + block],
@@ -147,7 +148,14 @@ def workspace_map(
                 tangent=tangent,
                 **options,
             )
-        )
+        except ParameterError as exc:
+            # (The core names a row of the block it was given: named by its row in `tensions`.)
+            found = re.match(r"tensions\[(\d+), (\d+)\]$", getattr(exc, "parameter", "") or "")
+            if not found or start == 0:
+                raise
+            row, col = int(found.group(1)) + start, found.group(2)
+            raise _args.bad(str(exc).replace(exc.parameter, f"tensions[{row}, {col}]", 1)) from None
+        parts.append(part)
         bar.update(min(start + block, total) - start)
     bar.close()
     if not parts:
