@@ -67,18 +67,7 @@ pub(crate) fn obstacles(
             _ => 0.0,
         };
         let made = made.and_then(|m| m.with_friction(friction));
-        out.push(made.map_err(|e| match e {
-            softrod::Error::InvalidParameter {
-                name: n,
-                value,
-                expected,
-            } => to_py_err(softrod::Error::InvalidParameter {
-                name: format!("obstacles[{i}].{n}"),
-                value,
-                expected,
-            }),
-            other => to_py_err(other),
-        })?);
+        out.push(made.map_err(|e| to_py_err(e.map_name(|n| format!("obstacles[{i}].{n}"))))?);
     }
     Ok(out)
 }
@@ -106,17 +95,10 @@ pub(crate) fn tip_constraint(
         return Ok(None);
     };
     let what = "softrod.Clamp(pose), softrod.Pin(point) or softrod.Slide(point, normal)";
-    let fix = |e: softrod::Error| match e {
-        softrod::Error::InvalidParameter {
-            name,
-            value,
-            expected,
-        } => to_py_err(softrod::Error::InvalidParameter {
-            name: format!("tip_constraint.{}", name.trim_start_matches("base_pose.")),
-            value,
-            expected,
-        }),
-        other => to_py_err(other),
+    let fix = |e: softrod::Error| {
+        to_py_err(
+            e.map_name(|name| format!("tip_constraint.{}", name.trim_start_matches("base_pose."))),
+        )
     };
     if let Ok(p) = obj.getattr("pose") {
         let (pos, rot) = pose(&p, "tip_constraint.pose")?;

@@ -90,6 +90,24 @@ impl Error {
         }
     }
 
+    /// The same error with the parameter name of an [`Error::InvalidParameter`] mapped by `f`
+    /// (an entry of an array argument, a prefix); other errors unchanged.
+    #[must_use]
+    pub fn map_name(self, f: impl FnOnce(String) -> String) -> Self {
+        match self {
+            Error::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => Error::InvalidParameter {
+                name: f(name),
+                value,
+                expected,
+            },
+            other => other,
+        }
+    }
+
     /// Whether this is an [`Error::InvalidParameter`] naming `parameter`.
     pub fn names(&self, parameter: &str) -> bool {
         self.parameter()

@@ -95,30 +95,14 @@ fn rows3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
     Ok(a.outer_iter().map(|r| [r[0], r[1], r[2]]).collect())
 }
 
-/// A core error with its parameter name mapped by `f` (other errors unchanged).
-fn map_name(e: softrod::Error, f: impl FnOnce(String) -> String) -> softrod::Error {
-    match e {
-        softrod::Error::InvalidParameter {
-            name,
-            value,
-            expected,
-        } => softrod::Error::InvalidParameter {
-            name: f(name),
-            value,
-            expected,
-        },
-        other => other,
-    }
-}
-
 /// The name of a core error prefixed: `segments[0].curvature` as `warm_start[0].curvature`.
 fn renamed(e: softrod::Error, from: &str, to: &str) -> softrod::Error {
-    map_name(e, |name| name.replacen(from, to, 1))
+    e.map_name(|name| name.replacen(from, to, 1))
 }
 
 /// A parameter error of entry `i` of an array argument: the parameter named `name[i]`.
 fn indexed(e: softrod::Error, i: usize) -> softrod::Error {
-    map_name(e, |name| format!("{name}[{i}]"))
+    e.map_name(|name| format!("{name}[{i}]"))
 }
 
 fn vector3(v: Floats, name: &str) -> PyResult<Vector3<f64>> {

@@ -103,20 +103,9 @@ pub fn workspace_map(
     // Every row within the load limits, named by its row (a map to 1e308 N solved every
     // sample to its failure, and a summary of the few that stayed below).
     for (k, row) in tensions.chunks(nt).enumerate() {
-        if let Err(e) = model.check_actuation(&actuation(row)) {
-            return Err(match e {
-                Error::InvalidParameter {
-                    name,
-                    value,
-                    expected,
-                } if name.starts_with("tensions[") => Error::InvalidParameter {
-                    name: name.replacen("tensions[", &format!("tensions[{k}, "), 1),
-                    value,
-                    expected,
-                },
-                other => other,
-            });
-        }
+        model
+            .check_actuation(&actuation(row))
+            .map_err(|e| e.map_name(|n| n.replacen("tensions[", &format!("tensions[{k}, "), 1)))?;
     }
     // Validate the problem once (errors here are the user's, not a sample's).
     let mut quiet = *options;

@@ -625,18 +625,8 @@ impl PccChain {
             .iter()
             .enumerate()
             .map(|(i, q)| {
-                PccSegment::checked(q[0], q[1], q[2]).map_err(|e| match e {
-                    Error::InvalidParameter {
-                        name,
-                        value,
-                        expected,
-                    } => Error::InvalidParameter {
-                        name: format!("segments[{i}].{name}"),
-                        value,
-                        expected,
-                    },
-                    other => other,
-                })
+                PccSegment::checked(q[0], q[1], q[2])
+                    .map_err(|e| e.map_name(|name| format!("segments[{i}].{name}")))
             })
             .collect::<Result<Vec<_>>>()?;
         Self::new(segments)

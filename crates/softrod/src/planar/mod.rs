@@ -828,16 +828,8 @@ pub fn solve_planar_many(
 ) -> Result<PlanarBatch> {
     let samples = &check_samples(samples, arm.length)?[..];
     for (i, &t) in tensions.iter().enumerate() {
-        arm.check_tension(t).map_err(|e| match e {
-            Error::InvalidParameter {
-                value, expected, ..
-            } => Error::InvalidParameter {
-                name: format!("tensions[{i}]"),
-                value,
-                expected,
-            },
-            other => other,
-        })?;
+        arm.check_tension(t)
+            .map_err(|e| e.map_name(|_| format!("tensions[{i}]")))?;
     }
     let (nt, ns) = (tensions.len(), samples.len());
     let mut batch = PlanarBatch {
