@@ -372,3 +372,58 @@ fn section_solve_converges_where_the_curvature_vanishes() {
         assert!(d < 1e-5 * 0.5, "point load at {at}: tip {a:?} vs {b:?}");
     }
 }
+
+/// A soft tapered rod hanging in gravity (0.35 m, 1e5 Pa, radius 4.9 to 1.6 mm, 1100 kg/m³,
+/// gravity along its axis) pulled sideways by a 0.05 N tendon at 0.96 mm: its weight's tension
+/// over its bending stiffness (`L √(T / EI)` about 18) makes the tip moment of a march about
+/// 5e7 times as sensitive to the base moment, so that the residual of a march cannot fall
+/// below its round-off (about 1e-6 here, against a tolerance of 1e-10).
+fn hanging_soft_rod() -> (std::sync::Arc<RobotModel>, Actuation) {
+    let rod = Rod::new(
+        0.35,
+        Section::tapered_circular(4.9e-3, 1.6e-3).unwrap(),
+        LinearElastic::new(1e5, 0.45).unwrap(),
+    )
+    .unwrap()
+    .with_density(1100.0)
+    .unwrap();
+    let tendons = [0.0f64, 2.094, 4.189]
+        .iter()
+        .map(|a| softrod::Tendon::constant([0.96e-3 * a.cos(), 0.96e-3 * a.sin()], None).unwrap())
+        .collect();
+    let loads = Loads {
+        gravity: Vector3::new(0.0, 0.0, 9.81),
+        ..Default::default()
+    };
+    let model = RobotModel::new(rod, tendons, Vec::new(), loads).unwrap();
+    (model, Actuation::tensions(&[0.05, 0.0, 0.0]))
+}
+
+#[test]
+fn a_rod_whose_residual_is_bounded_by_round_off_converges_at_fourth_order() {
+    // Newton stops where its exact step is below the rounding of the unknowns: the answers
+    // on 40 to 320 RK4 steps, each stopped at its round-off, still converge with RK4's order.
+    let (model, act) = hanging_soft_rod();
+    let tips: Vec<[f64; 3]> = [40, 80, 160, 320]
+        .iter()
+        .map(|&steps| {
+            let opts = SolveOptions {
+                integrator: Integrator::Rk4 { steps },
+                ..Default::default()
+            };
+            let sol = solve_statics(&model, &act, &opts).unwrap();
+            assert!(sol.stats.converged, "{steps} steps: {:?}", sol.stats);
+            if steps == 40 {
+                // Above the tolerance asked: converged at the round-off of the march.
+                assert!(sol.stats.residual > 1e-9, "{:?}", sol.stats);
+            }
+            sol.tip_position()
+        })
+        .collect();
+    let d: Vec<f64> = tips.windows(2).map(|w| dist(w[0], w[1])).collect();
+    println!("tip differences 40-80, 80-160, 160-320 steps: {d:?}");
+    for w in d.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!((3.7..4.3).contains(&order), "observed order {order}: {d:?}");
+    }
+}

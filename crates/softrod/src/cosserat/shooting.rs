@@ -538,6 +538,12 @@ impl Problem for Shooting<'_> {
         }
     }
 
+    fn stops_at_round_off(&self) -> bool {
+        // The fixed mesh makes the residual smooth in the unknowns and the columns its exact
+        // Jacobian; the adaptive integrator's residual carries its error control instead.
+        matches!(self.integrator, Integrator::Rk4 { .. })
+    }
+
     fn load_derivative(&mut self, x: &[f64], lambda: f64, out: &mut [f64]) -> bool {
         if !self.held.is_empty() {
             // The held rows change with the shape: a secant predictor.

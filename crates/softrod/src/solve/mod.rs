@@ -135,7 +135,19 @@ pub trait Problem {
         let _ = (x, lambda);
         false
     }
+    /// Whether an exact Newton step below the rounding of the unknowns ([`ROUND_OFF_STEP`]
+    /// units of the machine epsilon of `max(1, |x|∞)`) ends the solve as converged, at the
+    /// residual it reached: the residual is a smooth function of the unknowns whose Jacobian is
+    /// exact, so that no representable point is closer to its root, and what remains is the
+    /// round-off of its evaluation amplified by its sensitivity. `false` by default.
+    fn stops_at_round_off(&self) -> bool {
+        false
+    }
 }
+
+/// Units of the machine epsilon (relative to `max(1, |x|∞)`) of an exact Newton step that
+/// ends a solve whose problem [stops at round-off](Problem::stops_at_round_off).
+pub const ROUND_OFF_STEP: f64 = 16.0;
 
 /// Max norm, infinite if any entry is not finite.
 pub fn max_norm(v: &[f64]) -> f64 {

@@ -1,7 +1,7 @@
 //! Damped Newton at one load factor, with Broyden updates of the Jacobian between exact
 //! evaluations.
 
-use super::{max_norm, Evaluated, NewtonOptions, Problem};
+use super::{max_norm, Evaluated, NewtonOptions, Problem, ROUND_OFF_STEP};
 use crate::math::linalg::DenseLu;
 
 /// Sufficient-decrease condition of a step of length `alpha`: accepts the trial residual
@@ -447,6 +447,9 @@ impl<P: Problem + ?Sized> Run<'_, '_, P> {
         if !self.direction(lu, dx) {
             return Turn::Stop;
         }
+        if self.at_round_off(dx) {
+            return Turn::Converged;
+        }
         let tol = self.problem.tolerance(&self.it.x, self.options.tolerance);
         // Under superlinear convergence the next residual is about rn² / r_prev: a step
         // predicted to converge is taken with the Jacobian when the solve must end on one.
@@ -469,6 +472,16 @@ impl<P: Problem + ?Sized> Run<'_, '_, P> {
         self.out.at_x = true;
         self.out.iterations += 1;
         self.converged_or_next()
+    }
+
+    /// Whether the exact Newton step `dx` from the iterate (the problem's last evaluation) is
+    /// below the rounding of the unknowns, for a problem that [stops at
+    /// round-off](Problem::stops_at_round_off).
+    fn at_round_off(&self, dx: &[f64]) -> bool {
+        self.it.exact
+            && self.out.at_x
+            && self.problem.stops_at_round_off()
+            && max_norm(dx) <= ROUND_OFF_STEP * f64::EPSILON * max_norm(&self.it.x).max(1.0)
     }
 
     /// [`Turn::Converged`] if the iterate is within the tolerance, else [`Turn::Next`].
@@ -738,6 +751,78 @@ mod tests {
         let a = Armijo { c: 0.1 };
         assert!(a.accept(1.0, 1.0, 0.9) && !a.accept(1.0, 1.0, 0.95));
         assert!(a.accept(0.5, 1.0, 0.95));
+    }
+
+    /// `r(x) = K (x - a) + e(x)`: a root resolved only to `|e| / K`, `e` a deterministic
+    /// evaluation noise of amplitude `noise` (from the bits of `x`); with `root` false,
+    /// `r(x) = x² + 1`, which has no root.
+    struct Stiff {
+        root: bool,
+        noise: f64,
+        at_round_off: bool,
+    }
+
+    const STIFF_K: f64 = 1e9;
+    const STIFF_A: f64 = 0.3;
+
+    impl Problem for Stiff {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn evaluate(
+            &mut self,
+            x: &[f64],
+            _lambda: f64,
+            jacobian: Option<&mut [f64]>,
+            r: &mut [f64],
+        ) -> Evaluated {
+            let e = self.noise * ((x[0].to_bits() % 1000) as f64 / 500.0 - 1.0);
+            let j;
+            (r[0], j) = if self.root {
+                (STIFF_K * (x[0] - STIFF_A) + e, STIFF_K)
+            } else {
+                (x[0] * x[0] + 1.0, 2.0 * x[0])
+            };
+            match jacobian {
+                Some(jac) => {
+                    jac[0] = j;
+                    Evaluated::Jacobian
+                }
+                None => Evaluated::Residual,
+            }
+        }
+        fn stops_at_round_off(&self) -> bool {
+            self.at_round_off
+        }
+    }
+
+    #[test]
+    fn an_exact_step_below_the_rounding_of_the_unknowns_ends_a_solve_that_allows_it() {
+        let o = NewtonOptions {
+            tolerance: 1e-10,
+            ..OPTS
+        };
+        for at_round_off in [false, true] {
+            let mut p = Stiff {
+                root: true,
+                noise: 1e-6,
+                at_round_off,
+            };
+            let out = newton(&mut p, &[0.2], 1.0, &o, &settings(false));
+            assert_eq!(out.converged, at_round_off, "{out:?}");
+            // Where the noise allows: |x - a| <= |e| / K (and the rounding of a).
+            assert!((out.x[0] - STIFF_A).abs() <= 1e-6 / STIFF_K + 4.0 * f64::EPSILON);
+            // Its residual is the noise's, above the tolerance.
+            assert!(!at_round_off || out.residual > o.tolerance, "{out:?}");
+        }
+        // A residual without a root is never reported converged.
+        let mut p = Stiff {
+            root: false,
+            noise: 0.0,
+            at_round_off: true,
+        };
+        let out = newton(&mut p, &[0.5], 1.0, &o, &settings(false));
+        assert!(!out.converged && out.residual >= 1.0, "{out:?}");
     }
 
     #[test]
