@@ -5,6 +5,8 @@ and identifiability."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -250,3 +252,42 @@ def test_a_fit_stuck_far_from_its_measurements_is_reported_poor(niti):
         warnings.simplefilter("error", softrod.PoorFitWarning)
         good = softrod.calibrate(niti, data, [name])
     assert rel(good.values[name], 54e9) < 1e-6 and good.rms < 1e-9
+
+
+def test_more_starts_leave_the_local_minimum_and_every_start_is_reported(niti):
+    # The stuck fit above with eight starts (log-uniform in [1e6, 1e12] Pa, the default
+    # bounds around 1 GPa): some reach the modulus the measurements were made with.
+    import warnings
+
+    t = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    data = [(t, niti.solve(t, s_out=S).position, S)]
+    name = "rod.material.youngs_modulus"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", softrod.PoorFitWarning)
+        fit = softrod.calibrate(niti, data, [name], initial={name: 1e9}, starts=8)
+    assert rel(fit.values[name], 54e9) < 1e-6 and fit.rms < 1e-9
+    assert len(fit.starts) == 8 and fit.starts[0]["initial"] == {name: 1e9}
+    # The first start alone stops at the local minimum; the best start is returned.
+    assert fit.starts[0]["rms"] > cal.POOR_FIT_FRACTION * 0.4
+    fitted = [st for st in fit.starts if "rms" in st]
+    assert min(st["rms"] for st in fitted) == pytest.approx(fit.rms, rel=1e-9)
+    assert fit.initial in [st["initial"] for st in fitted]
+    for st in fit.starts:  # drawn within the bounds; the others say why they were left
+        assert 1e6 <= st["initial"][name] <= 1e12
+        assert "error" in st or st["evaluations"] >= 1
+    assert fit.evaluations == sum(st.get("evaluations", 0) for st in fit.starts)
+    # The same starts every time (seeded).
+    again = softrod.calibrate(niti, data, [name], initial={name: 1e9}, starts=8)
+    assert [st["initial"] for st in again.starts] == [st["initial"] for st in fit.starts]
+
+
+def test_starts_are_checked(niti):
+    t = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    data = [(t, niti.solve(t, s_out=S).position, S)]
+    name = "rod.material.youngs_modulus"
+    with pytest.raises(softrod.ParameterError, match="`starts` = 0") as e:
+        softrod.calibrate(niti, data, [name], starts=0)
+    assert e.value.parameter == "starts"
+    with pytest.raises(softrod.ParameterError, match="finite, to draw `starts`") as e:
+        softrod.calibrate(niti, data, [name], starts=2, bounds={name: (1e9, math.inf)})
+    assert e.value.parameter == f"bounds[{name!r}]"

@@ -134,3 +134,18 @@ def test_a_misspelt_parameter_suggests_the_key(tmp_path, capsys):
     assert main([*argv, "--parameters", "rod.material.youngs_modulu"]) == 2
     err = capsys.readouterr().err
     assert "did you mean `youngs_modulus`?" in err and "stiffness_scale" not in err
+
+
+def test_starts_are_reported_and_the_best_is_kept(csvs, tmp_path, capsys):
+    out = tmp_path / "fit.json"
+    args = ["calibrate", "planar", "--measurements", *(f"{t}:{p}" for t, p in csvs)]
+    args += ["--parameters", "E", "a", "--unit-scale", "1e-3", "--json", str(out)]
+    assert main([*args, "--starts", "4"]) == 0
+    text = capsys.readouterr().out
+    assert "of 4 fitted" in text
+    fit = json.loads(out.read_text())
+    assert len(fit["starts"]) == 4 and abs(fit["values"]["youngs_modulus"] / 140e3 - 1) < 1e-6
+    fitted = [st for st in fit["starts"] if "rms" in st]
+    assert fit["rms"] == min(st["rms"] for st in fitted)
+    assert main([*args, "--starts", "0", "--overwrite"]) == 2
+    assert "--starts" in capsys.readouterr().err

@@ -112,7 +112,11 @@ class Calibration:
         success: Whether the solver met its tolerances.
         message: The solver's message, and the number of rejected trial values (where the
             model cannot be evaluated) with the last one, if any.
-        evaluations: Number of residual evaluations.
+        evaluations: Number of residual evaluations (over all starts).
+        starts: Each start of the fit, in order: ``initial`` values, and either the
+            ``values`` it reached with their ``rms`` residual (m) and ``evaluations``, or the
+            ``error`` why it could not be fitted from (the model refused the start, or every
+            trial step). ``initial`` above is the start of the fit returned.
     """
 
     parameters: tuple[str, ...]
@@ -133,6 +137,7 @@ class Calibration:
     success: bool
     message: str
     evaluations: int
+    starts: list[dict[str, Any]] = field(default_factory=list, repr=False)
     extra: dict = field(default_factory=dict, repr=False)
 
     def interval(self, level: float = 0.95) -> dict[str, tuple[float, float]]:
@@ -674,6 +679,133 @@ def _at_start(exc: Exception, values: Mapping[str, float]) -> Exception:
     return err
 
 
+@dataclass
+class _Run:
+    """One least-squares fit of :func:`calibrate` from one start (scaled unknowns ``z0``)."""
+
+    z0: np.ndarray
+    result: Any  # SciPy's OptimizeResult
+    final: dict[str, Any]  # the evaluation at the optimum: r, j, parts, infos
+    message: str
+    stuck: ConvergenceError | None  # every trial from the start was rejected
+
+    @property
+    def cost(self) -> float:
+        """Half the sum of squared residuals at the optimum (infinite for a stuck run)."""
+        r = self.final["r"]
+        return math.inf if self.stuck is not None else float(0.5 * np.dot(r, r))
+
+    def summary(self, names: Sequence[str], scale: np.ndarray) -> dict[str, Any]:
+        """The start, its optimum and RMS residual (m), or why it could not move."""
+        out: dict[str, Any] = {"initial": dict(zip(names, (self.z0 * scale).tolist(), strict=True))}
+        if self.stuck is not None:
+            out["error"] = " ".join(str(self.stuck).split())
+        else:
+            r = self.final["r"]
+            out["values"] = dict(zip(names, (self.result.x * scale).tolist(), strict=True))
+            out["rms"] = float(np.sqrt(np.mean(r * r)))
+            out["evaluations"] = int(self.result.nfev)
+        return out
+
+
+def _least_squares_from(
+    z0, first, model, names, meas, metric, scale, zbounds, init, loss, max_evaluations
+) -> _Run:
+    """SciPy's trust-region least squares from the scaled start ``z0``. A start the model
+    cannot be evaluated at raises (for the ``first``, the caller's, named as theirs); trial
+    values it cannot be evaluated at are rejected (non-finite residuals)."""
+    from scipy.optimize import least_squares
+
+    cache: dict[str, Any] = {}
+    rejected: list[tuple[dict[str, float], Exception]] = []
+
+    def evaluate(z: np.ndarray):
+        key = z.tobytes()
+        if cache.get("key") != key:
+            values = dict(zip(names, (z * scale).tolist(), strict=True))
+            infos: list[Any] = []
+            try:
+                r, j, parts = _stack(model, values, names, meas, metric, infos)
+            except (ParameterError, ConvergenceError) as exc:
+                if "parts" not in cache:  # the starting point: nothing to fall back on
+                    if not first or not init or not _evaluates(model, names, meas, metric):
+                        raise  # not the caller's starting values: the error stands
+                    raise _at_start(exc, values) from exc
+                # A trial the model cannot be evaluated at (e.g. a modulus at which a
+                # measured tension would compress the arm to zero length): non-finite
+                # residuals make the trust-region solver reject it and shrink its step.
+                rejected.append((values, exc))
+                size = int(sum(cache["parts"]))
+                r, j = np.full(size, np.nan), np.full((size, len(names)), np.nan)
+                parts, infos = cache["parts"], cache["infos"]
+            else:  # trials other than the start that could be evaluated
+                cache.setdefault("start", key)
+                cache["evaluated"] = cache.get("evaluated", 0) + (key != cache["start"])
+            cache.update(key=key, r=r, j=j * scale[None, :], parts=parts, infos=infos)
+        return cache
+
+    res = least_squares(
+        lambda z: evaluate(z)["r"],
+        z0,
+        jac=lambda z: evaluate(z)["j"],
+        bounds=zbounds,
+        method="trf",
+        ftol=1e-10,
+        xtol=1e-10,
+        gtol=1e-10,
+        x_scale=1.0,
+        loss=loss,
+        max_nfev=max_evaluations,
+    )
+    evaluated = cache.get("evaluated", 0)
+    final = dict(evaluate(res.x))
+    message = str(res.message)
+    stuck = None
+    if rejected:
+        at, exc = rejected[-1]
+        message += (
+            f"; {len(rejected)} trial value(s) rejected where the model cannot be evaluated "
+            f"(last: {_fmt_values(at)}: {' '.join(str(exc).split())})"
+        )
+        if evaluated == 0:  # no trial other than the start could be evaluated
+            at, exc = rejected[0]  # the first, largest step
+            start = dict(zip(names, (z0 * scale).tolist(), strict=True))
+            stuck = ConvergenceError(
+                f"calibrate could not move from the starting values ({_fmt_values(start)}): "
+                "every trial value of the fitted parameters was rejected, the model cannot be "
+                f"evaluated there (e.g. at the trial value {_fmt_values(at)}: "
+                f"{' '.join(str(exc).split())}); give `initial` values or `bounds` of the "
+                "fitted parameters where it can"
+            )
+            # The optimiser's evaluations, its residual at the start (none moved), full data.
+            stuck.iterations = int(res.nfev)
+            stuck.residual = float(np.linalg.norm(final["r"]))
+            stuck.load_factor = 1.0
+    return _Run(z0, res, final, message, stuck)
+
+
+def _other_starts(
+    starts: int, names: Sequence[str], lo: np.ndarray, hi: np.ndarray, scale: np.ndarray
+) -> np.ndarray:
+    """The scaled starts after the first: a Latin hypercube (seed 0) of ``starts - 1`` points
+    in the bounds, log-uniform for a parameter with positive bounds, uniform otherwise."""
+    if starts <= 1:
+        return np.empty((0, len(names)))
+    for n, a, c in zip(names, lo, hi, strict=True):
+        if not (math.isfinite(a) and math.isfinite(c)):
+            raise _args.value_error(
+                f"bounds[{n!r}]", (float(a), float(c)), "finite, to draw `starts` from"
+            )
+    from scipy.stats import qmc
+
+    u = qmc.LatinHypercube(d=len(names), seed=0).random(starts - 1)
+    log = lo > 0.0
+    a = np.where(log, np.log(np.where(log, lo, 1.0)), lo)
+    c = np.where(log, np.log(np.where(log, hi, 1.0)), hi)
+    x = a + u * (c - a)
+    return np.where(log, np.exp(x), x) / scale
+
+
 def calibrate(
     robot: Any,
     measurements: Sequence[Any],
@@ -686,6 +818,7 @@ def calibrate(
     loss: str = "linear",
     max_evaluations: int = 200,
     condition_limit: float = 1e8,
+    starts: int = 1,
 ) -> Calibration:
     """Fits named parameters of a robot to measured shapes or tip poses.
 
@@ -714,7 +847,11 @@ def calibrate(
         initial: Starting values (parameter -> value) instead of the robot's.
         loss: SciPy's loss (``"linear"``, or a robust one such as ``"soft_l1"``; the standard
             errors assume ``"linear"``).
-        max_evaluations: Largest number of residual evaluations.
+        max_evaluations: Largest number of residual evaluations of one start.
+        starts: Number of starts (1 to 1000): the first is the robot's values (or
+            ``initial``), the others a Latin hypercube (seed 0) in the bounds, log-uniform for
+            a positive parameter; the fit with the smallest sum of squared residuals is
+            returned, every start in ``Calibration.starts``. Needs finite bounds.
         condition_limit: Condition number of the scaled Jacobian above which the parameters
             are reported not identifiable.
 
@@ -738,8 +875,6 @@ def calibrate(
         PoorFitWarning: The RMS residual exceeds :data:`POOR_FIT_FRACTION` of the arm's
             length (a local minimum, or a model that does not describe the data).
     """
-    from scipy.optimize import least_squares
-
     model = _model_for(robot)
     if metric not in METRICS:
         raise _args.value_error("metric", metric, f"one of {', '.join(METRICS)}")
@@ -751,6 +886,7 @@ def calibrate(
     if len(set(names)) != len(names):
         raise _args.bad(f"invalid parameter `parameters` = {list(parameters)}: repeated")
     max_evaluations = _args.count(max_evaluations, "max_evaluations", 1, 100_000)
+    starts = _args.count(starts, "starts", 1, 1000)
     condition_limit = _args.number(condition_limit, "condition_limit")
     if not condition_limit > 1.0:
         raise _args.value_error("condition_limit", condition_limit, "> 1")
@@ -767,75 +903,35 @@ def calibrate(
     lo, hi = _bounds(bounds, names, model, p0)
     scale = np.array([model.typical(n, v) for n, v in zip(names, p0, strict=True)])
 
-    cache: dict[str, Any] = {}
-    rejected: list[tuple[dict[str, float], Exception]] = []
-
-    def evaluate(z: np.ndarray):
-        key = z.tobytes()
-        if cache.get("key") != key:
-            values = dict(zip(names, (z * scale).tolist(), strict=True))
-            infos: list[Any] = []
-            try:
-                r, j, parts = _stack(model, values, names, meas, metric, infos)
-            except (ParameterError, ConvergenceError) as exc:
-                if "parts" not in cache:  # the starting point: nothing to fall back on
-                    if not init or not _evaluates(model, names, meas, metric):
-                        raise  # not the caller's starting values: the error stands
-                    raise _at_start(exc, values) from exc
-                # A trial the model cannot be evaluated at (e.g. a modulus at which a
-                # measured tension would compress the arm to zero length): non-finite
-                # residuals make the trust-region solver reject it and shrink its step.
-                rejected.append((values, exc))
-                size = int(sum(cache["parts"]))
-                r, j = np.full(size, np.nan), np.full((size, len(names)), np.nan)
-                parts, infos = cache["parts"], cache["infos"]
-            else:  # trials other than the start that could be evaluated
-                cache.setdefault("start", key)
-                cache["evaluated"] = cache.get("evaluated", 0) + (key != cache["start"])
-            cache.update(key=key, r=r, j=j * scale[None, :], parts=parts, infos=infos)
-        return cache
-
-    z0 = p0 / scale
-    zlo, zhi = lo / scale, hi / scale
-    z0 = np.clip(z0, zlo, zhi)
-    res = least_squares(
-        lambda z: evaluate(z)["r"],
-        z0,
-        jac=lambda z: evaluate(z)["j"],
-        bounds=(zlo, zhi),
-        method="trf",
-        ftol=1e-10,
-        xtol=1e-10,
-        gtol=1e-10,
-        x_scale=1.0,
-        loss=loss,
-        max_nfev=max_evaluations,
-    )
-    evaluated = cache.get("evaluated", 0)
-    z = res.x
-    final = evaluate(z)
-    message = str(res.message)
-    if rejected:
-        at, exc = rejected[-1]
-        message += (
-            f"; {len(rejected)} trial value(s) rejected where the model cannot be evaluated "
-            f"(last: {_fmt_values(at)}: {' '.join(str(exc).split())})"
+    def fit_from(z0: np.ndarray, first: bool) -> _Run:
+        return _least_squares_from(
+            z0, first, model, names, meas, metric, scale, (zlo, zhi), init, loss, max_evaluations
         )
-        if evaluated == 0:  # no trial other than the start could be evaluated
-            at, exc = rejected[0]  # the first, largest step
-            err = ConvergenceError(
-                "calibrate could not move from the starting values "
-                f"({_fmt_values(dict(zip(names, p0.tolist(), strict=True)))}): every trial "
-                "value of the fitted parameters was rejected, the model cannot be evaluated "
-                f"there (e.g. at the trial value {_fmt_values(at)}: "
-                f"{' '.join(str(exc).split())}); give `initial` values or `bounds` of the "
-                "fitted parameters where it can"
+
+    zlo, zhi = lo / scale, hi / scale
+    z0 = np.clip(p0 / scale, zlo, zhi)
+    runs = [fit_from(z0, True)]
+    tried = [runs[0].summary(names, scale)]
+    for zs in _other_starts(starts, names, lo, hi, scale):
+        try:
+            run = fit_from(zs, False)
+        except (ParameterError, ConvergenceError) as exc:  # the model refuses this start
+            tried.append(
+                {
+                    "initial": dict(zip(names, (zs * scale).tolist(), strict=True)),
+                    "error": " ".join(str(exc).split()),
+                }
             )
-            # The optimiser's evaluations, its residual at the start (none moved), full data.
-            err.iterations = int(res.nfev)
-            err.residual = float(np.linalg.norm(cache["r"])) if "r" in cache else float("nan")
-            err.load_factor = 1.0
-            raise err
+            continue
+        runs.append(run)
+        tried.append(run.summary(names, scale))
+    moved = [run for run in runs if run.stuck is None]
+    if not moved:
+        raise runs[0].stuck  # type: ignore[misc]
+    best = min(moved, key=lambda run: run.cost)
+    res, final, message = best.result, best.final, best.message
+    p0 = best.z0 * scale
+    z = res.x
     r, jz, parts = final["r"], final["j"], final["parts"]
     p = z * scale
     values = dict(zip(names, p.tolist(), strict=True))
@@ -896,7 +992,8 @@ def calibrate(
             PoorFitWarning(
                 f"the fit leaves an RMS residual of {rms:.3g} m, {100 * rms / model.length:.3g} "
                 f"% of the arm's length ({_fmt_values(values)}): a local minimum (try other "
-                "`initial` values) or a model that does not describe the measurements",
+                "`initial` values or more `starts`) or a model that does not describe the "
+                "measurements",
                 rms,
                 model.length,
             ),
@@ -928,6 +1025,7 @@ def calibrate(
         metric=metric,
         success=bool(res.success),
         message=message,
-        evaluations=int(res.nfev),
+        evaluations=sum(int(run.result.nfev) for run in runs),
+        starts=tried,
         extra={"weak": weak},
     )

@@ -82,6 +82,8 @@ def _cmd_calibrate(args) -> int:
     robot = PlanarCableArm.published_arm() if planar else load_robot(args.robot_file)
     if planar and args.write_robot:
         raise bad("--write-robot", args.write_robot, "needs a robot file (not the planar arm)")
+    if not 1 <= args.starts <= 1000:
+        raise bad("--starts", args.starts, "in [1, 1000]")
     data = _measurements(args.measurements, args.unit_scale, 2 if planar else 3)
     if planar:
         for tensions, _ in data:
@@ -99,6 +101,7 @@ def _cmd_calibrate(args) -> int:
             bounds=bounds or None,
             metric=args.metric,
             initial=initial or None,
+            starts=args.starts,
         )
     for w in caught:
         print(f"softrod: warning: {w.message}", file=sys.stderr)
@@ -113,6 +116,14 @@ def _cmd_calibrate(args) -> int:
         print(
             f"{k:{width}s}  {fit.initial[k]:12.6g}  {v:12.6g}  {fit.standard_errors[k]:10.3g}  "
             f"[{lo:.6g}, {hi:.6g}]"
+        )
+    if len(fit.starts) > 1:
+        fitted = [st for st in fit.starts if "rms" in st]
+        best = next(i for i, st in enumerate(fit.starts) if st["initial"] == fit.initial)
+        print(
+            f"starts: {len(fitted)} of {len(fit.starts)} fitted (the others refused by the "
+            f"model), rms from {min(st['rms'] for st in fitted):.3g} to "
+            f"{max(st['rms'] for st in fitted):.3g} m; the fit above is from start {best + 1}"
         )
     if len(fit.values) > 1:
         print("correlation:")
@@ -141,6 +152,7 @@ def _cmd_calibrate(args) -> int:
                 "identifiable": fit.identifiable,
                 "metric": fit.metric,
                 "evaluations": fit.evaluations,
+                "starts": fit.starts,
             },
         )
     if args.write_robot:
@@ -184,6 +196,14 @@ def register(sub) -> None:
     )
     p.add_argument("--bounds", nargs="+", metavar="NAME=LO:HI", help="bounds of parameters")
     p.add_argument("--initial", nargs="+", metavar="NAME=VALUE", help="starting values")
+    p.add_argument(
+        "--starts",
+        type=int,
+        default=1,
+        metavar="N",
+        help="starts of the fit: the first from the robot (or --initial), the others drawn in "
+        "the bounds; the best fit is reported (default 1)",
+    )
     p.add_argument(
         "--unit-scale",
         type=float,
