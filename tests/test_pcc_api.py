@@ -67,6 +67,28 @@ def test_inverse_maps_round_trip():
     assert residual < 1e-12
 
 
+def test_the_misfit_of_inextensible_displacements_is_their_common_change():
+    # Three tendons 120 degrees apart at one distance: an inextensible arc's displacements sum
+    # to zero, so a common change c (a stretched backbone, or encoders' offsets) is what no
+    # inextensible arc explains: the misfit is -c at every tendon, and the arc is unchanged.
+    d = [0.01] * 3
+    dl = pcc.tendon_displacements([5.0, 0.4, 0.2], d, ANGLES)
+    np.testing.assert_allclose(
+        pcc.tendon_displacement_misfit(dl, d, ANGLES, 0.2, extensible=False), 0.0, atol=1e-17
+    )
+    measured = dl + 3e-4
+    misfit = pcc.tendon_displacement_misfit(measured, d, ANGLES, 0.2, extensible=False)
+    np.testing.assert_allclose(misfit, -3e-4, rtol=1e-12)
+    arc = pcc.arc_from_tendon_displacements(measured, d, ANGLES, 0.2, extensible=False)
+    np.testing.assert_allclose(arc, [5.0, 0.4, 0.2], rtol=1e-12)
+    # Extensible, three tendons resolve the elongation too: no misfit.
+    extensible = pcc.tendon_displacement_misfit(measured, d, ANGLES, 0.2)
+    np.testing.assert_allclose(extensible, 0.0, atol=1e-17)
+    with pytest.raises(softrod.ParameterError, match="displacements") as e:
+        pcc.tendon_displacement_misfit([0.0, 0.0], d, ANGLES, 0.2)
+    assert e.value.parameter == "displacements.len()"
+
+
 def test_actuation_maps_shapes():
     d = [0.01] * 3
     dl = pcc.tendon_displacements([5.0, 0.4, 0.2], d, ANGLES)

@@ -925,6 +925,14 @@ def pcc_arc_from_tendon_displacements(
     *,
     extensible: bool = True,
 ) -> NDArray[np.float64]: ...
+def pcc_tendon_displacement_misfit(
+    displacements: _Floats,
+    distances: _Floats,
+    angles: _Floats,
+    rest_length: float,
+    *,
+    extensible: bool = True,
+) -> NDArray[np.float64]: ...
 def pcc_arc_from_tendon_displacements_jacobian(
     displacements: _Floats,
     distances: _Floats,

@@ -50,6 +50,7 @@ from ._core import pcc_chain_jacobian as chain_jacobian
 from ._core import pcc_chain_pose as chain_pose
 from ._core import pcc_solve as solve
 from ._core import pcc_tendon_displacement_jacobian as tendon_displacement_jacobian
+from ._core import pcc_tendon_displacement_misfit as tendon_displacement_misfit
 from ._core import pcc_tendon_displacements as tendon_displacements
 from .inverse import _Deferred, _from_core, _warm_arguments
 
@@ -162,5 +163,6 @@ __all__ = [
     "inverse_statics",
     "solve",
     "tendon_displacement_jacobian",
+    "tendon_displacement_misfit",
     "tendon_displacements",
 ]

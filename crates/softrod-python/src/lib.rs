@@ -121,6 +121,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pcc::pcc_tendon_displacements, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_tendon_displacement_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(pcc::pcc_arc_from_tendon_displacements, m)?)?;
+    m.add_function(wrap_pyfunction!(pcc::pcc_tendon_displacement_misfit, m)?)?;
     m.add_function(wrap_pyfunction!(
         pcc::pcc_arc_from_tendon_displacements_jacobian,
         m

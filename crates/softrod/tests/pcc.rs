@@ -10,8 +10,9 @@ use softrod::pcc::{
     arc_frames, arc_from_pressures, arc_from_pressures_jacobian, arc_from_tendon_displacements,
     arc_from_tendon_displacements_jacobian, arc_from_tendon_tensions,
     arc_from_tendon_tensions_jacobian, arc_from_tip, arc_from_tip_with_length, arc_jacobian,
-    arc_pose, chain_jacobian, chain_pose, tendon_displacement_jacobian, tendon_displacements,
-    ArcCoordinates, ElasticSegment, JacobianFrame, PccChain, PccChambers, PccSegment, PccTendons,
+    arc_pose, chain_jacobian, chain_pose, tendon_displacement_jacobian, tendon_displacement_misfit,
+    tendon_displacements, ArcCoordinates, ElasticSegment, JacobianFrame, PccChain, PccChambers,
+    PccSegment, PccTendons,
 };
 use softrod::Error;
 
@@ -569,6 +570,10 @@ fn tendon_displacements_match_path_lengths_and_round_trip() {
     // Degenerate layouts are rejected.
     let opposite = PccTendons::new(&[0.01, 0.01], &[0.0, PI]).unwrap();
     assert!(matches!(
+        tendon_displacement_misfit(&[0.0, 0.0], &opposite, 0.3, false),
+        Err(Error::InvalidParameter { name, .. }) if name == "tendons"
+    ));
+    assert!(matches!(
         arc_from_tendon_displacements(&[0.0, 0.0], &opposite, 0.3, false),
         Err(Error::InvalidParameter { name, .. }) if name == "tendons"
     ));
@@ -771,4 +776,41 @@ fn invalid_parameters_are_named() {
         arc_from_tip_with_length(&Vector3::new(0.1, 0.0, 0.1), 0.0),
         Err(Error::InvalidParameter { name, .. }) if name == "length"
     ));
+}
+
+#[test]
+fn the_misfit_is_what_no_arc_explains() {
+    // Four tendons 90° apart at one distance: the displacement map's range is spanned by
+    // (1, 1, 1, 1) (elongation) and the two bending columns; (1, -1, 1, -1) is orthogonal to
+    // it. Three tendons 120° apart, inextensible: a common change (1, 1, 1) is orthogonal to
+    // the bending columns. Added to an arc's displacements, such a change is the misfit
+    // (negated), and the arc is unchanged.
+    let d = 0.01;
+    let s = seg(5.0, 0.8, 0.26);
+    for (n, extensible, orthogonal) in [
+        (4, true, vec![1.0, -1.0, 1.0, -1.0]),
+        (3, false, vec![1.0, 1.0, 1.0]),
+    ] {
+        let tendons = PccTendons::equally_spaced(n, d, 0.0).unwrap();
+        let l0 = if extensible { 0.25 } else { 0.26 };
+        let dl = tendon_displacements(&s, &tendons, Some(l0)).unwrap();
+        let consistent = tendon_displacement_misfit(&dl, &tendons, l0, extensible).unwrap();
+        assert!(consistent.iter().all(|m| m.abs() < 1e-16), "{consistent:?}");
+        let eps = 2e-4;
+        let measured: Vec<f64> = dl
+            .iter()
+            .zip(&orthogonal)
+            .map(|(a, o)| a + eps * o)
+            .collect();
+        let misfit = tendon_displacement_misfit(&measured, &tendons, l0, extensible).unwrap();
+        for (m, o) in misfit.iter().zip(&orthogonal) {
+            assert!((m + eps * o).abs() < 1e-16, "{misfit:?}");
+        }
+        let back = arc_from_tendon_displacements(&measured, &tendons, l0, extensible).unwrap();
+        assert!(max_abs(&(back.pose() - s.pose())) < 1e-13);
+    }
+    // As many tendons as unknowns: every set of displacements is one arc's.
+    let two = PccTendons::new(&[0.01, 0.012], &[0.0, 2.0]).unwrap();
+    let m = tendon_displacement_misfit(&[0.003, -0.001], &two, 0.3, false).unwrap();
+    assert!(m.iter().all(|v| v.abs() < 1e-18), "{m:?}");
 }

@@ -75,6 +75,29 @@ pub(crate) fn pcc_arc_from_tendon_displacements<'py>(
     Ok(arc_array(py, &s))
 }
 
+/// Per tendon, the length change of the least-squares arc minus the one given (m).
+#[pyfunction]
+#[pyo3(signature = (displacements, distances, angles, rest_length, *, extensible=true))]
+pub(crate) fn pcc_tendon_displacement_misfit<'py>(
+    py: Python<'py>,
+    #[pyo3(from_py_with = arg::displacements)] displacements: Floats,
+    #[pyo3(from_py_with = arg::distances)] distances: Floats,
+    #[pyo3(from_py_with = arg::angles)] angles: Floats,
+    #[pyo3(from_py_with = arg::rest_length)] rest_length: f64,
+    #[pyo3(from_py_with = arg::extensible)] extensible: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let t = tendons_from(distances, angles)?;
+    let m = pcc::tendon_displacement_misfit(&displacements.to_vec()?, &t, rest_length, extensible)
+        .map_err(blame(&[
+            "displacements",
+            "distances",
+            "angles",
+            "rest_length",
+            "extensible",
+        ]))?;
+    Ok(m.into_pyarray(py))
+}
+
 /// 3×n Jacobian of the arc from tendon length changes.
 #[pyfunction]
 #[pyo3(signature = (displacements, distances, angles, rest_length, *, extensible=true, coordinates="arc"))]

@@ -28,7 +28,7 @@ pub(crate) use actuation::{
     pcc_arc_from_pressures, pcc_arc_from_pressures_jacobian, pcc_arc_from_tendon_displacements,
     pcc_arc_from_tendon_displacements_jacobian, pcc_arc_from_tendon_tensions,
     pcc_arc_from_tendon_tensions_jacobian, pcc_tendon_displacement_jacobian,
-    pcc_tendon_displacements,
+    pcc_tendon_displacement_misfit, pcc_tendon_displacements,
 };
 pub(crate) use kinematics::{
     pcc_arc_frames, pcc_arc_from_tip, pcc_arc_from_tip_with_length, pcc_arc_jacobian, pcc_arc_pose,

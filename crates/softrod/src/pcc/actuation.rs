@@ -457,6 +457,29 @@ pub fn arc_from_tendon_displacements(
     PccSegment::checked(arc.curvature(), arc.plane_angle(), arc.length())
 }
 
+/// The misfit of [`arc_from_tendon_displacements`]: for each tendon, the length change (m) of
+/// the least-squares arc minus the one given, `Δl_i(arc) - displacements[i]`. Zero to rounding
+/// when the displacements are those of one arc (always with as many tendons as unknowns);
+/// with more tendons, what one arc cannot explain: measurement error, a slack or stretched
+/// tendon, a segment that is not an arc, or (inextensible) a length change of the backbone.
+///
+/// # Errors
+/// As [`arc_from_tendon_displacements`].
+pub fn tendon_displacement_misfit(
+    displacements: &[f64],
+    tendons: &PccTendons,
+    rest_length: f64,
+    extensible: bool,
+) -> Result<Vec<f64>> {
+    let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
+    Ok((0..tendons.len())
+        .map(|i| {
+            let d = tendons.distances[i];
+            e - d * (a * tendons.cos[i] + b * tendons.sin[i]) - displacements[i]
+        })
+        .collect())
+}
+
 /// Converts a 3×n Jacobian into `(u_x, u_y, ℓ)` at curvature vector `(u_x, u_y)` into
 /// `coordinates`.
 fn to_coordinates(
