@@ -128,6 +128,15 @@ def main() -> None:
         times.append(time.perf_counter() - t0)
     med_map = statistics.median(times)
     print(f"\nworkspace map, 10 000 configurations (median of {len(times)}): {med_map:.3f} s")
+    # The compliance at many arc lengths: each is a stop of one step-size-controlled march.
+    sol = robot.solve([4.0, 0.0, 0.0, 0.0, 2.0, 0.0])
+    print("\ncompliance(sol, s_out) at n arc lengths (median of 3)")
+    print("| n | total (s) | per arc length (us) |")
+    print("| ---: | ---: | ---: |")
+    for n in (1_000, 10_000) if args.quick else (1_000, 10_000, 100_000, 200_000):
+        s = np.linspace(0.0, robot.rod.length, n)
+        t = median_time(lambda s=s: softrod.compliance(sol, s_out=s), calls=1, repeats=3)
+        print(f"| {n} | {t:.3f} | {t / n * 1e6:.2f} |")
 
 
 if __name__ == "__main__":

@@ -515,3 +515,29 @@ fn adaptive_tangent_matches_finite_difference() {
     let tr = tangent_compliance(&sr, TendonControl::Tension, None).unwrap();
     assert_blocks_close(&t.world, &tr.world, 1e-6, "adaptive vs rk4 tangent");
 }
+
+#[test]
+fn compliance_at_arc_lengths_in_any_order_with_repeats_is_the_sorted_one_rearranged() {
+    // Invariance: each requested arc length is a stop of one march, so the answer at a point
+    // does not depend on the order of the request or on repeats in it.
+    use softrod::compliance::compliance_at;
+    let rod = common::niti_rod();
+    let tendons = common::niti_tendons(&[4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    let loads = Loads::tip_force(Vector3::new(0.05, -0.02, 0.0));
+    let sol = common::solve(&rod, &tendons, &loads, &SolveOptions::default()).unwrap();
+    let length = rod.length();
+    let sorted: Vec<f64> = (0..=200).map(|i| length * i as f64 / 200.0).collect();
+    let base = compliance_at(&sol, &sorted).unwrap();
+    // Reversed, every other point repeated, the ends and the break (0.2 m) again.
+    let mut request: Vec<usize> = (0..=200).rev().collect();
+    request.extend((0..=200).step_by(2));
+    request.extend([0, 200, 100, 100]);
+    let s_out: Vec<f64> = request.iter().map(|&i| sorted[i]).collect();
+    let c = compliance_at(&sol, &s_out).unwrap();
+    assert_eq!(c.s, s_out);
+    for (k, &i) in request.iter().enumerate() {
+        // The same set of stops: the same march, bit for bit.
+        assert_eq!(c.world[k], base.world[i], "s = {}", s_out[k]);
+        assert_eq!(c.body[k], base.body[i], "s = {}", s_out[k]);
+    }
+}

@@ -197,7 +197,13 @@ pub(crate) fn march_compliance(
         controlled: WIDTH,
     };
     let mut recorded: Vec<(f64, [f64; WIDTH], [f64; 6])> = Vec::new();
-    let wanted = |s: f64| s_out.contains(&s);
+    let mut sorted = s_out.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    // (`==` on the sorted values: -0 is 0.)
+    let wanted = |s: f64| {
+        let k = sorted.partition_point(|&x| x < s);
+        k < sorted.len() && sorted[k] == s
+    };
     march(
         &mut sys,
         model.breaks(),
@@ -220,9 +226,13 @@ pub(crate) fn march_compliance(
     let mut used = vec![false; recorded.len()];
     let mut out = Vec::with_capacity(s_out.len());
     for &s in s_out {
-        let k = (0..recorded.len())
-            .find(|&k| !used[k] && recorded[k].0 == s)
-            .or_else(|| recorded.iter().rposition(|r| r.0 == s))
+        // The march records in increasing s (a break twice): the first node at s not yet
+        // reported, else the last one at s.
+        let first = recorded.partition_point(|r| r.0 < s);
+        let same = first + recorded[first..].iter().take_while(|r| r.0 == s).count();
+        let k = (first..same)
+            .find(|&k| !used[k])
+            .or_else(|| same.checked_sub(1).filter(|&k| k >= first))
             .ok_or_else(|| Error::invalid("s_out", s, "a point of the rod"))?;
         used[k] = true;
         let (s, y, element) = &recorded[k];
