@@ -142,18 +142,48 @@ def test_pareto_of_dataarrays_keeps_coordinates():
         softrod.Pareto([1.0, 2.0], [1.0])
 
 
-def test_a_robot_with_obstacles_or_a_tip_constraint_is_refused():
-    # (A sweep solves the free rod: its samples went through a sphere, reported converged and
-    # stable.)
-    niti = softrod.load_robot(softrod.examples.path("niti_two_segment"))
+@pytest.mark.filterwarnings("ignore::softrod.StabilityWarning")
+def test_a_robot_with_obstacles_or_a_tip_constraint_solves_its_contacts():
+    # (Sweeps solved the free rod: their samples went into obstacles, reported converged and
+    # stable; then robots with obstacles were refused.) Each sample is now the
+    # contact solve of its actuation: robot.solve's, bit for bit; out of the sphere; and the
+    # base carries the contacts' force, the only external load (N(0) = the contacts' sum).
+    niti = softrod.load_robot(softrod.examples.path("niti_two_segment")).with_tensions([0] * 6)
     kw = {"rod": niti.rod, "tendons": niti.tendons, "solver": niti.solver}
-    for extra in (
-        {"obstacles": [softrod.Sphere((0.06, 0, 0.3), 0.04)]},
-        {"tip_constraint": softrod.Pin((0.05, 0, 0.38))},
-    ):
-        with pytest.raises(softrod.ParameterError) as e:
-            softrod.sweep(softrod.Robot(**kw, **extra), progress=False)
-        assert e.value.parameter == "robot" and "robot.solve" in str(e.value)
+    centre, radius, rod_radius = np.array([0.0, 0.13, 0.3]), 0.04, 0.7e-3
+    sphere = softrod.Robot(**kw, obstacles=[softrod.Sphere(tuple(centre), radius)])
+    tensions = [0.0, 1.0, 2.0, 3.0, 4.0]
+    axis = {"tendons[0].tension": tensions}
+    outs = ("tip_pose", "contacts", "backbone", "stability")
+    ds = softrod.sweep(
+        sphere, actuation=axis, outputs=outs, arm_index=np.linspace(0, 1, 41), progress=False
+    )
+    assert (ds["status"].values == 0).all()
+    assert "every sample starts cold" in ds.attrs["warm_start_rule"]
+    touching = 0
+    for k, t in enumerate(tensions):
+        sol = sphere.with_tensions([t, 0, 0, 0, 0, 0]).solve()
+        np.testing.assert_array_equal(ds["tip_position"].values[k], sol.tip_position)
+        assert ds["contact_count"].values[k] == len(sol.contacts)
+        assert ds["stable"].values[k] == int(sol.stable)
+        gap = np.linalg.norm(ds["backbone_position"].values[k] - centre, axis=1)
+        assert gap.min() >= radius + rod_radius - 1e-9
+        f = ds["contact_force"].values[k]
+        np.testing.assert_allclose(sol.base_wrench[:3], f, atol=1e-9 * max(1e-3, abs(f).max()))
+        assert np.isnan(ds["tip_reaction"].values[k]).all()
+        touching += int(ds["contact_count"].values[k] > 0)
+    assert touching >= 2
+    # A pinned tip: the tip stays on the pin; the reaction is the solve's.
+    point = (0.0, 0.05, 0.39)
+    pin = softrod.Robot(**kw, tip_constraint=softrod.Pin(point))
+    tensions = [0.5, 1.0, 1.5]
+    axis = {"tendons[0].tension": tensions}
+    ds = softrod.sweep(pin, actuation=axis, outputs=("tip_pose", "contacts"), progress=False)
+    assert (ds["status"].values == 0).all()
+    for k, t in enumerate(tensions):
+        sol = pin.with_tensions([t, 0, 0, 0, 0, 0]).solve()
+        np.testing.assert_allclose(ds["tip_position"].values[k], point, atol=1e-9)
+        np.testing.assert_array_equal(ds["tip_reaction"].values[k], sol.tip_reaction)
     with pytest.raises(TypeError, match="`robot`"):
         softrod.sweep(None)  # (a ParameterTypeError: a TypeError naming `robot`)
 

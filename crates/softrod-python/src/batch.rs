@@ -15,7 +15,7 @@ use crate::statics::{solve_options, Given, OptionArgs, Problem};
 /// The output names of a sweep, in the order of the docs.
 const OUTPUTS: &str = "\"tip_pose\", \"tendon_lengths\", \"backbone\", \"compliance\", \
                        \"stiffness\", \"gamma_c\", \"eigen_stiffness\", \
-                       \"translational_compliance\"";
+                       \"translational_compliance\", \"contacts\"";
 
 fn request(outputs: &[String]) -> PyResult<SweepRequest> {
     let mut r = SweepRequest::default();
@@ -29,6 +29,7 @@ fn request(outputs: &[String]) -> PyResult<SweepRequest> {
             "gamma_c" => r.gamma_c = true,
             "eigen_stiffness" => r.eigen_stiffness = true,
             "translational_compliance" => r.translational_compliance = true,
+            "contacts" => r.contacts = true,
             other => {
                 return Err(param_err(
                     &format!("outputs[{i}]"),
@@ -95,6 +96,13 @@ struct Converted {
     tip_force: Option<Vec<f64>>,
     tip_moment: Option<Vec<f64>>,
     arc_lengths: Vec<f64>,
+    obstacles: Vec<softrod::Obstacle>,
+    tip_constraint: Option<softrod::TipConstraint>,
+}
+
+/// An optional item of a job dict (None when missing).
+fn optional<'py>(job: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<Bound<'py, PyAny>>> {
+    Ok(job.get_item(key)?.filter(|v| !v.is_none()))
 }
 
 fn convert(job: &Bound<'_, PyDict>, k: usize) -> PyResult<Converted> {
@@ -147,6 +155,9 @@ fn convert(job: &Bound<'_, PyDict>, k: usize) -> PyResult<Converted> {
     let arcs: PyReadonlyArray1<'_, f64> = item(job, k, "arc_lengths")?
         .extract()
         .map_err(|_| param_err(&name("arc_lengths"), "<object>", "a 1-d float64 array"))?;
+    // (A robot's obstacles and tip constraint were checked when it was made.)
+    let obstacles = crate::contact::obstacles(job.py(), optional(job, "obstacles")?.as_ref())?;
+    let tip_constraint = crate::contact::tip_constraint(optional(job, "tip_constraint")?.as_ref())?;
     Ok(Converted {
         problem,
         options,
@@ -156,6 +167,8 @@ fn convert(job: &Bound<'_, PyDict>, k: usize) -> PyResult<Converted> {
         tip_force,
         tip_moment,
         arc_lengths: arcs.as_array().to_vec(),
+        obstacles,
+        tip_constraint,
     })
 }
 
@@ -237,6 +250,18 @@ fn arrays<'py>(
             Array::from_shape_fn((n, nt), |(i, j)| samples[i].tendon_lengths[j]).into_pyarray(py),
         )?;
     }
+    if request.contacts {
+        let counts: Vec<i64> = samples.iter().map(|s| s.contact_count as i64).collect();
+        d.set_item("contact_count", counts.into_pyarray(py))?;
+        d.set_item(
+            "contact_force",
+            Array::from_shape_fn((n, 3), |(i, j)| samples[i].contact_force[j]).into_pyarray(py),
+        )?;
+        d.set_item(
+            "tip_reaction",
+            Array::from_shape_fn((n, 6), |(i, j)| samples[i].tip_reaction[j]).into_pyarray(py),
+        )?;
+    }
     let m = n_arcs;
     let arc = |i: usize, a: usize| samples[i].arcs.get(a);
     let put3 = |key: &str, width: usize, f: &dyn Fn(&softrod::ArcSample, usize) -> f64| {
@@ -285,8 +310,9 @@ fn arrays<'py>(
 /// Each job is a dict: `rod`, `tendons`, `chambers`, `loads` (robot objects; their tensions
 /// and pressures are replaced), `options` (a robot's solver options), `samples` (M),
 /// `tensions` (N, shape (M, n_tendons)), `pressures` (Pa, shape (M, n_chambers)),
-/// `tip_force` and `tip_moment` (N, N m, shape (M, 3), or None to keep the loads') and
-/// `arc_lengths` (m, shape (K,)). `outputs` names what to measure; rows are warm-started
+/// `tip_force` and `tip_moment` (N, N m, shape (M, 3), or None to keep the loads'),
+/// `arc_lengths` (m, shape (K,)) and, optionally, `obstacles` and `tip_constraint` (as
+/// `solve_statics` takes them; each sample is then a contact solve, started cold). `outputs` names what to measure; rows are warm-started
 /// within blocks of `block` rows (see docs/sweeps.md); `parallel` runs the blocks on all
 /// cores. Returns one dict of arrays per job (`status`: 0 converged, 1 not converged,
 /// 2 failed; `error`: the error class per sample, "" if none).
@@ -322,6 +348,8 @@ pub(crate) fn _sweep<'py>(
                 tip_moment: c.tip_moment.as_deref(),
             },
             arc_lengths: c.arc_lengths.clone(),
+            obstacles: c.obstacles.clone(),
+            tip_constraint: c.tip_constraint,
         })
         .collect();
     let own_pool = parallel && converted.iter().any(|c| c.problem.has_callables);

@@ -74,6 +74,8 @@ fn job<'a>(
         options,
         actuations: t,
         arc_lengths: s.to_vec(),
+        obstacles: Vec::new(),
+        tip_constraint: None,
     }
 }
 
@@ -87,6 +89,7 @@ fn all() -> SweepRequest {
         gamma_c: true,
         eigen_stiffness: true,
         translational_compliance: true,
+        contacts: true,
     }
 }
 
@@ -115,6 +118,9 @@ fn same(a: &SweepSample, b: &SweepSample) -> bool {
         && bits(&a.tip_quaternion) == bits(&b.tip_quaternion)
         && bits(&a.tendon_lengths) == bits(&b.tendon_lengths)
         && bits(&arcs(a)) == bits(&arcs(b))
+        && a.contact_count == b.contact_count
+        && bits(&a.contact_force) == bits(&b.contact_force)
+        && bits(&a.tip_reaction) == bits(&b.tip_reaction)
 }
 
 #[test]
@@ -490,4 +496,61 @@ fn an_arc_length_beyond_a_jobs_rod_fails_its_samples_by_name() {
             other => panic!("{other:?}"),
         }
     }
+}
+
+#[test]
+fn a_job_with_an_obstacle_solves_its_contacts_and_balances_their_force() {
+    // The NiTi robot bent towards +y onto a wall at y = 0.1 m: every sample is the contact
+    // solve of that actuation (bit for bit, each row cold), no node passes the wall, and the
+    // base carries the contacts' force (the only external load): N(0) = sum of contact forces.
+    use softrod::{solve_constrained, Obstacle};
+    let model = common::niti_model(Loads::default(), None, 0.0);
+    let wall = Obstacle::plane([0.0, 0.1, 0.0], [0.0, -1.0, 0.0]).unwrap();
+    let n = 6;
+    let rows: Vec<f64> = (0..n)
+        .flat_map(|i| [0.5 + 0.7 * i as f64, 0.0, 0.0, 0.0, 0.0, 0.0])
+        .collect();
+    let mut j = job(&model, SolveOptions::default(), table(n, &rows), &[0.2]);
+    j.obstacles = vec![wall.clone()];
+    let out = sweep(&[j], &all(), 4, true).unwrap();
+    let mut touching = 0;
+    for (i, sample) in out[0].iter().enumerate() {
+        assert_eq!(
+            sample.status,
+            SampleStatus::Converged,
+            "{i}: {:?}",
+            sample.error
+        );
+        let act = Actuation::tensions(&rows[6 * i..6 * i + 6]);
+        let direct = solve_constrained(
+            &model,
+            &act,
+            &SolveOptions::default(),
+            None,
+            std::slice::from_ref(&wall),
+        )
+        .unwrap();
+        assert_eq!(sample.tip_position, direct.solution.tip_position(), "{i}");
+        assert_eq!(sample.contact_count, direct.contacts.len(), "{i}");
+        // Out of the wall (to the rod's radius and the contact tolerance).
+        let radius = 0.7e-3;
+        for p in &direct.solution.position {
+            assert!(p[1] <= 0.1 - radius + 1e-9, "{i}: y = {}", p[1]);
+        }
+        let f = sample.contact_force;
+        let n0 = &direct.solution.base_wrench;
+        let scale = f.iter().map(|v| v.abs()).fold(1e-12, f64::max);
+        for k in 0..3 {
+            assert!(
+                (n0[k] - f[k]).abs() <= 1e-9 * scale,
+                "{i}: N(0) {n0:?} vs contacts {f:?}"
+            );
+        }
+        assert!(sample.tip_reaction.iter().all(|v| v.is_nan()));
+        touching += usize::from(sample.contact_count > 0);
+    }
+    assert!(
+        touching >= 3,
+        "only {touching} of {n} samples touch the wall"
+    );
 }

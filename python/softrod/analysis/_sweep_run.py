@@ -139,6 +139,8 @@ def _job(robot, rows: np.ndarray, spec: TaskSpec) -> dict:
         "tip_force": loads["tip_force"],
         "tip_moment": loads["tip_moment"],
         "arc_lengths": arcs,
+        "obstacles": list(robot.obstacles) or None,
+        "tip_constraint": robot.tip_constraint,
     }
 
 

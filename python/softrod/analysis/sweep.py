@@ -51,6 +51,7 @@ OUTPUTS = (
     "gamma_c",
     "eigen_stiffness",
     "translational_compliance",
+    "contacts",
     "convergence",
     "stability",
 )
@@ -71,7 +72,7 @@ WARM_START_RULE = (
     "samples of a design point are solved in boustrophedon order of the actuation grid (table "
     "order for a table) and cut into blocks of `block` samples aligned to that order; the first "
     "sample of a block starts cold, every other from the converged sample before it (cold if "
-    "that one did not converge)"
+    "that one did not converge); with obstacles or a held tip every sample starts cold"
 )
 
 _TWIST = ["dx", "dy", "dz", "rx", "ry", "rz"]
@@ -200,6 +201,8 @@ def sweep(
             (position, quaternion), ``compliance`` and ``stiffness`` (6x6, world frame, the
             integrated compliance), ``gamma_c``, ``eigen_stiffness``,
             ``translational_compliance`` (principal values of the force-to-translation block);
+            ``contacts`` (``contact_count``, the total ``contact_force`` on the rod and the tip
+            constraint's ``tip_reaction``, for a robot with obstacles or a held tip);
             ``convergence`` (iterations, residual, load factor, load steps, evaluations).
             ``status`` and ``error`` are always recorded.
         arc_lengths: Arc lengths (m, in [0, L]) of the per-arc-length outputs (dimension
@@ -231,9 +234,7 @@ def sweep(
             grid that is not 1-D or not finite, a bad tension or pressure (named by its path),
             an arc length beyond the rod (the shortest design rod with ``rod.length`` a design
             axis), two axes naming one parameter (both named), more points than the limit
-            (the number of points and the limit named; refused before any allocation); a
-            robot with obstacles or a tip constraint (named ``robot``: sweeps solve the free
-            rod).
+            (the number of points and the limit named; refused before any allocation).
         ParameterTypeError: ``robot`` is not a :class:`softrod.Robot`.
     """
     import xarray as xr
@@ -242,16 +243,6 @@ def sweep(
 
     if not isinstance(robot, Robot):
         raise _args.type_error("robot", robot, "a softrod.Robot")
-    if robot.obstacles or robot.tip_constraint is not None:
-        # (Sweeps solve the free rod: its samples went through the obstacles, reported
-        # converged.)
-        what = "obstacles" if robot.obstacles else "a tip constraint"
-        raise _args.value_error(
-            "robot",
-            robot.name,
-            f"a robot without obstacles or a tip constraint (it has {what}; a sweep solves "
-            "the free rod: solve each sample with robot.solve)",
-        )
     names = _outputs(outputs)
     block = _positive_int("block", block)
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
@@ -493,6 +484,7 @@ class _Store:
             coords["tendon"] = ("tendon", np.arange(self.n_tendons))
         if "compliance" in names or "stiffness" in names:
             coords["twist"] = ("twist", _TWIST)
+        if "compliance" in names or "stiffness" in names or "contacts" in names:
             coords["wrench"] = ("wrench", _WRENCH)
         if "eigen_stiffness" in names:
             coords["screw"] = ("screw", np.arange(6))
@@ -555,6 +547,15 @@ _VARIABLES: dict[str, tuple[tuple[str, ...], dict[str, str]]] = {
     "translational_compliance": (
         ("ARC", "principal"),
         {"units": "m/N", "long_name": "principal translational compliances, decreasing"},
+    ),
+    "contact_count": ((), {"units": "1", "long_name": "active contacts"}),
+    "contact_force": (
+        ("xyz",),
+        {"units": "N", "long_name": "total contact force on the rod (world)"},
+    ),
+    "tip_reaction": (
+        ("wrench",),
+        {"units": "N, N m", "long_name": "reaction [f; m] of the tip constraint (world)"},
     ),
     "iterations": ((), {"units": "1", "long_name": "Newton iterations"}),
     "residual": ((), {"units": "1", "long_name": "final scaled residual"}),

@@ -11,6 +11,11 @@
 //! coarse fails the sample naming `steps`). The convergence of every sample is recorded; a sample that
 //! fails is reported with its status and error, never dropped.
 //!
+//! A job with obstacles or a held tip solves every sample by [`solve_constrained`] (under the
+//! same mesh control) and starts every row cold, as a single solve of that robot does: a
+//! contact solve warm-started from another actuation may find its contacts on another
+//! branch.
+//!
 //! # Determinism: the warm-start rule
 //! The rows of a job are cut into blocks of `block` consecutive rows aligned to the row index
 //! (rows `[k block, (k + 1) block)`). The first row of a block starts cold (the core's
@@ -29,7 +34,8 @@ use super::arc::{pose_at, ComplianceAt};
 use crate::compliance::eigenscrew::{eigenscrews, MatrixKind};
 use crate::compliance::gamma_c;
 use crate::compliance::{compliance, compliance_at};
-use crate::cosserat::mesh::solve_at_output;
+use crate::contact::{solve_constrained, ContactSolution, Obstacle, TipConstraint};
+use crate::cosserat::mesh::{solve_at_output, with_mesh_control};
 use crate::cosserat::statics::{Integrator, SolveOptions, StaticsSolution};
 use crate::error::{Error, Result};
 use crate::math::linalg::invert_spd;
@@ -62,6 +68,9 @@ pub struct SweepRequest {
     /// Principal translational compliances (eigenvalues of the force-to-translation block
     /// of `C_world`, m/N) at the arc lengths, decreasing.
     pub translational_compliance: bool,
+    /// The contacts: their number, their total force on the rod and the tip constraint's
+    /// reaction (jobs with obstacles or a held tip).
+    pub contacts: bool,
 }
 
 impl SweepRequest {
@@ -108,6 +117,17 @@ pub struct SweepJob<'a> {
     pub actuations: ActuationTable<'a>,
     /// Arc lengths of the per-arc-length outputs (m).
     pub arc_lengths: Vec<f64>,
+    /// Obstacles the rod is kept out of (none: the free rod).
+    pub obstacles: Vec<Obstacle>,
+    /// The tip's constraint, if held.
+    pub tip_constraint: Option<TipConstraint>,
+}
+
+impl SweepJob<'_> {
+    /// Whether its samples are contact solves.
+    fn constrained(&self) -> bool {
+        !self.obstacles.is_empty() || self.tip_constraint.is_some()
+    }
 }
 
 /// How a sample ended.
@@ -174,6 +194,14 @@ pub struct SweepSample {
     /// Whether the converged equilibrium is stable ([`StaticsSolution::stable`], judged by
     /// the solve itself: always recorded, no extra cost); `None` when it did not converge.
     pub stable: Option<bool>,
+    /// Active contacts (0 for a free rod; with [`SweepRequest::contacts`], else 0).
+    pub contact_count: usize,
+    /// Total force of the contacts on the rod (N, world), normal and tangential (NaN unless
+    /// requested and converged).
+    pub contact_force: [f64; 3],
+    /// Reaction wrench `[f; m]` of the tip constraint on the rod (N, N m; world; NaN without
+    /// one, unless requested, or not converged).
+    pub tip_reaction: [f64; 6],
 }
 
 impl SweepSample {
@@ -193,7 +221,26 @@ impl SweepSample {
             tendon_lengths: vec![f64::NAN; nt],
             arcs: vec![ArcSample::nan(); job.arc_lengths.len()],
             stable: None,
+            contact_count: 0,
+            contact_force: [f64::NAN; 3],
+            tip_reaction: [f64::NAN; 6],
         }
+    }
+
+    /// The contact outputs of a converged contact solution.
+    fn with_contacts(mut self, c: &ContactSolution) -> Self {
+        self.contact_count = c.contacts.len();
+        let mut f = [0.0; 3];
+        for contact in &c.contacts {
+            for (k, fk) in f.iter_mut().enumerate() {
+                *fk += contact.normal[k] * contact.normal_force + contact.tangential_force[k];
+            }
+        }
+        self.contact_force = f;
+        if let Some(r) = c.tip_reaction {
+            self.tip_reaction = r;
+        }
+        self
     }
 }
 
@@ -317,7 +364,8 @@ fn sample_problem(job: &SweepJob<'_>, i: usize) -> Result<(Arc<RobotModel>, Actu
 }
 
 /// Solves rows `[start, end)` of a job in order, each warm-started from the converged row
-/// before it (`start` is a block start: its row starts cold).
+/// before it (`start` is a block start: its row starts cold; every row of a contact job
+/// starts cold).
 fn solve_block(
     job: &SweepJob<'_>,
     start: usize,
@@ -358,17 +406,27 @@ fn solve_block(
             warm_start: warm.take(),
             ..quiet
         };
-        let result = sample_problem(job, i)
-            .and_then(|(model, act)| solve_at_output(&model, &act, &opts, &[]));
-        let sample = match result {
+        let result =
+            sample_problem(job, i).and_then(|(model, act)| solve_sample(job, &model, &act, &opts));
+        let sample = match result.as_ref().map(Solved::statics) {
             Ok(sol) if sol.stats.converged => {
-                warm = Some(sol.warm_start());
-                measure(&sol, job, request)
+                if !job.constrained() {
+                    warm = Some(sol.warm_start());
+                }
+                let sample = measure(sol, job, request);
+                match &result {
+                    Ok(Solved::Contact(c)) if request.contacts => sample.with_contacts(c),
+                    _ => sample,
+                }
             }
             Ok(sol) => SweepSample::failed(
                 SampleStatus::NotConverged,
                 Some(Error::NotConverged {
-                    what: "shooting Newton (Cosserat rod statics)".into(),
+                    what: if job.constrained() {
+                        "contact statics (Cosserat rod with obstacles or a held tip)".into()
+                    } else {
+                        "shooting Newton (Cosserat rod statics)".into()
+                    },
                     iterations: sol.stats.iterations,
                     residual: sol.stats.residual,
                     load_factor: sol.stats.load_factor,
@@ -376,19 +434,53 @@ fn solve_block(
                 sol.stats,
                 job,
             ),
-            Err(e @ Error::NotConverged { .. }) => SweepSample::failed(
-                SampleStatus::NotConverged,
-                Some(e),
-                SolverStats::default(),
-                job,
-            ),
             Err(e) => {
-                SweepSample::failed(SampleStatus::Failed, Some(e), SolverStats::default(), job)
+                let status = match e {
+                    Error::NotConverged { .. } => SampleStatus::NotConverged,
+                    _ => SampleStatus::Failed,
+                };
+                SweepSample::failed(status, Some(e.clone()), SolverStats::default(), job)
             }
         };
         out.push(sample);
     }
     out
+}
+
+/// The solution of one sample: of the free rod, or with its contacts.
+enum Solved {
+    Free(StaticsSolution),
+    Contact(ContactSolution),
+}
+
+impl Solved {
+    fn statics(&self) -> &StaticsSolution {
+        match self {
+            Self::Free(s) => s,
+            Self::Contact(c) => &c.solution,
+        }
+    }
+}
+
+/// The solution of one sample (a contact solve for a job with obstacles or a held tip), under
+/// mesh control.
+fn solve_sample(
+    job: &SweepJob<'_>,
+    model: &Arc<RobotModel>,
+    actuation: &Actuation,
+    options: &SolveOptions,
+) -> Result<Solved> {
+    if !job.constrained() {
+        return solve_at_output(model, actuation, options, &[]).map(Solved::Free);
+    }
+    let tip = job.tip_constraint.as_ref();
+    with_mesh_control(
+        options,
+        options.integrator.is_default_mesh(),
+        |o| solve_constrained(model, actuation, o, tip, &job.obstacles),
+        |c| &c.solution,
+    )
+    .map(Solved::Contact)
 }
 
 /// Eigenvalues of a symmetric 3×3 block, decreasing.
@@ -415,6 +507,9 @@ fn measure(sol: &StaticsSolution, job: &SweepJob<'_>, request: &SweepRequest) ->
         },
         arcs: vec![ArcSample::nan(); job.arc_lengths.len()],
         stable: Some(sol.stable),
+        contact_count: 0,
+        contact_force: [f64::NAN; 3],
+        tip_reaction: [f64::NAN; 6],
     };
     if request.tip_pose {
         sample.tip_position = sol.tip_position();
