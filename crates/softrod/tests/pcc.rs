@@ -809,6 +809,20 @@ fn the_misfit_is_what_no_arc_explains() {
         let back = arc_from_tendon_displacements(&measured, &tendons, l0, extensible).unwrap();
         assert!(max_abs(&(back.pose() - s.pose())) < 1e-13);
     }
+    // Displacements no arc has are refused as by the arc itself (were NaN misfits).
+    let three = PccTendons::equally_spaced(3, 0.01, 0.0).unwrap();
+    for (dl, extensible) in [
+        ([1e308; 3], true),
+        ([1e307, -1e307, 0.0], false),
+        ([1e300, 0.0, 0.0], true),
+    ] {
+        let arc = arc_from_tendon_displacements(&dl, &three, 0.2, extensible).map(|_| ());
+        let misfit = tendon_displacement_misfit(&dl, &three, 0.2, extensible).map(|_| ());
+        assert!(
+            arc.is_err() && misfit == arc,
+            "{dl:?}: {misfit:?} vs {arc:?}"
+        );
+    }
     // As many tendons as unknowns: every set of displacements is one arc's.
     let two = PccTendons::new(&[0.01, 0.012], &[0.0, 2.0]).unwrap();
     let m = tendon_displacement_misfit(&[0.003, -0.001], &two, 0.3, false).unwrap();

@@ -700,6 +700,7 @@ class _Run:
         out: dict[str, Any] = {"initial": dict(zip(names, (self.z0 * scale).tolist(), strict=True))}
         if self.stuck is not None:
             out["error"] = " ".join(str(self.stuck).split())
+            out["evaluations"] = int(self.result.nfev)
         else:
             r = self.final["r"]
             out["values"] = dict(zip(names, (self.result.x * scale).tolist(), strict=True))
@@ -799,11 +800,13 @@ def _other_starts(
     from scipy.stats import qmc
 
     u = qmc.LatinHypercube(d=len(names), seed=0).random(starts - 1)
-    log = lo > 0.0
-    a = np.where(log, np.log(np.where(log, lo, 1.0)), lo)
-    c = np.where(log, np.log(np.where(log, hi, 1.0)), hi)
-    x = a + u * (c - a)
-    return np.where(log, np.exp(x), x) / scale
+    x = np.empty_like(u)
+    for j, (a, c) in enumerate(zip(lo, hi, strict=True)):
+        if a > 0.0:  # log-uniform
+            x[:, j] = np.exp(np.log(a) + u[:, j] * (np.log(c) - np.log(a)))
+        else:
+            x[:, j] = a + u[:, j] * (c - a)
+    return x / scale
 
 
 def calibrate(
@@ -910,9 +913,10 @@ def calibrate(
 
     zlo, zhi = lo / scale, hi / scale
     z0 = np.clip(p0 / scale, zlo, zhi)
+    others = _other_starts(starts, names, lo, hi, scale)  # (bounds checked before any fit)
     runs = [fit_from(z0, True)]
     tried = [runs[0].summary(names, scale)]
-    for zs in _other_starts(starts, names, lo, hi, scale):
+    for zs in others:
         try:
             run = fit_from(zs, False)
         except (ParameterError, ConvergenceError) as exc:  # the model refuses this start

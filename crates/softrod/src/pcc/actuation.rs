@@ -471,6 +471,8 @@ pub fn tendon_displacement_misfit(
     rest_length: f64,
     extensible: bool,
 ) -> Result<Vec<f64>> {
+    // (The arc's own checks first: displacements it refuses have no misfit either.)
+    arc_from_tendon_displacements(displacements, tendons, rest_length, extensible)?;
     let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
     Ok((0..tendons.len())
         .map(|i| {
