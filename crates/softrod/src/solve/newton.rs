@@ -1,7 +1,7 @@
 //! Damped Newton at one load factor, with Broyden updates of the Jacobian between exact
 //! evaluations.
 
-use super::{max_norm, Evaluated, NewtonOptions, Problem, ROUND_OFF_STEP};
+use super::{max_norm, Evaluated, NewtonOptions, Problem, ROUND_OFF_RESIDUAL, ROUND_OFF_STEP};
 use crate::math::linalg::DenseLu;
 
 /// Sufficient-decrease condition of a step of length `alpha`: accepts the trial residual
@@ -481,6 +481,7 @@ impl<P: Problem + ?Sized> Run<'_, '_, P> {
         self.it.exact
             && self.out.at_x
             && self.problem.stops_at_round_off()
+            && self.it.rn <= ROUND_OFF_RESIDUAL
             && max_norm(dx) <= ROUND_OFF_STEP * f64::EPSILON * max_norm(&self.it.x).max(1.0)
     }
 
