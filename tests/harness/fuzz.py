@@ -925,6 +925,7 @@ def _define_targets() -> None:
                 loss="linear",
                 max_evaluations=50,
                 condition_limit=1e8,
+                starts=2,
             ),
         )
     )
@@ -1111,6 +1112,12 @@ def _define_targets() -> None:
         lambda d: (
             pcc.arc_from_tendon_displacements,
             dict(displacements=[-0.001, 0.0005, 0.0005], **geo, rest_length=0.2, extensible=True),
+        )
+    )
+    t("pcc.tendon_displacement_misfit")(
+        lambda d: (
+            pcc.tendon_displacement_misfit,
+            dict(displacements=[-0.001, 0.0005, 0.0006], **geo, rest_length=0.2, extensible=False),
         )
     )
     t("pcc.arc_from_tendon_displacements_jacobian")(
