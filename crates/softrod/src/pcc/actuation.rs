@@ -451,10 +451,21 @@ pub fn arc_from_tendon_displacements(
     rest_length: f64,
     extensible: bool,
 ) -> Result<PccSegment> {
+    fitted_arc(displacements, tendons, rest_length, extensible).map(|(arc, _)| arc)
+}
+
+/// The least-squares arc of [`arc_from_tendon_displacements`] and its unknowns `(e, a, b)`.
+fn fitted_arc(
+    displacements: &[f64],
+    tendons: &PccTendons,
+    rest_length: f64,
+    extensible: bool,
+) -> Result<(PccSegment, (f64, f64, f64))> {
     let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
     let l = rest_length + e;
     let arc = PccSegment::from_curvature_vector(-b / l, a / l, l)?;
-    PccSegment::checked(arc.curvature(), arc.plane_angle(), arc.length())
+    let arc = PccSegment::checked(arc.curvature(), arc.plane_angle(), arc.length())?;
+    Ok((arc, (e, a, b)))
 }
 
 /// The misfit of [`arc_from_tendon_displacements`]: for each tendon, the length change (m) of
@@ -471,9 +482,8 @@ pub fn tendon_displacement_misfit(
     rest_length: f64,
     extensible: bool,
 ) -> Result<Vec<f64>> {
-    // (The arc's own checks first: displacements it refuses have no misfit either.)
-    arc_from_tendon_displacements(displacements, tendons, rest_length, extensible)?;
-    let (e, a, b) = displacement_unknowns(displacements, tendons, rest_length, extensible)?;
+    // (Displacements the arc refuses have no misfit either.)
+    let (_, (e, a, b)) = fitted_arc(displacements, tendons, rest_length, extensible)?;
     Ok((0..tendons.len())
         .map(|i| {
             let d = tendons.distances[i];
